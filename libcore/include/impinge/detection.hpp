@@ -1,0 +1,67 @@
+#pragma once
+/// @file detection.hpp
+/// Per-vertex gap by look-up in the other body's radial distance map (thesis sec. 3.3,
+/// Algorithm 2), and the statistics of a scan.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "impinge/impingement_levels.hpp"
+#include "impinge/mesh.hpp"
+#include "impinge/radial_distance_map.hpp"
+
+namespace impinge {
+
+/// Which way the gap is measured: the ball lies inside the socket map's surface, the socket
+/// outside the ball map's surface. gap = d_map - r for `inside`, r - d_map for `outside`, so
+/// that gap > 0 means apart and gap < 0 penetrating for both scans.
+enum class ScanSide { inside = 1, outside = -1 };
+
+/// Per-vertex result of one scan. gap_mm[i] is NaN where vertex i was not tested (masked
+/// out) or the other map has no surface in its direction; status[i] tells which.
+struct ScanGaps {
+  enum Status : std::uint8_t { tested = 0, no_surface = 1, beyond_reach = 2 };
+  std::vector<float> gap_mm;          ///< n gaps, mm
+  std::vector<std::uint8_t> status;   ///< n statuses
+};
+
+/// Statistics of a scan (thesis sec. 3.4 colour levels; counts so nothing is dropped silently).
+struct ScanSummary {
+  std::int64_t vertices = 0;             ///< vertices in the mesh
+  std::int64_t vertices_tested = 0;      ///< looked up and gap computed
+  std::int64_t vertices_no_surface = 0;  ///< the other map has no surface in their direction
+  std::int64_t vertices_beyond_reach = 0;  ///< skipped: not on their body's first surface seen
+                                            ///< from the COR, or beyond the region radius
+  double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< NaN when none tested
+  std::int64_t vertices_penetrating = 0;  ///< gap <= 0
+  double area_penetrating_mm2 = 0;        ///< their vertex area
+  std::vector<std::int64_t> level_vertices;  ///< count per impingement level
+  std::vector<double> level_area_mm2;        ///< vertex area per impingement level
+};
+
+/// One scan of Algorithm 2: for every vertex i with mask[i] != 0, q = R * P.row(i) (P: n x 3,
+/// mm, relative to the COR in the vertex body's frame; R: 3 x 3 rotation into the map's frame),
+/// gap = side * (map.sample(q) - |q|). Allocation-free per vertex; no virtual dispatch.
+/// `out` is resized to n. Vertices at the COR itself are reported as no surface.
+template <typename Scalar>
+void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
+               const RadialDistanceMapT<Scalar>& map, ScanSide side, ScanGaps& out);
+
+/// Vertices of a body that lie on its own first surface seen from the COR:
+/// mask[i] = 1 when |p_i| <= own_map.sample(p_i) + tolerance_mm and |p_i| <= max_radius_mm.
+/// Pose-invariant (the COR is fixed in both bodies), so computed once per body. Vertices hidden
+/// behind their own body's nearer surface (the femoral shaft behind the head, the inner pelvic
+/// wall behind the acetabulum) are not represented by a radial map and would give a spurious
+/// gap against the other map.
+template <typename Scalar>
+std::vector<std::uint8_t> first_surface_mask(const Vertices& P, const RadialDistanceMapT<Scalar>& own_map,
+                                             double tolerance_mm, double max_radius_mm);
+
+/// Summary of a scan: counts, minimum gap, penetration and levels weighted by vertex area
+/// (`vertex_area`: n values, mm^2).
+ScanSummary summarize_scan(const ScanGaps& gaps, const Eigen::VectorXd& vertex_area, const ImpingementLevels& levels);
+
+}  // namespace impinge

@@ -1,0 +1,70 @@
+#pragma once
+/// @file joint.hpp
+/// A ball-and-socket joint ready for detection: both maps built once, then any number of
+/// poses queried (thesis Fig. 27: preprocessing, then simulation).
+
+#include <Eigen/Core>
+#include <limits>
+#include <vector>
+
+#include "impinge/detection.hpp"
+#include "impinge/impingement_levels.hpp"
+#include "impinge/mesh.hpp"
+#include "impinge/radial_distance_map.hpp"
+#include "impinge/rasterize.hpp"
+
+namespace impinge {
+
+/// Options of a Joint.
+struct JointOptions {
+  double precision_deg = 0.5;                 ///< equiangular precision p, degrees
+  DistanceMode mode = DistanceMode::exact;    ///< rasterisation distance mode
+  double occlusion_tolerance_mm = 1.0;        ///< a vertex farther than its own map's surface
+                                              ///< plus this is hidden (not on the first surface)
+  double max_radius_mm = std::numeric_limits<double>::infinity();  ///< region of interest about
+                                                                   ///< the COR, mm
+  ImpingementLevels levels;                   ///< gap classes
+};
+
+/// One body of the joint after preprocessing.
+struct JointBody {
+  TriangleMesh mesh;            ///< anatomical frame, mm
+  Vertices relative;            ///< n x 3, vertices minus the COR, mm
+  RadialDistanceMap map;        ///< its radial distance map about the COR
+  std::vector<std::uint8_t> mask;  ///< 1 for vertices on the first surface within the region
+  Eigen::VectorXd vertex_area;  ///< n, mm^2
+  SamplingStats sampling;       ///< rasterisation counts
+  double sampling_ms = 0;       ///< wall time of the rasterisation, ms
+};
+
+/// Result of both scans at one pose.
+struct PoseResult {
+  ScanGaps ball_gaps, socket_gaps;
+  ScanSummary ball, socket;
+  double ball_detection_ms = 0, socket_detection_ms = 0;
+};
+
+/// Ball (femur) and socket (pelvis) about a fixed COR.
+class Joint {
+ public:
+  /// Rasterise both meshes (anatomical frame, mm) about `cor` (mm) and compute the first-
+  /// surface masks. Throws impinge::Error on invalid options or a non-finite COR.
+  Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options);
+
+  /// Both scans (ball vertices against the socket map, socket vertices against the ball map)
+  /// with the ball rotated by R (3 x 3) about the COR. Thesis Algorithm 2 applied twice.
+  PoseResult detect(const Eigen::Matrix3d& R) const;
+
+  const JointBody& ball() const { return ball_; }
+  const JointBody& socket() const { return socket_; }
+  const Eigen::Vector3d& cor() const { return cor_; }
+  const JointOptions& options() const { return options_; }
+
+ private:
+  JointBody build(TriangleMesh mesh) const;
+  Eigen::Vector3d cor_;
+  JointOptions options_;
+  JointBody ball_, socket_;
+};
+
+}  // namespace impinge

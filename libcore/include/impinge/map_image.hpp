@@ -1,0 +1,17 @@
+#pragma once
+/// @file map_image.hpp
+/// A radial distance map as a grey-scale PNG (thesis Fig. 31: theta across, phi down).
+
+#include <string>
+
+#include "impinge/radial_distance_map.hpp"
+
+namespace impinge {
+
+/// Write `map` as an 8-bit grey PNG of columns x rows pixels: theta across (0 at the left),
+/// phi down (0 at the top). Covered nodes are grey from 40 (nearest) to 255 (farthest,
+/// normalised over the map); nodes with no surface are black (0). Throws impinge::Error if the
+/// file cannot be written.
+void write_map_png(const std::string& path, const RadialDistanceMap& map);
+
+}  // namespace impinge

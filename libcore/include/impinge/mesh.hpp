@@ -1,0 +1,40 @@
+#pragma once
+/// @file mesh.hpp
+/// Triangle mesh: vertex positions and triangle indices, plus validation and per-vertex areas.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+
+namespace impinge {
+
+/// Row-major matrices so that one vertex / one face is contiguous in memory.
+using Vertices = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;  ///< V: n x 3, mm
+using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;        ///< F: m x 3, 0-based
+
+/// A triangle mesh. Invariants after `validate_mesh`: n >= 3 vertices, every coordinate
+/// finite, every index in [0, n), m >= 1 triangles.
+struct TriangleMesh {
+  Vertices V;            ///< n x 3 vertex positions, mm, in the frame of the file it came from
+  Faces F;               ///< m x 3 vertex indices (counter-clockwise not required)
+  std::string source;    ///< file name (or generator name) used in error messages
+  int degenerate_faces_skipped = 0;  ///< zero-area triangles removed while loading
+};
+
+/// Check the invariants of `mesh` and throw impinge::Error naming `mesh.source` and the first
+/// offending element (vertex with a non-finite coordinate, face with an out-of-range index,
+/// empty mesh).
+void validate_mesh(const TriangleMesh& mesh);
+
+/// Remove triangles whose area is below `min_area_mm2` or which repeat a vertex index;
+/// returns how many were removed and adds that to `mesh.degenerate_faces_skipped`.
+int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2 = 1e-12);
+
+/// Per-vertex area (mm^2): one third of the area of every incident triangle (barycentric dual
+/// area), so the sum over vertices equals the surface area. Returns n values.
+Eigen::VectorXd vertex_areas(const TriangleMesh& mesh);
+
+/// Surface area of the mesh in mm^2.
+double surface_area(const TriangleMesh& mesh);
+
+}  // namespace impinge

@@ -1,0 +1,59 @@
+#pragma once
+/// @file rasterize.hpp
+/// Sampling a mesh into a radial distance map by rasterisation (thesis sec. 3.2, Algorithm 1).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+
+#include "impinge/mesh.hpp"
+#include "impinge/radial_distance_map.hpp"
+
+namespace impinge {
+
+/// How the distance at a covered node is computed.
+enum class DistanceMode {
+  /// The thesis' Algorithm 1: the vertices' distances interpolated linearly over the
+  /// triangle in (theta, phi) (barycentric in the 2-D grid); triangles around a pole are split
+  /// at the pole and interpolated over the trapezoid (theta, 0..phi) as in thesis Fig. 34.
+  linear,
+  /// The distance at which the node's ray meets the triangle's plane (exact for the mesh).
+  exact,
+};
+
+/// Parse "linear" or "exact"; throws impinge::Error naming the value otherwise.
+DistanceMode parse_distance_mode(const std::string& name);
+/// "linear" or "exact".
+const char* to_string(DistanceMode mode);
+
+/// Counts reported by a sampling run, so that nothing is dropped silently.
+struct SamplingStats {
+  std::int64_t triangles = 0;             ///< triangles in the mesh
+  std::int64_t triangles_edge_on = 0;     ///< skipped: plane through the COR (covers no direction)
+  std::int64_t pole_triangles = 0;        ///< triangles touching or containing a pole (cases 1-3)
+  std::int64_t seam_triangles = 0;        ///< triangles crossing theta = 0/360
+  std::int64_t node_tests = 0;            ///< node-in-triangle tests performed
+  std::int64_t nodes_covered = 0;         ///< nodes with a surface after sampling
+};
+
+/// Fill `map` with the nearest hit of every node's ray on `mesh` by rasterisation: each
+/// triangle is projected into the (phi, theta) grid (its bounding rows and columns, with the
+/// theta = 0/360 seam and the poles handled: the whole row range is taken when the triangle's
+/// cone contains a pole), and every node in that box is tested against the triangle's cone with
+/// three edge functions of the node's direction (watertight: nodes on a shared edge are covered
+/// by both triangles). Where several triangles cover a node the smallest distance is kept
+/// (the pelvis is not star-shaped from the COR). Nodes no triangle covers keep "no surface".
+///
+/// `mesh`: vertices in mm in the map's frame; `cor` (mm): origin of the spherical frame.
+/// Cost O(triangles + nodes in the triangles' bounding boxes). Existing map values are kept
+/// where they are nearer (so several meshes can be sampled into one map).
+/// Source: thesis sec. 3.2, Algorithm 1, Fig. 33-34.
+template <typename Scalar>
+SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, DistanceMode mode,
+                        RadialDistanceMapT<Scalar>& map);
+
+/// One-shot convenience: a new float map of precision `precision_deg` sampled from `mesh`.
+RadialDistanceMap rasterize_map(const TriangleMesh& mesh, const Eigen::Vector3d& cor, double precision_deg,
+                                DistanceMode mode, SamplingStats* stats = nullptr);
+
+}  // namespace impinge

@@ -1,0 +1,42 @@
+#pragma once
+/// @file subject.hpp
+/// A subject: femur and pelvis meshes, side and frame convention, from subject.json.
+
+#include <Eigen/Core>
+#include <string>
+
+#include "impinge/mesh.hpp"
+#include "impinge/pose.hpp"
+
+namespace impinge {
+
+/// Frame convention of a scan. LPS: +x left, +y posterior, +z superior (DICOM);
+/// RAS: +x right, +y anterior, +z superior. impinge's anatomical frame is RAS.
+enum class FrameConvention { LPS, RAS };
+
+/// Parsed subject.json: {"side": "right"|"left", "frame": "LPS"|"RAS", "units": "mm",
+/// "femur": file, "pelvis": file} (file names relative to the json's folder).
+struct SubjectInfo {
+  std::string name;         ///< folder name
+  Side side = Side::right;
+  FrameConvention frame = FrameConvention::RAS;
+  std::string femur_path;   ///< absolute or relative-to-cwd path
+  std::string pelvis_path;
+};
+
+/// Read `json_path`. Throws impinge::Error naming the file and the key on a missing or bad
+/// key, unknown side/frame, units other than mm, or unreadable JSON.
+SubjectInfo load_subject(const std::string& json_path);
+
+/// Linear map (3 x 3) from `frame` coordinates to the anatomical frame (RAS). Orthogonal and
+/// its own inverse for LPS (diag(-1, -1, 1)).
+Eigen::Matrix3d to_anatomical(FrameConvention frame);
+
+/// Apply a 3 x 3 linear map to every vertex in place (V <- V * M^T).
+void transform_vertices(Vertices& V, const Eigen::Matrix3d& M);
+
+/// Parse "LPS" / "RAS"; "right" / "left". Throw impinge::Error naming `context` otherwise.
+FrameConvention parse_frame(const std::string& s, const std::string& context);
+Side parse_side(const std::string& s, const std::string& context);
+
+}  // namespace impinge

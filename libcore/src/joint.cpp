@@ -1,0 +1,54 @@
+#include "impinge/joint.hpp"
+
+#include <chrono>
+
+#include "impinge/error.hpp"
+
+namespace impinge {
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options)
+    : cor_(cor),
+      options_(options),
+      ball_{TriangleMesh{}, Vertices{}, RadialDistanceMap{EquiangularGrid(options.precision_deg)}, {}, {}, {}, 0},
+      socket_{TriangleMesh{}, Vertices{}, RadialDistanceMap{EquiangularGrid(options.precision_deg)}, {}, {}, {}, 0} {
+  require(cor.allFinite(), "joint: centre of rotation is not finite");
+  require(options.occlusion_tolerance_mm >= 0, "joint: occlusion tolerance must be >= 0 mm");
+  require(options.max_radius_mm > 0, "joint: region radius must be > 0 mm");
+  options.levels.validate();
+  validate_mesh(ball);
+  validate_mesh(socket);
+  ball_ = build(std::move(ball));
+  socket_ = build(std::move(socket));
+}
+
+JointBody Joint::build(TriangleMesh mesh) const {
+  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{EquiangularGrid(options_.precision_deg)}, {}, {}, {}, 0};
+  b.relative = b.mesh.V.rowwise() - cor_.transpose();
+  const auto t0 = std::chrono::steady_clock::now();
+  b.sampling = rasterize(b.mesh, cor_, options_.mode, b.map);
+  b.sampling_ms = ms_since(t0);
+  b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);
+  b.vertex_area = vertex_areas(b.mesh);
+  return b;
+}
+
+PoseResult Joint::detect(const Eigen::Matrix3d& R) const {
+  PoseResult res;
+  auto t0 = std::chrono::steady_clock::now();
+  scan_gaps(ball_.relative, R, ball_.mask, socket_.map, ScanSide::inside, res.ball_gaps);
+  res.ball_detection_ms = ms_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  scan_gaps(socket_.relative, R.transpose(), socket_.mask, ball_.map, ScanSide::outside, res.socket_gaps);
+  res.socket_detection_ms = ms_since(t0);
+  res.ball = summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels);
+  res.socket = summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels);
+  return res;
+}
+
+}  // namespace impinge

@@ -1,0 +1,6 @@
+#include "impinge/radial_distance_map.hpp"
+
+namespace impinge {
+template class RadialDistanceMapT<float>;
+template class RadialDistanceMapT<double>;
+}  // namespace impinge
