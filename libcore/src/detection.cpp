@@ -40,10 +40,16 @@ std::vector<std::uint8_t> first_surface_mask(const Vertices& P, const RadialDist
     const Eigen::Vector3d p = P.row(i).transpose();
     const double r = p.norm();
     if (!(r > 0) || r > max_radius_mm) continue;
-    const double d = own_map.sample(p);
-    // No surface in the own map here can only come from rounding at an uncovered boundary:
-    // the vertex itself is on the surface, so keep it.
-    if (std::isnan(d) || r <= d + tolerance_mm) mask[static_cast<std::size_t>(i)] = 1;
+    double d = own_map.sample(p);
+    if (std::isnan(d)) {
+      // At the edge of the map's coverage: compare with the nearest surface among the stencil
+      // nodes that have one (a rim vertex of an outer shell is still hidden by the inner one).
+      const Stencil st = own_map.grid().interpolate(p / r);
+      d = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 4; ++k)
+        if (own_map.has_surface(st.nodes[k])) d = std::min<double>(d, own_map.at(st.nodes[k]));
+    }
+    if (r <= d + tolerance_mm) mask[static_cast<std::size_t>(i)] = 1;
   }
   return mask;
 }

@@ -1,5 +1,6 @@
 #include "impinge/mesh_io.hpp"
 
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -34,8 +35,14 @@ TriangleMesh load_mesh(const std::string& path) {
   }
   const std::string ext = lower_extension(path);
   unsigned flags = 0;
-  if (ext == ".stl" || ext == ".obj") flags |= aiProcess_JoinIdenticalVertices;
   Assimp::Importer importer;
+  if (ext == ".stl" || ext == ".obj") {
+    // Weld corners by position only: drop the per-face normals and texture coordinates that
+    // would otherwise keep identical positions apart.
+    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TEXCOORDS |
+                                                            aiComponent_COLORS | aiComponent_TANGENTS_AND_BITANGENTS);
+    flags |= aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices;
+  }
   const aiScene* scene = importer.ReadFile(path, flags);
   if (scene == nullptr) throw Error(path + ": cannot parse mesh: " + importer.GetErrorString());
   require(scene->mNumMeshes > 0, path + ": file holds no mesh");

@@ -5,6 +5,7 @@
 #include <gsl/gsl_vector.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <sstream>
@@ -171,14 +172,26 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
   SphereFitResult res;
   Eigen::Vector3d c = best_c;
   double r = best_r;
+  double threshold = o.inlier_threshold_mm;
   for (int round = 0; round < o.refinement_rounds; ++round) {
     std::vector<Eigen::Index> in;
-    for (Eigen::Index i : cand)
-      if (std::abs((V.row(i).transpose() - c).norm() - r) < o.inlier_threshold_mm) in.push_back(i);
+    std::vector<double> abs_res;
+    for (Eigen::Index i : cand) {
+      const double e = std::abs((V.row(i).transpose() - c).norm() - r);
+      if (e < threshold) {
+        in.push_back(i);
+        abs_res.push_back(e);
+      }
+    }
     require(in.size() >= 4, msg.str());
     res = fit_sphere_geometric(gather(V, in));
     c = res.centre;
     r = res.radius;
+    // Tighten the band to 3 robust sigmas (1.4826 MAD) of the inliers, within
+    // [0.2, 1] x the user's threshold: drops the neck and cam points that the first band let in.
+    std::nth_element(abs_res.begin(), abs_res.begin() + abs_res.size() / 2, abs_res.end());
+    const double sigma = 1.4826 * abs_res[abs_res.size() / 2];
+    threshold = std::clamp(3 * sigma, 0.2 * o.inlier_threshold_mm, o.inlier_threshold_mm);
   }
   res.iterations = o.refinement_rounds;
   return res;

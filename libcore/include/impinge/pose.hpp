@@ -3,6 +3,7 @@
 /// Joint pose: rotation of the ball about the COR from anatomical angles.
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <string>
 
 namespace impinge {

@@ -1,0 +1,132 @@
+// Detection (thesis Algorithm 2) against analytic gaps:
+//  - concentric ball (r_b) and cup (r_c): every tested ball and socket vertex has gap r_c - r_b
+//    within faceting + interpolation bounds that shrink with precision;
+//  - moving ball and socket together (translation, rotation about z by whole grid steps) leaves
+//    every gap unchanged;
+//  - a ball pushed into the cup reports penetration with the analytic depth;
+//  - vertices hidden behind their own first surface are skipped and counted, not reported.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "impinge/detection.hpp"
+#include "impinge/generated_models.hpp"
+#include "impinge/joint.hpp"
+#include "impinge/pose.hpp"
+#include "impinge/spherical_frame.hpp"
+#include "test_support.hpp"
+
+using namespace impinge;
+
+namespace {
+double sagitta(double r, double edge_angle_rad) { return r * (1 - std::cos(edge_angle_rad / 2)); }
+}  // namespace
+
+TEST(Detection, ConcentricBallAndCupGiveRadiusDifference) {
+  const Eigen::Vector3d cor(10, -20, 30);
+  const double rb = 22, rc = 25;
+  const int n = 360;  // 1 deg mesh
+  const TriangleMesh ball = make_uv_sphere(rb, cor, n, n / 2, Eigen::Vector3d(0.3, 0.2, 0.93));
+  const TriangleMesh cup = make_cup(rc, rc + 5, 100, cor, Eigen::Vector3d(-0.5, 0.1, 0.86), n, 100);
+  // Faceting: cup mesh chords lie inside its sphere by <= sagitta over the cell diagonal; ball
+  // vertices lie exactly on theirs. Interpolation of a constant-radius map adds the same order.
+  const double facet = sagitta(rc, std::sqrt(2.0) * 2 * kPi / n) + sagitta(rb, std::sqrt(2.0) * 2 * kPi / n);
+  for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
+    for (double p : {1.0, 0.5, 0.25}) {
+      JointOptions o;
+      o.precision_deg = p;
+      o.mode = mode;
+      const Joint j(ball, cup, cor, o);
+      const PoseResult r = j.detect(Eigen::Matrix3d::Identity());
+      const double h = p * kDegToRad;
+      const double bound = facet + sagitta(rc, std::sqrt(2.0) * h) + 1e-4;
+      std::int64_t tested = 0;
+      for (std::size_t i = 0; i < r.ball_gaps.gap_mm.size(); ++i)
+        if (r.ball_gaps.status[i] == ScanGaps::tested) {
+          ++tested;
+          ASSERT_NEAR(r.ball_gaps.gap_mm[i], rc - rb, bound) << "ball vertex " << i << " p=" << p;
+        }
+      EXPECT_GT(tested, 1000);
+      for (std::size_t i = 0; i < r.socket_gaps.gap_mm.size(); ++i)
+        if (r.socket_gaps.status[i] == ScanGaps::tested)
+          ASSERT_NEAR(r.socket_gaps.gap_mm[i], rc - rb, bound) << "socket vertex " << i;
+      // the cup's outer shell is hidden behind its inner shell: skipped, not a 5 mm-farther gap
+      EXPECT_GT(r.socket.vertices_beyond_reach, 1000);
+      EXPECT_EQ(r.ball.vertices_penetrating, 0);
+    }
+  }
+}
+
+TEST(Detection, MovingBothBodiesTogetherLeavesGapsUnchanged) {
+  HipModelOptions ho;
+  ho.target_triangles = 3000;
+  ho.cam_height_mm = 2;
+  const HipModel h = make_hip_model(ho);
+  JointOptions o;
+  o.precision_deg = 0.5;
+  const Eigen::Matrix3d pose = pose_rotation({20, 10, 5}, Side::right);
+  const PoseResult a = Joint(h.ball, h.socket, h.cor, o).detect(pose);
+  // Rigid motion of the whole joint: translate, and rotate about z by 7 grid steps (the map's
+  // grid then maps onto itself, so the gaps must agree to rounding).
+  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(7 * 0.5 * kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d t(-40, 13, 100);
+  const TriangleMesh ball2 = test::transformed(h.ball, Rz, t), socket2 = test::transformed(h.socket, Rz, t);
+  const Eigen::Vector3d cor2 = Rz * h.cor + t;
+  const PoseResult b = Joint(ball2, socket2, cor2, o).detect(Rz * pose * Rz.transpose());
+  ASSERT_EQ(a.ball_gaps.gap_mm.size(), b.ball_gaps.gap_mm.size());
+  int compared = 0;
+  for (std::size_t i = 0; i < a.ball_gaps.gap_mm.size(); ++i) {
+    ASSERT_EQ(a.ball_gaps.status[i], b.ball_gaps.status[i]) << i;
+    if (a.ball_gaps.status[i] != ScanGaps::tested) continue;
+    ++compared;
+    EXPECT_NEAR(a.ball_gaps.gap_mm[i], b.ball_gaps.gap_mm[i], 1e-4) << i;
+  }
+  for (std::size_t i = 0; i < a.socket_gaps.gap_mm.size(); ++i)
+    if (a.socket_gaps.status[i] == ScanGaps::tested)
+      EXPECT_NEAR(a.socket_gaps.gap_mm[i], b.socket_gaps.gap_mm[i], 1e-4) << i;
+  EXPECT_GT(compared, 100);
+}
+
+TEST(Detection, PushedBallReportsPenetrationDepth) {
+  // Ball of radius 22 in a cup of radius 23, ball centre moved 3 mm toward the cup pole: the
+  // deepest ball vertex is 2 mm beyond the cup surface (analytic: 22 + 3 - 23).
+  const Eigen::Vector3d cor = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d(0.2, -0.3, 0.93).normalized();
+  const TriangleMesh ball = make_uv_sphere(22, cor + 3 * axis, 240, 120, Eigen::Vector3d(1, 0, 0.2));
+  const TriangleMesh cup = make_cup(23, 28, 90, cor, axis, 240, 60);
+  JointOptions o;
+  o.precision_deg = 0.25;
+  o.occlusion_tolerance_mm = 10;  // the shifted ball is not star-shaped about cor in the same way
+  const PoseResult r = Joint(ball, cup, cor, o).detect(Eigen::Matrix3d::Identity());
+  EXPECT_NEAR(r.ball.min_gap_mm, -2.0, 0.05);
+  EXPECT_GT(r.ball.vertices_penetrating, 100);
+  EXPECT_GT(r.ball.area_penetrating_mm2, 0);
+  EXPECT_GT(r.ball.level_vertices.back(), 0);  // purple
+}
+
+TEST(Detection, ScanOfMaskedAndNoSurfaceVertices) {
+  // Direct use of scan_gaps: masked vertices are beyond reach, directions the map does not
+  // cover are no surface, and gaps follow the sign convention of each side.
+  RadialDistanceMap map{EquiangularGrid(1)};
+  for (std::int64_t i = 0; i < map.num_nodes() / 2; ++i) map.data()[i] = 10;  // northern half only
+  Vertices P(4, 3);
+  P << 0, 0, 8,  // inside the 10 mm surface: gap 2 (inside) / -2 (outside)
+      0, 0, 12,  // beyond it
+      0, 0, -5,  // southern: no surface
+      0, 0, 9;   // masked
+  std::vector<std::uint8_t> mask{1, 1, 1, 0};
+  ScanGaps g;
+  scan_gaps(P, Eigen::Matrix3d::Identity(), mask, map, ScanSide::inside, g);
+  EXPECT_FLOAT_EQ(g.gap_mm[0], 2);
+  EXPECT_FLOAT_EQ(g.gap_mm[1], -2);
+  EXPECT_EQ(g.status[2], ScanGaps::no_surface);
+  EXPECT_EQ(g.status[3], ScanGaps::beyond_reach);
+  scan_gaps(P, Eigen::Matrix3d::Identity(), mask, map, ScanSide::outside, g);
+  EXPECT_FLOAT_EQ(g.gap_mm[0], -2);
+  const ScanSummary s = summarize_scan(g, Eigen::VectorXd::Ones(4), ImpingementLevels{});
+  EXPECT_EQ(s.vertices_tested, 2);
+  EXPECT_EQ(s.vertices_no_surface, 1);
+  EXPECT_EQ(s.vertices_beyond_reach, 1);
+  EXPECT_EQ(s.vertices_penetrating, 1);
+  EXPECT_FLOAT_EQ(s.min_gap_mm, -2);
+}

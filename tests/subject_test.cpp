@@ -1,0 +1,42 @@
+// subject.json parsing and frames: LPS maps to RAS by negating x and y; bad keys name the file.
+#include <gtest/gtest.h>
+
+#include "impinge/error.hpp"
+#include "impinge/subject.hpp"
+#include "test_support.hpp"
+
+using namespace impinge;
+
+TEST(Subject, ParsesAndResolvesPaths) {
+  const std::string d = test::temp_dir("subject");
+  test::write_text(d + "/subject.json",
+                   R"({"side": "left", "frame": "LPS", "units": "mm", "femur": "f.ply", "pelvis": "p.ply"})");
+  const SubjectInfo s = load_subject(d + "/subject.json");
+  EXPECT_EQ(s.side, Side::left);
+  EXPECT_EQ(s.frame, FrameConvention::LPS);
+  EXPECT_EQ(s.femur_path, d + "/f.ply");
+  const Eigen::Matrix3d M = to_anatomical(FrameConvention::LPS);
+  EXPECT_EQ(M * Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(-1, -2, 3));  // left -> right negated
+  EXPECT_EQ(M * M, Eigen::Matrix3d::Identity());
+  EXPECT_EQ(to_anatomical(FrameConvention::RAS), Eigen::Matrix3d::Identity());
+}
+
+TEST(Subject, BadFilesNameFileAndKey) {
+  const std::string d = test::temp_dir("subject_bad");
+  auto expect = [&](const std::string& body, const std::string& fragment) {
+    test::write_text(d + "/s.json", body);
+    try {
+      load_subject(d + "/s.json");
+      FAIL() << body;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("s.json"), std::string::npos) << e.what();
+    }
+  };
+  expect("{not json", "not valid JSON");
+  expect(R"({"frame": "LPS", "femur": "f", "pelvis": "p"})", "'side'");
+  expect(R"({"side": "up", "frame": "LPS", "femur": "f", "pelvis": "p"})", "side 'up'");
+  expect(R"({"side": "right", "frame": "XYZ", "femur": "f", "pelvis": "p"})", "frame 'XYZ'");
+  expect(R"({"side": "right", "frame": "RAS", "units": "cm", "femur": "f", "pelvis": "p"})", "units");
+  EXPECT_THROW(load_subject(d + "/absent.json"), Error);
+}

@@ -1,0 +1,41 @@
+#include "test_support.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace impinge::test {
+
+Eigen::Matrix3d random_rotation(std::mt19937_64& rng) {
+  std::normal_distribution<double> n(0, 1);
+  Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
+  q.normalize();
+  return q.toRotationMatrix();
+}
+
+TriangleMesh transformed(const TriangleMesh& m, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  TriangleMesh out = m;
+  for (Eigen::Index i = 0; i < out.V.rows(); ++i) out.V.row(i) = (R * m.V.row(i).transpose() + t).transpose();
+  return out;
+}
+
+std::string temp_dir(const std::string& name) {
+  const auto p = std::filesystem::temp_directory_path() / ("impinge_test_" + name);
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p.string();
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream os(path, std::ios::binary);
+  os << text;
+}
+
+double ray_sphere_far(const Eigen::Vector3d& o, const Eigen::Vector3d& u, const Eigen::Vector3d& c, double r) {
+  const Eigen::Vector3d oc = o - c;
+  const double b = oc.dot(u), cc = oc.squaredNorm() - r * r;
+  return -b + std::sqrt(b * b - cc);
+}
+
+}  // namespace impinge::test

@@ -1,0 +1,22 @@
+#pragma once
+// Shared fixtures and oracles for the tests.
+#include <Eigen/Core>
+#include <random>
+#include <string>
+
+#include "impinge/mesh.hpp"
+
+namespace impinge::test {
+
+/// A random rotation from a seeded RNG.
+Eigen::Matrix3d random_rotation(std::mt19937_64& rng);
+/// Apply x -> R x + t to every vertex.
+TriangleMesh transformed(const TriangleMesh& m, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+/// A fresh temporary directory for a test.
+std::string temp_dir(const std::string& name);
+/// Write text to a file.
+void write_text(const std::string& path, const std::string& text);
+/// Analytic oracle: distance from origin o along unit u to the sphere (c, r), far root.
+double ray_sphere_far(const Eigen::Vector3d& o, const Eigen::Vector3d& u, const Eigen::Vector3d& c, double r);
+
+}  // namespace impinge::test
