@@ -1,0 +1,116 @@
+"""08_distance_maps: gap statistics on the real joints and the generated model, map images
+(thesis Fig. 31) and colour-mapped renders of both bones (Fig. 41-42).
+
+Reads RESULTS/08_distance_maps/gap_statistics.csv and vertex_gaps.csv; writes table_finest.tex,
+table_convergence.tex, min_gap.pdf, levels.pdf, render_<subject>.pdf, macros.tex."""
+import json
+import os
+
+import numpy as np
+import matplotlib.pyplot as plt
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+
+d = experiment_dir("08_distance_maps")
+st = read_csv(d, "gap_statistics.csv")
+vg = read_csv(d, "vertex_gaps.csv")
+with open(os.path.join(d, "meta.json")) as f:
+    meta = json.load(f)
+finest = st.precision_deg.min()
+subjects = list(dict.fromkeys(st.subject))
+
+# Table: finest precision, exact mode, both scans per subject.
+rows = []
+for s in subjects:
+    for scan in ("ball", "socket"):
+        r = st[(st.subject == s) & (st.precision_deg == finest) & (st["mode"] == "exact") & (st.scan == scan)].iloc[0]
+        rows.append([s, scan, f"{int(r.vertices_tested):,}", f"{int(r.vertices_no_surface):,}",
+                     f"{int(r.vertices_beyond_reach):,}", f"{r.min_gap_mm:.2f}", f"{int(r.vertices_penetrating)}",
+                     f"{r.area_penetrating_mm2:.1f}", f"{r.head_radius_mm:.2f}", f"{r.sphere_fit_rms_mm:.2f}"])
+write_table(d, "table_finest", ["subject", "scan", "tested", "no surface", "beyond reach", "min gap (mm)",
+                                "pen. vertices", "pen. area (mm$^2$)", "head $r$ (mm)", "fit RMS (mm)"], rows,
+            align="llrrrrrrrr")
+
+# Table: min gap and penetration against precision and mode (ball scan).
+rows = []
+for s in subjects:
+    for (p, mode), g in st[(st.subject == s) & (st.scan == "ball")].groupby(["precision_deg", "mode"], sort=False):
+        r = g.iloc[0]
+        sock = st[(st.subject == s) & (st.scan == "socket") & (st.precision_deg == p) & (st["mode"] == mode)].iloc[0]
+        lin = "" if np.isnan(r.linear_vs_exact_p95_abs_mm) else f"{r.linear_vs_exact_p95_abs_mm:.4f}"
+        rows.append([s, f"{p:g}", mode, f"{r.min_gap_mm:.3f}", f"{sock.min_gap_mm:.3f}", f"{int(r.vertices_penetrating)}",
+                     f"{r.sampling_ms:.1f}", f"{sock.sampling_ms:.1f}", f"{r.detection_ns_per_lookup:.0f}", lin])
+write_table(d, "table_convergence", ["subject", "$p$", "mode", "ball min gap", "socket min gap", "ball pen.",
+                                     "femur map ms", "pelvis map ms", "ns/lookup", "lin-exact p95"], rows,
+            align="lrlrrrrrrr")
+
+# Figure: min gap vs precision.
+fig, axes = plt.subplots(1, 2, figsize=(8, 3.2), sharey=False)
+for ax, scan in zip(axes, ("ball", "socket")):
+    for s in subjects:
+        for mode, ls in (("exact", "-"), ("linear", "--")):
+            g = st[(st.subject == s) & (st.scan == scan) & (st["mode"] == mode)].sort_values("precision_deg")
+            ax.semilogx(g.precision_deg, g.min_gap_mm, ls, marker="o", markersize=3, label=f"{s} {mode}")
+    ax.set_title(f"{scan} scan")
+    ax.set_xlabel("precision p (deg)")
+    ax.set_ylabel("minimum gap (mm)")
+    ax.invert_xaxis()
+    ax.axhline(0, color="k", lw=0.5)
+    ax.grid(True, alpha=0.3)
+axes[1].legend(fontsize=6)
+save(fig, d, "min_gap")
+
+# Figure: impingement levels (area share) at the finest precision, exact mode.
+levels = ["level_none", "level_yellow", "level_orange", "level_red", "level_purple"]
+colours = ["#28aa3c", "#ffe600", "#ff8c00", "#dc1414", "#8c00c8"]
+fig, ax = plt.subplots(figsize=(6, 3))
+labels, bottoms = [], None
+data = []
+for s in subjects:
+    for scan in ("ball", "socket"):
+        r = st[(st.subject == s) & (st.precision_deg == finest) & (st["mode"] == "exact") & (st.scan == scan)].iloc[0]
+        labels.append(f"{s}\n{scan}")
+        data.append([r[l] for l in levels])
+data = np.array(data, dtype=float)
+bottom = np.zeros(len(labels))
+for k, l in enumerate(levels):
+    ax.bar(range(len(labels)), data[:, k], bottom=bottom, color=colours[k], label=l.replace("level_", ""))
+    bottom += data[:, k]
+ax.set_xticks(range(len(labels)))
+ax.set_xticklabels(labels, fontsize=6)
+ax.set_ylabel("tested vertices")
+ax.legend(fontsize=6, ncol=5)
+save(fig, d, "levels")
+
+# Renders: vertices within 45 mm of the COR, coloured by impingement level (grey: not tested).
+thr = meta["parameters"]["levels_thresholds_mm"]
+
+
+def level_colour(g, scan):
+    """Thesis sec. 3.4 colours: green (ball) / blue (socket) for no impingement, then yellow,
+    orange, red, purple; grey where untested."""
+    if np.isnan(g):
+        return "#c8c8c8"
+    if g <= thr[-1]:
+        return colours[4]
+    k = sum(1 for t in thr[:-1] if g < t)
+    return ("#3264dc" if scan == "socket" else colours[0]) if k == 0 else colours[k]
+
+
+for s in subjects:
+    fig = plt.figure(figsize=(8, 4))
+    for k, scan in enumerate(("socket", "ball")):
+        g = vg[(vg.subject == s) & (vg.scan == scan)]
+        ax = fig.add_subplot(1, 2, k + 1, projection="3d")
+        ax.scatter(g.x_mm, g.y_mm, g.z_mm, c=[level_colour(x, scan) for x in g.gap_mm], s=0.6, depthshade=False)
+        ax.set_title(f"{s}: {'pelvis (socket)' if scan == 'socket' else 'femur (ball)'}", fontsize=8)
+        ax.view_init(elev=10, azim=0 if scan == "socket" else 180)  # lateral view of the acetabulum
+        ax.set_axis_off()
+    save(fig, d, f"render_{s}")
+
+pen = st[(st.precision_deg == finest) & (st["mode"] == "exact") & (st.scan == "ball")]
+write_macros(d, "macros", {
+    "DMfinest": f"{finest:g}",
+    "DMsubjects": str(len(subjects)),
+    "DMpenetratingSubjects": str(int((pen.vertices_penetrating > 0).sum())),
+})

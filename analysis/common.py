@@ -1,0 +1,56 @@
+"""Shared helpers of the analysis scripts: read a results folder, save figures, write LaTeX tables.
+
+Every script reads only the CSVs its driver wrote; no number is typed in here."""
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+
+
+def experiment_dir(name):
+    """RESULTS/name from argv[1] (default results/)."""
+    root = sys.argv[1] if len(sys.argv) > 1 else "results"
+    d = os.path.join(root, name)
+    if not os.path.isdir(d):
+        sys.exit(f"{d}: no such results folder; run the driver first")
+    return d
+
+
+def read_csv(d, file):
+    path = os.path.join(d, file)
+    if not os.path.exists(path):
+        sys.exit(f"{path}: missing; run the driver first")
+    return pd.read_csv(path)
+
+
+def save(fig, d, stem):
+    """Save as PDF (for the paper) and PNG (for viewing)."""
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, stem + ".pdf"))
+    fig.savefig(os.path.join(d, stem + ".png"), dpi=130)
+    plt.close(fig)
+
+
+def latex_escape(s):
+    return str(s).replace("_", r"\_").replace("%", r"\%").replace("&", r"\&")
+
+
+def write_table(d, stem, header, rows, align=None):
+    """A booktabs tabular in d/stem.tex. header: list of str; rows: list of lists of str."""
+    align = align or "l" + "r" * (len(header) - 1)
+    lines = [r"\begin{tabular}{" + align + "}", r"\toprule", " & ".join(header) + r" \\", r"\midrule"]
+    lines += [" & ".join(latex_escape(c) for c in r) + r" \\" for r in rows]
+    lines += [r"\bottomrule", r"\end{tabular}"]
+    with open(os.path.join(d, stem + ".tex"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def write_macros(d, stem, values):
+    """LaTeX macros \\name{value} for numbers quoted in the paper text."""
+    with open(os.path.join(d, stem + ".tex"), "w") as f:
+        for k, v in values.items():
+            f.write("\\newcommand{\\%s}{%s}\n" % (k, v))

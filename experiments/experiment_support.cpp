@@ -1,0 +1,135 @@
+#include "experiment_support.hpp"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <iostream>
+
+#include "impinge/error.hpp"
+#include "impinge/mesh_io.hpp"
+#include "impinge/subject.hpp"
+
+namespace impinge::experiment {
+
+namespace fs = std::filesystem;
+
+Args parse_args(int argc, char** argv, const std::string& description) {
+  CLI::App app{description};
+  Args a;
+  app.add_option("--out", a.out, "Results root (writes OUT/NN_name/)")->capture_default_str();
+  app.add_option("--data", a.data, "Folder of real subjects (skipped when absent)");
+  app.add_flag("--quick", a.quick, "Coarse resolutions and fewer repetitions");
+  int reps = 0;
+  app.add_option("--repetitions", reps, "Timing repetitions (default 5, quick 3)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    std::exit(app.exit(e));
+  }
+  a.repetitions = reps > 0 ? reps : (a.quick ? 3 : 5);
+  return a;
+}
+
+std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& generated_triangles) {
+  std::vector<Subject> out;
+  if (!args.data.empty() && fs::is_directory(args.data)) {
+    std::vector<fs::path> dirs;
+    for (const auto& e : fs::directory_iterator(args.data))
+      if (fs::exists(e.path() / "subject.json")) dirs.push_back(e.path());
+    std::sort(dirs.begin(), dirs.end());
+    for (const auto& d : dirs) {
+      const SubjectInfo info = load_subject((d / "subject.json").string());
+      Subject s;
+      s.name = info.name;
+      s.source = "shared/data/hips/" + info.name;
+      s.side = info.side;
+      s.femur = load_mesh(info.femur_path);
+      s.pelvis = load_mesh(info.pelvis_path);
+      transform_vertices(s.femur.V, to_anatomical(info.frame));
+      transform_vertices(s.pelvis.V, to_anatomical(info.frame));
+      out.push_back(std::move(s));
+    }
+  }
+  for (int t : generated_triangles) {
+    HipModelOptions o;
+    o.target_triangles = t;
+    o.cam_height_mm = 2.0;
+    const HipModel h = make_hip_model(o);
+    Subject s;
+    s.name = "generated-" + (t % 1000 == 0 ? std::to_string(t / 1000) + "k" : std::to_string(t));
+    s.source = "make_hip_model(target_triangles=" + std::to_string(t) + ", cam_height_mm=2)";
+    s.generated = true;
+    s.femur = h.ball;
+    s.pelvis = h.socket;
+    s.true_cor = h.cor;
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+double median_ms(const std::function<void()>& fn, int reps) {
+  fn();
+  std::vector<double> t;
+  for (int i = 0; i < std::max(1, reps); ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    fn();
+    t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(t.begin(), t.end());
+  return t.size() % 2 ? t[t.size() / 2] : 0.5 * (t[t.size() / 2 - 1] + t[t.size() / 2]);
+}
+
+std::string experiment_dir(const Args& args, const std::string& name) {
+  const fs::path d = fs::path(args.out) / name;
+  fs::create_directories(d);
+  return d.string();
+}
+
+namespace {
+std::string command_output(const std::string& cmd) {
+  std::string out;
+  if (FILE* p = popen(cmd.c_str(), "r")) {
+    char buf[256];
+    while (fgets(buf, sizeof buf, p) != nullptr) out += buf;
+    pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return out;
+}
+}  // namespace
+
+void write_meta(const std::string& dir, const Args& args, nlohmann::json params) {
+  nlohmann::json m;
+  m["parameters"] = std::move(params);
+  m["quick"] = args.quick;
+  m["repetitions"] = args.repetitions;
+  m["timing"] = "median wall time after one warm-up run, single thread";
+  m["data_folder"] = args.data;
+  const std::string commit = command_output("git -C '" IMPINGE_SOURCE_DIR "' rev-parse HEAD 2>/dev/null");
+  const std::string dirty = command_output("git -C '" IMPINGE_SOURCE_DIR "' status --porcelain --untracked-files=no 2>/dev/null");
+  m["git_commit"] = commit.empty() ? "unknown" : commit + (dirty.empty() ? "" : "-dirty");
+  m["compiler"] = IMPINGE_COMPILER;
+  m["cpu_model"] = command_output("grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'");
+  m["cores"] = command_output("nproc");
+  const std::time_t now = std::time(nullptr);
+  char buf[64];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  m["date"] = buf;
+  std::ofstream os(fs::path(dir) / "meta.json");
+  require(os.good(), dir + "/meta.json: cannot open for writing");
+  os << m.dump(2) << "\n";
+}
+
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header) : os_(path) {
+  require(os_.good(), path + ": cannot open for writing");
+  for (std::size_t k = 0; k < header.size(); ++k) os_ << (k ? "," : "") << header[k];
+  os_ << "\n";
+}
+
+void progress(const std::string& experiment, int done, int total, const std::string& what) {
+  std::cerr << "[" << experiment << "] " << done << "/" << total << " " << what << std::endl;
+}
+
+}  // namespace impinge::experiment

@@ -1,0 +1,85 @@
+#pragma once
+// Shared pieces of the experiment drivers: command line, subjects, timing, CSV and meta.json.
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <type_traits>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "impinge/generated_models.hpp"
+#include "impinge/mesh.hpp"
+#include "impinge/pose.hpp"
+
+namespace impinge::experiment {
+
+/// Command-line options every driver accepts.
+struct Args {
+  std::string out = "results";  ///< results root; the driver writes OUT/NN_name/
+  std::string data;             ///< folder of real subjects (one sub-folder with subject.json each)
+  bool quick = false;           ///< coarse resolutions, fewer repetitions
+  int repetitions = 5;          ///< timing repetitions (median reported); quick: 3
+};
+
+/// Parse argv (--out, --data, --quick, --repetitions). Exits on --help or a bad option.
+Args parse_args(int argc, char** argv, const std::string& description);
+
+/// A joint to run on: a real subject or a generated one, in the anatomical frame.
+struct Subject {
+  std::string name;      ///< folder name or "generated-3k"
+  std::string source;    ///< citation / generator
+  bool generated = false;
+  Side side = Side::right;
+  TriangleMesh femur, pelvis;
+  Eigen::Vector3d true_cor = Eigen::Vector3d::Constant(std::nan(""));  ///< known for generated
+};
+
+/// Every real subject under args.data (sorted by name; none when the folder is absent), then
+/// the generated hip model(s) with the given triangle counts.
+std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& generated_triangles);
+
+/// Median wall time in ms of `fn` over `reps` runs after one warm-up run.
+double median_ms(const std::function<void()>& fn, int reps);
+
+/// OUT/NN_name, created.
+std::string experiment_dir(const Args& args, const std::string& name);
+
+/// Write meta.json: the parameters plus git commit, compiler, CPU model, date, repetitions.
+void write_meta(const std::string& dir, const Args& args, nlohmann::json params);
+
+/// Minimal CSV writer: header once, then rows of already-formatted cells.
+class CsvWriter {
+ public:
+  CsvWriter(const std::string& path, const std::vector<std::string>& header);
+  template <typename... T>
+  void row(const T&... cells) {
+    std::size_t k = 0;
+    ((os_ << (k++ ? "," : "") << cell(cells)), ...);
+    os_ << "\n";
+  }
+
+ private:
+  static std::string cell(const std::string& s) { return s; }
+  static std::string cell(const char* s) { return s; }
+  template <typename N>
+  static std::string cell(N x) {
+    if constexpr (std::is_floating_point_v<N>) {
+      if (!std::isfinite(static_cast<double>(x))) return "nan";
+      std::ostringstream o;
+      o.precision(10);
+      o << x;
+      return o.str();
+    } else {
+      return std::to_string(x);
+    }
+  }
+  std::ofstream os_;
+};
+
+/// Print a progress line to stderr ("[08_distance_maps] 3/24 lhdl-ct p=0.1 exact").
+void progress(const std::string& experiment, int done, int total, const std::string& what);
+
+}  // namespace impinge::experiment
