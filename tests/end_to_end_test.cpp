@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <iostream>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -113,6 +114,8 @@ TEST_P(RealSubject, ExactModeAgreesWithExactRayCastAtTenthDegree) {
       if (std::abs(exact - g.gap_mm[i]) <= 0.05) ++within;
     }
     EXPECT_GT(tested, 500);
+    std::cout << GetParam() << ": " << within << " of " << tested << " tested vertices ("
+              << 100.0 * double(within) / double(tested) << " %) within 0.05 mm of the exact ray cast\n";
     EXPECT_GE(double(within), 0.95 * double(tested)) << GetParam() << ": " << within << " of " << tested;
   };
   check(r.ball_gaps, j.ball(), pelvis, 1.0);

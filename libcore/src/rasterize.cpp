@@ -30,13 +30,17 @@ double wrap_pi(double a) {
 
 bool on_axis(const V3& v) { return v.x() * v.x() + v.y() * v.y() <= 1e-24 * v.squaredNorm(); }
 
-/// Spherical coordinates of a triangle corner (theta of a point on the axis is 0).
+/// A triangle corner relative to the COR with its spherical coordinates, computed once per
+/// mesh vertex (theta of a point on the axis is 0).
 struct Corner {
+  V3 p;        ///< position relative to the COR, mm
+  V3 u;        ///< unit direction
   double d, phi, theta;
+  bool axis;   ///< on the z axis (a pole vertex, thesis case 1)
 };
 Corner corner(const V3& v) {
   const SphericalCoordinates s = to_spherical(v);
-  return {s.d, s.phi, s.theta};
+  return {v, s.d > 0 ? V3(v / s.d) : V3::Zero(), s.d, s.phi, s.theta, on_axis(v)};
 }
 
 /// Range of z over the great-circle arc from unit u to unit v (interior extremes included).
@@ -81,27 +85,27 @@ class Rasterizer {
     }
   }
 
-  void triangle(const V3& a, const V3& b, const V3& c) {
+  void triangle(const Corner& a, const Corner& b, const Corner& c) {
     ++stats_.triangles;
-    const double det = a.dot(b.cross(c));
-    if (!(std::abs(det) > 1e-12 * a.norm() * b.norm() * c.norm())) {
+    const double det = a.p.dot(b.p.cross(c.p));
+    if (!(std::abs(det) > 1e-12 * a.d * b.d * c.d)) {
       ++stats_.triangles_edge_on;
       return;
     }
-    const bool north = in_cone(a, b, c, det, V3::UnitZ());
-    const bool south = in_cone(a, b, c, det, -V3::UnitZ());
+    const bool north = in_cone(a.p, b.p, c.p, det, V3::UnitZ());
+    const bool south = in_cone(a.p, b.p, c.p, det, -V3::UnitZ());
     if (north || south) ++stats_.pole_triangles;
     if (mode_ == DistanceMode::linear && (north || south)) {
       // Thesis Fig. 34: split at the pole so that each part has the pole as a corner.
-      const V3* axis_vertex = on_axis(a) ? &a : on_axis(b) ? &b : on_axis(c) ? &c : nullptr;
+      const Corner* axis_vertex = a.axis ? &a : b.axis ? &b : c.axis ? &c : nullptr;
       if (axis_vertex != nullptr) {  // case 1, vertex case: already a corner
-        const V3& p = *axis_vertex;
-        const V3& x = (&p == &a) ? b : a;
-        const V3& y = (&p == &c) ? b : c;
+        const Corner& p = *axis_vertex;
+        const Corner& x = (&p == &a) ? b : a;
+        const Corner& y = (&p == &c) ? b : c;
         cone(x, y, p, /*apex=*/true);
       } else {  // cases 2 and 3: the pole on an edge or inside the face
-        const V3 n = (b - a).cross(c - a);
-        const V3 p = V3(0, 0, n.dot(a) / n.z());
+        const V3 n = (b.p - a.p).cross(c.p - a.p);
+        const Corner p = corner(V3(0, 0, n.dot(a.p) / n.z()));
         cone(a, b, p, true);
         cone(b, c, p, true);
         cone(c, a, p, true);
@@ -119,9 +123,10 @@ class Rasterizer {
 
   /// Rasterise the cone of triangle (a, b, c). With `apex`, c lies on the z axis (the pole
   /// corner) and linear mode uses the trapezoid interpolation of thesis Fig. 34.
-  void cone(const V3& a, const V3& b, const V3& c, bool apex) {
+  void cone(const Corner& ka, const Corner& kb, const Corner& kc, bool apex) {
+    const V3 &a = ka.p, &b = kb.p, &c = kc.p;
     const double det = a.dot(b.cross(c));
-    if (!(std::abs(det) > 1e-12 * a.norm() * b.norm() * c.norm())) return;  // empty part
+    if (!(std::abs(det) > 1e-12 * ka.d * kb.d * kc.d)) return;  // empty part
     const double s = det > 0 ? 1.0 : -1.0;
     const V3 e0 = s * b.cross(c), e1 = s * c.cross(a), e2 = s * a.cross(b);
     const double adet = std::abs(det);
@@ -129,7 +134,7 @@ class Rasterizer {
     const double h = grid_.step();
 
     // Bounding rows: phi range of the spherical triangle, poles included.
-    const V3 ua = a.normalized(), ub = b.normalized(), uc = c.normalized();
+    const V3 &ua = ka.u, &ub = kb.u, &uc = kc.u;
     double zlo = 1, zhi = -1, lo, hi;
     arc_z_range(ua, ub, lo, hi);
     zlo = std::min(zlo, lo), zhi = std::max(zhi, hi);
@@ -148,8 +153,7 @@ class Rasterizer {
     // Bounding columns: the smallest arc holding the corners' azimuths (< 180 deg when the
     // cone holds no pole: azimuth is monotone along a great circle that misses the axis).
     int c0 = 0, c1 = cols - 1;
-    bool full = north || south || on_axis(a) || on_axis(b) || on_axis(c);
-    const Corner ka = corner(a), kb = corner(b), kc = corner(c);
+    bool full = north || south || ka.axis || kb.axis || kc.axis;
     if (!full) {
       const double tb = ka.theta + wrap_pi(kb.theta - ka.theta);
       const double tc = ka.theta + wrap_pi(kc.theta - ka.theta);
@@ -240,12 +244,13 @@ SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, Di
   require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
   SamplingStats stats;
   Rasterizer<Scalar> raster(map, mode, stats);
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-    const V3 a = mesh.V.row(mesh.F(f, 0)).transpose() - cor;
-    const V3 b = mesh.V.row(mesh.F(f, 1)).transpose() - cor;
-    const V3 c = mesh.V.row(mesh.F(f, 2)).transpose() - cor;
-    raster.triangle(a, b, c);
-  }
+  // Spherical coordinates once per vertex (a vertex is shared by about six triangles).
+  std::vector<Corner> corners(static_cast<std::size_t>(mesh.V.rows()));
+  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
+    corners[static_cast<std::size_t>(i)] = corner(mesh.V.row(i).transpose() - cor);
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    raster.triangle(corners[static_cast<std::size_t>(mesh.F(f, 0))], corners[static_cast<std::size_t>(mesh.F(f, 1))],
+                    corners[static_cast<std::size_t>(mesh.F(f, 2))]);
   stats.nodes_covered = map.nodes_covered();
   return stats;
 }
