@@ -18,6 +18,7 @@
 #include "impinge/joint.hpp"
 #include "impinge/map_image.hpp"
 #include "impinge/mesh_io.hpp"
+#include "impinge/parse.hpp"
 #include "impinge/pose.hpp"
 #include "impinge/sphere_fit.hpp"
 #include "impinge/subject.hpp"
@@ -26,23 +27,6 @@ using namespace impinge;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& what) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(item, &used));
-      require(used == item.size() && std::isfinite(v.back()), "");
-    } catch (const std::exception&) {
-      throw Error(what + " '" + text + "': '" + item + "' is not a finite number");
-    }
-  }
-  require(v.size() == count, what + " '" + text + "': expected " + std::to_string(count) + " comma-separated numbers");
-  return v;
-}
 
 nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double detection_ms,
                          const ImpingementLevels& levels) {
@@ -129,14 +113,14 @@ int run_distance(const std::string& ball_path_in, const std::string& socket_path
   SphereFitResult fit;
   std::string cor_method;
   if (!head_region.empty()) {
-    const auto v = parse_numbers(head_region, 4, "--head-region");
+    const auto v = parse_number_list(head_region, "--head-region", 4);
     fit = fit_sphere_in_region(ball, M * Eigen::Vector3d(v[0], v[1], v[2]), v[3]);
     cor_method = "sphere fit in region";
   } else if (cor_text == "auto") {
     fit = fit_femoral_head(ball);
     cor_method = "automatic sphere fit (RANSAC + geometric)";
   } else {
-    const auto v = parse_numbers(cor_text, 3, "--cor");
+    const auto v = parse_number_list(cor_text, "--cor", 3);
     fit.centre = M * Eigen::Vector3d(v[0], v[1], v[2]);
     fit.radius = std::numeric_limits<double>::quiet_NaN();
     fit.rms_residual = std::numeric_limits<double>::quiet_NaN();

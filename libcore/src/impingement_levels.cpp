@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "impinge/error.hpp"
+#include "impinge/parse.hpp"
 
 namespace impinge {
 
@@ -45,18 +45,7 @@ std::array<std::uint8_t, 3> level_colour(std::uint8_t level, int level_count, bo
 
 ImpingementLevels parse_levels(const std::string& csv) {
   ImpingementLevels lv;
-  lv.thresholds_mm.clear();
-  std::stringstream ss(csv);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t used = 0;
-      lv.thresholds_mm.push_back(std::stod(item, &used));
-      require(used == item.size(), "");
-    } catch (const std::exception&) {
-      throw Error("impingement levels '" + csv + "': '" + item + "' is not a number");
-    }
-  }
+  lv.thresholds_mm = parse_number_list(csv, "impingement levels");
   lv.validate();
   return lv;
 }

@@ -2,10 +2,10 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <sstream>
 #include <vector>
 
 #include "impinge/error.hpp"
+#include "impinge/parse.hpp"
 #include "impinge/spherical_frame.hpp"
 
 namespace impinge {
@@ -21,22 +21,8 @@ Eigen::Matrix3d pose_rotation(const PoseAngles& a, Side side) {
 }
 
 PoseAngles parse_pose(const std::string& text) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(item, &used));
-      require(used == item.size(), "");
-    } catch (const std::exception&) {
-      throw Error("pose '" + text + "': '" + item + "' is not a number (expected FLEX,ABD,ROT in degrees)");
-    }
-  }
-  require(v.size() == 3, "pose '" + text + "': expected three angles FLEX,ABD,ROT in degrees");
-  PoseAngles p{v[0], v[1], v[2]};
-  pose_rotation(p, Side::right);  // validates finiteness
-  return p;
+  const std::vector<double> v = parse_number_list(text, "pose (FLEX,ABD,ROT in degrees)", 3);
+  return PoseAngles{v[0], v[1], v[2]};
 }
 
 }  // namespace impinge
