@@ -20,6 +20,8 @@
 #include "impinge/mesh_io.hpp"
 #include "impinge/parse.hpp"
 #include "impinge/pose.hpp"
+#include "impinge/sampling.hpp"
+#include "impinge/spherical_frame.hpp"
 #include "impinge/sphere_fit.hpp"
 #include "impinge/subject.hpp"
 
@@ -47,12 +49,14 @@ nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double det
   j["levels"] = lv;
   j["map_nodes"] = body.map.num_nodes();
   j["map_nodes_covered"] = body.sampling.nodes_covered;
+  j["sampling_method"] = to_string(body.sampling.method);
+  if (body.sampling.resample_precision_deg > 0) j["resample_precision_deg"] = body.sampling.resample_precision_deg;
   j["map_bytes"] = body.map.bytes();
-  j["triangles"] = body.sampling.triangles;
+  j["triangles"] = body.mesh.F.rows();
   j["degenerate_triangles_skipped"] = body.mesh.degenerate_faces_skipped;
-  j["triangles_edge_on"] = body.sampling.triangles_edge_on;
-  j["pole_triangles"] = body.sampling.pole_triangles;
-  j["seam_triangles"] = body.sampling.seam_triangles;
+  j["triangles_edge_on"] = body.sampling.raster.triangles_edge_on;
+  j["pole_triangles"] = body.sampling.raster.pole_triangles;
+  j["seam_triangles"] = body.sampling.raster.seam_triangles;
   j["sampling_ms"] = body.sampling_ms;
   j["detection_ms"] = detection_ms;
   return j;
@@ -79,8 +83,8 @@ void write_body_ply(const std::string& path, const JointBody& body, const ScanGa
 }
 
 int run_distance(const std::string& ball_path_in, const std::string& socket_path_in, const std::string& subject_path,
-                 const std::string& cor_text, const std::string& head_region, double precision,
-                 const std::string& mode_text, const std::string& pose_text, const std::string& side_text,
+                 const std::string& cor_text, const std::string& head_region, const std::string& scheme_name,
+                 double resolution, const std::string& sampling_text, const std::string& mode_text, const std::string& pose_text, const std::string& side_text,
                  const std::string& frame_text, const std::string& levels_text, double occlusion_tol,
                  double max_radius, const std::string& out_dir) {
   std::string ball_path = ball_path_in, socket_path = socket_path_in;
@@ -96,12 +100,12 @@ int run_distance(const std::string& ball_path_in, const std::string& socket_path
   require(!ball_path.empty(), "--ball is required (or --subject)");
   require(!socket_path.empty(), "--socket is required (or --subject)");
   JointOptions opt;
-  opt.precision_deg = precision;
+  opt.scheme = make_scheme(scheme_name, resolution);  // validates before the expensive work
   opt.mode = parse_distance_mode(mode_text);
+  opt.sampling = parse_sampling_method(sampling_text);
   opt.occlusion_tolerance_mm = occlusion_tol;
   opt.max_radius_mm = max_radius > 0 ? max_radius : std::numeric_limits<double>::infinity();
   if (!levels_text.empty()) opt.levels = parse_levels(levels_text);
-  EquiangularGrid check(precision);  // validates before the expensive work
   const PoseAngles pose = parse_pose(pose_text);
   const Eigen::Matrix3d R = pose_rotation(pose, side);
 
@@ -150,7 +154,12 @@ int run_distance(const std::string& ball_path_in, const std::string& socket_path
   j["head_radius_mm"] = num_or_null(fit.radius);
   j["sphere_fit_rms_mm"] = num_or_null(fit.rms_residual);
   j["sphere_fit_points"] = fit.points_used;
-  j["precision_deg"] = precision;
+  const auto* grid = dynamic_cast<const EquiangularGrid*>(opt.scheme.get());
+  j["scheme"] = opt.scheme->name();
+  j[opt.scheme->resolution_name()] = opt.scheme->resolution();
+  j["precision_deg"] = grid ? nlohmann::json(grid->precision_deg()) : nlohmann::json(nullptr);
+  j["max_node_spacing_deg"] = opt.scheme->max_node_spacing() * kRadToDeg;
+  j["sampling_method"] = to_string(joint.ball().sampling.method);
   j["mode"] = to_string(opt.mode);
   j["pose_deg"] = {pose.flexion_deg, pose.abduction_deg, pose.rotation_deg};
   j["pose_axes"] = "flexion about medio-lateral, abduction about antero-posterior, rotation about superior-inferior";
@@ -196,8 +205,8 @@ int main(int argc, char** argv) {
 
   auto* dist = app.add_subcommand("distance", "Per-vertex gap between ball (femur) and socket (pelvis) at one pose");
   std::string ball, socket, subject, cor = "auto", head_region, mode = "exact", pose = "0,0,0", out, side = "right",
-                                      frame = "RAS", levels;
-  double precision = 0.5, occlusion_tol = 1.0, max_radius = 0;
+                                      frame = "RAS", levels, scheme = "equiangular", sampling = "auto";
+  double precision = 0.5, turns = 0, resolution = 0, occlusion_tol = 1.0, max_radius = 0;
   dist->add_option("--ball", ball, "Ball mesh (femur): PLY, STL, OBJ or OFF, mm");
   dist->add_option("--socket", socket, "Socket mesh (pelvis): PLY, STL, OBJ or OFF, mm");
   dist->add_option("--subject", subject,
@@ -207,7 +216,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   dist->add_option("--head-region", head_region,
                    "X,Y,Z,R: fit the head sphere to femur vertices within R mm of (X,Y,Z), input frame");
-  dist->add_option("--precision", precision, "Equiangular map precision p in degrees (180/p integral)")
+  std::string registered;
+  for (const auto& [name, res] : scheme_names()) registered += (registered.empty() ? "" : ", ") + name + " (" + res + ")";
+  dist->add_option("--scheme", scheme, "Sampling scheme of the maps: " + registered)->capture_default_str();
+  dist->add_option("--resolution", resolution, "Resolution parameter of the scheme (any scheme)");
+  dist->add_option("--precision", precision, "Equiangular precision p in degrees (180/p integral); the resolution "
+                                             "when neither --resolution nor --turns is given")
+      ->capture_default_str();
+  dist->add_option("--turns", turns, "Helix turns k (w = k^2 nodes; thesis Table 6: 229, 458, 2292, 4584)");
+  dist->add_option("--sampling", sampling, "auto, rasterize, resample or ray-cast (naive, small meshes only)")
       ->capture_default_str();
   dist->add_option("--mode", mode, "Distance mode: 'linear' (thesis Alg. 1) or 'exact' (ray-plane)")
       ->capture_default_str();
@@ -243,8 +260,9 @@ int main(int argc, char** argv) {
   }
   try {
     if (*dist)
-      return run_distance(ball, socket, subject, cor, head_region, precision, mode, pose, side, frame, levels,
-                          occlusion_tol, max_radius, out);
+      return run_distance(ball, socket, subject, cor, head_region, scheme,
+                          resolution > 0 ? resolution : (turns > 0 ? turns : precision), sampling, mode, pose, side,
+                          frame, levels, occlusion_tol, max_radius, out);
     if (*gen) return run_generate(triangles, cam, coverage, gen_out);
   } catch (const std::exception& e) {
     std::cerr << "impinge: error: " << e.what() << "\n";

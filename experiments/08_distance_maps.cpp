@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
       for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
         progress("08_distance_maps", ++done, total, s.name + " p=" + std::to_string(p) + " " + to_string(mode));
         JointOptions o;
-        o.precision_deg = p;
+        o.scheme = make_scheme("equiangular", p);
         o.mode = mode;
         const Joint joint(s.femur, s.pelvis, fit.centre, o);
         const PoseResult res = joint.detect(Eigen::Matrix3d::Identity());

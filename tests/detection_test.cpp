@@ -35,7 +35,7 @@ TEST(Detection, ConcentricBallAndCupGiveRadiusDifference) {
   for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
     for (double p : {1.0, 0.5, 0.25}) {
       JointOptions o;
-      o.precision_deg = p;
+      o.scheme = make_scheme("equiangular", p);
       o.mode = mode;
       const Joint j(ball, cup, cor, o);
       const PoseResult r = j.detect(Eigen::Matrix3d::Identity());
@@ -64,7 +64,7 @@ TEST(Detection, MovingBothBodiesTogetherLeavesGapsUnchanged) {
   ho.cam_height_mm = 2;
   const HipModel h = make_hip_model(ho);
   JointOptions o;
-  o.precision_deg = 0.5;
+  o.scheme = make_scheme("equiangular", 0.5);
   const Eigen::Matrix3d pose = pose_rotation({20, 10, 5}, Side::right);
   const PoseResult a = Joint(h.ball, h.socket, h.cor, o).detect(pose);
   // Rigid motion of the whole joint: translate, and rotate about z by 7 grid steps (the map's
@@ -95,7 +95,7 @@ TEST(Detection, PushedBallReportsPenetrationDepth) {
   const TriangleMesh ball = make_uv_sphere(22, cor + 3 * axis, 240, 120, Eigen::Vector3d(1, 0, 0.2));
   const TriangleMesh cup = make_cup(23, 28, 90, cor, axis, 240, 60);
   JointOptions o;
-  o.precision_deg = 0.25;
+  o.scheme = make_scheme("equiangular", 0.25);
   o.occlusion_tolerance_mm = 10;  // the shifted ball is not star-shaped about cor in the same way
   const PoseResult r = Joint(ball, cup, cor, o).detect(Eigen::Matrix3d::Identity());
   EXPECT_NEAR(r.ball.min_gap_mm, -2.0, 0.05);

@@ -98,7 +98,7 @@ TEST_P(RealSubject, ExactModeAgreesWithExactRayCastAtTenthDegree) {
   EXPECT_LT(fit.radius, 30);
   EXPECT_LT(fit.rms_residual, 1.0);
   JointOptions o;
-  o.precision_deg = 0.1;
+  o.scheme = make_scheme("equiangular", 0.1);
   o.mode = DistanceMode::exact;
   const Joint j(femur, pelvis, fit.centre, o);
   const PoseResult r = j.detect(Eigen::Matrix3d::Identity());

@@ -12,6 +12,26 @@ void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<st
   out.status.resize(static_cast<std::size_t>(n));
   const double s = static_cast<double>(static_cast<int>(side));
   const float nan = std::numeric_limits<float>::quiet_NaN();
+  // Vertices to look up are gathered in blocks: one call into the scheme per block, the
+  // per-vertex stencil inlined there (no virtual dispatch per vertex).
+  constexpr int kBlock = 256;
+  double pts[3 * kBlock], radius[kBlock], d[kBlock];
+  std::size_t index[kBlock];
+  int m = 0;
+  auto flush = [&] {
+    map.sample_many(pts, m, d);
+    for (int j = 0; j < m; ++j) {
+      const std::size_t k = index[j];
+      if (std::isnan(d[j])) {
+        out.gap_mm[k] = nan;
+        out.status[k] = ScanGaps::no_surface;
+      } else {
+        out.gap_mm[k] = static_cast<float>(s * (d[j] - radius[j]));
+        out.status[k] = ScanGaps::tested;
+      }
+    }
+    m = 0;
+  };
   for (Eigen::Index i = 0; i < n; ++i) {
     const auto k = static_cast<std::size_t>(i);
     if (!mask[k]) {
@@ -21,15 +41,17 @@ void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<st
     }
     const Eigen::Vector3d q = R * P.row(i).transpose();
     const double r = q.norm();
-    const double d = r > 0 ? map.sample(q) : std::numeric_limits<double>::quiet_NaN();
-    if (std::isnan(d)) {
+    if (!(r > 0)) {
       out.gap_mm[k] = nan;
       out.status[k] = ScanGaps::no_surface;
-    } else {
-      out.gap_mm[k] = static_cast<float>(s * (d - r));
-      out.status[k] = ScanGaps::tested;
+      continue;
     }
+    pts[3 * m] = q.x(), pts[3 * m + 1] = q.y(), pts[3 * m + 2] = q.z();
+    radius[m] = r;
+    index[m] = k;
+    if (++m == kBlock) flush();
   }
+  flush();
 }
 
 template <typename Scalar>
@@ -44,7 +66,7 @@ std::vector<std::uint8_t> first_surface_mask(const Vertices& P, const RadialDist
     if (std::isnan(d)) {
       // At the edge of the map's coverage: compare with the nearest surface among the stencil
       // nodes that have one (a rim vertex of an outer shell is still hidden by the inner one).
-      const Stencil st = own_map.grid().interpolate(p / r);
+      const Stencil st = own_map.scheme().interpolate(p / r);
       d = std::numeric_limits<double>::infinity();
       for (int k = 0; k < 4; ++k)
         if (own_map.has_surface(st.nodes[k])) d = std::min<double>(d, own_map.at(st.nodes[k]));

@@ -17,6 +17,7 @@ EquiangularGrid::EquiangularGrid(double precision_deg) : precision_deg_(precisio
   rows_ = static_cast<int>(std::lround(n)) + 1;
   cols_ = 2 * (rows_ - 1);
   step_ = kPi / (rows_ - 1);
+  inv_step_ = 1.0 / step_;
 }
 
 Eigen::Vector3d EquiangularGrid::node_direction(std::int64_t i) const {
@@ -37,23 +38,12 @@ std::int64_t EquiangularGrid::node(const Eigen::Vector3d& u) const {
   return std::int64_t(r) * cols_ + c;
 }
 
-Stencil EquiangularGrid::interpolate(const Eigen::Vector3d& u) const {
-  const SphericalCoordinates s = to_spherical(u);
-  const double fr = s.phi / step_;
-  int r0 = static_cast<int>(std::floor(fr));
-  if (r0 > rows_ - 2) r0 = rows_ - 2;
-  if (r0 < 0) r0 = 0;
-  const double t = fr - r0;
-  const double fc = s.theta / step_;
-  int c0 = static_cast<int>(std::floor(fc));
-  const double w = fc - c0;
-  if (c0 >= cols_) c0 -= cols_;
-  const int c1 = (c0 + 1 == cols_) ? 0 : c0 + 1;
-  Stencil st;
-  const std::int64_t base0 = std::int64_t(r0) * cols_, base1 = base0 + cols_;
-  st.nodes = {base0 + c0, base0 + c1, base1 + c0, base1 + c1};
-  st.weights = {(1 - t) * (1 - w), (1 - t) * w, t * (1 - w), t * w};
-  return st;
+void EquiangularGrid::node_angles(std::int64_t first, std::int64_t count, double* phi, double* theta) const {
+  for (std::int64_t j = 0; j < count; ++j) {
+    const std::int64_t i = first + j;
+    phi[j] = static_cast<double>(i / cols_) * step_;
+    theta[j] = static_cast<double>(i % cols_) * step_;
+  }
 }
 
 }  // namespace impinge

@@ -7,6 +7,10 @@
 namespace impinge {
 
 namespace {
+const std::shared_ptr<const SamplingScheme>& checked(const std::shared_ptr<const SamplingScheme>& s) {
+  require(s != nullptr, "joint: no sampling scheme given");
+  return s;
+}
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -15,8 +19,8 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options)
     : cor_(cor),
       options_(options),
-      ball_{TriangleMesh{}, Vertices{}, RadialDistanceMap{EquiangularGrid(options.precision_deg)}, {}, {}, {}, 0},
-      socket_{TriangleMesh{}, Vertices{}, RadialDistanceMap{EquiangularGrid(options.precision_deg)}, {}, {}, {}, 0} {
+      ball_{TriangleMesh{}, Vertices{}, RadialDistanceMap{checked(options.scheme)}, {}, {}, {}, 0},
+      socket_{TriangleMesh{}, Vertices{}, RadialDistanceMap{options.scheme}, {}, {}, {}, 0} {
   require(cor.allFinite(), "joint: centre of rotation is not finite");
   require(options.occlusion_tolerance_mm >= 0, "joint: occlusion tolerance must be >= 0 mm");
   require(options.max_radius_mm > 0, "joint: region radius must be > 0 mm");
@@ -28,10 +32,13 @@ Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor,
 }
 
 JointBody Joint::build(TriangleMesh mesh) const {
-  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{EquiangularGrid(options_.precision_deg)}, {}, {}, {}, 0};
+  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, 0};
   b.relative = b.mesh.V.rowwise() - cor_.transpose();
   const auto t0 = std::chrono::steady_clock::now();
-  b.sampling = rasterize(b.mesh, cor_, options_.mode, b.map);
+  SamplingOptions so;
+  so.mode = options_.mode;
+  so.method = options_.sampling;
+  b.sampling = sample_surface(b.mesh, cor_, so, b.map);
   b.sampling_ms = ms_since(t0);
   b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);
   b.vertex_area = vertex_areas(b.mesh);

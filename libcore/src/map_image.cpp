@@ -2,11 +2,14 @@
 
 #include <png.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <vector>
 
 #include "impinge/error.hpp"
+#include "impinge/spherical_frame.hpp"
 
 namespace impinge {
 
@@ -35,15 +38,30 @@ void write_grey_png(const std::string& path, const unsigned char* pixels, int w,
 
 
 void write_map_png(const std::string& path, const RadialDistanceMap& map) {
-  const int w = map.grid().columns(), h = map.grid().rows();
+  // Pixel values: the node values of an equiangular map, else the map interpolated at the
+  // nodes of an equiangular image grid matched to the scheme's spacing (at most 3600 x 1801).
+  std::vector<double> value;
+  int w, h;
+  if (const auto* g = dynamic_cast<const EquiangularGrid*>(&map.scheme())) {
+    w = g->columns(), h = g->rows();
+    value.assign(map.data(), map.data() + map.num_nodes());
+  } else {
+    const double spacing_deg = std::max(map.scheme().max_node_spacing() * kRadToDeg, 0.1);
+    const EquiangularGrid img(180.0 / std::max(1.0, std::round(180.0 / spacing_deg)));
+    w = img.columns(), h = img.rows();
+    value.resize(static_cast<std::size_t>(img.num_nodes()));
+    for (std::int64_t i = 0; i < img.num_nodes(); ++i) {
+      const double v = map.sample(img.node_direction(i));
+      value[static_cast<std::size_t>(i)] = std::isnan(v) ? std::numeric_limits<double>::infinity() : v;
+    }
+  }
   double lo = std::numeric_limits<double>::infinity(), hi = 0;
-  for (std::int64_t i = 0; i < map.num_nodes(); ++i)
-    if (map.has_surface(i)) lo = std::min<double>(lo, map.at(i)), hi = std::max<double>(hi, map.at(i));
+  for (double v : value)
+    if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
   const double span = hi > lo ? hi - lo : 1.0;
-  std::vector<unsigned char> pixels(static_cast<std::size_t>(map.num_nodes()));
-  for (std::int64_t i = 0; i < map.num_nodes(); ++i)
-    pixels[static_cast<std::size_t>(i)] =
-        map.has_surface(i) ? static_cast<unsigned char>(40 + 215.0 * (map.at(i) - lo) / span) : 0;
+  std::vector<unsigned char> pixels(value.size());
+  for (std::size_t i = 0; i < value.size(); ++i)
+    pixels[i] = std::isfinite(value[i]) ? static_cast<unsigned char>(40 + 215.0 * (value[i] - lo) / span) : 0;
   write_grey_png(path, pixels.data(), w, h);
 }
 

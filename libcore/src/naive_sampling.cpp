@@ -39,7 +39,7 @@ void sample_naive(const TriangleMesh& mesh, const Eigen::Vector3d& cor, RadialDi
   const std::int64_t n = map.num_nodes();
   if (triangle_of_node != nullptr) triangle_of_node->assign(static_cast<std::size_t>(n), -1);
   for (std::int64_t i = 0; i < n; ++i) {
-    const auto hit = cast_ray_naive(mesh, cor, map.grid().node_direction(i));
+    const auto hit = cast_ray_naive(mesh, cor, map.scheme().node_direction(i));
     if (!hit) continue;
     const Scalar v = static_cast<Scalar>(hit->first);
     if (v < map.data()[i]) map.data()[i] = v;

@@ -3,48 +3,80 @@
 /// The equiangular (phi, theta) sampling scheme of RSID (thesis sec. 3.1, Table 2).
 
 #include <Eigen/Core>
-#include <array>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
-#include <vector>
+#include <string>
+
+#include "impinge/sampling_scheme.hpp"
 
 namespace impinge {
-
-/// Interpolation stencil of a direction: up to four node indices and their weights (sum 1).
-struct Stencil {
-  std::array<std::int64_t, 4> nodes{};  ///< node indices
-  std::array<double, 4> weights{};       ///< bilinear weights, >= 0, sum to 1
-};
 
 /// Equiangular grid at precision p degrees: rows phi_i = i p for i = 0..180/p (both poles
 /// included), columns theta_j = j p for j = 0..360/p - 1 (theta periodic), node index
 /// i * columns + j. Node count (180/p + 1) x (360/p) (thesis Table 2: 65,160 at 1 deg).
 /// Every node of row 0 (and of the last row) has the same direction, the pole.
-class EquiangularGrid {
+/// Interpolation: bilinear in (phi, theta) over the four surrounding nodes (thesis Alg. 2).
+class EquiangularGrid : public SchemeImpl<EquiangularGrid> {
  public:
   /// Grid of precision `precision_deg` (degrees). Throws impinge::Error unless
   /// 0 < p <= 90 and 180 / p is an integer (to 1e-9 relative).
   explicit EquiangularGrid(double precision_deg);
 
+  std::string name() const override { return "equiangular"; }
+  std::string resolution_name() const override { return "precision_deg"; }
+  double resolution() const override { return precision_deg_; }
   double precision_deg() const { return precision_deg_; }  ///< resolution parameter p, degrees
   double step() const { return step_; }                    ///< p in radians
   int rows() const { return rows_; }                       ///< 180/p + 1
   int columns() const { return cols_; }                    ///< 360/p
-  std::int64_t num_nodes() const { return std::int64_t(rows_) * cols_; }
+  std::int64_t num_nodes() const override { return std::int64_t(rows_) * cols_; }
 
   /// Direction (unit vector) of node i, 0 <= i < num_nodes().
-  Eigen::Vector3d node_direction(std::int64_t i) const;
+  Eigen::Vector3d node_direction(std::int64_t i) const override;
+  void node_angles(std::int64_t first, std::int64_t count, double* phi, double* theta) const override;
   /// Nearest node to a unit direction `u` (ties toward the lower index).
-  std::int64_t node(const Eigen::Vector3d& u) const;
-  /// Bilinear stencil of a unit direction `u` over the four nodes around (phi, theta),
-  /// theta wrapping at 360 deg.
-  Stencil interpolate(const Eigen::Vector3d& u) const;
+  std::int64_t node(const Eigen::Vector3d& u) const override;
   /// Largest great-circle distance between neighbouring nodes in radians: p (along a
   /// meridian and along the equator). Feeds the error bounds (thesis Eq. 7).
-  double max_node_spacing() const { return step_; }
+  double max_node_spacing() const override { return step_; }
+
+  /// Bilinear stencil of the direction of (x, y, z) (nonzero), the hot path of detection:
+  /// acos, atan2, no allocation. Theta wraps at 360 deg.
+  void stencil_at(double x, double y, double z, std::int64_t nodes[4], double w[4]) const {
+    const double r = std::sqrt(x * x + y * y + z * z);
+    const double phi = std::acos(std::clamp(z / r, -1.0, 1.0));
+    double theta = std::atan2(y, x);
+    if (theta < 0) theta += 2 * 3.14159265358979323846;
+    stencil_angles(phi, theta, nodes, w);
+  }
+
+  /// As stencil_at from phi in [0, pi] and theta in [0, 2 pi) radians.
+  void stencil_angles(double phi, double theta, std::int64_t nodes[4], double w[4]) const {
+    const double fr = phi * inv_step_;
+    int r0 = static_cast<int>(fr);
+    if (r0 > rows_ - 2) r0 = rows_ - 2;
+    const double t = fr - r0;
+    const double fc = theta * inv_step_;
+    int c0 = static_cast<int>(fc);
+    const double s = fc - c0;
+    if (c0 >= cols_) c0 -= cols_;
+    const int c1 = (c0 + 1 == cols_) ? 0 : c0 + 1;
+    const std::int64_t b0 = std::int64_t(r0) * cols_, b1 = b0 + cols_;
+    nodes[0] = b0 + c0;
+    nodes[1] = b0 + c1;
+    nodes[2] = b1 + c0;
+    nodes[3] = b1 + c1;
+    w[0] = (1 - t) * (1 - s);
+    w[1] = (1 - t) * s;
+    w[2] = t * (1 - s);
+    w[3] = t * s;
+  }
 
  private:
   double precision_deg_;
   double step_;
+  double inv_step_;
   int rows_;
   int cols_;
 };

@@ -12,13 +12,17 @@
 #include "impinge/mesh.hpp"
 #include "impinge/radial_distance_map.hpp"
 #include "impinge/rasterize.hpp"
+#include "impinge/sampling.hpp"
+#include "impinge/sampling_scheme.hpp"
 
 namespace impinge {
 
 /// Options of a Joint.
 struct JointOptions {
-  double precision_deg = 0.5;                 ///< equiangular precision p, degrees
+  /// Sampling scheme of both maps (make_scheme); default equiangular at p = 0.5 deg.
+  std::shared_ptr<const SamplingScheme> scheme = make_scheme("equiangular", 0.5);
   DistanceMode mode = DistanceMode::exact;    ///< rasterisation distance mode
+  SamplingMethod sampling = SamplingMethod::automatic;  ///< how maps are filled
   double occlusion_tolerance_mm = 1.0;        ///< a vertex farther than its own map's surface
                                               ///< plus this is hidden (not on the first surface)
   double max_radius_mm = std::numeric_limits<double>::infinity();  ///< region of interest about
@@ -33,8 +37,8 @@ struct JointBody {
   RadialDistanceMap map;        ///< its radial distance map about the COR
   std::vector<std::uint8_t> mask;  ///< 1 for vertices on the first surface within the region
   Eigen::VectorXd vertex_area;  ///< n, mm^2
-  SamplingStats sampling;       ///< rasterisation counts
-  double sampling_ms = 0;       ///< wall time of the rasterisation, ms
+  SamplingReport sampling;      ///< how the map was filled, with counts
+  double sampling_ms = 0;       ///< wall time of filling the map, ms
 };
 
 /// Result of both scans at one pose.

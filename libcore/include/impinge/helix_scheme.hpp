@@ -1,0 +1,112 @@
+#pragma once
+/// @file helix_scheme.hpp
+/// The spherical-helix sampling scheme of USID (thesis ch. 4): w = k^2 helix orientation
+/// points equally spaced along the k-turn helix theta = 2 k phi (Eq. 9, Nishio et al. 2006),
+/// stored as a 1-D map.
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "impinge/helix_arc_length.hpp"
+#include "impinge/sampling_scheme.hpp"
+
+namespace impinge {
+
+/// How a direction's traveled distance is computed when locating its neighbours (thesis
+/// sec. 4.3). It never changes which nodes exist: nodes are equally spaced in exact arc length.
+enum class TraveledDistance {
+  exact,   ///< exact arc length (elliptic integral, HelixArcLength)
+  fitted,  ///< the thesis' fitted formula Eq. 10, T = (4k+1)(1 - cos phi)/2, scaled to w - 1 steps
+};
+
+/// k-turn spherical helix scheme. Node i lies at arc length s_i = i L / (w - 1) (L the total
+/// length), so node 0 is the north pole and node w - 1 the south pole.
+/// Stencil of a direction (phi, theta) (thesis Fig. 48, Algorithm 3): the helix crosses the
+/// meridian theta at phi_a <= phi < phi_b = phi_a + pi/k (the two bracketing turns); on each
+/// crossing the two nodes bracketing its traveled distance, linearly weighted along the curve;
+/// then linear in phi between the crossings. In the first (last) turn the north (south) pole
+/// node replaces the missing crossing: three neighbours.
+class HelixScheme : public SchemeImpl<HelixScheme> {
+ public:
+  /// k >= 2 integral turns (thesis Table 6: 229, 458, 2292, 4584). Throws impinge::Error.
+  explicit HelixScheme(double turns, TraveledDistance locate = TraveledDistance::exact);
+
+  std::string name() const override { return locate_ == TraveledDistance::exact ? "helix" : "helix-eq10"; }
+  std::string resolution_name() const override { return "turns"; }
+  double resolution() const override { return k_; }
+  double turns() const { return k_; }
+  TraveledDistance locate() const { return locate_; }
+  std::int64_t num_nodes() const override { return w_; }
+  /// Arc length between consecutive nodes, radians (= the largest node spacing).
+  double node_spacing() const { return dx_; }
+  double max_node_spacing() const override { return dx_; }
+  const HelixArcLength& arc_length() const { return arc_; }
+
+  Eigen::Vector3d node_direction(std::int64_t i) const override;
+  /// Incremental inversion of the arc length along consecutive nodes (fast path of resampling).
+  void node_angles(std::int64_t first, std::int64_t count, double* phi, double* theta) const override;
+  /// The node with the largest stencil weight.
+  std::int64_t node(const Eigen::Vector3d& u) const override;
+  /// Traveled distance of a point of the helix at polar angle phi, in node steps (so that
+  /// node i is at i), by the chosen formula.
+  double steps_at(double phi) const {
+    if (locate_ == TraveledDistance::fitted) return half_w1_ * (1 - std::cos(phi));
+    return arc_(phi) * inv_dx_;
+  }
+
+  /// Thesis Algorithm 3's neighbour location and interpolation (see class comment).
+  void stencil_at(double x, double y, double z, std::int64_t nodes[4], double w[4]) const {
+    const double r = std::sqrt(x * x + y * y + z * z);
+    const double c = z / r;
+    const double phi = std::acos(c < -1 ? -1 : (c > 1 ? 1 : c));
+    double theta = std::atan2(y, x);
+    if (theta < 0) theta += kTwoPi;
+    // bracketing crossings of the meridian theta
+    const double j = std::floor((2 * k_ * phi - theta) * kInvTwoPi);
+    double phi_a = (theta + kTwoPi * j) * inv_2k_;
+    double phi_b = phi_a + kPiOverK_;
+    double u;
+    if (phi_a <= 0) {  // first turn: the north pole node replaces the upper crossing
+      phi_a = 0;
+      nodes[0] = nodes[1] = 0;
+      w[0] = 1, w[1] = 0;
+    } else {
+      along(phi_a, nodes, w);
+    }
+    if (phi_b >= kPi_) {  // last turn: the south pole node
+      phi_b = kPi_;
+      nodes[2] = nodes[3] = w_ - 1;
+      w[2] = 1, w[3] = 0;
+    } else {
+      along(phi_b, nodes + 2, w + 2);
+    }
+    u = (phi - phi_a) / (phi_b - phi_a);
+    u = u < 0 ? 0 : (u > 1 ? 1 : u);
+    w[0] *= 1 - u, w[1] *= 1 - u, w[2] *= u, w[3] *= u;
+  }
+
+ private:
+  /// The two nodes bracketing the helix point at phi along the curve, with linear weights.
+  void along(double phi, std::int64_t* nodes, double* w) const {
+    const double f = steps_at(phi);
+    std::int64_t i = static_cast<std::int64_t>(f);
+    if (i > w_ - 2) i = w_ - 2;
+    if (i < 0) i = 0;
+    double t = f - static_cast<double>(i);
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    nodes[0] = i, nodes[1] = i + 1;
+    w[0] = 1 - t, w[1] = t;
+  }
+
+  static constexpr double kPi_ = 3.14159265358979323846;
+  static constexpr double kTwoPi = 2 * kPi_;
+  static constexpr double kInvTwoPi = 1 / kTwoPi;
+  double k_;
+  TraveledDistance locate_;
+  std::int64_t w_;
+  HelixArcLength arc_;
+  double dx_, inv_dx_, inv_2k_, kPiOverK_, half_w1_;
+};
+
+}  // namespace impinge

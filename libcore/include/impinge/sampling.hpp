@@ -1,0 +1,57 @@
+#pragma once
+/// @file sampling.hpp
+/// Filling a radial distance map of any scheme from a mesh: rasterisation (equiangular),
+/// resampling of a rasterised equiangular map (thesis sec. 4.2.2, accelerated USID sampling),
+/// or casting every node's ray (thesis sec. 4.2.1, the O(m n) reference).
+
+#include <Eigen/Core>
+#include <string>
+
+#include "impinge/mesh.hpp"
+#include "impinge/radial_distance_map.hpp"
+#include "impinge/rasterize.hpp"
+
+namespace impinge {
+
+/// How a map is filled.
+enum class SamplingMethod {
+  automatic,  ///< rasterize for equiangular maps, resample for every other scheme
+  rasterize,  ///< equiangular maps only (thesis Algorithm 1)
+  resample,   ///< rasterise a temporary equiangular map, interpolate it at every node, release it
+  ray_cast,   ///< every node's ray against every triangle (naive, O(nodes x triangles))
+};
+
+/// Parse "auto", "rasterize", "resample", "ray-cast"; throws impinge::Error otherwise.
+SamplingMethod parse_sampling_method(const std::string& name);
+const char* to_string(SamplingMethod method);
+
+/// Options of sample_surface.
+struct SamplingOptions {
+  DistanceMode mode = DistanceMode::exact;        ///< rasterisation distance mode
+  SamplingMethod method = SamplingMethod::automatic;
+  double resample_precision_deg = 0;  ///< temporary equiangular precision for `resample`; 0 picks
+                                      ///< 180 / round(180 / node spacing in degrees), the precision
+                                      ///< whose equator count matches the scheme's (thesis Table 6)
+};
+
+/// What a sampling run did.
+struct SamplingReport {
+  SamplingMethod method = SamplingMethod::automatic;  ///< the method actually used
+  SamplingStats raster;                   ///< counts of the rasterisation (equiangular part)
+  double resample_precision_deg = 0;      ///< temporary map precision (resample), else 0
+  std::int64_t nodes_covered = 0;         ///< nodes with a surface in the filled map
+  double rasterize_ms = 0, resample_ms = 0, ray_cast_ms = 0;  ///< wall times of the stages
+};
+
+/// Fill `map` (any scheme) from `mesh` (mm) about `cor` (mm): nearest hit per node, +inf where
+/// no surface. Throws impinge::Error for `rasterize` on a non-equiangular map or a non-finite COR.
+template <typename Scalar>
+SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& cor, const SamplingOptions& options,
+                              RadialDistanceMapT<Scalar>& map);
+
+/// Resample `source` (equiangular) at every node of `target`: target[i] = bilinear value of
+/// `source` in node i's direction (+inf where any weighted source node has no surface).
+template <typename Scalar>
+void resample(const RadialDistanceMap& source, RadialDistanceMapT<Scalar>& target);
+
+}  // namespace impinge
