@@ -32,21 +32,26 @@ TEST(Detection, ConcentricBallAndCupGiveRadiusDifference) {
   // Faceting: cup mesh chords lie inside its sphere by <= sagitta over the cell diagonal; ball
   // vertices lie exactly on theirs. Interpolation of a constant-radius map adds the same order.
   const double facet = sagitta(rc, std::sqrt(2.0) * 2 * kPi / n) + sagitta(rb, std::sqrt(2.0) * 2 * kPi / n);
+  // Equiangular at three precisions and the helix (USID) at two: the bound shrinks with the
+  // scheme's node spacing h (resampled helix maps interpolate twice: 2 sagittas).
+  const std::vector<std::pair<std::string, double>> schemes{
+      {"equiangular", 1.0}, {"equiangular", 0.5}, {"equiangular", 0.25}, {"helix", 229}, {"helix", 458}};
   for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
-    for (double p : {1.0, 0.5, 0.25}) {
+    for (const auto& [name, res] : schemes) {
       JointOptions o;
-      o.scheme = make_scheme("equiangular", p);
+      o.scheme = make_scheme(name, res);
       o.mode = mode;
       const Joint j(ball, cup, cor, o);
       const PoseResult r = j.detect(Eigen::Matrix3d::Identity());
-      const double h = p * kDegToRad;
-      const double bound = facet + sagitta(rc, std::sqrt(2.0) * h) + 1e-4;
+      const double h = o.scheme->max_node_spacing();
+      const double bound = facet + (name == "helix" ? 2 : 1) * sagitta(rc, std::sqrt(2.0) * h) + 1e-4;
+      const double p = res;
       std::int64_t tested = 0;
-      for (std::size_t i = 0; i < r.ball_gaps.gap_mm.size(); ++i)
-        if (r.ball_gaps.status[i] == ScanGaps::tested) {
-          ++tested;
-          ASSERT_NEAR(r.ball_gaps.gap_mm[i], rc - rb, bound) << "ball vertex " << i << " p=" << p;
-        }
+      for (std::size_t i = 0; i < r.ball_gaps.gap_mm.size(); ++i) {
+        if (r.ball_gaps.status[i] != ScanGaps::tested) continue;
+        ++tested;
+        ASSERT_NEAR(r.ball_gaps.gap_mm[i], rc - rb, bound) << "ball vertex " << i << " " << name << " " << p;
+      }
       EXPECT_GT(tested, 1000);
       for (std::size_t i = 0; i < r.socket_gaps.gap_mm.size(); ++i)
         if (r.socket_gaps.status[i] == ScanGaps::tested)

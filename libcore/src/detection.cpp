@@ -66,10 +66,13 @@ std::vector<std::uint8_t> first_surface_mask(const Vertices& P, const RadialDist
     if (std::isnan(d)) {
       // At the edge of the map's coverage: compare with the nearest surface among the stencil
       // nodes that have one (a rim vertex of an outer shell is still hidden by the inner one).
+      // With none, the map cannot confirm the vertex is on the first surface: skip it.
       const Stencil st = own_map.scheme().interpolate(p / r);
-      d = std::numeric_limits<double>::infinity();
+      d = -std::numeric_limits<double>::infinity();
       for (int k = 0; k < 4; ++k)
-        if (own_map.has_surface(st.nodes[k])) d = std::min<double>(d, own_map.at(st.nodes[k]));
+        if (own_map.has_surface(st.nodes[k]))
+          d = d == -std::numeric_limits<double>::infinity() ? double(own_map.at(st.nodes[k]))
+                                                            : std::min<double>(d, own_map.at(st.nodes[k]));
     }
     if (r <= d + tolerance_mm) mask[static_cast<std::size_t>(i)] = 1;
   }

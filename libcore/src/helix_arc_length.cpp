@@ -20,10 +20,7 @@ HelixArcLength::HelixArcLength(double turns) : k_(turns) {
   require(std::isfinite(turns) && turns > 0, "helix: turns must be > 0");
   gsl_set_error_handler_off();
   m_ = 4 * k_ * k_;
-  sqrt1m_ = std::sqrt(1 + m_);
-  kappa_ = std::sqrt(m_ / (1 + m_));
-  e_complete_ = gsl_sf_ellint_Ecomp(kappa_, GSL_PREC_DOUBLE);
-  total_ = 2 * sqrt1m_ * e_complete_;
+  total_ = 2 * quarter(kPi / 2);
   cap_ = std::min(kPi / 2, 20.0 / k_);
   h_ = kPi / kTableIntervals;
   inv_h_ = 1 / h_;
@@ -36,10 +33,22 @@ HelixArcLength::HelixArcLength(double turns) : k_(turns) {
   }
 }
 
+double HelixArcLength::quarter(double phi) const {
+  // Incomplete elliptic integral of the second kind with negative parameter -m in Carlson's
+  // symmetric form (DLMF 19.25.9): E(phi | -m) = s R_F(c^2, 1 + m s^2, 1) + (m/3) s^3
+  // R_D(c^2, 1 + m s^2, 1), s = sin phi, c = cos phi. Both terms are positive: no cancellation,
+  // unlike the complementary form sqrt(1 + m) [E(pi/2, kappa) - E(pi/2 - phi, kappa)], which
+  // loses up to 1e-4 relative near the poles and 2e-8 absolute at k = 4584 in GSL.
+  const double s = std::sin(phi), c = std::cos(phi);
+  const double y = 1 + m_ * s * s;
+  return s * gsl_sf_ellint_RF(c * c, y, 1, GSL_PREC_DOUBLE) +
+         m_ / 3 * s * s * s * gsl_sf_ellint_RD(c * c, y, 1, GSL_PREC_DOUBLE);
+}
+
 double HelixArcLength::exact(double phi) const {
-  const double x = kPi / 2 - phi;  // in [-pi/2, pi/2]; E is odd in its amplitude
-  const double ex = gsl_sf_ellint_E(std::abs(x), kappa_, GSL_PREC_DOUBLE);
-  return sqrt1m_ * (e_complete_ - (x < 0 ? -ex : ex));
+  if (phi <= 0) return 0;
+  if (phi >= kPi) return total_;
+  return phi <= kPi / 2 ? quarter(phi) : total_ - quarter(kPi - phi);  // symmetric about pi/2
 }
 
 double HelixArcLength::derivative(double phi) const {

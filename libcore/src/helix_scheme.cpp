@@ -53,8 +53,11 @@ void HelixScheme::node_angles(std::int64_t first, std::int64_t count, double* ph
       const double c = arc_(prev) - 2 * k_ * (1 - std::cos(prev));
       const double y = std::clamp((s - c) / (4 * k_), 0.0, 1.0);
       p = 2 * std::asin(std::sqrt(y));
-      p -= (arc_(p) - s) / arc_.derivative(p);
-      p = std::clamp(p, 0.0, kPi);
+      for (int it = 0; it < 20; ++it) {  // Newton; one step suffices for large k
+        const double step = (arc_(p) - s) / arc_.derivative(p);
+        p = std::clamp(p - step, 0.0, kPi);
+        if (std::abs(step) < 1e-13) break;
+      }
     }
     prev = p;
     phi[j] = p;

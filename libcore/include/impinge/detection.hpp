@@ -52,7 +52,9 @@ void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<st
                const RadialDistanceMapT<Scalar>& map, ScanSide side, ScanGaps& out);
 
 /// Vertices of a body that lie on its own first surface seen from the COR:
-/// mask[i] = 1 when |p_i| <= own_map.sample(p_i) + tolerance_mm and |p_i| <= max_radius_mm.
+/// mask[i] = 1 when |p_i| <= own_map.sample(p_i) + tolerance_mm and |p_i| <= max_radius_mm; at
+/// the edge of the own map's coverage the nearest covered stencil node is used, and a vertex
+/// none of whose stencil nodes is covered is skipped (the map cannot place its first surface).
 /// Pose-invariant (the COR is fixed in both bodies), so computed once per body. Vertices hidden
 /// behind their own body's nearer surface (the femoral shaft behind the head, the inner pelvic
 /// wall behind the acetabulum) are not represented by a radial map and would give a spurious

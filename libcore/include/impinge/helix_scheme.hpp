@@ -81,7 +81,8 @@ class HelixScheme : public SchemeImpl<HelixScheme> {
     } else {
       along(phi_b, nodes + 2, w + 2);
     }
-    u = (phi - phi_a) / (phi_b - phi_a);
+    const double span = phi_b - phi_a;  // 0 when a crossing falls exactly on the south pole
+    u = span > 0 ? (phi - phi_a) / span : 0;
     u = u < 0 ? 0 : (u > 1 ? 1 : u);
     w[0] *= 1 - u, w[1] *= 1 - u, w[2] *= u, w[3] *= u;
   }
