@@ -2,7 +2,8 @@
 //   build/benchmarks/impinge_bench [--benchmark_filter=...] [--benchmark_repetitions=N]
 // Subject: lhdl-ct from ../shared/data/hips when present (IMPINGE_BENCH_SUBJECT overrides the
 // folder), else the generated 12k hip model. Meshes and maps are built once.
-// Precision index: 0 = 1 deg, 1 = 0.5, 2 = 0.1, 3 = 0.05.
+// Scheme index: 0-3 equiangular at p = 1, 0.5, 0.1, 0.05 deg; 4-7 helix at the matched turns
+// k = 229, 458, 2292, 4584 (thesis Table 6).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include "impinge/generated_models.hpp"
 #include "impinge/mesh_io.hpp"
 #include "impinge/rasterize.hpp"
+#include "impinge/sampling.hpp"
 #include "impinge/sphere_fit.hpp"
 #include "impinge/subject.hpp"
 
@@ -23,6 +25,10 @@ using namespace impinge;
 
 namespace {
 const double kPrecisions[] = {1.0, 0.5, 0.1, 0.05};
+const double kTurns[] = {229, 458, 2292, 4584};
+std::shared_ptr<const SamplingScheme> scheme_of(int index) {
+  return index < 4 ? make_scheme("equiangular", kPrecisions[index]) : make_scheme("helix", kTurns[index - 4]);
+}
 
 struct Scene {
   std::string name;
@@ -70,9 +76,12 @@ const Built& built(int pi, DistanceMode mode) {
   auto& b = cache[{pi, int(mode)}];
   if (!b) {
     const Scene& s = scene();
-    const double p = kPrecisions[pi];
-    b = std::make_unique<Built>(Built{rasterize_map(s.femur, s.cor, p, mode), rasterize_map(s.pelvis, s.cor, p, mode),
-                                      {}, {}});
+    const auto scheme = scheme_of(pi);
+    b = std::make_unique<Built>(Built{RadialDistanceMap(scheme), RadialDistanceMap(scheme), {}, {}});
+    SamplingOptions o;
+    o.mode = mode;
+    sample_surface(s.femur, s.cor, o, b->femur_map);
+    sample_surface(s.pelvis, s.cor, o, b->pelvis_map);
     b->femur_mask = first_surface_mask(s.femur_rel, b->femur_map, 1.0, 1e30);
     b->pelvis_mask = first_surface_mask(s.pelvis_rel, b->pelvis_map, 1.0, 1e30);
   }
@@ -109,6 +118,19 @@ void BM_FillMap(benchmark::State& st) {
 }
 BENCHMARK(BM_FillMap)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Accelerated helix sampling (thesis sec. 4.2.2): rasterise the matched equiangular map,
+// resample it at the helix points, release it. args: body, turns index (229, 458, 2292, 4584).
+void BM_HelixSample(benchmark::State& st) {
+  const Scene& s = scene();
+  const TriangleMesh& m = st.range(0) == 0 ? s.femur : s.pelvis;
+  RadialDistanceMap map(scheme_of(4 + int(st.range(1))));
+  SamplingOptions o;
+  for (auto _ : st) benchmark::DoNotOptimize(sample_surface(m, s.cor, o, map));
+  st.SetLabel(s.name + (st.range(0) == 0 ? " femur" : " pelvis") + " exact, k=" + std::to_string(int(kTurns[st.range(1)])));
+  st.counters["nodes"] = double(map.num_nodes());
+}
+BENCHMARK(BM_HelixSample)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->UseRealTime();
+
 // One scan (args: 0 = femur vertices against the pelvis map, 1 = pelvis against femur;
 // precision index). Items = map look-ups (vertices on their first surface); ns per item.
 void BM_Query(benchmark::State& st) {
@@ -126,13 +148,12 @@ void BM_Query(benchmark::State& st) {
   }
   const auto lookups = std::count(mask.begin(), mask.end(), std::uint8_t{1});
   st.SetItemsProcessed(st.iterations() * lookups);
-  st.counters["ns_per_lookup"] = benchmark::Counter(double(lookups), benchmark::Counter::kIsIterationInvariantRate |
-                                                                         benchmark::Counter::kInvert);
   st.counters["ns_per_lookup"] = benchmark::Counter(
       double(lookups) * double(st.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  st.SetLabel(s.name + (ball ? " femur vs pelvis map" : " pelvis vs femur map"));
+  st.SetLabel(s.name + (ball ? " femur vs pelvis map, " : " pelvis vs femur map, ") + other.scheme().name() + " " +
+              std::to_string(other.scheme().resolution()));
 }
-BENCHMARK(BM_Query)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_Query)->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}})->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");

@@ -22,14 +22,14 @@ HelixArcLength::HelixArcLength(double turns) : k_(turns) {
   m_ = 4 * k_ * k_;
   total_ = 2 * quarter(kPi / 2);
   cap_ = std::min(kPi / 2, 20.0 / k_);
+  intervals_ = kTableIntervals;
   h_ = kPi / kTableIntervals;
   inv_h_ = 1 / h_;
-  c_.resize(kTableIntervals + 1);
-  dc_.resize(kTableIntervals + 1);
+  s_.resize(kTableIntervals + 1);
+  ds_.resize(kTableIntervals + 1);
   for (int j = 0; j <= kTableIntervals; ++j) {
-    const double phi = j * h_;
-    c_[j] = exact(phi) - 2 * k_ * (1 - std::cos(phi));
-    dc_[j] = derivative(phi) - 2 * k_ * std::sin(phi);
+    s_[j] = exact(j * h_);
+    ds_[j] = derivative(j * h_);
   }
 }
 
@@ -56,21 +56,12 @@ double HelixArcLength::derivative(double phi) const {
   return std::sqrt(1 + m_ * s * s);
 }
 
-double HelixArcLength::operator()(double phi) const {
-  if (phi < cap_ || phi > kPi - cap_) return exact(std::clamp(phi, 0.0, kPi));
-  const double f = phi * inv_h_;
-  int j = static_cast<int>(f);
-  if (j >= kTableIntervals) j = kTableIntervals - 1;
-  const double t = f - j, t2 = t * t, t3 = t2 * t;
-  const double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + t, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
-  const double c = h00 * c_[j] + h10 * h_ * dc_[j] + h01 * c_[j + 1] + h11 * h_ * dc_[j + 1];
-  return 2 * k_ * (1 - std::cos(phi)) + c;
-}
-
 double HelixArcLength::inverse(double s, double guess) const {
   double phi = std::clamp(guess, 0.0, kPi);
   for (int it = 0; it < 60; ++it) {
-    const double step = ((*this)(phi)-s) / derivative(phi);
+    double v, dv;
+    value_and_derivative(phi, v, dv);
+    const double step = (v - s) / dv;
     phi = std::clamp(phi - step, 0.0, kPi);
     if (std::abs(step) < 1e-15) break;
   }

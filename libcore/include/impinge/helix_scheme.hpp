@@ -88,6 +88,8 @@ class HelixScheme : public SchemeImpl<HelixScheme> {
   }
 
  private:
+  /// Polar angle of node i by Newton from `guess` (radians; <= 0 for a closed-form start).
+  double phi_of_node(std::int64_t i, double guess) const;
   /// The two nodes bracketing the helix point at phi along the curve, with linear weights.
   void along(double phi, std::int64_t* nodes, double* w) const {
     const double f = steps_at(phi);
