@@ -1,34 +1,70 @@
-"""01_lut_memory: thesis Table 2 beside the formula and the measured allocation.
+"""01_lut_memory: thesis Tables 2, 6, 7 and Fig. 49's counts beside the formula and the
+measured allocation; node density against latitude for both schemes.
 
-Reads RESULTS/01_lut_memory/lut_memory.csv; writes table.tex and memory.pdf/png."""
-import numpy as np
+Reads RESULTS/01_lut_memory/{lut_memory,helix_match,density}.csv; writes table.tex,
+table_helix.tex, table_match.tex, memory.pdf/png, density.pdf/png, macros.tex."""
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, read_csv, save, write_table
+from common import experiment_dir, read_csv, save, write_macros, write_table
 
 d = experiment_dir("01_lut_memory")
 df = read_csv(d, "lut_memory.csv")
+match = read_csv(d, "helix_match.csv")
+dens = read_csv(d, "density.csv")
 MiB = 1024.0 * 1024.0
 
-rows = []
-for p, g in df.groupby("precision_deg", sort=False):
-    dbl = g[g.storage == "double"].iloc[0]
-    flt = g[g.storage == "float"].iloc[0]
-    rows.append([f"{p:g}", f"{int(dbl.nodes):,}", f"{int(dbl.thesis_nodes):,}", f"{dbl.thesis_memory_mb:g}",
-                 f"{dbl.bytes_formula / MiB:.3f}", f"{dbl.bytes_allocated / MiB:.3f}",
-                 f"{flt.bytes_allocated / MiB:.3f}", f"{dbl.rss_growth_bytes / MiB:.3f}"])
-write_table(d, "table", ["$p$ (deg)", "nodes", "thesis nodes", "thesis MB", "formula MiB (double)",
-                         "allocated MiB (double)", "allocated MiB (float)", "RSS growth MiB (double)"], rows)
 
-fig, ax = plt.subplots(figsize=(5, 3.4))
-for storage, marker in (("double", "o"), ("float", "s")):
-    g = df[df.storage == storage]
-    ax.loglog(g.precision_deg, g.bytes_allocated / MiB, marker=marker, label=f"impinge, {storage} (allocated)")
-g = df[df.storage == "double"]
-ax.loglog(g.precision_deg, g.thesis_memory_mb, "k+", markersize=12, label="thesis Table 2 (double)")
-ax.set_xlabel("precision p (deg)")
-ax.set_ylabel("map memory (MiB)")
+def rows_for(scheme):
+    rows = []
+    for p, g in df[df.scheme == scheme].groupby("matched_precision_deg", sort=False):
+        dbl = g[g.storage == "double"].iloc[0]
+        flt = g[g.storage == "float"].iloc[0]
+        res = f"{p:g}" if scheme == "equiangular" else f"{int(dbl.resolution)}"
+        rows.append([res, f"{int(dbl.nodes):,}", f"{int(dbl.thesis_nodes):,}", f"{dbl.thesis_memory_mb:g}",
+                     f"{dbl.bytes_formula / MiB:.3f}", f"{dbl.bytes_allocated / MiB:.3f}",
+                     f"{flt.bytes_allocated / MiB:.3f}", f"{dbl.rss_growth_bytes / MiB:.3f}"])
+    return rows
+
+
+hdr = ["nodes", "thesis nodes", "thesis MB", "formula MiB (double)", "allocated MiB (double)",
+       "allocated MiB (float)", "RSS growth MiB (double)"]
+write_table(d, "table", ["$p$ (deg)"] + hdr, rows_for("equiangular"))
+write_table(d, "table_helix", ["$k$"] + hdr, rows_for("helix"))
+write_table(d, "table_match", ["$p$ (deg)", "grid equator nodes", "$k$", "thesis $k$", "helix spacing (deg)",
+                               "helix equator nodes", "thesis", "$w = k^2$", "grid nodes", "$w$ / grid"],
+            [[f"{r.precision_deg:g}", f"{int(r.equiangular_equator_nodes):,}", f"{int(r.turns):,}",
+              f"{int(r.thesis_turns):,}", f"{r.helix_node_spacing_deg:.5f}", f"{r.helix_equator_nodes:.1f}",
+              f"{int(r.thesis_helix_equator_nodes):,}", f"{int(r.helix_nodes):,}", f"{int(r.equiangular_nodes):,}",
+              f"{r.node_ratio:.4f}"] for r in match.itertuples()])
+
+fig, ax = plt.subplots(figsize=(5.5, 3.6))
+for scheme, marker in (("equiangular", "o"), ("helix", "^")):
+    for storage, ls in (("double", "-"), ("float", "--")):
+        g = df[(df.scheme == scheme) & (df.storage == storage)]
+        ax.loglog(g.matched_precision_deg, g.bytes_allocated / MiB, ls, marker=marker, label=f"{scheme}, {storage}")
+for scheme, c in (("equiangular", "k"), ("helix", "r")):
+    g = df[(df.scheme == scheme) & (df.storage == "double")]
+    ax.loglog(g.matched_precision_deg, g.thesis_memory_mb, c + "+", markersize=12, label=f"thesis, {scheme}")
+ax.set_xlabel("precision p (deg; helix at the matched k)")
+ax.set_ylabel("map memory allocated (MiB)")
 ax.invert_xaxis()
 ax.grid(True, which="both", alpha=0.3)
-ax.legend(fontsize=8)
+ax.legend(fontsize=7)
 save(fig, d, "memory")
+
+fig, ax = plt.subplots(figsize=(5.5, 3.2))
+for (scheme, res), g in dens.groupby(["scheme", "resolution"], sort=False):
+    ax.semilogy((g.phi_low_deg + g.phi_high_deg) / 2, g.nodes_per_sr, label=f"{scheme} ({res:g})")
+ax.set_xlabel("polar angle phi (deg)")
+ax.set_ylabel("nodes per steradian")
+ax.grid(True, alpha=0.3)
+ax.legend(fontsize=8)
+save(fig, d, "density")
+
+eq1 = df[(df.scheme == "equiangular") & (df.matched_precision_deg == 1)].iloc[0]
+hx1 = df[(df.scheme == "helix") & (df.matched_precision_deg == 1)].iloc[0]
+fine = match.iloc[-1]
+write_macros(d, "macros", {
+    "LMeqOne": f"{int(eq1.nodes):,}", "LMhxOne": f"{int(hx1.nodes):,}",
+    "LMratioFine": f"{fine.node_ratio:.4f}", "LMkFine": f"{int(fine.turns):,}",
+})

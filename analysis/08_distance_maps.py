@@ -1,5 +1,5 @@
 """08_distance_maps: gap statistics on the real joints and the generated model, map images
-(thesis Fig. 31) and colour-mapped renders of both bones (Fig. 41-42).
+(thesis Fig. 31), colour-mapped renders of both bones (Fig. 41-42), RSID beside USID (Fig. 50).
 
 Reads RESULTS/08_distance_maps/gap_statistics.csv and vertex_gaps.csv; writes table_finest.tex,
 table_convergence.tex, min_gap.pdf, levels.pdf, render_<subject>.pdf, macros.tex."""
@@ -12,7 +12,9 @@ import matplotlib.pyplot as plt
 from common import experiment_dir, read_csv, save, write_macros, write_table
 
 d = experiment_dir("08_distance_maps")
-st = read_csv(d, "gap_statistics.csv")
+allst = read_csv(d, "gap_statistics.csv")
+st = allst[allst.scheme == "equiangular"]
+hx = allst[allst.scheme == "helix"]
 vg = read_csv(d, "vertex_gaps.csv")
 with open(os.path.join(d, "meta.json")) as f:
     meta = json.load(f)
@@ -107,6 +109,34 @@ for s in subjects:
         ax.view_init(elev=10, azim=0 if scan == "socket" else 180)  # lateral view of the acetabulum
         ax.set_axis_off()
     save(fig, d, f"render_{s}")
+
+# RSID beside USID (thesis Fig. 50): same precision (helix at the matched k), same mode.
+rows = []
+for s_ in subjects:
+    for (p, mode), g in hx[(hx.subject == s_) & (hx.scan == "ball")].groupby(["precision_deg", "mode"], sort=False):
+        h = g.iloc[0]
+        e = st[(st.subject == s_) & (st.scan == "ball") & (st.precision_deg == p) & (st["mode"] == mode)].iloc[0]
+        hs = hx[(hx.subject == s_) & (hx.scan == "socket") & (hx.precision_deg == p) & (hx["mode"] == mode)].iloc[0]
+        es = st[(st.subject == s_) & (st.scan == "socket") & (st.precision_deg == p) & (st["mode"] == mode)].iloc[0]
+        rows.append([s_, f"{p:g} / {int(h.resolution)}", mode, f"{e.min_gap_mm:.3f}", f"{h.min_gap_mm:.3f}",
+                     f"{h.vs_equiangular_p95_abs_mm:.4f}", f"{h.vs_equiangular_max_abs_mm:.2f}",
+                     f"{(e.sampling_ms + es.sampling_ms):.0f}", f"{(h.sampling_ms + hs.sampling_ms):.0f}",
+                     f"{e.detection_ns_per_lookup:.0f}", f"{h.detection_ns_per_lookup:.0f}",
+                     f"{h.map_bytes / e.map_bytes:.3f}"])
+write_table(d, "table_usid", ["subject", "$p$ / $k$", "mode", "RSID min", "USID min", "p95 $|\Delta|$",
+                              "max $|\Delta|$", "RSID ms", "USID ms", "RSID ns", "USID ns", "bytes ratio"], rows,
+            align="llrrrrrrrrrr")
+
+fig, ax = plt.subplots(figsize=(5.5, 3.2))
+for s_ in subjects:
+    g = hx[(hx.subject == s_) & (hx.scan == "ball") & (hx["mode"] == "exact")].sort_values("precision_deg")
+    ax.loglog(g.precision_deg, g.vs_equiangular_p95_abs_mm, marker="o", label=s_)
+ax.set_xlabel("precision p (deg; helix at matched k)")
+ax.set_ylabel("p95 |USID - RSID| ball gap (mm)")
+ax.invert_xaxis()
+ax.grid(True, which="both", alpha=0.3)
+ax.legend(fontsize=7)
+save(fig, d, "usid_vs_rsid")
 
 pen = st[(st.precision_deg == finest) & (st["mode"] == "exact") & (st.scan == "ball")]
 write_macros(d, "macros", {

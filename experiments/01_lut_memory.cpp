@@ -1,15 +1,21 @@
-// 01_lut_memory -- thesis Table 2: equiangular map size and memory, formula and measured.
+// 01_lut_memory -- thesis Tables 2, 6, 7 and Fig. 49's counts: map sizes and memory of RSID
+// (equiangular) and USID (helix), formula and measured; node density against latitude.
 //
-// Inputs: none. Outputs: OUT/01_lut_memory/lut_memory.csv, meta.json.
+// Inputs: none. Outputs: OUT/01_lut_memory/
+//   lut_memory.csv    one row per scheme x resolution x storage (float / double)
+//   helix_match.csv   Table 6: k matched to the equator's node count of each precision
+//   density.csv       nodes per steradian in 1-deg latitude bands, both schemes at 1 deg / k = 229
+//   meta.json
 // Command: build/experiments/exp_01_lut_memory --out results
-// For p = 1, 0.5, 0.1, 0.05 deg and float / double storage: node count by the formula
-// (180/p + 1)(360/p), bytes by the formula, bytes allocated by the map (capacity x size), and the
-// resident-set growth when the map is created (every node is written, so every page is touched).
-#include <fstream>
 #include <unistd.h>
 
+#include <fstream>
+
 #include "experiment_support.hpp"
+#include "impinge/equiangular_grid.hpp"
+#include "impinge/helix_scheme.hpp"
 #include "impinge/radial_distance_map.hpp"
+#include "impinge/spherical_frame.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;
@@ -23,42 +29,92 @@ long resident_bytes() {
 }
 
 template <typename Scalar>
-void measure(CsvWriter& csv, double p, std::int64_t thesis_nodes, double thesis_mb) {
-  const EquiangularGrid g(p);
-  const std::int64_t formula = (std::int64_t(std::llround(180 / p)) + 1) * std::int64_t(std::llround(360 / p));
+void measure(CsvWriter& csv, const std::shared_ptr<const SamplingScheme>& scheme, std::int64_t nodes_formula,
+             std::int64_t thesis_nodes, double thesis_mb, double matched_precision) {
   const long before = resident_bytes();
   std::size_t allocated = 0;
   long rss = 0;
   {
-    RadialDistanceMapT<Scalar> map(g);
+    RadialDistanceMapT<Scalar> map(scheme);
     allocated = map.bytes();
     rss = resident_bytes() - before;
   }
-  csv.row(p, sizeof(Scalar) == 4 ? "float" : "double", formula, g.num_nodes(), int(sizeof(Scalar)),
-          map_bytes_formula(formula, sizeof(Scalar)), std::int64_t(allocated), std::int64_t(rss),
-          double(allocated) / (1024.0 * 1024.0), thesis_nodes, thesis_mb);
+  csv.row(scheme->name(), scheme->resolution(), matched_precision, sizeof(Scalar) == 4 ? "float" : "double",
+          nodes_formula, scheme->num_nodes(), int(sizeof(Scalar)), map_bytes_formula(nodes_formula, sizeof(Scalar)),
+          std::int64_t(allocated), std::int64_t(rss), double(allocated) / (1024.0 * 1024.0), thesis_nodes, thesis_mb);
 }
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Args args = parse_args(argc, argv, "01_lut_memory: thesis Table 2, map sizes and memory");
+  const Args args = parse_args(argc, argv, "01_lut_memory: thesis Tables 2, 6, 7; map sizes and memory");
   const std::string dir = experiment_dir(args, "01_lut_memory");
   CsvWriter csv(dir + "/lut_memory.csv",
-                {"precision_deg", "storage", "nodes_formula", "nodes", "bytes_per_node", "bytes_formula",
-                 "bytes_allocated", "rss_growth_bytes", "memory_mib", "thesis_nodes", "thesis_memory_mb"});
-  // Thesis Table 2 (double storage): nodes and "MB" (the thesis' MB are MiB: 65,160 x 8 / 2^20 = 0.497).
+                {"scheme", "resolution", "matched_precision_deg", "storage", "nodes_formula", "nodes",
+                 "bytes_per_node", "bytes_formula", "bytes_allocated", "rss_growth_bytes", "memory_mib",
+                 "thesis_nodes", "thesis_memory_mb"});
+  CsvWriter match(dir + "/helix_match.csv",
+                  {"precision_deg", "equiangular_equator_nodes", "turns", "thesis_turns", "helix_node_spacing_deg",
+                   "helix_equator_nodes", "thesis_helix_equator_nodes", "helix_nodes", "equiangular_nodes",
+                   "node_ratio"});
+  // Thesis Table 2 (equiangular, double) and Tables 6-7 (helix, double). The thesis' "MB" are
+  // MiB: 65,160 x 8 / 2^20 = 0.497.
   const struct {
     double p;
     std::int64_t nodes;
     double mb;
-  } table2[] = {{1, 65160, 0.497}, {0.5, 259920, 1.98}, {0.1, 6483600, 49.5}, {0.05, 25927200, 197.8}};
-  int k = 0;
-  for (const auto& row : table2) {
-    progress("01_lut_memory", ++k, 4, "p=" + std::to_string(row.p));
-    measure<float>(csv, row.p, row.nodes, row.mb);
-    measure<double>(csv, row.p, row.nodes, row.mb);
+    double k;
+    std::int64_t helix_nodes;
+    double helix_mb;
+    std::int64_t helix_equator;
+  } thesis[] = {{1, 65160, 0.497, 229, 52441, 0.40, 360},
+                {0.5, 259920, 1.98, 458, 209764, 1.60, 720},
+                {0.1, 6483600, 49.5, 2292, 5253264, 40.07, 3601},
+                {0.05, 25927200, 197.8, 4584, 21013056, 160.32, 7201}};
+  int step = 0;
+  for (const auto& t : thesis) {
+    progress("01_lut_memory", ++step, 4, "p=" + std::to_string(t.p));
+    const std::int64_t n = std::llround(180 / t.p);
+    const std::int64_t eq_formula = (n + 1) * (2 * n);
+    // Table 6: the helix whose equator carries as many nodes as the grid's equator row (360/p):
+    // about pi k / 2 nodes per turn at the equator (spacing ~4/k), so k = round(720 / (pi p)).
+    const double k = std::round(2.0 * (360.0 / t.p) / kPi);
+    const auto eq = make_scheme("equiangular", t.p);
+    const auto hx = std::make_shared<HelixScheme>(k);
+    const double helix_equator = 2 * kPi / hx->node_spacing();
+    match.row(t.p, 2 * n, k, t.k, hx->node_spacing() * kRadToDeg, helix_equator, t.helix_equator, hx->num_nodes(),
+              eq->num_nodes(), double(hx->num_nodes()) / double(eq->num_nodes()));
+    measure<float>(csv, eq, eq_formula, t.nodes, t.mb, t.p);
+    measure<double>(csv, eq, eq_formula, t.nodes, t.mb, t.p);
+    const std::int64_t w = std::int64_t(k) * std::int64_t(k);
+    measure<float>(csv, hx, w, t.helix_nodes, t.helix_mb, t.p);
+    measure<double>(csv, hx, w, t.helix_nodes, t.helix_mb, t.p);
   }
-  write_meta(dir, args, {{"precisions_deg", {1, 0.5, 0.1, 0.05}}, {"storages", {"float", "double"}},
-                         {"thesis_source", "thesis Table 2 (sec. 3.4), double storage"}});
+  // Node density against latitude (Fig. 49 compares the two at 1 deg): nodes per steradian in
+  // 1-deg bands of phi.
+  {
+    CsvWriter dens(dir + "/density.csv", {"scheme", "resolution", "phi_low_deg", "phi_high_deg", "nodes",
+                                          "band_sr", "nodes_per_sr"});
+    const EquiangularGrid eq(1);
+    const HelixScheme hx(229);
+    for (const SamplingScheme* s : std::initializer_list<const SamplingScheme*>{&eq, &hx}) {
+      std::vector<std::int64_t> count(180, 0);
+      std::vector<double> phi(4096), theta(4096);
+      for (std::int64_t first = 0; first < s->num_nodes(); first += 4096) {
+        const std::int64_t c = std::min<std::int64_t>(4096, s->num_nodes() - first);
+        s->node_angles(first, c, phi.data(), theta.data());
+        for (std::int64_t j = 0; j < c; ++j)
+          ++count[std::min<std::size_t>(179, static_cast<std::size_t>(phi[j] * kRadToDeg))];
+      }
+      for (int b = 0; b < 180; ++b) {
+        const double sr = 2 * kPi * (std::cos(b * kDegToRad) - std::cos((b + 1) * kDegToRad));
+        dens.row(s->name(), s->resolution(), b, b + 1, count[b], sr, double(count[b]) / sr);
+      }
+    }
+  }
+  write_meta(dir, args,
+             {{"precisions_deg", {1, 0.5, 0.1, 0.05}}, {"turns", {229, 458, 2292, 4584}},
+              {"storages", {"float", "double"}},
+              {"thesis_source", "thesis Table 2 (sec. 3.4), Tables 6-7 and Fig. 49 (sec. 4.4), double storage"},
+              {"matching", "k = round(720 / (pi p)): helix equator nodes (2 pi / spacing) = 360 / p"}});
   return 0;
 }

@@ -1,4 +1,5 @@
-// 08_distance_maps -- thesis Fig. 31, 40-42: distance maps and gap statistics on real joints.
+// 08_distance_maps -- thesis Fig. 31, 40-42, 50: distance maps and gap statistics on real
+// joints, RSID (equiangular) and USID (helix at the matched number of turns) side by side.
 //
 // Inputs: every subject under --data (real hips) and the generated 3k hip model.
 // Outputs: OUT/08_distance_maps/
@@ -6,16 +7,21 @@
 //                       vertices are tested against the other body's map, while map_* and
 //                       sampling_ms describe the scanned body's own map; COR in the RAS frame
 //   vertex_gaps.csv     per-vertex gaps within 45 mm of the COR at the finest precision, exact mode
-//   map_<subject>_<body>.png  the maps at 0.5 deg (theta across, phi down)
+//   map_<subject>_<body>.png  the maps at 0.5 deg (theta across, phi down); *_helix.png at k = 458
 //   meta.json
 // Command: build/experiments/exp_08_distance_maps --out results --data ../shared/data/hips [--quick]
-// Precisions 1, 0.5, 0.1 and (outside quick mode) 0.05 deg; modes linear and exact; scan pose
-// (identity). Sampling and detection times are medians over the repetitions.
+// Precisions 1, 0.5, 0.1 and (outside quick mode) 0.05 deg, each with the helix of matched turns
+// k = round(720 / (pi p)) (thesis Table 6); modes linear and exact; scan pose (identity). Sampling
+// and detection times are medians over the repetitions. Helix rows also give the difference of
+// their gaps from the equiangular ones at the same precision and mode (thesis Fig. 50).
 #include <filesystem>
+#include <map>
 
 #include "experiment_support.hpp"
 #include "impinge/joint.hpp"
 #include "impinge/map_image.hpp"
+#include "impinge/sampling.hpp"
+#include "impinge/spherical_frame.hpp"
 #include "impinge/sphere_fit.hpp"
 
 using namespace impinge;
@@ -30,25 +36,41 @@ int main(int argc, char** argv) {
   const double finest = precisions.back();
 
   CsvWriter stats(dir + "/gap_statistics.csv",
-                  {"subject", "generated", "precision_deg", "mode", "scan", "cor_ras_x_mm", "cor_ras_y_mm", "cor_ras_z_mm",
+                  {"subject", "generated", "scheme", "resolution", "precision_deg", "mode", "scan", "cor_ras_x_mm", "cor_ras_y_mm", "cor_ras_z_mm",
                    "head_radius_mm", "sphere_fit_rms_mm", "cor_error_mm", "vertices", "vertices_tested",
                    "vertices_no_surface", "vertices_beyond_reach", "min_gap_mm", "vertices_penetrating",
                    "area_penetrating_mm2", "level_none", "level_yellow", "level_orange", "level_red",
                    "level_purple", "map_nodes", "map_nodes_covered", "map_bytes", "sampling_ms", "detection_ms",
-                   "detection_ns_per_lookup", "linear_vs_exact_p95_abs_mm"});
+                   "detection_ns_per_lookup", "linear_vs_exact_p95_abs_mm", "vs_equiangular_p95_abs_mm",
+                   "vs_equiangular_max_abs_mm", "vs_equiangular_compared"});
   CsvWriter vertices(dir + "/vertex_gaps.csv", {"subject", "scan", "vertex", "x_mm", "y_mm", "z_mm", "gap_mm"});
 
-  const int total = static_cast<int>(subjects.size() * precisions.size() * 2);
+  const int total = static_cast<int>(subjects.size() * precisions.size() * 4);
+  auto abs_diff = [](const std::vector<float>& a, const std::vector<float>& b) {
+    std::vector<double> d;
+    for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
+      if (std::isfinite(a[i]) && std::isfinite(b[i])) d.push_back(std::abs(double(a[i]) - b[i]));
+    std::sort(d.begin(), d.end());
+    return d;
+  };
+  auto quantile = [](const std::vector<double>& d, double q) {
+    return d.empty() ? std::nan("") : d[static_cast<std::size_t>(q * double(d.size() - 1))];
+  };
   int done = 0;
   for (const Subject& s : subjects) {
     const SphereFitResult fit = fit_femoral_head(s.femur);
     const double cor_error = s.generated ? (fit.centre - s.true_cor).norm() : std::nan("");
     for (double p : precisions) {
+     std::map<DistanceMode, std::vector<float>> rsid_ball;  // equiangular ball gaps per mode
+     const double k = std::round(720.0 / (kPi * p));
+     for (const auto& scheme : {make_scheme("equiangular", p), make_scheme("helix", k)}) {
+      const bool helix = scheme->name() != "equiangular";
       std::vector<float> exact_ball;  // exact-mode gaps, for the linear-vs-exact difference
       for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
-        progress("08_distance_maps", ++done, total, s.name + " p=" + std::to_string(p) + " " + to_string(mode));
+        progress("08_distance_maps", ++done, total,
+                 s.name + " " + scheme->name() + " " + std::to_string(scheme->resolution()) + " " + to_string(mode));
         JointOptions o;
-        o.scheme = make_scheme("equiangular", p);
+        o.scheme = scheme;
         o.mode = mode;
         const Joint joint(s.femur, s.pelvis, fit.centre, o);
         const PoseResult res = joint.detect(Eigen::Matrix3d::Identity());
@@ -57,11 +79,13 @@ int main(int argc, char** argv) {
         double sample_ms[2], detect_ms[2];
         const JointBody* bodies[2] = {&joint.ball(), &joint.socket()};
         for (int b = 0; b < 2; ++b) {
-          RadialDistanceMap scratch{EquiangularGrid(p)};
+          RadialDistanceMap scratch{scheme};
+          SamplingOptions so;
+          so.mode = mode;
           sample_ms[b] = median_ms(
               [&] {
                 std::fill(scratch.data(), scratch.data() + scratch.num_nodes(), RadialDistanceMap::no_surface());
-                rasterize(bodies[b]->mesh, fit.centre, mode, scratch);
+                sample_surface(bodies[b]->mesh, fit.centre, so, scratch);
               },
               reps);
         }
@@ -78,18 +102,19 @@ int main(int argc, char** argv) {
                         ScanSide::outside, scratch_gaps);
             },
             args.repetitions);
-        double p95 = std::nan("");
-        if (mode == DistanceMode::exact) {
+        double p95 = std::nan(""), vs_p95 = std::nan(""), vs_max = std::nan("");
+        std::int64_t vs_n = 0;
+        if (mode == DistanceMode::exact)
           exact_ball = res.ball_gaps.gap_mm;
+        else
+          p95 = quantile(abs_diff(exact_ball, res.ball_gaps.gap_mm), 0.95);
+        if (!helix) {
+          rsid_ball[mode] = res.ball_gaps.gap_mm;
         } else {
-          std::vector<double> diff;
-          for (std::size_t i = 0; i < exact_ball.size(); ++i)
-            if (std::isfinite(exact_ball[i]) && std::isfinite(res.ball_gaps.gap_mm[i]))
-              diff.push_back(std::abs(double(exact_ball[i]) - res.ball_gaps.gap_mm[i]));
-          if (!diff.empty()) {
-            std::sort(diff.begin(), diff.end());
-            p95 = diff[static_cast<std::size_t>(0.95 * double(diff.size() - 1))];
-          }
+          const std::vector<double> d = abs_diff(rsid_ball[mode], res.ball_gaps.gap_mm);
+          vs_p95 = quantile(d, 0.95);
+          vs_max = d.empty() ? std::nan("") : d.back();
+          vs_n = static_cast<std::int64_t>(d.size());
         }
         const ScanSummary* sums[2] = {&res.ball, &res.socket};
         for (int b = 0; b < 2; ++b) {
@@ -98,19 +123,22 @@ int main(int argc, char** argv) {
                     // per map look-up (tested + no surface); masked vertices cost one byte test each
           const std::int64_t lookups = sm.vertices_tested + sm.vertices_no_surface;
           const double ns = lookups > 0 ? detect_ms[b] * 1e6 / double(lookups) : std::nan("");
-          stats.row(s.name, int(s.generated), p, to_string(mode), b == 0 ? "ball" : "socket", fit.centre.x(),
+          stats.row(s.name, int(s.generated), scheme->name(), scheme->resolution(), p, to_string(mode),
+                    b == 0 ? "ball" : "socket", fit.centre.x(),
                     fit.centre.y(), fit.centre.z(), fit.radius, fit.rms_residual, cor_error, sm.vertices,
                     sm.vertices_tested, sm.vertices_no_surface, sm.vertices_beyond_reach, sm.min_gap_mm,
                     sm.vertices_penetrating, sm.area_penetrating_mm2, sm.level_vertices[0], sm.level_vertices[1],
                     sm.level_vertices[2], sm.level_vertices[3], sm.level_vertices[4], body.map.num_nodes(),
                     body.sampling.nodes_covered, std::int64_t(body.map.bytes()), sample_ms[b], detect_ms[b], ns,
-                    b == 0 ? p95 : std::nan(""));
+                    b == 0 ? p95 : std::nan(""), b == 0 ? vs_p95 : std::nan(""), b == 0 ? vs_max : std::nan(""),
+                    b == 0 ? vs_n : std::int64_t(0));
         }
         if (p == 0.5 && mode == DistanceMode::exact) {
-          write_map_png(dir + "/map_" + s.name + "_ball.png", joint.ball().map);
-          write_map_png(dir + "/map_" + s.name + "_socket.png", joint.socket().map);
+          const std::string suffix = helix ? "_helix.png" : ".png";
+          write_map_png(dir + "/map_" + s.name + "_ball" + suffix, joint.ball().map);
+          write_map_png(dir + "/map_" + s.name + "_socket" + suffix, joint.socket().map);
         }
-        if (p == finest && mode == DistanceMode::exact) {
+        if (p == finest && mode == DistanceMode::exact && !helix) {
           const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};
           for (int b = 0; b < 2; ++b)
             for (Eigen::Index i = 0; i < bodies[b]->relative.rows(); ++i) {
@@ -121,12 +149,14 @@ int main(int argc, char** argv) {
             }
         }
       }
+     }
     }
   }
   nlohmann::json subj = nlohmann::json::array();
   for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
   write_meta(dir, args,
-             {{"precisions_deg", precisions}, {"modes", {"exact", "linear"}}, {"pose_deg", {0, 0, 0}},
+             {{"precisions_deg", precisions}, {"helix_turns", "round(720 / (pi p)) for each precision p"},
+              {"modes", {"exact", "linear"}}, {"pose_deg", {0, 0, 0}},
               {"subjects", subj}, {"cor", "fit_femoral_head defaults (RANSAC + geometric sphere fit)"},
               {"vertex_gaps_region_mm", 45}, {"occlusion_tolerance_mm", JointOptions{}.occlusion_tolerance_mm},
               {"levels_thresholds_mm", ImpingementLevels{}.thresholds_mm}});

@@ -1,0 +1,77 @@
+// 07_helix_arc_length -- thesis Eq. 10 (the fitted "traveled distance") against the exact arc
+// length of the k-turn spherical helix (an elliptic integral of the second kind).
+//
+// Inputs: none. Outputs: OUT/07_helix_arc_length/
+//   arc_length.csv    per k and phi (0.1-deg steps): exact s, Eq. 10's T, their absolute and
+//                     relative difference, and the difference in node steps used for locating
+//   index_errors.csv  per k: how often locating with Eq. 10 picks other stencil nodes than the
+//                     exact arc length, over random directions, and by how many nodes at most
+//   meta.json
+// Command: build/experiments/exp_07_helix_arc_length --out results [--quick]
+#include <random>
+
+#include "experiment_support.hpp"
+#include "impinge/helix_scheme.hpp"
+#include "impinge/spherical_frame.hpp"
+
+using namespace impinge;
+using namespace impinge::experiment;
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv, "07_helix_arc_length: thesis Eq. 10 against the exact arc length");
+  const std::string dir = experiment_dir(args, "07_helix_arc_length");
+  const std::vector<double> turns{10, 40, 229, 458, 2292, 4584};
+  const int directions = args.quick ? 50000 : 400000;
+  CsvWriter arc(dir + "/arc_length.csv", {"turns", "phi_deg", "s_exact", "t_eq10", "abs_error", "rel_error",
+                                          "steps_exact", "steps_eq10", "index_error_steps"});
+  CsvWriter idx(dir + "/index_errors.csv",
+                {"turns", "nodes", "node_spacing_deg", "total_length_exact", "total_length_eq10", "directions",
+                 "stencils_differing", "fraction_differing", "nearest_node_differing", "fraction_nearest_differing",
+                 "max_node_index_difference", "max_abs_index_error_steps", "exact_ns_per_locate",
+                 "eq10_ns_per_locate"});
+  int step = 0;
+  for (double k : turns) {
+    progress("07_helix_arc_length", ++step, int(turns.size()), "k=" + std::to_string(int(k)));
+    const HelixScheme exact(k), fitted(k, TraveledDistance::fitted);
+    const HelixArcLength& s = exact.arc_length();
+    double max_steps = 0;
+    for (int j = 0; j <= 1800; ++j) {
+      const double phi = j * 0.1 * kDegToRad;
+      const double se = s.exact(phi), t10 = traveled_distance_eq10(k, std::cos(phi));
+      const double steps_e = exact.steps_at(phi), steps_f = fitted.steps_at(phi);
+      max_steps = std::max(max_steps, std::abs(steps_f - steps_e));
+      arc.row(k, j * 0.1, se, t10, t10 - se, j > 0 ? (t10 - se) / se : std::nan(""), steps_e, steps_f,
+              steps_f - steps_e);
+    }
+    std::mt19937_64 rng(1234);
+    std::uniform_real_distribution<double> U(0, 1);
+    std::vector<Eigen::Vector3d> dirs(static_cast<std::size_t>(directions));
+    for (auto& u : dirs) u = direction(std::acos(2 * U(rng) - 1), 2 * kPi * U(rng));
+    std::int64_t differ = 0, nearest_differ = 0, max_diff = 0;
+    for (const auto& u : dirs) {
+      const Stencil a = exact.interpolate(u), b = fitted.interpolate(u);
+      if (a.nodes != b.nodes) ++differ;
+      for (int j = 0; j < 4; ++j) max_diff = std::max<std::int64_t>(max_diff, std::abs(a.nodes[j] - b.nodes[j]));
+      if (exact.node(u) != fitted.node(u)) ++nearest_differ;
+    }
+    // Locate cost (stencil only), medians.
+    std::vector<double> pts(3 * dirs.size()), out(dirs.size());
+    for (std::size_t j = 0; j < dirs.size(); ++j)
+      for (int c = 0; c < 3; ++c) pts[3 * j + c] = dirs[j][c];
+    std::vector<float> values(static_cast<std::size_t>(exact.num_nodes()), 1.0f);
+    const auto n = static_cast<std::int64_t>(dirs.size());
+    const double t_exact = median_ms([&] { exact.interpolate_many(values.data(), pts.data(), n, out.data()); },
+                                     args.repetitions);
+    const double t_fit = median_ms([&] { fitted.interpolate_many(values.data(), pts.data(), n, out.data()); },
+                                   args.repetitions);
+    idx.row(k, exact.num_nodes(), exact.node_spacing() * kRadToDeg, s.total(), traveled_distance_eq10(k, -1.0),
+            directions, differ, double(differ) / directions, nearest_differ, double(nearest_differ) / directions,
+            max_diff, max_steps, t_exact * 1e6 / directions, t_fit * 1e6 / directions);
+  }
+  write_meta(dir, args,
+             {{"turns", turns}, {"directions", directions}, {"phi_step_deg", 0.1},
+              {"exact", "Carlson symmetric form of the incomplete elliptic integral E(phi | -4k^2) (GSL)"},
+              {"eq10", "T = (4k + 1)(1 - cos phi) / 2 (thesis Eq. 10); for locating scaled to w - 1 steps"},
+              {"directions_distribution", "uniform on the sphere, seed 1234"}});
+  return 0;
+}
