@@ -54,8 +54,9 @@ TEST(Detection, ConcentricBallAndCupGiveRadiusDifference) {
       }
       EXPECT_GT(tested, 1000);
       for (std::size_t i = 0; i < r.socket_gaps.gap_mm.size(); ++i)
-        if (r.socket_gaps.status[i] == ScanGaps::tested)
+        if (r.socket_gaps.status[i] == ScanGaps::tested) {
           ASSERT_NEAR(r.socket_gaps.gap_mm[i], rc - rb, bound) << "socket vertex " << i;
+        }
       // the cup's outer shell is hidden behind its inner shell: skipped, not a 5 mm-farther gap
       EXPECT_GT(r.socket.vertices_beyond_reach, 1000);
       EXPECT_EQ(r.ball.vertices_penetrating, 0);
@@ -88,8 +89,9 @@ TEST(Detection, MovingBothBodiesTogetherLeavesGapsUnchanged) {
     EXPECT_NEAR(a.ball_gaps.gap_mm[i], b.ball_gaps.gap_mm[i], 1e-4) << i;
   }
   for (std::size_t i = 0; i < a.socket_gaps.gap_mm.size(); ++i)
-    if (a.socket_gaps.status[i] == ScanGaps::tested)
+    if (a.socket_gaps.status[i] == ScanGaps::tested) {
       EXPECT_NEAR(a.socket_gaps.gap_mm[i], b.socket_gaps.gap_mm[i], 1e-4) << i;
+    }
   EXPECT_GT(compared, 100);
 }
 

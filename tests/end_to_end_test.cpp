@@ -177,7 +177,9 @@ TEST_P(SchemesAgree, HelixAndEquiangularGapsAgree) {
     std::cout << GetParam() << " " << body << ": " << diff.size() << " vertices, p95 |helix - equiangular| = " << p95
               << " mm, max " << diff.back() << " mm\n";
     EXPECT_LE(p95, 0.05) << body;
-    if (GetParam() == "generated") EXPECT_LE(diff.back(), 0.02) << body;
+    if (GetParam() == "generated") {
+      EXPECT_LE(diff.back(), 0.02) << body;
+    }
   }
 }
 

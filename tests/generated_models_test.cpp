@@ -2,6 +2,7 @@
 // the target, the head sphere and cup concentric about the true COR.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 
 #include "impinge/generated_models.hpp"
@@ -37,4 +38,18 @@ TEST(GeneratedModels, ClosedAtThesisTriangleLevels) {
       min_socket = std::min(min_socket, (h.socket.V.row(i).transpose() - h.cor).norm());
     EXPECT_NEAR(min_socket, o.head_radius_mm + o.cartilage_gap_mm, 1e-9);
   }
+}
+
+TEST(GeneratedModels, SlicedSphereAndConchoidAreClosedAndStarShaped) {
+  const TriangleMesh st = make_sliced_sphere(22, 1.25, Eigen::Vector3d(1, 2, 3), 96);
+  EXPECT_TRUE(closed(st));
+  // a staircase stays within one slice thickness of the sphere, and its rings lie on slice
+  // boundaries z = c.z + k * 1.25
+  for (Eigen::Index i = 0; i < st.V.rows(); ++i) {
+    const Eigen::Vector3d d = st.V.row(i).transpose() - Eigen::Vector3d(1, 2, 3);
+    EXPECT_LE(std::abs(d.norm() - 22), 1.25);
+    EXPECT_NEAR(d.z() / 1.25, std::round(d.z() / 1.25), 1e-9);
+  }
+  const TriangleMesh c = make_conchoid_surface(20.501, 17.843, Eigen::Vector3d::Zero(), 64, 32);
+  EXPECT_TRUE(closed(c));
 }

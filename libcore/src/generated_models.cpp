@@ -107,6 +107,78 @@ TriangleMesh make_cup(double inner_mm, double outer_mm, double coverage_deg, con
   return m;
 }
 
+TriangleMesh make_sliced_sphere(double radius_mm, double slice_mm, const Eigen::Vector3d& centre, int segments) {
+  require(radius_mm > 0 && slice_mm > 0 && slice_mm <= radius_mm && segments >= 3,
+          "sliced sphere: need 0 < slice <= radius and segments >= 3");
+  // Slice k covers [k t, (k+1) t] for k = -n..n-1; keep those whose mid height is inside.
+  const int n = static_cast<int>(std::ceil(radius_mm / slice_mm));
+  std::vector<std::pair<double, double>> z_band;  // (z_lo, z_hi) of kept slices, bottom to top
+  std::vector<double> rho;
+  for (int k = -n; k < n; ++k) {
+    const double zm = (k + 0.5) * slice_mm;
+    if (std::abs(zm) >= radius_mm) continue;
+    z_band.emplace_back(k * slice_mm, (k + 1) * slice_mm);
+    rho.push_back(std::sqrt(radius_mm * radius_mm - zm * zm));
+  }
+  TriangleMesh m;
+  m.source = "generated sliced sphere";
+  std::vector<Eigen::Vector3d> V;
+  std::vector<Eigen::Vector3i> F;
+  auto ring = [&](double z, double r) {
+    const int first = static_cast<int>(V.size());
+    for (int j = 0; j < segments; ++j) {
+      const double a = 2 * kPi * j / segments;
+      V.push_back(centre + Eigen::Vector3d(r * std::cos(a), r * std::sin(a), z));
+    }
+    return first;
+  };
+  auto band = [&](int lo, int hi, bool outward_up) {  // quads between two rings
+    for (int j = 0; j < segments; ++j) {
+      const int j1 = (j + 1) % segments;
+      if (outward_up) {
+        F.push_back({lo + j, lo + j1, hi + j1});
+        F.push_back({lo + j, hi + j1, hi + j});
+      } else {
+        F.push_back({lo + j, hi + j1, lo + j1});
+        F.push_back({lo + j, hi + j, hi + j1});
+      }
+    }
+  };
+  const int bottom_c = static_cast<int>(V.size());
+  V.push_back(centre + Eigen::Vector3d(0, 0, z_band.front().first));
+  int prev_top = -1;
+  for (std::size_t k = 0; k < z_band.size(); ++k) {
+    const int lo = ring(z_band[k].first, rho[k]);
+    const int hi = ring(z_band[k].second, rho[k]);
+    if (k == 0) {
+      for (int j = 0; j < segments; ++j) F.push_back({bottom_c, lo + (j + 1) % segments, lo + j});
+    } else {
+      band(prev_top, lo, rho[k] > rho[k - 1]);  // flat step between slices
+    }
+    band(lo, hi, true);
+    prev_top = hi;
+  }
+  const int top_c = static_cast<int>(V.size());
+  V.push_back(centre + Eigen::Vector3d(0, 0, z_band.back().second));
+  for (int j = 0; j < segments; ++j) F.push_back({top_c, prev_top + j, prev_top + (j + 1) % segments});
+  m.V.resize(static_cast<Eigen::Index>(V.size()), 3);
+  for (std::size_t i = 0; i < V.size(); ++i) m.V.row(static_cast<Eigen::Index>(i)) = V[i].transpose();
+  m.F.resize(static_cast<Eigen::Index>(F.size()), 3);
+  for (std::size_t i = 0; i < F.size(); ++i) m.F.row(static_cast<Eigen::Index>(i)) = F[i].transpose();
+  return m;
+}
+
+TriangleMesh make_conchoid_surface(double a_mm, double b_mm, const Eigen::Vector3d& origin, int n_theta, int n_phi,
+                                   const Eigen::Vector3d& axis) {
+  require(a_mm > b_mm && b_mm >= 0, "conchoid surface: need a > b >= 0");
+  const Eigen::Vector3d ax = axis.normalized();
+  TriangleMesh m = make_radial_surface(
+      [&](const Eigen::Vector3d& u) { return a_mm + b_mm * std::clamp(u.dot(ax), -1.0, 1.0); }, origin, n_theta,
+      n_phi, ax);
+  m.source = "generated conchoid surface";
+  return m;
+}
+
 HipModel make_hip_model(const HipModelOptions& o) {
   require(o.target_triangles >= 50, "hip model: target_triangles must be >= 50");
   require(o.neck_radius_mm < o.head_radius_mm && o.neck_length_mm > o.head_radius_mm,

@@ -1,6 +1,7 @@
 // The registry of sampling schemes: one line per scheme.
 #include <functional>
 
+#include "impinge/conchoid_grid.hpp"
 #include "impinge/equiangular_grid.hpp"
 #include "impinge/error.hpp"
 #include "impinge/helix_scheme.hpp"
@@ -18,6 +19,8 @@ const std::vector<Entry>& registry() {
   static const std::vector<Entry> entries{
       {"equiangular", "precision_deg", [](double p) { return std::make_shared<EquiangularGrid>(p); }},
       {"helix", "turns", [](double k) { return std::make_shared<HelixScheme>(k); }},
+      {"helix-eq10", "turns", [](double k) { return std::make_shared<HelixScheme>(k, TraveledDistance::fitted); }},
+      {"conchoid", "precision_deg", [](double p) { return std::make_shared<ConchoidGrid>(p); }},
   };
   return entries;
 }

@@ -27,6 +27,18 @@ TriangleMesh make_radial_surface(const std::function<double(const Eigen::Vector3
 TriangleMesh make_cup(double inner_mm, double outer_mm, double coverage_deg, const Eigen::Vector3d& centre,
                       const Eigen::Vector3d& axis, int n_beta, int n_alpha);
 
+/// Closed staircase sphere as a segmentation of CT slices gives (thesis sec. 3.5.2): slices of
+/// thickness `slice_mm` with boundaries at z = centre.z + i slice_mm (the middle plane is a
+/// boundary); each slice is a cylinder of the sphere's cross-section radius at the slice's mid
+/// height (slices whose mid height is outside the sphere are empty), joined by flat steps and
+/// capped by disks; `segments` around. Star-shaped about `centre`.
+TriangleMesh make_sliced_sphere(double radius_mm, double slice_mm, const Eigen::Vector3d& centre, int segments);
+
+/// Closed surface of revolution of Menschik's conchoid r(phi) = a + b cos(phi) about `axis`
+/// through `origin` (the conchoid's origin; thesis sec. 5.1, Fig. 54), as a radial surface.
+TriangleMesh make_conchoid_surface(double a_mm, double b_mm, const Eigen::Vector3d& origin, int n_theta, int n_phi,
+                                   const Eigen::Vector3d& axis = Eigen::Vector3d::UnitZ());
+
 /// Options of a generated hip (right side, anatomical RAS frame).
 struct HipModelOptions {
   int target_triangles = 3000;        ///< per model (thesis levels 300, 1k, 3k, 12k)
