@@ -36,8 +36,8 @@ write_table(d, "table", ["$k$", "nodes", "exact $L$", "Eq. 10 $L$", "max index e
                          "stencils differing", "nearest node differing", "max node diff",
                          "ns/locate exact", "ns/locate Eq. 10"],
             [[f"{int(r.turns)}", f"{int(r.nodes):,}", f"{r.total_length_exact:.6f}", f"{r.total_length_eq10:.1f}",
-              f"{r.max_abs_index_error_steps:.3f}", f"{100 * r.fraction_differing:.2f}\\%",
-              f"{100 * r.fraction_nearest_differing:.2f}\\%", f"{int(r.max_node_index_difference)}",
+              f"{r.max_abs_index_error_steps:.3f}", f"{100 * r.fraction_differing:.2f}%",
+              f"{100 * r.fraction_nearest_differing:.2f}%", f"{int(r.max_node_index_difference)}",
               f"{r.exact_ns_per_locate:.0f}", f"{r.eq10_ns_per_locate:.0f}"] for r in idx.itertuples()])
 big = idx.iloc[-1]
 write_macros(d, "macros", {

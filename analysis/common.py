@@ -36,7 +36,9 @@ def save(fig, d, stem):
 
 
 def latex_escape(s):
-    return str(s).replace("_", r"\_").replace("%", r"\%").replace("&", r"\&")
+    """Escape a table cell (cells are plain text; headers are LaTeX and are not escaped)."""
+    return (str(s).replace("\\", r"\textbackslash{}").replace("_", r"\_").replace("%", r"\%")
+            .replace("&", r"\&").replace("^", r"\textasciicircum{}").replace("#", r"\#"))
 
 
 def write_table(d, stem, header, rows, align=None):

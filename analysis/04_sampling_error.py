@@ -1,0 +1,90 @@
+"""04_sampling_error: thesis Table 5 and Eq. 7 reproduced; (a) nearest-sample distance and
+(b) radial error after interpolation measured against exact references, with the bound.
+
+Reads RESULTS/04_sampling_error/{table5,covering,radial_error}.csv; writes table5.tex,
+table_covering.tex, table_radial.tex, radial.pdf/png, covering.pdf/png, macros.tex."""
+import matplotlib.pyplot as plt
+import numpy as np
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+
+d = experiment_dir("04_sampling_error")
+t5 = read_csv(d, "table5.csv")
+cov = read_csv(d, "covering.csv")
+rad = read_csv(d, "radial_error.csv")
+
+write_table(d, "table5", ["$p$ (deg)", "$N$", "Eq. 7 (mm)", "thesis (mm)", "Eq. 8 (\\%)", "thesis (\\%)"],
+            [[f"{r.precision_deg:g}", f"{int(r.equator_nodes)}", f"{r.eq7_mm:.4f}", f"{r.thesis_eq7_mm:.3f}",
+              f"{r.eq8_percent:.3f}", f"{r.thesis_eq8_percent:.2f}"] for r in t5.itertuples()])
+
+# (a): worst cap per shape x scheme x resolution, ratio to Eq. 7 with the local radius
+rows = []
+for (shape, scheme, res), g in cov.groupby(["shape", "scheme", "resolution"], sort=False):
+    w = g.loc[(g.max_nearest_mm / g.eq7_mm).idxmax()]
+    rows.append([shape, scheme, f"{res:g}", f"{g.max_nearest_mm.max():.4f}", f"{w.eq7_mm:.4f}",
+                 f"{(g.max_nearest_mm / g.eq7_mm).max():.3f}", f"{w.cap_phi_deg:.0f}"])
+write_table(d, "table_covering", ["shape", "scheme", "res.", "max nearest (mm)", "Eq. 7 (mm)", "max ratio",
+                                  "at cap phi (deg)"], rows, align="lllrrrr")
+
+# (b): radial error statistics beside Eq. 7 and the bound
+rows = []
+for r in rad.itertuples():
+    bound = "" if np.isnan(r.bound_mm) else f"{r.bound_mm:.2e}"
+    within = f"{100 * r.fraction_within_bound:.2f}" if not np.isnan(r.fraction_within_bound) else (
+        f"{100 * r.fraction_within_local_bound:.1f} (local)" if not np.isnan(r.fraction_within_local_bound) else "")
+    rows.append([r.shape, r.scheme, r.mode, f"{r.resolution:g}", f"{r.max_mm:.2e}", f"{r.p95_mm:.2e}",
+                 f"{r.median_mm:.2e}", f"{r.eq7_mm:.3f}", bound, within])
+write_table(d, "table_radial", ["shape", "scheme", "mode", "res.", "max (mm)", "p95 (mm)", "median (mm)",
+                                "Eq. 7 (mm)", "bound (mm)", "within bound (\\%)"], rows, align="llllrrrrrr")
+
+shapes = list(dict.fromkeys(rad["shape"]))
+fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), sharey=True)
+for ax, stat in zip(axes, ("max_mm", "p95_mm")):
+    for shape in shapes:
+        for (scheme, mode), ls in ((("equiangular", "exact"), "-"), (("equiangular", "linear"), ":"),
+                                   (("helix", "exact"), "--")):
+            g = rad[(rad["shape"] == shape) & (rad.scheme == scheme) & (rad["mode"] == mode)]
+            if len(g):
+                ax.loglog(g.precision_deg, g[stat], ls, marker=".", label=f"{shape} {scheme} {mode}")
+    g = rad[(rad["shape"] == shapes[0]) & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]
+    ax.loglog(g.precision_deg, g.eq7_mm, "k-", lw=2, label="Eq. 7 (r = 22 mm)")
+    ax.set_xlabel("precision p (deg; helix matched)")
+    ax.set_title({"max_mm": "max", "p95_mm": "95th percentile"}[stat] + " |interpolated - exact| radial distance",
+                 fontsize=8)
+    ax.invert_xaxis()
+    ax.grid(True, which="both", alpha=0.3)
+axes[0].set_ylabel("mm")
+axes[1].legend(fontsize=5, ncol=2)
+save(fig, d, "radial")
+
+fig, ax = plt.subplots(figsize=(5.5, 3.4))
+for (shape, scheme), g in cov.groupby(["shape", "scheme"], sort=False):
+    m = g.groupby("precision_deg").apply(lambda x: (x.max_nearest_mm / x.eq7_mm).max())
+    ax.semilogx(m.index, m.values, marker="o" if scheme == "equiangular" else "^", label=f"{shape} {scheme}")
+ax.axhline(1, color="k", lw=1)
+ax.set_xlabel("precision p (deg; helix matched)")
+ax.set_ylabel("max nearest-sample distance / Eq. 7")
+ax.invert_xaxis()
+ax.grid(True, alpha=0.3)
+ax.legend(fontsize=6)
+save(fig, d, "covering")
+
+sph = rad[(rad["shape"] == "sphere") & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]
+heads = rad[rad["shape"].str.startswith("head_") & (rad.scheme == "equiangular")]
+fine = rad.precision_deg.min()
+lin_heads = heads[(heads["mode"] == "linear") & (heads.precision_deg == fine)]
+ex_heads = heads[(heads["mode"] == "exact") & (heads.precision_deg == fine)]
+ex_local = rad[rad["shape"].str.startswith("head_") & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]
+hx_cov = cov[cov.scheme == "helix"]
+write_macros(d, "macros", {
+    "SElocalExact": (f"{100 * ex_local.fraction_within_local_bound.min():.0f}--"
+                     f"{100 * ex_local.fraction_within_local_bound.max():.0f}" if len(ex_local) else "n/a"),
+    "SEhelixCov": f"{(hx_cov.max_nearest_mm / hx_cov.eq7_mm).min():.2f}--{(hx_cov.max_nearest_mm / hx_cov.eq7_mm).max():.2f}",
+    "SEsphereMax": f"{sph.max_mm.max():.1e}",
+    "SEcovRatioMax": f"{(cov.max_nearest_mm / cov.eq7_mm).max():.2f}",
+    "SEfine": f"{fine:g}",
+    "SElinHeadPninetyfive": (f"{lin_heads.p95_mm.min():.3f}--{lin_heads.p95_mm.max():.3f}" if len(lin_heads) else "n/a"),
+    "SEexHeadPninetyfive": (f"{ex_heads.p95_mm.min():.1e}--{ex_heads.p95_mm.max():.1e}" if len(ex_heads) else "n/a"),
+    "SEanalyticWithin": f"{100 * rad[rad.scheme == 'equiangular'].fraction_within_bound.min():.3f}",
+    "SEhelixWithin": f"{100 * rad[rad.scheme == 'helix'].fraction_within_bound.min():.2f}",
+})

@@ -1,0 +1,66 @@
+"""06_conchoid_sampling: thesis sec. 5.1 -- curve length, Table 10, Fig. 58-59, approximations,
+and weighted vs equiangular vs helix sampling at equal node count on a conchoid joint.
+
+Reads RESULTS/06_conchoid_sampling/{length,table10,angles,equal_nodes}.csv; writes
+table_length.tex, table10.tex, angles.pdf/png, table_equal.tex, equal.pdf/png, macros.tex."""
+import matplotlib.pyplot as plt
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+
+d = experiment_dir("06_conchoid_sampling")
+ln = read_csv(d, "length.csv")
+t10 = read_csv(d, "table10.csv")
+an = read_csv(d, "angles.csv")
+eq = read_csv(d, "equal_nodes.csv")
+
+write_table(d, "table_length", ["variant", "length (mm)", "length / $b$", "rel. error"],
+            [[r.variant, f"{r.length_mm:.4f}", f"{r.length_over_b:.4f}", f"{100 * r.rel_error_vs_exact:+.3f}%"]
+             for r in ln.itertuples()], align="lrrr")
+write_table(d, "table10", ["$i$", "original", "thesis", "Eq. 16", "exact", "Eq. 16 adj.", "exact adj."],
+            [[f"{int(r.i)}", f"{r.original_deg:.0f}", f"{r.thesis_adjusted_deg:.0f}", f"{r.eq16_deg:.2f}",
+              f"{r.exact_deg:.2f}", f"{r.eq16_adjustment_deg:+.2f}", f"{r.exact_adjustment_deg:+.2f}"]
+             for r in t10.itertuples()])
+
+fig, axes = plt.subplots(1, 2, figsize=(8.5, 3.2))
+axes[0].plot(an.original_deg, an.original_deg, label="original (equiangular)")
+axes[0].plot(an.original_deg, an.eq16_deg, label="Eq. 16")
+axes[0].plot(an.original_deg, an.exact_deg, "--", label="exact inversion")
+axes[0].set_xlabel("original phi (deg)")
+axes[0].set_ylabel("ray angle (deg)")
+axes[0].legend(fontsize=7)
+axes[1].plot(an.original_deg, an.eq16_adjustment_deg, label="Eq. 16")
+axes[1].plot(an.original_deg, an.exact_adjustment_deg, "--", label="exact inversion")
+axes[1].set_xlabel("original phi (deg)")
+axes[1].set_ylabel("adjustment (deg)")
+axes[1].legend(fontsize=7)
+for ax in axes:
+    ax.grid(True, alpha=0.3)
+save(fig, d, "angles")
+
+write_table(d, "table_equal", ["scheme", "res.", "nodes", "hip-region nodes", "max (mm)", "p95 (mm)", "RMS (mm)"],
+            [[r.scheme, f"{r.resolution:g}", f"{int(r.nodes):,}", f"{int(r.hip_region_nodes):,}", f"{r.max_mm:.2e}",
+              f"{r.p95_mm:.2e}", f"{r.rms_mm:.2e}"] for r in eq.itertuples()], align="llrrrrr")
+fig, ax = plt.subplots(figsize=(5.5, 3.2))
+for scheme, g in eq.groupby("scheme", sort=False):
+    ax.loglog(g.nodes, g.max_mm, "o-", label=f"{scheme} (max)")
+ax.set_xlabel("nodes")
+ax.set_ylabel("radial error over phi <= 90 deg (mm)")
+ax.grid(True, which="both", alpha=0.3)
+ax.legend(fontsize=7)
+save(fig, d, "equal")
+
+ratio_c = (eq[eq.scheme == "conchoid"].max_mm.values / eq[eq.scheme == "equiangular"].max_mm.values)
+ratio_h = (eq[eq.scheme == "helix"].max_mm.values / eq[eq.scheme == "equiangular"].max_mm.values)
+exact_len = ln.iloc[0]
+write_macros(d, "macros", {
+    "CSlenOverB": f"{exact_len.length_over_b:.3f}", "CSlen": f"{exact_len.length_mm:.2f}",
+    "CSmaxAdjEq": f"{an.eq16_adjustment_deg.min():.2f}", "CSmaxAdjExact": f"{an.exact_adjustment_deg.min():.2f}",
+    "CSmaxAdjAt": f"{an.loc[an.exact_adjustment_deg.idxmin()].original_deg:.1f}",
+    "CSratioConchoid": f"{ratio_c.min():.2f}--{ratio_c.max():.2f}",
+    "CSratioHelix": f"{ratio_h.min():.2f}--{ratio_h.max():.2f}",
+    "CSthesisClosed": f"{ln.iloc[2].length_over_b:.4f}",
+    "CSrelAonefifteen": f"{100 * abs(ln.iloc[1].rel_error_vs_exact):.2f}",
+    "CSrelClosed": f"{100 * abs(ln.iloc[2].rel_error_vs_exact):.2f}",
+    "CSteqOne": f"{t10.eq16_deg[1]:.2f}", "CSteqTwo": f"{t10.eq16_deg[2]:.2f}", "CSteqThree": f"{t10.eq16_deg[3]:.2f}",
+    "CStexOne": f"{t10.exact_deg[1]:.2f}", "CStexTwo": f"{t10.exact_deg[2]:.2f}",
+})
