@@ -49,6 +49,11 @@ ax.grid(True, which="both", alpha=0.3)
 ax.legend(fontsize=7)
 save(fig, d, "equal")
 
+def span(v):
+    lo, hi = f"{v.min():.2f}", f"{v.max():.2f}"
+    return lo if lo == hi else f"{lo}--{hi}"
+
+
 ratio_c = (eq[eq.scheme == "conchoid"].max_mm.values / eq[eq.scheme == "equiangular"].max_mm.values)
 ratio_h = (eq[eq.scheme == "helix"].max_mm.values / eq[eq.scheme == "equiangular"].max_mm.values)
 exact_len = ln.iloc[0]
@@ -56,8 +61,8 @@ write_macros(d, "macros", {
     "CSlenOverB": f"{exact_len.length_over_b:.3f}", "CSlen": f"{exact_len.length_mm:.2f}",
     "CSmaxAdjEq": f"{an.eq16_adjustment_deg.min():.2f}", "CSmaxAdjExact": f"{an.exact_adjustment_deg.min():.2f}",
     "CSmaxAdjAt": f"{an.loc[an.exact_adjustment_deg.idxmin()].original_deg:.1f}",
-    "CSratioConchoid": f"{ratio_c.min():.2f}--{ratio_c.max():.2f}",
-    "CSratioHelix": f"{ratio_h.min():.2f}--{ratio_h.max():.2f}",
+    "CSratioConchoid": span(ratio_c),
+    "CSratioHelix": span(ratio_h),
     "CSthesisClosed": f"{ln.iloc[2].length_over_b:.4f}",
     "CSrelAonefifteen": f"{100 * abs(ln.iloc[1].rel_error_vs_exact):.2f}",
     "CSrelClosed": f"{100 * abs(ln.iloc[2].rel_error_vs_exact):.2f}",
