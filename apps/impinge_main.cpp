@@ -21,8 +21,8 @@
 #include "impinge/parse.hpp"
 #include "impinge/pose.hpp"
 #include "impinge/sampling.hpp"
-#include "impinge/spherical_frame.hpp"
 #include "impinge/sphere_fit.hpp"
+#include "impinge/spherical_frame.hpp"
 #include "impinge/subject.hpp"
 
 using namespace impinge;
@@ -67,8 +67,7 @@ void write_body_ply(const std::string& path, const JointBody& body, const ScanGa
                     bool is_ball) {
   const Eigen::Index n = body.mesh.V.rows();
   Vertices V(n, 3);
-  for (Eigen::Index i = 0; i < n; ++i)
-    V.row(i) = (to_input * (cor + R * body.relative.row(i).transpose())).transpose();
+  for (Eigen::Index i = 0; i < n; ++i) V.row(i) = (to_input * (cor + R * body.relative.row(i).transpose())).transpose();
   Eigen::VectorXf gap(n);
   Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
   Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
@@ -84,9 +83,9 @@ void write_body_ply(const std::string& path, const JointBody& body, const ScanGa
 
 int run_distance(const std::string& ball_path_in, const std::string& socket_path_in, const std::string& subject_path,
                  const std::string& cor_text, const std::string& head_region, const std::string& scheme_name,
-                 double resolution, const std::string& sampling_text, const std::string& mode_text, const std::string& pose_text, const std::string& side_text,
-                 const std::string& frame_text, const std::string& levels_text, double occlusion_tol,
-                 double max_radius, const std::string& out_dir) {
+                 double resolution, const std::string& sampling_text, const std::string& mode_text,
+                 const std::string& pose_text, const std::string& side_text, const std::string& frame_text,
+                 const std::string& levels_text, double occlusion_tol, double max_radius, const std::string& out_dir) {
   std::string ball_path = ball_path_in, socket_path = socket_path_in;
   Side side = parse_side(side_text, "--side");
   FrameConvention frame = parse_frame(frame_text, "--frame");
@@ -186,9 +185,14 @@ int run_generate(int triangles, double cam, double coverage, const std::string& 
   fs::create_directories(out_dir);
   write_ply((fs::path(out_dir) / "femur_r.ply").string(), h.ball);
   write_ply((fs::path(out_dir) / "pelvis.ply").string(), h.socket);
-  nlohmann::json s = {{"side", "right"}, {"frame", "RAS"}, {"units", "mm"}, {"femur", "femur_r.ply"},
-                      {"pelvis", "pelvis.ply"}, {"generated", true},
-                      {"true_cor_mm", {h.cor.x(), h.cor.y(), h.cor.z()}}, {"head_radius_mm", o.head_radius_mm}};
+  nlohmann::json s = {{"side", "right"},
+                      {"frame", "RAS"},
+                      {"units", "mm"},
+                      {"femur", "femur_r.ply"},
+                      {"pelvis", "pelvis.ply"},
+                      {"generated", true},
+                      {"true_cor_mm", {h.cor.x(), h.cor.y(), h.cor.z()}},
+                      {"head_radius_mm", o.head_radius_mm}};
   std::ofstream os(fs::path(out_dir) / "subject.json");
   require(os.good(), out_dir + "/subject.json: cannot open for writing");
   os << s.dump(2) << "\n";
@@ -205,23 +209,26 @@ int main(int argc, char** argv) {
 
   auto* dist = app.add_subcommand("distance", "Per-vertex gap between ball (femur) and socket (pelvis) at one pose");
   std::string ball, socket, subject, cor = "auto", head_region, mode = "exact", pose = "0,0,0", out, side = "right",
-                                      frame = "RAS", levels, scheme = "equiangular", sampling = "auto";
+                                     frame = "RAS", levels, scheme = "equiangular", sampling = "auto";
   double precision = 0.5, turns = 0, resolution = 0, occlusion_tol = 1.0, max_radius = 0;
   dist->add_option("--ball", ball, "Ball mesh (femur): PLY, STL, OBJ or OFF, mm");
   dist->add_option("--socket", socket, "Socket mesh (pelvis): PLY, STL, OBJ or OFF, mm");
   dist->add_option("--subject", subject,
                    "subject.json giving side and frame (LPS or RAS); supplies --ball/--socket when omitted");
-  dist->add_option("--cor", cor, "Centre of rotation: 'auto' (sphere fit of the femoral head) or X,Y,Z in mm in the "
-                                 "input files' frame")
+  dist->add_option("--cor", cor,
+                   "Centre of rotation: 'auto' (sphere fit of the femoral head) or X,Y,Z in mm in the "
+                   "input files' frame")
       ->capture_default_str();
   dist->add_option("--head-region", head_region,
                    "X,Y,Z,R: fit the head sphere to femur vertices within R mm of (X,Y,Z), input frame");
   std::string registered;
-  for (const auto& [name, res] : scheme_names()) registered += (registered.empty() ? "" : ", ") + name + " (" + res + ")";
+  for (const auto& [name, res] : scheme_names())
+    registered += (registered.empty() ? "" : ", ") + name + " (" + res + ")";
   dist->add_option("--scheme", scheme, "Sampling scheme of the maps: " + registered)->capture_default_str();
   dist->add_option("--resolution", resolution, "Resolution parameter of the scheme (any scheme)");
-  dist->add_option("--precision", precision, "Equiangular precision p in degrees (180/p integral); the resolution "
-                                             "when neither --resolution nor --turns is given")
+  dist->add_option("--precision", precision,
+                   "Equiangular precision p in degrees (180/p integral); the resolution "
+                   "when neither --resolution nor --turns is given")
       ->capture_default_str();
   dist->add_option("--turns", turns, "Helix turns k (w = k^2 nodes; thesis Table 6: 229, 458, 2292, 4584)");
   dist->add_option("--sampling", sampling, "auto, rasterize, resample or ray-cast (naive, small meshes only)")

@@ -102,10 +102,7 @@ void BM_Rasterize(benchmark::State& st) {
   st.counters["triangles"] = double(m.F.rows());
   st.counters["nodes"] = double(map.num_nodes());
 }
-BENCHMARK(BM_Rasterize)
-    ->ArgsProduct({{0, 1}, {0, 1, 2, 3}, {0, 1}})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_Rasterize)->ArgsProduct({{0, 1}, {0, 1, 2, 3}, {0, 1}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The floor: std::fill of a map of the same size (args: precision index).
 void BM_FillMap(benchmark::State& st) {
@@ -126,7 +123,8 @@ void BM_HelixSample(benchmark::State& st) {
   RadialDistanceMap map(scheme_of(4 + int(st.range(1))));
   SamplingOptions o;
   for (auto _ : st) benchmark::DoNotOptimize(sample_surface(m, s.cor, o, map));
-  st.SetLabel(s.name + (st.range(0) == 0 ? " femur" : " pelvis") + " exact, k=" + std::to_string(int(kTurns[st.range(1)])));
+  st.SetLabel(s.name + (st.range(0) == 0 ? " femur" : " pelvis") +
+              " exact, k=" + std::to_string(int(kTurns[st.range(1)])));
   st.counters["nodes"] = double(map.num_nodes());
 }
 BENCHMARK(BM_HelixSample)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -148,8 +146,8 @@ void BM_Query(benchmark::State& st) {
   }
   const auto lookups = std::count(mask.begin(), mask.end(), std::uint8_t{1});
   st.SetItemsProcessed(st.iterations() * lookups);
-  st.counters["ns_per_lookup"] = benchmark::Counter(
-      double(lookups) * double(st.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["ns_per_lookup"] = benchmark::Counter(double(lookups) * double(st.iterations()),
+                                                    benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   st.SetLabel(s.name + (ball ? " femur vs pelvis map, " : " pelvis vs femur map, ") + other.scheme().name() + " " +
               std::to_string(other.scheme().resolution()));
 }

@@ -48,14 +48,13 @@ void measure(CsvWriter& csv, const std::shared_ptr<const SamplingScheme>& scheme
 int main(int argc, char** argv) {
   const Args args = parse_args(argc, argv, "01_lut_memory: thesis Tables 2, 6, 7; map sizes and memory");
   const std::string dir = experiment_dir(args, "01_lut_memory");
-  CsvWriter csv(dir + "/lut_memory.csv",
-                {"scheme", "resolution", "matched_precision_deg", "storage", "nodes_formula", "nodes",
-                 "bytes_per_node", "bytes_formula", "bytes_allocated", "rss_growth_bytes", "memory_mib",
-                 "thesis_nodes", "thesis_memory_mb"});
-  CsvWriter match(dir + "/helix_match.csv",
-                  {"precision_deg", "equiangular_equator_nodes", "turns", "thesis_turns", "helix_node_spacing_deg",
-                   "helix_equator_nodes", "thesis_helix_equator_nodes", "helix_nodes", "equiangular_nodes",
-                   "node_ratio"});
+  CsvWriter csv(dir + "/lut_memory.csv", {"scheme", "resolution", "matched_precision_deg", "storage", "nodes_formula",
+                                          "nodes", "bytes_per_node", "bytes_formula", "bytes_allocated",
+                                          "rss_growth_bytes", "memory_mib", "thesis_nodes", "thesis_memory_mb"});
+  CsvWriter match(
+      dir + "/helix_match.csv",
+      {"precision_deg", "equiangular_equator_nodes", "turns", "thesis_turns", "helix_node_spacing_deg",
+       "helix_equator_nodes", "thesis_helix_equator_nodes", "helix_nodes", "equiangular_nodes", "node_ratio"});
   // Thesis Table 2 (equiangular, double) and Tables 6-7 (helix, double). The thesis' "MB" are
   // MiB: 65,160 x 8 / 2^20 = 0.497.
   const struct {
@@ -92,8 +91,8 @@ int main(int argc, char** argv) {
   // Node density against latitude (Fig. 49 compares the two at 1 deg): nodes per steradian in
   // 1-deg bands of phi.
   {
-    CsvWriter dens(dir + "/density.csv", {"scheme", "resolution", "phi_low_deg", "phi_high_deg", "nodes",
-                                          "band_sr", "nodes_per_sr"});
+    CsvWriter dens(dir + "/density.csv",
+                   {"scheme", "resolution", "phi_low_deg", "phi_high_deg", "nodes", "band_sr", "nodes_per_sr"});
     const EquiangularGrid eq(1);
     const HelixScheme hx(229);
     for (const SamplingScheme* s : std::initializer_list<const SamplingScheme*>{&eq, &hx}) {
@@ -112,7 +111,8 @@ int main(int argc, char** argv) {
     }
   }
   write_meta(dir, args,
-             {{"precisions_deg", {1, 0.5, 0.1, 0.05}}, {"turns", {229, 458, 2292, 4584}},
+             {{"precisions_deg", {1, 0.5, 0.1, 0.05}},
+              {"turns", {229, 458, 2292, 4584}},
               {"storages", {"float", "double"}},
               {"thesis_source", "thesis Table 2 (sec. 3.4), Tables 6-7 and Fig. 49 (sec. 4.4), double storage"},
               {"matching", "k = round(720 / (pi p)): helix equator nodes (2 pi / spacing) = 360 / p"}});

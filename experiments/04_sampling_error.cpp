@@ -37,7 +37,7 @@ struct Shape {
   Eigen::Vector3d cor;
   std::function<double(const Eigen::Vector3d&)> exact;  ///< radial distance along unit u, NaN if none
   std::function<bool(const Eigen::Vector3d&)> in_region;
-  double radius;  ///< typical radius for Eq. 7, mm
+  double radius;                      ///< typical radius for Eq. 7, mm
   std::vector<Eigen::Vector3d> caps;  ///< cap centres for (a)
 };
 
@@ -90,22 +90,34 @@ int main(int argc, char** argv) {
   std::vector<Shape> shapes;
   const Eigen::Vector3d origin(10, -20, 30);
   {
-    Shape s{"sphere", make_uv_sphere(22, origin, 1440, 720, Eigen::Vector3d(0.2, 0.3, 0.93)), origin,
-            [](const Eigen::Vector3d&) { return 22.0; }, [](const Eigen::Vector3d&) { return true; }, 22, {}};
+    Shape s{"sphere",
+            make_uv_sphere(22, origin, 1440, 720, Eigen::Vector3d(0.2, 0.3, 0.93)),
+            origin,
+            [](const Eigen::Vector3d&) { return 22.0; },
+            [](const Eigen::Vector3d&) { return true; },
+            22,
+            {}};
     shapes.push_back(std::move(s));
     const Eigen::Vector3d off = 3.0 * Eigen::Vector3d(1, 1, 1).normalized();
-    Shape o{"offset_sphere", make_uv_sphere(22, origin + off, 1440, 720, Eigen::Vector3d(0.2, 0.3, 0.93)), origin,
+    Shape o{"offset_sphere",
+            make_uv_sphere(22, origin + off, 1440, 720, Eigen::Vector3d(0.2, 0.3, 0.93)),
+            origin,
             [off](const Eigen::Vector3d& u) {
               const double b = u.dot(off);
               return b + std::sqrt(b * b - off.squaredNorm() + 22.0 * 22.0);
             },
-            [](const Eigen::Vector3d&) { return true; }, 22, {}};
+            [](const Eigen::Vector3d&) { return true; },
+            22,
+            {}};
     shapes.push_back(std::move(o));
     const Eigen::Vector3d ax = Eigen::Vector3d(0.3, -0.2, 1).normalized();
-    Shape c{"conchoid", make_conchoid_surface(kMenschikA, kMenschikB, origin, 1440, 720, ax), origin,
+    Shape c{"conchoid",
+            make_conchoid_surface(kMenschikA, kMenschikB, origin, 1440, 720, ax),
+            origin,
             [ax](const Eigen::Vector3d& u) { return kMenschikA + kMenschikB * u.dot(ax); },
             [ax](const Eigen::Vector3d& u) { return u.dot(ax) >= 0; },  // the hip region, phi <= 90 deg
-            kMenschikA + kMenschikB * 0.5, {}};
+            kMenschikA + kMenschikB * 0.5,
+            {}};
     shapes.push_back(std::move(c));
   }
   for (Shape& s : shapes)
@@ -120,12 +132,16 @@ int main(int argc, char** argv) {
       const ExactReference* ref = refs.back().get();
       const Eigen::Vector3d cor = fit.centre;
       const double R = fit.radius;
-      Shape h{"head_" + sub.name, std::move(sub.femur), cor,
+      Shape h{"head_" + sub.name,
+              std::move(sub.femur),
+              cor,
               [ref, cor](const Eigen::Vector3d& u) {
                 const auto t = ref->first_hit(cor, u);
                 return t ? *t : std::nan("");
               },
-              nullptr, R, {}};
+              nullptr,
+              R,
+              {}};
       h.in_region = [ref, cor, R](const Eigen::Vector3d& u) {
         const auto t = ref->first_hit(cor, u);
         return t && std::abs(*t - R) < 3.0;
@@ -137,9 +153,9 @@ int main(int argc, char** argv) {
     }
   }
 
-  CsvWriter cov(dir + "/covering.csv", {"shape", "scheme", "resolution", "precision_deg", "cap", "cap_phi_deg",
-                                        "sample_points", "test_points", "max_nearest_mm", "p95_nearest_mm",
-                                        "local_radius_mm", "eq7_mm"});
+  CsvWriter cov(dir + "/covering.csv",
+                {"shape", "scheme", "resolution", "precision_deg", "cap", "cap_phi_deg", "sample_points", "test_points",
+                 "max_nearest_mm", "p95_nearest_mm", "local_radius_mm", "eq7_mm"});
   CsvWriter rad(dir + "/radial_error.csv",
                 {"shape", "scheme", "mode", "resolution", "precision_deg", "directions", "max_mm", "p99_mm", "p95_mm",
                  "median_mm", "eq7_mm", "h_rad", "max_r_phiphi", "max_r_thetatheta", "bound_mm",
@@ -227,8 +243,7 @@ int main(int argc, char** argv) {
         }
         rad.row(s.name, v.scheme->name(), to_string(v.mode), v.scheme->resolution(), p, std::int64_t(err.size()),
                 se.empty() ? std::nan("") : se.back(), q(se, 0.99), q(se, 0.95), q(se, 0.5), eq7, h, mpp, mtt, bound,
-                within, local_checked,
-                local_checked > 0 ? double(local_within) / double(local_checked) : std::nan(""));
+                within, local_checked, local_checked > 0 ? double(local_within) / double(local_checked) : std::nan(""));
         // (a) covering radius in caps (exact-mode maps: the sample points lie on the mesh)
         if (!cgal || v.mode != DistanceMode::exact) continue;
         const std::int64_t n = map.num_nodes();
@@ -271,9 +286,14 @@ int main(int argc, char** argv) {
     }
   }
   write_meta(dir, args,
-             {{"precisions_deg", precisions}, {"helix_turns", "round(720 / (pi p))"}, {"directions", n_dirs},
-              {"cap_test_points", n_test}, {"cap_radius_deg", 4}, {"cap_test_radius_deg", 3},
-              {"analytic_mesh", "UV 1440 x 720 (0.25 deg facets)"}, {"cgal", cgal},
+             {{"precisions_deg", precisions},
+              {"helix_turns", "round(720 / (pi p))"},
+              {"directions", n_dirs},
+              {"cap_test_points", n_test},
+              {"cap_radius_deg", 4},
+              {"cap_test_radius_deg", 3},
+              {"analytic_mesh", "UV 1440 x 720 (0.25 deg facets)"},
+              {"cgal", cgal},
               {"real_head_region", "directions whose exact first hit is within 3 mm of the fitted head sphere"},
               {"thesis_source", "thesis Table 5, Eq. 7-8 (sec. 3.5.1)"}});
   return 0;

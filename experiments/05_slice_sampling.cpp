@@ -52,10 +52,9 @@ int main(int argc, char** argv) {
   for (int j = 0; j < n_dirs; ++j) dirs.push_back(direction(std::acos(2 * U(rng) - 1), 2 * kPi * U(rng)));
   std::vector<double> stair_exact(dirs.size());
   for (std::size_t j = 0; j < dirs.size(); ++j) stair_exact[j] = cast_ray_naive(stairs, cor, dirs[j])->first;
-  CsvWriter st(dir + "/staircase.csv",
-               {"precision_deg", "directions", "vs_sphere_rms_mm", "vs_sphere_max_mm", "vs_staircase_rms_mm",
-                "vs_staircase_max_mm", "staircase_vs_sphere_rms_mm", "gap_vs_smooth_rms_mm", "gap_vs_smooth_max_mm",
-                "nyquist_precision_deg"});
+  CsvWriter st(dir + "/staircase.csv", {"precision_deg", "directions", "vs_sphere_rms_mm", "vs_sphere_max_mm",
+                                        "vs_staircase_rms_mm", "vs_staircase_max_mm", "staircase_vs_sphere_rms_mm",
+                                        "gap_vs_smooth_rms_mm", "gap_vs_smooth_max_mm", "nyquist_precision_deg"});
   const double nyquist = slice_sampling(R, T).nyquist_precision_deg;
   std::vector<double> precisions{5, 3, 2, 1.5, 1, 0.5, 0.25, 0.1};
   if (!args.quick) precisions.push_back(0.05);
@@ -89,8 +88,12 @@ int main(int argc, char** argv) {
            gn > 0 ? std::sqrt(g2 / double(gn)) : std::nan(""), gmax, nyquist);
   }
   write_meta(dir, args,
-             {{"radius_mm", R}, {"slice_mm", T}, {"staircase_segments", 720}, {"directions", n_dirs},
-              {"precisions_deg", precisions}, {"thesis_source", "thesis sec. 3.5.2, Fig. 45-46"},
+             {{"radius_mm", R},
+              {"slice_mm", T},
+              {"staircase_segments", 720},
+              {"directions", n_dirs},
+              {"precisions_deg", precisions},
+              {"thesis_source", "thesis sec. 3.5.2, Fig. 45-46"},
               {"staircase", "slices [k t, (k+1) t] with the sphere's cross-section radius at mid height"}});
   return 0;
 }

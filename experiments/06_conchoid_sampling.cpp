@@ -36,9 +36,11 @@ int main(int argc, char** argv) {
     const double Lth = conchoid_length_thesis(b);
     // the thesis' printed rounding: 3.03 b
     const double L303 = 3.03 * b;
-    for (auto [name, v] : std::initializer_list<std::pair<const char*, double>>{
-             {"exact (a, b; GSL QAGS)", L}, {"a = 1.15 b", L115}, {"a = 1.15 b, 2.3 b^2 (thesis closed form)", Lth},
-             {"3.03 b (thesis, printed)", L303}})
+    for (auto [name, v] :
+         std::initializer_list<std::pair<const char*, double>>{{"exact (a, b; GSL QAGS)", L},
+                                                               {"a = 1.15 b", L115},
+                                                               {"a = 1.15 b, 2.3 b^2 (thesis closed form)", Lth},
+                                                               {"3.03 b (thesis, printed)", L303}})
       len.row(std::string("\"") + name + "\"", v, v / b, (v - L) / L);
   }
   {
@@ -51,8 +53,8 @@ int main(int argc, char** argv) {
               ex[i] * kRadToDeg - 30.0 * i);
   }
   {
-    CsvWriter an(dir + "/angles.csv", {"i", "original_deg", "eq16_deg", "exact_deg", "eq16_adjustment_deg",
-                                       "exact_adjustment_deg"});
+    CsvWriter an(dir + "/angles.csv",
+                 {"i", "original_deg", "eq16_deg", "exact_deg", "eq16_adjustment_deg", "exact_adjustment_deg"});
     const int n = 901;  // 0.1 deg over [0, 90]
     const std::vector<double> e16 = conchoid_angles_eq16(n), ex = exact.equal_length_angles(n, kPi / 2);
     for (int i = 0; i < n; ++i)
@@ -104,7 +106,10 @@ int main(int argc, char** argv) {
     }
   }
   write_meta(dir, args,
-             {{"a_mm", a}, {"b_mm", b}, {"precisions_deg", precisions}, {"directions", n_dirs},
+             {{"a_mm", a},
+              {"b_mm", b},
+              {"precisions_deg", precisions},
+              {"directions", n_dirs},
               {"helix_turns", "round(sqrt(equiangular node count)) (equal node count)"},
               {"thesis_source", "thesis sec. 5.1, Eq. 11-16, Table 10, Fig. 58-59"}});
   return 0;

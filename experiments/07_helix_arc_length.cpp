@@ -24,11 +24,11 @@ int main(int argc, char** argv) {
   const int directions = args.quick ? 50000 : 400000;
   CsvWriter arc(dir + "/arc_length.csv", {"turns", "phi_deg", "s_exact", "t_eq10", "abs_error", "rel_error",
                                           "steps_exact", "steps_eq10", "index_error_steps"});
-  CsvWriter idx(dir + "/index_errors.csv",
-                {"turns", "nodes", "node_spacing_deg", "total_length_exact", "total_length_eq10", "directions",
-                 "stencils_differing", "fraction_differing", "nearest_node_differing", "fraction_nearest_differing",
-                 "max_node_index_difference", "max_abs_index_error_steps", "exact_ns_per_locate",
-                 "eq10_ns_per_locate"});
+  CsvWriter idx(
+      dir + "/index_errors.csv",
+      {"turns", "nodes", "node_spacing_deg", "total_length_exact", "total_length_eq10", "directions",
+       "stencils_differing", "fraction_differing", "nearest_node_differing", "fraction_nearest_differing",
+       "max_node_index_difference", "max_abs_index_error_steps", "exact_ns_per_locate", "eq10_ns_per_locate"});
   int step = 0;
   for (double k : turns) {
     progress("07_helix_arc_length", ++step, int(turns.size()), "k=" + std::to_string(int(k)));
@@ -60,16 +60,18 @@ int main(int argc, char** argv) {
       for (int c = 0; c < 3; ++c) pts[3 * j + c] = dirs[j][c];
     std::vector<float> values(static_cast<std::size_t>(exact.num_nodes()), 1.0f);
     const auto n = static_cast<std::int64_t>(dirs.size());
-    const double t_exact = median_ms([&] { exact.interpolate_many(values.data(), pts.data(), n, out.data()); },
-                                     args.repetitions);
-    const double t_fit = median_ms([&] { fitted.interpolate_many(values.data(), pts.data(), n, out.data()); },
-                                   args.repetitions);
+    const double t_exact =
+        median_ms([&] { exact.interpolate_many(values.data(), pts.data(), n, out.data()); }, args.repetitions);
+    const double t_fit =
+        median_ms([&] { fitted.interpolate_many(values.data(), pts.data(), n, out.data()); }, args.repetitions);
     idx.row(k, exact.num_nodes(), exact.node_spacing() * kRadToDeg, s.total(), traveled_distance_eq10(k, -1.0),
             directions, differ, double(differ) / directions, nearest_differ, double(nearest_differ) / directions,
             max_diff, max_steps, t_exact * 1e6 / directions, t_fit * 1e6 / directions);
   }
   write_meta(dir, args,
-             {{"turns", turns}, {"directions", directions}, {"phi_step_deg", 0.1},
+             {{"turns", turns},
+              {"directions", directions},
+              {"phi_step_deg", 0.1},
               {"exact", "Carlson symmetric form of the incomplete elliptic integral E(phi | -4k^2) (GSL)"},
               {"eq10", "T = (4k + 1)(1 - cos phi) / 2 (thesis Eq. 10); for locating scaled to w - 1 steps"},
               {"directions_distribution", "uniform on the sphere, seed 1234"}});

@@ -21,8 +21,8 @@
 #include "impinge/joint.hpp"
 #include "impinge/map_image.hpp"
 #include "impinge/sampling.hpp"
-#include "impinge/spherical_frame.hpp"
 #include "impinge/sphere_fit.hpp"
+#include "impinge/spherical_frame.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;
@@ -35,14 +35,41 @@ int main(int argc, char** argv) {
   if (!args.quick) precisions.push_back(0.05);
   const double finest = precisions.back();
 
-  CsvWriter stats(dir + "/gap_statistics.csv",
-                  {"subject", "generated", "scheme", "resolution", "precision_deg", "mode", "scan", "cor_ras_x_mm", "cor_ras_y_mm", "cor_ras_z_mm",
-                   "head_radius_mm", "sphere_fit_rms_mm", "cor_error_mm", "vertices", "vertices_tested",
-                   "vertices_no_surface", "vertices_beyond_reach", "min_gap_mm", "vertices_penetrating",
-                   "area_penetrating_mm2", "level_none", "level_yellow", "level_orange", "level_red",
-                   "level_purple", "map_nodes", "map_nodes_covered", "map_bytes", "sampling_ms", "detection_ms",
-                   "detection_ns_per_lookup", "linear_vs_exact_p95_abs_mm", "vs_equiangular_p95_abs_mm",
-                   "vs_equiangular_max_abs_mm", "vs_equiangular_compared"});
+  CsvWriter stats(dir + "/gap_statistics.csv", {"subject",
+                                                "generated",
+                                                "scheme",
+                                                "resolution",
+                                                "precision_deg",
+                                                "mode",
+                                                "scan",
+                                                "cor_ras_x_mm",
+                                                "cor_ras_y_mm",
+                                                "cor_ras_z_mm",
+                                                "head_radius_mm",
+                                                "sphere_fit_rms_mm",
+                                                "cor_error_mm",
+                                                "vertices",
+                                                "vertices_tested",
+                                                "vertices_no_surface",
+                                                "vertices_beyond_reach",
+                                                "min_gap_mm",
+                                                "vertices_penetrating",
+                                                "area_penetrating_mm2",
+                                                "level_none",
+                                                "level_yellow",
+                                                "level_orange",
+                                                "level_red",
+                                                "level_purple",
+                                                "map_nodes",
+                                                "map_nodes_covered",
+                                                "map_bytes",
+                                                "sampling_ms",
+                                                "detection_ms",
+                                                "detection_ns_per_lookup",
+                                                "linear_vs_exact_p95_abs_mm",
+                                                "vs_equiangular_p95_abs_mm",
+                                                "vs_equiangular_max_abs_mm",
+                                                "vs_equiangular_compared"});
   CsvWriter vertices(dir + "/vertex_gaps.csv", {"subject", "scan", "vertex", "x_mm", "y_mm", "z_mm", "gap_mm"});
 
   const int total = static_cast<int>(subjects.size() * precisions.size() * 4);
@@ -61,104 +88,107 @@ int main(int argc, char** argv) {
     const SphereFitResult fit = fit_femoral_head(s.femur);
     const double cor_error = s.generated ? (fit.centre - s.true_cor).norm() : std::nan("");
     for (double p : precisions) {
-     std::map<DistanceMode, std::vector<float>> rsid_ball;  // equiangular ball gaps per mode
-     const double k = std::round(720.0 / (kPi * p));
-     for (const auto& scheme : {make_scheme("equiangular", p), make_scheme("helix", k)}) {
-      const bool helix = scheme->name() != "equiangular";
-      std::vector<float> exact_ball;  // exact-mode gaps, for the linear-vs-exact difference
-      for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
-        progress("08_distance_maps", ++done, total,
-                 s.name + " " + scheme->name() + " " + std::to_string(scheme->resolution()) + " " + to_string(mode));
-        JointOptions o;
-        o.scheme = scheme;
-        o.mode = mode;
-        const Joint joint(s.femur, s.pelvis, fit.centre, o);
-        const PoseResult res = joint.detect(Eigen::Matrix3d::Identity());
-        // Timings: rasterisation of each body and each scan, medians.
-        const int reps = p <= 0.05 ? std::max(1, args.repetitions / 2) : args.repetitions;
-        double sample_ms[2], detect_ms[2];
-        const JointBody* bodies[2] = {&joint.ball(), &joint.socket()};
-        for (int b = 0; b < 2; ++b) {
-          RadialDistanceMap scratch{scheme};
-          SamplingOptions so;
-          so.mode = mode;
-          sample_ms[b] = median_ms(
+      std::map<DistanceMode, std::vector<float>> rsid_ball;  // equiangular ball gaps per mode
+      const double k = std::round(720.0 / (kPi * p));
+      for (const auto& scheme : {make_scheme("equiangular", p), make_scheme("helix", k)}) {
+        const bool helix = scheme->name() != "equiangular";
+        std::vector<float> exact_ball;  // exact-mode gaps, for the linear-vs-exact difference
+        for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
+          progress("08_distance_maps", ++done, total,
+                   s.name + " " + scheme->name() + " " + std::to_string(scheme->resolution()) + " " + to_string(mode));
+          JointOptions o;
+          o.scheme = scheme;
+          o.mode = mode;
+          const Joint joint(s.femur, s.pelvis, fit.centre, o);
+          const PoseResult res = joint.detect(Eigen::Matrix3d::Identity());
+          // Timings: rasterisation of each body and each scan, medians.
+          const int reps = p <= 0.05 ? std::max(1, args.repetitions / 2) : args.repetitions;
+          double sample_ms[2], detect_ms[2];
+          const JointBody* bodies[2] = {&joint.ball(), &joint.socket()};
+          for (int b = 0; b < 2; ++b) {
+            RadialDistanceMap scratch{scheme};
+            SamplingOptions so;
+            so.mode = mode;
+            sample_ms[b] = median_ms(
+                [&] {
+                  std::fill(scratch.data(), scratch.data() + scratch.num_nodes(), RadialDistanceMap::no_surface());
+                  sample_surface(bodies[b]->mesh, fit.centre, so, scratch);
+                },
+                reps);
+          }
+          ScanGaps scratch_gaps;
+          detect_ms[0] = median_ms(
               [&] {
-                std::fill(scratch.data(), scratch.data() + scratch.num_nodes(), RadialDistanceMap::no_surface());
-                sample_surface(bodies[b]->mesh, fit.centre, so, scratch);
+                scan_gaps(joint.ball().relative, Eigen::Matrix3d::Identity(), joint.ball().mask, joint.socket().map,
+                          ScanSide::inside, scratch_gaps);
               },
-              reps);
-        }
-        ScanGaps scratch_gaps;
-        detect_ms[0] = median_ms(
-            [&] {
-              scan_gaps(joint.ball().relative, Eigen::Matrix3d::Identity(), joint.ball().mask, joint.socket().map,
-                        ScanSide::inside, scratch_gaps);
-            },
-            args.repetitions);
-        detect_ms[1] = median_ms(
-            [&] {
-              scan_gaps(joint.socket().relative, Eigen::Matrix3d::Identity(), joint.socket().mask, joint.ball().map,
-                        ScanSide::outside, scratch_gaps);
-            },
-            args.repetitions);
-        double p95 = std::nan(""), vs_p95 = std::nan(""), vs_max = std::nan("");
-        std::int64_t vs_n = 0;
-        if (mode == DistanceMode::exact)
-          exact_ball = res.ball_gaps.gap_mm;
-        else
-          p95 = quantile(abs_diff(exact_ball, res.ball_gaps.gap_mm), 0.95);
-        if (!helix) {
-          rsid_ball[mode] = res.ball_gaps.gap_mm;
-        } else {
-          const std::vector<double> d = abs_diff(rsid_ball[mode], res.ball_gaps.gap_mm);
-          vs_p95 = quantile(d, 0.95);
-          vs_max = d.empty() ? std::nan("") : d.back();
-          vs_n = static_cast<std::int64_t>(d.size());
-        }
-        const ScanSummary* sums[2] = {&res.ball, &res.socket};
-        for (int b = 0; b < 2; ++b) {
-          const ScanSummary& sm = *sums[b];
-          const JointBody& body = *bodies[b];
-                    // per map look-up (tested + no surface); masked vertices cost one byte test each
-          const std::int64_t lookups = sm.vertices_tested + sm.vertices_no_surface;
-          const double ns = lookups > 0 ? detect_ms[b] * 1e6 / double(lookups) : std::nan("");
-          stats.row(s.name, int(s.generated), scheme->name(), scheme->resolution(), p, to_string(mode),
-                    b == 0 ? "ball" : "socket", fit.centre.x(),
-                    fit.centre.y(), fit.centre.z(), fit.radius, fit.rms_residual, cor_error, sm.vertices,
-                    sm.vertices_tested, sm.vertices_no_surface, sm.vertices_beyond_reach, sm.min_gap_mm,
-                    sm.vertices_penetrating, sm.area_penetrating_mm2, sm.level_vertices[0], sm.level_vertices[1],
-                    sm.level_vertices[2], sm.level_vertices[3], sm.level_vertices[4], body.map.num_nodes(),
-                    body.sampling.nodes_covered, std::int64_t(body.map.bytes()), sample_ms[b], detect_ms[b], ns,
-                    b == 0 ? p95 : std::nan(""), b == 0 ? vs_p95 : std::nan(""), b == 0 ? vs_max : std::nan(""),
-                    b == 0 ? vs_n : std::int64_t(0));
-        }
-        if (p == 0.5 && mode == DistanceMode::exact) {
-          const std::string suffix = helix ? "_helix.png" : ".png";
-          write_map_png(dir + "/map_" + s.name + "_ball" + suffix, joint.ball().map);
-          write_map_png(dir + "/map_" + s.name + "_socket" + suffix, joint.socket().map);
-        }
-        if (p == finest && mode == DistanceMode::exact && !helix) {
-          const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};
-          for (int b = 0; b < 2; ++b)
-            for (Eigen::Index i = 0; i < bodies[b]->relative.rows(); ++i) {
-              if (bodies[b]->relative.row(i).norm() > 45) continue;
-              const Eigen::Vector3d v = bodies[b]->mesh.V.row(i).transpose();
-              vertices.row(s.name, b == 0 ? "ball" : "socket", std::int64_t(i), v.x(), v.y(), v.z(),
-                           double(gaps[b]->gap_mm[static_cast<std::size_t>(i)]));
-            }
+              args.repetitions);
+          detect_ms[1] = median_ms(
+              [&] {
+                scan_gaps(joint.socket().relative, Eigen::Matrix3d::Identity(), joint.socket().mask, joint.ball().map,
+                          ScanSide::outside, scratch_gaps);
+              },
+              args.repetitions);
+          double p95 = std::nan(""), vs_p95 = std::nan(""), vs_max = std::nan("");
+          std::int64_t vs_n = 0;
+          if (mode == DistanceMode::exact)
+            exact_ball = res.ball_gaps.gap_mm;
+          else
+            p95 = quantile(abs_diff(exact_ball, res.ball_gaps.gap_mm), 0.95);
+          if (!helix) {
+            rsid_ball[mode] = res.ball_gaps.gap_mm;
+          } else {
+            const std::vector<double> d = abs_diff(rsid_ball[mode], res.ball_gaps.gap_mm);
+            vs_p95 = quantile(d, 0.95);
+            vs_max = d.empty() ? std::nan("") : d.back();
+            vs_n = static_cast<std::int64_t>(d.size());
+          }
+          const ScanSummary* sums[2] = {&res.ball, &res.socket};
+          for (int b = 0; b < 2; ++b) {
+            const ScanSummary& sm = *sums[b];
+            const JointBody& body = *bodies[b];
+            // per map look-up (tested + no surface); masked vertices cost one byte test each
+            const std::int64_t lookups = sm.vertices_tested + sm.vertices_no_surface;
+            const double ns = lookups > 0 ? detect_ms[b] * 1e6 / double(lookups) : std::nan("");
+            stats.row(s.name, int(s.generated), scheme->name(), scheme->resolution(), p, to_string(mode),
+                      b == 0 ? "ball" : "socket", fit.centre.x(), fit.centre.y(), fit.centre.z(), fit.radius,
+                      fit.rms_residual, cor_error, sm.vertices, sm.vertices_tested, sm.vertices_no_surface,
+                      sm.vertices_beyond_reach, sm.min_gap_mm, sm.vertices_penetrating, sm.area_penetrating_mm2,
+                      sm.level_vertices[0], sm.level_vertices[1], sm.level_vertices[2], sm.level_vertices[3],
+                      sm.level_vertices[4], body.map.num_nodes(), body.sampling.nodes_covered,
+                      std::int64_t(body.map.bytes()), sample_ms[b], detect_ms[b], ns, b == 0 ? p95 : std::nan(""),
+                      b == 0 ? vs_p95 : std::nan(""), b == 0 ? vs_max : std::nan(""), b == 0 ? vs_n : std::int64_t(0));
+          }
+          if (p == 0.5 && mode == DistanceMode::exact) {
+            const std::string suffix = helix ? "_helix.png" : ".png";
+            write_map_png(dir + "/map_" + s.name + "_ball" + suffix, joint.ball().map);
+            write_map_png(dir + "/map_" + s.name + "_socket" + suffix, joint.socket().map);
+          }
+          if (p == finest && mode == DistanceMode::exact && !helix) {
+            const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};
+            for (int b = 0; b < 2; ++b)
+              for (Eigen::Index i = 0; i < bodies[b]->relative.rows(); ++i) {
+                if (bodies[b]->relative.row(i).norm() > 45) continue;
+                const Eigen::Vector3d v = bodies[b]->mesh.V.row(i).transpose();
+                vertices.row(s.name, b == 0 ? "ball" : "socket", std::int64_t(i), v.x(), v.y(), v.z(),
+                             double(gaps[b]->gap_mm[static_cast<std::size_t>(i)]));
+              }
+          }
         }
       }
-     }
     }
   }
   nlohmann::json subj = nlohmann::json::array();
   for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
   write_meta(dir, args,
-             {{"precisions_deg", precisions}, {"helix_turns", "round(720 / (pi p)) for each precision p"},
-              {"modes", {"exact", "linear"}}, {"pose_deg", {0, 0, 0}},
-              {"subjects", subj}, {"cor", "fit_femoral_head defaults (RANSAC + geometric sphere fit)"},
-              {"vertex_gaps_region_mm", 45}, {"occlusion_tolerance_mm", JointOptions{}.occlusion_tolerance_mm},
+             {{"precisions_deg", precisions},
+              {"helix_turns", "round(720 / (pi p)) for each precision p"},
+              {"modes", {"exact", "linear"}},
+              {"pose_deg", {0, 0, 0}},
+              {"subjects", subj},
+              {"cor", "fit_femoral_head defaults (RANSAC + geometric sphere fit)"},
+              {"vertex_gaps_region_mm", 45},
+              {"occlusion_tolerance_mm", JointOptions{}.occlusion_tolerance_mm},
               {"levels_thresholds_mm", ImpingementLevels{}.thresholds_mm}});
   return 0;
 }

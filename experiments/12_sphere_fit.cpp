@@ -37,8 +37,9 @@ int main(int argc, char** argv) {
     for (double noise : noises)
       for (double cov : coverages)
         for (double cam : cams) {
-          progress("12_sphere_fit", ++step, int(noises.size() * coverages.size() * cams.size()),
-                   "noise " + std::to_string(noise) + " coverage " + std::to_string(cov) + " cam " + std::to_string(cam));
+          progress(
+              "12_sphere_fit", ++step, int(noises.size() * coverages.size() * cams.size()),
+              "noise " + std::to_string(noise) + " coverage " + std::to_string(cov) + " cam " + std::to_string(cam));
           for (int seed = 0; seed < seeds; ++seed) {
             // Head points: a cap of half-angle `cov` about +z (superior) with Gaussian radial noise;
             // the cam bump: a Gaussian bump of height `cam` and width 15 deg at 60 deg from the top.
@@ -79,8 +80,8 @@ int main(int argc, char** argv) {
           }
         }
   }
-  CsvWriter real(dir + "/real.csv", {"subject", "proximal_extent_mm", "inlier_threshold_mm", "cx_mm", "cy_mm",
-                                     "cz_mm", "radius_mm", "rms_mm", "inliers", "shift_from_default_mm"});
+  CsvWriter real(dir + "/real.csv", {"subject", "proximal_extent_mm", "inlier_threshold_mm", "cx_mm", "cy_mm", "cz_mm",
+                                     "radius_mm", "rms_mm", "inliers", "shift_from_default_mm"});
   CsvWriter res(dir + "/residuals.csv", {"subject", "phi_deg", "theta_deg", "residual_mm"});
   for (const Subject& s : load_subjects(args, {12000})) {
     const SphereFitResult def = fit_femoral_head(s.femur);
@@ -108,7 +109,11 @@ int main(int argc, char** argv) {
     }
   }
   write_meta(dir, args,
-             {{"seeds", seeds}, {"points", 4000}, {"radius_mm", 22}, {"cam_width_deg", 15}, {"cam_at_deg", 60},
+             {{"seeds", seeds},
+              {"points", 4000},
+              {"radius_mm", 22},
+              {"cam_width_deg", 15},
+              {"cam_at_deg", 60},
               {"thesis_source", "thesis sec. 3.4, Fig. 38-39; Eberly 1999"},
               {"automatic", "fit_femoral_head defaults (RANSAC 3000 iterations, 1 mm band, 4 geometric refits)"}});
   return 0;

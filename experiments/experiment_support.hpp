@@ -2,12 +2,12 @@
 // Shared pieces of the experiment drivers: command line, subjects, timing, CSV and meta.json.
 #include <chrono>
 #include <cmath>
-#include <sstream>
-#include <type_traits>
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "impinge/generated_models.hpp"
@@ -29,8 +29,8 @@ Args parse_args(int argc, char** argv, const std::string& description);
 
 /// A joint to run on: a real subject or a generated one, in the anatomical frame.
 struct Subject {
-  std::string name;      ///< folder name or "generated-3k"
-  std::string source;    ///< citation / generator
+  std::string name;    ///< folder name or "generated-3k"
+  std::string source;  ///< citation / generator
   bool generated = false;
   Side side = Side::right;
   TriangleMesh femur, pelvis;

@@ -2,11 +2,12 @@
 // a -> b: the cardioid, 4 a sin(phi / 2)); Table 10 and the closed form 3.03 b to the printed
 // digits; equal-length angles cut the curve into equal lengths; the weighted grid keeps the
 // scheme invariants.
+#include "impinge/conchoid.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "impinge/conchoid.hpp"
 #include "impinge/conchoid_grid.hpp"
 #include "impinge/error.hpp"
 #include "impinge/radial_distance_map.hpp"
@@ -23,8 +24,8 @@ TEST(Conchoid, ArcLengthClosedForms) {
 }
 
 TEST(Conchoid, ThesisNumbersToPrintedDigits) {
-  EXPECT_NEAR(conchoid_length_thesis(1.0), 3.03, 0.005);  // "3.03 b"
-  EXPECT_NEAR(kMenschikA / kMenschikB, 1.15, 0.005);       // "a = 1.15 b"
+  EXPECT_NEAR(conchoid_length_thesis(1.0), 3.03, 0.005);    // "3.03 b"
+  EXPECT_NEAR(kMenschikA / kMenschikB, 1.15, 0.005);        // "a = 1.15 b"
   const std::vector<double> t10 = conchoid_angles_eq16(4);  // Table 10: 0, 27, 56, 90 deg
   const double printed[] = {0, 27, 56, 90};
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(t10[i] * kRadToDeg, printed[i], 0.5) << i;

@@ -5,12 +5,13 @@
 //    every gap unchanged;
 //  - a ball pushed into the cup reports penetration with the analytic depth;
 //  - vertices hidden behind their own first surface are skipped and counted, not reported.
+#include "impinge/detection.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 
-#include "impinge/detection.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/joint.hpp"
 #include "impinge/pose.hpp"

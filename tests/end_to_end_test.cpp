@@ -8,9 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "impinge/joint.hpp"
@@ -58,8 +58,8 @@ TEST(EndToEnd, CliOnGeneratedSubject) {
   for (const char* key : {"cor_mm", "head_radius_mm", "sphere_fit_rms_mm", "precision_deg", "mode", "pose_deg"})
     EXPECT_TRUE(j.contains(key)) << key;
   for (const char* body : {"ball", "socket"})
-    for (const char* key : {"vertices_tested", "vertices_no_surface", "min_gap_mm", "vertices_penetrating",
-                            "map_nodes", "map_nodes_covered", "map_bytes", "sampling_ms", "detection_ms"})
+    for (const char* key : {"vertices_tested", "vertices_no_surface", "min_gap_mm", "vertices_penetrating", "map_nodes",
+                            "map_nodes_covered", "map_bytes", "sampling_ms", "detection_ms"})
       EXPECT_TRUE(j[body].contains(key)) << body << "." << key;
   EXPECT_EQ(j["mode"], "linear");
   EXPECT_NEAR(j["head_radius_mm"].get<double>(), 22, 0.05);

@@ -1,11 +1,12 @@
 // Invariants: node counts follow thesis Table 2; node(direction(i)) == i off the poles; every
 // pole-row node points at the pole; stencils have non-negative weights summing to 1 and
 // reproduce the direction's (phi, theta) bilinearly; bad precisions throw.
+#include "impinge/equiangular_grid.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "impinge/equiangular_grid.hpp"
 #include "impinge/error.hpp"
 #include "impinge/spherical_frame.hpp"
 

@@ -1,10 +1,11 @@
 // CGAL exact references against closed forms: first hit from inside a fine sphere and closest
 // distance from outside; the point index against brute force.
+#include "impinge/exact_reference.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "impinge/exact_reference.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/naive_sampling.hpp"
 #include "impinge/spherical_frame.hpp"

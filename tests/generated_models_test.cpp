@@ -1,11 +1,11 @@
 // Generated models: closed (every edge shared by exactly two triangles), triangle counts near
 // the target, the head sphere and cup concentric about the true COR.
+#include "impinge/generated_models.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
-
-#include "impinge/generated_models.hpp"
 
 using namespace impinge;
 

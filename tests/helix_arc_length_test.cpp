@@ -1,13 +1,14 @@
 // Helix arc length against independent quadrature (Gauss-Legendre of sqrt(1 + 4k^2 sin^2 t)), the
 // closed forms (k -> 0: a meridian, s = phi; total length -> 4k + O(log k / k)), and the fast
 // tabulated form against the elliptic-integral one to 1e-9 of a node spacing.
-#include <gtest/gtest.h>
+#include "impinge/helix_arc_length.hpp"
+
 #include <gsl/gsl_integration.h>
+#include <gtest/gtest.h>
 
 #include <random>
 
 #include "impinge/error.hpp"
-#include "impinge/helix_arc_length.hpp"
 #include "impinge/spherical_frame.hpp"
 
 using namespace impinge;
@@ -49,7 +50,9 @@ TEST(HelixArcLength, EllipticIntegralMatchesQuadrature) {
 TEST(HelixArcLength, ClosedFormLimits) {
   const HelixArcLength meridian(1e-9);  // k -> 0: the helix is a meridian, s = phi
   for (double phi : {0.3, 1.7, kPi}) EXPECT_NEAR(meridian.exact(phi), phi, 1e-12);
-  for (double k : {229.0, 4584.0}) {  // s(pi) = 4k + (ln(8k) + 1/2) / (2k) + ... (E near kappa = 1: E ~ 1 + kp^2 (ln(4/kp) - 1/2) / 2)
+  for (double k :
+       {229.0,
+        4584.0}) {  // s(pi) = 4k + (ln(8k) + 1/2) / (2k) + ... (E near kappa = 1: E ~ 1 + kp^2 (ln(4/kp) - 1/2) / 2)
     const HelixArcLength s(k);
     EXPECT_GT(s.total(), 4 * k);
     EXPECT_NEAR(s.total(), 4 * k + (std::log(8 * k) + 0.5) / (2 * k), 1e-3 / k);

@@ -7,6 +7,8 @@
 //    and the theta seam;
 //  - weights are >= 0 and sum to 1, so a constant map interpolates to the constant everywhere;
 //  - Eq. 10 locating picks other neighbours for a fraction of directions (reported).
+#include "impinge/helix_scheme.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -15,7 +17,6 @@
 #include <set>
 
 #include "impinge/error.hpp"
-#include "impinge/helix_scheme.hpp"
 #include "impinge/radial_distance_map.hpp"
 #include "impinge/spherical_frame.hpp"
 
@@ -59,8 +60,7 @@ TEST(HelixScheme, NodeOfDirectionRoundTrips) {
     const HelixScheme h(k);
     std::vector<double> phi(h.num_nodes()), theta(h.num_nodes());
     h.node_angles(0, h.num_nodes(), phi.data(), theta.data());
-    for (std::int64_t i = 0; i < h.num_nodes(); ++i)
-      ASSERT_EQ(h.node(direction(phi[i], theta[i])), i) << "k=" << k;
+    for (std::int64_t i = 0; i < h.num_nodes(); ++i) ASSERT_EQ(h.node(direction(phi[i], theta[i])), i) << "k=" << k;
   }
 }
 

@@ -1,8 +1,9 @@
 // Level boundaries follow the documented half-open intervals; purple includes gap == 0.
+#include "impinge/impingement_levels.hpp"
+
 #include <gtest/gtest.h>
 
 #include "impinge/error.hpp"
-#include "impinge/impingement_levels.hpp"
 
 using namespace impinge;
 

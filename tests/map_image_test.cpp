@@ -1,11 +1,12 @@
 // The map PNG has columns x rows pixels (theta across, phi down): checked in the IHDR chunk.
+#include "impinge/map_image.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <iterator>
 
 #include "impinge/error.hpp"
-#include "impinge/map_image.hpp"
 #include "test_support.hpp"
 
 using namespace impinge;

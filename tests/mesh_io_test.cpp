@@ -1,10 +1,11 @@
 // Mesh loading: every bad file gives an impinge::Error naming the file and the element; a
 // PLY written and read back keeps vertex order and count; degenerate triangles are counted.
+#include "impinge/mesh_io.hpp"
+
 #include <gtest/gtest.h>
 
 #include "impinge/error.hpp"
 #include "impinge/generated_models.hpp"
-#include "impinge/mesh_io.hpp"
 #include "test_support.hpp"
 
 using namespace impinge;

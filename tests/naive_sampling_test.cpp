@@ -1,12 +1,13 @@
 // The naive caster is itself an oracle, so it is checked against closed forms: rays from
 // inside a fine sphere hit it at the analytic distance (minus faceting), rays that miss a
 // single triangle return nothing, and the nearest of two shells is returned.
+#include "impinge/naive_sampling.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "impinge/generated_models.hpp"
-#include "impinge/naive_sampling.hpp"
 #include "impinge/spherical_frame.hpp"
 #include "test_support.hpp"
 
@@ -39,6 +40,6 @@ TEST(NaiveSampling, NearestOfTwoShellsAndMisses) {
   EXPECT_FALSE(cast_ray_naive(cup, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -1)).has_value());
   RadialDistanceMap map{EquiangularGrid(5)};
   sample_naive(cup, Eigen::Vector3d::Zero(), map);
-  EXPECT_TRUE(map.has_surface(0));                       // north pole row
-  EXPECT_FALSE(map.has_surface(map.num_nodes() - 1));    // south pole row: no cup there
+  EXPECT_TRUE(map.has_surface(0));                     // north pole row
+  EXPECT_FALSE(map.has_surface(map.num_nodes() - 1));  // south pole row: no cup there
 }

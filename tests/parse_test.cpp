@@ -1,8 +1,9 @@
 // Number lists: exact parse, count check, and errors that quote the option and the bad item.
+#include "impinge/parse.hpp"
+
 #include <gtest/gtest.h>
 
 #include "impinge/error.hpp"
-#include "impinge/parse.hpp"
 
 using namespace impinge;
 

@@ -1,9 +1,10 @@
 // Pose angles: + flexion moves the knee (distal femur, -z) anterior (+y), + abduction moves it
 // lateral (+x on the right, -x on the left), + rotation turns the anterior femur medially.
+#include "impinge/pose.hpp"
+
 #include <gtest/gtest.h>
 
 #include "impinge/error.hpp"
-#include "impinge/pose.hpp"
 
 using namespace impinge;
 

@@ -7,13 +7,14 @@
 //  - linear mode stays within its interpolation bound (vertex-distance range of the triangle
 //    down to the plane distance) of the exact ray cast;
 //  - on a sphere off the COR the map converges to the analytic ray-sphere distance as p shrinks.
+#include "impinge/rasterize.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "impinge/generated_models.hpp"
 #include "impinge/naive_sampling.hpp"
-#include "impinge/rasterize.hpp"
 #include "impinge/spherical_frame.hpp"
 #include "test_support.hpp"
 
@@ -104,7 +105,8 @@ TEST(Rasterize, ClosedMeshAroundCorCoversEveryNode) {
   std::mt19937_64 rng(11);
   for (int trial = 0; trial < 4; ++trial) {
     // random axis: poles and seams fall on arbitrary triangles; one trial with the z axis
-    const Eigen::Vector3d axis = trial == 0 ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : Eigen::Vector3d(test::random_rotation(rng).col(0));
+    const Eigen::Vector3d axis =
+        trial == 0 ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : Eigen::Vector3d(test::random_rotation(rng).col(0));
     const TriangleMesh s = make_uv_sphere(20, Eigen::Vector3d::Zero(), 17 + trial, 9 + trial, axis);
     for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
       for (double p : {1.0, 0.5}) {
@@ -144,9 +146,9 @@ TEST(Rasterize, ExactModeAgreesWithNaiveOnNonStarShapedMesh) {
   const Eigen::Vector3d cor(1.0, -0.5, 0.7);
   std::vector<TriangleMesh> meshes;
   meshes.push_back(make_cup(25, 31, 110, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.3, 0.5, 0.8), 14, 5));
-  meshes.push_back(make_radial_surface(
-      [](const Eigen::Vector3d& u) { return 20 + 2 * std::sin(3 * u.x()) * std::cos(2 * u.y()); },
-      Eigen::Vector3d::Zero(), 13, 8, Eigen::Vector3d(0.2, -0.9, 0.3)));
+  meshes.push_back(
+      make_radial_surface([](const Eigen::Vector3d& u) { return 20 + 2 * std::sin(3 * u.x()) * std::cos(2 * u.y()); },
+                          Eigen::Vector3d::Zero(), 13, 8, Eigen::Vector3d(0.2, -0.9, 0.3)));
   for (const TriangleMesh& m0 : meshes) {
     const TriangleMesh m = test::transformed(m0, test::random_rotation(rng), Eigen::Vector3d::Zero());
     RadialDistanceMapDouble r{EquiangularGrid(2.0)}, n{EquiangularGrid(2.0)};
@@ -164,9 +166,8 @@ TEST(Rasterize, LinearModeWithinInterpolationBoundOfExact) {
   // exact one in [dist(COR, plane of t), max_k |v_k|], so |linear - exact| <= max_k |v_k| -
   // dist(COR, plane). Checked on every node against the triangle the naive caster hits.
   const Eigen::Vector3d cor(0.4, 0.2, -0.3);
-  const TriangleMesh m = make_radial_surface(
-      [](const Eigen::Vector3d& u) { return 22 + 1.5 * u.x() * u.y(); }, Eigen::Vector3d::Zero(), 15, 9,
-      Eigen::Vector3d(0.5, 0.5, 0.7));
+  const TriangleMesh m = make_radial_surface([](const Eigen::Vector3d& u) { return 22 + 1.5 * u.x() * u.y(); },
+                                             Eigen::Vector3d::Zero(), 15, 9, Eigen::Vector3d(0.5, 0.5, 0.7));
   RadialDistanceMapDouble lin{EquiangularGrid(2.0)}, n{EquiangularGrid(2.0)};
   rasterize(m, cor, DistanceMode::linear, lin);
   std::vector<std::int64_t> tri;

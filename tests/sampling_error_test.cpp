@@ -1,11 +1,12 @@
 // Thesis Table 5 (Eq. 7-8 at r = 22 mm) and the slice analysis of sec. 3.5.2 reproduced to the
 // printed digits; the interpolation bound helpers against closed forms.
+#include "impinge/sampling_error.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "impinge/error.hpp"
-#include "impinge/sampling_error.hpp"
 
 using namespace impinge;
 
@@ -22,7 +23,7 @@ TEST(SamplingError, Table5ToPrintedDigits) {
 
 TEST(SamplingError, SliceAnalysisOfThesis) {
   const SliceAnalysis a = slice_sampling(22, 1.25);
-  EXPECT_EQ(a.dphi_deg.size(), 17u);  // 17 slices above the middle plane
+  EXPECT_EQ(a.dphi_deg.size(), 17u);      // 17 slices above the middle plane
   EXPECT_NEAR(a.min_dphi_deg, 3.0, 0.3);  // "about 3 deg"
   EXPECT_NEAR(a.min_dphi_deg, 90 - std::acos(1.25 / 22) * 180 / 3.14159265358979323846, 1e-12);
   EXPECT_NEAR(a.nyquist_precision_deg, a.min_dphi_deg / 2, 1e-15);

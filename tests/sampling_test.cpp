@@ -2,12 +2,13 @@
 // resample it at the helix points) agrees with casting every helix point's ray within the
 // bilinear resampling bound; the automatic method picks rasterisation for equiangular maps and
 // resampling otherwise; rasterising into a helix map is refused with a clear error.
+#include "impinge/sampling.hpp"
+
 #include <gtest/gtest.h>
 
 #include "impinge/error.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/helix_scheme.hpp"
-#include "impinge/sampling.hpp"
 #include "impinge/spherical_frame.hpp"
 
 using namespace impinge;

@@ -2,13 +2,14 @@
 // (30 % of the sphere, sigma = 0.05 mm) gives the centre within 0.05 mm and the radius within
 // 0.03 mm with the geometric fit; the automatic head fit finds a generated head's centre and
 // radius despite the neck and a cam bump; too few / coplanar points throw.
+#include "impinge/sphere_fit.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "impinge/error.hpp"
 #include "impinge/generated_models.hpp"
-#include "impinge/sphere_fit.hpp"
 #include "impinge/spherical_frame.hpp"
 
 using namespace impinge;

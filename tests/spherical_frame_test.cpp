@@ -1,9 +1,9 @@
 // Thesis Eq. 5 and 6 are inverse to each other; theta is wrapped into [0, 2 pi).
+#include "impinge/spherical_frame.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
-
-#include "impinge/spherical_frame.hpp"
 
 using namespace impinge;
 

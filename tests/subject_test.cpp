@@ -1,8 +1,9 @@
 // subject.json parsing and frames: LPS maps to RAS by negating x and y; bad keys name the file.
+#include "impinge/subject.hpp"
+
 #include <gtest/gtest.h>
 
 #include "impinge/error.hpp"
-#include "impinge/subject.hpp"
 #include "test_support.hpp"
 
 using namespace impinge;

@@ -23,7 +23,8 @@ ConchoidGrid::ConchoidGrid(double precision_deg, double a_mm, double b_mm) : pre
   for (int r = 1; r <= n_half; ++r) row_phi_.push_back(kPi / 2 + r * step_);
   row_phi_.back() = kPi;
   max_spacing_ = step_;
-  for (std::size_t r = 1; r < row_phi_.size(); ++r) max_spacing_ = std::max(max_spacing_, row_phi_[r] - row_phi_[r - 1]);
+  for (std::size_t r = 1; r < row_phi_.size(); ++r)
+    max_spacing_ = std::max(max_spacing_, row_phi_[r] - row_phi_[r - 1]);
 }
 
 Eigen::Vector3d ConchoidGrid::node_direction(std::int64_t i) const {

@@ -114,8 +114,8 @@ template void scan_gaps<float>(const Vertices&, const Eigen::Matrix3d&, const st
                                const RadialDistanceMapT<float>&, ScanSide, ScanGaps&);
 template void scan_gaps<double>(const Vertices&, const Eigen::Matrix3d&, const std::vector<std::uint8_t>&,
                                 const RadialDistanceMapT<double>&, ScanSide, ScanGaps&);
-template std::vector<std::uint8_t> first_surface_mask<float>(const Vertices&, const RadialDistanceMapT<float>&,
-                                                             double, double);
+template std::vector<std::uint8_t> first_surface_mask<float>(const Vertices&, const RadialDistanceMapT<float>&, double,
+                                                             double);
 template std::vector<std::uint8_t> first_surface_mask<double>(const Vertices&, const RadialDistanceMapT<double>&,
                                                               double, double);
 

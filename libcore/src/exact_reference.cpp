@@ -53,8 +53,8 @@ std::optional<double> ExactReference::first_hit(const Eigen::Vector3d& origin, c
   if (p != nullptr) return std::sqrt(CGAL::squared_distance(*p, ray.source()));
   const K::Segment_3* s = boost::get<K::Segment_3>(&hit->first);  // ray in the triangle's plane
   if (s != nullptr)
-    return std::sqrt(std::min(CGAL::squared_distance(s->source(), ray.source()),
-                              CGAL::squared_distance(s->target(), ray.source())));
+    return std::sqrt(
+        std::min(CGAL::squared_distance(s->source(), ray.source()), CGAL::squared_distance(s->target(), ray.source())));
   return std::nullopt;
 }
 

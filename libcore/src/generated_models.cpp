@@ -57,8 +57,8 @@ TriangleMesh make_radial_surface(const std::function<double(const Eigen::Vector3
 
 TriangleMesh make_uv_sphere(double radius_mm, const Eigen::Vector3d& centre, int n_theta, int n_phi,
                             const Eigen::Vector3d& axis) {
-  TriangleMesh m = make_radial_surface([radius_mm](const Eigen::Vector3d&) { return radius_mm; }, centre, n_theta,
-                                       n_phi, axis);
+  TriangleMesh m =
+      make_radial_surface([radius_mm](const Eigen::Vector3d&) { return radius_mm; }, centre, n_theta, n_phi, axis);
   m.source = "generated sphere";
   return m;
 }
@@ -172,9 +172,9 @@ TriangleMesh make_conchoid_surface(double a_mm, double b_mm, const Eigen::Vector
                                    const Eigen::Vector3d& axis) {
   require(a_mm > b_mm && b_mm >= 0, "conchoid surface: need a > b >= 0");
   const Eigen::Vector3d ax = axis.normalized();
-  TriangleMesh m = make_radial_surface(
-      [&](const Eigen::Vector3d& u) { return a_mm + b_mm * std::clamp(u.dot(ax), -1.0, 1.0); }, origin, n_theta,
-      n_phi, ax);
+  TriangleMesh m =
+      make_radial_surface([&](const Eigen::Vector3d& u) { return a_mm + b_mm * std::clamp(u.dot(ax), -1.0, 1.0); },
+                          origin, n_theta, n_phi, ax);
   m.source = "generated conchoid surface";
   return m;
 }
@@ -188,7 +188,8 @@ HipModel make_hip_model(const HipModelOptions& o) {
   const Eigen::Vector3d neck = Eigen::Vector3d(0.80, 0.25, -0.55).normalized();
   const double alpha0 = std::asin(o.neck_radius_mm / o.head_radius_mm);
   // cam bump: antero-superior side of the head-neck junction
-  const Eigen::Vector3d up_ant = (Eigen::Vector3d(0, 0.5, 1) - neck * neck.dot(Eigen::Vector3d(0, 0.5, 1))).normalized();
+  const Eigen::Vector3d up_ant =
+      (Eigen::Vector3d(0, 0.5, 1) - neck * neck.dot(Eigen::Vector3d(0, 0.5, 1))).normalized();
   const Eigen::Vector3d cam_dir = (std::cos(alpha0 + 0.12) * neck + std::sin(alpha0 + 0.12) * up_ant).normalized();
   auto ball_radius = [&](const Eigen::Vector3d& u) {
     const double ca = std::clamp(u.dot(neck), -1.0, 1.0), alpha = std::acos(ca);
@@ -206,7 +207,8 @@ HipModel make_hip_model(const HipModelOptions& o) {
   h.ball = make_radial_surface(ball_radius, o.cor, nt, np, neck);
   h.ball.source = "generated ball (" + std::to_string(o.target_triangles) + " triangles)";
   const Eigen::Vector3d cup_axis = Eigen::Vector3d(-0.65, -0.2, 0.73).normalized();
-  const int nb = std::max(6, static_cast<int>(std::lround(std::sqrt(o.target_triangles * 360.0 / (4 * o.cup_coverage_deg)))));
+  const int nb =
+      std::max(6, static_cast<int>(std::lround(std::sqrt(o.target_triangles * 360.0 / (4 * o.cup_coverage_deg)))));
   const int na = std::max(1, static_cast<int>(std::lround(o.target_triangles / (4.0 * nb))));
   const double inner = o.head_radius_mm + o.cartilage_gap_mm;
   h.socket = make_cup(inner, inner + o.cup_wall_mm, o.cup_coverage_deg, o.cor, cup_axis, nb, na);

@@ -7,9 +7,13 @@
 namespace impinge {
 
 namespace {
-const std::shared_ptr<const SamplingScheme>& checked(const std::shared_ptr<const SamplingScheme>& s) {
-  require(s != nullptr, "joint: no sampling scheme given");
-  return s;
+const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
+  require(o.scheme != nullptr, "joint: no sampling scheme given");
+  require(cor.allFinite(), "joint: centre of rotation is not finite");
+  require(o.occlusion_tolerance_mm >= 0, "joint: occlusion tolerance must be >= 0 mm");
+  require(o.max_radius_mm > 0, "joint: region radius must be > 0 mm");
+  o.levels.validate();
+  return o;
 }
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -17,27 +21,16 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options)
-    : cor_(cor),
-      options_(options),
-      ball_{TriangleMesh{}, Vertices{}, RadialDistanceMap{checked(options.scheme)}, {}, {}, {}, 0},
-      socket_{TriangleMesh{}, Vertices{}, RadialDistanceMap{options.scheme}, {}, {}, {}, 0} {
-  require(cor.allFinite(), "joint: centre of rotation is not finite");
-  require(options.occlusion_tolerance_mm >= 0, "joint: occlusion tolerance must be >= 0 mm");
-  require(options.max_radius_mm > 0, "joint: region radius must be > 0 mm");
-  options.levels.validate();
-  validate_mesh(ball);
-  validate_mesh(socket);
-  ball_ = build(std::move(ball));
-  socket_ = build(std::move(socket));
-}
+    : cor_(cor), options_(checked(options, cor)), ball_(build(std::move(ball))), socket_(build(std::move(socket))) {}
 
 JointBody Joint::build(TriangleMesh mesh) const {
+  validate_mesh(mesh);
   JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, 0};
   b.relative = b.mesh.V.rowwise() - cor_.transpose();
-  const auto t0 = std::chrono::steady_clock::now();
   SamplingOptions so;
   so.mode = options_.mode;
   so.method = options_.sampling;
+  const auto t0 = std::chrono::steady_clock::now();
   b.sampling = sample_surface(b.mesh, cor_, so, b.map);
   b.sampling_ms = ms_since(t0);
   b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);

@@ -36,7 +36,6 @@ void write_grey_png(const std::string& path, const unsigned char* pixels, int w,
 }
 }  // namespace
 
-
 void write_map_png(const std::string& path, const RadialDistanceMap& map) {
   // Pixel values: the node values of an equiangular map, else the map interpolated at the
   // nodes of an equiangular image grid matched to the scheme's spacing (at most 3600 x 1801).

@@ -15,8 +15,8 @@ void validate_mesh(const TriangleMesh& mesh) {
     for (int k = 0; k < 3; ++k) {
       if (!std::isfinite(mesh.V(i, k))) {
         std::ostringstream os;
-        os << src << ": vertex " << i << " has a non-finite coordinate (" << mesh.V(i, 0) << ", "
-           << mesh.V(i, 1) << ", " << mesh.V(i, 2) << ")";
+        os << src << ": vertex " << i << " has a non-finite coordinate (" << mesh.V(i, 0) << ", " << mesh.V(i, 1)
+           << ", " << mesh.V(i, 2) << ")";
         throw Error(os.str());
       }
     }
@@ -54,8 +54,7 @@ int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2) {
 Eigen::VectorXd vertex_areas(const TriangleMesh& mesh) {
   Eigen::VectorXd area = Eigen::VectorXd::Zero(mesh.V.rows());
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-    const Eigen::Vector3d pa = mesh.V.row(mesh.F(f, 0)), pb = mesh.V.row(mesh.F(f, 1)),
-                          pc = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d pa = mesh.V.row(mesh.F(f, 0)), pb = mesh.V.row(mesh.F(f, 1)), pc = mesh.V.row(mesh.F(f, 2));
     const double third = (pb - pa).cross(pc - pa).norm() / 6.0;
     for (int k = 0; k < 3; ++k) area[mesh.F(f, k)] += third;
   }

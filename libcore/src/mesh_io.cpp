@@ -71,16 +71,15 @@ TriangleMesh load_mesh(const std::string& path) {
       const aiFace& face = am->mFaces[f];
       if (face.mNumIndices != 3) {
         std::ostringstream os;
-        os << path << ": face " << (fo + f) << " has " << face.mNumIndices
-           << " vertices; only triangles are supported";
+        os << path << ": face " << (fo + f) << " has " << face.mNumIndices << " vertices; only triangles are supported";
         throw Error(os.str());
       }
       for (int k = 0; k < 3; ++k) {
         const unsigned idx = face.mIndices[k];
         if (idx >= am->mNumVertices) {
           std::ostringstream os;
-          os << path << ": face " << (fo + f) << " has vertex index " << idx << " outside [0, "
-             << am->mNumVertices << ")";
+          os << path << ": face " << (fo + f) << " has vertex index " << idx << " outside [0, " << am->mNumVertices
+             << ")";
           throw Error(os.str());
         }
         mesh.F(fo + f, k) = static_cast<int>(vo + idx);
@@ -109,8 +108,8 @@ void write_faces(std::ofstream& os, const Faces& F) {
 }
 }  // namespace
 
-void write_gap_ply(const std::string& path, const Vertices& V, const Faces& F,
-                   const Eigen::VectorXf& gap_mm, const Eigen::Matrix<unsigned char, Eigen::Dynamic, 1>& level,
+void write_gap_ply(const std::string& path, const Vertices& V, const Faces& F, const Eigen::VectorXf& gap_mm,
+                   const Eigen::Matrix<unsigned char, Eigen::Dynamic, 1>& level,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor>& rgb) {
   require(gap_mm.size() == V.rows() && level.size() == V.rows() && rgb.rows() == V.rows(),
           path + ": per-vertex arrays do not match the vertex count");

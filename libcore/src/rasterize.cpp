@@ -33,10 +33,10 @@ bool on_axis(const V3& v) { return v.x() * v.x() + v.y() * v.y() <= 1e-24 * v.sq
 /// A triangle corner relative to the COR with its spherical coordinates, computed once per
 /// mesh vertex (theta of a point on the axis is 0).
 struct Corner {
-  V3 p;        ///< position relative to the COR, mm
-  V3 u;        ///< unit direction
+  V3 p;  ///< position relative to the COR, mm
+  V3 u;  ///< unit direction
   double d, phi, theta;
-  bool axis;   ///< on the z axis (a pole vertex, thesis case 1)
+  bool axis;  ///< on the z axis (a pole vertex, thesis case 1)
 };
 Corner corner(const V3& v) {
   const SphericalCoordinates s = to_spherical(v);
@@ -203,8 +203,8 @@ class Rasterizer {
   }
 
   /// Thesis linear mode: barycentric interpolation in the (theta, phi) plane.
-  static double planar_value(const Corner& ka, const Corner& kb, const Corner& kc, double ta, double tb,
-                             double tc, double area2, double phi, double theta, double exact) {
+  static double planar_value(const Corner& ka, const Corner& kb, const Corner& kc, double ta, double tb, double tc,
+                             double area2, double phi, double theta, double exact) {
     if (std::abs(area2) < 1e-18) return exact;  // collapsed in the grid: no 2-D interpolant
     const double tn = ta + wrap_pi(theta - ta);
     double lb = ((tn - ta) * (kc.phi - ka.phi) - (tc - ta) * (phi - ka.phi)) / area2;

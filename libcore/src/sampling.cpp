@@ -20,10 +20,14 @@ SamplingMethod parse_sampling_method(const std::string& name) {
 
 const char* to_string(SamplingMethod method) {
   switch (method) {
-    case SamplingMethod::automatic: return "auto";
-    case SamplingMethod::rasterize: return "rasterize";
-    case SamplingMethod::resample: return "resample";
-    case SamplingMethod::ray_cast: return "ray-cast";
+    case SamplingMethod::automatic:
+      return "auto";
+    case SamplingMethod::rasterize:
+      return "rasterize";
+    case SamplingMethod::resample:
+      return "resample";
+    case SamplingMethod::ray_cast:
+      return "ray-cast";
   }
   return "?";
 }

@@ -18,8 +18,7 @@ double eq8_relative_error(double equator_nodes) {
 }
 
 SliceAnalysis slice_sampling(double radius_mm, double slice_mm) {
-  require(std::isfinite(radius_mm) && std::isfinite(slice_mm) && radius_mm > 0 && slice_mm > 0 &&
-              slice_mm <= radius_mm,
+  require(std::isfinite(radius_mm) && std::isfinite(slice_mm) && radius_mm > 0 && slice_mm > 0 && slice_mm <= radius_mm,
           "slice analysis: need 0 < slice thickness <= radius (mm)");
   SliceAnalysis a;
   const int n = static_cast<int>(std::floor(radius_mm / slice_mm + 1e-12));

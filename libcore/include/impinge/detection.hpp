@@ -24,22 +24,22 @@ enum class ScanSide { inside = 1, outside = -1 };
 /// out) or the other map has no surface in its direction; status[i] tells which.
 struct ScanGaps {
   enum Status : std::uint8_t { tested = 0, no_surface = 1, beyond_reach = 2 };
-  std::vector<float> gap_mm;          ///< n gaps, mm
-  std::vector<std::uint8_t> status;   ///< n statuses
+  std::vector<float> gap_mm;         ///< n gaps, mm
+  std::vector<std::uint8_t> status;  ///< n statuses
 };
 
 /// Statistics of a scan (thesis sec. 3.4 colour levels; counts so nothing is dropped silently).
 struct ScanSummary {
-  std::int64_t vertices = 0;             ///< vertices in the mesh
-  std::int64_t vertices_tested = 0;      ///< looked up and gap computed
-  std::int64_t vertices_no_surface = 0;  ///< the other map has no surface in their direction
-  std::int64_t vertices_beyond_reach = 0;  ///< skipped: not on their body's first surface seen
-                                            ///< from the COR, or beyond the region radius
+  std::int64_t vertices = 0;                                     ///< vertices in the mesh
+  std::int64_t vertices_tested = 0;                              ///< looked up and gap computed
+  std::int64_t vertices_no_surface = 0;                          ///< the other map has no surface in their direction
+  std::int64_t vertices_beyond_reach = 0;                        ///< skipped: not on their body's first surface seen
+                                                                 ///< from the COR, or beyond the region radius
   double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< NaN when none tested
-  std::int64_t vertices_penetrating = 0;  ///< gap <= 0
-  double area_penetrating_mm2 = 0;        ///< their vertex area
-  std::vector<std::int64_t> level_vertices;  ///< count per impingement level
-  std::vector<double> level_area_mm2;        ///< vertex area per impingement level
+  std::int64_t vertices_penetrating = 0;                         ///< gap <= 0
+  double area_penetrating_mm2 = 0;                               ///< their vertex area
+  std::vector<std::int64_t> level_vertices;                      ///< count per impingement level
+  std::vector<double> level_area_mm2;                            ///< vertex area per impingement level
 };
 
 /// One scan of Algorithm 2: for every vertex i with mask[i] != 0, q = R * P.row(i) (P: n x 3,

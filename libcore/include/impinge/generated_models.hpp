@@ -41,15 +41,15 @@ TriangleMesh make_conchoid_surface(double a_mm, double b_mm, const Eigen::Vector
 
 /// Options of a generated hip (right side, anatomical RAS frame).
 struct HipModelOptions {
-  int target_triangles = 3000;        ///< per model (thesis levels 300, 1k, 3k, 12k)
-  double head_radius_mm = 22;         ///< femoral head (44 mm diameter, thesis sec. 3.5)
-  double cartilage_gap_mm = 2.5;      ///< cup inner radius minus head radius
-  double neck_radius_mm = 15;         ///< femoral neck (a cylinder)
-  double neck_length_mm = 50;         ///< COR to the neck's cut end
-  double cup_wall_mm = 6;             ///< cup thickness
-  double cup_coverage_deg = 100;      ///< rim angle from the cup pole; > 90 over-covers (pincer)
-  double cam_height_mm = 0;           ///< cam bump at the antero-superior head-neck junction
-  Eigen::Vector3d cor{60, -20, 30};   ///< where the model is placed, mm
+  int target_triangles = 3000;       ///< per model (thesis levels 300, 1k, 3k, 12k)
+  double head_radius_mm = 22;        ///< femoral head (44 mm diameter, thesis sec. 3.5)
+  double cartilage_gap_mm = 2.5;     ///< cup inner radius minus head radius
+  double neck_radius_mm = 15;        ///< femoral neck (a cylinder)
+  double neck_length_mm = 50;        ///< COR to the neck's cut end
+  double cup_wall_mm = 6;            ///< cup thickness
+  double cup_coverage_deg = 100;     ///< rim angle from the cup pole; > 90 over-covers (pincer)
+  double cam_height_mm = 0;          ///< cam bump at the antero-superior head-neck junction
+  Eigen::Vector3d cor{60, -20, 30};  ///< where the model is placed, mm
 };
 
 /// A generated joint and its true COR.

@@ -59,7 +59,7 @@ class HelixArcLength {
   static constexpr double kPiHelix = 3.14159265358979323846;
   double quarter(double phi) const;  ///< s(phi) for phi in [0, pi/2]
   double k_, m_, total_;
-  double cap_;    ///< below cap_ (and above pi - cap_) s is computed exactly
+  double cap_;  ///< below cap_ (and above pi - cap_) s is computed exactly
   int intervals_;
   double h_, inv_h_;
   std::vector<double> s_, ds_;  ///< s(phi) and s'(phi) at phi = j h

@@ -21,24 +21,24 @@ namespace impinge {
 struct JointOptions {
   /// Sampling scheme of both maps (make_scheme); default equiangular at p = 0.5 deg.
   std::shared_ptr<const SamplingScheme> scheme = make_scheme("equiangular", 0.5);
-  DistanceMode mode = DistanceMode::exact;    ///< rasterisation distance mode
-  SamplingMethod sampling = SamplingMethod::automatic;  ///< how maps are filled
-  double occlusion_tolerance_mm = 1.0;        ///< a vertex farther than its own map's surface
-                                              ///< plus this is hidden (not on the first surface)
+  DistanceMode mode = DistanceMode::exact;                         ///< rasterisation distance mode
+  SamplingMethod sampling = SamplingMethod::automatic;             ///< how maps are filled
+  double occlusion_tolerance_mm = 1.0;                             ///< a vertex farther than its own map's surface
+                                                                   ///< plus this is hidden (not on the first surface)
   double max_radius_mm = std::numeric_limits<double>::infinity();  ///< region of interest about
                                                                    ///< the COR, mm
-  ImpingementLevels levels;                   ///< gap classes
+  ImpingementLevels levels;                                        ///< gap classes
 };
 
 /// One body of the joint after preprocessing.
 struct JointBody {
-  TriangleMesh mesh;            ///< anatomical frame, mm
-  Vertices relative;            ///< n x 3, vertices minus the COR, mm
-  RadialDistanceMap map;        ///< its radial distance map about the COR
+  TriangleMesh mesh;               ///< anatomical frame, mm
+  Vertices relative;               ///< n x 3, vertices minus the COR, mm
+  RadialDistanceMap map;           ///< its radial distance map about the COR
   std::vector<std::uint8_t> mask;  ///< 1 for vertices on the first surface within the region
-  Eigen::VectorXd vertex_area;  ///< n, mm^2
-  SamplingReport sampling;      ///< how the map was filled, with counts
-  double sampling_ms = 0;       ///< wall time of filling the map, ms
+  Eigen::VectorXd vertex_area;     ///< n, mm^2
+  SamplingReport sampling;         ///< how the map was filled, with counts
+  double sampling_ms = 0;          ///< wall time of filling the map, ms
 };
 
 /// Result of both scans at one pose.

@@ -10,9 +10,9 @@ namespace impinge {
 
 /// Write `map` as an 8-bit grey PNG: theta across (0 at the left), phi down (0 at the top); for
 /// an equiangular map one pixel per node (columns x rows), for another scheme the map
-/// interpolated on an equiangular pixel grid matched to its node spacing (at most 0.1 deg). Covered nodes are grey from 40 (nearest) to 255 (farthest,
-/// normalised over the map); nodes with no surface are black (0). Throws impinge::Error if the
-/// file cannot be written.
+/// interpolated on an equiangular pixel grid matched to its node spacing (at most 0.1 deg). Covered nodes are grey from
+/// 40 (nearest) to 255 (farthest, normalised over the map); nodes with no surface are black (0). Throws impinge::Error
+/// if the file cannot be written.
 void write_map_png(const std::string& path, const RadialDistanceMap& map);
 
 }  // namespace impinge

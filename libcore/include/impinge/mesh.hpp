@@ -15,9 +15,9 @@ using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;        ///
 /// A triangle mesh. Invariants after `validate_mesh`: n >= 3 vertices, every coordinate
 /// finite, every index in [0, n), m >= 1 triangles.
 struct TriangleMesh {
-  Vertices V;            ///< n x 3 vertex positions, mm, in the frame of the file it came from
-  Faces F;               ///< m x 3 vertex indices (counter-clockwise not required)
-  std::string source;    ///< file name (or generator name) used in error messages
+  Vertices V;                        ///< n x 3 vertex positions, mm, in the frame of the file it came from
+  Faces F;                           ///< m x 3 vertex indices (counter-clockwise not required)
+  std::string source;                ///< file name (or generator name) used in error messages
   int degenerate_faces_skipped = 0;  ///< zero-area triangles removed while loading
 };
 

@@ -79,8 +79,6 @@ using RadialDistanceMap = RadialDistanceMapT<float>;         ///< float32 map (d
 using RadialDistanceMapDouble = RadialDistanceMapT<double>;  ///< float64 map (thesis Table 2)
 
 /// Memory of a map of `nodes` nodes at `bytes_per_node` bytes (thesis Table 2's formula).
-inline std::int64_t map_bytes_formula(std::int64_t nodes, int bytes_per_node) {
-  return nodes * bytes_per_node;
-}
+inline std::int64_t map_bytes_formula(std::int64_t nodes, int bytes_per_node) { return nodes * bytes_per_node; }
 
 }  // namespace impinge

@@ -28,12 +28,12 @@ const char* to_string(DistanceMode mode);
 
 /// Counts reported by a sampling run, so that nothing is dropped silently.
 struct SamplingStats {
-  std::int64_t triangles = 0;             ///< triangles in the mesh
-  std::int64_t triangles_edge_on = 0;     ///< skipped: plane through the COR (covers no direction)
-  std::int64_t pole_triangles = 0;        ///< triangles touching or containing a pole (cases 1-3)
-  std::int64_t seam_triangles = 0;        ///< triangles crossing theta = 0/360
-  std::int64_t node_tests = 0;            ///< node-in-triangle tests performed
-  std::int64_t nodes_covered = 0;         ///< nodes with a surface after sampling
+  std::int64_t triangles = 0;          ///< triangles in the mesh
+  std::int64_t triangles_edge_on = 0;  ///< skipped: plane through the COR (covers no direction)
+  std::int64_t pole_triangles = 0;     ///< triangles touching or containing a pole (cases 1-3)
+  std::int64_t seam_triangles = 0;     ///< triangles crossing theta = 0/360
+  std::int64_t node_tests = 0;         ///< node-in-triangle tests performed
+  std::int64_t nodes_covered = 0;      ///< nodes with a surface after sampling
 };
 
 /// Fill `map` with the nearest hit of every node's ray on `mesh` by rasterisation: each

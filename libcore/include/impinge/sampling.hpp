@@ -27,7 +27,7 @@ const char* to_string(SamplingMethod method);
 
 /// Options of sample_surface.
 struct SamplingOptions {
-  DistanceMode mode = DistanceMode::exact;        ///< rasterisation distance mode
+  DistanceMode mode = DistanceMode::exact;  ///< rasterisation distance mode
   SamplingMethod method = SamplingMethod::automatic;
   double resample_precision_deg = 0;  ///< temporary equiangular precision for `resample`; 0 picks
                                       ///< 180 / round(180 / node spacing in degrees), the precision
@@ -36,10 +36,10 @@ struct SamplingOptions {
 
 /// What a sampling run did.
 struct SamplingReport {
-  SamplingMethod method = SamplingMethod::automatic;  ///< the method actually used
-  SamplingStats raster;                   ///< counts of the rasterisation (equiangular part)
-  double resample_precision_deg = 0;      ///< temporary map precision (resample), else 0
-  std::int64_t nodes_covered = 0;         ///< nodes with a surface in the filled map
+  SamplingMethod method = SamplingMethod::automatic;          ///< the method actually used
+  SamplingStats raster;                                       ///< counts of the rasterisation (equiangular part)
+  double resample_precision_deg = 0;                          ///< temporary map precision (resample), else 0
+  std::int64_t nodes_covered = 0;                             ///< nodes with a surface in the filled map
   double rasterize_ms = 0, resample_ms = 0, ray_cast_ms = 0;  ///< wall times of the stages
 };
 

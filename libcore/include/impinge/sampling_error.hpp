@@ -18,9 +18,9 @@ double eq8_relative_error(double equator_nodes);
 /// thickness t at z_i = i t (i = 0, 1, ...; the middle plane is slice 0) is sampled in
 /// phi_i = arccos(i t / r); the smallest step is between the middle plane and the first slice.
 struct SliceAnalysis {
-  std::vector<double> phi_deg;   ///< phi_i for i = 0..floor(r / t), degrees
-  std::vector<double> dphi_deg;  ///< phi_i - phi_{i+1}, degrees (one fewer entry)
-  double min_dphi_deg = 0;       ///< smallest step (the first one), degrees
+  std::vector<double> phi_deg;       ///< phi_i for i = 0..floor(r / t), degrees
+  std::vector<double> dphi_deg;      ///< phi_i - phi_{i+1}, degrees (one fewer entry)
+  double min_dphi_deg = 0;           ///< smallest step (the first one), degrees
   double nyquist_precision_deg = 0;  ///< half of it (Shannon: twice the sampling rate), degrees
 };
 

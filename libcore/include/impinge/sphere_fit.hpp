@@ -15,7 +15,7 @@ namespace impinge {
 struct SphereFitResult {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< mm, frame of the input points
   double radius = 0;                                 ///< mm
-  double rms_residual = 0;  ///< sqrt(mean (|p - centre| - radius)^2) over the fitted points, mm
+  double rms_residual = 0;       ///< sqrt(mean (|p - centre| - radius)^2) over the fitted points, mm
   std::int64_t points_used = 0;  ///< points in the final fit (the inliers for a robust fit)
   int iterations = 0;            ///< solver iterations (geometric fit) or refinement rounds
   bool converged = false;        ///< solver reached its tolerance
@@ -41,8 +41,8 @@ struct HeadFitOptions {
   double max_radius_mm = 40;
   double inlier_threshold_mm = 1.0;  ///< |distance - r| below this counts as an inlier
   int ransac_iterations = 3000;
-  int refinement_rounds = 4;       ///< geometric refit on re-selected inliers
-  std::uint64_t seed = 12345;      ///< RNG seed: results are reproducible
+  int refinement_rounds = 4;   ///< geometric refit on re-selected inliers
+  std::uint64_t seed = 12345;  ///< RNG seed: results are reproducible
 };
 
 /// Automatic centre of rotation of a femur: RANSAC sphere detection on the proximal femur

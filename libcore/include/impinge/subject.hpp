@@ -17,10 +17,10 @@ enum class FrameConvention { LPS, RAS };
 /// Parsed subject.json: {"side": "right"|"left", "frame": "LPS"|"RAS", "units": "mm",
 /// "femur": file, "pelvis": file} (file names relative to the json's folder).
 struct SubjectInfo {
-  std::string name;         ///< folder name
+  std::string name;  ///< folder name
   Side side = Side::right;
   FrameConvention frame = FrameConvention::RAS;
-  std::string femur_path;   ///< absolute or relative-to-cwd path
+  std::string femur_path;  ///< absolute or relative-to-cwd path
   std::string pelvis_path;
 };
 
