@@ -47,8 +47,8 @@ double HelixScheme::phi_of_node(std::int64_t i, double guess) const {
 void HelixScheme::node_angles(std::int64_t first, std::int64_t count, double* phi, double* theta) const {
   // Incremental inversion of the arc length along consecutive nodes: predict
   // phi_i = phi_{i-1} + dx / s'(phi_{i-1}) (error ~ dx^2 |s''| / s'^3, ~1e-14 rad for large k),
-  // then Newton on the tabulated s until the step is below 1e-13 (one step for large k; no
-  // trigonometry). The chain is
+  // then Newton on the tabulated s (one step for large k, with the previous node's slope: one
+  // division per node; no trigonometry). The chain is
   // serial, so kLanes independent chains over consecutive sub-ranges advance in lockstep for
   // instruction-level parallelism. Within 20/k of a pole: Newton on the exact integral.
   constexpr int kLanes = 8;
@@ -63,8 +63,8 @@ void HelixScheme::node_angles(std::int64_t first, std::int64_t count, double* ph
   }
   auto emit = [&](std::int64_t i, double value) {
     phi[i - first] = value;
-    double t = 2 * k_ * value;
-    t -= kTwoPi * std::floor(t * kInvTwoPi);
+    double t = 2 * k_ * value;  // >= 0: truncation is the floor (no libm call)
+    t -= kTwoPi * static_cast<double>(static_cast<std::int64_t>(t * kInvTwoPi));
     theta[i - first] = t;
   };
   for (std::int64_t step = 0; step < per_lane; ++step) {
@@ -73,18 +73,23 @@ void HelixScheme::node_angles(std::int64_t first, std::int64_t count, double* ph
       if (i >= stop[l]) continue;
       double q;
       if (p[l] <= 0 || i >= w_ - 1 || arc_.in_cap(p[l])) {  // lane start, poles, polar caps
-        q = phi_of_node(i, p[l] > 0 && ds[l] > 0 ? p[l] + dx_ / ds[l] : -1);
-        ds[l] = arc_.derivative(q);
+        q = phi_of_node(i, p[l] > 0 && ds[l] > 0 ? p[l] + dx_ * ds[l] : -1);
+        ds[l] = 1 / arc_.derivative(q);
       } else {
-        q = p[l] + dx_ / ds[l];
-        double v, dv, step_size;
-        int it = 0;
-        do {  // one step for large k (predictor error ~1e-14); more for coarse helices
+        // ds[] holds 1 / s' at the previous node: the predictor and a first Newton step with that
+        // slope (s' changes by ~1e-6 relative between nodes, so the step's error is ~1e-6 of an
+        // already ~1e-14 rad predictor error); full Newton only when the step is not tiny.
+        q = p[l] + dx_ * ds[l];
+        double v, dv;
+        arc_.value_and_derivative(q, v, dv);
+        double step_size = (v - static_cast<double>(i) * dx_) * ds[l];
+        q -= step_size;
+        for (int it = 0; std::abs(step_size) > 1e-12 && it < 8; ++it) {
           arc_.value_and_derivative(q, v, dv);
           step_size = (v - static_cast<double>(i) * dx_) / dv;
           q -= step_size;
-        } while (std::abs(step_size) > 1e-13 && ++it < 8);
-        ds[l] = dv;
+        }
+        ds[l] = 1 / dv;
         if (arc_.in_cap(q)) q = phi_of_node(i, q);
       }
       p[l] = q;

@@ -63,7 +63,9 @@ class HelixScheme : public SchemeImpl<HelixScheme> {
     double theta = std::atan2(y, x);
     if (theta < 0) theta += kTwoPi;
     // bracketing crossings of the meridian theta
-    const double j = std::floor((2 * k_ * phi - theta) * kInvTwoPi);
+    const double jf = (2 * k_ * phi - theta) * kInvTwoPi;  // floor without a libm call
+    double j = static_cast<double>(static_cast<std::int64_t>(jf));
+    if (j > jf) j -= 1;
     double phi_a = (theta + kTwoPi * j) * inv_2k_;
     double phi_b = phi_a + kPiOverK_;
     double u;
