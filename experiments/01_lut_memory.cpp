@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
     const std::int64_t eq_formula = (n + 1) * (2 * n);
     // Table 6: the helix whose equator carries as many nodes as the grid's equator row (360/p):
     // about pi k / 2 nodes per turn at the equator (spacing ~4/k), so k = round(720 / (pi p)).
-    const double k = std::round(2.0 * (360.0 / t.p) / kPi);
+    const double k = matched_helix_turns(t.p);
     const auto eq = make_scheme("equiangular", t.p);
     const auto hx = std::make_shared<HelixScheme>(k);
     const double helix_equator = 2 * kPi / hx->node_spacing();

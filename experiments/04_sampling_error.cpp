@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
     const bool analytic = s.name.rfind("head_", 0) != 0;
     for (double p : precisions) {
       progress("04_sampling_error", ++step, total, s.name + " p=" + std::to_string(p));
-      const double k = std::round(720.0 / (kPi * p));
+      const double k = matched_helix_turns(p);
       struct Variant {
         std::shared_ptr<const SamplingScheme> scheme;
         DistanceMode mode;

@@ -18,6 +18,7 @@
 #include <map>
 
 #include "experiment_support.hpp"
+#include "impinge/helix_scheme.hpp"
 #include "impinge/joint.hpp"
 #include "impinge/map_image.hpp"
 #include "impinge/sampling.hpp"
@@ -89,7 +90,7 @@ int main(int argc, char** argv) {
     const double cor_error = s.generated ? (fit.centre - s.true_cor).norm() : std::nan("");
     for (double p : precisions) {
       std::map<DistanceMode, std::vector<float>> rsid_ball;  // equiangular ball gaps per mode
-      const double k = std::round(720.0 / (kPi * p));
+      const double k = matched_helix_turns(p);
       for (const auto& scheme : {make_scheme("equiangular", p), make_scheme("helix", k)}) {
         const bool helix = scheme->name() != "equiangular";
         std::vector<float> exact_ball;  // exact-mode gaps, for the linear-vs-exact difference

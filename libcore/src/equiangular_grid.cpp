@@ -1,5 +1,6 @@
 #include "impinge/equiangular_grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -7,6 +8,10 @@
 #include "impinge/spherical_frame.hpp"
 
 namespace impinge {
+
+double matched_equiangular_precision(double spacing_rad) {
+  return 180.0 / std::max(1.0, std::round(180.0 / (spacing_rad * kRadToDeg)));
+}
 
 EquiangularGrid::EquiangularGrid(double precision_deg) : precision_deg_(precision_deg) {
   std::ostringstream os;

@@ -45,8 +45,8 @@ void write_map_png(const std::string& path, const RadialDistanceMap& map) {
     w = g->columns(), h = g->rows();
     value.assign(map.data(), map.data() + map.num_nodes());
   } else {
-    const double spacing_deg = std::max(map.scheme().max_node_spacing() * kRadToDeg, 0.1);
-    const EquiangularGrid img(180.0 / std::max(1.0, std::round(180.0 / spacing_deg)));
+    const EquiangularGrid img(
+        matched_equiangular_precision(std::max(map.scheme().max_node_spacing(), 0.1 * kDegToRad)));
     w = img.columns(), h = img.rows();
     value.resize(static_cast<std::size_t>(img.num_nodes()));
     for (std::int64_t i = 0; i < img.num_nodes(); ++i) {

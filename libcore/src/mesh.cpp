@@ -61,6 +61,4 @@ Eigen::VectorXd vertex_areas(const TriangleMesh& mesh) {
   return area;
 }
 
-double surface_area(const TriangleMesh& mesh) { return vertex_areas(mesh).sum(); }
-
 }  // namespace impinge

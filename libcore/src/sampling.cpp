@@ -88,10 +88,7 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
       break;
     case SamplingMethod::resample: {
       double p = o.resample_precision_deg;
-      if (p <= 0) {
-        const double spacing_deg = map.scheme().max_node_spacing() * kRadToDeg;
-        p = 180.0 / std::max(1.0, std::round(180.0 / spacing_deg));
-      }
+      if (p <= 0) p = matched_equiangular_precision(map.scheme().max_node_spacing());
       rep.resample_precision_deg = p;
       {
         RadialDistanceMap tmp{EquiangularGrid(p)};

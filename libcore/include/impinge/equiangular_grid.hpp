@@ -17,6 +17,11 @@ namespace impinge {
 /// i * columns + j. Node count (180/p + 1) x (360/p) (thesis Table 2: 65,160 at 1 deg).
 /// Every node of row 0 (and of the last row) has the same direction, the pole.
 /// Interpolation: bilinear in (phi, theta) over the four surrounding nodes (thesis Alg. 2).
+/// The valid precision (degrees, 180/p integral) nearest to a node spacing of `spacing_rad`
+/// radians: 180 / round(180 / spacing_deg), at most 180. Used to rasterise the equiangular map
+/// that other schemes are resampled from (thesis Table 6's matching) and to image them.
+double matched_equiangular_precision(double spacing_rad);
+
 class EquiangularGrid : public SchemeImpl<EquiangularGrid> {
  public:
   /// Grid of precision `precision_deg` (degrees). Throws impinge::Error unless

@@ -27,6 +27,13 @@ enum class TraveledDistance {
 /// crossing the two nodes bracketing its traveled distance, linearly weighted along the curve;
 /// then linear in phi between the crossings. In the first (last) turn the north (south) pole
 /// node replaces the missing crossing: three neighbours.
+/// Turns k whose helix carries as many nodes on the equator as the equiangular grid of precision
+/// p degrees (360/p): a helix of spacing ~4/k has ~pi k / 2 equator nodes, so k = round(720 / (pi p))
+/// (thesis Table 6: 229, 458, 2292, 4584 for p = 1, 0.5, 0.1, 0.05).
+inline double matched_helix_turns(double precision_deg) {
+  return std::round(720.0 / (3.14159265358979323846 * precision_deg));
+}
+
 class HelixScheme : public SchemeImpl<HelixScheme> {
  public:
   /// k >= 2 integral turns (thesis Table 6: 229, 458, 2292, 4584). Throws impinge::Error.

@@ -34,7 +34,4 @@ int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2 = 1e-12);
 /// area), so the sum over vertices equals the surface area. Returns n values.
 Eigen::VectorXd vertex_areas(const TriangleMesh& mesh);
 
-/// Surface area of the mesh in mm^2.
-double surface_area(const TriangleMesh& mesh);
-
 }  // namespace impinge

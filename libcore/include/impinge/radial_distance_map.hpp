@@ -48,14 +48,6 @@ class RadialDistanceMapT {
   std::int64_t nodes_covered() const {
     return std::count_if(distance_.begin(), distance_.end(), [](Scalar d) { return d != no_surface(); });
   }
-  /// Largest stored distance (mm) over covered nodes, or 0 when none is covered.
-  double max_distance() const {
-    double m = 0;
-    for (Scalar d : distance_)
-      if (d != no_surface()) m = std::max<double>(m, d);
-    return m;
-  }
-
   /// Interpolated radial distance (mm) of the surface in the direction of `p` (any nonzero
   /// vector relative to the COR), by the scheme's stencil (thesis Algorithms 2 and 3). NaN when
   /// a node with nonzero weight has no surface. One virtual call: for many points use
