@@ -102,17 +102,17 @@ class Rasterizer {
         const Corner& p = *axis_vertex;
         const Corner& x = (&p == &a) ? b : a;
         const Corner& y = (&p == &c) ? b : c;
-        cone(x, y, p, /*apex=*/true);
+        cone(x, y, p, /*apex=*/true, north, south);
       } else {  // cases 2 and 3: the pole on an edge or inside the face
         const V3 n = (b.p - a.p).cross(c.p - a.p);
         const Corner p = corner(V3(0, 0, n.dot(a.p) / n.z()));
-        cone(a, b, p, true);
-        cone(b, c, p, true);
-        cone(c, a, p, true);
+        cone(a, b, p, true, north, south);
+        cone(b, c, p, true, north, south);
+        cone(c, a, p, true, north, south);
       }
       return;
     }
-    cone(a, b, c, false);
+    cone(a, b, c, false, north, south);
   }
 
  private:
@@ -122,8 +122,10 @@ class Rasterizer {
   }
 
   /// Rasterise the cone of triangle (a, b, c). With `apex`, c lies on the z axis (the pole
-  /// corner) and linear mode uses the trapezoid interpolation of thesis Fig. 34.
-  void cone(const Corner& ka, const Corner& kb, const Corner& kc, bool apex) {
+  /// corner) and linear mode uses the trapezoid interpolation of thesis Fig. 34. `north` /
+  /// `south`: the cone holds that pole (computed once per mesh triangle; a part split at a pole
+  /// holds the same pole at its apex and never the other).
+  void cone(const Corner& ka, const Corner& kb, const Corner& kc, bool apex, bool north, bool south) {
     const V3 &a = ka.p, &b = kb.p, &c = kc.p;
     const double det = a.dot(b.cross(c));
     if (!(std::abs(det) > 1e-12 * ka.d * kb.d * kc.d)) return;  // empty part
@@ -142,8 +144,6 @@ class Rasterizer {
     zlo = std::min(zlo, lo), zhi = std::max(zhi, hi);
     arc_z_range(uc, ua, lo, hi);
     zlo = std::min(zlo, lo), zhi = std::max(zhi, hi);
-    const bool north = in_cone(a, b, c, det, V3::UnitZ());
-    const bool south = in_cone(a, b, c, det, -V3::UnitZ());
     const double phi_min = north ? 0.0 : std::acos(std::clamp(zhi, -1.0, 1.0));
     const double phi_max = south ? kPi : std::acos(std::clamp(zlo, -1.0, 1.0));
     constexpr double pad = 1e-4;  // in steps; acos near +-1 loses ~1e-8 rad
