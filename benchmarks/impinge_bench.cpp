@@ -70,6 +70,7 @@ const Scene& scene() {
 struct Built {
   RadialDistanceMap femur_map, pelvis_map;
   std::vector<std::uint8_t> femur_mask, pelvis_mask;
+  ScanSet femur_set, pelvis_set;
 };
 const Built& built(int pi, DistanceMode mode) {
   static std::map<std::pair<int, int>, std::unique_ptr<Built>> cache;
@@ -77,13 +78,15 @@ const Built& built(int pi, DistanceMode mode) {
   if (!b) {
     const Scene& s = scene();
     const auto scheme = scheme_of(pi);
-    b = std::make_unique<Built>(Built{RadialDistanceMap(scheme), RadialDistanceMap(scheme), {}, {}});
+    b = std::make_unique<Built>(Built{RadialDistanceMap(scheme), RadialDistanceMap(scheme), {}, {}, {}, {}});
     SamplingOptions o;
     o.mode = mode;
     sample_surface(s.femur, s.cor, o, b->femur_map);
     sample_surface(s.pelvis, s.cor, o, b->pelvis_map);
     b->femur_mask = first_surface_mask(s.femur_rel, b->femur_map, 1.0, 1e30);
     b->pelvis_mask = first_surface_mask(s.pelvis_rel, b->pelvis_map, 1.0, 1e30);
+    b->femur_set = make_scan_set(s.femur_rel, b->femur_mask);
+    b->pelvis_set = make_scan_set(s.pelvis_rel, b->pelvis_mask);
   }
   return *b;
 }
@@ -135,16 +138,15 @@ void BM_Query(benchmark::State& st) {
   const Scene& s = scene();
   const Built& b = built(int(st.range(1)), DistanceMode::exact);
   const bool ball = st.range(0) == 0;
-  const Vertices& P = ball ? s.femur_rel : s.pelvis_rel;
-  const auto& mask = ball ? b.femur_mask : b.pelvis_mask;
+  const ScanSet& set = ball ? b.femur_set : b.pelvis_set;
   const RadialDistanceMap& other = ball ? b.pelvis_map : b.femur_map;
-  ScanGaps out;
+  std::vector<float> out(static_cast<std::size_t>(set.size()));
   const Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   for (auto _ : st) {
-    scan_gaps(P, R, mask, other, ball ? ScanSide::inside : ScanSide::outside, out);
-    benchmark::DoNotOptimize(out.gap_mm.data());
+    scan_gaps_compact(set, R, Eigen::Vector3d::Zero(), other, ball ? ScanSide::inside : ScanSide::outside, out.data());
+    benchmark::DoNotOptimize(out.data());
   }
-  const auto lookups = std::count(mask.begin(), mask.end(), std::uint8_t{1});
+  const auto lookups = set.size();
   st.SetItemsProcessed(st.iterations() * lookups);
   st.counters["ns_per_lookup"] = benchmark::Counter(double(lookups) * double(st.iterations()),
                                                     benchmark::Counter::kIsRate | benchmark::Counter::kInvert);

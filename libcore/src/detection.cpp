@@ -2,56 +2,69 @@
 
 #include <cmath>
 
+#include "impinge/error.hpp"
+
 namespace impinge {
+
+ScanSet make_scan_set(const Vertices& P, const std::vector<std::uint8_t>& mask) {
+  require(static_cast<Eigen::Index>(mask.size()) == P.rows(),
+          "scan set: mask has " + std::to_string(mask.size()) + " entries for " + std::to_string(P.rows()) + " vertices");
+  require(P.rows() < Eigen::Index(std::numeric_limits<std::int32_t>::max()), "scan set: too many vertices");
+  ScanSet s;
+  s.vertices = P.rows();
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    if (!mask[static_cast<std::size_t>(i)]) continue;
+    s.index.push_back(static_cast<std::int32_t>(i));
+    s.x.push_back(P(i, 0));
+    s.y.push_back(P(i, 1));
+    s.z.push_back(P(i, 2));
+  }
+  return s;
+}
+
+template <typename Scalar>
+void scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                       const RadialDistanceMapT<Scalar>& map, ScanSide side, float* gap_mm) {
+  const double s = static_cast<double>(static_cast<int>(side));
+  const double r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2), r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2), r20 = R(2, 0),
+               r21 = R(2, 1), r22 = R(2, 2), tx = t.x(), ty = t.y(), tz = t.z();
+  constexpr std::int64_t kBlock = 256;
+  double qx[kBlock], qy[kBlock], qz[kBlock], radius[kBlock], d[kBlock];
+  const std::int64_t n = set.size();
+  const double *X = set.x.data(), *Y = set.y.data(), *Z = set.z.data();
+  for (std::int64_t b = 0; b < n; b += kBlock) {
+    const std::int64_t m = std::min(kBlock, n - b);
+    for (std::int64_t j = 0; j < m; ++j) {  // vectorised: rotate, translate, radius
+      const double x = X[b + j], y = Y[b + j], z = Z[b + j];
+      qx[j] = r00 * x + r01 * y + r02 * z + tx;
+      qy[j] = r10 * x + r11 * y + r12 * z + ty;
+      qz[j] = r20 * x + r21 * y + r22 * z + tz;
+      radius[j] = std::sqrt(qx[j] * qx[j] + qy[j] * qy[j] + qz[j] * qz[j]);
+    }
+    map.sample_many_soa(qx, qy, qz, m, d);
+    for (std::int64_t j = 0; j < m; ++j)  // NaN (no surface) stays NaN
+      gap_mm[b + j] = radius[j] > 0 ? static_cast<float>(s * (d[j] - radius[j])) : std::numeric_limits<float>::quiet_NaN();
+  }
+}
 
 template <typename Scalar>
 void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
                const RadialDistanceMapT<Scalar>& map, ScanSide side, ScanGaps& out) {
-  const Eigen::Index n = P.rows();
-  out.gap_mm.resize(static_cast<std::size_t>(n));
-  out.status.resize(static_cast<std::size_t>(n));
-  const double s = static_cast<double>(static_cast<int>(side));
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  // Vertices to look up are gathered in blocks: one call into the scheme per block, the
-  // per-vertex stencil inlined there (no virtual dispatch per vertex).
-  constexpr int kBlock = 256;
-  double pts[3 * kBlock], radius[kBlock], d[kBlock];
-  std::size_t index[kBlock];
-  int m = 0;
-  auto flush = [&] {
-    map.sample_many(pts, m, d);
-    for (int j = 0; j < m; ++j) {
-      const std::size_t k = index[j];
-      if (std::isnan(d[j])) {
-        out.gap_mm[k] = nan;
-        out.status[k] = ScanGaps::no_surface;
-      } else {
-        out.gap_mm[k] = static_cast<float>(s * (d[j] - radius[j]));
-        out.status[k] = ScanGaps::tested;
-      }
-    }
-    m = 0;
-  };
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (!mask[k]) {
-      out.gap_mm[k] = nan;
-      out.status[k] = ScanGaps::beyond_reach;
-      continue;
-    }
-    const Eigen::Vector3d q = R * P.row(i).transpose();
-    const double r = q.norm();
-    if (!(r > 0)) {
-      out.gap_mm[k] = nan;
-      out.status[k] = ScanGaps::no_surface;
-      continue;
-    }
-    pts[3 * m] = q.x(), pts[3 * m + 1] = q.y(), pts[3 * m + 2] = q.z();
-    radius[m] = r;
-    index[m] = k;
-    if (++m == kBlock) flush();
+  const ScanSet set = make_scan_set(P, mask);
+  std::vector<float> gaps(static_cast<std::size_t>(set.size()));
+  scan_gaps_compact(set, R, Eigen::Vector3d::Zero(), map, side, gaps.data());
+  expand_scan(set, gaps.data(), out);
+}
+
+void expand_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out) {
+  const auto n = static_cast<std::size_t>(set.vertices);
+  out.gap_mm.assign(n, std::numeric_limits<float>::quiet_NaN());
+  out.status.assign(n, ScanGaps::beyond_reach);
+  for (std::size_t j = 0; j < set.index.size(); ++j) {
+    const auto i = static_cast<std::size_t>(set.index[j]);
+    out.gap_mm[i] = gap_mm[j];
+    out.status[i] = std::isnan(gap_mm[j]) ? ScanGaps::no_surface : ScanGaps::tested;
   }
-  flush();
 }
 
 template <typename Scalar>
@@ -114,6 +127,10 @@ template void scan_gaps<float>(const Vertices&, const Eigen::Matrix3d&, const st
                                const RadialDistanceMapT<float>&, ScanSide, ScanGaps&);
 template void scan_gaps<double>(const Vertices&, const Eigen::Matrix3d&, const std::vector<std::uint8_t>&,
                                 const RadialDistanceMapT<double>&, ScanSide, ScanGaps&);
+template void scan_gaps_compact<float>(const ScanSet&, const Eigen::Matrix3d&, const Eigen::Vector3d&,
+                                       const RadialDistanceMapT<float>&, ScanSide, float*);
+template void scan_gaps_compact<double>(const ScanSet&, const Eigen::Matrix3d&, const Eigen::Vector3d&,
+                                        const RadialDistanceMapT<double>&, ScanSide, float*);
 template std::vector<std::uint8_t> first_surface_mask<float>(const Vertices&, const RadialDistanceMapT<float>&, double,
                                                              double);
 template std::vector<std::uint8_t> first_surface_mask<double>(const Vertices&, const RadialDistanceMapT<double>&,

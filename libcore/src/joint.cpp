@@ -25,7 +25,7 @@ Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor,
 
 JointBody Joint::build(TriangleMesh mesh) const {
   validate_mesh(mesh);
-  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, 0};
+  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0};
   b.relative = b.mesh.V.rowwise() - cor_.transpose();
   SamplingOptions so;
   so.mode = options_.mode;
@@ -34,18 +34,24 @@ JointBody Joint::build(TriangleMesh mesh) const {
   b.sampling = sample_surface(b.mesh, cor_, so, b.map);
   b.sampling_ms = ms_since(t0);
   b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);
+  b.scan_set = make_scan_set(b.relative, b.mask);
   b.vertex_area = vertex_areas(b.mesh);
   return b;
 }
 
-PoseResult Joint::detect(const Eigen::Matrix3d& R) const {
+PoseResult Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const {
   PoseResult res;
+  std::vector<float> gaps(static_cast<std::size_t>(std::max(ball_.scan_set.size(), socket_.scan_set.size())));
   auto t0 = std::chrono::steady_clock::now();
-  scan_gaps(ball_.relative, R, ball_.mask, socket_.map, ScanSide::inside, res.ball_gaps);
+  scan_gaps_compact(ball_.scan_set, R, t, socket_.map, ScanSide::inside, gaps.data());
   res.ball_detection_ms = ms_since(t0);
+  expand_scan(ball_.scan_set, gaps.data(), res.ball_gaps);
+  // Socket vertices in the ball's frame: R^T (p - t).
   t0 = std::chrono::steady_clock::now();
-  scan_gaps(socket_.relative, R.transpose(), socket_.mask, ball_.map, ScanSide::outside, res.socket_gaps);
+  scan_gaps_compact(socket_.scan_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), ball_.map, ScanSide::outside,
+                    gaps.data());
   res.socket_detection_ms = ms_since(t0);
+  expand_scan(socket_.scan_set, gaps.data(), res.socket_gaps);
   res.ball = summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels);
   res.socket = summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels);
   return res;

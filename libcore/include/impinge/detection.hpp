@@ -51,6 +51,33 @@ template <typename Scalar>
 void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
                const RadialDistanceMapT<Scalar>& map, ScanSide side, ScanGaps& out);
 
+/// The vertices of one body that a scan looks up, prepared once (pose-invariant): the indices
+/// of the vertices with mask[i] != 0 and their coordinates relative to the COR in structure-of-
+/// arrays form, so a scan touches only them, in order, with no per-vertex branch on the mask.
+struct ScanSet {
+  std::vector<std::int32_t> index;  ///< k indices into the body's vertices, increasing
+  std::vector<double> x, y, z;      ///< k coordinates each, mm, relative to the COR, body frame
+  std::int64_t vertices = 0;        ///< n, vertices of the body
+  std::int64_t size() const { return static_cast<std::int64_t>(index.size()); }
+};
+
+/// ScanSet of the vertices P (n x 3, mm, relative to the COR) with mask[i] != 0. Throws
+/// impinge::Error when mask.size() != n or n exceeds 2^31 - 1.
+ScanSet make_scan_set(const Vertices& P, const std::vector<std::uint8_t>& mask);
+
+/// The fast scan (issue 4): for every vertex j of `set`, q = R * p_j + t in the map's frame
+/// (R: 3 x 3 rotation, t: translation, mm; the identity and 0 when the bodies share the COR),
+/// gap_mm[j] = side * (map.sample(q) - |q|), NaN where the map has no surface in q's direction
+/// or q is the COR. `gap_mm` must hold set.size() floats. Allocation-free, single thread; blocks
+/// of 256 vertices: transform, then the scheme's two-pass look-up (stencils, then loads).
+template <typename Scalar>
+void scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                       const RadialDistanceMapT<Scalar>& map, ScanSide side, float* gap_mm);
+
+/// Expand a compact scan into per-vertex ScanGaps (n entries): vertices outside the set are
+/// beyond reach, NaN gaps of the set are no surface.
+void expand_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out);
+
 /// Vertices of a body that lie on its own first surface seen from the COR:
 /// mask[i] = 1 when |p_i| <= own_map.sample(p_i) + tolerance_mm and |p_i| <= max_radius_mm; at
 /// the edge of the own map's coverage the nearest covered stencil node is used, and a vertex

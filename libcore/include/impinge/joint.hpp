@@ -36,6 +36,7 @@ struct JointBody {
   Vertices relative;               ///< n x 3, vertices minus the COR, mm
   RadialDistanceMap map;           ///< its radial distance map about the COR
   std::vector<std::uint8_t> mask;  ///< 1 for vertices on the first surface within the region
+  ScanSet scan_set;                ///< the masked vertices, prepared for the fast scan
   Eigen::VectorXd vertex_area;     ///< n, mm^2
   SamplingReport sampling;         ///< how the map was filled, with counts
   double sampling_ms = 0;          ///< wall time of filling the map, ms
@@ -56,8 +57,10 @@ class Joint {
   Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options);
 
   /// Both scans (ball vertices against the socket map, socket vertices against the ball map)
-  /// with the ball rotated by R (3 x 3) about the COR. Thesis Algorithm 2 applied twice.
-  PoseResult detect(const Eigen::Matrix3d& R) const;
+  /// with the ball rotated by R (3 x 3) about the COR and then translated by t (mm, socket
+  /// frame; zero for a pure ball-and-socket motion, nonzero to push the head into the cup).
+  /// Thesis Algorithm 2 applied twice, through scan_gaps_compact.
+  PoseResult detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) const;
 
   const JointBody& ball() const { return ball_; }
   const JointBody& socket() const { return socket_; }

@@ -61,6 +61,10 @@ class RadialDistanceMapT {
   void sample_many(const double* pts, std::int64_t n, double* out) const {
     scheme_->interpolate_many(distance_.data(), pts, n, out);
   }
+  /// sample_many with the points in structure-of-arrays form (x, y, z: n values each, mm).
+  void sample_many_soa(const double* x, const double* y, const double* z, std::int64_t n, double* out) const {
+    scheme_->interpolate_many_soa(distance_.data(), x, y, z, n, out);
+  }
 
  private:
   std::shared_ptr<const SamplingScheme> scheme_;

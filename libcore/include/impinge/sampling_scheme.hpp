@@ -7,6 +7,7 @@
 /// scheme_registry.cpp.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -54,6 +55,12 @@ class SamplingScheme {
   /// dispatch: one virtual call per block of vertices, the per-point work inlined.
   virtual void interpolate_many(const float* values, const double* pts, std::int64_t n, double* out) const = 0;
   virtual void interpolate_many(const double* values, const double* pts, std::int64_t n, double* out) const = 0;
+  /// As interpolate_many with the points in structure-of-arrays form (x, y, z: n values each),
+  /// the layout of the fast scan; schemes may override it with a vectorised kernel.
+  virtual void interpolate_many_soa(const float* values, const double* x, const double* y, const double* z,
+                                    std::int64_t n, double* out) const = 0;
+  virtual void interpolate_many_soa(const double* values, const double* x, const double* y, const double* z,
+                                    std::int64_t n, double* out) const = 0;
 };
 
 /// Base of concrete schemes: implements interpolate_many once, inlining Derived's
@@ -68,6 +75,14 @@ class SchemeImpl : public SamplingScheme {
   void interpolate_many(const double* values, const double* pts, std::int64_t n, double* out) const override {
     run(values, pts, n, out);
   }
+  void interpolate_many_soa(const float* values, const double* x, const double* y, const double* z, std::int64_t n,
+                            double* out) const override {
+    run_soa(values, x, y, z, n, out);
+  }
+  void interpolate_many_soa(const double* values, const double* x, const double* y, const double* z, std::int64_t n,
+                            double* out) const override {
+    run_soa(values, x, y, z, n, out);
+  }
   Stencil interpolate(const Eigen::Vector3d& u) const override {
     Stencil s;
     static_cast<const Derived*>(this)->stencil_at(u.x(), u.y(), u.z(), s.nodes.data(), s.weights.data());
@@ -75,17 +90,39 @@ class SchemeImpl : public SamplingScheme {
   }
 
  private:
+  /// Two passes per chunk of 64 points: all stencils first (pure arithmetic, no loads), then
+  /// the loads, so the cache misses of many points are in flight at once.
   template <typename Scalar>
   void run(const Scalar* values, const double* pts, std::int64_t n, double* out) const {
     const Derived& self = *static_cast<const Derived*>(this);
-    for (std::int64_t j = 0; j < n; ++j) {
-      std::int64_t nd[4];
-      double w[4];
-      self.stencil_at(pts[3 * j], pts[3 * j + 1], pts[3 * j + 2], nd, w);
-      const double v = w[0] * values[nd[0]] + w[1] * values[nd[1]] + w[2] * values[nd[2]] + w[3] * values[nd[3]];
-      out[j] = std::isfinite(v) ? v : slow_path(values, nd, w);
+    constexpr std::int64_t kChunk = 64;
+    std::int64_t nd[4 * kChunk];
+    double w[4 * kChunk];
+    for (std::int64_t b = 0; b < n; b += kChunk) {
+      const std::int64_t m = std::min(kChunk, n - b);
+      const double* p = pts + 3 * b;
+      for (std::int64_t j = 0; j < m; ++j) self.stencil_at(p[3 * j], p[3 * j + 1], p[3 * j + 2], nd + 4 * j, w + 4 * j);
+      for (std::int64_t j = 0; j < m; ++j) {
+        const std::int64_t* q = nd + 4 * j;
+        const double* u = w + 4 * j;
+        const double v = u[0] * values[q[0]] + u[1] * values[q[1]] + u[2] * values[q[2]] + u[3] * values[q[3]];
+        out[b + j] = std::isfinite(v) ? v : slow_path(values, q, u);
+      }
     }
   }
+  template <typename Scalar>
+  void run_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
+               double* out) const {
+    constexpr std::int64_t kChunk = 64;
+    double p[3 * kChunk];
+    for (std::int64_t b = 0; b < n; b += kChunk) {
+      const std::int64_t m = std::min(kChunk, n - b);
+      for (std::int64_t j = 0; j < m; ++j) p[3 * j] = x[b + j], p[3 * j + 1] = y[b + j], p[3 * j + 2] = z[b + j];
+      run(values, p, m, out + b);
+    }
+  }
+
+ protected:
   /// A node with no surface (+inf): NaN unless all such nodes have weight exactly 0.
   template <typename Scalar>
   static double slow_path(const Scalar* values, const std::int64_t* nd, const double* w) {

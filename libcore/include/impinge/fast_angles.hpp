@@ -1,0 +1,73 @@
+#pragma once
+/// @file fast_angles.hpp
+/// Spherical angles of a direction without libm trigonometry: the hot path of every map look-up
+/// (issue 4's fast query path). Branch-free (selects only), so loops over them vectorise.
+///
+/// Method: fold (y, x) into the first octant (0 <= mn <= mx), reduce once more with
+/// atan(t) = pi/4 + atan((t - 1) / (t + 1)) when t = mn / mx > tan(pi/8), so the argument u lies
+/// in [-tan(pi/8), tan(pi/8)], and evaluate an odd degree-17 polynomial u * q(u^2) fitted
+/// (iteratively reweighted least squares on Chebyshev nodes, near-minimax) to atan on that
+/// interval. Fit error 5.2e-15 rad; with rounding, every result is within
+/// `kFastAngleMaxError` = 1e-13 rad of the exact angle (tested against long-double atan2 on
+/// 4 million random and all edge-case directions in tests/fast_angles_test.cpp).
+///
+/// Effect on a look-up: a direction error of e radians moves the bilinear weights of a grid of
+/// spacing h by at most e / h, so the interpolated distance by at most (e / h) * (largest
+/// difference between neighbouring node values). At h = 0.05 deg and a 300 mm jump at a depth
+/// discontinuity that is 3.4e-8 mm, far below the 1e-4 mm the issue allows.
+
+#include <algorithm>
+#include <cmath>
+
+namespace impinge {
+
+/// Largest error (radians) of fast_polar_angle and fast_azimuth against the exact angles.
+inline constexpr double kFastAngleMaxError = 1e-13;
+
+namespace fast_angles_detail {
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kTanPi8 = 0.41421356237309504880;  // tan(pi/8) = sqrt(2) - 1
+
+/// atan(u) for |u| <= tan(pi/8): u * q(u^2), near-minimax, |error| <= 5.2e-15.
+inline double atan_reduced(double u) {
+  const double s = u * u;
+  double q = 0.02963552492242751;
+  q = q * s - 0.05799456218771525;
+  q = q * s + 0.07541112038780916;
+  q = q * s - 0.09074782228087129;
+  q = q * s + 0.1111005637975972;
+  q = q * s - 0.1428567343829258;
+  q = q * s + 0.199999991390151;
+  q = q * s - 0.3333333332505993;
+  q = q * s + 0.9999999999997656;
+  return u * q;
+}
+
+/// atan2(b, a) for a, b >= 0, in [0, pi/2]; 0 when both are 0.
+inline double atan2_first_quadrant(double b, double a) {
+  const double mn = std::min(a, b), mx = std::max(a, b);
+  const bool big = mn > kTanPi8 * mx;
+  const double num = big ? mn - mx : mn;
+  const double den = std::max(big ? mn + mx : mx, 1e-300);
+  const double r = (big ? kPi / 4 : 0.0) + atan_reduced(num / den);
+  return b > a ? kPi / 2 - r : r;
+}
+}  // namespace fast_angles_detail
+
+/// Polar angle phi = atan2(rho, z) in [0, pi] radians of a direction with rho = sqrt(x^2 + y^2)
+/// >= 0 (thesis Eq. 5, phi from +z). Error <= kFastAngleMaxError. (0, 0) gives 0.
+inline double fast_polar_angle(double rho, double z) {
+  const double a = fast_angles_detail::atan2_first_quadrant(rho, std::abs(z));
+  return z < 0 ? fast_angles_detail::kPi - a : a;
+}
+
+/// Azimuth theta = atan2(y, x) mapped to [0, 2 pi] radians (thesis Eq. 6; 2 pi only when y is a
+/// tiny negative number and rounding reaches it: callers wrap). Error <= kFastAngleMaxError.
+/// (0, 0) gives 0.
+inline double fast_azimuth(double y, double x) {
+  double a = fast_angles_detail::atan2_first_quadrant(std::abs(y), std::abs(x));
+  a = x < 0 ? fast_angles_detail::kPi - a : a;
+  return y < 0 ? 2 * fast_angles_detail::kPi - a : a;
+}
+
+}  // namespace impinge
