@@ -14,6 +14,9 @@
 #include <memory>
 
 #include "impinge/detection.hpp"
+#include "impinge/embree_ray_caster.hpp"
+#include "impinge/exact_reference.hpp"
+#include "impinge/fcl_collision.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/mesh_io.hpp"
 #include "impinge/rasterize.hpp"
@@ -154,6 +157,107 @@ void BM_Query(benchmark::State& st) {
               std::to_string(other.scheme().resolution()));
 }
 BENCHMARK(BM_Query)->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}})->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+// Peers on the same vertices as BM_Query at p = 0.1 deg (the first-surface vertices).
+// args: body (0 femur vertices against the pelvis, 1 pelvis against the femur), packet (0, 1).
+void BM_EmbreeQuery(benchmark::State& st) {
+  if (!have_embree()) return st.SkipWithError("no Embree in this build");
+  const Scene& s = scene();
+  const Built& b = built(2, DistanceMode::exact);
+  const bool ball = st.range(0) == 0;
+  static const EmbreeRayCaster pelvis(s.pelvis, s.cor), femur(s.femur, s.cor);
+  const ScanSet& set = ball ? b.femur_set : b.pelvis_set;
+  std::vector<float> out(static_cast<std::size_t>(set.size()));
+  for (auto _ : st) {
+    (ball ? pelvis : femur)
+        .scan_gaps(set, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(),
+                   ball ? ScanSide::inside : ScanSide::outside, out.data(), st.range(1) == 1);
+    benchmark::DoNotOptimize(out.data());
+  }
+  st.counters["ns_per_lookup"] = benchmark::Counter(double(set.size()) * double(st.iterations()),
+                                                    benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.SetLabel(s.name + (st.range(1) ? " rtcIntersect8" : " rtcIntersect1"));
+}
+BENCHMARK(BM_EmbreeQuery)->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+// CGAL AABB tree first intersection on the same vertices (args: body).
+void BM_CgalQuery(benchmark::State& st) {
+  if (!have_exact_reference()) return st.SkipWithError("no CGAL in this build");
+  const Scene& s = scene();
+  const Built& b = built(2, DistanceMode::exact);
+  const bool ball = st.range(0) == 0;
+  static const ExactReference pelvis(s.pelvis), femur(s.femur);
+  const ScanSet& set = ball ? b.femur_set : b.pelvis_set;
+  for (auto _ : st) {
+    double acc = 0;
+    for (std::int64_t j = 0; j < set.size(); ++j) {
+      const Eigen::Vector3d q(set.x[j], set.y[j], set.z[j]);
+      const auto h = (ball ? pelvis : femur).first_hit(s.cor, q.normalized());
+      acc += h ? *h - q.norm() : 0;
+    }
+    benchmark::DoNotOptimize(acc);
+  }
+  st.counters["ns_per_lookup"] = benchmark::Counter(double(set.size()) * double(st.iterations()),
+                                                    benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_CgalQuery)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Push of the femur into the acetabulum: 3 mm from the COR towards the centroid of the pelvis
+/// vertices within 45 mm (the acetabular fossa side), as in experiment 03.
+Eigen::Vector3d push_3mm(const Scene& s) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (Eigen::Index i = 0; i < s.pelvis_rel.rows(); ++i)
+    if (s.pelvis_rel.row(i).norm() <= 45) c += s.pelvis_rel.row(i).transpose(), ++n;
+  return c.normalized() * 3.0;
+}
+
+// Both scans of one pose over the hip region (vertices within 45 mm of the COR), femur pushed
+// 3 mm in (args: precision index).
+void BM_HipPoseScans(benchmark::State& st) {
+  const Scene& s = scene();
+  const Built& b = built(int(st.range(0)), DistanceMode::exact);
+  auto region = [](const Vertices& P, const std::vector<std::uint8_t>& mask) {
+    std::vector<std::uint8_t> m = mask;
+    for (Eigen::Index i = 0; i < P.rows(); ++i) m[std::size_t(i)] &= P.row(i).norm() <= 45 ? 1 : 0;
+    return make_scan_set(P, m);
+  };
+  const ScanSet fs = region(s.femur_rel, b.femur_mask), ps = region(s.pelvis_rel, b.pelvis_mask);
+  const Eigen::Vector3d t = push_3mm(s);
+  std::vector<float> g1(std::size_t(fs.size())), g2(std::size_t(ps.size()));
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  for (auto _ : st) {
+    scan_gaps_compact(fs, I, t, b.pelvis_map, ScanSide::inside, g1.data());
+    scan_gaps_compact(ps, I, Eigen::Vector3d(-t), b.femur_map, ScanSide::outside, g2.data());
+    benchmark::DoNotOptimize(g1.data());
+    benchmark::DoNotOptimize(g2.data());
+  }
+  st.counters["vertices"] = double(fs.size() + ps.size());
+}
+BENCHMARK(BM_HipPoseScans)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+// FCL OBBRSS collide at the same pose, every contact (args: 0 = rest, 1 = pushed 3 mm).
+void BM_FclCollide(benchmark::State& st) {
+  if (!have_fcl()) return st.SkipWithError("no FCL in this build");
+  const Scene& s = scene();
+  static const FclJoint j(s.femur, s.pelvis, s.cor);
+  const Eigen::Vector3d t = st.range(0) ? push_3mm(s) : Eigen::Vector3d::Zero();
+  std::int64_t contacts = 0;
+  for (auto _ : st) contacts = j.collide(Eigen::Matrix3d::Identity(), t).contacts;
+  st.counters["contacts"] = double(contacts);
+}
+BENCHMARK(BM_FclCollide)->DenseRange(0, 1)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+// Embree casting every node's ray to fill a map (args: body, precision index).
+void BM_EmbreeFillMap(benchmark::State& st) {
+  if (!have_embree()) return st.SkipWithError("no Embree in this build");
+  const Scene& s = scene();
+  const EmbreeRayCaster c(st.range(0) == 0 ? s.femur : s.pelvis, s.cor);
+  RadialDistanceMap map{EquiangularGrid(kPrecisions[st.range(1)])};
+  for (auto _ : st) benchmark::DoNotOptimize(c.fill_map(map));
+  st.counters["nodes"] = double(map.num_nodes());
+}
+BENCHMARK(BM_EmbreeFillMap)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");

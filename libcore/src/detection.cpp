@@ -1,20 +1,42 @@
 #include "impinge/detection.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "impinge/error.hpp"
 
 namespace impinge {
 
+namespace {
+/// Interleave the bits of a and b (Morton / Z order).
+std::uint64_t morton(std::uint32_t a, std::uint32_t b) {
+  std::uint64_t r = 0;
+  for (int k = 0; k < 16; ++k) r |= (std::uint64_t((a >> k) & 1u) << (2 * k + 1)) | (std::uint64_t((b >> k) & 1u) << (2 * k));
+  return r;
+}
+}  // namespace
+
 ScanSet make_scan_set(const Vertices& P, const std::vector<std::uint8_t>& mask) {
   require(static_cast<Eigen::Index>(mask.size()) == P.rows(),
           "scan set: mask has " + std::to_string(mask.size()) + " entries for " + std::to_string(P.rows()) + " vertices");
   require(P.rows() < Eigen::Index(std::numeric_limits<std::int32_t>::max()), "scan set: too many vertices");
-  ScanSet s;
-  s.vertices = P.rows();
+  // Order the vertices along a Z curve over their (phi, theta) direction (4096 x 8192 cells):
+  // a small rotation keeps neighbours neighbours, so consecutive look-ups hit the same cache
+  // lines of the other map. Results are returned in this order and mapped back by `index`.
+  std::vector<std::pair<std::uint64_t, std::int32_t>> order;
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
     if (!mask[static_cast<std::size_t>(i)]) continue;
-    s.index.push_back(static_cast<std::int32_t>(i));
+    const double x = P(i, 0), y = P(i, 1), z = P(i, 2);
+    const double phi = std::atan2(std::sqrt(x * x + y * y), z), theta = std::atan2(y, x) + 3.14159265358979323846;
+    const auto a = static_cast<std::uint32_t>(std::clamp(phi / 3.14159265358979323846 * 4096.0, 0.0, 4095.0));
+    const auto b = static_cast<std::uint32_t>(std::clamp(theta / 3.14159265358979323846 * 4096.0, 0.0, 8191.0));
+    order.emplace_back(morton(a, b), static_cast<std::int32_t>(i));
+  }
+  std::sort(order.begin(), order.end());
+  ScanSet s;
+  s.vertices = P.rows();
+  for (const auto& [key, i] : order) {
+    s.index.push_back(i);
     s.x.push_back(P(i, 0));
     s.y.push_back(P(i, 1));
     s.z.push_back(P(i, 2));

@@ -57,14 +57,14 @@ namespace {
 /// fractional position (t along phi, s along theta) of n directions. Branch-free so it
 /// vectorises; cloned for AVX2 (x86-64-v3) and chosen at run time.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("arch=x86-64-v3", "default")))
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #endif
 void locate_cells(const double* __restrict x, const double* __restrict y, const double* __restrict z, int n,
                   double inv_step, int rows, int cols, std::int32_t* __restrict base, std::int32_t* __restrict dc,
                   double* __restrict t, double* __restrict s) {
   for (int j = 0; j < n; ++j) {
-    const double phi = fast_polar_angle(std::sqrt(x[j] * x[j] + y[j] * y[j]), z[j]);
-    const double theta = fast_azimuth(y[j], x[j]);
+    double phi, theta;
+    fast_spherical_angles(x[j], y[j], z[j], phi, theta);
     const double fr = phi * inv_step;
     const int r0 = std::min(static_cast<int>(fr), rows - 2);
     const double fc = theta * inv_step;

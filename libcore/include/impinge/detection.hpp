@@ -53,9 +53,11 @@ void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<st
 
 /// The vertices of one body that a scan looks up, prepared once (pose-invariant): the indices
 /// of the vertices with mask[i] != 0 and their coordinates relative to the COR in structure-of-
-/// arrays form, so a scan touches only them, in order, with no per-vertex branch on the mask.
+/// arrays form, so a scan touches only them, with no per-vertex branch on the mask. They are
+/// ordered along a Z curve over their direction, so that consecutive look-ups share cache lines
+/// of the other map.
 struct ScanSet {
-  std::vector<std::int32_t> index;  ///< k indices into the body's vertices, increasing
+  std::vector<std::int32_t> index;  ///< k indices into the body's vertices (Z-curve order)
   std::vector<double> x, y, z;      ///< k coordinates each, mm, relative to the COR, body frame
   std::int64_t vertices = 0;        ///< n, vertices of the body
   std::int64_t size() const { return static_cast<std::int64_t>(index.size()); }

@@ -43,14 +43,25 @@ inline double atan_reduced(double u) {
   return u * q;
 }
 
-/// atan2(b, a) for a, b >= 0, in [0, pi/2]; 0 when both are 0.
-inline double atan2_first_quadrant(double b, double a) {
+/// The reduction of atan2(b, a), a, b >= 0: atan2(b, a) = finish(b, a, big, num / den).
+struct Reduced {
+  double num, den;
+  bool big;
+};
+inline Reduced reduce(double b, double a) {
   const double mn = std::min(a, b), mx = std::max(a, b);
   const bool big = mn > kTanPi8 * mx;
-  const double num = big ? mn - mx : mn;
-  const double den = std::max(big ? mn + mx : mx, 1e-300);
-  const double r = (big ? kPi / 4 : 0.0) + atan_reduced(num / den);
+  return {big ? mn - mx : mn, std::max(big ? mn + mx : mx, 1e-150), big};
+}
+inline double finish(double b, double a, bool big, double u) {
+  const double r = (big ? kPi / 4 : 0.0) + atan_reduced(u);
   return b > a ? kPi / 2 - r : r;
+}
+
+/// atan2(b, a) for a, b >= 0, in [0, pi/2]; 0 when both are 0.
+inline double atan2_first_quadrant(double b, double a) {
+  const Reduced q = reduce(b, a);
+  return finish(b, a, q.big, q.num / q.den);
 }
 }  // namespace fast_angles_detail
 
@@ -59,6 +70,21 @@ inline double atan2_first_quadrant(double b, double a) {
 inline double fast_polar_angle(double rho, double z) {
   const double a = fast_angles_detail::atan2_first_quadrant(rho, std::abs(z));
   return z < 0 ? fast_angles_detail::kPi - a : a;
+}
+
+/// Both angles of (x, y, z) with one division for the two reductions (num1 / den1 and
+/// num2 / den2 from one reciprocal of den1 * den2: two more roundings, within the same bound
+/// for |x|, |y|, |z| in [1e-100, 1e100]). phi in [0, pi], theta in [0, 2 pi].
+inline void fast_spherical_angles(double x, double y, double z, double& phi, double& theta) {
+  using namespace fast_angles_detail;
+  const double rho = std::sqrt(x * x + y * y), az = std::abs(z), ax = std::abs(x), ay = std::abs(y);
+  const Reduced p = reduce(rho, az), t = reduce(ay, ax);
+  const double inv = 1.0 / (p.den * t.den);
+  const double a = finish(rho, az, p.big, p.num * t.den * inv);
+  phi = z < 0 ? kPi - a : a;
+  double b = finish(ay, ax, t.big, t.num * p.den * inv);
+  b = x < 0 ? kPi - b : b;
+  theta = y < 0 ? 2 * kPi - b : b;
 }
 
 /// Azimuth theta = atan2(y, x) mapped to [0, 2 pi] radians (thesis Eq. 6; 2 pi only when y is a
