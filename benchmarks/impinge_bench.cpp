@@ -74,6 +74,7 @@ struct Built {
   RadialDistanceMap femur_map, pelvis_map;
   std::vector<std::uint8_t> femur_mask, pelvis_mask;
   ScanSet femur_set, pelvis_set;
+  ScanSet femur_hip, pelvis_hip;  ///< the sets restricted to the hip region (<= 45 mm from the COR)
 };
 const Built& built(int pi, DistanceMode mode) {
   static std::map<std::pair<int, int>, std::unique_ptr<Built>> cache;
@@ -81,7 +82,7 @@ const Built& built(int pi, DistanceMode mode) {
   if (!b) {
     const Scene& s = scene();
     const auto scheme = scheme_of(pi);
-    b = std::make_unique<Built>(Built{RadialDistanceMap(scheme), RadialDistanceMap(scheme), {}, {}, {}, {}});
+    b = std::make_unique<Built>(Built{RadialDistanceMap(scheme), RadialDistanceMap(scheme), {}, {}, {}, {}, {}, {}});
     SamplingOptions o;
     o.mode = mode;
     sample_surface(s.femur, s.cor, o, b->femur_map);
@@ -90,6 +91,12 @@ const Built& built(int pi, DistanceMode mode) {
     b->pelvis_mask = first_surface_mask(s.pelvis_rel, b->pelvis_map, 1.0, 1e30);
     b->femur_set = make_scan_set(s.femur_rel, b->femur_mask);
     b->pelvis_set = make_scan_set(s.pelvis_rel, b->pelvis_mask);
+    auto region = [](const Vertices& P, std::vector<std::uint8_t> m) {
+      for (Eigen::Index i = 0; i < P.rows(); ++i) m[std::size_t(i)] &= P.row(i).norm() <= 45 ? 1 : 0;
+      return make_scan_set(P, m);
+    };
+    b->femur_hip = region(s.femur_rel, b->femur_mask);
+    b->pelvis_hip = region(s.pelvis_rel, b->pelvis_mask);
   }
   return *b;
 }
@@ -136,12 +143,13 @@ void BM_HelixSample(benchmark::State& st) {
 BENCHMARK(BM_HelixSample)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // One scan (args: 0 = femur vertices against the pelvis map, 1 = pelvis against femur;
-// precision index). Items = map look-ups (vertices on their first surface); ns per item.
+// scheme index; set: 0 first-surface vertices, 1 those within 45 mm of the COR).
+// Items = map look-ups (vertices on their first surface); ns per item.
 void BM_Query(benchmark::State& st) {
   const Scene& s = scene();
   const Built& b = built(int(st.range(1)), DistanceMode::exact);
   const bool ball = st.range(0) == 0;
-  const ScanSet& set = ball ? b.femur_set : b.pelvis_set;
+  const ScanSet& set = st.range(2) ? (ball ? b.femur_hip : b.pelvis_hip) : (ball ? b.femur_set : b.pelvis_set);
   const RadialDistanceMap& other = ball ? b.pelvis_map : b.femur_map;
   std::vector<float> out(static_cast<std::size_t>(set.size()));
   const Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
@@ -156,17 +164,18 @@ void BM_Query(benchmark::State& st) {
   st.SetLabel(s.name + (ball ? " femur vs pelvis map, " : " pelvis vs femur map, ") + other.scheme().name() + " " +
               std::to_string(other.scheme().resolution()));
 }
-BENCHMARK(BM_Query)->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}})->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_Query)->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}, {0, 1}})->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 // Peers on the same vertices as BM_Query at p = 0.1 deg (the first-surface vertices).
-// args: body (0 femur vertices against the pelvis, 1 pelvis against the femur), packet (0, 1).
+// args: body (0 femur vertices against the pelvis, 1 pelvis against the femur), packet (0, 1),
+// set (0 first-surface vertices, 1 those within 45 mm of the COR).
 void BM_EmbreeQuery(benchmark::State& st) {
   if (!have_embree()) return st.SkipWithError("no Embree in this build");
   const Scene& s = scene();
   const Built& b = built(2, DistanceMode::exact);
   const bool ball = st.range(0) == 0;
   static const EmbreeRayCaster pelvis(s.pelvis, s.cor), femur(s.femur, s.cor);
-  const ScanSet& set = ball ? b.femur_set : b.pelvis_set;
+  const ScanSet& set = st.range(2) ? (ball ? b.femur_hip : b.pelvis_hip) : (ball ? b.femur_set : b.pelvis_set);
   std::vector<float> out(static_cast<std::size_t>(set.size()));
   for (auto _ : st) {
     (ball ? pelvis : femur)
@@ -178,7 +187,7 @@ void BM_EmbreeQuery(benchmark::State& st) {
                                                     benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   st.SetLabel(s.name + (st.range(1) ? " rtcIntersect8" : " rtcIntersect1"));
 }
-BENCHMARK(BM_EmbreeQuery)->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_EmbreeQuery)->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 // CGAL AABB tree first intersection on the same vertices (args: body).
 void BM_CgalQuery(benchmark::State& st) {

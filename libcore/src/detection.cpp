@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "impinge/error.hpp"
+#include "simd_clones.hpp"
 
 namespace impinge {
 
@@ -44,28 +45,43 @@ ScanSet make_scan_set(const Vertices& P, const std::vector<std::uint8_t>& mask) 
   return s;
 }
 
+namespace {
+/// q = R p + t and |q| for a block of vertices (vectorised clones).
+IMPINGE_SIMD_CLONES
+void pose_block(const double* __restrict X, const double* __restrict Y, const double* __restrict Z, int m,
+                const double* __restrict Rt, double* __restrict qx, double* __restrict qy, double* __restrict qz,
+                double* __restrict radius) {
+  for (int j = 0; j < m; ++j) {
+    const double x = X[j], y = Y[j], z = Z[j];
+    qx[j] = Rt[0] * x + Rt[1] * y + Rt[2] * z + Rt[9];
+    qy[j] = Rt[3] * x + Rt[4] * y + Rt[5] * z + Rt[10];
+    qz[j] = Rt[6] * x + Rt[7] * y + Rt[8] * z + Rt[11];
+    radius[j] = std::sqrt(qx[j] * qx[j] + qy[j] * qy[j] + qz[j] * qz[j]);
+  }
+}
+/// gap = side * (d - r) as float; NaN for no surface or r = 0.
+IMPINGE_SIMD_CLONES
+void gap_block(const double* __restrict d, const double* __restrict radius, double side, int m,
+               float* __restrict gap) {
+  for (int j = 0; j < m; ++j)
+    gap[j] = radius[j] > 0 ? static_cast<float>(side * (d[j] - radius[j])) : std::numeric_limits<float>::quiet_NaN();
+}
+}  // namespace
+
 template <typename Scalar>
 void scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                        const RadialDistanceMapT<Scalar>& map, ScanSide side, float* gap_mm) {
   const double s = static_cast<double>(static_cast<int>(side));
-  const double r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2), r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2), r20 = R(2, 0),
-               r21 = R(2, 1), r22 = R(2, 2), tx = t.x(), ty = t.y(), tz = t.z();
+  const double Rt[12] = {R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2),
+                         R(2, 0), R(2, 1), R(2, 2), t.x(),   t.y(),   t.z()};
   constexpr std::int64_t kBlock = 256;
   double qx[kBlock], qy[kBlock], qz[kBlock], radius[kBlock], d[kBlock];
   const std::int64_t n = set.size();
-  const double *X = set.x.data(), *Y = set.y.data(), *Z = set.z.data();
   for (std::int64_t b = 0; b < n; b += kBlock) {
-    const std::int64_t m = std::min(kBlock, n - b);
-    for (std::int64_t j = 0; j < m; ++j) {  // vectorised: rotate, translate, radius
-      const double x = X[b + j], y = Y[b + j], z = Z[b + j];
-      qx[j] = r00 * x + r01 * y + r02 * z + tx;
-      qy[j] = r10 * x + r11 * y + r12 * z + ty;
-      qz[j] = r20 * x + r21 * y + r22 * z + tz;
-      radius[j] = std::sqrt(qx[j] * qx[j] + qy[j] * qy[j] + qz[j] * qz[j]);
-    }
+    const int m = static_cast<int>(std::min(kBlock, n - b));
+    pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt, qx, qy, qz, radius);
     map.sample_many_soa(qx, qy, qz, m, d);
-    for (std::int64_t j = 0; j < m; ++j)  // NaN (no surface) stays NaN
-      gap_mm[b + j] = radius[j] > 0 ? static_cast<float>(s * (d[j] - radius[j])) : std::numeric_limits<float>::quiet_NaN();
+    gap_block(d, radius, s, m, gap_mm + b);
   }
 }
 

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "impinge/error.hpp"
 #include "impinge/spherical_frame.hpp"
+#include "simd_clones.hpp"
 
 namespace impinge {
 
@@ -55,10 +57,8 @@ void EquiangularGrid::node_angles(std::int64_t first, std::int64_t count, double
 namespace {
 /// Pass 1 of the look-up: cell (base node index, column step to the next column) and the
 /// fractional position (t along phi, s along theta) of n directions. Branch-free so it
-/// vectorises; cloned for AVX2 (x86-64-v3) and chosen at run time.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#endif
+/// vectorises; cloned for AVX-512 and AVX2 and chosen at run time.
+IMPINGE_SIMD_CLONES
 void locate_cells(const double* __restrict x, const double* __restrict y, const double* __restrict z, int n,
                   double inv_step, int rows, int cols, std::int32_t* __restrict base, std::int32_t* __restrict dc,
                   double* __restrict t, double* __restrict s) {
@@ -76,6 +76,28 @@ void locate_cells(const double* __restrict x, const double* __restrict y, const 
     base[j] = r0 * cols + c0;
   }
 }
+
+/// Pass 2: bilinear interpolation of the four nodes of each cell (gathers when vectorised).
+/// Non-finite results (a node without surface) are resolved by the caller.
+template <typename Scalar>
+inline void bilinear_body(const Scalar* __restrict values, const std::int32_t* __restrict base,
+                          const std::int32_t* __restrict dc, const double* __restrict t, const double* __restrict s,
+                          int n, int cols, double* __restrict out) {
+  for (int j = 0; j < n; ++j) {
+    const double v0 = values[base[j]], v1 = values[base[j] + dc[j]], v2 = values[base[j] + cols],
+                 v3 = values[base[j] + cols + dc[j]];
+    const double w0 = (1 - t[j]) * (1 - s[j]), w1 = (1 - t[j]) * s[j], w2 = t[j] * (1 - s[j]), w3 = t[j] * s[j];
+    out[j] = w0 * v0 + w1 * v1 + w2 * v2 + w3 * v3;
+  }
+}
+void bilinear(const float* values, const std::int32_t* base, const std::int32_t* dc, const double* t, const double* s,
+              int n, int cols, double* out) {
+  bilinear_body(values, base, dc, t, s, n, cols, out);
+}
+void bilinear(const double* values, const std::int32_t* base, const std::int32_t* dc, const double* t, const double* s,
+              int n, int cols, double* out) {
+  bilinear_body(values, base, dc, t, s, n, cols, out);
+}
 }  // namespace
 
 template <typename Scalar>
@@ -87,17 +109,26 @@ void EquiangularGrid::lookup_soa(const Scalar* values, const double* x, const do
   for (std::int64_t b = 0; b < n; b += kChunk) {
     const int m = static_cast<int>(std::min<std::int64_t>(kChunk, n - b));
     locate_cells(x + b, y + b, z + b, m, inv_step_, rows_, cols_, base, dc, t, s);
-    for (int j = 0; j < m; ++j) {  // pass 2: the loads, many misses in flight
-      const Scalar* v = values + base[j];
-      const double w0 = (1 - t[j]) * (1 - s[j]), w1 = (1 - t[j]) * s[j], w2 = t[j] * (1 - s[j]), w3 = t[j] * s[j];
-      const double r = w0 * v[0] + w1 * v[dc[j]] + w2 * v[cols_] + w3 * v[cols_ + dc[j]];
-      if (std::isfinite(r)) {
-        out[b + j] = r;
-      } else {
-        const std::int64_t nd[4] = {base[j], base[j] + dc[j], base[j] + cols_, base[j] + cols_ + dc[j]};
-        const double w[4] = {w0, w1, w2, w3};
-        out[b + j] = slow_path(values, nd, w);
-      }
+    for (int j = 0; j < m; ++j) {  // request both rows' cache lines before the first load
+      __builtin_prefetch(values + base[j]);
+      __builtin_prefetch(values + base[j] + cols_);
+    }
+    bilinear(values, base, dc, t, s, m, cols_, out + b);
+    // A node without surface (+inf) makes the sum non-finite: the result is NaN, unless that
+    // node's weight is exactly 0 (a direction exactly on a row or column), which goes to the
+    // exact slow path. The first loop is branch-free; the second almost never does anything.
+    bool any_edge = false;
+    for (int j = 0; j < m; ++j) {
+      const bool bad = !std::isfinite(out[b + j]);
+      any_edge |= bad && !(t[j] > 0 && t[j] < 1 && s[j] > 0 && s[j] < 1);
+      out[b + j] = bad ? std::numeric_limits<double>::quiet_NaN() : out[b + j];
+    }
+    if (!any_edge) continue;
+    for (int j = 0; j < m; ++j) {
+      if (!std::isnan(out[b + j]) || (t[j] > 0 && t[j] < 1 && s[j] > 0 && s[j] < 1)) continue;
+      const std::int64_t nd[4] = {base[j], base[j] + dc[j], base[j] + cols_, base[j] + cols_ + dc[j]};
+      const double w[4] = {(1 - t[j]) * (1 - s[j]), (1 - t[j]) * s[j], t[j] * (1 - s[j]), t[j] * s[j]};
+      out[b + j] = slow_path(values, nd, w);
     }
   }
 }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "impinge/equiangular_grid.hpp"
+#include "impinge/huge_page_allocator.hpp"
 #include "impinge/sampling_scheme.hpp"
 
 namespace impinge {
@@ -68,7 +69,7 @@ class RadialDistanceMapT {
 
  private:
   std::shared_ptr<const SamplingScheme> scheme_;
-  std::vector<Scalar> distance_;
+  std::vector<Scalar, HugePageAllocator<Scalar>> distance_;  ///< 2 MiB pages for large maps
 };
 
 using RadialDistanceMap = RadialDistanceMapT<float>;         ///< float32 map (default)
