@@ -101,21 +101,34 @@ const Built& built(int pi, DistanceMode mode) {
   return *b;
 }
 
-// args: body (0 femur, 1 pelvis), precision index, mode (0 exact, 1 linear)
+// args: body (0 femur, 1 pelvis), precision index, mode (0 exact, 1 linear, 2 exact with
+// face culling; the culling analysis is done once, outside the timed loop, like a BVH build).
+// The timed loop includes resetting the map (std::fill, BM_FillMap's floor).
 void BM_Rasterize(benchmark::State& st) {
   const Scene& s = scene();
   const TriangleMesh& m = st.range(0) == 0 ? s.femur : s.pelvis;
-  const DistanceMode mode = st.range(2) == 0 ? DistanceMode::exact : DistanceMode::linear;
+  const DistanceMode mode = st.range(2) == 1 ? DistanceMode::linear : DistanceMode::exact;
+  const FaceCulling fc = analyse_face_culling(m, s.cor);
+  const FaceCulling* cull = st.range(2) == 2 ? &fc : nullptr;
   RadialDistanceMap map{EquiangularGrid(kPrecisions[st.range(1)])};
   for (auto _ : st) {
     std::fill(map.data(), map.data() + map.num_nodes(), RadialDistanceMap::no_surface());
-    benchmark::DoNotOptimize(rasterize(m, s.cor, mode, map));
+    benchmark::DoNotOptimize(rasterize(m, s.cor, mode, map, cull));
   }
-  st.SetLabel(s.name + (st.range(0) == 0 ? " femur " : " pelvis ") + to_string(mode));
+  st.SetLabel(s.name + (st.range(0) == 0 ? " femur " : " pelvis ") + to_string(mode) +
+              (cull ? (fc.enabled ? " culled" : " (culling disabled: " + fc.reason + ")") : ""));
   st.counters["triangles"] = double(m.F.rows());
   st.counters["nodes"] = double(map.num_nodes());
 }
-BENCHMARK(BM_Rasterize)->ArgsProduct({{0, 1}, {0, 1, 2, 3}, {0, 1}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Rasterize)->ArgsProduct({{0, 1}, {0, 1, 2, 3}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The once-per-mesh face-culling analysis (args: body).
+void BM_FaceCullingAnalysis(benchmark::State& st) {
+  const Scene& s = scene();
+  const TriangleMesh& m = st.range(0) == 0 ? s.femur : s.pelvis;
+  for (auto _ : st) benchmark::DoNotOptimize(analyse_face_culling(m, s.cor));
+}
+BENCHMARK(BM_FaceCullingAnalysis)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The floor: std::fill of a map of the same size (args: precision index).
 void BM_FillMap(benchmark::State& st) {

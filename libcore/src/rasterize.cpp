@@ -2,10 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include "impinge/error.hpp"
+#include "impinge/fast_angles.hpp"
 #include "impinge/spherical_frame.hpp"
+#include "simd_clones.hpp"
 
 namespace impinge {
 
@@ -34,37 +41,152 @@ bool on_axis(const V3& v) { return v.x() * v.x() + v.y() * v.y() <= 1e-24 * v.sq
 /// mesh vertex (theta of a point on the axis is 0).
 struct Corner {
   V3 p;  ///< position relative to the COR, mm
-  V3 u;  ///< unit direction
   double d, phi, theta;
   bool axis;  ///< on the z axis (a pole vertex, thesis case 1)
+  V3 u() const { return d > 0 ? V3(p / d) : V3::Zero(); }  ///< unit direction
 };
+/// Angles by fast_angles.hpp (within 1e-13 rad of libm's): they only place bounding boxes
+/// (padded by 1e-4 steps) and feed linear mode's interpolation.
 Corner corner(const V3& v) {
-  const SphericalCoordinates s = to_spherical(v);
-  return {v, s.d > 0 ? V3(v / s.d) : V3::Zero(), s.d, s.phi, s.theta, on_axis(v)};
+  Corner k{v, v.norm(), 0, 0, on_axis(v)};
+  if (k.d > 0) fast_spherical_angles(v.x(), v.y(), v.z(), k.phi, k.theta);
+  if (k.theta >= 2 * kPi) k.theta -= 2 * kPi;
+  return k;
 }
 
 /// Range of z over the great-circle arc from unit u to unit v (interior extremes included).
+/// With n = u x v, the highest point of the great circle, e ~ z - (n.z / n.n) n, lies inside the
+/// arc iff z . (n x u) >= 0 and z . (v x n) >= 0 (the lowest: both <= 0), and its height is
+/// sqrt(1 - n.z^2 / n.n). Two cross-product z components, at most one sqrt.
 void arc_z_range(const V3& u, const V3& v, double& zmin, double& zmax) {
   zmin = std::min(u.z(), v.z());
   zmax = std::max(u.z(), v.z());
   const V3 n = u.cross(v);
-  const double nn = n.norm();
-  if (nn < 1e-15) return;
-  const V3 nh = n / nn;
-  V3 e = V3::UnitZ() - nh.z() * nh;
-  const double en = e.norm();
-  if (en < 1e-15) return;
-  e /= en;
-  if (u.cross(e).dot(n) >= 0 && e.cross(v).dot(n) >= 0) zmax = std::max(zmax, e.z());
-  const V3 f = -e;
-  if (u.cross(f).dot(n) >= 0 && f.cross(v).dot(n) >= 0) zmin = std::min(zmin, f.z());
+  const double nn = n.squaredNorm();
+  if (nn < 1e-30) return;
+  const double su = n.x() * u.y() - n.y() * u.x();  // z . (n x u)
+  const double sv = v.x() * n.y() - v.y() * n.x();  // z . (v x n)
+  if (su >= 0 && sv >= 0) zmax = std::max(zmax, std::sqrt(std::max(0.0, 1 - n.z() * n.z() / nn)));
+  if (su <= 0 && sv <= 0) zmin = std::min(zmin, -std::sqrt(std::max(0.0, 1 - n.z() * n.z() / nn)));
+}
+
+/// Exact-mode rows r0..r1 of one triangle's box. For a node of row r and column c the three
+/// edge functions are f_e = sin(phi_r) (e_e.x cos(theta_c) + e_e.y sin(theta_c)) + cos(phi_r) e_e.z
+/// (e_e: the oriented edge normals); the node is inside the cone when all are >= 0, and its
+/// distance is adet / (f0 + f1 + f2), where the ray meets the plane; the nearer value is kept.
+/// The columns are given as up to three contiguous segments (the box may wrap across theta =
+/// 0/360). Branch-free inner loops; the whole triangle in one call so the vectorised clone
+/// (AVX-512 / AVX2, chosen at run time) is dispatched once per triangle.
+struct ExactBox {
+  int r0, r1, nseg, seg[3][2];
+  double e[9], adet;
+};
+/// Distance of a node: adet / sum, in the map's precision (float maps divide in float: within
+/// 1.5 ulp of the correctly rounded value, 1e-5 mm at 100 mm; double maps in double).
+inline float node_distance(double adet, double sum, float) { return static_cast<float>(adet) / static_cast<float>(sum); }
+inline double node_distance(double adet, double sum, double) { return adet / sum; }
+
+/// Returns the number of nodes that had no surface before and have one now.
+template <typename Scalar>
+inline std::int64_t exact_rows_body(Scalar* __restrict map, int cols, const ExactBox& box,
+                                    const double* __restrict sin_phi, const double* __restrict cos_phi,
+                                    const double* __restrict cos_theta, const double* __restrict sin_theta) {
+  const double* e = box.e;
+  const double adet = box.adet;
+  constexpr Scalar none = std::numeric_limits<Scalar>::infinity();
+  std::int64_t newly = 0;
+  for (int r = box.r0; r <= box.r1; ++r) {
+    const double sp = sin_phi[r], cp = cos_phi[r];
+    const double a0 = sp * e[0], b0 = sp * e[1], c0 = cp * e[2], a1 = sp * e[3], b1 = sp * e[4], c1 = cp * e[5],
+                 a2 = sp * e[6], b2 = sp * e[7], c2 = cp * e[8];
+    Scalar* __restrict row = map + std::int64_t(r) * cols;
+    for (int g = 0; g < box.nseg; ++g) {
+      const int lo = box.seg[g][0], hi = box.seg[g][1];
+      for (int j = lo; j <= hi; ++j) {
+        const double ct = cos_theta[j], st = sin_theta[j];
+        const double f0 = a0 * ct + b0 * st + c0;
+        const double f1 = a1 * ct + b1 * st + c1;
+        const double f2 = a2 * ct + b2 * st + c2;
+        const bool inside = std::min(std::min(f0, f1), f2) >= 0;
+        const Scalar v = node_distance(adet, f0 + f1 + f2, Scalar{});
+        const Scalar old = row[j];
+        newly += (inside && old == none) ? 1 : 0;
+        row[j] = inside && v < old ? v : old;
+      }
+    }
+  }
+  return newly;
+}
+IMPINGE_SIMD_CLONES
+std::int64_t exact_rows_generic(float* map, int cols, const ExactBox& box, const double* sin_phi,
+                                const double* cos_phi, const double* cos_theta, const double* sin_theta) {
+  return exact_rows_body(map, cols, box, sin_phi, cos_phi, cos_theta, sin_theta);
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+/// exact_rows_body for float maps in AVX-512 with masked loads and stores: the short spans of
+/// small triangles (a few dozen nodes) run without scalar remainders. Same arithmetic as the
+/// generic body (double edge functions, float division), so the same values.
+__attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx512(
+    float* map, int cols, const ExactBox& box, const double* sin_phi, const double* cos_phi, const double* cos_theta,
+    const double* sin_theta) {
+  const double* e = box.e;
+  const __m256 adet = _mm256_set1_ps(static_cast<float>(box.adet));
+  const __m256 none = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+  const __m512d zero = _mm512_setzero_pd();
+  std::int64_t newly = 0;
+  for (int r = box.r0; r <= box.r1; ++r) {
+    const double sp = sin_phi[r], cp = cos_phi[r];
+    const __m512d a0 = _mm512_set1_pd(sp * e[0]), b0 = _mm512_set1_pd(sp * e[1]), c0 = _mm512_set1_pd(cp * e[2]),
+                  a1 = _mm512_set1_pd(sp * e[3]), b1 = _mm512_set1_pd(sp * e[4]), c1 = _mm512_set1_pd(cp * e[5]),
+                  a2 = _mm512_set1_pd(sp * e[6]), b2 = _mm512_set1_pd(sp * e[7]), c2 = _mm512_set1_pd(cp * e[8]);
+    float* row = map + std::int64_t(r) * cols;
+    for (int g = 0; g < box.nseg; ++g) {
+      const int lo = box.seg[g][0], hi = box.seg[g][1];
+      for (int j = lo; j <= hi; j += 8) {
+        const int left = hi - j + 1;
+        const __mmask8 m = left >= 8 ? __mmask8(0xFF) : __mmask8((1u << left) - 1u);
+        const __m512d ct = _mm512_maskz_loadu_pd(m, cos_theta + j), st = _mm512_maskz_loadu_pd(m, sin_theta + j);
+        // Same operation order as the generic body: a * ct + b * st + c.
+        const __m512d f0 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a0, ct), _mm512_mul_pd(b0, st)), c0);
+        const __m512d f1 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a1, ct), _mm512_mul_pd(b1, st)), c1);
+        const __m512d f2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a2, ct), _mm512_mul_pd(b2, st)), c2);
+        const __mmask8 inside = _mm512_mask_cmp_pd_mask(
+            _mm512_mask_cmp_pd_mask(_mm512_mask_cmp_pd_mask(m, f0, zero, _CMP_GE_OQ), f1, zero, _CMP_GE_OQ), f2, zero,
+            _CMP_GE_OQ);
+        if (!inside) continue;
+        const __m256 sum = _mm512_cvtpd_ps(_mm512_add_pd(_mm512_add_pd(f0, f1), f2));
+        const __m256 v = _mm256_div_ps(adet, sum);
+        const __m256 old = _mm256_maskz_loadu_ps(inside, row + j);
+        newly += __builtin_popcount(_mm256_mask_cmp_ps_mask(inside, old, none, _CMP_EQ_OQ));
+        _mm256_mask_storeu_ps(row + j, _mm256_mask_cmp_ps_mask(inside, v, old, _CMP_LT_OQ), v);
+      }
+    }
+  }
+  return newly;
+}
+#endif
+
+std::int64_t exact_rows(float* map, int cols, const ExactBox& box, const double* sin_phi, const double* cos_phi,
+                        const double* cos_theta, const double* sin_theta) {
+#if defined(__GNUC__) && defined(__x86_64__)
+  static const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                             __builtin_cpu_supports("avx512dq");
+  if (avx512) return exact_rows_avx512(map, cols, box, sin_phi, cos_phi, cos_theta, sin_theta);
+#endif
+  return exact_rows_generic(map, cols, box, sin_phi, cos_phi, cos_theta, sin_theta);
+}
+IMPINGE_SIMD_CLONES
+std::int64_t exact_rows(double* map, int cols, const ExactBox& box, const double* sin_phi, const double* cos_phi,
+                        const double* cos_theta, const double* sin_theta) {
+  return exact_rows_body(map, cols, box, sin_phi, cos_phi, cos_theta, sin_theta);
 }
 
 template <typename Scalar>
 class Rasterizer {
  public:
-  Rasterizer(RadialDistanceMapT<Scalar>& map, DistanceMode mode, SamplingStats& stats)
-      : map_(map), mode_(mode), stats_(stats), grid_(map.grid()) {
+  Rasterizer(RadialDistanceMapT<Scalar>& map, DistanceMode mode, SamplingStats& stats, int keep_sign)
+      : map_(map), mode_(mode), stats_(stats), grid_(map.grid()), keep_sign_(keep_sign) {
     const int rows = grid_.rows(), cols = grid_.columns();
     const double h = grid_.step();
     sin_phi_.resize(rows);
@@ -79,9 +201,11 @@ class Rasterizer {
     cos_phi_[rows - 1] = -1;
     cos_theta_.resize(cols);
     sin_theta_.resize(cols);
+
     for (int c = 0; c < cols; ++c) {
       cos_theta_[c] = std::cos(c * h);
       sin_theta_[c] = std::sin(c * h);
+
     }
   }
 
@@ -90,6 +214,10 @@ class Rasterizer {
     const double det = a.p.dot(b.p.cross(c.p));
     if (!(std::abs(det) > 1e-12 * a.d * b.d * c.d)) {
       ++stats_.triangles_edge_on;
+      return;
+    }
+    if (keep_sign_ != 0 && (det > 0 ? 1 : -1) != keep_sign_) {  // never the nearest hit (face_culling.hpp)
+      ++stats_.triangles_culled;
       return;
     }
     const bool north = in_cone(a.p, b.p, c.p, det, V3::UnitZ());
@@ -136,7 +264,7 @@ class Rasterizer {
     const double h = grid_.step();
 
     // Bounding rows: phi range of the spherical triangle, poles included.
-    const V3 &ua = ka.u, &ub = kb.u, &uc = kc.u;
+    const V3 ua = ka.u(), ub = kb.u(), uc = kc.u();
     double zlo = 1, zhi = -1, lo, hi;
     arc_z_range(ua, ub, lo, hi);
     zlo = std::min(zlo, lo), zhi = std::max(zhi, hi);
@@ -144,8 +272,9 @@ class Rasterizer {
     zlo = std::min(zlo, lo), zhi = std::max(zhi, hi);
     arc_z_range(uc, ua, lo, hi);
     zlo = std::min(zlo, lo), zhi = std::max(zhi, hi);
-    const double phi_min = north ? 0.0 : std::acos(std::clamp(zhi, -1.0, 1.0));
-    const double phi_max = south ? kPi : std::acos(std::clamp(zlo, -1.0, 1.0));
+    zhi = std::clamp(zhi, -1.0, 1.0), zlo = std::clamp(zlo, -1.0, 1.0);
+    const double phi_min = north ? 0.0 : fast_polar_angle(std::sqrt((1 - zhi) * (1 + zhi)), zhi);
+    const double phi_max = south ? kPi : fast_polar_angle(std::sqrt((1 - zlo) * (1 + zlo)), zlo);
     constexpr double pad = 1e-4;  // in steps; acos near +-1 loses ~1e-8 rad
     const int r0 = std::max(0, static_cast<int>(std::ceil(phi_min / h - pad)));
     const int r1 = std::min(rows - 1, static_cast<int>(std::floor(phi_max / h + pad)));
@@ -173,6 +302,20 @@ class Rasterizer {
     const double area2 = (tb - ta) * (kc.phi - ka.phi) - (tc - ta) * (kb.phi - ka.phi);
     const double dtheta_ab = wrap_pi(kb.theta - ka.theta);
 
+    if (mode_ == DistanceMode::exact) {
+      ExactBox box;
+      box.r0 = r0, box.r1 = r1, box.nseg = 0;
+      if (c0 < 0) box.seg[box.nseg][0] = c0 + cols, box.seg[box.nseg][1] = cols - 1, ++box.nseg;
+      box.seg[box.nseg][0] = std::max(c0, 0), box.seg[box.nseg][1] = std::min(c1, cols - 1), ++box.nseg;
+      if (c1 >= cols) box.seg[box.nseg][0] = 0, box.seg[box.nseg][1] = c1 - cols, ++box.nseg;
+      for (int k = 0; k < 3; ++k) box.e[k] = e0[k], box.e[3 + k] = e1[k], box.e[6 + k] = e2[k];
+      box.adet = adet;
+      if (r1 >= r0)
+        newly_covered_ +=
+            exact_rows(map_.data(), cols, box, sin_phi_.data(), cos_phi_.data(), cos_theta_.data(), sin_theta_.data());
+      stats_.node_tests += std::int64_t(std::max(0, r1 - r0 + 1)) * (c1 - c0 + 1);
+      return;
+    }
     for (int r = r0; r <= r1; ++r) {
       const double sp = sin_phi_[r], cp = cos_phi_[r];
       const double A0 = sp * e0.x(), B0 = sp * e0.y(), C0 = cp * e0.z();
@@ -187,15 +330,10 @@ class Rasterizer {
         const double f1 = A1 * ct + B1 * st + C1;
         const double f2 = A2 * ct + B2 * st + C2;
         if (f0 < 0 || f1 < 0 || f2 < 0) continue;
-        double value;
-        if (mode_ == DistanceMode::exact) {
-          value = adet / (f0 + f1 + f2);
-        } else if (apex) {
-          value = apex_value(ka, kb, kc, dtheta_ab, phi, col * h);
-        } else {
-          value = planar_value(ka, kb, kc, ta, tb, tc, area2, phi, col * h, adet / (f0 + f1 + f2));
-        }
+        const double value = apex ? apex_value(ka, kb, kc, dtheta_ab, phi, col * h)
+                                  : planar_value(ka, kb, kc, ta, tb, tc, area2, phi, col * h, adet / (f0 + f1 + f2));
         const Scalar v = static_cast<Scalar>(value);
+        newly_covered_ += row[col] == RadialDistanceMapT<Scalar>::no_surface() ? 1 : 0;
         if (v < row[col]) row[col] = v;
       }
       stats_.node_tests += (c1 - c0 + 1);
@@ -233,6 +371,10 @@ class Rasterizer {
   DistanceMode mode_;
   SamplingStats& stats_;
   const EquiangularGrid& grid_;
+  int keep_sign_;  ///< 0: no culling
+
+ public:
+  std::int64_t newly_covered_ = 0;  ///< nodes that had no surface and now have one
   std::vector<double> sin_phi_, cos_phi_, cos_theta_, sin_theta_;
 };
 
@@ -240,25 +382,41 @@ class Rasterizer {
 
 template <typename Scalar>
 SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, DistanceMode mode,
-                        RadialDistanceMapT<Scalar>& map) {
+                        RadialDistanceMapT<Scalar>& map, const FaceCulling* culling) {
   require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
   SamplingStats stats;
-  Rasterizer<Scalar> raster(map, mode, stats);
+  const int keep = (culling != nullptr && culling->enabled && mode == DistanceMode::exact) ? culling->keep_sign : 0;
+  Rasterizer<Scalar> raster(map, mode, stats, keep);
   // Spherical coordinates once per vertex (a vertex is shared by about six triangles).
-  std::vector<Corner> corners(static_cast<std::size_t>(mesh.V.rows()));
+  // Reused between calls on this thread: a fresh multi-megabyte buffer would be page-faulted in
+  // on every call.
+  thread_local std::vector<Corner> corners;
+  corners.resize(static_cast<std::size_t>(mesh.V.rows()));
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
     corners[static_cast<std::size_t>(i)] = corner(mesh.V.row(i).transpose() - cor);
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+  auto draw = [&](Eigen::Index f) {
     raster.triangle(corners[static_cast<std::size_t>(mesh.F(f, 0))], corners[static_cast<std::size_t>(mesh.F(f, 1))],
                     corners[static_cast<std::size_t>(mesh.F(f, 2))]);
-  stats.nodes_covered = map.nodes_covered();
+  };
+  if (keep != 0 && !culling->triangle_order.empty()) {
+    // The plan's order holds the kept triangles only: account for the culled ones here.
+    for (const std::int32_t f : culling->triangle_order) {
+      if (f < 0 || f >= mesh.F.rows()) throw Error(mesh.source + ": face culling plan does not match the mesh");
+      draw(f);
+    }
+    stats.triangles_culled += mesh.F.rows() - static_cast<std::int64_t>(culling->triangle_order.size());
+    stats.triangles += mesh.F.rows() - static_cast<std::int64_t>(culling->triangle_order.size());
+  } else {
+    for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) draw(f);
+  }
+  stats.nodes_covered = raster.newly_covered_;
   return stats;
 }
 
 template SamplingStats rasterize<float>(const TriangleMesh&, const Eigen::Vector3d&, DistanceMode,
-                                        RadialDistanceMapT<float>&);
+                                        RadialDistanceMapT<float>&, const FaceCulling*);
 template SamplingStats rasterize<double>(const TriangleMesh&, const Eigen::Vector3d&, DistanceMode,
-                                         RadialDistanceMapT<double>&);
+                                         RadialDistanceMapT<double>&, const FaceCulling*);
 
 RadialDistanceMap rasterize_map(const TriangleMesh& mesh, const Eigen::Vector3d& cor, double precision_deg,
                                 DistanceMode mode, SamplingStats* stats) {

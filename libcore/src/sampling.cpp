@@ -81,9 +81,20 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
   if (rep.method == SamplingMethod::automatic)
     rep.method = equiangular ? SamplingMethod::rasterize : SamplingMethod::resample;
   auto t0 = std::chrono::steady_clock::now();
+  // Face culling (exact mode): the caller's plan, or one made here when asked to.
+  FaceCulling own;
+  const FaceCulling* cull = o.culling;
+  if (cull == nullptr && o.cull_faces && o.mode == DistanceMode::exact &&
+      (rep.method == SamplingMethod::rasterize || rep.method == SamplingMethod::resample)) {
+    own = analyse_face_culling(mesh, cor);
+    cull = &own;
+    rep.culling_ms = ms_since(t0);
+    t0 = std::chrono::steady_clock::now();
+  }
+  rep.faces_culled = cull != nullptr && cull->enabled && o.mode == DistanceMode::exact;
   switch (rep.method) {
     case SamplingMethod::rasterize:
-      rep.raster = rasterize(mesh, cor, o.mode, map);  // throws via map.grid() when not equiangular
+      rep.raster = rasterize(mesh, cor, o.mode, map, cull);  // throws via map.grid() when not equiangular
       rep.rasterize_ms = ms_since(t0);
       break;
     case SamplingMethod::resample: {
@@ -92,7 +103,7 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
       rep.resample_precision_deg = p;
       {
         RadialDistanceMap tmp{EquiangularGrid(p)};
-        rep.raster = rasterize(mesh, cor, o.mode, tmp);
+        rep.raster = rasterize(mesh, cor, o.mode, tmp, cull);
         rep.rasterize_ms = ms_since(t0);
         t0 = std::chrono::steady_clock::now();
         resample(tmp, map);

@@ -32,6 +32,11 @@ struct SamplingOptions {
   double resample_precision_deg = 0;  ///< temporary equiangular precision for `resample`; 0 picks
                                       ///< 180 / round(180 / node spacing in degrees), the precision
                                       ///< whose equator count matches the scheme's (thesis Table 6)
+  /// Exact mode: skip the triangles that can never be the nearest hit (face_culling.hpp).
+  /// With `culling` null, the analysis is made here (O(m), counted in culling_ms); culling
+  /// turns itself off, and says why, on meshes where it would not be exact.
+  bool cull_faces = true;
+  const FaceCulling* culling = nullptr;  ///< a plan made once by analyse_face_culling, or null
 };
 
 /// What a sampling run did.
@@ -41,6 +46,8 @@ struct SamplingReport {
   double resample_precision_deg = 0;                          ///< temporary map precision (resample), else 0
   std::int64_t nodes_covered = 0;                             ///< nodes with a surface in the filled map
   double rasterize_ms = 0, resample_ms = 0, ray_cast_ms = 0;  ///< wall times of the stages
+  double culling_ms = 0;                                      ///< face-culling analysis made here
+  bool faces_culled = false;                                  ///< rasterised with culling
 };
 
 /// Fill `map` (any scheme) from `mesh` (mm) about `cor` (mm): nearest hit per node, +inf where
