@@ -69,6 +69,21 @@ std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& gen
   return out;
 }
 
+Eigen::Vector3d subject_cor(const Subject& s) {
+  return s.generated ? s.true_cor : fit_femoral_head(s.femur).centre;
+}
+
+Eigen::Vector3d push_direction(const TriangleMesh& pelvis, const Eigen::Vector3d& cor, double radius_mm) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (Eigen::Index i = 0; i < pelvis.V.rows(); ++i) {
+    const Eigen::Vector3d p = pelvis.V.row(i).transpose() - cor;
+    if (p.norm() <= radius_mm) c += p, ++n;
+  }
+  if (n == 0 || c.norm() == 0) return Eigen::Vector3d::UnitX();
+  return c.normalized();
+}
+
 double median_ms(const std::function<void()>& fn, int reps) {
   fn();
   std::vector<double> t;

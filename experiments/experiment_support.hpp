@@ -13,6 +13,7 @@
 #include "impinge/generated_models.hpp"
 #include "impinge/mesh.hpp"
 #include "impinge/pose.hpp"
+#include "impinge/sphere_fit.hpp"
 
 namespace impinge::experiment {
 
@@ -40,6 +41,14 @@ struct Subject {
 /// Every real subject under args.data (sorted by name; none when the folder is absent), then
 /// the generated hip model(s) with the given triangle counts.
 std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& generated_triangles);
+
+/// The COR of a subject: the true centre for generated models, the automatic femoral-head fit
+/// (fit_femoral_head) for real ones. mm, anatomical frame.
+Eigen::Vector3d subject_cor(const Subject& s);
+
+/// Unit direction in which the femur is pushed into the acetabulum: from the COR towards the
+/// centroid of the pelvis vertices within `radius_mm` of it (the acetabular fossa side).
+Eigen::Vector3d push_direction(const TriangleMesh& pelvis, const Eigen::Vector3d& cor, double radius_mm = 45);
 
 /// Median wall time in ms of `fn` over `reps` runs after one warm-up run.
 double median_ms(const std::function<void()>& fn, int reps);

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#endif
 #include <sstream>
 
 #include "impinge/error.hpp"
@@ -90,13 +94,70 @@ inline void bilinear_body(const Scalar* __restrict values, const std::int32_t* _
     out[j] = w0 * v0 + w1 * v1 + w2 * v2 + w3 * v3;
   }
 }
+void bilinear_generic(const float* values, const std::int32_t* base, const std::int32_t* dc, const double* t,
+                      const double* s, int n, int cols, double* out) {
+  bilinear_body(values, base, dc, t, s, n, cols, out);
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+/// bilinear_body for float maps with AVX2 gathers (vgatherdps): 8 points at a time, the four
+/// node values gathered, the weights and the sum in double in two 4-lane halves, in the same
+/// operation order as the generic body (so the same values).
+__attribute__((target("avx2,fma"))) void bilinear_avx2(const float* values, const std::int32_t* base,
+                                                       const std::int32_t* dc, const double* t, const double* s, int n,
+                                                       int cols, double* out) {
+  const __m256i vcols = _mm256_set1_epi32(cols);
+  const __m256d one = _mm256_set1_pd(1.0);
+  int j = 0;
+  for (; j + 8 <= n; j += 8) {
+    const __m256i b = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(base + j));
+    const __m256i d = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(dc + j));
+    const __m256i b2 = _mm256_add_epi32(b, vcols);
+    const __m256 v0 = _mm256_i32gather_ps(values, b, 4), v1 = _mm256_i32gather_ps(values, _mm256_add_epi32(b, d), 4),
+                 v2 = _mm256_i32gather_ps(values, b2, 4), v3 = _mm256_i32gather_ps(values, _mm256_add_epi32(b2, d), 4);
+    for (int h = 0; h < 2; ++h) {
+      const __m256d a0 = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(v0, 1) : _mm256_castps256_ps128(v0));
+      const __m256d a1 = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(v1, 1) : _mm256_castps256_ps128(v1));
+      const __m256d a2 = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(v2, 1) : _mm256_castps256_ps128(v2));
+      const __m256d a3 = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(v3, 1) : _mm256_castps256_ps128(v3));
+      const __m256d tt = _mm256_loadu_pd(t + j + 4 * h), ss = _mm256_loadu_pd(s + j + 4 * h);
+      const __m256d ut = _mm256_sub_pd(one, tt), us = _mm256_sub_pd(one, ss);
+      const __m256d w0 = _mm256_mul_pd(ut, us), w1 = _mm256_mul_pd(ut, ss), w2 = _mm256_mul_pd(tt, us),
+                    w3 = _mm256_mul_pd(tt, ss);
+      const __m256d r = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(w0, a0), _mm256_mul_pd(w1, a1)),
+                                                    _mm256_mul_pd(w2, a2)),
+                                      _mm256_mul_pd(w3, a3));
+      _mm256_storeu_pd(out + j + 4 * h, r);
+    }
+  }
+  if (j < n) bilinear_body(values, base + j, dc + j, t + j, s + j, n - j, cols, out + j);
+}
+#endif
+
 void bilinear(const float* values, const std::int32_t* base, const std::int32_t* dc, const double* t, const double* s,
               int n, int cols, double* out) {
-  bilinear_body(values, base, dc, t, s, n, cols, out);
+#if defined(__GNUC__) && defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (avx2) return bilinear_avx2(values, base, dc, t, s, n, cols, out);
+#endif
+  bilinear_generic(values, base, dc, t, s, n, cols, out);
 }
 void bilinear(const double* values, const std::int32_t* base, const std::int32_t* dc, const double* t, const double* s,
               int n, int cols, double* out) {
   bilinear_body(values, base, dc, t, s, n, cols, out);
+}
+/// Non-finite interpolated values become NaN; returns true when one of them lies on a row or
+/// column of the grid (a zero weight: the caller's exact slow path decides). Branch-free.
+IMPINGE_SIMD_CLONES
+bool mark_no_surface(double* __restrict out, const double* __restrict t, const double* __restrict s, int n) {
+  int edge = 0;
+  for (int j = 0; j < n; ++j) {
+    const int bad = !(std::abs(out[j]) <= std::numeric_limits<double>::max());  // inf or NaN
+    const int interior = (t[j] > 0) & (t[j] < 1) & (s[j] > 0) & (s[j] < 1);
+    edge |= bad & (1 - interior);
+    out[j] = bad ? std::numeric_limits<double>::quiet_NaN() : out[j];
+  }
+  return edge != 0;
 }
 }  // namespace
 
@@ -109,20 +170,11 @@ void EquiangularGrid::lookup_soa(const Scalar* values, const double* x, const do
   for (std::int64_t b = 0; b < n; b += kChunk) {
     const int m = static_cast<int>(std::min<std::int64_t>(kChunk, n - b));
     locate_cells(x + b, y + b, z + b, m, inv_step_, rows_, cols_, base, dc, t, s);
-    for (int j = 0; j < m; ++j) {  // request both rows' cache lines before the first load
-      __builtin_prefetch(values + base[j]);
-      __builtin_prefetch(values + base[j] + cols_);
-    }
     bilinear(values, base, dc, t, s, m, cols_, out + b);
     // A node without surface (+inf) makes the sum non-finite: the result is NaN, unless that
     // node's weight is exactly 0 (a direction exactly on a row or column), which goes to the
     // exact slow path. The first loop is branch-free; the second almost never does anything.
-    bool any_edge = false;
-    for (int j = 0; j < m; ++j) {
-      const bool bad = !std::isfinite(out[b + j]);
-      any_edge |= bad && !(t[j] > 0 && t[j] < 1 && s[j] > 0 && s[j] < 1);
-      out[b + j] = bad ? std::numeric_limits<double>::quiet_NaN() : out[b + j];
-    }
+    const bool any_edge = mark_no_surface(out + b, t, s, m);
     if (!any_edge) continue;
     for (int j = 0; j < m; ++j) {
       if (!std::isnan(out[b + j]) || (t[j] > 0 && t[j] < 1 && s[j] > 0 && s[j] < 1)) continue;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "impinge/helix_arc_length.hpp"
+#include "impinge/fast_angles.hpp"
 #include "impinge/sampling_scheme.hpp"
 
 namespace impinge {
@@ -64,11 +65,9 @@ class HelixScheme : public SchemeImpl<HelixScheme> {
 
   /// Thesis Algorithm 3's neighbour location and interpolation (see class comment).
   void stencil_at(double x, double y, double z, std::int64_t nodes[4], double w[4]) const {
-    const double r = std::sqrt(x * x + y * y + z * z);
-    const double c = z / r;
-    const double phi = std::acos(c < -1 ? -1 : (c > 1 ? 1 : c));
-    double theta = std::atan2(y, x);
-    if (theta < 0) theta += kTwoPi;
+    double phi, theta;  // no libm trigonometry (fast_angles.hpp: within 1e-13 rad)
+    fast_spherical_angles(x, y, z, phi, theta);
+    if (theta >= kTwoPi) theta -= kTwoPi;
     // bracketing crossings of the meridian theta
     const double jf = (2 * k_ * phi - theta) * kInvTwoPi;  // floor without a libm call
     double j = static_cast<double>(static_cast<std::int64_t>(jf));

@@ -1,0 +1,144 @@
+// 02_sampling_time -- thesis Tables 3 and 8: time to sample a bone into a radial distance map,
+// by method and precision, with std::fill of the same map as the floor.
+//
+// Inputs: the generated 3k hip model (the thesis' level) and every subject under --data.
+// Outputs: OUT/02_sampling_time/
+//   sampling_time.csv  one row per subject x body x precision x method:
+//     method: fill (std::fill of the map: the floor), rsid_linear (thesis Algorithm 1),
+//             rsid_exact (exact mode, every triangle), rsid_exact_culled (exact mode with the
+//             face-culling plan made once, face_culling.hpp), usid_accelerated (helix at the
+//             matched turns k = round(720 / (pi p)): rasterise the matched equiangular map with
+//             culling, resample, release; thesis sec. 4.2.2), embree_node_cast (Embree 3 casts
+//             every node's ray, 8-wide packets), pairwise (the thesis' O(m n) ray-triangle sampling,
+//             timed on a subset of nodes and scaled to the map: `extrapolated` = 1),
+//             culling_analysis (the plan itself, once per mesh; precision 0)
+//     thesis_ms: Table 3 / 8 value for the generated 3k rows (pairwise, RSID, USID)
+//   meta.json
+// Command: build/experiments/exp_02_sampling_time --out results --data ../shared/data/hips [--quick]
+// Quick mode: p = 1, 0.5, 0.1 and 300 pairwise nodes; full: also 0.05 and 2000 pairwise nodes.
+// Every time is the median of --repetitions runs after a warm-up, single thread; the map is
+// reset to "no surface" inside each timed run (so each method's row includes one fill).
+#include <algorithm>
+#include <iostream>
+#include <random>
+
+#include "experiment_support.hpp"
+#include "impinge/embree_ray_caster.hpp"
+#include "impinge/face_culling.hpp"
+#include "impinge/helix_scheme.hpp"
+#include "impinge/naive_sampling.hpp"
+#include "impinge/rasterize.hpp"
+#include "impinge/sampling.hpp"
+
+using namespace impinge;
+using namespace impinge::experiment;
+
+namespace {
+/// Thesis Tables 3 and 8 (3k generic model), ms; NaN where the thesis has no value.
+double thesis_ms(const std::string& method, double p) {
+  const double nan = std::nan("");
+  const int i = p == 1 ? 0 : p == 0.5 ? 1 : p == 0.1 ? 2 : p == 0.05 ? 3 : -1;
+  if (i < 0) return nan;
+  const double pairwise[] = {176328, 700844, 17722156, nan}, rsid[] = {15, 16, 62, 187},
+               usid[] = {31, 109, 2781, 11172};
+  if (method == "pairwise") return pairwise[i];
+  if (method == "rsid_linear") return rsid[i];
+  if (method == "usid_accelerated") return usid[i];
+  return nan;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv, "02_sampling_time: thesis Tables 3 and 8, sampling time by method");
+  const std::string dir = experiment_dir(args, "02_sampling_time");
+  const std::vector<Subject> subjects = load_subjects(args, {3000});
+  std::vector<double> precisions{1, 0.5, 0.1};
+  if (!args.quick) precisions.push_back(0.05);
+  const int pairwise_nodes = args.quick ? 300 : 2000;
+  const int reps = args.repetitions;
+
+  CsvWriter csv(dir + "/sampling_time.csv",
+                {"subject", "generated", "body", "triangles", "precision_deg", "scheme", "resolution", "method", "nodes",
+                 "nodes_covered", "time_ms", "extrapolated", "nodes_timed", "thesis_ms", "culling_enabled",
+                 "triangles_rasterised"});
+  const int total = static_cast<int>(subjects.size() * 2 * precisions.size());
+  int done = 0;
+  for (const Subject& s : subjects) {
+    const Eigen::Vector3d cor = subject_cor(s);
+    for (int body = 0; body < 2; ++body) {
+      const TriangleMesh& mesh = body == 0 ? s.femur : s.pelvis;
+      const std::string bname = body == 0 ? "femur" : "pelvis";
+      const auto tri = static_cast<std::int64_t>(mesh.F.rows());
+      FaceCulling plan;
+      const double t_plan = median_ms([&] { plan = analyse_face_culling(mesh, cor); }, reps);
+      csv.row(s.name, int(s.generated), bname, tri, 0.0, "none", 0.0, "culling_analysis", 0, 0, t_plan, 0, 0,
+              std::nan(""), int(plan.enabled), static_cast<std::int64_t>(plan.triangle_order.size()));
+      std::unique_ptr<EmbreeRayCaster> embree;
+      if (have_embree()) embree = std::make_unique<EmbreeRayCaster>(mesh, cor);
+      for (double p : precisions) {
+        progress("02_sampling_time", ++done, total, s.name + " " + bname + " p=" + std::to_string(p));
+        RadialDistanceMap map{EquiangularGrid(p)};
+        const std::int64_t nodes = map.num_nodes();
+        auto reset = [&] { std::fill(map.data(), map.data() + nodes, RadialDistanceMap::no_surface()); };
+        auto put = [&](const std::string& method, double ms, std::int64_t covered, int extrapolated, std::int64_t timed,
+                       std::int64_t rasterised, const std::string& scheme = "equiangular", double res = -1) {
+          csv.row(s.name, int(s.generated), bname, tri, p, scheme, res < 0 ? p : res, method,
+                  scheme == "equiangular" ? nodes : static_cast<std::int64_t>(res * res), covered, ms, extrapolated,
+                  timed, s.name == "generated-3k" ? thesis_ms(method, p) : std::nan(""), int(plan.enabled), rasterised);
+        };
+        put("fill", median_ms(reset, reps), 0, 0, nodes, 0);
+        SamplingStats st;
+        double t = median_ms([&] { reset(), st = rasterize(mesh, cor, DistanceMode::linear, map); }, reps);
+        put("rsid_linear", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled);
+        t = median_ms([&] { reset(), st = rasterize(mesh, cor, DistanceMode::exact, map); }, reps);
+        put("rsid_exact", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled);
+        const RadialDistanceMap full = map;
+        t = median_ms([&] { reset(), st = rasterize(mesh, cor, DistanceMode::exact, map, &plan); }, reps);
+        put("rsid_exact_culled", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled);
+        std::int64_t differing = 0;
+        for (std::int64_t i = 0; i < nodes; ++i) differing += map.at(i) != full.at(i);
+        if (differing != 0)
+          std::cerr << "02_sampling_time: WARNING " << s.name << " " << bname << " p=" << p << ": culled map differs at "
+                    << differing << " nodes\n";
+        {
+          const int k = static_cast<int>(matched_helix_turns(p));
+          RadialDistanceMap helix(make_scheme("helix", k));
+          SamplingOptions o;
+          o.culling = &plan;
+          SamplingReport rep;
+          t = median_ms([&] { rep = sample_surface(mesh, cor, o, helix); }, reps);
+          put("usid_accelerated", t, rep.nodes_covered, 0, helix.num_nodes(), rep.raster.triangles, "helix", k);
+        }
+        if (embree) {
+          std::int64_t covered = 0;
+          t = median_ms([&] { covered = embree->fill_map(map); }, p < 0.1 ? std::min(reps, 3) : reps);
+          put("embree_node_cast", t, covered, 0, nodes, tri);
+        }
+        {  // Pairwise O(m n): a random subset of nodes, scaled to the whole map.
+          std::mt19937_64 rng(11);
+          std::uniform_int_distribution<std::int64_t> pick(0, nodes - 1);
+          std::vector<std::int64_t> sample(static_cast<std::size_t>(std::min<std::int64_t>(pairwise_nodes, nodes)));
+          for (auto& i : sample) i = pick(rng);
+          volatile double sink = 0;  // keeps the casts from being optimised away
+          t = median_ms(
+              [&] {
+                for (std::int64_t i : sample) {
+                  const auto h = cast_ray_naive(mesh, cor, map.scheme().node_direction(i));
+                  sink = sink + (h ? h->first : 0);
+                }
+              },
+              1);
+          put("pairwise", t * double(nodes) / double(sample.size()), -1, 1, static_cast<std::int64_t>(sample.size()),
+              tri);
+        }
+      }
+    }
+  }
+  write_meta(dir, args,
+             {{"precisions_deg", precisions},
+              {"pairwise_nodes_timed", pairwise_nodes},
+              {"embree", have_embree()},
+              {"generated", "make_hip_model(target_triangles=3000, cam_height_mm=2)"},
+              {"note", "single thread; every row's time includes resetting the map once (fill)"}});
+  return 0;
+}

@@ -1,0 +1,227 @@
+// 03_detection_time -- thesis Tables 4 and 9: time of one pose's detection (both scans), by
+// method, on the generated models at the thesis' triangle levels and on every real subject.
+//
+// Inputs: generated hips of 300, 1k, 3k and 12k triangles per model, every subject under --data.
+// Outputs: OUT/03_detection_time/
+//   detection.csv   one row per subject x pose x method:
+//     pose: rest (the scan pose) or pushed_3mm (the femur translated 3 mm from the COR towards
+//           the centroid of the pelvis vertices within 45 mm: into the acetabulum)
+//     method: rsid (equiangular map, exact mode, fast scan), usid (helix at the matched turns),
+//             embree_radial (rtcIntersect1 per vertex), embree_radial_packet8 (rtcIntersect8),
+//             cgal_radial (CGAL AABB tree first intersection per vertex: the exact reference),
+//             fcl_collide (FCL OBBRSS trees, every contact), fcl_distance (FCL minimum distance),
+//             pairwise (the thesis' exhaustive triangle-pair test over the hip-region triangles)
+//     vertices: the scanned vertices of both bodies (first surface, within 45 mm of the COR);
+//     time_ms: both scans (or the whole query) of one pose; ball_ms, socket_ms: per scan;
+//     ns_per_vertex = time / vertices; result: min gap (mm) for the radial methods, contacts,
+//     distance (mm) or intersecting pairs for the others; thesis_ms: Table 4 / 9
+//   throughput.csv  poses per second for RSID and USID over 256 random poses (rotations up to
+//                   20 deg about the COR), with 1 and 2 threads (each thread its own poses)
+//   meta.json
+// Command: build/experiments/exp_03_detection_time --out results --data ../shared/data/hips [--quick]
+// Quick mode: fewer repetitions; the pairwise test only where it has <= 20 million pairs.
+#include <random>
+#include <thread>
+
+#include "experiment_support.hpp"
+#include "impinge/detection.hpp"
+#include "impinge/embree_ray_caster.hpp"
+#include "impinge/exact_reference.hpp"
+#include "impinge/face_culling.hpp"
+#include "impinge/fcl_collision.hpp"
+#include "impinge/helix_scheme.hpp"
+#include "impinge/pairwise.hpp"
+#include "impinge/sampling.hpp"
+
+using namespace impinge;
+using namespace impinge::experiment;
+
+namespace {
+constexpr double kRegionMm = 45;
+
+/// Thesis Tables 4 and 9 by triangle level (the 12k row was a real CT model), ms.
+double thesis_ms(const std::string& subject, const std::string& method) {
+  const double nan = std::nan("");
+  const int i = subject == "generated-300" ? 0 : subject == "generated-1k" ? 1 : subject == "generated-3k" ? 2
+                : subject == "generated-12k" ? 3 : -1;
+  if (i < 0) return nan;
+  const double pairwise[] = {30.7, 522, 2831, nan}, rapid[] = {1.41, 1.41, 1.43, 1.5}, rsid[] = {0.06, 0.18, 0.48, 5.7},
+               usid[] = {0.07, 0.65, 1.8, 12};
+  if (method == "pairwise") return pairwise[i];
+  if (method == "fcl_collide") return rapid[i];
+  if (method == "rsid") return rsid[i];
+  if (method == "usid") return usid[i];
+  return nan;
+}
+
+struct Body {
+  RadialDistanceMap map;
+  ScanSet set;
+};
+
+/// A body's map (exact mode, culled) and its hip-region scan set.
+Body build(const TriangleMesh& mesh, const Eigen::Vector3d& cor, const std::shared_ptr<const SamplingScheme>& scheme) {
+  Body b{RadialDistanceMap(scheme), {}};
+  sample_surface(mesh, cor, SamplingOptions{}, b.map);
+  const Vertices rel = mesh.V.rowwise() - cor.transpose();
+  b.set = make_scan_set(rel, first_surface_mask(rel, b.map, 1.0, kRegionMm));
+  return b;
+}
+
+double min_of(const std::vector<float>& a, const std::vector<float>& b) {
+  double m = std::numeric_limits<double>::infinity();
+  for (float g : a)
+    if (std::isfinite(g)) m = std::min<double>(m, g);
+  for (float g : b)
+    if (std::isfinite(g)) m = std::min<double>(m, g);
+  return m;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv, "03_detection_time: thesis Tables 4 and 9, detection time by method");
+  const std::string dir = experiment_dir(args, "03_detection_time");
+  const std::vector<Subject> subjects = load_subjects(args, {300, 1000, 3000, 12000});
+  const int reps = args.repetitions;
+  const double kPrecision = 0.5;  // RSID / USID maps of the detection table (the thesis does not say)
+  const std::vector<double> precisions{0.5, 0.1};
+
+  CsvWriter csv(dir + "/detection.csv",
+                {"subject", "generated", "femur_triangles", "pelvis_triangles", "pose", "method", "resolution",
+                 "vertices", "time_ms", "ball_ms", "socket_ms", "ns_per_vertex", "result", "result_kind",
+                 "thesis_ms"});
+  CsvWriter thr(dir + "/throughput.csv",
+                {"subject", "method", "resolution", "threads", "poses", "time_ms", "poses_per_s"});
+  int done = 0;
+  const int total = static_cast<int>(subjects.size());
+  for (const Subject& s : subjects) {
+    progress("03_detection_time", ++done, total, s.name);
+    const Eigen::Vector3d cor = subject_cor(s);
+    const Eigen::Vector3d push = 3.0 * push_direction(s.pelvis, cor, kRegionMm);
+    const auto ft = static_cast<std::int64_t>(s.femur.F.rows()), pt = static_cast<std::int64_t>(s.pelvis.F.rows());
+    auto row = [&](const std::string& pose, const std::string& method, double res, std::int64_t vertices, double ms,
+                   double ball_ms, double socket_ms, double result, const std::string& kind) {
+      csv.row(s.name, int(s.generated), ft, pt, pose, method, res, vertices, ms, ball_ms, socket_ms,
+              vertices > 0 ? ms * 1e6 / double(vertices) : std::nan(""), result, kind, thesis_ms(s.name, method));
+    };
+    // Maps: equiangular at each precision, helix at the matched turns.
+    struct Scheme {
+      std::string method;
+      double res;
+      std::shared_ptr<const SamplingScheme> scheme;
+    };
+    std::vector<Scheme> schemes;
+    for (double p : precisions) {
+      schemes.push_back({"rsid", p, make_scheme("equiangular", p)});
+      schemes.push_back({"usid", matched_helix_turns(p), make_scheme("helix", matched_helix_turns(p))});
+    }
+    std::vector<std::pair<Body, Body>> built;
+    for (const Scheme& sc : schemes) built.emplace_back(build(s.femur, cor, sc.scheme), build(s.pelvis, cor, sc.scheme));
+    // The peers' vertex sets: the first-surface hip-region vertices of the finest equiangular map.
+    const ScanSet& fset = built[2].first.set;
+    const ScanSet& pset = built[2].second.set;
+    const std::int64_t nv = fset.size() + pset.size();
+    std::unique_ptr<EmbreeRayCaster> emb_f, emb_p;
+    if (have_embree()) emb_f = std::make_unique<EmbreeRayCaster>(s.femur, cor), emb_p = std::make_unique<EmbreeRayCaster>(s.pelvis, cor);
+    std::unique_ptr<ExactReference> cg_f, cg_p;
+    if (have_exact_reference()) cg_f = std::make_unique<ExactReference>(s.femur), cg_p = std::make_unique<ExactReference>(s.pelvis);
+    std::unique_ptr<FclJoint> fcl;
+    if (have_fcl()) fcl = std::make_unique<FclJoint>(s.femur, s.pelvis, cor);
+    std::unique_ptr<PairwiseJoint> pairwise;
+    if (have_exact_reference()) pairwise = std::make_unique<PairwiseJoint>(s.femur, s.pelvis, cor, kRegionMm);
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+
+    for (int pose = 0; pose < 2; ++pose) {
+      const std::string pname = pose == 0 ? "rest" : "pushed_3mm";
+      const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
+      for (std::size_t k = 0; k < schemes.size(); ++k) {
+        const Body &fb = built[k].first, &pb = built[k].second;
+        std::vector<float> g1(std::size_t(fb.set.size())), g2(std::size_t(pb.set.size()));
+        const double tb = median_ms([&] { scan_gaps_compact(fb.set, I, t, pb.map, ScanSide::inside, g1.data()); }, reps);
+        const double ts = median_ms(
+            [&] { scan_gaps_compact(pb.set, I, Eigen::Vector3d(-t), fb.map, ScanSide::outside, g2.data()); }, reps);
+        row(pname, schemes[k].method, schemes[k].res, fb.set.size() + pb.set.size(), tb + ts, tb, ts, min_of(g1, g2),
+            "min_gap_mm");
+      }
+      std::vector<float> g1(std::size_t(fset.size())), g2(std::size_t(pset.size()));
+      if (emb_f) {
+        for (int packet = 0; packet < 2; ++packet) {
+          const double tb = median_ms([&] { emb_p->scan_gaps(fset, I, t, ScanSide::inside, g1.data(), packet); }, reps);
+          const double ts = median_ms(
+              [&] { emb_f->scan_gaps(pset, I, Eigen::Vector3d(-t), ScanSide::outside, g2.data(), packet); }, reps);
+          row(pname, packet ? "embree_radial_packet8" : "embree_radial", 0, nv, tb + ts, tb, ts, min_of(g1, g2),
+              "min_gap_mm");
+        }
+      }
+      if (cg_f) {
+        auto cgal_scan = [&](const ScanSet& set, const ExactReference& other, const Eigen::Vector3d& tt, double side,
+                             std::vector<float>& out) {
+          for (std::int64_t j = 0; j < set.size(); ++j) {
+            const Eigen::Vector3d q = Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + tt;
+            const auto h = other.first_hit(cor, q.normalized());
+            out[std::size_t(j)] = h ? float(side * (*h - q.norm())) : std::numeric_limits<float>::quiet_NaN();
+          }
+        };
+        const int r = std::max(1, reps / 2);
+        const double tb = median_ms([&] { cgal_scan(fset, *cg_p, t, 1, g1); }, r);
+        const double ts = median_ms([&] { cgal_scan(pset, *cg_f, Eigen::Vector3d(-t), -1, g2); }, r);
+        row(pname, "cgal_radial", 0, nv, tb + ts, tb, ts, min_of(g1, g2), "min_gap_mm");
+      }
+      if (fcl) {
+        FclContacts c;
+        const double tc = median_ms([&] { c = fcl->collide(I, t); }, reps);
+        row(pname, "fcl_collide", 0, 0, tc, std::nan(""), std::nan(""), double(c.contacts), "contacts");
+        double d = 0;
+        const double td = median_ms([&] { d = fcl->distance(I, t); }, reps);
+        row(pname, "fcl_distance", 0, 0, td, std::nan(""), std::nan(""), d, "distance_mm");
+      }
+      if (pairwise) {
+        const PairwiseResult probe = pairwise->intersect(Eigen::Matrix3d::Zero(), Eigen::Vector3d::Constant(1e6));
+        const bool affordable = !args.quick || double(probe.ball_triangles) * double(probe.socket_triangles) <= 2e7;
+        if (affordable) {
+          PairwiseResult r;
+          const double tp = median_ms([&] { r = pairwise->intersect(I, t); }, 1);
+          row(pname, "pairwise", 0, 0, tp, std::nan(""), std::nan(""), double(r.intersecting_pairs), "intersecting_pairs");
+        }
+      }
+    }
+    // Throughput: 256 random poses, one thread against two (each thread its own half).
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> ang(-20, 20);
+    std::vector<Eigen::Matrix3d> poses;
+    for (int i = 0; i < 256; ++i) poses.push_back(pose_rotation({ang(rng), ang(rng), ang(rng)}, s.side));
+    for (std::size_t k = 0; k < schemes.size(); ++k) {
+      const Body &fb = built[k].first, &pb = built[k].second;
+      auto run = [&](std::size_t lo, std::size_t hi) {
+        std::vector<float> a(std::size_t(fb.set.size())), b(std::size_t(pb.set.size()));
+        for (std::size_t i = lo; i < hi; ++i) {
+          scan_gaps_compact(fb.set, poses[i], Eigen::Vector3d::Zero(), pb.map, ScanSide::inside, a.data());
+          scan_gaps_compact(pb.set, Eigen::Matrix3d(poses[i].transpose()), Eigen::Vector3d::Zero(), fb.map,
+                            ScanSide::outside, b.data());
+        }
+      };
+      for (int threads : {1, 2}) {
+        const double ms = median_ms(
+            [&] {
+              if (threads == 1) return run(0, poses.size());
+              std::thread other([&] { run(poses.size() / 2, poses.size()); });
+              run(0, poses.size() / 2);
+              other.join();
+            },
+            reps);
+        thr.row(s.name, schemes[k].method, schemes[k].res, threads, static_cast<int>(poses.size()), ms,
+                1000.0 * double(poses.size()) / ms);
+      }
+    }
+  }
+  write_meta(dir, args,
+             {{"region_radius_mm", kRegionMm},
+              {"detection_table_precision_deg", kPrecision},
+              {"precisions_deg", precisions},
+              {"push_mm", 3.0},
+              {"embree", have_embree()},
+              {"fcl", have_fcl()},
+              {"cgal", have_exact_reference()},
+              {"note", "single thread unless throughput.csv says threads = 2"}});
+  return 0;
+}
