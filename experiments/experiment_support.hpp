@@ -78,7 +78,7 @@ class CsvWriter {
     if constexpr (std::is_floating_point_v<N>) {
       if (!std::isfinite(static_cast<double>(x))) return "nan";
       std::ostringstream o;
-      o.precision(7);
+      o.precision(9);
       o << x;
       return o.str();
     } else {

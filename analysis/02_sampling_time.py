@@ -1,0 +1,95 @@
+"""02_sampling_time: thesis Tables 3 and 8 beside ours, and sampling time against precision.
+
+Reads RESULTS/02_sampling_time/sampling_time.csv; writes table3_8.tex (generated 3k model, the
+thesis' level), table_real.tex (real bones, every method), sampling_time.pdf/png, macros.tex."""
+import numpy as np
+import matplotlib.pyplot as plt
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+
+d = experiment_dir("02_sampling_time")
+t = read_csv(d, "sampling_time.csv")
+maps = t[t.method != "culling_analysis"]
+methods = ["fill", "rsid_linear", "rsid_exact", "rsid_exact_culled", "usid_accelerated", "embree_node_cast",
+           "pairwise"]
+labels = {"fill": "std::fill (floor)", "rsid_linear": "RSID linear", "rsid_exact": "RSID exact",
+          "rsid_exact_culled": "RSID exact, culled", "usid_accelerated": "USID accelerated",
+          "embree_node_cast": "Embree node casting", "pairwise": "pair-wise O(mn)"}
+
+
+def fmt(ms):
+    if np.isnan(ms):
+        return "--"
+    if ms >= 100:
+        return f"{ms:,.0f}"
+    return f"{ms:.1f}" if ms >= 10 else (f"{ms:.2f}" if ms >= 1 else f"{ms:.3f}")
+
+
+def cell(g, method, body):
+    r = g[(g.method == method) & (g.body == body)]
+    return r.time_ms.iloc[0] if len(r) else np.nan
+
+
+# Table 3 / 8: the generated 3k model (pelvis = the socket model), thesis beside ours.
+gen = maps[maps.subject == "generated-3k"]
+rows = []
+for p in sorted(gen.precision_deg.unique(), reverse=True):
+    g = gen[gen.precision_deg == p]
+    th = {m: g[g.method == m].thesis_ms.iloc[0] if len(g[g.method == m]) else np.nan
+          for m in ("pairwise", "rsid_linear", "usid_accelerated")}
+    pw = cell(g, "pairwise", "pelvis")
+    rows.append([f"{p:g}", fmt(th["pairwise"]), fmt(pw) + "*", fmt(th["rsid_linear"]), fmt(cell(g, "rsid_linear", "pelvis")),
+                 fmt(cell(g, "rsid_exact_culled", "pelvis")), fmt(th["usid_accelerated"]),
+                 fmt(cell(g, "usid_accelerated", "pelvis")), fmt(cell(g, "embree_node_cast", "pelvis")),
+                 fmt(cell(g, "fill", "pelvis"))])
+write_table(d, "table3_8", ["$p$ (deg)", "pair-wise thesis", "pair-wise ours", "RSID thesis", "RSID linear",
+                            "RSID exact culled", "USID thesis", "USID ours", "Embree", "fill"], rows,
+            align="rrrrrrrrrr")
+
+# Real bones: every method at every precision.
+rows = []
+for (s, body), g0 in maps[~maps.generated.astype(bool)].groupby(["subject", "body"], sort=False):
+    for p in sorted(g0.precision_deg.unique(), reverse=True):
+        g = g0[g0.precision_deg == p]
+        rows.append([s, body, f"{p:g}"] + [fmt(cell(g, m, body)) for m in methods])
+write_table(d, "table_real", ["subject", "body", "$p$"] + [labels[m].replace("O(mn)", "$O(mn)$") for m in methods],
+            rows, align="llr" + "r" * len(methods))
+
+# Figure: time against precision for each body of the first real subject (or the generated one).
+real = maps[~maps.generated.astype(bool)]
+subj = real.subject.iloc[0] if len(real) else "generated-3k"
+fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
+for ax, body in zip(axes, ("femur", "pelvis")):
+    g0 = maps[(maps.subject == subj) & (maps.body == body)]
+    for m in methods:
+        g = g0[g0.method == m].sort_values("precision_deg")
+        if len(g):
+            ax.loglog(g.precision_deg, g.time_ms, marker="o", markersize=3, label=labels[m])
+    ax.invert_xaxis()
+    ax.set_xlabel("precision p (deg)")
+    ax.set_ylabel("time (ms)")
+    ax.set_title(f"{subj} {body}")
+    ax.grid(True, which="both", lw=0.3)
+axes[1].legend(fontsize=7)
+save(fig, d, "sampling_time")
+
+# Numbers quoted in the text: pelvis of the first real subject at the finest precision.
+macros = {}
+fin = real.precision_deg.min() if len(real) else gen.precision_deg.min()
+g = maps[(maps.subject == subj) & (maps.body == "pelvis") & (maps.precision_deg == fin)]
+culled, fill, emb = cell(g, "rsid_exact_culled", "pelvis"), cell(g, "fill", "pelvis"), cell(g, "embree_node_cast", "pelvis")
+full, lin = cell(g, "rsid_exact", "pelvis"), cell(g, "rsid_linear", "pelvis")
+macros.update({"SampSubject": subj, "SampFinest": f"{fin:g}", "SampCulledMs": fmt(culled), "SampFillMs": fmt(fill),
+               "SampEmbreeMs": fmt(emb), "SampExactMs": fmt(full), "SampLinearMs": fmt(lin),
+               "SampOverFill": f"{culled / fill:.1f}", "SampEmbreeOver": f"{emb / culled:.0f}"})
+ca = t[(t.method == "culling_analysis") & (t.subject == subj) & (t.body == "pelvis")]
+if len(ca):
+    macros["SampCullingMs"] = fmt(ca.time_ms.iloc[0])
+    macros["SampKeptTriangles"] = f"{int(ca.triangles_rasterised.iloc[0]):,}"
+    macros["SampTriangles"] = f"{int(ca.triangles.iloc[0]):,}"
+g3 = gen[gen.precision_deg == gen.precision_deg.min()]
+macros["SampGenFinest"] = f"{gen.precision_deg.min():g}"
+macros["SampGenRsidMs"] = fmt(cell(g3, "rsid_linear", "pelvis"))
+macros["SampGenUsidMs"] = fmt(cell(g3, "usid_accelerated", "pelvis"))
+write_macros(d, "macros", macros)
+print(f"02_sampling_time: wrote tables and figure to {d}")

@@ -1,0 +1,112 @@
+"""03_detection_time: thesis Tables 4 and 9 beside ours, peers on the same vertices, throughput.
+
+Reads RESULTS/03_detection_time/detection.csv and throughput.csv; writes table4_9.tex (generated
+models at the thesis' triangle levels), table_real.tex (every real subject, pushed pose),
+table_throughput.tex, detection_time.pdf/png, macros.tex."""
+import numpy as np
+import matplotlib.pyplot as plt
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+
+d = experiment_dir("03_detection_time")
+t = read_csv(d, "detection.csv")
+thr = read_csv(d, "throughput.csv")
+labels = {"rsid": "RSID", "usid": "USID", "embree_radial": "Embree rtcIntersect1",
+          "embree_radial_packet8": "Embree rtcIntersect8", "cgal_radial": "CGAL first hit",
+          "fcl_collide": "FCL collide", "fcl_distance": "FCL distance", "pairwise": "pair-wise"}
+
+
+def fmt(ms):
+    if ms is None or np.isnan(ms):
+        return "--"
+    if ms >= 100:
+        return f"{ms:,.0f}"
+    return f"{ms:.1f}" if ms >= 10 else (f"{ms:.2f}" if ms >= 1 else f"{ms:.3f}")
+
+
+def get(g, method, res=None, col="time_ms"):
+    r = g[g.method == method]
+    if res is not None:
+        r = r[np.isclose(r.resolution, res)]
+    return r[col].iloc[0] if len(r) else np.nan
+
+
+p_table = 0.5
+k_table = t[(t.method == "usid")].resolution.min()  # helix matched to the coarser precision
+
+# Tables 4 and 9: generated models, pushed pose (contact), thesis beside ours.
+rows = []
+for s in ["generated-300", "generated-1k", "generated-3k", "generated-12k"]:
+    g = t[(t.subject == s) & (t.pose == "pushed_3mm")]
+    if not len(g):
+        continue
+    rows.append([s.replace("generated-", ""), f"{int(g.femur_triangles.iloc[0]):,}",
+                 fmt(get(g, "pairwise", col="thesis_ms")), fmt(get(g, "pairwise")),
+                 fmt(get(g, "fcl_collide", col="thesis_ms")), fmt(get(g, "fcl_collide")),
+                 fmt(get(g, "rsid", col="thesis_ms")), fmt(get(g, "rsid", p_table)),
+                 fmt(get(g, "usid", col="thesis_ms")), fmt(get(g, "usid", k_table)),
+                 fmt(get(g, "embree_radial")), fmt(get(g, "cgal_radial"))])
+write_table(d, "table4_9", ["level", "triangles", "pair-wise thesis", "pair-wise ours", "RAPID thesis", "FCL ours",
+                            "RSID thesis", "RSID ours", "USID thesis", "USID ours", "Embree", "CGAL"], rows,
+            align="lrrrrrrrrrrr")
+
+# Real subjects, both poses: every method; per pose ms and ns per vertex.
+rows = []
+for (s, pose), g in t[~t.generated.astype(bool)].groupby(["subject", "pose"], sort=False):
+    nv = int(get(g, "rsid", 0.1, "vertices"))
+    rows.append([s, pose.replace("_", " "), f"{nv:,}", fmt(get(g, "rsid", 0.5)), fmt(get(g, "rsid", 0.1)),
+                 fmt(get(g, "usid", k_table)), fmt(get(g, "embree_radial")), fmt(get(g, "embree_radial_packet8")),
+                 fmt(get(g, "cgal_radial")), fmt(get(g, "fcl_collide")), f"{get(g, 'fcl_collide', col='result'):.0f}",
+                 fmt(get(g, "fcl_distance")), fmt(get(g, "pairwise")), f"{get(g, 'rsid', 0.1, 'result'):.2f}"])
+write_table(d, "table_real", ["subject", "pose", "vertices", "RSID 0.5", "RSID 0.1", "USID", "Embree", "Embree x8",
+                              "CGAL", "FCL collide", "contacts", "FCL dist.", "pair-wise", "min gap (mm)"], rows,
+            align="llrrrrrrrrrrrr")
+
+rows = []
+for (s, m, r), g in thr.groupby(["subject", "method", "resolution"], sort=False):
+    one = g[g.threads == 1].poses_per_s.iloc[0]
+    two = g[g.threads == 2].poses_per_s.iloc[0]
+    rows.append([s, labels[m], f"{r:g}", f"{one:,.0f}", f"{two:,.0f}", f"{two / one:.2f}"])
+write_table(d, "table_throughput", ["subject", "method", "resolution", "poses/s, 1 thread", "poses/s, 2 threads",
+                                    "speed-up"], rows, align="llrrrr")
+
+# Figure: ms per pose (both scans) against triangles per model, pushed pose, log-log.
+fig, ax = plt.subplots(figsize=(6.5, 3.8))
+gen = t[t.generated.astype(bool) & (t.pose == "pushed_3mm")]
+for m, res in [("rsid", p_table), ("rsid", 0.1), ("usid", k_table), ("embree_radial", None), ("cgal_radial", None),
+               ("fcl_collide", None), ("pairwise", None)]:
+    g = gen[gen.method == m]
+    if res is not None:
+        g = g[np.isclose(g.resolution, res)]
+    g = g.sort_values("femur_triangles")
+    if len(g):
+        ax.loglog(g.femur_triangles, g.time_ms, marker="o", markersize=3,
+                  label=labels[m] + (f" {res:g}" if res is not None else ""))
+for col, mk, name in [("rsid", "s", "thesis RSID"), ("fcl_collide", "^", "thesis RAPID"), ("pairwise", "x", "thesis pair-wise")]:
+    g = gen[(gen.method == col)].drop_duplicates("subject").sort_values("femur_triangles")
+    ax.loglog(g.femur_triangles, g.thesis_ms, mk, color="k", markersize=5, label=name)
+ax.set_xlabel("triangles per model")
+ax.set_ylabel("ms per pose (both scans)")
+ax.grid(True, which="both", lw=0.3)
+ax.legend(fontsize=6, ncol=2)
+save(fig, d, "detection_time")
+
+# Numbers for the text: first real subject, pushed pose.
+real = t[~t.generated.astype(bool)]
+macros = {}
+if len(real):
+    s = real.subject.iloc[0]
+    g = real[(real.subject == s) & (real.pose == "pushed_3mm")]
+    g0 = real[(real.subject == s) & (real.pose == "rest")]
+    rs, emb, cg, fcl = get(g, "rsid", 0.1), get(g, "embree_radial"), get(g, "cgal_radial"), get(g, "fcl_collide")
+    macros.update({"DetSubject": s, "DetVertices": f"{int(get(g, 'rsid', 0.1, 'vertices')):,}",
+                   "DetRsidMs": fmt(rs), "DetRsidNs": f"{get(g, 'rsid', 0.1, 'ns_per_vertex'):.1f}",
+                   "DetEmbreeNs": f"{get(g, 'embree_radial', col='ns_per_vertex'):.0f}",
+                   "DetCgalNs": f"{get(g, 'cgal_radial', col='ns_per_vertex'):,.0f}",
+                   "DetFclMs": fmt(fcl), "DetFclContacts": f"{get(g, 'fcl_collide', col='result'):.0f}",
+                   "DetFclOverRsid": f"{fcl / rs:.0f}", "DetEmbreeOverRsid": f"{emb / rs:.1f}",
+                   "DetCgalOverRsid": f"{cg / rs:.0f}", "DetUsidMs": fmt(get(g, "usid", k_table)),
+                   "DetFclDistance": f"{get(g0, 'fcl_distance', col='result'):.3f}",
+                   "DetRsidMinGapRest": f"{get(g0, 'rsid', 0.1, 'result'):.3f}"})
+write_macros(d, "macros", macros)
+print(f"03_detection_time: wrote tables and figure to {d}")

@@ -1,0 +1,117 @@
+"""10_error_vs_runtime: |gap error| against CGAL's exact radial gap beside query time, sampling time
+and memory, for every scheme, mode and resolution; Pareto figures; where the errors concentrate.
+
+Reads RESULTS/10_error_vs_runtime/error_runtime.csv and vertex_errors.csv; writes table_main.tex
+(first real subject, rest pose, every configuration), table_peers.tex, pareto_time.pdf,
+pareto_memory.pdf, error_map.pdf (per-vertex errors over the sphere), macros.tex."""
+import numpy as np
+import matplotlib.pyplot as plt
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+
+d = experiment_dir("10_error_vs_runtime")
+t = read_csv(d, "error_runtime.csv")
+v = read_csv(d, "vertex_errors.csv")
+peers = ("embree_radial", "embree_radial_packet8", "cgal_radial")
+maps = t[~t.scheme.isin(peers)]
+real = t[~t.generated.astype(bool)]
+subj = real.subject.iloc[0] if len(real) else t.subject.iloc[0]
+
+
+def e(x):
+    return "--" if np.isnan(x) else (f"{x:.2g}" if x < 0.01 else f"{x:.3f}")
+
+
+# Table: first subject, rest pose, every scheme x mode x resolution.
+rows = []
+g0 = maps[(maps.subject == subj) & (maps.pose == "rest")]
+for _, r in g0.sort_values(["scheme", "mode", "precision_deg"], ascending=[True, True, False]).iterrows():
+    rows.append([r.scheme, r["mode"], f"{r.resolution:g}", e(r.max_abs_mm), e(r.p99_abs_mm), e(r.p95_abs_mm),
+                 e(r.median_abs_mm), f"{int(r.mismatched)}", f"{r.query_ns_per_vertex:.1f}", f"{r.sampling_ms:.1f}",
+                 f"{r.bytes / 2**20:.1f}"])
+write_table(d, "table_main", ["scheme", "mode", "res.", "max", "p99", "p95", "median", "mism.", "ns/vertex",
+                              "sampling ms", "MiB"], rows, align="llrrrrrrrrr")
+
+# Peers and the headline configuration (equiangular 0.1 exact) per subject and pose.
+rows = []
+for (s, pose), g in t.groupby(["subject", "pose"], sort=False):
+    r = g[(g.scheme == "equiangular") & (g["mode"] == "exact") & np.isclose(g.precision_deg, 0.1)]
+    emb = g[g.scheme == "embree_radial"]
+    cg = g[g.scheme == "cgal_radial"]
+    if not len(r):
+        continue
+    r = r.iloc[0]
+    en = emb.query_ns_per_vertex.iloc[0] if len(emb) else np.nan
+    cn = cg.query_ns_per_vertex.iloc[0] if len(cg) else np.nan
+    rows.append([s, pose.replace("_", " "), f"{int(r.vertices):,}", e(r.p95_abs_mm), e(r.max_abs_mm),
+                 f"{r.query_ns_per_vertex:.1f}", f"{en:.0f}", f"{cn:,.0f}", f"{en / r.query_ns_per_vertex:.1f}",
+                 f"{cn / r.query_ns_per_vertex:.0f}",
+                 e(emb.p95_abs_mm.iloc[0]) if len(emb) else "--"])
+write_table(d, "table_peers", ["subject", "pose", "vertices", "p95 (mm)", "max (mm)", "ns/vertex", "Embree ns",
+                               "CGAL ns", "Embree / ours", "CGAL / ours", "Embree p95"], rows,
+            align="llrrrrrrrrr")
+
+# Pareto figures: p95 error against query time and against memory, rest pose, first subject.
+markers = {"equiangular": "o", "helix": "s", "helix-eq10": "v", "conchoid": "^"}
+for xcol, stem, xlabel in [("query_ns_per_vertex", "pareto_time", "query time (ns per vertex)"),
+                           ("bytes", "pareto_memory", "memory of both maps (bytes)")]:
+    fig, ax = plt.subplots(figsize=(6, 3.8))
+    for (scheme, mode), g in g0.groupby(["scheme", "mode"]):
+        g = g.sort_values("precision_deg")
+        ax.loglog(g[xcol], g.p95_abs_mm.clip(lower=1e-7), marker=markers.get(scheme, "o"),
+                  ls="-" if mode == "exact" else "--", markersize=4, label=f"{scheme} {mode}")
+    if xcol == "query_ns_per_vertex":
+        for pname, mk in (("embree_radial", "P"), ("cgal_radial", "X")):
+            g = t[(t.subject == subj) & (t.pose == "rest") & (t.scheme == pname)]
+            if len(g):
+                ax.loglog(g[xcol], g.p95_abs_mm.clip(lower=1e-7), mk, color="k", markersize=8, label=pname)
+    ax.axhline(0.05, color="r", lw=0.6, ls=":")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("p95 |gap error| (mm)")
+    ax.set_title(f"{subj}, rest pose (error floor clipped at 1e-7 mm)", fontsize=8)
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=6, ncol=2)
+    save(fig, d, stem)
+
+# Where the errors are: per-vertex errors of equiangular 0.1 exact over (theta, phi).
+fig, ax = plt.subplots(figsize=(7, 3.4))
+vv = v[v.subject == subj]
+sc = ax.scatter(vv.theta_deg, vv.phi_deg, c=np.log10(vv.error_mm.clip(lower=1e-7)), s=3, cmap="viridis")
+big = vv[vv.stencil_spread_mm > 2]
+ax.scatter(big.theta_deg, big.phi_deg, s=12, facecolors="none", edgecolors="r", lw=0.5,
+           label="stencil spans > 2 mm (depth jump)")
+ax.invert_yaxis()
+ax.set_xlabel("theta (deg)")
+ax.set_ylabel("phi (deg)")
+ax.legend(fontsize=7, loc="lower right")
+fig.colorbar(sc, label="log10 |error| (mm)")
+save(fig, d, "error_map")
+
+# Macros for the text.
+macros = {"ErrSubject": subj}
+h = g0[(g0.scheme == "equiangular") & (g0["mode"] == "exact") & np.isclose(g0.precision_deg, 0.1)]
+if len(h):
+    h = h.iloc[0]
+    emb = t[(t.subject == subj) & (t.pose == "rest") & (t.scheme == "embree_radial")]
+    cg = t[(t.subject == subj) & (t.pose == "rest") & (t.scheme == "cgal_radial")]
+    macros.update({"ErrPninetyFive": e(h.p95_abs_mm), "ErrMax": e(h.max_abs_mm), "ErrNs": f"{h.query_ns_per_vertex:.1f}",
+                   "ErrVertices": f"{int(h.vertices):,}", "ErrCompared": f"{int(h.compared):,}",
+                   "ErrLarge": f"{int(h.large_errors)}", "ErrAtJump": f"{int(h.at_discontinuity)}"})
+    if len(emb):
+        macros["ErrEmbreeNs"] = f"{emb.query_ns_per_vertex.iloc[0]:.0f}"
+        macros["ErrEmbreeRatio"] = f"{emb.query_ns_per_vertex.iloc[0] / h.query_ns_per_vertex:.1f}"
+    if len(cg):
+        macros["ErrCgalNs"] = f"{cg.query_ns_per_vertex.iloc[0]:,.0f}"
+        macros["ErrCgalRatio"] = f"{cg.query_ns_per_vertex.iloc[0] / h.query_ns_per_vertex:.0f}"
+lin = g0[(g0.scheme == "equiangular") & (g0["mode"] == "linear")]
+if len(lin):
+    f = lin[lin.precision_deg == lin.precision_deg.min()].iloc[0]
+    macros["ErrLinearFinestPninetyFive"] = e(f.p95_abs_mm)
+    macros["ErrFinest"] = f"{f.precision_deg:g}"
+tot = maps[maps.pose == "rest"]
+macros["ErrLargeTotal"] = f"{int(tot.large_errors.sum()):,}"
+macros["ErrJumpTotal"] = f"{int(tot.at_discontinuity.sum()):,}"
+macros["ErrPoleTotal"] = f"{int(tot.near_pole.sum()):,}"
+macros["ErrSeamTotal"] = f"{int(tot.near_seam.sum()):,}"
+write_macros(d, "macros", macros)
+print(f"10_error_vs_runtime: wrote tables and figures to {d}")
