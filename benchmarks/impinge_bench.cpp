@@ -19,6 +19,8 @@
 #include "impinge/fcl_collision.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/mesh_io.hpp"
+#include "impinge/naive_sampling.hpp"
+#include "impinge/pairwise.hpp"
 #include "impinge/rasterize.hpp"
 #include "impinge/sampling.hpp"
 #include "impinge/sphere_fit.hpp"
@@ -177,7 +179,10 @@ void BM_Query(benchmark::State& st) {
   st.SetLabel(s.name + (ball ? " femur vs pelvis map, " : " pelvis vs femur map, ") + other.scheme().name() + " " +
               std::to_string(other.scheme().resolution()));
 }
-BENCHMARK(BM_Query)->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}, {0, 1}})->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_Query)
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}, {0, 1}})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 // Peers on the same vertices as BM_Query at p = 0.1 deg (the first-surface vertices).
 // args: body (0 femur vertices against the pelvis, 1 pelvis against the femur), packet (0, 1),
@@ -280,6 +285,39 @@ void BM_EmbreeFillMap(benchmark::State& st) {
   st.counters["nodes"] = double(map.num_nodes());
 }
 BENCHMARK(BM_EmbreeFillMap)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The thesis' baselines on the generated 3k model (its Table 3/4 level), built once: the
+// exhaustive triangle-pair test at the pushed pose, and pair-wise O(m n) sampling of a 5 deg map.
+const HipModel& model_3k() {
+  static const HipModel h = [] {
+    HipModelOptions o;
+    o.target_triangles = 3000;
+    o.cam_height_mm = 2;
+    return make_hip_model(o);
+  }();
+  return h;
+}
+void BM_PairwiseDetect(benchmark::State& st) {
+  if (!have_exact_reference()) return st.SkipWithError("no CGAL in this build");
+  const HipModel& h = model_3k();
+  static const PairwiseJoint j(h.ball, h.socket, h.cor);
+  const Eigen::Vector3d t = 3.0 * (h.socket.V.colwise().mean().transpose() - h.cor).normalized();
+  std::int64_t pairs = 0;
+  for (auto _ : st) pairs = j.intersect(Eigen::Matrix3d::Identity(), t).intersecting_pairs;
+  st.counters["intersecting_pairs"] = double(pairs);
+}
+BENCHMARK(BM_PairwiseDetect)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_PairwiseSample(benchmark::State& st) {
+  const HipModel& h = model_3k();
+  RadialDistanceMap map{EquiangularGrid(5)};
+  for (auto _ : st) {
+    std::fill(map.data(), map.data() + map.num_nodes(), RadialDistanceMap::no_surface());
+    sample_naive(h.socket, h.cor, map);
+  }
+  st.counters["nodes"] = double(map.num_nodes());
+}
+BENCHMARK(BM_PairwiseSample)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");

@@ -58,8 +58,8 @@ int main(int argc, char** argv) {
   const int reps = args.repetitions;
 
   CsvWriter csv(dir + "/sampling_time.csv",
-                {"subject", "generated", "body", "triangles", "precision_deg", "scheme", "resolution", "method", "nodes",
-                 "nodes_covered", "time_ms", "extrapolated", "nodes_timed", "thesis_ms", "culling_enabled",
+                {"subject", "generated", "body", "triangles", "precision_deg", "scheme", "resolution", "method",
+                 "nodes", "nodes_covered", "time_ms", "extrapolated", "nodes_timed", "thesis_ms", "culling_enabled",
                  "triangles_rasterised"});
   const int total = static_cast<int>(subjects.size() * 2 * precisions.size());
   int done = 0;
@@ -98,8 +98,8 @@ int main(int argc, char** argv) {
         std::int64_t differing = 0;
         for (std::int64_t i = 0; i < nodes; ++i) differing += map.at(i) != full.at(i);
         if (differing != 0)
-          std::cerr << "02_sampling_time: WARNING " << s.name << " " << bname << " p=" << p << ": culled map differs at "
-                    << differing << " nodes\n";
+          std::cerr << "02_sampling_time: WARNING " << s.name << " " << bname << " p=" << p
+                    << ": culled map differs at " << differing << " nodes\n";
         {
           const int k = static_cast<int>(matched_helix_turns(p));
           RadialDistanceMap helix(make_scheme("helix", k));

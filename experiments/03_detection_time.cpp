@@ -42,8 +42,11 @@ constexpr double kRegionMm = 45;
 /// Thesis Tables 4 and 9 by triangle level (the 12k row was a real CT model), ms.
 double thesis_ms(const std::string& subject, const std::string& method) {
   const double nan = std::nan("");
-  const int i = subject == "generated-300" ? 0 : subject == "generated-1k" ? 1 : subject == "generated-3k" ? 2
-                : subject == "generated-12k" ? 3 : -1;
+  const int i = subject == "generated-300"   ? 0
+                : subject == "generated-1k"  ? 1
+                : subject == "generated-3k"  ? 2
+                : subject == "generated-12k" ? 3
+                                             : -1;
   if (i < 0) return nan;
   const double pairwise[] = {30.7, 522, 2831, nan}, rapid[] = {1.41, 1.41, 1.43, 1.5}, rsid[] = {0.06, 0.18, 0.48, 5.7},
                usid[] = {0.07, 0.65, 1.8, 12};
@@ -88,8 +91,7 @@ int main(int argc, char** argv) {
 
   CsvWriter csv(dir + "/detection.csv",
                 {"subject", "generated", "femur_triangles", "pelvis_triangles", "pose", "method", "resolution",
-                 "vertices", "time_ms", "ball_ms", "socket_ms", "ns_per_vertex", "result", "result_kind",
-                 "thesis_ms"});
+                 "vertices", "time_ms", "ball_ms", "socket_ms", "ns_per_vertex", "result", "result_kind", "thesis_ms"});
   CsvWriter thr(dir + "/throughput.csv",
                 {"subject", "method", "resolution", "threads", "poses", "time_ms", "poses_per_s"});
   int done = 0;
@@ -116,15 +118,18 @@ int main(int argc, char** argv) {
       schemes.push_back({"usid", matched_helix_turns(p), make_scheme("helix", matched_helix_turns(p))});
     }
     std::vector<std::pair<Body, Body>> built;
-    for (const Scheme& sc : schemes) built.emplace_back(build(s.femur, cor, sc.scheme), build(s.pelvis, cor, sc.scheme));
+    for (const Scheme& sc : schemes)
+      built.emplace_back(build(s.femur, cor, sc.scheme), build(s.pelvis, cor, sc.scheme));
     // The peers' vertex sets: the first-surface hip-region vertices of the finest equiangular map.
     const ScanSet& fset = built[2].first.set;
     const ScanSet& pset = built[2].second.set;
     const std::int64_t nv = fset.size() + pset.size();
     std::unique_ptr<EmbreeRayCaster> emb_f, emb_p;
-    if (have_embree()) emb_f = std::make_unique<EmbreeRayCaster>(s.femur, cor), emb_p = std::make_unique<EmbreeRayCaster>(s.pelvis, cor);
+    if (have_embree())
+      emb_f = std::make_unique<EmbreeRayCaster>(s.femur, cor), emb_p = std::make_unique<EmbreeRayCaster>(s.pelvis, cor);
     std::unique_ptr<ExactReference> cg_f, cg_p;
-    if (have_exact_reference()) cg_f = std::make_unique<ExactReference>(s.femur), cg_p = std::make_unique<ExactReference>(s.pelvis);
+    if (have_exact_reference())
+      cg_f = std::make_unique<ExactReference>(s.femur), cg_p = std::make_unique<ExactReference>(s.pelvis);
     std::unique_ptr<FclJoint> fcl;
     if (have_fcl()) fcl = std::make_unique<FclJoint>(s.femur, s.pelvis, cor);
     std::unique_ptr<PairwiseJoint> pairwise;
@@ -137,7 +142,8 @@ int main(int argc, char** argv) {
       for (std::size_t k = 0; k < schemes.size(); ++k) {
         const Body &fb = built[k].first, &pb = built[k].second;
         std::vector<float> g1(std::size_t(fb.set.size())), g2(std::size_t(pb.set.size()));
-        const double tb = median_ms([&] { scan_gaps_compact(fb.set, I, t, pb.map, ScanSide::inside, g1.data()); }, reps);
+        const double tb =
+            median_ms([&] { scan_gaps_compact(fb.set, I, t, pb.map, ScanSide::inside, g1.data()); }, reps);
         const double ts = median_ms(
             [&] { scan_gaps_compact(pb.set, I, Eigen::Vector3d(-t), fb.map, ScanSide::outside, g2.data()); }, reps);
         row(pname, schemes[k].method, schemes[k].res, fb.set.size() + pb.set.size(), tb + ts, tb, ts, min_of(g1, g2),
@@ -181,7 +187,8 @@ int main(int argc, char** argv) {
         if (affordable) {
           PairwiseResult r;
           const double tp = median_ms([&] { r = pairwise->intersect(I, t); }, 1);
-          row(pname, "pairwise", 0, 0, tp, std::nan(""), std::nan(""), double(r.intersecting_pairs), "intersecting_pairs");
+          row(pname, "pairwise", 0, 0, tp, std::nan(""), std::nan(""), double(r.intersecting_pairs),
+              "intersecting_pairs");
         }
       }
     }

@@ -84,9 +84,10 @@ int main(int argc, char** argv) {
   const int reps = args.repetitions;
 
   CsvWriter csv(dir + "/error_runtime.csv",
-                {"subject", "generated", "pose", "scheme", "mode", "resolution", "precision_deg", "vertices",
-                 "compared", "mismatched", "max_abs_mm", "p99_abs_mm", "p95_abs_mm", "median_abs_mm",
-                 "query_ns_per_vertex", "sampling_ms", "bytes", "large_errors", "at_discontinuity", "near_pole",
+                {"subject",     "generated",     "pose",         "scheme",           "mode",
+                 "resolution",  "precision_deg", "vertices",     "compared",         "mismatched",
+                 "max_abs_mm",  "p99_abs_mm",    "p95_abs_mm",   "median_abs_mm",    "query_ns_per_vertex",
+                 "sampling_ms", "bytes",         "large_errors", "at_discontinuity", "near_pole",
                  "near_seam"});
   CsvWriter vcsv(dir + "/vertex_errors.csv",
                  {"subject", "scan", "x_mm", "y_mm", "z_mm", "phi_deg", "theta_deg", "stencil_spread_mm", "error_mm"});
@@ -118,7 +119,7 @@ int main(int argc, char** argv) {
         }
       }
     }
-    auto evaluate = [&](int pose, const std::vector<float> (&g)[2], const RadialDistanceMap* fm,
+    auto evaluate = [&](int pose, const std::vector<float>(&g)[2], const RadialDistanceMap* fm,
                         const RadialDistanceMap* pm, bool dump) {
       Errors e;
       std::vector<double> abs;
@@ -136,13 +137,14 @@ int main(int argc, char** argv) {
             const Stencil st = other->scheme().interpolate(q.normalized());
             double lo = 1e300, hi = -1e300;
             for (int k = 0; k < 4; ++k)
-              if (st.weights[k] > 0) lo = std::min<double>(lo, other->at(st.nodes[k])), hi = std::max<double>(hi, other->at(st.nodes[k]));
+              if (st.weights[k] > 0)
+                lo = std::min<double>(lo, other->at(st.nodes[k])), hi = std::max<double>(hi, other->at(st.nodes[k]));
             spread = hi - lo;
           }
           const SphericalCoordinates sc = to_spherical(q);
           if (dump)
-            vcsv.row(s.name, scan == 0 ? "ball" : "socket", q.x(), q.y(), q.z(), sc.phi * kRadToDeg, sc.theta * kRadToDeg,
-                     spread, err);
+            vcsv.row(s.name, scan == 0 ? "ball" : "socket", q.x(), q.y(), q.z(), sc.phi * kRadToDeg,
+                     sc.theta * kRadToDeg, spread, err);
           if (err > 0.05) {
             ++e.large;
             e.discontinuity += spread > 2.0;
@@ -209,7 +211,8 @@ int main(int argc, char** argv) {
     for (int pose = 0; pose < 2; ++pose) {
       const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
       const std::string pname = pose == 0 ? "rest" : "pushed_3mm";
-      std::vector<float> g[2] = {std::vector<float>(std::size_t(fset.size())), std::vector<float>(std::size_t(pset.size()))};
+      std::vector<float> g[2] = {std::vector<float>(std::size_t(fset.size())),
+                                 std::vector<float>(std::size_t(pset.size()))};
       if (have_embree()) {
         const EmbreeRayCaster ef(s.femur, cor), ep(s.pelvis, cor);
         for (int packet = 0; packet < 2; ++packet) {
@@ -219,8 +222,8 @@ int main(int argc, char** argv) {
                 ef.scan_gaps(pset, I, Eigen::Vector3d(-t), ScanSide::outside, g[1].data(), packet);
               },
               reps);
-          put(pname, packet ? "embree_radial_packet8" : "embree_radial", "exact", 0, 0, evaluate(pose, g, nullptr, nullptr, false),
-              tq * 1e6 / double(nv), std::nan(""), std::nan(""));
+          put(pname, packet ? "embree_radial_packet8" : "embree_radial", "exact", 0, 0,
+              evaluate(pose, g, nullptr, nullptr, false), tq * 1e6 / double(nv), std::nan(""), std::nan(""));
         }
       }
       const double tq = median_ms(

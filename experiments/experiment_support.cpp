@@ -69,9 +69,7 @@ std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& gen
   return out;
 }
 
-Eigen::Vector3d subject_cor(const Subject& s) {
-  return s.generated ? s.true_cor : fit_femoral_head(s.femur).centre;
-}
+Eigen::Vector3d subject_cor(const Subject& s) { return s.generated ? s.true_cor : fit_femoral_head(s.femur).centre; }
 
 Eigen::Vector3d push_direction(const TriangleMesh& pelvis, const Eigen::Vector3d& cor, double radius_mm) {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();

@@ -4,14 +4,19 @@
 //  - moving ball and socket together (translation, rotation about z by whole grid steps) leaves
 //    every gap unchanged;
 //  - a ball pushed into the cup reports penetration with the analytic depth;
-//  - vertices hidden behind their own first surface are skipped and counted, not reported.
+//  - vertices hidden behind their own first surface are skipped and counted, not reported;
+//  - the fast scan with a translation matches CGAL's exact radial gap, and Joint::detect the
+//    fast scan; a scan set keeps exactly the masked vertices.
 #include "impinge/detection.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
+#include "impinge/error.hpp"
+#include "impinge/exact_reference.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/joint.hpp"
 #include "impinge/pose.hpp"
@@ -137,4 +142,54 @@ TEST(Detection, ScanOfMaskedAndNoSurfaceVertices) {
   EXPECT_EQ(s.vertices_beyond_reach, 1);
   EXPECT_EQ(s.vertices_penetrating, 1);
   EXPECT_FLOAT_EQ(s.min_gap_mm, -2);
+}
+
+// The fast scan with a translation against the exact radial gap (CGAL), and the scan set: the
+// head pushed into the cup gives every gap within the map's interpolation error of the exact one,
+// and Joint::detect with the same translation reports the same gaps per vertex.
+TEST(Detection, TranslatedScanMatchesTheExactRadialGap) {
+  if (!have_exact_reference()) GTEST_SKIP() << "no CGAL in this build";
+  HipModelOptions o;
+  o.target_triangles = 3000;
+  o.cam_height_mm = 2;
+  const HipModel h = make_hip_model(o);
+  JointOptions jo;
+  jo.scheme = make_scheme("equiangular", 0.25);
+  const Joint joint(h.ball, h.socket, h.cor, jo);
+  const ExactReference socket_ref(h.socket);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix();
+  const Eigen::Vector3d t = 3.0 * (h.socket.V.colwise().mean().transpose() - h.cor).normalized();
+  const ScanSet& set = joint.ball().scan_set;
+  ASSERT_GT(set.size(), 100);
+  std::vector<float> gaps(std::size_t(set.size()));
+  scan_gaps_compact(set, R, t, joint.socket().map, ScanSide::inside, gaps.data());
+  const PoseResult res = joint.detect(R, t);
+  int compared = 0, penetrating = 0;
+  for (std::int64_t j = 0; j < set.size(); ++j) {
+    const std::size_t i = std::size_t(set.index[std::size_t(j)]);
+    EXPECT_TRUE(std::isnan(gaps[j]) ? std::isnan(res.ball_gaps.gap_mm[i]) : gaps[j] == res.ball_gaps.gap_mm[i]) << j;
+    const Eigen::Vector3d q = R * Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + t;
+    const auto hit = socket_ref.first_hit(h.cor, q.normalized());
+    if (!hit || std::isnan(gaps[j])) continue;
+    ++compared;
+    penetrating += gaps[j] < 0;
+    EXPECT_NEAR(gaps[j], *hit - q.norm(), 0.02) << j;
+  }
+  EXPECT_GT(compared, 100);
+  EXPECT_GT(penetrating, 0);  // a 3 mm push towards the cup closes its 2.5 mm cartilage space
+  // Vertices outside the set are beyond reach; the set holds each masked vertex once.
+  std::int64_t beyond = 0;
+  for (auto st : res.ball_gaps.status) beyond += st == ScanGaps::beyond_reach;
+  EXPECT_EQ(beyond + set.size(), set.vertices);
+}
+
+TEST(Detection, ScanSetRejectsAMaskOfTheWrongSize) {
+  const Vertices P = Vertices::Random(10, 3);
+  EXPECT_THROW(make_scan_set(P, std::vector<std::uint8_t>(9, 1)), Error);
+  const ScanSet s = make_scan_set(P, std::vector<std::uint8_t>{1, 0, 1, 0, 1, 0, 1, 0, 1, 0});
+  EXPECT_EQ(s.size(), 5);
+  std::vector<std::int32_t> idx = s.index;
+  std::sort(idx.begin(), idx.end());
+  EXPECT_EQ(idx, (std::vector<std::int32_t>{0, 2, 4, 6, 8}));
+  for (std::int64_t j = 0; j < s.size(); ++j) EXPECT_EQ(s.x[j], P(s.index[j], 0));
 }

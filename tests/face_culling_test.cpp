@@ -18,7 +18,7 @@
 #include "impinge/mesh_io.hpp"
 #include "impinge/rasterize.hpp"
 #include "impinge/sphere_fit.hpp"
-#include "impinge/subject.hpp"
+#include "test_support.hpp"
 
 using namespace impinge;
 
@@ -62,7 +62,8 @@ namespace {
 /// inside the first leaves it, then enters and leaves the second.
 TriangleMesh two_spheres() {
   const TriangleMesh a = make_uv_sphere(10, Eigen::Vector3d::Zero(), 48, 24, Eigen::Vector3d(0.3, 0.2, 1).normalized());
-  const TriangleMesh b = make_uv_sphere(8, Eigen::Vector3d(30, 0, 0), 48, 24, Eigen::Vector3d(0.1, 1, 0.2).normalized());
+  const TriangleMesh b =
+      make_uv_sphere(8, Eigen::Vector3d(30, 0, 0), 48, 24, Eigen::Vector3d(0.1, 1, 0.2).normalized());
   TriangleMesh m;
   m.V.resize(a.V.rows() + b.V.rows(), 3);
   m.V << a.V, b.V;
@@ -106,17 +107,12 @@ TEST(FaceCulling, OpenMeshDisablesCullingAndSaysWhy) {
 }
 
 TEST(FaceCulling, RealBonesCulledMapsEqualFullMaps) {
-  const std::string dir = std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct";
-  if (!std::filesystem::exists(dir + "/subject.json")) GTEST_SKIP() << "no shared data at " << dir;
-  const SubjectInfo info = load_subject(dir + "/subject.json");
-  TriangleMesh femur = load_mesh(info.femur_path), pelvis = load_mesh(info.pelvis_path);
-  transform_vertices(femur.V, to_anatomical(info.frame));
-  transform_vertices(pelvis.V, to_anatomical(info.frame));
-  const Eigen::Vector3d cor = fit_femoral_head(femur).centre;
-  for (const TriangleMesh* m : {&femur, &pelvis}) {
-    const FaceCulling fc = analyse_face_culling(*m, cor);
+  const auto real = test::load_real_joint("lhdl-ct");
+  if (!real) GTEST_SKIP() << "no shared data (" << IMPINGE_SHARED_DATA << ")";
+  for (const TriangleMesh* m : {&real->femur, &real->pelvis}) {
+    const FaceCulling fc = analyse_face_culling(*m, real->cor);
     ASSERT_TRUE(fc.enabled) << m->source << ": " << fc.reason;
-    EXPECT_EQ(differing_nodes(*m, cor, 0.25, fc), 0) << m->source;
+    EXPECT_EQ(differing_nodes(*m, real->cor, 0.25, fc), 0) << m->source;
   }
 }
 

@@ -18,7 +18,7 @@
 #include "impinge/mesh_io.hpp"
 #include "impinge/sampling.hpp"
 #include "impinge/sphere_fit.hpp"
-#include "impinge/subject.hpp"
+#include "test_support.hpp"
 
 using namespace impinge;
 
@@ -109,9 +109,9 @@ void compare_scans(const TriangleMesh& ball, const TriangleMesh& socket, const E
   const ScanSet ss = make_scan_set(sp, first_surface_mask(sp, sm, 1.0, 1e30));
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> a(-0.3, 0.3);
-  const Eigen::Matrix3d R = (Eigen::AngleAxisd(a(rng), Eigen::Vector3d::UnitX()) *
-                             Eigen::AngleAxisd(a(rng), Eigen::Vector3d::UnitY()))
-                                .toRotationMatrix();
+  const Eigen::Matrix3d R =
+      (Eigen::AngleAxisd(a(rng), Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(a(rng), Eigen::Vector3d::UnitY()))
+          .toRotationMatrix();
   double worst = 0;
   int nan_mismatch = 0, compared = 0;
   for (int scan = 0; scan < 2; ++scan) {
@@ -151,12 +151,7 @@ TEST(FastLookup, MovesNoGapByMoreThanATenThousandthMillimetreGenerated) {
 }
 
 TEST(FastLookup, MovesNoGapByMoreThanATenThousandthMillimetreRealSubject) {
-  const std::string dir = std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct";
-  if (!std::filesystem::exists(dir + "/subject.json")) GTEST_SKIP() << "no shared data at " << dir;
-  const SubjectInfo info = load_subject(dir + "/subject.json");
-  TriangleMesh femur = load_mesh(info.femur_path), pelvis = load_mesh(info.pelvis_path);
-  transform_vertices(femur.V, to_anatomical(info.frame));
-  transform_vertices(pelvis.V, to_anatomical(info.frame));
-  const Eigen::Vector3d cor = fit_femoral_head(femur).centre;
-  for (double p : {0.1, 0.05}) compare_scans(femur, pelvis, cor, p);
+  const auto real = test::load_real_joint("lhdl-ct");
+  if (!real) GTEST_SKIP() << "no shared data (" << IMPINGE_SHARED_DATA << ")";
+  for (double p : {0.1, 0.05}) compare_scans(real->femur, real->pelvis, real->cor, p);
 }

@@ -5,7 +5,22 @@
 #include <filesystem>
 #include <fstream>
 
+#include "impinge/mesh_io.hpp"
+#include "impinge/sphere_fit.hpp"
+#include "impinge/subject.hpp"
+
 namespace impinge::test {
+
+std::optional<RealJoint> load_real_joint(const std::string& name) {
+  const std::string dir = std::string(IMPINGE_SHARED_DATA) + "/" + name;
+  if (!std::filesystem::exists(dir + "/subject.json")) return std::nullopt;
+  const SubjectInfo info = load_subject(dir + "/subject.json");
+  RealJoint j{load_mesh(info.femur_path), load_mesh(info.pelvis_path), Eigen::Vector3d::Zero()};
+  transform_vertices(j.femur.V, to_anatomical(info.frame));
+  transform_vertices(j.pelvis.V, to_anatomical(info.frame));
+  j.cor = fit_femoral_head(j.femur).centre;
+  return j;
+}
 
 Eigen::Matrix3d random_rotation(std::mt19937_64& rng) {
   std::normal_distribution<double> n(0, 1);

@@ -1,6 +1,7 @@
 #pragma once
 // Shared fixtures and oracles for the tests.
 #include <Eigen/Core>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -16,6 +17,13 @@ TriangleMesh transformed(const TriangleMesh& m, const Eigen::Matrix3d& R, const 
 std::string temp_dir(const std::string& name);
 /// Write text to a file.
 void write_text(const std::string& path, const std::string& text);
+/// A real subject of ../shared/data/hips in the anatomical frame with its automatic COR, or
+/// nullopt when the shared data folder is absent (the caller skips).
+struct RealJoint {
+  TriangleMesh femur, pelvis;
+  Eigen::Vector3d cor;
+};
+std::optional<RealJoint> load_real_joint(const std::string& name);
 /// Analytic oracle: distance from origin o along unit u to the sphere (c, r), far root.
 double ray_sphere_far(const Eigen::Vector3d& o, const Eigen::Vector3d& u, const Eigen::Vector3d& c, double r);
 

@@ -12,14 +12,16 @@ namespace {
 /// Interleave the bits of a and b (Morton / Z order).
 std::uint64_t morton(std::uint32_t a, std::uint32_t b) {
   std::uint64_t r = 0;
-  for (int k = 0; k < 16; ++k) r |= (std::uint64_t((a >> k) & 1u) << (2 * k + 1)) | (std::uint64_t((b >> k) & 1u) << (2 * k));
+  for (int k = 0; k < 16; ++k)
+    r |= (std::uint64_t((a >> k) & 1u) << (2 * k + 1)) | (std::uint64_t((b >> k) & 1u) << (2 * k));
   return r;
 }
 }  // namespace
 
 ScanSet make_scan_set(const Vertices& P, const std::vector<std::uint8_t>& mask) {
-  require(static_cast<Eigen::Index>(mask.size()) == P.rows(),
-          "scan set: mask has " + std::to_string(mask.size()) + " entries for " + std::to_string(P.rows()) + " vertices");
+  require(
+      static_cast<Eigen::Index>(mask.size()) == P.rows(),
+      "scan set: mask has " + std::to_string(mask.size()) + " entries for " + std::to_string(P.rows()) + " vertices");
   require(P.rows() < Eigen::Index(std::numeric_limits<std::int32_t>::max()), "scan set: too many vertices");
   // Order the vertices along a Z curve over their (phi, theta) direction (4096 x 8192 cells):
   // a small rotation keeps neighbours neighbours, so consecutive look-ups hit the same cache
@@ -61,8 +63,7 @@ void pose_block(const double* __restrict X, const double* __restrict Y, const do
 }
 /// gap = side * (d - r) as float; NaN for no surface or r = 0.
 IMPINGE_SIMD_CLONES
-void gap_block(const double* __restrict d, const double* __restrict radius, double side, int m,
-               float* __restrict gap) {
+void gap_block(const double* __restrict d, const double* __restrict radius, double side, int m, float* __restrict gap) {
   for (int j = 0; j < m; ++j)
     gap[j] = radius[j] > 0 ? static_cast<float>(side * (d[j] - radius[j])) : std::numeric_limits<float>::quiet_NaN();
 }

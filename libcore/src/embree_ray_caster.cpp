@@ -41,8 +41,8 @@ EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d
                                                          3 * sizeof(float), static_cast<std::size_t>(mesh.V.rows())));
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
     for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(mesh.V(i, k) - origin[k]);
-  auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                            3 * sizeof(unsigned), static_cast<std::size_t>(mesh.F.rows())));
+  auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+      g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), static_cast<std::size_t>(mesh.F.rows())));
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
     for (int k = 0; k < 3; ++k) ib[3 * f + k] = static_cast<unsigned>(mesh.F(f, k));
   rtcCommitGeometry(g);
@@ -91,8 +91,8 @@ float EmbreeRayCaster::first_hit(float dx, float dy, float dz) const {
   return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? std::numeric_limits<float>::infinity() : rh.ray.tfar;
 }
 
-void EmbreeRayCaster::scan_gaps(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
-                                ScanSide side, float* gap_mm, bool packet8) const {
+void EmbreeRayCaster::scan_gaps(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, ScanSide side,
+                                float* gap_mm, bool packet8) const {
   const double s = static_cast<double>(static_cast<int>(side));
   const float nan = std::numeric_limits<float>::quiet_NaN();
   RTCIntersectContext ctx;
@@ -112,7 +112,8 @@ void EmbreeRayCaster::scan_gaps(const ScanSet& set, const Eigen::Matrix3d& R, co
       RTCRayHit rh;
       init_ray(rh, ux, uy, uz);
       rtcIntersect1(impl_->scene, &ctx, &rh);
-      gap_mm[j] = (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || !(r > 0)) ? nan : static_cast<float>(s * (rh.ray.tfar - r));
+      gap_mm[j] =
+          (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || !(r > 0)) ? nan : static_cast<float>(s * (rh.ray.tfar - r));
     }
     return;
   }

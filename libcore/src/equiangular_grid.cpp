@@ -124,9 +124,9 @@ __attribute__((target("avx2,fma"))) void bilinear_avx2(const float* values, cons
       const __m256d ut = _mm256_sub_pd(one, tt), us = _mm256_sub_pd(one, ss);
       const __m256d w0 = _mm256_mul_pd(ut, us), w1 = _mm256_mul_pd(ut, ss), w2 = _mm256_mul_pd(tt, us),
                     w3 = _mm256_mul_pd(tt, ss);
-      const __m256d r = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(w0, a0), _mm256_mul_pd(w1, a1)),
-                                                    _mm256_mul_pd(w2, a2)),
-                                      _mm256_mul_pd(w3, a3));
+      const __m256d r = _mm256_add_pd(
+          _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(w0, a0), _mm256_mul_pd(w1, a1)), _mm256_mul_pd(w2, a2)),
+          _mm256_mul_pd(w3, a3));
       _mm256_storeu_pd(out + j + 4 * h, r);
     }
   }

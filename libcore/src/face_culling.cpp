@@ -21,11 +21,13 @@ void order_triangles(const TriangleMesh& mesh, const Eigen::Vector3d& cor, FaceC
   std::vector<std::pair<std::uint64_t, std::int32_t>> key;
   key.reserve(static_cast<std::size_t>(mesh.F.rows()));
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose() - cor, b = mesh.V.row(mesh.F(f, 1)).transpose() - cor,
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose() - cor,
+                          b = mesh.V.row(mesh.F(f, 1)).transpose() - cor,
                           c = mesh.V.row(mesh.F(f, 2)).transpose() - cor;
     if (fc.enabled && (a.dot(b.cross(c)) > 0 ? 1 : -1) != fc.keep_sign) continue;
     const Eigen::Vector3d m = a + b + c;
-    const double phi = std::atan2(std::hypot(m.x(), m.y()), m.z()), theta = std::atan2(m.y(), m.x()) + 3.14159265358979323846;
+    const double phi = std::atan2(std::hypot(m.x(), m.y()), m.z()),
+                 theta = std::atan2(m.y(), m.x()) + 3.14159265358979323846;
     const auto i = static_cast<std::uint32_t>(std::clamp(phi / 3.14159265358979323846 * 4096.0, 0.0, 4095.0));
     const auto j = static_cast<std::uint32_t>(std::clamp(theta / 3.14159265358979323846 * 4096.0, 0.0, 8191.0));
     key.emplace_back(morton(i, j), static_cast<std::int32_t>(f));
@@ -50,17 +52,20 @@ FaceCulling analyse_face_culling(const TriangleMesh& mesh, const Eigen::Vector3d
   for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
   std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) to[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.F(f, k))]++)] = mesh.F(f, (k + 1) % 3);
+    for (int k = 0; k < 3; ++k)
+      to[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.F(f, k))]++)] = mesh.F(f, (k + 1) % 3);
   for (std::size_t i = 0; i < n; ++i)
     for (std::int32_t e = start[i]; e < start[i + 1]; ++e) {
       const auto j = static_cast<std::size_t>(to[static_cast<std::size_t>(e)]);
       int reverse = 0, same = 0;
-      for (std::int32_t g = start[j]; g < start[j + 1]; ++g) reverse += to[static_cast<std::size_t>(g)] == std::int32_t(i);
+      for (std::int32_t g = start[j]; g < start[j + 1]; ++g)
+        reverse += to[static_cast<std::size_t>(g)] == std::int32_t(i);
       for (std::int32_t g = start[i]; g < start[i + 1]; ++g) same += to[static_cast<std::size_t>(g)] == std::int32_t(j);
       if (reverse != 1 || same != 1) ++fc.boundary_edges;
     }
   if (fc.boundary_edges > 0) {
-    fc.reason = std::to_string(fc.boundary_edges) + " directed edges without exactly one reverse (open or inconsistently "
+    fc.reason = std::to_string(fc.boundary_edges) +
+                " directed edges without exactly one reverse (open or inconsistently "
                 "oriented mesh)";
     order_triangles(mesh, cor, fc);
     return fc;
@@ -68,14 +73,16 @@ FaceCulling analyse_face_culling(const TriangleMesh& mesh, const Eigen::Vector3d
   // Orientation of the nearest hit along rays towards triangle centroids spread over the mesh.
   for (int k = 0; k < rays; ++k) {
     const Eigen::Index f = (mesh.F.rows() - 1) * k / std::max(1, rays - 1);
-    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose() - cor, b = mesh.V.row(mesh.F(f, 1)).transpose() - cor,
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose() - cor,
+                          b = mesh.V.row(mesh.F(f, 1)).transpose() - cor,
                           c = mesh.V.row(mesh.F(f, 2)).transpose() - cor;
     const Eigen::Vector3d u = (a + b + c).normalized();
     if (!u.allFinite()) continue;
     const auto hit = cast_ray_naive(mesh, cor, u);
     if (!hit) continue;
     const Eigen::Index h = hit->second;
-    const Eigen::Vector3d p = mesh.V.row(mesh.F(h, 0)).transpose() - cor, q = mesh.V.row(mesh.F(h, 1)).transpose() - cor,
+    const Eigen::Vector3d p = mesh.V.row(mesh.F(h, 0)).transpose() - cor,
+                          q = mesh.V.row(mesh.F(h, 1)).transpose() - cor,
                           r = mesh.V.row(mesh.F(h, 2)).transpose() - cor;
     const double det = p.dot(q.cross(r));
     if (det == 0) continue;

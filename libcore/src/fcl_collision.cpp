@@ -24,9 +24,9 @@ std::shared_ptr<Model> build_model(const TriangleMesh& mesh, const Eigen::Vector
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) v[static_cast<std::size_t>(i)] = mesh.V.row(i).transpose() - cor;
   std::vector<fcl::Triangle> f(static_cast<std::size_t>(mesh.F.rows()));
   for (Eigen::Index i = 0; i < mesh.F.rows(); ++i)
-    f[static_cast<std::size_t>(i)] = fcl::Triangle(static_cast<std::size_t>(mesh.F(i, 0)),
-                                                   static_cast<std::size_t>(mesh.F(i, 1)),
-                                                   static_cast<std::size_t>(mesh.F(i, 2)));
+    f[static_cast<std::size_t>(i)] =
+        fcl::Triangle(static_cast<std::size_t>(mesh.F(i, 0)), static_cast<std::size_t>(mesh.F(i, 1)),
+                      static_cast<std::size_t>(mesh.F(i, 2)));
   auto m = std::make_shared<Model>();
   require(m->beginModel() == fcl::BVH_OK, "fcl: beginModel failed for " + mesh.source);
   require(m->addSubModel(v, f) == fcl::BVH_OK, "fcl: addSubModel failed for " + mesh.source);

@@ -48,8 +48,8 @@ PoseResult Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) con
   expand_scan(ball_.scan_set, gaps.data(), res.ball_gaps);
   // Socket vertices in the ball's frame: R^T (p - t).
   t0 = std::chrono::steady_clock::now();
-  scan_gaps_compact(socket_.scan_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), ball_.map, ScanSide::outside,
-                    gaps.data());
+  scan_gaps_compact(socket_.scan_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), ball_.map,
+                    ScanSide::outside, gaps.data());
   res.socket_detection_ms = ms_since(t0);
   expand_scan(socket_.scan_set, gaps.data(), res.socket_gaps);
   res.ball = summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels);

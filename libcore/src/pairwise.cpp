@@ -13,7 +13,7 @@ namespace impinge {
 
 namespace {
 Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor> region_triangles(const TriangleMesh& m,
-                                                                          const Eigen::Vector3d& cor, double radius) {
+                                                                           const Eigen::Vector3d& cor, double radius) {
   validate_mesh(m);
   std::vector<Eigen::Index> keep;
   for (Eigen::Index f = 0; f < m.F.rows(); ++f)
@@ -57,8 +57,9 @@ PairwiseResult PairwiseJoint::intersect(const Eigen::Matrix3d& R, const Eigen::V
     socket.push_back(tri(socket_.block<1, 3>(j, 0).transpose(), socket_.block<1, 3>(j, 3).transpose(),
                          socket_.block<1, 3>(j, 6).transpose()));
   for (Eigen::Index i = 0; i < ball_.rows(); ++i) {
-    const K::Triangle_3 a = tri(R * ball_.block<1, 3>(i, 0).transpose() + t, R * ball_.block<1, 3>(i, 3).transpose() + t,
-                                R * ball_.block<1, 3>(i, 6).transpose() + t);
+    const K::Triangle_3 a =
+        tri(R * ball_.block<1, 3>(i, 0).transpose() + t, R * ball_.block<1, 3>(i, 3).transpose() + t,
+            R * ball_.block<1, 3>(i, 6).transpose() + t);
     for (const K::Triangle_3& b : socket) r.intersecting_pairs += CGAL::do_intersect(a, b) ? 1 : 0;
   }
   r.pairs_tested = r.ball_triangles * r.socket_triangles;

@@ -42,7 +42,7 @@ bool on_axis(const V3& v) { return v.x() * v.x() + v.y() * v.y() <= 1e-24 * v.sq
 struct Corner {
   V3 p;  ///< position relative to the COR, mm
   double d, phi, theta;
-  bool axis;  ///< on the z axis (a pole vertex, thesis case 1)
+  bool axis;                                               ///< on the z axis (a pole vertex, thesis case 1)
   V3 u() const { return d > 0 ? V3(p / d) : V3::Zero(); }  ///< unit direction
 };
 /// Angles by fast_angles.hpp (within 1e-13 rad of libm's): they only place bounding boxes
@@ -83,7 +83,9 @@ struct ExactBox {
 };
 /// Distance of a node: adet / sum, in the map's precision (float maps divide in float: within
 /// 1.5 ulp of the correctly rounded value, 1e-5 mm at 100 mm; double maps in double).
-inline float node_distance(double adet, double sum, float) { return static_cast<float>(adet) / static_cast<float>(sum); }
+inline float node_distance(double adet, double sum, float) {
+  return static_cast<float>(adet) / static_cast<float>(sum);
+}
 inline double node_distance(double adet, double sum, double) { return adet / sum; }
 
 /// Returns the number of nodes that had no surface before and have one now.
@@ -118,8 +120,8 @@ inline std::int64_t exact_rows_body(Scalar* __restrict map, int cols, const Exac
   return newly;
 }
 IMPINGE_SIMD_CLONES
-std::int64_t exact_rows_generic(float* map, int cols, const ExactBox& box, const double* sin_phi,
-                                const double* cos_phi, const double* cos_theta, const double* sin_theta) {
+std::int64_t exact_rows_generic(float* map, int cols, const ExactBox& box, const double* sin_phi, const double* cos_phi,
+                                const double* cos_theta, const double* sin_theta) {
   return exact_rows_body(map, cols, box, sin_phi, cos_phi, cos_theta, sin_theta);
 }
 
@@ -170,8 +172,8 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
 std::int64_t exact_rows(float* map, int cols, const ExactBox& box, const double* sin_phi, const double* cos_phi,
                         const double* cos_theta, const double* sin_theta) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                             __builtin_cpu_supports("avx512dq");
+  static const bool avx512 =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
   if (avx512) return exact_rows_avx512(map, cols, box, sin_phi, cos_phi, cos_theta, sin_theta);
 #endif
   return exact_rows_generic(map, cols, box, sin_phi, cos_phi, cos_theta, sin_theta);
@@ -205,7 +207,6 @@ class Rasterizer {
     for (int c = 0; c < cols; ++c) {
       cos_theta_[c] = std::cos(c * h);
       sin_theta_[c] = std::sin(c * h);
-
     }
   }
 

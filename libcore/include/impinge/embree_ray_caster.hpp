@@ -38,8 +38,8 @@ class EmbreeRayCaster {
   /// The radial scan through Embree, the peer of scan_gaps_compact: for vertex j of `set`,
   /// q = R p_j + t, gap_mm[j] = side * (nearest hit along q - |q|), NaN on a miss.
   /// `packet8`: rtcIntersect8 on 8 rays at a time instead of rtcIntersect1 per ray.
-  void scan_gaps(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, ScanSide side,
-                 float* gap_mm, bool packet8) const;
+  void scan_gaps(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, ScanSide side, float* gap_mm,
+                 bool packet8) const;
 
   /// Fill `map` by casting every node's ray (nearest hit; +inf on a miss), in 8-ray packets.
   /// Returns the number of nodes with a surface.

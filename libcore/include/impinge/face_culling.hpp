@@ -22,12 +22,12 @@ namespace impinge {
 
 /// Result of the analysis, with the evidence.
 struct FaceCulling {
-  bool enabled = false;            ///< true when culling is exact for this mesh and COR
-  int keep_sign = 0;               ///< +1 or -1: keep triangles with sign(det) == keep_sign
+  bool enabled = false;             ///< true when culling is exact for this mesh and COR
+  int keep_sign = 0;                ///< +1 or -1: keep triangles with sign(det) == keep_sign
   std::int64_t boundary_edges = 0;  ///< directed edges without exactly one reverse edge
-  int rays_checked = 0;            ///< rays whose nearest hit was found by brute force
-  int rays_agreeing = 0;           ///< of those, rays whose nearest hit has keep_sign
-  std::string reason;              ///< why culling is disabled (empty when enabled)
+  int rays_checked = 0;             ///< rays whose nearest hit was found by brute force
+  int rays_agreeing = 0;            ///< of those, rays whose nearest hit has keep_sign
+  std::string reason;               ///< why culling is disabled (empty when enabled)
   /// The triangles to rasterise (the kept ones when enabled, else all), in Z-curve order of
   /// their centroid's direction from the COR, so that consecutive triangles write the same
   /// cache lines of the map (a 100 MB map at 0.05 deg does not fit in cache).

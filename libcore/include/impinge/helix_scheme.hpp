@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <string>
 
-#include "impinge/helix_arc_length.hpp"
 #include "impinge/fast_angles.hpp"
+#include "impinge/helix_arc_length.hpp"
 #include "impinge/sampling_scheme.hpp"
 
 namespace impinge {
