@@ -184,6 +184,62 @@ std::int64_t exact_rows(double* map, int cols, const ExactBox& box, const double
   return exact_rows_body(map, cols, box, sin_phi, cos_phi, cos_theta, sin_theta);
 }
 
+/// Linear-mode (thesis Algorithm 1) rows of one triangle's box away from the poles: the same
+/// cone test as exact mode, and at covered nodes the barycentric interpolation of the corner
+/// distances in the (theta, phi) plane (planar_value's formula, theta unwrapped as the box's own
+/// column index), clamped to the triangle. Branch-free; vectorised clones.
+struct LinearBox {
+  ExactBox box;
+  int seg_offset[3];  ///< unwrapped column = stored column + offset, per segment
+  double h, ta, tb, tc, pa, pb, pc, da, db, dc, inv_area2;
+};
+template <typename Scalar>
+inline std::int64_t linear_rows_body(Scalar* __restrict map, int cols, const LinearBox& L,
+                                     const double* __restrict sin_phi, const double* __restrict cos_phi,
+                                     const double* __restrict cos_theta, const double* __restrict sin_theta) {
+  const ExactBox& box = L.box;
+  const double* e = box.e;
+  constexpr Scalar none = std::numeric_limits<Scalar>::infinity();
+  std::int64_t newly = 0;
+  for (int r = box.r0; r <= box.r1; ++r) {
+    const double sp = sin_phi[r], cp = cos_phi[r];
+    const double a0 = sp * e[0], b0 = sp * e[1], c0 = cp * e[2], a1 = sp * e[3], b1 = sp * e[4], c1 = cp * e[5],
+                 a2 = sp * e[6], b2 = sp * e[7], c2 = cp * e[8];
+    const double phi = r * L.h;
+    Scalar* __restrict row = map + std::int64_t(r) * cols;
+    for (int g = 0; g < box.nseg; ++g) {
+      const int lo = box.seg[g][0], hi = box.seg[g][1], off = L.seg_offset[g];
+      for (int j = lo; j <= hi; ++j) {
+        const double ct = cos_theta[j], st = sin_theta[j];
+        const double f0 = a0 * ct + b0 * st + c0;
+        const double f1 = a1 * ct + b1 * st + c1;
+        const double f2 = a2 * ct + b2 * st + c2;
+        const bool inside = std::min(std::min(f0, f1), f2) >= 0;
+        const double tn = (j + off) * L.h;
+        double lb = ((tn - L.ta) * (L.pc - L.pa) - (L.tc - L.ta) * (phi - L.pa)) * L.inv_area2;
+        double lc = ((L.tb - L.ta) * (phi - L.pa) - (tn - L.ta) * (L.pb - L.pa)) * L.inv_area2;
+        double la = 1 - lb - lc;
+        la = std::max(la, 0.0), lb = std::max(lb, 0.0), lc = std::max(lc, 0.0);
+        const Scalar v = static_cast<Scalar>((la * L.da + lb * L.db + lc * L.dc) / (la + lb + lc));
+        const Scalar old = row[j];
+        newly += (inside && old == none) ? 1 : 0;
+        row[j] = inside && v < old ? v : old;
+      }
+    }
+  }
+  return newly;
+}
+IMPINGE_SIMD_CLONES
+std::int64_t linear_rows(float* map, int cols, const LinearBox& L, const double* sin_phi, const double* cos_phi,
+                         const double* cos_theta, const double* sin_theta) {
+  return linear_rows_body(map, cols, L, sin_phi, cos_phi, cos_theta, sin_theta);
+}
+IMPINGE_SIMD_CLONES
+std::int64_t linear_rows(double* map, int cols, const LinearBox& L, const double* sin_phi, const double* cos_phi,
+                         const double* cos_theta, const double* sin_theta) {
+  return linear_rows_body(map, cols, L, sin_phi, cos_phi, cos_theta, sin_theta);
+}
+
 template <typename Scalar>
 class Rasterizer {
  public:
@@ -314,6 +370,24 @@ class Rasterizer {
       if (r1 >= r0)
         newly_covered_ +=
             exact_rows(map_.data(), cols, box, sin_phi_.data(), cos_phi_.data(), cos_theta_.data(), sin_theta_.data());
+      stats_.node_tests += std::int64_t(std::max(0, r1 - r0 + 1)) * (c1 - c0 + 1);
+      return;
+    }
+    if (!apex && !full && std::abs(area2) >= 1e-18) {  // linear mode away from the poles: vectorised
+      LinearBox L;
+      ExactBox& box = L.box;
+      box.r0 = r0, box.r1 = r1, box.nseg = 0;
+      if (c0 < 0) box.seg[box.nseg][0] = c0 + cols, box.seg[box.nseg][1] = cols - 1, L.seg_offset[box.nseg++] = -cols;
+      box.seg[box.nseg][0] = std::max(c0, 0), box.seg[box.nseg][1] = std::min(c1, cols - 1),
+      L.seg_offset[box.nseg++] = 0;
+      if (c1 >= cols) box.seg[box.nseg][0] = 0, box.seg[box.nseg][1] = c1 - cols, L.seg_offset[box.nseg++] = cols;
+      for (int k = 0; k < 3; ++k) box.e[k] = e0[k], box.e[3 + k] = e1[k], box.e[6 + k] = e2[k];
+      box.adet = adet;
+      L.h = h, L.ta = ta, L.tb = tb, L.tc = tc, L.pa = ka.phi, L.pb = kb.phi, L.pc = kc.phi;
+      L.da = ka.d, L.db = kb.d, L.dc = kc.d, L.inv_area2 = 1 / area2;
+      if (r1 >= r0)
+        newly_covered_ +=
+            linear_rows(map_.data(), cols, L, sin_phi_.data(), cos_phi_.data(), cos_theta_.data(), sin_theta_.data());
       stats_.node_tests += std::int64_t(std::max(0, r1 - r0 + 1)) * (c1 - c0 + 1);
       return;
     }
