@@ -5,18 +5,9 @@
 
 #include "impinge/error.hpp"
 #include "simd_clones.hpp"
+#include "z_order.hpp"
 
 namespace impinge {
-
-namespace {
-/// Interleave the bits of a and b (Morton / Z order).
-std::uint64_t morton(std::uint32_t a, std::uint32_t b) {
-  std::uint64_t r = 0;
-  for (int k = 0; k < 16; ++k)
-    r |= (std::uint64_t((a >> k) & 1u) << (2 * k + 1)) | (std::uint64_t((b >> k) & 1u) << (2 * k));
-  return r;
-}
-}  // namespace
 
 ScanSet make_scan_set(const Vertices& P, const std::vector<std::uint8_t>& mask) {
   require(
@@ -29,11 +20,7 @@ ScanSet make_scan_set(const Vertices& P, const std::vector<std::uint8_t>& mask) 
   std::vector<std::pair<std::uint64_t, std::int32_t>> order;
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
     if (!mask[static_cast<std::size_t>(i)]) continue;
-    const double x = P(i, 0), y = P(i, 1), z = P(i, 2);
-    const double phi = std::atan2(std::sqrt(x * x + y * y), z), theta = std::atan2(y, x) + 3.14159265358979323846;
-    const auto a = static_cast<std::uint32_t>(std::clamp(phi / 3.14159265358979323846 * 4096.0, 0.0, 4095.0));
-    const auto b = static_cast<std::uint32_t>(std::clamp(theta / 3.14159265358979323846 * 4096.0, 0.0, 8191.0));
-    order.emplace_back(morton(a, b), static_cast<std::int32_t>(i));
+    order.emplace_back(detail::direction_z_order(P(i, 0), P(i, 1), P(i, 2)), static_cast<std::int32_t>(i));
   }
   std::sort(order.begin(), order.end());
   ScanSet s;

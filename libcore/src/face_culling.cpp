@@ -6,16 +6,11 @@
 
 #include "impinge/error.hpp"
 #include "impinge/naive_sampling.hpp"
+#include "z_order.hpp"
 
 namespace impinge {
 
 namespace {
-std::uint64_t morton(std::uint32_t a, std::uint32_t b) {
-  std::uint64_t r = 0;
-  for (int k = 0; k < 16; ++k)
-    r |= (std::uint64_t((a >> k) & 1u) << (2 * k + 1)) | (std::uint64_t((b >> k) & 1u) << (2 * k));
-  return r;
-}
 /// Kept triangles (all when culling is disabled) in Z-curve order of their centroid direction.
 void order_triangles(const TriangleMesh& mesh, const Eigen::Vector3d& cor, FaceCulling& fc) {
   std::vector<std::pair<std::uint64_t, std::int32_t>> key;
@@ -26,11 +21,7 @@ void order_triangles(const TriangleMesh& mesh, const Eigen::Vector3d& cor, FaceC
                           c = mesh.V.row(mesh.F(f, 2)).transpose() - cor;
     if (fc.enabled && (a.dot(b.cross(c)) > 0 ? 1 : -1) != fc.keep_sign) continue;
     const Eigen::Vector3d m = a + b + c;
-    const double phi = std::atan2(std::hypot(m.x(), m.y()), m.z()),
-                 theta = std::atan2(m.y(), m.x()) + 3.14159265358979323846;
-    const auto i = static_cast<std::uint32_t>(std::clamp(phi / 3.14159265358979323846 * 4096.0, 0.0, 4095.0));
-    const auto j = static_cast<std::uint32_t>(std::clamp(theta / 3.14159265358979323846 * 4096.0, 0.0, 8191.0));
-    key.emplace_back(morton(i, j), static_cast<std::int32_t>(f));
+    key.emplace_back(detail::direction_z_order(m.x(), m.y(), m.z()), static_cast<std::int32_t>(f));
   }
   std::sort(key.begin(), key.end());
   fc.triangle_order.resize(key.size());

@@ -79,8 +79,55 @@ void arc_z_range(const V3& u, const V3& v, double& zmin, double& zmax) {
 /// (AVX-512 / AVX2, chosen at run time) is dispatched once per triangle.
 struct ExactBox {
   int r0, r1, nseg, seg[3][2];
+  int seg_offset[3];  ///< the box's own (unwrapped) column = stored column + offset, per segment
   double e[9], adet;
 };
+
+/// The box of rows r0..r1 and unwrapped columns c0..c1 (c0 may be negative, c1 may reach past the
+/// last column: the box wraps across theta = 0/360) as up to three contiguous segments.
+ExactBox make_box(int r0, int r1, int c0, int c1, int cols, const Eigen::Vector3d& e0, const Eigen::Vector3d& e1,
+                  const Eigen::Vector3d& e2, double adet) {
+  ExactBox b;
+  b.r0 = r0, b.r1 = r1, b.nseg = 0;
+  auto add = [&](int lo, int hi, int offset) {
+    b.seg[b.nseg][0] = lo, b.seg[b.nseg][1] = hi, b.seg_offset[b.nseg] = offset, ++b.nseg;
+  };
+  if (c0 < 0) add(c0 + cols, cols - 1, -cols);
+  add(std::max(c0, 0), std::min(c1, cols - 1), 0);
+  if (c1 >= cols) add(0, c1 - cols, cols);
+  for (int k = 0; k < 3; ++k) b.e[k] = e0[k], b.e[3 + k] = e1[k], b.e[6 + k] = e2[k];
+  b.adet = adet;
+  return b;
+}
+
+/// The three edge functions of one row (coefficients folded with sin and cos of its phi).
+struct RowEdges {
+  double a0, b0, c0, a1, b1, c1, a2, b2, c2;
+  RowEdges(const double* e, double sp, double cp)
+      : a0(sp * e[0]),
+        b0(sp * e[1]),
+        c0(cp * e[2]),
+        a1(sp * e[3]),
+        b1(sp * e[4]),
+        c1(cp * e[5]),
+        a2(sp * e[6]),
+        b2(sp * e[7]),
+        c2(cp * e[8]) {}
+  /// Inside the cone (all three >= 0); `sum` = f0 + f1 + f2 (the ray-plane denominator).
+  bool inside(double ct, double st, double& sum) const {
+    const double f0 = a0 * ct + b0 * st + c0, f1 = a1 * ct + b1 * st + c1, f2 = a2 * ct + b2 * st + c2;
+    sum = f0 + f1 + f2;
+    return std::min(std::min(f0, f1), f2) >= 0;
+  }
+};
+
+/// Keep the nearer value at a covered node; count nodes that had no surface before.
+template <typename Scalar>
+inline void keep_nearer(Scalar& node, bool inside, Scalar v, std::int64_t& newly) {
+  const Scalar old = node;
+  newly += (inside && old == std::numeric_limits<Scalar>::infinity()) ? 1 : 0;
+  node = inside && v < old ? v : old;
+}
 /// Distance of a node: adet / sum, in the map's precision (float maps divide in float: within
 /// 1.5 ulp of the correctly rounded value, 1e-5 mm at 100 mm; double maps in double).
 inline float node_distance(double adet, double sum, float) {
@@ -93,29 +140,16 @@ template <typename Scalar>
 inline std::int64_t exact_rows_body(Scalar* __restrict map, int cols, const ExactBox& box,
                                     const double* __restrict sin_phi, const double* __restrict cos_phi,
                                     const double* __restrict cos_theta, const double* __restrict sin_theta) {
-  const double* e = box.e;
-  const double adet = box.adet;
-  constexpr Scalar none = std::numeric_limits<Scalar>::infinity();
   std::int64_t newly = 0;
   for (int r = box.r0; r <= box.r1; ++r) {
-    const double sp = sin_phi[r], cp = cos_phi[r];
-    const double a0 = sp * e[0], b0 = sp * e[1], c0 = cp * e[2], a1 = sp * e[3], b1 = sp * e[4], c1 = cp * e[5],
-                 a2 = sp * e[6], b2 = sp * e[7], c2 = cp * e[8];
+    const RowEdges edges(box.e, sin_phi[r], cos_phi[r]);
     Scalar* __restrict row = map + std::int64_t(r) * cols;
-    for (int g = 0; g < box.nseg; ++g) {
-      const int lo = box.seg[g][0], hi = box.seg[g][1];
-      for (int j = lo; j <= hi; ++j) {
-        const double ct = cos_theta[j], st = sin_theta[j];
-        const double f0 = a0 * ct + b0 * st + c0;
-        const double f1 = a1 * ct + b1 * st + c1;
-        const double f2 = a2 * ct + b2 * st + c2;
-        const bool inside = std::min(std::min(f0, f1), f2) >= 0;
-        const Scalar v = node_distance(adet, f0 + f1 + f2, Scalar{});
-        const Scalar old = row[j];
-        newly += (inside && old == none) ? 1 : 0;
-        row[j] = inside && v < old ? v : old;
+    for (int g = 0; g < box.nseg; ++g)
+      for (int j = box.seg[g][0]; j <= box.seg[g][1]; ++j) {
+        double sum;
+        const bool inside = edges.inside(cos_theta[j], sin_theta[j], sum);
+        keep_nearer(row[j], inside, node_distance(box.adet, sum, Scalar{}), newly);
       }
-    }
   }
   return newly;
 }
@@ -126,6 +160,8 @@ std::int64_t exact_rows_generic(float* map, int cols, const ExactBox& box, const
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's own _mm512_cvtpd_ps (a false positive)
 /// exact_rows_body for float maps in AVX-512 with masked loads and stores: the short spans of
 /// small triangles (a few dozen nodes) run without scalar remainders. Same arithmetic as the
 /// generic body (double edge functions, float division), so the same values.
@@ -167,6 +203,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
   }
   return newly;
 }
+#pragma GCC diagnostic pop
 #endif
 
 std::int64_t exact_rows(float* map, int cols, const ExactBox& box, const double* sin_phi, const double* cos_phi,
@@ -190,7 +227,6 @@ std::int64_t exact_rows(double* map, int cols, const ExactBox& box, const double
 /// column index), clamped to the triangle. Branch-free; vectorised clones.
 struct LinearBox {
   ExactBox box;
-  int seg_offset[3];  ///< unwrapped column = stored column + offset, per segment
   double h, ta, tb, tc, pa, pb, pc, da, db, dc, inv_area2;
 };
 template <typename Scalar>
@@ -198,34 +234,22 @@ inline std::int64_t linear_rows_body(Scalar* __restrict map, int cols, const Lin
                                      const double* __restrict sin_phi, const double* __restrict cos_phi,
                                      const double* __restrict cos_theta, const double* __restrict sin_theta) {
   const ExactBox& box = L.box;
-  const double* e = box.e;
-  constexpr Scalar none = std::numeric_limits<Scalar>::infinity();
   std::int64_t newly = 0;
   for (int r = box.r0; r <= box.r1; ++r) {
-    const double sp = sin_phi[r], cp = cos_phi[r];
-    const double a0 = sp * e[0], b0 = sp * e[1], c0 = cp * e[2], a1 = sp * e[3], b1 = sp * e[4], c1 = cp * e[5],
-                 a2 = sp * e[6], b2 = sp * e[7], c2 = cp * e[8];
+    const RowEdges edges(box.e, sin_phi[r], cos_phi[r]);
     const double phi = r * L.h;
     Scalar* __restrict row = map + std::int64_t(r) * cols;
-    for (int g = 0; g < box.nseg; ++g) {
-      const int lo = box.seg[g][0], hi = box.seg[g][1], off = L.seg_offset[g];
-      for (int j = lo; j <= hi; ++j) {
-        const double ct = cos_theta[j], st = sin_theta[j];
-        const double f0 = a0 * ct + b0 * st + c0;
-        const double f1 = a1 * ct + b1 * st + c1;
-        const double f2 = a2 * ct + b2 * st + c2;
-        const bool inside = std::min(std::min(f0, f1), f2) >= 0;
-        const double tn = (j + off) * L.h;
+    for (int g = 0; g < box.nseg; ++g)
+      for (int j = box.seg[g][0]; j <= box.seg[g][1]; ++j) {
+        double sum;
+        const bool inside = edges.inside(cos_theta[j], sin_theta[j], sum);
+        const double tn = (j + box.seg_offset[g]) * L.h;
         double lb = ((tn - L.ta) * (L.pc - L.pa) - (L.tc - L.ta) * (phi - L.pa)) * L.inv_area2;
         double lc = ((L.tb - L.ta) * (phi - L.pa) - (tn - L.ta) * (L.pb - L.pa)) * L.inv_area2;
         double la = 1 - lb - lc;
         la = std::max(la, 0.0), lb = std::max(lb, 0.0), lc = std::max(lc, 0.0);
-        const Scalar v = static_cast<Scalar>((la * L.da + lb * L.db + lc * L.dc) / (la + lb + lc));
-        const Scalar old = row[j];
-        newly += (inside && old == none) ? 1 : 0;
-        row[j] = inside && v < old ? v : old;
+        keep_nearer(row[j], inside, static_cast<Scalar>((la * L.da + lb * L.db + lc * L.dc) / (la + lb + lc)), newly);
       }
-    }
   }
   return newly;
 }
@@ -360,13 +384,7 @@ class Rasterizer {
     const double dtheta_ab = wrap_pi(kb.theta - ka.theta);
 
     if (mode_ == DistanceMode::exact) {
-      ExactBox box;
-      box.r0 = r0, box.r1 = r1, box.nseg = 0;
-      if (c0 < 0) box.seg[box.nseg][0] = c0 + cols, box.seg[box.nseg][1] = cols - 1, ++box.nseg;
-      box.seg[box.nseg][0] = std::max(c0, 0), box.seg[box.nseg][1] = std::min(c1, cols - 1), ++box.nseg;
-      if (c1 >= cols) box.seg[box.nseg][0] = 0, box.seg[box.nseg][1] = c1 - cols, ++box.nseg;
-      for (int k = 0; k < 3; ++k) box.e[k] = e0[k], box.e[3 + k] = e1[k], box.e[6 + k] = e2[k];
-      box.adet = adet;
+      const ExactBox box = make_box(r0, r1, c0, c1, cols, e0, e1, e2, adet);
       if (r1 >= r0)
         newly_covered_ +=
             exact_rows(map_.data(), cols, box, sin_phi_.data(), cos_phi_.data(), cos_theta_.data(), sin_theta_.data());
@@ -374,17 +392,18 @@ class Rasterizer {
       return;
     }
     if (!apex && !full && std::abs(area2) >= 1e-18) {  // linear mode away from the poles: vectorised
-      LinearBox L;
-      ExactBox& box = L.box;
-      box.r0 = r0, box.r1 = r1, box.nseg = 0;
-      if (c0 < 0) box.seg[box.nseg][0] = c0 + cols, box.seg[box.nseg][1] = cols - 1, L.seg_offset[box.nseg++] = -cols;
-      box.seg[box.nseg][0] = std::max(c0, 0), box.seg[box.nseg][1] = std::min(c1, cols - 1),
-      L.seg_offset[box.nseg++] = 0;
-      if (c1 >= cols) box.seg[box.nseg][0] = 0, box.seg[box.nseg][1] = c1 - cols, L.seg_offset[box.nseg++] = cols;
-      for (int k = 0; k < 3; ++k) box.e[k] = e0[k], box.e[3 + k] = e1[k], box.e[6 + k] = e2[k];
-      box.adet = adet;
-      L.h = h, L.ta = ta, L.tb = tb, L.tc = tc, L.pa = ka.phi, L.pb = kb.phi, L.pc = kc.phi;
-      L.da = ka.d, L.db = kb.d, L.dc = kc.d, L.inv_area2 = 1 / area2;
+      LinearBox L{make_box(r0, r1, c0, c1, cols, e0, e1, e2, adet),
+                  h,
+                  ta,
+                  tb,
+                  tc,
+                  ka.phi,
+                  kb.phi,
+                  kc.phi,
+                  ka.d,
+                  kb.d,
+                  kc.d,
+                  1 / area2};
       if (r1 >= r0)
         newly_covered_ +=
             linear_rows(map_.data(), cols, L, sin_phi_.data(), cos_phi_.data(), cos_theta_.data(), sin_theta_.data());
