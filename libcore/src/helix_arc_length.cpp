@@ -9,6 +9,7 @@
 
 #include "impinge/error.hpp"
 #include "impinge/spherical_frame.hpp"
+#include "simd_clones.hpp"
 
 namespace impinge {
 
@@ -66,6 +67,28 @@ double HelixArcLength::inverse(double s, double guess) const {
     if (std::abs(step) < 1e-15) break;
   }
   return phi;
+}
+
+namespace {
+/// Cubic Hermite of the tabulated s and s' (the body of operator() outside the caps).
+IMPINGE_SIMD_CLONES
+void hermite_many(const double* __restrict phi, int n, const double* __restrict s, const double* __restrict ds,
+                  double h, double inv_h, int intervals, double* __restrict out) {
+  for (int k = 0; k < n; ++k) {
+    const double f = std::max(phi[k], 0.0) * inv_h;
+    int j = static_cast<int>(f);
+    j = j >= intervals ? intervals - 1 : j;
+    const double t = f - j, t2 = t * t, t3 = t2 * t;
+    out[k] = (2 * t3 - 3 * t2 + 1) * s[j] + (t3 - 2 * t2 + t) * h * ds[j] + (-2 * t3 + 3 * t2) * s[j + 1] +
+             (t3 - t2) * h * ds[j + 1];
+  }
+}
+}  // namespace
+
+void HelixArcLength::evaluate_many(const double* phi, int n, double* s_out) const {
+  hermite_many(phi, n, s_.data(), ds_.data(), h_, inv_h_, intervals_, s_out);
+  for (int k = 0; k < n; ++k)
+    if (in_cap(phi[k])) s_out[k] = (*this)(phi[k]);
 }
 
 }  // namespace impinge

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "impinge/error.hpp"
 #include "impinge/spherical_frame.hpp"
+#include "simd_clones.hpp"
 
 namespace impinge {
 
@@ -102,6 +104,94 @@ void HelixScheme::node_angles(std::int64_t first, std::int64_t count, double* ph
 std::int64_t HelixScheme::node(const Eigen::Vector3d& u) const {
   const Stencil s = interpolate(u);
   return s.nodes[static_cast<std::size_t>(std::max_element(s.weights.begin(), s.weights.end()) - s.weights.begin())];
+}
+
+namespace {
+/// Pass 1 of the helix look-up: angles of each point and the polar angles of the two crossings
+/// of its meridian that bracket it (clamped to the poles in the first and last turn), with the
+/// weight u between them. Branch-free; vectorised clones.
+IMPINGE_SIMD_CLONES
+void helix_crossings(const double* __restrict x, const double* __restrict y, const double* __restrict z, int n,
+                     double k, double inv_2k, double pi_over_k, double* __restrict phi_a, double* __restrict phi_b,
+                     double* __restrict u) {
+  constexpr double kTwoPi = 2 * 3.14159265358979323846, kPiC = 3.14159265358979323846;
+  for (int j = 0; j < n; ++j) {
+    double phi, theta;
+    fast_spherical_angles(x[j], y[j], z[j], phi, theta);
+    theta = theta >= kTwoPi ? theta - kTwoPi : theta;
+    const double jf = (2 * k * phi - theta) * (1 / kTwoPi);
+    double t = static_cast<double>(static_cast<std::int64_t>(jf));
+    t = t > jf ? t - 1 : t;
+    const double a = (theta + kTwoPi * t) * inv_2k, b = a + pi_over_k;
+    const double pa = a <= 0 ? 0.0 : a, pb = b >= kPiC ? kPiC : b;
+    const double span = pb - pa;
+    double w = span > 0 ? (phi - pa) / span : 0.0;
+    w = w < 0 ? 0.0 : (w > 1 ? 1.0 : w);
+    phi_a[j] = pa, phi_b[j] = pb, u[j] = w;
+  }
+}
+/// Pass 3: node and weight along the curve at each crossing (i, t: nodes i and i + 1 with
+/// weights 1 - t and t). The pole crossings give node 0 (weight 1) and node w - 1 (weight 1).
+IMPINGE_SIMD_CLONES
+void helix_along(const double* __restrict s, int n, double inv_dx, double last, std::int32_t* __restrict i_out,
+                 double* __restrict t_out) {
+  for (int j = 0; j < n; ++j) {
+    const double f = s[j] * inv_dx;
+    double i = static_cast<double>(static_cast<std::int64_t>(f));
+    i = i > last - 1 ? last - 1 : (i < 0 ? 0.0 : i);
+    double t = f - i;
+    t = t < 0 ? 0.0 : (t > 1 ? 1.0 : t);
+    i_out[j] = static_cast<std::int32_t>(i), t_out[j] = t;
+  }
+}
+}  // namespace
+
+template <typename Scalar>
+void HelixScheme::lookup_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
+                             double* out) const {
+  constexpr int kChunk = 128;
+  double pa[kChunk], pb[kChunk], u[kChunk], sa[kChunk], sb[kChunk], ta[kChunk], tb[kChunk];
+  std::int32_t ia[kChunk], ib[kChunk];
+  const double last = static_cast<double>(w_ - 1);
+  for (std::int64_t b = 0; b < n; b += kChunk) {
+    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, n - b));
+    helix_crossings(x + b, y + b, z + b, m, k_, inv_2k_, kPiOverK_, pa, pb, u);
+    arc_.evaluate_many(pa, m, sa);
+    arc_.evaluate_many(pb, m, sb);
+    helix_along(sa, m, inv_dx_, last, ia, ta);
+    helix_along(sb, m, inv_dx_, last, ib, tb);
+    for (int j = 0; j < m; ++j) {
+      const double wa = 1 - u[j], wb = u[j];
+      const double v = wa * ((1 - ta[j]) * values[ia[j]] + ta[j] * values[ia[j] + 1]) +
+                       wb * ((1 - tb[j]) * values[ib[j]] + tb[j] * values[ib[j] + 1]);
+      if (std::isfinite(v)) {
+        out[b + j] = v;
+        continue;
+      }
+      // A node without surface: NaN unless its weight is exactly 0 (the pole crossings, a
+      // direction on a node): the exact scalar stencil decides.
+      const bool zero_weight = u[j] == 0 || u[j] == 1 || ta[j] == 0 || ta[j] == 1 || tb[j] == 0 || tb[j] == 1;
+      if (!zero_weight) {
+        out[b + j] = std::numeric_limits<double>::quiet_NaN();
+        continue;
+      }
+      std::int64_t nd[4];
+      double w[4];
+      stencil_at(x[b + j], y[b + j], z[b + j], nd, w);
+      out[b + j] = slow_path(values, nd, w);
+    }
+  }
+}
+
+void HelixScheme::interpolate_many_soa(const float* values, const double* x, const double* y, const double* z,
+                                       std::int64_t n, double* out) const {
+  if (locate_ == TraveledDistance::exact) return lookup_soa(values, x, y, z, n, out);
+  SchemeImpl<HelixScheme>::interpolate_many_soa(values, x, y, z, n, out);
+}
+void HelixScheme::interpolate_many_soa(const double* values, const double* x, const double* y, const double* z,
+                                       std::int64_t n, double* out) const {
+  if (locate_ == TraveledDistance::exact) return lookup_soa(values, x, y, z, n, out);
+  SchemeImpl<HelixScheme>::interpolate_many_soa(values, x, y, z, n, out);
 }
 
 }  // namespace impinge

@@ -44,6 +44,10 @@ class HelixArcLength {
     s = (2 * t3 - 3 * t2 + 1) * s0 + (t3 - 2 * t2 + t) * h_ * d0 + (-2 * t3 + 3 * t2) * s1 + (t3 - t2) * h_ * d1;
     ds = (6 * t2 - 6 * t) * inv_h_ * (s0 - s1) + (3 * t2 - 4 * t + 1) * d0 + (3 * t2 - 2 * t) * d1;
   }
+  /// s at n angles (phi: n values in [0, pi], radians) into s_out: the table's cubic Hermite in a
+  /// vectorised pass, then the exact integral for the few angles inside the polar caps. Same
+  /// values as operator().
+  void evaluate_many(const double* phi, int n, double* s_out) const;
   /// True where the fast form uses the exact integral (within 20/k of a pole).
   bool in_cap(double phi) const { return phi < cap_ || phi > kPiHelix - cap_; }
   /// s(phi) by the elliptic integral (slow reference, ~0.3 us).

@@ -95,7 +95,18 @@ class HelixScheme : public SchemeImpl<HelixScheme> {
     w[0] *= 1 - u, w[1] *= 1 - u, w[2] *= u, w[3] *= u;
   }
 
+  /// Vectorised look-up (exact locator; the Eq. 10 locator uses the generic path): the angles
+  /// and both bracketing crossings of a block in one pass, the arc lengths of the crossings in
+  /// a second, the stencils in a third, then the loads. Same stencil as stencil_at.
+  void interpolate_many_soa(const float* values, const double* x, const double* y, const double* z, std::int64_t n,
+                            double* out) const override;
+  void interpolate_many_soa(const double* values, const double* x, const double* y, const double* z, std::int64_t n,
+                            double* out) const override;
+
  private:
+  template <typename Scalar>
+  void lookup_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
+                  double* out) const;
   /// Polar angle of node i by Newton from `guess` (radians; <= 0 for a closed-form start).
   double phi_of_node(std::int64_t i, double guess) const;
   /// The two nodes bracketing the helix point at phi along the curve, with linear weights.
