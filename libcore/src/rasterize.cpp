@@ -179,6 +179,10 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
                   a1 = _mm512_set1_pd(sp * e[3]), b1 = _mm512_set1_pd(sp * e[4]), c1 = _mm512_set1_pd(cp * e[5]),
                   a2 = _mm512_set1_pd(sp * e[6]), b2 = _mm512_set1_pd(sp * e[7]), c2 = _mm512_set1_pd(cp * e[8]);
     float* row = map + std::int64_t(r) * cols;
+    if (r + 2 <= box.r1)  // rows are a whole map row apart: no hardware prefetcher follows them
+      for (int g = 0; g < box.nseg; ++g)
+        for (int j = box.seg[g][0]; j <= box.seg[g][1]; j += 16)
+          _mm_prefetch(reinterpret_cast<const char*>(row + 2 * std::int64_t(cols) + j), _MM_HINT_T0);
     for (int g = 0; g < box.nseg; ++g) {
       const int lo = box.seg[g][0], hi = box.seg[g][1];
       for (int j = lo; j <= hi; j += 8) {
