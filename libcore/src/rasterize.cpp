@@ -294,6 +294,9 @@ class Rasterizer {
     }
   }
 
+  /// Nodes that had no surface before this rasteriser and have one now.
+  std::int64_t newly_covered() const { return newly_covered_; }
+
   void triangle(const Corner& a, const Corner& b, const Corner& c) {
     ++stats_.triangles;
     const double det = a.p.dot(b.p.cross(c.p));
@@ -469,9 +472,7 @@ class Rasterizer {
   DistanceMode mode_;
   SamplingStats& stats_;
   const EquiangularGrid& grid_;
-  int keep_sign_;  ///< 0: no culling
-
- public:
+  int keep_sign_;                   ///< 0: no culling
   std::int64_t newly_covered_ = 0;  ///< nodes that had no surface and now have one
   std::vector<double> sin_phi_, cos_phi_, cos_theta_, sin_theta_;
 };
@@ -507,7 +508,7 @@ SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, Di
   } else {
     for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) draw(f);
   }
-  stats.nodes_covered = raster.newly_covered_;
+  stats.nodes_covered = raster.newly_covered();
   return stats;
 }
 

@@ -44,9 +44,10 @@ struct ScanSummary {
 
 /// One scan of Algorithm 2: for every vertex i with mask[i] != 0, q = R * P.row(i) (P: n x 3,
 /// mm, relative to the COR in the vertex body's frame; R: 3 x 3 rotation into the map's frame),
-/// gap = side * (map.sample(q) - |q|). Allocation-free; one call into the map's scheme per
-/// block of 256 vertices, the stencil inlined there (no virtual dispatch per vertex).
-/// `out` is resized to n. Vertices at the COR itself are reported as no surface.
+/// gap = side * (map.sample(q) - |q|). A one-shot convenience: it builds the ScanSet of the mask
+/// and runs scan_gaps_compact; for many poses build the set once (make_scan_set, as Joint does)
+/// and call scan_gaps_compact. `out` is resized to n. Vertices at the COR itself are reported
+/// as no surface.
 template <typename Scalar>
 void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
                const RadialDistanceMapT<Scalar>& map, ScanSide side, ScanGaps& out);
