@@ -85,7 +85,9 @@ TEST(EmbreeRayCaster, FillMapEqualsTheNaiveRayCast) {
       ++mismatched;  // a ray through an edge or a vertex: the two casters may round differently
       continue;
     }
-    if (a.has_surface(i)) EXPECT_NEAR(a.at(i), b.at(i), 1e-3) << i;
+    if (a.has_surface(i)) {
+      EXPECT_NEAR(a.at(i), b.at(i), 1e-3) << i;
+    }
   }
   EXPECT_LE(mismatched, 2);
 }
