@@ -114,21 +114,7 @@ IMPINGE_SIMD_CLONES
 void helix_crossings(const double* __restrict x, const double* __restrict y, const double* __restrict z, int n,
                      double k, double inv_2k, double pi_over_k, double* __restrict phi_a, double* __restrict phi_b,
                      double* __restrict u) {
-  constexpr double kTwoPi = 2 * 3.14159265358979323846, kPiC = 3.14159265358979323846;
-  for (int j = 0; j < n; ++j) {
-    double phi, theta;
-    fast_spherical_angles(x[j], y[j], z[j], phi, theta);
-    theta = theta >= kTwoPi ? theta - kTwoPi : theta;
-    const double jf = (2 * k * phi - theta) * (1 / kTwoPi);
-    double t = static_cast<double>(static_cast<std::int64_t>(jf));
-    t = t > jf ? t - 1 : t;
-    const double a = (theta + kTwoPi * t) * inv_2k, b = a + pi_over_k;
-    const double pa = a <= 0 ? 0.0 : a, pb = b >= kPiC ? kPiC : b;
-    const double span = pb - pa;
-    double w = span > 0 ? (phi - pa) / span : 0.0;
-    w = w < 0 ? 0.0 : (w > 1 ? 1.0 : w);
-    phi_a[j] = pa, phi_b[j] = pb, u[j] = w;
-  }
+  for (int j = 0; j < n; ++j) helix_crossings_of(x[j], y[j], z[j], k, inv_2k, pi_over_k, phi_a[j], phi_b[j], u[j]);
 }
 /// Pass 3: node and weight along the curve at each crossing (i, t: nodes i and i + 1 with
 /// weights 1 - t and t). The pole crossings give node 0 (weight 1) and node w - 1 (weight 1).

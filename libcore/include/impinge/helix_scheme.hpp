@@ -35,6 +35,29 @@ inline double matched_helix_turns(double precision_deg) {
   return std::round(720.0 / (3.14159265358979323846 * precision_deg));
 }
 
+/// The two crossings of the meridian of direction (x, y, z) by a k-turn helix that bracket it
+/// (thesis Fig. 48): polar angles phi_a <= phi < phi_b = phi_a + pi/k, clamped to 0 in the
+/// first turn and to pi in the last (where a pole node replaces the missing crossing), and the
+/// weight u of phi_b in the linear interpolation between them (0 when the span is empty).
+/// No libm trigonometry (fast_angles.hpp). inv_2k = 1 / (2k), pi_over_k = pi / k. Shared by
+/// HelixScheme::stencil_at and the vectorised look-up, branch-free so that loops vectorise.
+inline void helix_crossings_of(double x, double y, double z, double k, double inv_2k, double pi_over_k, double& phi_a,
+                               double& phi_b, double& u) {
+  constexpr double kPi = 3.14159265358979323846, kTwoPi = 2 * kPi;
+  double phi, theta;
+  fast_spherical_angles(x, y, z, phi, theta);
+  theta = theta >= kTwoPi ? theta - kTwoPi : theta;
+  const double jf = (2 * k * phi - theta) * (1 / kTwoPi);  // floor without a libm call
+  double j = static_cast<double>(static_cast<std::int64_t>(jf));
+  j = j > jf ? j - 1 : j;
+  const double a = (theta + kTwoPi * j) * inv_2k, b = a + pi_over_k;
+  phi_a = a <= 0 ? 0.0 : a;
+  phi_b = b >= kPi ? kPi : b;
+  const double span = phi_b - phi_a;  // 0 when a crossing falls exactly on the south pole
+  double w = span > 0 ? (phi - phi_a) / span : 0.0;
+  u = w < 0 ? 0.0 : (w > 1 ? 1.0 : w);
+}
+
 class HelixScheme : public SchemeImpl<HelixScheme> {
  public:
   /// k >= 2 integral turns (thesis Table 6: 229, 458, 2292, 4584). Throws impinge::Error.
@@ -65,33 +88,20 @@ class HelixScheme : public SchemeImpl<HelixScheme> {
 
   /// Thesis Algorithm 3's neighbour location and interpolation (see class comment).
   void stencil_at(double x, double y, double z, std::int64_t nodes[4], double w[4]) const {
-    double phi, theta;  // no libm trigonometry (fast_angles.hpp: within 1e-13 rad)
-    fast_spherical_angles(x, y, z, phi, theta);
-    if (theta >= kTwoPi) theta -= kTwoPi;
-    // bracketing crossings of the meridian theta
-    const double jf = (2 * k_ * phi - theta) * kInvTwoPi;  // floor without a libm call
-    double j = static_cast<double>(static_cast<std::int64_t>(jf));
-    if (j > jf) j -= 1;
-    double phi_a = (theta + kTwoPi * j) * inv_2k_;
-    double phi_b = phi_a + kPiOverK_;
-    double u;
+    double phi_a, phi_b, u;
+    helix_crossings_of(x, y, z, k_, inv_2k_, kPiOverK_, phi_a, phi_b, u);
     if (phi_a <= 0) {  // first turn: the north pole node replaces the upper crossing
-      phi_a = 0;
       nodes[0] = nodes[1] = 0;
       w[0] = 1, w[1] = 0;
     } else {
       along(phi_a, nodes, w);
     }
     if (phi_b >= kPi_) {  // last turn: the south pole node
-      phi_b = kPi_;
       nodes[2] = nodes[3] = w_ - 1;
       w[2] = 1, w[3] = 0;
     } else {
       along(phi_b, nodes + 2, w + 2);
     }
-    const double span = phi_b - phi_a;  // 0 when a crossing falls exactly on the south pole
-    u = span > 0 ? (phi - phi_a) / span : 0;
-    u = u < 0 ? 0 : (u > 1 ? 1 : u);
     w[0] *= 1 - u, w[1] *= 1 - u, w[2] *= u, w[3] *= u;
   }
 
