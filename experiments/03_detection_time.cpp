@@ -182,8 +182,8 @@ int main(int argc, char** argv) {
         row(pname, "fcl_distance", 0, 0, td, std::nan(""), std::nan(""), d, "distance_mm");
       }
       if (pairwise) {
-        const PairwiseResult probe = pairwise->intersect(Eigen::Matrix3d::Zero(), Eigen::Vector3d::Constant(1e6));
-        const bool affordable = !args.quick || double(probe.ball_triangles) * double(probe.socket_triangles) <= 2e7;
+        const bool affordable =
+            !args.quick || double(pairwise->ball_triangles()) * double(pairwise->socket_triangles()) <= 2e7;
         if (affordable) {
           PairwiseResult r;
           const double tp = median_ms([&] { r = pairwise->intersect(I, t); }, 1);

@@ -31,6 +31,9 @@ class PairwiseJoint {
   /// Test every pair with the ball rotated by R about the COR and translated by t (mm).
   /// O(m n): seconds for 12k x 12k triangles.
   PairwiseResult intersect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const;
+  /// Triangles kept in the region, per body.
+  std::int64_t ball_triangles() const { return ball_.rows(); }
+  std::int64_t socket_triangles() const { return socket_.rows(); }
 
  private:
   Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor> ball_, socket_;  ///< corners relative to the COR
