@@ -2,6 +2,8 @@
 //  - fast_polar_angle and fast_azimuth are within kFastAngleMaxError (1e-13 rad) of long-double
 //    atan2 on 4 million random directions and on every edge case (axes, signed zeros, octant
 //    boundaries, tiny and huge components);
+//  - fast_acos_coarse is within kFastAcosCoarseMaxError (3e-8 rad) of long-double acos on a
+//    dense grid of [-1, 1] (refined near +-1, where acos is steepest) and at the ends;
 //  - the vectorised equiangular look-up (scan_gaps_compact) moves no gap by more than 1e-4 mm
 //    against a reference that uses libm acos/atan2 and the same bilinear stencil, on the
 //    generated 12k hip and on a real subject when ../shared/data is present.
@@ -58,6 +60,21 @@ TEST(FastAngles, RandomDirectionsWithinTheBound) {
   }
   EXPECT_LE(worst, kFastAngleMaxError);
   RecordProperty("worst_error_rad", std::to_string(worst));
+}
+
+TEST(FastAngles, CoarseAcosWithinItsBound) {
+  double worst = 0;
+  auto check = [&](double x) {
+    const double e = double(std::abs((long double)fast_acos_coarse(x) - std::acos((long double)x)));
+    worst = std::max(worst, e);
+  };
+  for (int i = -2000000; i <= 2000000; ++i) check(i / 2000000.0);
+  for (int k = 1; k <= 52; ++k)  // within 2^-k of the ends
+    for (double s : {1.0, -1.0}) check(s * (1 - std::ldexp(1.0, -k)));
+  EXPECT_LE(worst, kFastAcosCoarseMaxError);
+  EXPECT_GT(worst, 1e-9);  // the polynomial's own error: the check measures what it claims
+  EXPECT_EQ(fast_acos_coarse(1.0), 0.0);
+  EXPECT_NEAR(fast_acos_coarse(-1.0), 3.14159265358979323846, 1e-8);
 }
 
 TEST(FastAngles, EdgeCases) {

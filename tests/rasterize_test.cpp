@@ -6,13 +6,18 @@
 //    precision on the nodes both cover, and the two coverages differ only on silhouette edges;
 //  - linear mode stays within its interpolation bound (vertex-distance range of the triangle
 //    down to the plane distance) of the exact ray cast;
-//  - on a sphere off the COR the map converges to the analytic ray-sphere distance as p shrinks.
+//  - on a sphere off the COR the map converges to the analytic ray-sphere distance as p shrinks;
+//  - row spans give the same map, node for node, as testing every node of each box (random,
+//    pole, seam, grid-aligned and row-tangent triangles; real bones), and a plan made for
+//    another mesh or COR is refused.
 #include "impinge/rasterize.hpp"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
+#include "impinge/error.hpp"
+#include "impinge/face_culling.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/naive_sampling.hpp"
 #include "impinge/spherical_frame.hpp"
@@ -210,4 +215,126 @@ TEST(Rasterize, ConvergesToAnalyticSphereOffTheCor) {
     EXPECT_LT(worst, prev) << "p=" << p;
     prev = worst;
   }
+}
+
+namespace {
+/// Triangles that stress row spans: random sizes from 0.05 to 80 deg anywhere (near the poles
+/// and across the seam included), corners on node directions (edges through nodes), edges along
+/// meridians, and edges whose great circle is tangent to a row (where a span's end moves by the
+/// square root of any rounding).
+TriangleMesh span_stress_mesh(double p, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> U(0, 1);
+  const double h = p * kDegToRad;
+  std::vector<Eigen::Vector3d> v;
+  std::vector<Eigen::Vector3i> f;
+  auto add = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+    const int n = static_cast<int>(v.size());
+    v.push_back(a), v.push_back(b), v.push_back(c);
+    f.push_back({n, n + 1, n + 2});
+  };
+  auto radius = [&] { return 20 + 20 * U(rng); };
+  for (int t = 0; t < 300; ++t) {
+    const double size = std::pow(10.0, -1.3 + 3.2 * U(rng)) * kDegToRad;  // 0.05 .. 80 deg
+    double phi0 = std::acos(2 * U(rng) - 1), theta0 = 2 * kPi * U(rng);
+    if (t % 10 == 1) phi0 = 0.3 * size * U(rng);        // at the north pole
+    if (t % 10 == 2) phi0 = kPi - 0.3 * size * U(rng);  // at the south pole
+    if (t % 10 == 3) theta0 = 0.2 * size * (U(rng) - 0.5);  // across the seam
+    const Eigen::Vector3d c = direction(phi0, theta0);
+    const Eigen::Vector3d e1 = c.unitOrthogonal(), e2 = c.cross(e1);
+    Eigen::Vector3d k[3];
+    for (auto& x : k) {
+      const double a = 2 * kPi * U(rng), s = size * (0.3 + U(rng));
+      x = radius() * (c + std::tan(s) * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
+    }
+    if (t % 10 == 4)  // corners on node directions
+      for (auto& x : k) {
+        const double ph = std::round(std::acos(x.normalized().z()) / h) * h;
+        const double th = std::round(std::atan2(x.y(), x.x()) / h) * h;
+        x = radius() * direction(ph, th);
+      }
+    if (t % 10 == 5) {  // an edge along a meridian
+      const double th = std::round(theta0 / h) * h;
+      k[0] = radius() * direction(std::max(phi0 - size, 0.01), th);
+      k[1] = radius() * direction(std::min(phi0 + size, kPi - 0.01), th);
+    }
+    if (t % 10 == 6 || t % 10 == 7) {
+      // An edge on the great circle tangent to row r at azimuth th: normal at polar angle
+      // pi/2 - phi_r (north of the equator) or its mirror, azimuth th + pi.
+      const double phr = std::round(phi0 / h) * h, th = std::round(theta0 / h) * h;
+      const Eigen::Vector3d n = direction(phr < kPi / 2 ? kPi / 2 + phr : phr - kPi / 2, th);
+      const Eigen::Vector3d touch = direction(phr, th);
+      const Eigen::Vector3d along = n.cross(touch).normalized();
+      k[0] = radius() * (touch + std::tan(size) * along).normalized();
+      k[1] = radius() * (touch - std::tan(size) * (0.5 + U(rng)) * along).normalized();
+      k[2] = radius() * (touch + (t % 10 == 6 ? 1 : -1) * std::tan(size) * (touch.cross(along))).normalized();
+    }
+    add(k[0], k[1], k[2]);
+  }
+  TriangleMesh m = make_mesh(v, f);
+  m.source = "span stress mesh";
+  return m;
+}
+
+template <typename M>
+std::int64_t nodes_not_identical(const M& a, const M& b) {
+  std::int64_t n = 0;
+  for (std::int64_t i = 0; i < a.num_nodes(); ++i) n += !(a.at(i) == b.at(i));
+  return n;
+}
+}  // namespace
+
+TEST(Rasterize, RowSpansGiveTheSameMapAsWholeBoxes) {
+  // Row spans only skip nodes the full box test rejects: the maps must be identical, node for
+  // node, in float and double, with and without a culling plan, and test fewer nodes.
+  std::mt19937_64 rng(17);
+  for (double p : {2.0, 0.5, 0.1}) {
+    const TriangleMesh m = span_stress_mesh(p, rng);
+    const Eigen::Vector3d cor = Eigen::Vector3d::Zero();
+    const FaceCulling plan = analyse_face_culling(m, cor);  // open mesh: disabled, all cones
+    ASSERT_FALSE(plan.enabled);
+    RadialDistanceMap box{EquiangularGrid(p)}, span{EquiangularGrid(p)}, planned{EquiangularGrid(p)};
+    const SamplingStats sb = rasterize(m, cor, DistanceMode::exact, box, nullptr, /*row_spans=*/false);
+    const SamplingStats ss = rasterize(m, cor, DistanceMode::exact, span);
+    const SamplingStats sp = rasterize(m, cor, DistanceMode::exact, planned, &plan);
+    EXPECT_EQ(nodes_not_identical(box, span), 0) << "p=" << p;
+    EXPECT_EQ(nodes_not_identical(box, planned), 0) << "p=" << p;
+    EXPECT_EQ(sb.nodes_covered, ss.nodes_covered);
+    EXPECT_EQ(sb.nodes_covered, sp.nodes_covered);
+    EXPECT_GT(sb.nodes_covered, 1000);
+    EXPECT_LT(ss.node_tests, sb.node_tests);
+    EXPECT_GT(ss.pole_triangles, 0);
+    EXPECT_GT(ss.seam_triangles, 0);
+    RadialDistanceMapDouble box_d{EquiangularGrid(p)}, span_d{EquiangularGrid(p)};
+    rasterize(m, cor, DistanceMode::exact, box_d, nullptr, false);
+    rasterize(m, cor, DistanceMode::exact, span_d);
+    EXPECT_EQ(nodes_not_identical(box_d, span_d), 0) << "p=" << p;
+  }
+}
+
+TEST(Rasterize, RowSpansOnRealBonesGiveTheSameMap) {
+  const auto real = test::load_real_joint("lhdl-ct");
+  if (!real) GTEST_SKIP() << "no shared data (" << IMPINGE_SHARED_DATA << ")";
+  for (const TriangleMesh* m : {&real->femur, &real->pelvis}) {
+    const FaceCulling plan = analyse_face_culling(*m, real->cor);
+    RadialDistanceMap box{EquiangularGrid(0.1)}, span{EquiangularGrid(0.1)};
+    rasterize(*m, real->cor, DistanceMode::exact, box, &plan, false);
+    const SamplingStats st = rasterize(*m, real->cor, DistanceMode::exact, span, &plan);
+    EXPECT_EQ(nodes_not_identical(box, span), 0) << m->source;
+    EXPECT_GT(st.nodes_covered, box.num_nodes() / 10) << m->source;
+  }
+}
+
+TEST(Rasterize, PlanOfAnotherMeshOrCorIsRefused) {
+  const HipModel h = make_hip_model(HipModelOptions{});
+  const FaceCulling plan = analyse_face_culling(h.socket, h.cor);
+  RadialDistanceMap map{EquiangularGrid(2.0)};
+  EXPECT_NO_THROW(rasterize(h.socket, h.cor, DistanceMode::exact, map, &plan));
+  EXPECT_THROW(rasterize(h.ball, h.cor, DistanceMode::exact, map, &plan), Error);
+  EXPECT_THROW(rasterize(h.socket, Eigen::Vector3d(h.cor + Eigen::Vector3d(0, 0, 1e-9)), DistanceMode::exact, map, &plan),
+               Error);
+  TriangleMesh moved = h.socket;
+  moved.V(7, 1) += 1e-12;  // one coordinate, one ulp-scale edit
+  EXPECT_THROW(rasterize(moved, h.cor, DistanceMode::exact, map, &plan), Error);
+  // Linear mode does not use the plan's cones (the thesis' algorithm on every triangle).
+  EXPECT_NO_THROW(rasterize(h.ball, h.cor, DistanceMode::linear, map, &plan));
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "impinge/error.hpp"
@@ -26,8 +27,35 @@ void order_triangles(const TriangleMesh& mesh, const Eigen::Vector3d& cor, FaceC
   std::sort(key.begin(), key.end());
   fc.triangle_order.resize(key.size());
   for (std::size_t k = 0; k < key.size(); ++k) fc.triangle_order[k] = key[k].second;
+  fc.cones = triangle_cones(mesh, cor, fc.triangle_order, &fc.cones_edge_on);
+  fc.cor = cor;
+  fc.mesh_fingerprint = mesh_fingerprint(mesh);
+}
+
+/// Mix of 64-bit words: position-weighted sum of the words and of their rotations (a
+/// multiply-rotate hash whose loop vectorises).
+template <typename T>
+void mix_words(const T* data, std::size_t n, std::uint64_t& h) {
+  static_assert(sizeof(T) == 8 || sizeof(T) == 4);
+  std::uint64_t a = 0, b = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t w = 0;
+    std::memcpy(&w, data + i, sizeof(T));
+    a += w * (2 * i + 1);
+    b += ((w << 29) | (w >> 35)) * 0x9E3779B97F4A7C15ull;
+  }
+  h = (h ^ a) * 0xff51afd7ed558ccdull;
+  h = (h ^ b ^ n) * 0xc4ceb9fe1a85ec53ull;
+  h ^= h >> 33;
 }
 }  // namespace
+
+std::uint64_t mesh_fingerprint(const TriangleMesh& mesh) {
+  std::uint64_t h = 0x243F6A8885A308D3ull;
+  mix_words(mesh.V.data(), static_cast<std::size_t>(mesh.V.size()), h);
+  mix_words(mesh.F.data(), static_cast<std::size_t>(mesh.F.size()), h);
+  return h ^ static_cast<std::uint64_t>(mesh.V.rows()) * 31 ^ static_cast<std::uint64_t>(mesh.F.rows());
+}
 
 FaceCulling analyse_face_culling(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays) {
   validate_mesh(mesh);

@@ -13,10 +13,12 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "impinge/mesh.hpp"
+#include "impinge/triangle_cone.hpp"
 
 namespace impinge {
 
@@ -32,14 +34,27 @@ struct FaceCulling {
   /// their centroid's direction from the COR, so that consecutive triangles write the same
   /// cache lines of the map (a 100 MB map at 0.05 deg does not fit in cache).
   std::vector<std::int32_t> triangle_order;
+  /// Exact-mode set-up of each triangle of triangle_order (same order) whose plane misses the
+  /// COR, made once here so that rasterize() only turns angles into rows, columns and spans.
+  std::vector<TriangleCone> cones;
+  std::int64_t cones_edge_on = 0;  ///< triangles of triangle_order left out of cones (edge-on)
+  /// What the plan was made for; rasterize() refuses a plan whose mesh or COR differs.
+  Eigen::Vector3d cor = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::uint64_t mesh_fingerprint = 0;  ///< mesh_fingerprint() of the mesh analysed
 };
+
+/// A 64-bit fingerprint of a mesh's vertex coordinates (bit patterns), face indices and sizes:
+/// any edit of a coordinate or index changes it with overwhelming probability. O(n + m), about
+/// 0.1 ms for a 100k-triangle bone. Used to check that a plan belongs to the mesh it is used on.
+std::uint64_t mesh_fingerprint(const TriangleMesh& mesh);
 
 /// Decide whether culling is exact for `mesh` about `cor` (mm), and order the triangles for
 /// rasterisation. For culling, every directed edge must have
 /// exactly one reverse edge (closed and consistently oriented), and the nearest hits of
 /// `rays` brute-force rays (towards triangle centroids spread over the mesh) must all have one
-/// orientation, which becomes keep_sign. Cost O(m) for the edges plus O(rays x m); a
-/// once-per-mesh precomputation like building a BVH. Throws impinge::Error for an invalid
+/// orientation, which becomes keep_sign. Also makes the triangles' cones (triangle_cone.hpp).
+/// Cost O(m) for the edges and cones plus O(rays x m); a once-per-mesh precomputation like
+/// building a BVH. Throws impinge::Error for an invalid
 /// mesh or a non-finite COR.
 FaceCulling analyse_face_culling(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays = 8);
 

@@ -50,13 +50,18 @@ struct SamplingStats {
 /// `mesh`: vertices in mm in the map's frame; `cor` (mm): origin of the spherical frame.
 /// Cost O(triangles + nodes in the triangles' bounding boxes). Existing map values are kept
 /// where they are nearer (so several meshes can be sampled into one map).
-/// `culling` (exact mode only; ignored when null or disabled): skip the triangles that can
-/// never be the nearest hit (analyse_face_culling), about half of a closed mesh. Exact mode's
-/// row spans run in vectorised clones (AVX-512 / AVX2 chosen at run time).
-/// Source: thesis sec. 3.2, Algorithm 1, Fig. 33-34; culling and spans: issue 4.
+/// `culling` (exact mode only; ignored in linear mode): the plan of analyse_face_culling for
+/// this mesh and COR. Its cones are rasterised (set up once; the kept triangles when culling is
+/// enabled, about half of a closed mesh, else all). Throws impinge::Error naming the mesh when
+/// the plan was made for another mesh or COR (mesh_fingerprint).
+/// `row_spans` (exact mode): test only the columns of each row that the cone can cover
+/// (triangle_cone.hpp) instead of the whole box; the map is the same node for node (tested), so
+/// false is only the reference for that test. The row kernels run in vectorised clones
+/// (AVX-512 / AVX2 chosen at run time).
+/// Source: thesis sec. 3.2, Algorithm 1, Fig. 33-34; culling, cones and spans: issue 4.
 template <typename Scalar>
 SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, DistanceMode mode,
-                        RadialDistanceMapT<Scalar>& map, const FaceCulling* culling = nullptr);
+                        RadialDistanceMapT<Scalar>& map, const FaceCulling* culling = nullptr, bool row_spans = true);
 
 /// One-shot convenience: a new float map of precision `precision_deg` sampled from `mesh`.
 RadialDistanceMap rasterize_map(const TriangleMesh& mesh, const Eigen::Vector3d& cor, double precision_deg,
