@@ -381,8 +381,6 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
   const __m256 adet = _mm256_set1_ps(static_cast<float>(S.adet));
   const __m256 none = _mm256_set1_ps(std::numeric_limits<float>::infinity());
   const __m512d zero = _mm512_setzero_pd();
-  const __m256i minus_one = _mm256_set1_epi32(-1);
-  __m256i newly_lanes = _mm256_setzero_si256();  // per lane (< 2^31: one triangle's nodes)
   std::int64_t newly = 0;
   for (int r = S.r0; r <= S.r1; ++r) {
     const int i = r - S.r0;
@@ -415,18 +413,12 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
         const __mmask8 inside = _mm512_mask_cmp_pd_mask(m, _mm512_min_pd(_mm512_min_pd(f0, f1), f2), zero, _CMP_GE_OQ);
         const __m256 sum = _mm512_cvtpd_ps(_mm512_add_pd(_mm512_add_pd(f0, f1), f2));
         const __m256 v = _mm256_div_ps(adet, sum);
-        // Loaded under the span mask, not the inside mask: the load does not wait for the
-        // edge functions (lanes outside the cone are neither counted nor stored).
-        const __m256 old = _mm256_maskz_loadu_ps(m, row + j);
-        newly_lanes = _mm256_mask_sub_epi32(newly_lanes, _mm256_mask_cmp_ps_mask(inside, old, none, _CMP_EQ_OQ),
-                                            newly_lanes, minus_one);
+        const __m256 old = _mm256_maskz_loadu_ps(inside, row + j);
+        newly += __builtin_popcount(_mm256_mask_cmp_ps_mask(inside, old, none, _CMP_EQ_OQ));
         _mm256_mask_storeu_ps(row + j, _mm256_mask_cmp_ps_mask(inside, v, old, _CMP_LT_OQ), v);
       }
     }
   }
-  alignas(32) std::int32_t lanes[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(lanes), newly_lanes);
-  for (const std::int32_t n : lanes) newly += n;
   return newly;
 }
 #pragma GCC diagnostic pop
@@ -582,64 +574,29 @@ class Rasterizer {
 
   /// Exact mode: the nodes of the cone's row spans (or of its whole box without row spans).
   void exact_cone(const TriangleCone& t) {
-    prepare(t, pending_[0]);
-    draw(pending_[0]);
-  }
-  /// Exact mode over a sequence of cones, software-pipelined: the next cone's spans are found,
-  /// and its first rows prefetched, before the current cone is drawn.
-  void exact_cones(const std::vector<TriangleCone>& cones) {
-    if (cones.empty()) return;
-    prepare(cones[0], pending_[0]);
-    for (std::size_t k = 0; k < cones.size(); ++k) {
-      Pending& now = pending_[k % 2];
-      if (k + 1 < cones.size()) prepare(cones[k + 1], pending_[(k + 1) % 2]);
-      draw(now);
-    }
-  }
-
- private:
-  /// One cone with its rows and spans, found but not drawn yet.
-  struct Pending {
-    SpanRows S{};
-    bool empty = true;
-    std::vector<int> lo, hi;
-  };
-
-  void prepare(const TriangleCone& t, Pending& p) {
     const int rows = grid_.rows(), cols = grid_.columns();
     const double h = grid_.step();
     if (t.north || t.south) ++stats_.pole_triangles;
     if (t.seam) ++stats_.seam_triangles;
     const Box b = box_of(t, h, rows, cols);
-    p.empty = b.r1 < b.r0;
-    if (p.empty) return;
+    if (b.r1 < b.r0) return;
     const auto n = static_cast<std::size_t>(b.r1 - b.r0 + 1);
-    if (p.lo.size() < n) p.lo.resize(n), p.hi.resize(n);
+    if (lo_.size() < n) lo_.resize(n), hi_.resize(n);
     // Rows of 16 columns or fewer take one or two vector steps anyway: no spans for them.
     if (row_spans_ && !t.full_theta && b.c1 - b.c0 >= kMinSpanBox) {
       stats_.node_tests += row_spans(span_setup(t, b, h, cols), b.r0, b.r1, t_.cot_phi.data(),
-                                     t_.rsqrt_sin_phi.data(), p.lo.data(), p.hi.data());
+                                     t_.rsqrt_sin_phi.data(), lo_.data(), hi_.data());
     } else {
-      std::fill(p.lo.begin(), p.lo.begin() + std::ptrdiff_t(n), b.c0);
-      std::fill(p.hi.begin(), p.hi.begin() + std::ptrdiff_t(n), b.c1);
+      std::fill(lo_.begin(), lo_.begin() + std::ptrdiff_t(n), b.c0);
+      std::fill(hi_.begin(), hi_.begin() + std::ptrdiff_t(n), b.c1);
       stats_.node_tests += std::int64_t(n) * (b.c1 - b.c0 + 1);
     }
-    p.S = SpanRows{b.r0, b.r1, p.lo.data(), p.hi.data(), t.e, t.adet};
-    // The kernel prefetches two rows ahead of itself; its first two rows are fetched here.
-    for (int r = b.r0; r <= std::min(b.r1, b.r0 + 1); ++r) {
-      const int first = std::max(p.lo[r - b.r0], 0), last = std::min(p.hi[r - b.r0], cols - 1);
-      const Scalar* row = map_.data() + std::int64_t(r) * cols;
-      for (int j = first; j <= last; j += 64 / int(sizeof(Scalar))) __builtin_prefetch(row + j, 1);
-      if (first <= last) __builtin_prefetch(row + last, 1);
-    }
+    const SpanRows S{b.r0, b.r1, lo_.data(), hi_.data(), t.e, t.adet};
+    newly_covered_ += exact_rows(map_.data(), cols, S, t_.sin_phi.data(), t_.cos_phi.data(), t_.cos_theta.data(),
+                                 t_.sin_theta.data());
   }
 
-  void draw(const Pending& p) {
-    if (p.empty) return;
-    newly_covered_ += exact_rows(map_.data(), grid_.columns(), p.S, t_.sin_phi.data(), t_.cos_phi.data(),
-                                 t_.cos_theta.data(), t_.sin_theta.data());
-  }
-
+ private:
   /// Linear mode: rasterise the cone of triangle (a, b, c). With `apex`, c lies on the z axis
   /// (the pole corner) and the trapezoid interpolation of thesis Fig. 34 is used. `north` /
   /// `south`: the cone holds that pole (computed once per mesh triangle; a part split at a pole
@@ -730,7 +687,7 @@ class Rasterizer {
   bool row_spans_;                  ///< exact mode: test only the row spans (else whole boxes)
   const GridTables& t_;             ///< this grid's trigonometry
   std::int64_t newly_covered_ = 0;  ///< nodes that had no surface and now have one
-  Pending pending_[2];              ///< exact mode: the cone being drawn and the next one
+  std::vector<int> lo_, hi_;        ///< row spans of the current cone
 };
 
 /// Spherical coordinates of every vertex relative to `cor` (a vertex is shared by about six
@@ -778,7 +735,7 @@ SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, Di
     // The plan's cones: the kept triangles (all when culling is disabled), set up once.
     if (culling->cor != cor || culling->mesh_fingerprint != mesh_fingerprint(mesh))
       throw Error(mesh.source + ": face culling plan was made for another mesh or centre of rotation");
-    raster.exact_cones(culling->cones);
+    for (const TriangleCone& t : culling->cones) raster.exact_cone(t);
     const auto planned = static_cast<std::int64_t>(culling->triangle_order.size());
     stats.triangles = mesh.F.rows();
     stats.triangles_edge_on = culling->cones_edge_on;
