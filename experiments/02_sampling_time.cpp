@@ -6,13 +6,15 @@
 //   sampling_time.csv  one row per subject x body x precision x method:
 //     method: fill (std::fill of the map: the floor), rsid_linear (thesis Algorithm 1),
 //             rsid_exact (exact mode, every triangle), rsid_exact_culled (exact mode with the
-//             face-culling plan made once, face_culling.hpp), usid_accelerated (helix at the
+//             face-culling plan made once, face_culling.hpp: its cones and row spans),
+//             usid_accelerated (helix at the
 //             matched turns k = round(720 / (pi p)): rasterise the matched equiangular map with
 //             culling, resample, release; thesis sec. 4.2.2), embree_node_cast (Embree 3 casts
 //             every node's ray, 8-wide packets), pairwise (the thesis' O(m n) ray-triangle sampling,
 //             timed on a subset of nodes and scaled to the map: `extrapolated` = 1),
 //             culling_analysis (the plan itself, once per mesh; precision 0)
 //     thesis_ms: Table 3 / 8 value for the generated 3k rows (pairwise, RSID, USID)
+//     node_tests: node-in-cone tests of the rasterisation rows (SamplingStats; 0 otherwise)
 //   meta.json
 // Command: build/experiments/exp_02_sampling_time --out results --data ../shared/data/hips [--quick]
 // Quick mode: p = 1, 0.5, 0.1 and 300 pairwise nodes; full: also 0.05 and 2000 pairwise nodes.
@@ -60,7 +62,7 @@ int main(int argc, char** argv) {
   CsvWriter csv(dir + "/sampling_time.csv",
                 {"subject", "generated", "body", "triangles", "precision_deg", "scheme", "resolution", "method",
                  "nodes", "nodes_covered", "time_ms", "extrapolated", "nodes_timed", "thesis_ms", "culling_enabled",
-                 "triangles_rasterised"});
+                 "triangles_rasterised", "node_tests"});
   const int total = static_cast<int>(subjects.size() * 2 * precisions.size());
   int done = 0;
   for (const Subject& s : subjects) {
@@ -72,7 +74,7 @@ int main(int argc, char** argv) {
       FaceCulling plan;
       const double t_plan = median_ms([&] { plan = analyse_face_culling(mesh, cor); }, reps);
       csv.row(s.name, int(s.generated), bname, tri, 0.0, "none", 0.0, "culling_analysis", 0, 0, t_plan, 0, 0,
-              std::nan(""), int(plan.enabled), static_cast<std::int64_t>(plan.triangle_order.size()));
+              std::nan(""), int(plan.enabled), static_cast<std::int64_t>(plan.triangle_order.size()), 0);
       std::unique_ptr<EmbreeRayCaster> embree;
       if (have_embree()) embree = std::make_unique<EmbreeRayCaster>(mesh, cor);
       for (double p : precisions) {
@@ -81,20 +83,25 @@ int main(int argc, char** argv) {
         const std::int64_t nodes = map.num_nodes();
         auto reset = [&] { std::fill(map.data(), map.data() + nodes, RadialDistanceMap::no_surface()); };
         auto put = [&](const std::string& method, double ms, std::int64_t covered, int extrapolated, std::int64_t timed,
-                       std::int64_t rasterised, const std::string& scheme = "equiangular", double res = -1) {
+                       std::int64_t rasterised, const std::string& scheme = "equiangular", double res = -1,
+                       std::int64_t tests = 0) {
           csv.row(s.name, int(s.generated), bname, tri, p, scheme, res < 0 ? p : res, method,
                   scheme == "equiangular" ? nodes : static_cast<std::int64_t>(res * res), covered, ms, extrapolated,
-                  timed, s.name == "generated-3k" ? thesis_ms(method, p) : std::nan(""), int(plan.enabled), rasterised);
+                  timed, s.name == "generated-3k" ? thesis_ms(method, p) : std::nan(""), int(plan.enabled), rasterised,
+                  tests);
         };
         put("fill", median_ms(reset, reps), 0, 0, nodes, 0);
         SamplingStats st;
         double t = median_ms([&] { reset(), st = rasterize(mesh, cor, DistanceMode::linear, map); }, reps);
-        put("rsid_linear", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled);
+        put("rsid_linear", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
+            st.node_tests);
         t = median_ms([&] { reset(), st = rasterize(mesh, cor, DistanceMode::exact, map); }, reps);
-        put("rsid_exact", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled);
+        put("rsid_exact", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
+            st.node_tests);
         const RadialDistanceMap full = map;
         t = median_ms([&] { reset(), st = rasterize(mesh, cor, DistanceMode::exact, map, &plan); }, reps);
-        put("rsid_exact_culled", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled);
+        put("rsid_exact_culled", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
+            st.node_tests);
         std::int64_t differing = 0;
         for (std::int64_t i = 0; i < nodes; ++i) differing += map.at(i) != full.at(i);
         if (differing != 0)
