@@ -327,6 +327,39 @@ inline float node_distance(double adet, double sum, float) {
 }
 inline double node_distance(double adet, double sum, double) { return adet / sum; }
 
+/// Per-row and per-column trigonometry of one grid, made once per thread and precision.
+struct GridTables {
+  double step = 0;
+  std::vector<double> sin_phi, cos_phi, cot_phi, rsqrt_sin_phi, cos_theta, sin_theta;
+};
+const GridTables& grid_tables(const EquiangularGrid& grid) {
+  thread_local GridTables t;
+  if (t.step == grid.step() && !t.sin_phi.empty()) return t;
+  const int rows = grid.rows(), cols = grid.columns();
+  const double h = grid.step();
+  t.step = h;
+  t.sin_phi.resize(rows), t.cos_phi.resize(rows), t.cot_phi.resize(rows), t.rsqrt_sin_phi.resize(rows);
+  for (int r = 0; r < rows; ++r) {
+    t.sin_phi[r] = std::sin(r * h);
+    t.cos_phi[r] = std::cos(r * h);
+  }
+  t.sin_phi[0] = 0;  // both pole rows are exactly the pole direction
+  t.cos_phi[0] = 1;
+  t.sin_phi[rows - 1] = 0;
+  t.cos_phi[rows - 1] = -1;
+  for (int r = 0; r < rows; ++r) {
+    const bool pole = t.sin_phi[r] <= 0;  // the pole rows keep the whole box (row_spans)
+    t.cot_phi[r] = pole ? 0.0 : t.cos_phi[r] / t.sin_phi[r];
+    t.rsqrt_sin_phi[r] = pole ? std::numeric_limits<double>::infinity() : 1 / std::sqrt(t.sin_phi[r]);
+  }
+  t.cos_theta.resize(cols), t.sin_theta.resize(cols);
+  for (int c = 0; c < cols; ++c) {
+    t.cos_theta[c] = std::cos(c * h);
+    t.sin_theta[c] = std::sin(c * h);
+  }
+  return t;
+}
+
 /// One cone's rows r0..r1 with their spans lo[r - r0] .. hi[r - r0] (unwrapped columns), for
 /// the exact-mode kernels: e (the three edge normals) and adet as in TriangleCone.
 struct SpanRows {
@@ -337,35 +370,46 @@ struct SpanRows {
   double adet;
 };
 
-/// Exact mode over a cone's row spans. For a node of row r and column c the three edge
-/// functions are f_e = sin(phi_r) (e_e.x cos(theta_c) + e_e.y sin(theta_c)) + cos(phi_r) e_e.z;
-/// the node is inside the cone when all are >= 0, and its distance is adet / (f0 + f1 + f2),
-/// where the ray meets the plane; the nearer value is kept. Branch-free inner loops; the whole
-/// triangle in one call so the vectorised clone is dispatched once per triangle. Returns the
-/// number of nodes that had no surface before and have one now.
+/// Exact mode over a cone's row spans. For a node of row r (polar angle phi, sin phi > 0) and
+/// column c the three edge functions, divided by sin phi (which keeps their signs), are
+/// f_k = e_k.x cos(theta_c) + e_k.y sin(theta_c) + cot(phi_r) e_k.z; the node is inside the cone
+/// when all are >= 0, and its distance is (adet / sin phi) / (f_0 + f_1 + f_2), where the ray meets
+/// the plane (double sums, division in the map's precision); the nearer value is kept. The two
+/// pole rows (sin phi = 0: one direction, (0, 0, +-1)) use f_k = cos(phi) e_k.z and adet. A
+/// negated edge normal negates f exactly, so two triangles sharing an edge still cover every
+/// node on it (watertight). Branch-free inner loops; the whole triangle in one call so the
+/// vectorised clone is dispatched once per triangle. Returns the number of nodes that had no
+/// surface before and have one now.
 template <typename Scalar>
-inline std::int64_t exact_rows_body(Scalar* __restrict map, int cols, const SpanRows& S,
-                                    const double* __restrict sin_phi, const double* __restrict cos_phi,
-                                    const double* __restrict cos_theta, const double* __restrict sin_theta) {
+inline std::int64_t exact_rows_body(Scalar* __restrict map, int cols, const SpanRows& S, const GridTables& T) {
+  const double* e = S.e;
+  const double* __restrict cos_theta = T.cos_theta.data();
+  const double* __restrict sin_theta = T.sin_theta.data();
   std::int64_t newly = 0;
   for (int r = S.r0; r <= S.r1; ++r) {
-    const RowEdges edges(S.e, sin_phi[r], cos_phi[r]);
+    const double sp = T.sin_phi[r];
+    const bool pole = sp <= 0;
+    const double ex = pole ? 0.0 : 1.0;  // pole rows: no azimuth term
+    const double ez = pole ? T.cos_phi[r] : T.cot_phi[r];
+    const double a0 = ex * e[0], b0 = ex * e[1], c0 = ez * e[2], a1 = ex * e[3], b1 = ex * e[4], c1 = ez * e[5],
+                 a2 = ex * e[6], b2 = ex * e[7], c2 = ez * e[8];
+    const double adet = pole ? S.adet : S.adet / sp;
     Scalar* __restrict row = map + std::int64_t(r) * cols;
     int seg[3][2];
     const int nseg = segments(S.lo[r - S.r0], S.hi[r - S.r0], cols, seg);
     for (int g = 0; g < nseg; ++g)
       for (int j = seg[g][0]; j <= seg[g][1]; ++j) {
-        double sum;
-        const bool inside = edges.inside(cos_theta[j], sin_theta[j], sum);
-        keep_nearer(row[j], inside, node_distance(S.adet, sum, Scalar{}), newly);
+        const double ct = cos_theta[j], st = sin_theta[j];
+        const double f0 = a0 * ct + (b0 * st + c0), f1 = a1 * ct + (b1 * st + c1), f2 = a2 * ct + (b2 * st + c2);
+        const bool inside = std::min(std::min(f0, f1), f2) >= 0;
+        keep_nearer(row[j], inside, node_distance(adet, f0 + f1 + f2, Scalar{}), newly);
       }
   }
   return newly;
 }
 IMPINGE_SIMD_CLONES
-std::int64_t exact_rows_generic(float* map, int cols, const SpanRows& S, const double* sin_phi, const double* cos_phi,
-                                const double* cos_theta, const double* sin_theta) {
-  return exact_rows_body(map, cols, S, sin_phi, cos_phi, cos_theta, sin_theta);
+std::int64_t exact_rows_generic(float* map, int cols, const SpanRows& S, const GridTables& T) {
+  return exact_rows_body(map, cols, S, T);
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -392,26 +436,33 @@ __attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline int e
 
 /// exact_rows_body for float maps in AVX-512 with masked loads and stores: the short spans of
 /// small triangles (a few dozen nodes) run without scalar remainders. Same arithmetic as the
-/// generic body (double edge functions, float division), so the same values. The per-row work
-/// is kept small (it is about half of the time at 0.05 deg): the edge normals in registers, a
-/// fixed three-line prefetch two rows ahead, and rows across the seam in a separate loop.
-__attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx512(
-    float* map, int cols, const SpanRows& S, const double* sin_phi, const double* cos_phi, const double* cos_theta,
-    const double* sin_theta) {
-  const double e0 = S.e[0], e1 = S.e[1], e2 = S.e[2], e3 = S.e[3], e4 = S.e[4], e5 = S.e[5], e6 = S.e[6],
-               e7 = S.e[7], e8 = S.e[8];
+/// generic body (double edge functions, float division), with fused multiply-adds. The
+/// per-row work is kept small (it is about half of the time at 0.05 deg): the edge normals'
+/// x and y in registers for the whole triangle, three products per row, a fixed three-line
+/// prefetch two rows ahead, and rows across the seam in a separate loop.
+__attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx512(float* map, int cols,
+                                                                                 const SpanRows& S,
+                                                                                 const GridTables& T) {
+  const double* e = S.e;
+  const double e2 = e[2], e5 = e[5], e8 = e[8];
+  const __m512d x0 = _mm512_set1_pd(e[0]), y0 = _mm512_set1_pd(e[1]), x1 = _mm512_set1_pd(e[3]),
+                y1 = _mm512_set1_pd(e[4]), x2 = _mm512_set1_pd(e[6]), y2 = _mm512_set1_pd(e[7]);
+  const __m512d zero = _mm512_setzero_pd();
+  const double* cos_theta = T.cos_theta.data();
+  const double* sin_theta = T.sin_theta.data();
   const int* __restrict lo_of = S.lo;
   const int* __restrict hi_of = S.hi;
   const int r0 = S.r0, r1 = S.r1;
-  const __m256 adet = _mm256_set1_ps(static_cast<float>(S.adet));
+  const double adet = S.adet;
   std::int64_t newly = 0;
   for (int r = r0; r <= r1; ++r) {
     const int i = r - r0, lo = lo_of[i], hi = hi_of[i];
     if (lo > hi) continue;
-    const double sp = sin_phi[r], cp = cos_phi[r];
-    const __m512d a0 = _mm512_set1_pd(sp * e0), b0 = _mm512_set1_pd(sp * e1), c0 = _mm512_set1_pd(cp * e2),
-                  a1 = _mm512_set1_pd(sp * e3), b1 = _mm512_set1_pd(sp * e4), c1 = _mm512_set1_pd(cp * e5),
-                  a2 = _mm512_set1_pd(sp * e6), b2 = _mm512_set1_pd(sp * e7), c2 = _mm512_set1_pd(cp * e8);
+    const double sp = T.sin_phi[r];
+    const bool pole = sp <= 0;
+    const double ez = pole ? T.cos_phi[r] : T.cot_phi[r];
+    const __m512d c0 = _mm512_set1_pd(ez * e2), c1 = _mm512_set1_pd(ez * e5), c2 = _mm512_set1_pd(ez * e8);
+    const __m256 row_adet = _mm256_set1_ps(static_cast<float>(pole ? adet : adet / sp));
     float* row = map + std::int64_t(r) * cols;
     if (r + 2 <= r1) {  // rows are a whole map row apart: no hardware prefetcher follows them
       // The first, second and last line of the span two rows ahead (spans are mostly under 48
@@ -422,11 +473,13 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
       _mm_prefetch(reinterpret_cast<const char*>(ahead + std::min(first + 16, last)), _MM_HINT_T0);
       _mm_prefetch(reinterpret_cast<const char*>(ahead + last), _MM_HINT_T0);
     }
+    const __m512d a0 = pole ? zero : x0, b0 = pole ? zero : y0, a1 = pole ? zero : x1, b1 = pole ? zero : y1,
+                  a2 = pole ? zero : x2, b2 = pole ? zero : y2;
     if (lo >= 0 && hi < cols) {  // the common case: a span that does not wrap
       for (int j = lo; j <= hi; j += 8) {
         const int left = hi - j + 1;
         const __mmask8 m = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1);
-        newly += exact_step_avx512(row, j, m, cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2, b2, c2, adet);
+        newly += exact_step_avx512(row, j, m, cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2, b2, c2, row_adet);
       }
       continue;
     }
@@ -436,7 +489,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
       for (int j = seg[g][0]; j <= seg[g][1]; j += 8) {
         const int left = seg[g][1] - j + 1;
         const __mmask8 m = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1);
-        newly += exact_step_avx512(row, j, m, cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2, b2, c2, adet);
+        newly += exact_step_avx512(row, j, m, cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2, b2, c2, row_adet);
       }
   }
   return newly;
@@ -444,19 +497,17 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
 #pragma GCC diagnostic pop
 #endif
 
-std::int64_t exact_rows(float* map, int cols, const SpanRows& S, const double* sin_phi, const double* cos_phi,
-                        const double* cos_theta, const double* sin_theta) {
+std::int64_t exact_rows(float* map, int cols, const SpanRows& S, const GridTables& T) {
 #if defined(__GNUC__) && defined(__x86_64__)
   static const bool avx512 =
       __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
-  if (avx512) return exact_rows_avx512(map, cols, S, sin_phi, cos_phi, cos_theta, sin_theta);
+  if (avx512) return exact_rows_avx512(map, cols, S, T);
 #endif
-  return exact_rows_generic(map, cols, S, sin_phi, cos_phi, cos_theta, sin_theta);
+  return exact_rows_generic(map, cols, S, T);
 }
 IMPINGE_SIMD_CLONES
-std::int64_t exact_rows(double* map, int cols, const SpanRows& S, const double* sin_phi, const double* cos_phi,
-                        const double* cos_theta, const double* sin_theta) {
-  return exact_rows_body(map, cols, S, sin_phi, cos_phi, cos_theta, sin_theta);
+std::int64_t exact_rows(double* map, int cols, const SpanRows& S, const GridTables& T) {
+  return exact_rows_body(map, cols, S, T);
 }
 
 /// Linear-mode (thesis Algorithm 1) rows of one triangle's box away from the poles: the same
@@ -505,39 +556,6 @@ std::int64_t linear_rows(double* map, int cols, const LinearBox& L, const double
 /// Boxes narrower than this many columns (plus one) are tested whole (measured on lhdl-ct's
 /// pelvis at 0.05 deg: 16 is about 7 % faster than spans everywhere; the map is the same).
 constexpr int kMinSpanBox = 16;
-
-/// Per-row and per-column trigonometry of one grid, made once per thread and precision.
-struct GridTables {
-  double step = 0;
-  std::vector<double> sin_phi, cos_phi, cot_phi, rsqrt_sin_phi, cos_theta, sin_theta;
-};
-const GridTables& grid_tables(const EquiangularGrid& grid) {
-  thread_local GridTables t;
-  if (t.step == grid.step() && !t.sin_phi.empty()) return t;
-  const int rows = grid.rows(), cols = grid.columns();
-  const double h = grid.step();
-  t.step = h;
-  t.sin_phi.resize(rows), t.cos_phi.resize(rows), t.cot_phi.resize(rows), t.rsqrt_sin_phi.resize(rows);
-  for (int r = 0; r < rows; ++r) {
-    t.sin_phi[r] = std::sin(r * h);
-    t.cos_phi[r] = std::cos(r * h);
-  }
-  t.sin_phi[0] = 0;  // both pole rows are exactly the pole direction
-  t.cos_phi[0] = 1;
-  t.sin_phi[rows - 1] = 0;
-  t.cos_phi[rows - 1] = -1;
-  for (int r = 0; r < rows; ++r) {
-    const bool pole = t.sin_phi[r] <= 0;  // the pole rows keep the whole box (row_spans)
-    t.cot_phi[r] = pole ? 0.0 : t.cos_phi[r] / t.sin_phi[r];
-    t.rsqrt_sin_phi[r] = pole ? std::numeric_limits<double>::infinity() : 1 / std::sqrt(t.sin_phi[r]);
-  }
-  t.cos_theta.resize(cols), t.sin_theta.resize(cols);
-  for (int c = 0; c < cols; ++c) {
-    t.cos_theta[c] = std::cos(c * h);
-    t.sin_theta[c] = std::sin(c * h);
-  }
-  return t;
-}
 
 template <typename Scalar>
 class Rasterizer {
@@ -612,8 +630,7 @@ class Rasterizer {
       stats_.node_tests += std::int64_t(n) * (b.c1 - b.c0 + 1);
     }
     const SpanRows S{b.r0, b.r1, lo_.data(), hi_.data(), t.e, t.adet};
-    newly_covered_ += exact_rows(map_.data(), cols, S, t_.sin_phi.data(), t_.cos_phi.data(), t_.cos_theta.data(),
-                                 t_.sin_theta.data());
+    newly_covered_ += exact_rows(map_.data(), cols, S, t_);
   }
 
  private:
