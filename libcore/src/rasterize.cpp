@@ -473,16 +473,16 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
       _mm_prefetch(reinterpret_cast<const char*>(ahead + std::min(first + 16, last)), _MM_HINT_T0);
       _mm_prefetch(reinterpret_cast<const char*>(ahead + last), _MM_HINT_T0);
     }
-    const __m512d a0 = pole ? zero : x0, b0 = pole ? zero : y0, a1 = pole ? zero : x1, b1 = pole ? zero : y1,
-                  a2 = pole ? zero : x2, b2 = pole ? zero : y2;
-    if (lo >= 0 && hi < cols) {  // the common case: a span that does not wrap
+    if (!pole && lo >= 0 && hi < cols) {  // the common case: a span that does not wrap
       for (int j = lo; j <= hi; j += 8) {
         const int left = hi - j + 1;
         const __mmask8 m = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1);
-        newly += exact_step_avx512(row, j, m, cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2, b2, c2, row_adet);
+        newly += exact_step_avx512(row, j, m, cos_theta, sin_theta, x0, y0, c0, x1, y1, c1, x2, y2, c2, row_adet);
       }
       continue;
     }
+    const __m512d a0 = pole ? zero : x0, b0 = pole ? zero : y0, a1 = pole ? zero : x1, b1 = pole ? zero : y1,
+                  a2 = pole ? zero : x2, b2 = pole ? zero : y2;
     int seg[3][2];
     const int nseg = segments(lo, hi, cols, seg);
     for (int g = 0; g < nseg; ++g)
