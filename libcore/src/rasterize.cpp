@@ -84,7 +84,8 @@ TriangleCone make_cone(const Corner& ka, const Corner& kb, const Corner& kc, dou
   const V3 e[3] = {s * b.cross(c), s * c.cross(a), s * a.cross(b)};
   for (int k = 0; k < 3; ++k) {
     for (int i = 0; i < 3; ++i) t.e[3 * k + i] = e[k][i];
-    const double rho = std::hypot(e[k].x(), e[k].y()), norm = e[k].norm();
+    // (edge normals are products of mm coordinates: no overflow, so no std::hypot, which is slow)
+    const double rho = std::sqrt(e[k].x() * e[k].x() + e[k].y() * e[k].y()), norm = e[k].norm();
     t.span_edge[k] = rho > 1e-12 * norm;
     t.alpha[k] = t.span_edge[k] ? fast_azimuth(e[k].y(), e[k].x()) : 0.0;
     t.k[k] = t.span_edge[k] ? -e[k].z() / rho : 0.0;
