@@ -190,6 +190,9 @@ std::int64_t row_spans_scalar(const SpanSetup& P, int r0, int r1, const double* 
   return nodes;
 }
 
+/// The first min(n, 8) of 8 lanes (n >= 1): the mask of a vector step with n items left.
+inline std::uint8_t first_lanes(int n) { return n >= 8 ? std::uint8_t(0xff) : std::uint8_t((1u << n) - 1); }
+
 #if defined(__GNUC__) && defined(__x86_64__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's own AVX-512 headers (false positives)
@@ -208,7 +211,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx5
   std::int64_t nodes = 0;
   for (int r = r0; r <= r1; r += 8) {
     const int left = r1 - r + 1;
-    const __mmask8 m = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1);
+    const __mmask8 m = first_lanes(left);
     const __m512d ct = _mm512_maskz_loadu_pd(m, cot_phi + r), rs = _mm512_maskz_loadu_pd(m, rsqrt_sin_phi + r);
     __m512d L = _mm512_set1_pd(P.c0), H = _mm512_set1_pd(P.c1);
     for (int k = 0; k < 3; ++k) {
@@ -435,6 +438,17 @@ __attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline int e
   return __builtin_popcount(_mm256_mask_cmp_ps_mask(inside, old, none, _CMP_EQ_OQ));
 }
 
+/// exact_step_avx512 over stored columns first..last of `row`; returns the nodes newly covered.
+__attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline std::int64_t exact_run_avx512(
+    float* row, int first, int last, const double* cos_theta, const double* sin_theta, __m512d a0, __m512d b0,
+    __m512d c0, __m512d a1, __m512d b1, __m512d c1, __m512d a2, __m512d b2, __m512d c2, __m256 adet) {
+  std::int64_t newly = 0;
+  for (int j = first; j <= last; j += 8)
+    newly += exact_step_avx512(row, j, first_lanes(last - j + 1), cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2,
+                               b2, c2, adet);
+  return newly;
+}
+
 /// exact_rows_body for float maps in AVX-512 with masked loads and stores: the short spans of
 /// small triangles (a few dozen nodes) run without scalar remainders. Same arithmetic as the
 /// generic body (double edge functions, float division), with fused multiply-adds. The
@@ -475,11 +489,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
       _mm_prefetch(reinterpret_cast<const char*>(ahead + last), _MM_HINT_T0);
     }
     if (!pole && lo >= 0 && hi < cols) {  // the common case: a span that does not wrap
-      for (int j = lo; j <= hi; j += 8) {
-        const int left = hi - j + 1;
-        const __mmask8 m = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1);
-        newly += exact_step_avx512(row, j, m, cos_theta, sin_theta, x0, y0, c0, x1, y1, c1, x2, y2, c2, row_adet);
-      }
+      newly += exact_run_avx512(row, lo, hi, cos_theta, sin_theta, x0, y0, c0, x1, y1, c1, x2, y2, c2, row_adet);
       continue;
     }
     const __m512d a0 = pole ? zero : x0, b0 = pole ? zero : y0, a1 = pole ? zero : x1, b1 = pole ? zero : y1,
@@ -487,11 +497,8 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
     int seg[3][2];
     const int nseg = segments(lo, hi, cols, seg);
     for (int g = 0; g < nseg; ++g)
-      for (int j = seg[g][0]; j <= seg[g][1]; j += 8) {
-        const int left = seg[g][1] - j + 1;
-        const __mmask8 m = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1);
-        newly += exact_step_avx512(row, j, m, cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2, b2, c2, row_adet);
-      }
+      newly += exact_run_avx512(row, seg[g][0], seg[g][1], cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2, b2, c2,
+                                row_adet);
   }
   return newly;
 }
