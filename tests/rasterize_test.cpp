@@ -287,7 +287,7 @@ TEST(Rasterize, RowSpansGiveTheSameMapAsWholeBoxes) {
   // Row spans only skip nodes the full box test rejects: the maps must be identical, node for
   // node, in float and double, with and without a culling plan, and test fewer nodes.
   std::mt19937_64 rng(17);
-  for (double p : {2.0, 0.5, 0.1}) {
+  for (double p : {2.0, 0.5, 0.1, 0.75, 0.3}) {
     const TriangleMesh m = span_stress_mesh(p, rng);
     const Eigen::Vector3d cor = Eigen::Vector3d::Zero();
     const FaceCulling plan = analyse_face_culling(m, cor);  // open mesh: disabled, all cones
@@ -308,6 +308,45 @@ TEST(Rasterize, RowSpansGiveTheSameMapAsWholeBoxes) {
     rasterize(m, cor, DistanceMode::exact, box_d, nullptr, false);
     rasterize(m, cor, DistanceMode::exact, span_d);
     EXPECT_EQ(nodes_not_identical(box_d, span_d), 0) << "p=" << p;
+  }
+}
+
+TEST(Rasterize, MapStartResetEqualsAFreshMapAndKeepKeepsNearerValues) {
+  // MapStart::reset (with a plan: reset in bands of rows fused with the drawing) must give the
+  // map of a fresh one, whatever was in the map before; MapStart::keep must keep nearer values.
+  std::mt19937_64 rng(5);
+  const HipModel h = make_hip_model(HipModelOptions{});
+  const TriangleMesh stress = span_stress_mesh(0.1, rng);  // pole cones reach over many bands
+  for (const TriangleMesh* m : {&stress, &h.socket}) {
+    const Eigen::Vector3d cor = m == &stress ? Eigen::Vector3d::Zero() : h.cor;
+    const FaceCulling plan = analyse_face_culling(*m, cor);
+    for (double p : {0.1, 0.75}) {  // 51 bands of rows and one (float maps)
+      RadialDistanceMap fresh{EquiangularGrid(p)};
+      const SamplingStats sf = rasterize(*m, cor, DistanceMode::exact, fresh, &plan);
+      ASSERT_GT(sf.nodes_covered, 1000) << m->source;
+      RadialDistanceMap dirty{EquiangularGrid(p)}, dirty_unplanned{EquiangularGrid(p)};
+      std::fill(dirty.data(), dirty.data() + dirty.num_nodes(), 0.5f);  // nearer than any surface
+      std::fill(dirty_unplanned.data(), dirty_unplanned.data() + dirty_unplanned.num_nodes(), 0.5f);
+      const SamplingStats sr = rasterize(*m, cor, DistanceMode::exact, dirty, &plan, true, MapStart::reset);
+      EXPECT_EQ(nodes_not_identical(fresh, dirty), 0) << m->source << " p=" << p;
+      EXPECT_EQ(sr.nodes_covered, sf.nodes_covered);
+      EXPECT_EQ(sr.node_tests, sf.node_tests);
+      rasterize(*m, cor, DistanceMode::exact, dirty_unplanned, nullptr, true, MapStart::reset);
+      RadialDistanceMap fresh_unplanned{EquiangularGrid(p)};
+      rasterize(*m, cor, DistanceMode::exact, fresh_unplanned);
+      EXPECT_EQ(nodes_not_identical(fresh_unplanned, dirty_unplanned), 0) << m->source << " p=" << p;
+      RadialDistanceMapDouble fresh_d{EquiangularGrid(p)}, dirty_d{EquiangularGrid(p)};
+      rasterize(*m, cor, DistanceMode::exact, fresh_d, &plan);
+      std::fill(dirty_d.data(), dirty_d.data() + dirty_d.num_nodes(), 0.5);
+      rasterize(*m, cor, DistanceMode::exact, dirty_d, &plan, true, MapStart::reset);
+      EXPECT_EQ(nodes_not_identical(fresh_d, dirty_d), 0) << m->source << " p=" << p;
+      // keep: the 0.5 mm values are nearer than every hit, so nothing changes.
+      RadialDistanceMap kept{EquiangularGrid(p)};
+      std::fill(kept.data(), kept.data() + kept.num_nodes(), 0.5f);
+      const SamplingStats sk = rasterize(*m, cor, DistanceMode::exact, kept, &plan, true, MapStart::keep);
+      EXPECT_EQ(sk.nodes_covered, 0);
+      EXPECT_EQ(std::count(kept.data(), kept.data() + kept.num_nodes(), 0.5f), kept.num_nodes());
+    }
   }
 }
 

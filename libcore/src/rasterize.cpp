@@ -82,6 +82,8 @@ TriangleCone make_cone(const Corner& ka, const Corner& kb, const Corner& kc, dou
   const V3 &a = ka.p, &b = kb.p, &c = kc.p;
   const double s = det > 0 ? 1.0 : -1.0;
   const V3 e[3] = {s * b.cross(c), s * c.cross(a), s * a.cross(b)};
+  const V3 n = s * (b - a).cross(c - a);
+  for (int i = 0; i < 3; ++i) t.n[i] = n[i];
   for (int k = 0; k < 3; ++k) {
     for (int i = 0; i < 3; ++i) t.e[3 * k + i] = e[k][i];
     // (edge normals are products of mm coordinates: no overflow, so no std::hypot, which is slow)
@@ -117,17 +119,18 @@ TriangleCone make_cone(const Corner& ka, const Corner& kb, const Corner& kc, dou
   return t;
 }
 
-/// Rows r0..r1 and unwrapped columns c0..c1 of a cone's box on a grid of step h (rad).
+/// Rows r0..r1 and unwrapped columns c0..c1 of a cone's box on a grid of step h (rad), given
+/// as inv_h = 1 / h.
 struct Box {
   int r0, r1, c0, c1;
 };
-Box box_of(const TriangleCone& t, double h, int rows, int cols) {
+Box box_of(const TriangleCone& t, double inv_h, int rows, int cols) {
   constexpr double pad = 1e-4;  // in steps; acos near +-1 loses ~1e-8 rad
-  Box b{std::max(0, static_cast<int>(std::ceil(t.phi_min / h - pad))),
-        std::min(rows - 1, static_cast<int>(std::floor(t.phi_max / h + pad))), 0, cols - 1};
+  Box b{std::max(0, static_cast<int>(std::ceil(t.phi_min * inv_h - pad))),
+        std::min(rows - 1, static_cast<int>(std::floor(t.phi_max * inv_h + pad))), 0, cols - 1};
   if (!t.full_theta) {
-    b.c0 = static_cast<int>(std::ceil(t.theta_min / h - pad));
-    b.c1 = static_cast<int>(std::floor(t.theta_max / h + pad));
+    b.c0 = static_cast<int>(std::ceil(t.theta_min * inv_h - pad));
+    b.c1 = static_cast<int>(std::floor(t.theta_max * inv_h + pad));
   }
   return b;
 }
@@ -140,13 +143,13 @@ struct SpanSetup {
   double c0, c1, inv_h, half, quarter;
   double k[3], pad[3], near[3], far[3];
 };
-SpanSetup span_setup(const TriangleCone& t, const Box& b, double h, int cols) {
+SpanSetup span_setup(const TriangleCone& t, const Box& b, double inv_h, int cols) {
   SpanSetup p;
-  p.c0 = b.c0, p.c1 = b.c1, p.inv_h = 1 / h, p.half = 0.5 * cols, p.quarter = 0.25 * cols;
-  const double mid = 0.5 * (b.c0 + b.c1);
+  p.c0 = b.c0, p.c1 = b.c1, p.inv_h = inv_h, p.half = 0.5 * cols, p.quarter = 0.25 * cols;
+  const double mid = 0.5 * (b.c0 + b.c1), inv_cols = 1.0 / cols;
   for (int k = 0; k < 3; ++k) {
-    double a = t.alpha[k] / h;
-    a += cols * std::round((mid - a) / cols);
+    double a = t.alpha[k] * inv_h;
+    a += cols * std::round((mid - a) * inv_cols);
     p.near[k] = a;
     p.far[k] = a <= mid ? a + p.half : a - p.half;
     p.k[k] = t.k[k];
@@ -158,34 +161,57 @@ SpanSetup span_setup(const TriangleCone& t, const Box& b, double h, int cols) {
 /// Absolute padding (rad) of a span's ends: fast_acos_coarse's error and 1e-9.
 constexpr double kSpanAnglePad = kFastAcosCoarseMaxError + 1e-9;
 
-/// Narrow the span L..H of one row (cot phi = ct, 1 / sqrt(sin phi) = rs) by edge k.
-inline void edge_span(const SpanSetup& P, int k, double ct, double rs, double& L, double& H) {
+/// Narrow the span L..H of one row (cot phi = ct, 1 / sqrt(sin phi) = rs) by edge k. `widen`
+/// becomes the largest widening d (columns) of an edge so far; `split` is set when the span
+/// cannot be sure (span_is_sure): the edge's forbidden arc, or that arc widened by 2 d, lies
+/// inside the span, or the arc is within 2 d of the wide case's limit.
+inline void edge_span(const SpanSetup& P, int k, double ct, double rs, double& L, double& H, double& widen,
+                      bool& split) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   const double x = std::min(std::max(P.k[k] * ct, -1.0), 1.0);
   const double w = fast_acos_coarse(x);
-  const double W = (w + P.pad[k] * rs + kSpanAnglePad) * P.inv_h + 1e-6;
+  const double d = (P.pad[k] * rs + kSpanAnglePad) * P.inv_h + 1e-6;
+  const double W = w * P.inv_h + d;
   const double V = P.half - W;
   const bool narrow = W <= P.quarter;
   const bool cut_low = P.far[k] - V < L;
   const bool cut_high = (P.far[k] + V > H) & !cut_low;
+  // Not sure: a forbidden arc inside the span, or one of the shrunk arc (half-width V + 2 d, so
+  // a tangent edge's empty arc counts), or an arc whose shrunk form is no longer wide.
+  split = split || (!narrow && ((!cut_low && !cut_high && V + 2 * d > 0) || W - 2 * d <= P.quarter));
+  widen = std::max(widen, d);
   const double wide_low = cut_low ? P.far[k] + V : -inf, wide_high = cut_high ? P.far[k] - V : inf;
   L = std::max(L, narrow ? P.near[k] - W : wide_low);
   H = std::min(H, narrow ? P.near[k] + W : wide_high);
 }
 
+/// Whether every node of span L..H (edge_span's result) is certainly inside the cone: the span
+/// shrunk by twice the largest widening at both ends holds the same nodes. (Each edge's limit
+/// moves by twice its own widening when the arc is shrunk instead of widened, and the largest
+/// of those limits by at most twice the largest widening; a split span is never sure, and an
+/// edge without spans, or a pole row, has an infinite widening.)
+inline bool span_is_sure(double L, double H, double widen, bool split) {
+  return !split && std::ceil(L) == std::ceil(L + 2 * widen) && std::floor(H) == std::floor(H - 2 * widen);
+}
+
 /// Row spans lo[i] .. hi[i] (unwrapped columns, empty when lo > hi) of rows r0 + i, i <= r1 - r0,
-/// of a cone whose box is narrower than 180 deg. Row tables: cot_phi (0 at the pole rows) and
-/// rsqrt_sin_phi (+inf at the pole rows, which so keep the whole box). Returns the number of
-/// nodes in the spans.
+/// of a cone whose box is narrower than 180 deg. Bit i % 8 of sure[i / 8] is set when every
+/// node of the span is certainly inside the cone (the inner span holds the same nodes). Row
+/// tables: cot_phi (0 at the pole rows) and rsqrt_sin_phi (+inf at the pole rows, which so keep
+/// the whole box and are never sure). Returns the number of nodes in the spans.
 std::int64_t row_spans_scalar(const SpanSetup& P, int r0, int r1, const double* cot_phi, const double* rsqrt_sin_phi,
-                              int* lo, int* hi) {
+                              int* lo, int* hi, std::uint8_t* sure) {
   std::int64_t nodes = 0;
   for (int r = r0; r <= r1; ++r) {
-    double L = P.c0, H = P.c1;
-    for (int k = 0; k < 3; ++k) edge_span(P, k, cot_phi[r], rsqrt_sin_phi[r], L, H);
-    const int l = static_cast<int>(std::ceil(L)), u = static_cast<int>(std::floor(H));
-    lo[r - r0] = l, hi[r - r0] = u;
-    nodes += std::max(0, u - l + 1);
+    double L = P.c0, H = P.c1, widen = 0;
+    bool split = false;
+    for (int k = 0; k < 3; ++k) edge_span(P, k, cot_phi[r], rsqrt_sin_phi[r], L, H, widen, split);
+    const int i = r - r0;
+    lo[i] = static_cast<int>(std::ceil(L)), hi[i] = static_cast<int>(std::floor(H));
+    const bool certain = span_is_sure(L, H, widen, split);
+    if (i % 8 == 0) sure[i / 8] = 0;
+    sure[i / 8] |= static_cast<std::uint8_t>(certain ? 1u << (i % 8) : 0u);
+    nodes += std::max(0, hi[i] - lo[i] + 1);
   }
   return nodes;
 }
@@ -196,13 +222,35 @@ inline std::uint8_t first_lanes(int n) { return n >= 8 ? std::uint8_t(0xff) : st
 #if defined(__GNUC__) && defined(__x86_64__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's own AVX-512 headers (false positives)
+/// One edge's arc for 8 rows in AVX-512 (edge_span's cases): the arc of column half-width W
+/// about nearv, or the complement of the arc of half-width half - W about farv, intersected
+/// with L..H; adds to `split` the lanes that cannot be sure (edge_span).
+__attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline void narrow_by_arc(
+    __m512d W, __m512d d, __m512d nearv, __m512d farv, __m512d half, __m512d quarter, __m512d& L, __m512d& H,
+    __mmask8& split) {
+  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
+  const __m512d V = _mm512_sub_pd(half, W);
+  const __mmask8 narrow = _mm512_cmp_pd_mask(W, quarter, _CMP_LE_OQ);
+  const __mmask8 cut_low = _mm512_cmp_pd_mask(_mm512_sub_pd(farv, V), L, _CMP_LT_OQ);
+  const __mmask8 cut_high = _mm512_cmp_pd_mask(_mm512_add_pd(farv, V), H, _CMP_GT_OQ) & __mmask8(~cut_low);
+  const __m512d d2 = _mm512_add_pd(d, d);
+  const __mmask8 inner_arc = __mmask8(~(cut_low | cut_high)) &
+                             _mm512_cmp_pd_mask(_mm512_add_pd(V, d2), _mm512_setzero_pd(), _CMP_GT_OQ);
+  split |= __mmask8(__mmask8(~narrow) & (inner_arc | _mm512_cmp_pd_mask(_mm512_sub_pd(W, d2), quarter, _CMP_LE_OQ)));
+  const __m512d wide_low = _mm512_mask_blend_pd(cut_low, _mm512_sub_pd(_mm512_setzero_pd(), inf), _mm512_add_pd(farv, V));
+  const __m512d wide_high = _mm512_mask_blend_pd(cut_high, inf, _mm512_sub_pd(farv, V));
+  L = _mm512_max_pd(L, _mm512_mask_blend_pd(narrow, wide_low, _mm512_sub_pd(nearv, W)));
+  H = _mm512_min_pd(H, _mm512_mask_blend_pd(narrow, wide_high, _mm512_add_pd(nearv, W)));
+}
+
 /// row_spans_scalar for 8 rows at a time in AVX-512: the same operations (fast_acos_coarse),
 /// with fused multiply-adds, so the ends may differ by rounding
-/// (1e-16 rad), far inside the spans' padding: both are supersets of the covered nodes.
+/// (1e-16 rad), far inside the spans' padding: both are supersets of the covered nodes, and
+/// both mark sure only rows whose nodes are certainly covered.
 __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx512(
-    const SpanSetup& P, int r0, int r1, const double* cot_phi, const double* rsqrt_sin_phi, int* lo, int* hi) {
+    const SpanSetup& P, int r0, int r1, const double* cot_phi, const double* rsqrt_sin_phi, int* lo, int* hi,
+    std::uint8_t* sure) {
   const __m512d one = _mm512_set1_pd(1.0), minus_one = _mm512_set1_pd(-1.0), zero = _mm512_setzero_pd();
-  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity()), ninf = _mm512_set1_pd(-std::numeric_limits<double>::infinity());
   const __m512d pi = _mm512_set1_pd(kPi);
   const __m512d inv_h = _mm512_set1_pd(P.inv_h), half = _mm512_set1_pd(P.half), quarter = _mm512_set1_pd(P.quarter);
   const __m512d abs_pad = _mm512_set1_pd(kSpanAnglePad), col_pad = _mm512_set1_pd(1e-6);
@@ -213,7 +261,8 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx5
     const int left = r1 - r + 1;
     const __mmask8 m = first_lanes(left);
     const __m512d ct = _mm512_maskz_loadu_pd(m, cot_phi + r), rs = _mm512_maskz_loadu_pd(m, rsqrt_sin_phi + r);
-    __m512d L = _mm512_set1_pd(P.c0), H = _mm512_set1_pd(P.c1);
+    __m512d L = _mm512_set1_pd(P.c0), H = _mm512_set1_pd(P.c1), widen = zero;
+    __mmask8 split = 0;
     for (int k = 0; k < 3; ++k) {
       const __m512d x = _mm512_min_pd(_mm512_max_pd(_mm512_mul_pd(_mm512_set1_pd(P.k[k]), ct), minus_one), one);
       // w = fast_acos_coarse(x)
@@ -222,21 +271,23 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx5
       for (int i = 1; i < 8; ++i) poly = _mm512_fmadd_pd(poly, ax, _mm512_set1_pd(q[i]));
       const __m512d root = _mm512_mul_pd(_mm512_sqrt_pd(_mm512_max_pd(zero, _mm512_sub_pd(one, ax))), poly);
       const __m512d w = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(x, zero, _CMP_LT_OQ), root, _mm512_sub_pd(pi, root));
-      // W = (w + pad rs + kSpanAnglePad) / h + 1e-6 and the narrow / wide cases of edge_span
-      const __m512d W = _mm512_add_pd(
-          _mm512_mul_pd(_mm512_add_pd(_mm512_fmadd_pd(_mm512_set1_pd(P.pad[k]), rs, w), abs_pad), inv_h), col_pad);
-      const __m512d V = _mm512_sub_pd(half, W);
-      const __m512d nearv = _mm512_set1_pd(P.near[k]), farv = _mm512_set1_pd(P.far[k]);
-      const __mmask8 narrow = _mm512_cmp_pd_mask(W, quarter, _CMP_LE_OQ);
-      const __mmask8 cut_low = _mm512_cmp_pd_mask(_mm512_sub_pd(farv, V), L, _CMP_LT_OQ);
-      const __mmask8 cut_high = _mm512_cmp_pd_mask(_mm512_add_pd(farv, V), H, _CMP_GT_OQ) & __mmask8(~cut_low);
-      const __m512d wide_low = _mm512_mask_blend_pd(cut_low, ninf, _mm512_add_pd(farv, V));
-      const __m512d wide_high = _mm512_mask_blend_pd(cut_high, inf, _mm512_sub_pd(farv, V));
-      L = _mm512_max_pd(L, _mm512_mask_blend_pd(narrow, wide_low, _mm512_sub_pd(nearv, W)));
-      H = _mm512_min_pd(H, _mm512_mask_blend_pd(narrow, wide_high, _mm512_add_pd(nearv, W)));
+      // W = w / h + d, d = (pad rs + kSpanAnglePad) / h + 1e-6 (edge_span)
+      const __m512d d = _mm512_fmadd_pd(_mm512_fmadd_pd(_mm512_set1_pd(P.pad[k]), rs, abs_pad), inv_h, col_pad);
+      const __m512d W = _mm512_fmadd_pd(w, inv_h, d);
+      widen = _mm512_max_pd(widen, d);
+      narrow_by_arc(W, d, _mm512_set1_pd(P.near[k]), _mm512_set1_pd(P.far[k]), half, quarter, L, H, split);
     }
-    const __m256i l = _mm512_cvtpd_epi32(_mm512_roundscale_pd(L, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC));
-    const __m256i u = _mm512_cvtpd_epi32(_mm512_roundscale_pd(H, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+    const __m512d Lc = _mm512_roundscale_pd(L, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC);
+    const __m512d Hf = _mm512_roundscale_pd(H, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    // span_is_sure
+    const __m512d twice = _mm512_add_pd(widen, widen);
+    const __m512d Li = _mm512_add_pd(L, twice), Hi = _mm512_sub_pd(H, twice);
+    const __mmask8 certain =
+        __mmask8(~split) &
+        _mm512_cmp_pd_mask(Lc, _mm512_roundscale_pd(Li, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC), _CMP_EQ_OQ) &
+        _mm512_cmp_pd_mask(Hf, _mm512_roundscale_pd(Hi, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC), _CMP_EQ_OQ);
+    sure[(r - r0) / 8] = static_cast<std::uint8_t>(certain & m);
+    const __m256i l = _mm512_cvtpd_epi32(Lc), u = _mm512_cvtpd_epi32(Hf);
     _mm256_mask_storeu_epi32(lo + (r - r0), m, l);
     _mm256_mask_storeu_epi32(hi + (r - r0), m, u);
     const __m256i count = _mm256_max_epi32(_mm256_add_epi32(_mm256_sub_epi32(u, l), _mm256_set1_epi32(1)),
@@ -251,13 +302,13 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx5
 #endif
 
 std::int64_t row_spans(const SpanSetup& P, int r0, int r1, const double* cot_phi, const double* rsqrt_sin_phi, int* lo,
-                       int* hi) {
+                       int* hi, std::uint8_t* sure) {
 #if defined(__GNUC__) && defined(__x86_64__)
   static const bool avx512 =
       __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
-  if (avx512) return row_spans_avx512(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi);
+  if (avx512) return row_spans_avx512(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi, sure);
 #endif
-  return row_spans_scalar(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi);
+  return row_spans_scalar(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi, sure);
 }
 
 /// The stored columns of unwrapped span lo..hi (lo >= -cols, hi < 2 cols) as up to three
@@ -365,28 +416,35 @@ const GridTables& grid_tables(const EquiangularGrid& grid) {
 }
 
 /// One cone's rows r0..r1 with their spans lo[r - r0] .. hi[r - r0] (unwrapped columns), for
-/// the exact-mode kernels: e (the three edge normals) and adet as in TriangleCone.
+/// the exact-mode kernels: e (the three edge normals), n (the face normal) and adet as in
+/// TriangleCone; sure (or null): bit i % 8 of sure[i / 8] set when every node of row r0 + i's
+/// span is certainly inside the cone (row_spans).
 struct SpanRows {
   int r0, r1;
   const int* lo;
   const int* hi;
+  const std::uint8_t* sure;
   const double* e;
+  const double* n;
   double adet;
 };
 
 /// Exact mode over a cone's row spans. For a node of row r (polar angle phi, sin phi > 0) and
 /// column c the three edge functions, divided by sin phi (which keeps their signs), are
 /// f_k = e_k.x cos(theta_c) + e_k.y sin(theta_c) + cot(phi_r) e_k.z; the node is inside the cone
-/// when all are >= 0, and its distance is (adet / sin phi) / (f_0 + f_1 + f_2), where the ray meets
-/// the plane (double sums, division in the map's precision); the nearer value is kept. The two
-/// pole rows (sin phi = 0: one direction, (0, 0, +-1)) use f_k = cos(phi) e_k.z and adet. A
-/// negated edge normal negates f exactly, so two triangles sharing an edge still cover every
-/// node on it (watertight). Branch-free inner loops; the whole triangle in one call so the
-/// vectorised clone is dispatched once per triangle. Returns the number of nodes that had no
-/// surface before and have one now.
+/// when all are >= 0, and its distance is (adet / sin phi) / g with g = n.x cos(theta_c) +
+/// n.y sin(theta_c) + cot(phi_r) n.z, where the ray meets the plane (double g, division in the
+/// map's precision); the nearer value is kept. The two pole rows (sin phi = 0: one direction,
+/// (0, 0, +-1)) use f_k = cos(phi) e_k.z, g = cos(phi) n.z and adet. A negated edge normal
+/// negates f exactly, so two triangles sharing an edge still cover every node on it
+/// (watertight). On a sure row (S.sure) every node of the span is inside and only the distances
+/// are computed. Branch-free inner loops; the whole triangle in one call so the vectorised
+/// clone is dispatched once per triangle. Returns the number of nodes that had no surface
+/// before and have one now.
 template <typename Scalar>
 inline std::int64_t exact_rows_body(Scalar* __restrict map, int cols, const SpanRows& S, const GridTables& T) {
   const double* e = S.e;
+  const double* n = S.n;
   const double* __restrict cos_theta = T.cos_theta.data();
   const double* __restrict sin_theta = T.sin_theta.data();
   std::int64_t newly = 0;
@@ -396,18 +454,27 @@ inline std::int64_t exact_rows_body(Scalar* __restrict map, int cols, const Span
     const double ex = pole ? 0.0 : 1.0;  // pole rows: no azimuth term
     const double ez = pole ? T.cos_phi[r] : T.cot_phi[r];
     const double a0 = ex * e[0], b0 = ex * e[1], c0 = ez * e[2], a1 = ex * e[3], b1 = ex * e[4], c1 = ez * e[5],
-                 a2 = ex * e[6], b2 = ex * e[7], c2 = ez * e[8];
+                 a2 = ex * e[6], b2 = ex * e[7], c2 = ez * e[8], an = ex * n[0], bn = ex * n[1], cn = ez * n[2];
     const double adet = pole ? S.adet : S.adet / sp;
     Scalar* __restrict row = map + std::int64_t(r) * cols;
+    const int i = r - S.r0;
+    const bool sure = S.sure != nullptr && ((S.sure[i >> 3] >> (i & 7)) & 1);
     int seg[3][2];
-    const int nseg = segments(S.lo[r - S.r0], S.hi[r - S.r0], cols, seg);
-    for (int g = 0; g < nseg; ++g)
+    const int nseg = segments(S.lo[i], S.hi[i], cols, seg);
+    for (int g = 0; g < nseg; ++g) {
+      if (sure) {  // every node of the span is inside: only the distances
+        for (int j = seg[g][0]; j <= seg[g][1]; ++j)
+          keep_nearer(row[j], true, node_distance(adet, an * cos_theta[j] + (bn * sin_theta[j] + cn), Scalar{}),
+                      newly);
+        continue;
+      }
       for (int j = seg[g][0]; j <= seg[g][1]; ++j) {
         const double ct = cos_theta[j], st = sin_theta[j];
         const double f0 = a0 * ct + (b0 * st + c0), f1 = a1 * ct + (b1 * st + c1), f2 = a2 * ct + (b2 * st + c2);
         const bool inside = std::min(std::min(f0, f1), f2) >= 0;
-        keep_nearer(row[j], inside, node_distance(adet, f0 + f1 + f2, Scalar{}), newly);
+        keep_nearer(row[j], inside, node_distance(adet, an * ct + (bn * st + cn), Scalar{}), newly);
       }
+    }
   }
   return newly;
 }
@@ -419,54 +486,64 @@ std::int64_t exact_rows_generic(float* map, int cols, const SpanRows& S, const G
 #if defined(__GNUC__) && defined(__x86_64__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's own _mm512_cvtpd_ps (a false positive)
-/// One 8-node step of exact_rows_avx512 at stored columns j.. (lanes m) of `row`; returns the
-/// nodes newly covered.
+/// A row's coefficients for the AVX-512 steps: f_k = x_k cos + y_k sin + c_k, g = xn cos + yn sin + cn.
+struct RowCoefficients {
+  __m512d x0, y0, c0, x1, y1, c1, x2, y2, c2, xn, yn, cn;
+  __m256 adet;
+};
+
+/// One 8-node step of exact_rows_avx512 at stored columns j.. (lanes m) of `row`; with `test`
+/// the edge functions decide which lanes are inside, else all lanes m are (a sure row). Returns
+/// the nodes newly covered.
+template <bool test>
 __attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline int exact_step_avx512(
-    float* row, int j, __mmask8 m, const double* cos_theta, const double* sin_theta, __m512d a0, __m512d b0,
-    __m512d c0, __m512d a1, __m512d b1, __m512d c1, __m512d a2, __m512d b2, __m512d c2, __m256 adet) {
+    float* row, int j, __mmask8 m, const double* cos_theta, const double* sin_theta, const RowCoefficients& R) {
   const __m256 none = _mm256_set1_ps(std::numeric_limits<float>::infinity());
   const __m512d ct = _mm512_maskz_loadu_pd(m, cos_theta + j), st = _mm512_maskz_loadu_pd(m, sin_theta + j);
-  const __m512d f0 = _mm512_fmadd_pd(a0, ct, _mm512_fmadd_pd(b0, st, c0));
-  const __m512d f1 = _mm512_fmadd_pd(a1, ct, _mm512_fmadd_pd(b1, st, c1));
-  const __m512d f2 = _mm512_fmadd_pd(a2, ct, _mm512_fmadd_pd(b2, st, c2));
-  const __mmask8 inside =
-      _mm512_mask_cmp_pd_mask(m, _mm512_min_pd(_mm512_min_pd(f0, f1), f2), _mm512_setzero_pd(), _CMP_GE_OQ);
-  const __m256 sum = _mm512_cvtpd_ps(_mm512_add_pd(_mm512_add_pd(f0, f1), f2));
-  const __m256 v = _mm256_div_ps(adet, sum);
+  __mmask8 inside = m;
+  if constexpr (test) {
+    const __m512d f0 = _mm512_fmadd_pd(R.x0, ct, _mm512_fmadd_pd(R.y0, st, R.c0));
+    const __m512d f1 = _mm512_fmadd_pd(R.x1, ct, _mm512_fmadd_pd(R.y1, st, R.c1));
+    const __m512d f2 = _mm512_fmadd_pd(R.x2, ct, _mm512_fmadd_pd(R.y2, st, R.c2));
+    inside = _mm512_mask_cmp_pd_mask(m, _mm512_min_pd(_mm512_min_pd(f0, f1), f2), _mm512_setzero_pd(), _CMP_GE_OQ);
+  }
+  const __m256 g = _mm512_cvtpd_ps(_mm512_fmadd_pd(R.xn, ct, _mm512_fmadd_pd(R.yn, st, R.cn)));
+  const __m256 v = _mm256_div_ps(R.adet, g);
   const __m256 old = _mm256_maskz_loadu_ps(inside, row + j);
   _mm256_mask_storeu_ps(row + j, _mm256_mask_cmp_ps_mask(inside, v, old, _CMP_LT_OQ), v);
   return __builtin_popcount(_mm256_mask_cmp_ps_mask(inside, old, none, _CMP_EQ_OQ));
 }
 
 /// exact_step_avx512 over stored columns first..last of `row`; returns the nodes newly covered.
+template <bool test>
 __attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline std::int64_t exact_run_avx512(
-    float* row, int first, int last, const double* cos_theta, const double* sin_theta, __m512d a0, __m512d b0,
-    __m512d c0, __m512d a1, __m512d b1, __m512d c1, __m512d a2, __m512d b2, __m512d c2, __m256 adet) {
+    float* row, int first, int last, const double* cos_theta, const double* sin_theta, const RowCoefficients& R) {
   std::int64_t newly = 0;
   for (int j = first; j <= last; j += 8)
-    newly += exact_step_avx512(row, j, first_lanes(last - j + 1), cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2,
-                               b2, c2, adet);
+    newly += exact_step_avx512<test>(row, j, first_lanes(last - j + 1), cos_theta, sin_theta, R);
   return newly;
 }
 
 /// exact_rows_body for float maps in AVX-512 with masked loads and stores: the short spans of
 /// small triangles (a few dozen nodes) run without scalar remainders. Same arithmetic as the
 /// generic body (double edge functions, float division), with fused multiply-adds. The
-/// per-row work is kept small (it is about half of the time at 0.05 deg): the edge normals'
-/// x and y in registers for the whole triangle, three products per row, a fixed three-line
-/// prefetch two rows ahead, and rows across the seam in a separate loop.
+/// per-row work is kept small (it is about half of the time at 0.05 deg): sure rows skip the
+/// edge functions, the normals' x and y stay in registers for the whole triangle, a fixed
+/// three-line prefetch two rows ahead, and rows across the seam in a separate loop.
 __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx512(float* map, int cols,
                                                                                  const SpanRows& S,
                                                                                  const GridTables& T) {
   const double* e = S.e;
-  const double e2 = e[2], e5 = e[5], e8 = e[8];
-  const __m512d x0 = _mm512_set1_pd(e[0]), y0 = _mm512_set1_pd(e[1]), x1 = _mm512_set1_pd(e[3]),
-                y1 = _mm512_set1_pd(e[4]), x2 = _mm512_set1_pd(e[6]), y2 = _mm512_set1_pd(e[7]);
-  const __m512d zero = _mm512_setzero_pd();
+  const double e2 = e[2], e5 = e[5], e8 = e[8], n2 = S.n[2];
+  RowCoefficients R;
+  R.x0 = _mm512_set1_pd(e[0]), R.y0 = _mm512_set1_pd(e[1]), R.x1 = _mm512_set1_pd(e[3]),
+  R.y1 = _mm512_set1_pd(e[4]), R.x2 = _mm512_set1_pd(e[6]), R.y2 = _mm512_set1_pd(e[7]);
+  R.xn = _mm512_set1_pd(S.n[0]), R.yn = _mm512_set1_pd(S.n[1]);
   const double* cos_theta = T.cos_theta.data();
   const double* sin_theta = T.sin_theta.data();
   const int* __restrict lo_of = S.lo;
   const int* __restrict hi_of = S.hi;
+  const std::uint8_t* sure = S.sure;
   const int r0 = S.r0, r1 = S.r1;
   const double adet = S.adet;
   std::int64_t newly = 0;
@@ -476,29 +553,27 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
     const double sp = T.sin_phi[r];
     const bool pole = sp <= 0;
     const double ez = pole ? T.cos_phi[r] : T.cot_phi[r];
-    const __m512d c0 = _mm512_set1_pd(ez * e2), c1 = _mm512_set1_pd(ez * e5), c2 = _mm512_set1_pd(ez * e8);
-    const __m256 row_adet = _mm256_set1_ps(static_cast<float>(pole ? adet : adet / sp));
+    R.cn = _mm512_set1_pd(ez * n2);
+    R.adet = _mm256_set1_ps(static_cast<float>(pole ? adet : adet / sp));
     float* row = map + std::int64_t(r) * cols;
-    if (r + 2 <= r1) {  // rows are a whole map row apart: no hardware prefetcher follows them
-      // The first, second and last line of the span two rows ahead (spans are mostly under 48
-      // nodes); a hint, so a span that wraps is only partly fetched.
-      const float* ahead = row + 2 * std::int64_t(cols);
-      const int first = std::clamp(lo_of[i + 2], 0, cols - 1), last = std::clamp(hi_of[i + 2], 0, cols - 1);
-      _mm_prefetch(reinterpret_cast<const char*>(ahead + first), _MM_HINT_T0);
-      _mm_prefetch(reinterpret_cast<const char*>(ahead + std::min(first + 16, last)), _MM_HINT_T0);
-      _mm_prefetch(reinterpret_cast<const char*>(ahead + last), _MM_HINT_T0);
-    }
-    if (!pole && lo >= 0 && hi < cols) {  // the common case: a span that does not wrap
-      newly += exact_run_avx512(row, lo, hi, cos_theta, sin_theta, x0, y0, c0, x1, y1, c1, x2, y2, c2, row_adet);
+    const bool plain = !pole && lo >= 0 && hi < cols;  // the common case: a span that does not wrap
+    if (plain && sure != nullptr && ((sure[i >> 3] >> (i & 7)) & 1)) {
+      newly += exact_run_avx512<false>(row, lo, hi, cos_theta, sin_theta, R);
       continue;
     }
-    const __m512d a0 = pole ? zero : x0, b0 = pole ? zero : y0, a1 = pole ? zero : x1, b1 = pole ? zero : y1,
-                  a2 = pole ? zero : x2, b2 = pole ? zero : y2;
+    R.c0 = _mm512_set1_pd(ez * e2), R.c1 = _mm512_set1_pd(ez * e5), R.c2 = _mm512_set1_pd(ez * e8);
+    if (plain) {
+      newly += exact_run_avx512<true>(row, lo, hi, cos_theta, sin_theta, R);
+      continue;
+    }
+    RowCoefficients P = R;  // the seam or a pole row
+    if (pole) {
+      const __m512d zero = _mm512_setzero_pd();
+      P.x0 = P.y0 = P.x1 = P.y1 = P.x2 = P.y2 = P.xn = P.yn = zero;
+    }
     int seg[3][2];
     const int nseg = segments(lo, hi, cols, seg);
-    for (int g = 0; g < nseg; ++g)
-      newly += exact_run_avx512(row, seg[g][0], seg[g][1], cos_theta, sin_theta, a0, b0, c0, a1, b1, c1, a2, b2, c2,
-                                row_adet);
+    for (int g = 0; g < nseg; ++g) newly += exact_run_avx512<true>(row, seg[g][0], seg[g][1], cos_theta, sin_theta, P);
   }
   return newly;
 }
@@ -565,6 +640,11 @@ std::int64_t linear_rows(double* map, int cols, const LinearBox& L, const double
 /// pelvis at 0.05 deg: 16 is about 7 % faster than spans everywhere; the map is the same).
 constexpr int kMinSpanBox = 16;
 
+/// Rows reset together by MapStart::reset with a plan: 512 KiB of map, half of this machine's
+/// per-core L2 (lhdl-ct pelvis at 0.05 deg: 128 KiB 19-21 ms, 256 KiB 18 ms, 512 KiB 17-17.8 ms,
+/// 1 MiB 18-19 ms; the cones that start in a band reach into the next ones).
+constexpr std::size_t kResetBandBytes = 512 * 1024;
+
 template <typename Scalar>
 class Rasterizer {
  public:
@@ -575,7 +655,8 @@ class Rasterizer {
         grid_(map.grid()),
         keep_sign_(keep_sign),
         row_spans_(row_spans),
-        t_(grid_tables(grid_)) {}
+        t_(grid_tables(grid_)),
+        inv_h_(1 / grid_.step()) {}
 
   /// Nodes that had no surface before this rasteriser and have one now.
   std::int64_t newly_covered() const { return newly_covered_; }
@@ -619,25 +700,72 @@ class Rasterizer {
   }
 
   /// Exact mode: the nodes of the cone's row spans (or of its whole box without row spans).
-  void exact_cone(const TriangleCone& t) {
+  void exact_cone(const TriangleCone& t) { exact_cone(t, box_of(t, inv_h_, grid_.rows(), grid_.columns())); }
+
+  /// Exact mode with every node first set to no surface, in bands of rows: each band is reset
+  /// just before the cones that start in it are drawn, so that their map lines are still in the
+  /// cache (the rows a cone reaches below its band are reset with it). Same map as a reset
+  /// followed by exact_cone over `cones` in order: a node's value is the minimum over the cones
+  /// covering it, whatever the order.
+  void exact_cones_fresh(const std::vector<TriangleCone>& cones) {
     const int rows = grid_.rows(), cols = grid_.columns();
-    const double h = grid_.step();
+    const int band = std::max(1, static_cast<int>(kResetBandBytes / (sizeof(Scalar) * std::size_t(cols))));
+    const int bands = (rows + band - 1) / band;
+    thread_local std::vector<Box> boxes;
+    thread_local std::vector<std::int32_t> order, start;
+    const std::size_t n = cones.size();
+    boxes.resize(n), order.resize(n), start.assign(std::size_t(bands) + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      boxes[i] = box_of(cones[i], inv_h_, rows, cols);
+      if (boxes[i].r1 >= boxes[i].r0) ++start[std::size_t(boxes[i].r0 / band) + 1];
+    }
+    for (int g = 0; g < bands; ++g) start[std::size_t(g) + 1] += start[std::size_t(g)];
+    std::vector<std::int32_t> next(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      if (boxes[i].r1 >= boxes[i].r0) order[std::size_t(next[std::size_t(boxes[i].r0 / band)]++)] = std::int32_t(i);
+    Scalar* map = map_.data();
+    int reset = 0;  // rows 0 .. reset - 1 are reset
+    const auto reset_to = [&](int r) {
+      if (r <= reset) return;
+      std::fill(map + std::int64_t(reset) * cols, map + std::int64_t(r) * cols, RadialDistanceMapT<Scalar>::no_surface());
+      reset = r;
+    };
+    for (int g = 0; g < bands; ++g) {
+      const auto b0 = std::size_t(start[std::size_t(g)]), b1 = std::size_t(start[std::size_t(g) + 1]);
+      int need = std::min(rows, (g + 1) * band);
+      for (std::size_t j = b0; j < b1; ++j) need = std::max(need, boxes[std::size_t(order[j])].r1 + 1);
+      reset_to(need);
+      for (std::size_t j = b0; j < b1; ++j) {
+        if (j + 4 < b1) {  // the cones of a band are scattered in the plan (Z order)
+          const char* ahead = reinterpret_cast<const char*>(&cones[std::size_t(order[j + 4])]);
+          for (std::size_t line = 0; line < sizeof(TriangleCone); line += 64) __builtin_prefetch(ahead + line);
+        }
+        exact_cone(cones[std::size_t(order[j])], boxes[std::size_t(order[j])]);
+      }
+    }
+    reset_to(rows);
+  }
+
+  /// exact_cone with the cone's box b (box_of).
+  void exact_cone(const TriangleCone& t, const Box& b) {
+    const int cols = grid_.columns();
     if (t.north || t.south) ++stats_.pole_triangles;
     if (t.seam) ++stats_.seam_triangles;
-    const Box b = box_of(t, h, rows, cols);
     if (b.r1 < b.r0) return;
     const auto n = static_cast<std::size_t>(b.r1 - b.r0 + 1);
-    if (lo_.size() < n) lo_.resize(n), hi_.resize(n);
+    if (lo_.size() < n) lo_.resize(n), hi_.resize(n), sure_.resize(n / 8 + 1);
     // Rows of 16 columns or fewer take one or two vector steps anyway: no spans for them.
+    const std::uint8_t* sure = nullptr;
     if (row_spans_ && !t.full_theta && b.c1 - b.c0 >= kMinSpanBox) {
-      stats_.node_tests += row_spans(span_setup(t, b, h, cols), b.r0, b.r1, t_.cot_phi.data(),
-                                     t_.rsqrt_sin_phi.data(), lo_.data(), hi_.data());
+      stats_.node_tests += row_spans(span_setup(t, b, inv_h_, cols), b.r0, b.r1, t_.cot_phi.data(),
+                                     t_.rsqrt_sin_phi.data(), lo_.data(), hi_.data(), sure_.data());
+      sure = sure_.data();
     } else {
       std::fill(lo_.begin(), lo_.begin() + std::ptrdiff_t(n), b.c0);
       std::fill(hi_.begin(), hi_.begin() + std::ptrdiff_t(n), b.c1);
       stats_.node_tests += std::int64_t(n) * (b.c1 - b.c0 + 1);
     }
-    const SpanRows S{b.r0, b.r1, lo_.data(), hi_.data(), t.e, t.adet};
+    const SpanRows S{b.r0, b.r1, lo_.data(), hi_.data(), sure, t.e, t.n, t.adet};
     newly_covered_ += exact_rows(map_.data(), cols, S, t_);
   }
 
@@ -653,7 +781,7 @@ class Rasterizer {
     const TriangleCone t = make_cone(ka, kb, kc, det, north, south);
     const int rows = grid_.rows(), cols = grid_.columns();
     const double h = grid_.step();
-    const Box bx = box_of(t, h, rows, cols);
+    const Box bx = box_of(t, inv_h_, rows, cols);
     const int r0 = bx.r0, r1 = bx.r1, c0 = bx.c0, c1 = bx.c1;
     if (t.seam) ++stats_.seam_triangles;
     const bool full = t.full_theta;
@@ -731,8 +859,10 @@ class Rasterizer {
   int keep_sign_;                   ///< 0: no culling
   bool row_spans_;                  ///< exact mode: test only the row spans (else whole boxes)
   const GridTables& t_;             ///< this grid's trigonometry
+  double inv_h_;                    ///< 1 / the grid's step (1/rad)
   std::int64_t newly_covered_ = 0;  ///< nodes that had no surface and now have one
   std::vector<int> lo_, hi_;        ///< row spans of the current cone
+  std::vector<std::uint8_t> sure_;  ///< their sure bits (row_spans)
 };
 
 /// Spherical coordinates of every vertex relative to `cor` (a vertex is shared by about six
@@ -771,20 +901,28 @@ std::vector<TriangleCone> triangle_cones(const TriangleMesh& mesh, const Eigen::
 
 template <typename Scalar>
 SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, DistanceMode mode,
-                        RadialDistanceMapT<Scalar>& map, const FaceCulling* culling, bool row_spans) {
+                        RadialDistanceMapT<Scalar>& map, const FaceCulling* culling, bool row_spans, MapStart start) {
   require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
+  const bool planned = culling != nullptr && mode == DistanceMode::exact;
+  // The plan's cones: the kept triangles (all when culling is disabled), set up once.
+  if (planned && (culling->cor != cor || culling->mesh_fingerprint != mesh_fingerprint(mesh)))
+    throw Error(mesh.source + ": face culling plan was made for another mesh or centre of rotation");
+  const bool banded = planned && start == MapStart::reset;  // the reset fused with the drawing
+  if (start == MapStart::reset && !banded)
+    std::fill(map.data(), map.data() + map.num_nodes(), RadialDistanceMapT<Scalar>::no_surface());
   SamplingStats stats;
-  const int keep = (culling != nullptr && culling->enabled && mode == DistanceMode::exact) ? culling->keep_sign : 0;
+  const int keep = planned && culling->enabled ? culling->keep_sign : 0;
   Rasterizer<Scalar> raster(map, mode, stats, keep, row_spans);
-  if (culling != nullptr && mode == DistanceMode::exact) {
-    // The plan's cones: the kept triangles (all when culling is disabled), set up once.
-    if (culling->cor != cor || culling->mesh_fingerprint != mesh_fingerprint(mesh))
-      throw Error(mesh.source + ": face culling plan was made for another mesh or centre of rotation");
-    for (const TriangleCone& t : culling->cones) raster.exact_cone(t);
-    const auto planned = static_cast<std::int64_t>(culling->triangle_order.size());
+  if (planned) {
+    if (banded) {
+      raster.exact_cones_fresh(culling->cones);
+    } else {
+      for (const TriangleCone& t : culling->cones) raster.exact_cone(t);
+    }
+    const auto kept = static_cast<std::int64_t>(culling->triangle_order.size());
     stats.triangles = mesh.F.rows();
     stats.triangles_edge_on = culling->cones_edge_on;
-    stats.triangles_culled = mesh.F.rows() - planned;
+    stats.triangles_culled = mesh.F.rows() - kept;
   } else {
     const std::vector<Corner>& k = vertex_corners(mesh, cor);
     for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
@@ -796,9 +934,9 @@ SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, Di
 }
 
 template SamplingStats rasterize<float>(const TriangleMesh&, const Eigen::Vector3d&, DistanceMode,
-                                        RadialDistanceMapT<float>&, const FaceCulling*, bool);
+                                        RadialDistanceMapT<float>&, const FaceCulling*, bool, MapStart);
 template SamplingStats rasterize<double>(const TriangleMesh&, const Eigen::Vector3d&, DistanceMode,
-                                         RadialDistanceMapT<double>&, const FaceCulling*, bool);
+                                         RadialDistanceMapT<double>&, const FaceCulling*, bool, MapStart);
 
 RadialDistanceMap rasterize_map(const TriangleMesh& mesh, const Eigen::Vector3d& cor, double precision_deg,
                                 DistanceMode mode, SamplingStats* stats) {

@@ -39,6 +39,17 @@ struct SamplingStats {
                                        ///< (for a fresh map: all nodes with a surface)
 };
 
+/// What rasterize does with the values already in the map.
+enum class MapStart {
+  /// Keep them where they are nearer (several meshes can be sampled into one map).
+  keep,
+  /// Set every node to "no surface" first: a fresh map. With a plan in exact mode the reset is
+  /// done in bands of rows, each just before the cones that start in it are drawn, so that
+  /// their map lines are still in the cache (the same map as std::fill followed by drawing,
+  /// and faster: issue 4).
+  reset,
+};
+
 /// Fill `map` with the nearest hit of every node's ray on `mesh` by rasterisation: each
 /// triangle is projected into the (phi, theta) grid (its bounding rows and columns, with the
 /// theta = 0/360 seam and the poles handled: the whole row range is taken when the triangle's
@@ -48,8 +59,8 @@ struct SamplingStats {
 /// (the pelvis is not star-shaped from the COR). Nodes no triangle covers keep "no surface".
 ///
 /// `mesh`: vertices in mm in the map's frame; `cor` (mm): origin of the spherical frame.
-/// Cost O(triangles + nodes in the triangles' bounding boxes). Existing map values are kept
-/// where they are nearer (so several meshes can be sampled into one map).
+/// Cost O(triangles + nodes in the triangles' bounding boxes). `start`: keep the map's values
+/// where they are nearer (the default) or reset the map first (MapStart).
 /// `culling` (exact mode only; ignored in linear mode): the plan of analyse_face_culling for
 /// this mesh and COR. Its cones are rasterised (set up once; the kept triangles when culling is
 /// enabled, about half of a closed mesh, else all). Throws impinge::Error naming the mesh when
@@ -61,7 +72,8 @@ struct SamplingStats {
 /// Source: thesis sec. 3.2, Algorithm 1, Fig. 33-34; culling, cones and spans: issue 4.
 template <typename Scalar>
 SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, DistanceMode mode,
-                        RadialDistanceMapT<Scalar>& map, const FaceCulling* culling = nullptr, bool row_spans = true);
+                        RadialDistanceMapT<Scalar>& map, const FaceCulling* culling = nullptr, bool row_spans = true,
+                        MapStart start = MapStart::keep);
 
 /// One-shot convenience: a new float map of precision `precision_deg` sampled from `mesh`.
 RadialDistanceMap rasterize_map(const TriangleMesh& mesh, const Eigen::Vector3d& cor, double precision_deg,
