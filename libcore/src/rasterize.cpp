@@ -161,12 +161,14 @@ SpanSetup span_setup(const TriangleCone& t, const Box& b, double inv_h, int cols
 /// Absolute padding (rad) of a span's ends: fast_acos_coarse's error and 1e-9.
 constexpr double kSpanAnglePad = kFastAcosCoarseMaxError + 1e-9;
 
-/// Narrow the span L..H of one row (cot phi = ct, 1 / sqrt(sin phi) = rs) by edge k. `widen`
-/// becomes the largest widening d (columns) of an edge so far; `split` is set when the span
-/// cannot be sure (span_is_sure): the edge's forbidden arc, or that arc widened by 2 d, lies
+/// Narrow the span L..H of one row (cot phi = ct, 1 / sqrt(sin phi) = rs) by edge k, whose arc
+/// is widened by d columns, and the inner span Li..Hi by the same limits moved inwards by 2 d
+/// (the arc shrunk by d instead: a subset of the cone). `split` is set when the inner span
+/// cannot be trusted: the edge bounds no span or the row is a pole row (d infinite), the
+/// edge's forbidden arc, or that arc grown by 2 d (so a tangent edge's empty arc counts), lies
 /// inside the span, or the arc is within 2 d of the wide case's limit.
-inline void edge_span(const SpanSetup& P, int k, double ct, double rs, double& L, double& H, double& widen,
-                      bool& split) {
+inline void edge_span(const SpanSetup& P, int k, double ct, double rs, double& L, double& H, double& Li,
+                      double& Hi, bool& split) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   const double x = std::min(std::max(P.k[k] * ct, -1.0), 1.0);
   const double w = fast_acos_coarse(x);
@@ -176,22 +178,18 @@ inline void edge_span(const SpanSetup& P, int k, double ct, double rs, double& L
   const bool narrow = W <= P.quarter;
   const bool cut_low = P.far[k] - V < L;
   const bool cut_high = (P.far[k] + V > H) & !cut_low;
-  // Not sure: a forbidden arc inside the span, or one of the shrunk arc (half-width V + 2 d, so
-  // a tangent edge's empty arc counts), or an arc whose shrunk form is no longer wide.
-  split = split || (!narrow && ((!cut_low && !cut_high && V + 2 * d > 0) || W - 2 * d <= P.quarter));
-  widen = std::max(widen, d);
+  split = split || !(d < inf) ||
+          (!narrow && ((!cut_low && !cut_high && V + 2 * d > 0) || W - 2 * d <= P.quarter));
   const double wide_low = cut_low ? P.far[k] + V : -inf, wide_high = cut_high ? P.far[k] - V : inf;
-  L = std::max(L, narrow ? P.near[k] - W : wide_low);
-  H = std::min(H, narrow ? P.near[k] + W : wide_high);
+  const double low = narrow ? P.near[k] - W : wide_low, high = narrow ? P.near[k] + W : wide_high;
+  L = std::max(L, low), H = std::min(H, high);
+  Li = std::max(Li, low + 2 * d), Hi = std::min(Hi, high - 2 * d);
 }
 
-/// Whether every node of span L..H (edge_span's result) is certainly inside the cone: the span
-/// shrunk by twice the largest widening at both ends holds the same nodes. (Each edge's limit
-/// moves by twice its own widening when the arc is shrunk instead of widened, and the largest
-/// of those limits by at most twice the largest widening; a split span is never sure, and an
-/// edge without spans, or a pole row, has an infinite widening.)
-inline bool span_is_sure(double L, double H, double widen, bool split) {
-  return !split && std::ceil(L) == std::ceil(L + 2 * widen) && std::floor(H) == std::floor(H - 2 * widen);
+/// Whether every node of span L..H (edge_span's result) is certainly inside the cone: the inner
+/// span Li..Hi holds the same nodes and nothing set `split`.
+inline bool span_is_sure(double L, double H, double Li, double Hi, bool split) {
+  return !split && std::ceil(L) == std::ceil(Li) && std::floor(H) == std::floor(Hi);
 }
 
 /// Row spans lo[i] .. hi[i] (unwrapped columns, empty when lo > hi) of rows r0 + i, i <= r1 - r0,
@@ -203,12 +201,12 @@ std::int64_t row_spans_scalar(const SpanSetup& P, int r0, int r1, const double* 
                               int* lo, int* hi, std::uint8_t* sure) {
   std::int64_t nodes = 0;
   for (int r = r0; r <= r1; ++r) {
-    double L = P.c0, H = P.c1, widen = 0;
+    double L = P.c0, H = P.c1, Li = P.c0, Hi = P.c1;
     bool split = false;
-    for (int k = 0; k < 3; ++k) edge_span(P, k, cot_phi[r], rsqrt_sin_phi[r], L, H, widen, split);
+    for (int k = 0; k < 3; ++k) edge_span(P, k, cot_phi[r], rsqrt_sin_phi[r], L, H, Li, Hi, split);
     const int i = r - r0;
     lo[i] = static_cast<int>(std::ceil(L)), hi[i] = static_cast<int>(std::floor(H));
-    const bool certain = span_is_sure(L, H, widen, split);
+    const bool certain = span_is_sure(L, H, Li, Hi, split);
     if (i % 8 == 0) sure[i / 8] = 0;
     sure[i / 8] |= static_cast<std::uint8_t>(certain ? 1u << (i % 8) : 0u);
     nodes += std::max(0, hi[i] - lo[i] + 1);
@@ -224,10 +222,11 @@ inline std::uint8_t first_lanes(int n) { return n >= 8 ? std::uint8_t(0xff) : st
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's own AVX-512 headers (false positives)
 /// One edge's arc for 8 rows in AVX-512 (edge_span's cases): the arc of column half-width W
 /// about nearv, or the complement of the arc of half-width half - W about farv, intersected
-/// with L..H; adds to `split` the lanes that cannot be sure (edge_span).
+/// with L..H, and the inner span Li..Hi; adds to `split` the lanes that cannot be sure
+/// (edge_span).
 __attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline void narrow_by_arc(
     __m512d W, __m512d d, __m512d nearv, __m512d farv, __m512d half, __m512d quarter, __m512d& L, __m512d& H,
-    __mmask8& split) {
+    __m512d& Li, __m512d& Hi, __mmask8& split) {
   const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
   const __m512d V = _mm512_sub_pd(half, W);
   const __mmask8 narrow = _mm512_cmp_pd_mask(W, quarter, _CMP_LE_OQ);
@@ -236,11 +235,14 @@ __attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline void 
   const __m512d d2 = _mm512_add_pd(d, d);
   const __mmask8 inner_arc = __mmask8(~(cut_low | cut_high)) &
                              _mm512_cmp_pd_mask(_mm512_add_pd(V, d2), _mm512_setzero_pd(), _CMP_GT_OQ);
-  split |= __mmask8(__mmask8(~narrow) & (inner_arc | _mm512_cmp_pd_mask(_mm512_sub_pd(W, d2), quarter, _CMP_LE_OQ)));
+  const __mmask8 wide_limit = _mm512_cmp_pd_mask(_mm512_sub_pd(W, d2), quarter, _CMP_LE_OQ);
+  split |= __mmask8(_mm512_cmp_pd_mask(d, inf, _CMP_NLT_UQ) | (__mmask8(~narrow) & (inner_arc | wide_limit)));
   const __m512d wide_low = _mm512_mask_blend_pd(cut_low, _mm512_sub_pd(_mm512_setzero_pd(), inf), _mm512_add_pd(farv, V));
   const __m512d wide_high = _mm512_mask_blend_pd(cut_high, inf, _mm512_sub_pd(farv, V));
-  L = _mm512_max_pd(L, _mm512_mask_blend_pd(narrow, wide_low, _mm512_sub_pd(nearv, W)));
-  H = _mm512_min_pd(H, _mm512_mask_blend_pd(narrow, wide_high, _mm512_add_pd(nearv, W)));
+  const __m512d low = _mm512_mask_blend_pd(narrow, wide_low, _mm512_sub_pd(nearv, W));
+  const __m512d high = _mm512_mask_blend_pd(narrow, wide_high, _mm512_add_pd(nearv, W));
+  L = _mm512_max_pd(L, low), H = _mm512_min_pd(H, high);
+  Li = _mm512_max_pd(Li, _mm512_add_pd(low, d2)), Hi = _mm512_min_pd(Hi, _mm512_sub_pd(high, d2));
 }
 
 /// row_spans_scalar for 8 rows at a time in AVX-512: the same operations (fast_acos_coarse),
@@ -261,7 +263,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx5
     const int left = r1 - r + 1;
     const __mmask8 m = first_lanes(left);
     const __m512d ct = _mm512_maskz_loadu_pd(m, cot_phi + r), rs = _mm512_maskz_loadu_pd(m, rsqrt_sin_phi + r);
-    __m512d L = _mm512_set1_pd(P.c0), H = _mm512_set1_pd(P.c1), widen = zero;
+    __m512d L = _mm512_set1_pd(P.c0), H = _mm512_set1_pd(P.c1), Li = L, Hi = H;
     __mmask8 split = 0;
     for (int k = 0; k < 3; ++k) {
       const __m512d x = _mm512_min_pd(_mm512_max_pd(_mm512_mul_pd(_mm512_set1_pd(P.k[k]), ct), minus_one), one);
@@ -274,14 +276,11 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx5
       // W = w / h + d, d = (pad rs + kSpanAnglePad) / h + 1e-6 (edge_span)
       const __m512d d = _mm512_fmadd_pd(_mm512_fmadd_pd(_mm512_set1_pd(P.pad[k]), rs, abs_pad), inv_h, col_pad);
       const __m512d W = _mm512_fmadd_pd(w, inv_h, d);
-      widen = _mm512_max_pd(widen, d);
-      narrow_by_arc(W, d, _mm512_set1_pd(P.near[k]), _mm512_set1_pd(P.far[k]), half, quarter, L, H, split);
+      narrow_by_arc(W, d, _mm512_set1_pd(P.near[k]), _mm512_set1_pd(P.far[k]), half, quarter, L, H, Li, Hi, split);
     }
     const __m512d Lc = _mm512_roundscale_pd(L, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC);
     const __m512d Hf = _mm512_roundscale_pd(H, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
     // span_is_sure
-    const __m512d twice = _mm512_add_pd(widen, widen);
-    const __m512d Li = _mm512_add_pd(L, twice), Hi = _mm512_sub_pd(H, twice);
     const __mmask8 certain =
         __mmask8(~split) &
         _mm512_cmp_pd_mask(Lc, _mm512_roundscale_pd(Li, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC), _CMP_EQ_OQ) &
