@@ -6,9 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "impinge/error.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/helix_scheme.hpp"
+#include "impinge/rasterize.hpp"
 #include "impinge/spherical_frame.hpp"
 
 using namespace impinge;
@@ -52,4 +55,26 @@ TEST(Sampling, MethodChoiceAndErrors) {
   EXPECT_EQ(sample_surface(s, Eigen::Vector3d(0.1, 0.2, 0.3), o, hx).nodes_covered, hx.num_nodes());
   EXPECT_THROW(parse_sampling_method("fast"), Error);
   EXPECT_THROW(make_scheme("healpix", 8), Error);
+}
+
+TEST(Sampling, RasterizingIntoAUsedMapGivesAFreshMap) {
+  // sample_surface fills the map: +inf where no surface, whatever it held before (with a plan,
+  // where the reset is fused with the drawing, and without). A rasterisation refused for a
+  // helix map leaves that map untouched.
+  const HipModel h = make_hip_model(HipModelOptions{});
+  for (const bool cull : {true, false}) {
+    SamplingOptions o;
+    o.cull_faces = cull;
+    RadialDistanceMap fresh{EquiangularGrid(1)}, used{EquiangularGrid(1)};
+    sample_surface(h.socket, h.cor, o, fresh);
+    std::fill(used.data(), used.data() + used.num_nodes(), 0.25f);
+    const SamplingReport r = sample_surface(h.socket, h.cor, o, used);
+    ASSERT_GT(r.nodes_covered, 0);
+    EXPECT_LT(r.nodes_covered, used.num_nodes());  // the socket leaves directions without surface
+    for (std::int64_t i = 0; i < used.num_nodes(); ++i) ASSERT_EQ(used.at(i), fresh.at(i)) << "node " << i;
+  }
+  RadialDistanceMap hx{HelixScheme(20)};
+  std::fill(hx.data(), hx.data() + hx.num_nodes(), 0.25f);
+  EXPECT_THROW(rasterize(h.socket, h.cor, DistanceMode::exact, hx, nullptr, true, MapStart::reset), Error);
+  EXPECT_EQ(std::count(hx.data(), hx.data() + hx.num_nodes(), 0.25f), hx.num_nodes());
 }

@@ -94,7 +94,9 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
   rep.faces_culled = cull != nullptr && cull->enabled && o.mode == DistanceMode::exact;
   switch (rep.method) {
     case SamplingMethod::rasterize:
-      rep.raster = rasterize(mesh, cor, o.mode, map, cull);  // throws via map.grid() when not equiangular
+      // A fresh map, as documented (with a plan the reset is fused with the drawing).
+      rep.raster = rasterize(mesh, cor, o.mode, map, cull, true, MapStart::reset);  // throws via map.grid()
+                                                                                      // when not equiangular
       rep.rasterize_ms = ms_since(t0);
       break;
     case SamplingMethod::resample: {
