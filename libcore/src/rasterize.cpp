@@ -527,8 +527,9 @@ __attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline std::
 /// small triangles (a few dozen nodes) run without scalar remainders. Same arithmetic as the
 /// generic body (double edge functions, float division), with fused multiply-adds. The
 /// per-row work is kept small (it is about half of the time at 0.05 deg): sure rows skip the
-/// edge functions, the normals' x and y stay in registers for the whole triangle, a fixed
-/// three-line prefetch two rows ahead, and rows across the seam in a separate loop.
+/// edge functions, the normals' x and y stay in registers for the whole triangle, and rows
+/// across the seam run in a separate loop. No software prefetch: with MapStart::reset the map
+/// lines are in L2 (a prefetch two rows ahead was within noise even without it).
 __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx512(float* map, int cols,
                                                                                  const SpanRows& S,
                                                                                  const GridTables& T) {
