@@ -214,6 +214,15 @@ std::int64_t row_spans_scalar(const SpanSetup& P, int r0, int r1, const double* 
   return nodes;
 }
 
+#if defined(__GNUC__) && defined(__x86_64__)
+/// Whether this CPU runs the AVX-512 (F, VL, DQ) kernels; asked once.
+bool cpu_has_avx512() {
+  static const bool yes =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
+  return yes;
+}
+#endif
+
 /// The first min(n, 8) of 8 lanes (n >= 1): the mask of a vector step with n items left.
 inline std::uint8_t first_lanes(int n) { return n >= 8 ? std::uint8_t(0xff) : std::uint8_t((1u << n) - 1); }
 
@@ -256,8 +265,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx5
   const __m512d pi = _mm512_set1_pd(kPi);
   const __m512d inv_h = _mm512_set1_pd(P.inv_h), half = _mm512_set1_pd(P.half), quarter = _mm512_set1_pd(P.quarter);
   const __m512d abs_pad = _mm512_set1_pd(kSpanAnglePad), col_pad = _mm512_set1_pd(1e-6);
-  static constexpr double q[8] = {-0.0012624911, 0.0066700901, -0.0170881256, 0.0308918810,
-                                  -0.0501743046, 0.0889789874, -0.2145988016, 1.5707963050};
+  const double* q = kFastAcosCoarseCoefficients;
   std::int64_t nodes = 0;
   for (int r = r0; r <= r1; r += 8) {
     const int left = r1 - r + 1;
@@ -303,9 +311,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx5
 std::int64_t row_spans(const SpanSetup& P, int r0, int r1, const double* cot_phi, const double* rsqrt_sin_phi, int* lo,
                        int* hi, std::uint8_t* sure) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool avx512 =
-      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
-  if (avx512) return row_spans_avx512(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi, sure);
+  if (cpu_has_avx512()) return row_spans_avx512(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi, sure);
 #endif
   return row_spans_scalar(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi, sure);
 }
@@ -582,9 +588,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
 
 std::int64_t exact_rows(float* map, int cols, const SpanRows& S, const GridTables& T) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool avx512 =
-      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
-  if (avx512) return exact_rows_avx512(map, cols, S, T);
+  if (cpu_has_avx512()) return exact_rows_avx512(map, cols, S, T);
 #endif
   return exact_rows_generic(map, cols, S, T);
 }

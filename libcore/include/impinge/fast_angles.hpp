@@ -99,6 +99,11 @@ inline double fast_azimuth(double y, double x) {
 /// Largest error (radians) of fast_acos_coarse, fit plus double rounding (tested).
 inline constexpr double kFastAcosCoarseMaxError = 3e-8;
 
+/// The degree-7 polynomial of fast_acos_coarse, highest degree first (Abramowitz and Stegun,
+/// eq. 4.4.46); vectorised copies of fast_acos_coarse use the same coefficients.
+inline constexpr double kFastAcosCoarseCoefficients[8] = {-0.0012624911, 0.0066700901, -0.0170881256, 0.0308918810,
+                                                          -0.0501743046, 0.0889789874, -0.2145988016, 1.5707963050};
+
 /// acos(x) in radians for x in [-1, 1] without a division: sqrt(1 - |x|) times a degree-7
 /// polynomial in |x| (Abramowitz and Stegun, Handbook of Mathematical Functions, eq. 4.4.46,
 /// fit error <= 2e-8), reflected as pi - acos(|x|) for x < 0. Error <= kFastAcosCoarseMaxError
@@ -106,14 +111,8 @@ inline constexpr double kFastAcosCoarseMaxError = 3e-8;
 /// rasteriser's row spans), not for look-ups.
 inline double fast_acos_coarse(double x) {
   const double a = std::abs(x);
-  double p = -0.0012624911;
-  p = p * a + 0.0066700901;
-  p = p * a - 0.0170881256;
-  p = p * a + 0.0308918810;
-  p = p * a - 0.0501743046;
-  p = p * a + 0.0889789874;
-  p = p * a - 0.2145988016;
-  p = p * a + 1.5707963050;
+  double p = kFastAcosCoarseCoefficients[0];
+  for (int i = 1; i < 8; ++i) p = p * a + kFastAcosCoarseCoefficients[i];
   const double r = std::sqrt(std::max(0.0, 1 - a)) * p;
   return x < 0 ? fast_angles_detail::kPi - r : r;
 }
