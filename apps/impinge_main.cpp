@@ -1,34 +1,223 @@
 // impinge command-line interface.
-//   impinge distance --ball FEMUR --socket PELVIS [--subject subject.json] [--cor auto|X,Y,Z]
-//                    [--precision DEG] [--mode linear|exact] [--pose FLEX,ABD,ROT] --out DIR
+//   impinge distance --subject S.json | --ball FEMUR --socket PELVIS  [map, frame options] --pose FLEX,ADD,IR --out DIR
+//   impinge motion   --subject S.json --motion FILE(.csv|.mot|.sto)   [map, frame options] --out DIR
 //   impinge generate --triangles N --out DIR
-// Errors exit non-zero with a one-line message.
+// Options bind to the structs below; errors exit 2 with a one-line message.
+
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "impinge/error.hpp"
 #include "impinge/generated_models.hpp"
+#include "impinge/hip_frames.hpp"
 #include "impinge/joint.hpp"
 #include "impinge/map_image.hpp"
 #include "impinge/mesh_io.hpp"
+#include "impinge/motion.hpp"
 #include "impinge/parse.hpp"
 #include "impinge/pose.hpp"
 #include "impinge/sampling.hpp"
 #include "impinge/sphere_fit.hpp"
 #include "impinge/spherical_frame.hpp"
 #include "impinge/subject.hpp"
+#include "impinge/vtk_output.hpp"
 
 using namespace impinge;
 namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
 
 namespace {
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// ---- options -------------------------------------------------------------------------------
+
+struct InputOptions {
+  std::string ball, socket, subject, side = "right", frame = "RAS", cor = "auto", head_region;
+};
+struct MapOptions {
+  std::string scheme = "equiangular", sampling = "auto", mode = "exact", levels;
+  double resolution = 0, precision = 0, turns = 0, occlusion_tolerance = 1.0, max_radius = 0;
+};
+struct FrameOptions {
+  std::string neutral;  // empty: subject.json's "neutral", else anatomical
+  std::string pelvis_frame = "isb", femur_frame = "epicondyles";
+};
+
+void add_input_options(CLI::App* app, InputOptions& o) {
+  app->add_option("--subject", o.subject,
+                  "subject.json giving side, frame (LPS or RAS) and optional landmarks; supplies --ball/--socket");
+  app->add_option("--ball", o.ball, "Ball mesh (femur): PLY, STL, OBJ or OFF, mm");
+  app->add_option("--socket", o.socket, "Socket mesh (pelvis): PLY, STL, OBJ or OFF, mm");
+  app->add_option("--side", o.side, "right or left (overridden by --subject)")->capture_default_str();
+  app->add_option("--frame", o.frame, "Input frame LPS or RAS (overridden by --subject)")->capture_default_str();
+  app->add_option("--cor", o.cor,
+                  "Centre of rotation: 'auto' (sphere fit of the femoral head, in any scan orientation) or X,Y,Z "
+                  "in mm in the input files' frame")
+      ->capture_default_str();
+  app->add_option("--head-region", o.head_region,
+                  "X,Y,Z,R: fit the head sphere to femur vertices within R mm of (X,Y,Z), input frame");
+}
+
+void add_map_options(CLI::App* app, MapOptions& o) {
+  std::string registered;
+  for (const auto& [name, res] : scheme_names())
+    registered += (registered.empty() ? "" : ", ") + name + " (" + res + ")";
+  app->add_option("--scheme", o.scheme, "Sampling scheme of the maps: " + registered)->capture_default_str();
+  app->add_option("--resolution", o.resolution,
+                  "Resolution of the scheme (its own unit, listed with --scheme); default: the scheme's equivalent "
+                  "of 0.5 deg node spacing");
+  app->add_option("--precision", o.precision, "Alias of --resolution for equiangular grids: precision p in degrees");
+  app->add_option("--turns", o.turns, "Alias of --resolution for the helix: k turns (w = k^2 nodes)");
+  app->add_option("--sampling", o.sampling, "auto, rasterize, resample or ray-cast (naive, small meshes only)")
+      ->capture_default_str();
+  app->add_option("--mode", o.mode, "Distance mode: 'linear' (thesis Alg. 1) or 'exact' (ray-plane)")
+      ->capture_default_str();
+  app->add_option("--levels", o.levels, "Impingement thresholds in mm, decreasing, e.g. 4,2.667,1.333,0");
+  app->add_option("--occlusion-tolerance", o.occlusion_tolerance,
+                  "mm: vertices farther than their own first surface plus this are skipped (beyond reach)")
+      ->capture_default_str();
+  app->add_option("--max-radius", o.max_radius, "mm: test only vertices within this distance of the COR (0 = all)")
+      ->capture_default_str();
+}
+
+void add_frame_options(CLI::App* app, FrameOptions& o) {
+  app->add_option("--neutral", o.neutral,
+                  "Zero pose: 'anatomical' (the femoral ISB frame parallel to the pelvic one, both found from the "
+                  "bones or given as landmarks in subject.json) or 'scan' (the pose in the scanner; angles about "
+                  "the input frame's axes: flexion about left-right, adduction about antero-posterior, rotation "
+                  "about superior-inferior). Default: subject.json's \"neutral\", else anatomical");
+  app->add_option("--pelvis-frame", o.pelvis_frame,
+                  "Pelvic axes: 'isb' (Wu et al. 2002: ASIS and PSIS) or 'app' (anterior pelvic plane: ASIS and "
+                  "pubic tubercles, as clinical ROM tools)")
+      ->capture_default_str();
+  app->add_option("--femur-frame", o.femur_frame,
+                  "Femoral medio-lateral axis: 'epicondyles' (ISB) or 'posterior-condyles' (posterior condylar axis)")
+      ->capture_default_str();
+}
+
+const char* kPoseHelp =
+    "FLEX,ADD,IR in degrees, ISB joint coordinate system (Wu et al. 2002): flexion about the pelvic "
+    "medio-lateral axis (+ = knee forward), adduction about the floating axis (+ = knee towards the midline, "
+    "negative = abduction), internal rotation about the femoral long axis (+ = front of the thigh turns "
+    "inwards); mirrored for the left side so the signs mean the same. Zero is set by --neutral";
+
+// ---- setting up a joint -------------------------------------------------------------------
+
+// Everything one run needs: meshes in the working (RAS) frame, COR, frames, the joint.
+struct Setup {
+  std::string ball_path, socket_path;
+  Side side = Side::right;
+  FrameConvention frame = FrameConvention::RAS;
+  Eigen::Matrix3d to_working = Eigen::Matrix3d::Identity();  // input frame -> working frame
+  JointOptions options;
+  Neutral neutral = Neutral::anatomical;
+  SphereFitResult fit;
+  std::string cor_method;
+  std::optional<HipFrames> frames;
+  std::optional<Joint> joint;
+  double frames_ms = 0;
+};
+
+double scheme_resolution(const MapOptions& m) {
+  if (m.resolution > 0) return m.resolution;
+  if (m.precision > 0) return m.precision;
+  if (m.turns > 0) return m.turns;
+  return default_resolution(m.scheme);
+}
+
+Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo) {
+  Setup s;
+  s.ball_path = in.ball;
+  s.socket_path = in.socket;
+  s.side = parse_side(in.side, "--side");
+  s.frame = parse_frame(in.frame, "--frame");
+  if (!fo.neutral.empty()) s.neutral = parse_neutral(fo.neutral, "--neutral");
+  Landmarks given;
+  if (!in.subject.empty()) {
+    const SubjectInfo info = load_subject(in.subject);
+    s.side = info.side;
+    s.frame = info.frame;
+    if (s.ball_path.empty()) s.ball_path = info.femur_path;
+    if (s.socket_path.empty()) s.socket_path = info.pelvis_path;
+    given = info.landmarks;
+    if (fo.neutral.empty() && !info.neutral.empty()) s.neutral = parse_neutral(info.neutral, in.subject);
+  }
+  require(!s.ball_path.empty(), "--ball is required (or --subject)");
+  require(!s.socket_path.empty(), "--socket is required (or --subject)");
+  HipFrameOptions hfo;
+  hfo.pelvis = parse_pelvis_frame_kind(fo.pelvis_frame, "--pelvis-frame");
+  hfo.femur = parse_femur_frame_kind(fo.femur_frame, "--femur-frame");
+  // Validate the cheap options before the expensive work.
+  s.options.scheme = make_scheme(mo.scheme, scheme_resolution(mo));
+  s.options.mode = parse_distance_mode(mo.mode);
+  s.options.sampling = parse_sampling_method(mo.sampling);
+  s.options.occlusion_tolerance_mm = mo.occlusion_tolerance;
+  s.options.max_radius_mm = mo.max_radius > 0 ? mo.max_radius : std::numeric_limits<double>::infinity();
+  if (!mo.levels.empty()) s.options.levels = parse_levels(mo.levels);
+
+  TriangleMesh ball = load_mesh(s.ball_path), socket = load_mesh(s.socket_path);
+  s.to_working = to_anatomical(s.frame);
+  const Eigen::Matrix3d& M = s.to_working;
+  transform_vertices(ball.V, M);
+  transform_vertices(socket.V, M);
+  for (auto& [name, p] : given) p = M * p;
+
+  if (!in.head_region.empty()) {
+    const auto v = parse_number_list(in.head_region, "--head-region", 4);
+    s.fit = fit_sphere_in_region(ball, M * Eigen::Vector3d(v[0], v[1], v[2]), v[3]);
+    s.cor_method = "sphere fit in region";
+  } else if (given.count("hip_centre")) {
+    s.fit.centre = given.at("hip_centre");
+    s.fit.radius = s.fit.rms_residual = std::nan("");
+    s.cor_method = "given (subject.json landmark hip_centre)";
+  } else if (in.cor == "auto") {
+    s.fit = locate_femoral_head(ball);
+    s.cor_method = "automatic sphere fit (long axis, RANSAC + geometric)";
+  } else {
+    const auto v = parse_number_list(in.cor, "--cor", 3);
+    s.fit.centre = M * Eigen::Vector3d(v[0], v[1], v[2]);
+    s.fit.radius = s.fit.rms_residual = std::nan("");
+    s.cor_method = "given";
+  }
+  if (s.neutral == Neutral::anatomical) {
+    const auto t0 = Clock::now();
+    given["hip_centre"] = s.fit.centre;  // frames share the COR chosen above
+    try {
+      s.frames = find_hip_frames(ball, socket, s.side, given, hfo);
+    } catch (const Error& e) {
+      throw Error(std::string(e.what()) +
+                  " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; --neutral scan "
+                  "uses the scan pose instead]");
+    }
+    s.frames->head = s.fit;
+    s.frames->femur.quality_mm = s.fit.rms_residual;
+    s.frames_ms = ms_since(t0);
+  }
+  s.joint.emplace(std::move(ball), std::move(socket), s.fit.centre, s.options);
+  return s;
+}
+
+Eigen::Matrix3d femur_pose(const Setup& s, const PoseAngles& a) {
+  return s.neutral == Neutral::anatomical ? femur_rotation(s.frames->pelvis, s.frames->femur, a, s.side)
+                                          : pose_rotation(a, s.side);
+}
+
+// ---- JSON ---------------------------------------------------------------------------------
+
+nlohmann::json num_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double detection_ms,
                          const ImpingementLevels& levels) {
@@ -37,7 +226,7 @@ nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double det
   j["vertices_tested"] = s.vertices_tested;
   j["vertices_no_surface"] = s.vertices_no_surface;
   j["vertices_beyond_reach"] = s.vertices_beyond_reach;
-  j["min_gap_mm"] = std::isnan(s.min_gap_mm) ? nlohmann::json(nullptr) : nlohmann::json(s.min_gap_mm);
+  j["min_gap_mm"] = num_or_null(s.min_gap_mm);
   j["vertices_penetrating"] = s.vertices_penetrating;
   j["area_penetrating_mm2"] = s.area_penetrating_mm2;
   nlohmann::json lv = nlohmann::json::array();
@@ -62,117 +251,242 @@ nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double det
   return j;
 }
 
-void write_body_ply(const std::string& path, const JointBody& body, const ScanGaps& gaps, const Eigen::Matrix3d& R,
-                    const Eigen::Vector3d& cor, const Eigen::Matrix3d& to_input, const ImpingementLevels& levels,
-                    bool is_ball) {
+nlohmann::json frame_json(const AnatomicalFrame& f, const Eigen::Matrix3d& to_input, const char* quality_name) {
+  nlohmann::json j;
+  j["definition"] = f.definition;
+  j["origin_mm"] = vec(to_input * f.origin);
+  j["x_axis"] = vec(to_input * f.axes.col(0));
+  j["y_axis"] = vec(to_input * f.axes.col(1));
+  j["z_axis"] = vec(to_input * f.axes.col(2));
+  nlohmann::json lm;
+  for (const auto& [name, p] : f.landmarks)
+    lm[name] = {{"position_mm", vec(to_input * p)}, {"source", f.landmark_source.count(name) ? f.landmark_source.at(name) : "found"}};
+  j["landmarks"] = lm;
+  j[quality_name] = num_or_null(f.quality_mm);
+  return j;
+}
+
+// The parts of summary.json every command writes: inputs, COR, maps, frames.
+nlohmann::json setup_json(const Setup& s) {
+  const Eigen::Matrix3d to_input = s.to_working.transpose();
+  const JointOptions& opt = s.options;
+  nlohmann::json j;
+  j["impinge_version"] = IMPINGE_VERSION;
+  j["ball_file"] = s.ball_path;
+  j["socket_file"] = s.socket_path;
+  j["side"] = s.side == Side::right ? "right" : "left";
+  j["input_frame"] = s.frame == FrameConvention::LPS ? "LPS" : "RAS";
+  j["cor_mm"] = vec(to_input * s.fit.centre);
+  j["cor_method"] = s.cor_method;
+  j["head_radius_mm"] = num_or_null(s.fit.radius);
+  j["sphere_fit_rms_mm"] = num_or_null(s.fit.rms_residual);
+  j["sphere_fit_points"] = s.fit.points_used;
+  j["scheme"] = opt.scheme->name();
+  j[opt.scheme->resolution_name()] = opt.scheme->resolution();
+  j["max_node_spacing_deg"] = opt.scheme->max_node_spacing() * kRadToDeg;
+  j["sampling_method"] = to_string(s.joint->ball().sampling.method);
+  j["mode"] = to_string(opt.mode);
+  j["levels_thresholds_mm"] = opt.levels.thresholds_mm;
+  j["occlusion_tolerance_mm"] = opt.occlusion_tolerance_mm;
+  j["neutral"] = s.neutral == Neutral::anatomical ? "anatomical" : "scan";
+  j["pose_convention"] =
+      "ISB joint coordinate system (Wu et al. 2002): flexion about the pelvic Z axis, adduction about the floating "
+      "axis, internal rotation about the femoral y axis; flexion, adduction and internal rotation positive; left "
+      "hips mirrored";
+  if (s.frames) {
+    nlohmann::json f;
+    f["pelvis"] = frame_json(s.frames->pelvis, to_input, "app_out_of_plane_mm");
+    f["femur"] = frame_json(s.frames->femur, to_input, "head_fit_rms_mm");
+    f["scan_pose_deg"] = {{"flexion", s.frames->scan_pose.flexion_deg},
+                          {"adduction", s.frames->scan_pose.adduction_deg},
+                          {"internal_rotation", s.frames->scan_pose.internal_rotation_deg}};
+    f["frames_ms"] = s.frames_ms;
+    f["axes_note"] = "axes and positions in the input files' frame; x anterior, y superior, z right (ISB)";
+    j["frames"] = f;
+  }
+  return j;
+}
+
+void write_json(const std::string& path, const nlohmann::json& j) {
+  std::ofstream os(path);
+  require(os.good(), path + ": cannot open for writing");
+  os << j.dump(2) << "\n";
+  require(os.good(), path + ": write failed");
+}
+
+// ---- meshes out ---------------------------------------------------------------------------
+
+// Vertices of `body` posed by R about the COR, in the input frame.
+Vertices posed_input(const Setup& s, const JointBody& body, const Eigen::Matrix3d& R) {
+  const Eigen::Matrix3d A = s.to_working.transpose() * R;
+  const Eigen::Vector3d c = s.to_working.transpose() * s.fit.centre;
+  Vertices V = (body.relative * A.transpose()).rowwise() + c.transpose();
+  return V;
+}
+
+std::vector<std::uint8_t> levels_of(const ScanGaps& g, const ImpingementLevels& levels) {
+  std::vector<std::uint8_t> out(g.gap_mm.size());
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = std::isnan(g.gap_mm[i]) ? 255 : static_cast<std::uint8_t>(levels.level(g.gap_mm[i]));
+  return out;
+}
+
+void write_body_ply(const std::string& path, const Setup& s, const JointBody& body, const ScanGaps& gaps,
+                    const Eigen::Matrix3d& R, bool is_ball) {
+  const ImpingementLevels& levels = s.options.levels;
   const Eigen::Index n = body.mesh.V.rows();
-  Vertices V(n, 3);
-  for (Eigen::Index i = 0; i < n; ++i) V.row(i) = (to_input * (cor + R * body.relative.row(i).transpose())).transpose();
+  const std::vector<std::uint8_t> lv = levels_of(gaps, levels);
   Eigen::VectorXf gap(n);
   Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
   Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
   for (Eigen::Index i = 0; i < n; ++i) {
     const auto k = static_cast<std::size_t>(i);
     gap[i] = gaps.gap_mm[k];
-    level[i] = std::isnan(gaps.gap_mm[k]) ? 255 : levels.level(gaps.gap_mm[k]);
+    level[i] = lv[k];
     const auto c = level_colour(level[i], levels.count(), is_ball);
     rgb.row(i) << c[0], c[1], c[2];
   }
-  write_gap_ply(path, V, body.mesh.F, gap, level, rgb);
+  write_gap_ply(path, posed_input(s, body, R), body.mesh.F, gap, level, rgb);
 }
 
-int run_distance(const std::string& ball_path_in, const std::string& socket_path_in, const std::string& subject_path,
-                 const std::string& cor_text, const std::string& head_region, const std::string& scheme_name,
-                 double resolution, const std::string& sampling_text, const std::string& mode_text,
-                 const std::string& pose_text, const std::string& side_text, const std::string& frame_text,
-                 const std::string& levels_text, double occlusion_tol, double max_radius, const std::string& out_dir) {
-  std::string ball_path = ball_path_in, socket_path = socket_path_in;
-  Side side = parse_side(side_text, "--side");
-  FrameConvention frame = parse_frame(frame_text, "--frame");
-  if (!subject_path.empty()) {
-    const SubjectInfo s = load_subject(subject_path);
-    side = s.side;
-    frame = s.frame;
-    if (ball_path.empty()) ball_path = s.femur_path;
-    if (socket_path.empty()) socket_path = s.pelvis_path;
-  }
-  require(!ball_path.empty(), "--ball is required (or --subject)");
-  require(!socket_path.empty(), "--socket is required (or --subject)");
-  JointOptions opt;
-  opt.scheme = make_scheme(scheme_name, resolution);  // validates before the expensive work
-  opt.mode = parse_distance_mode(mode_text);
-  opt.sampling = parse_sampling_method(sampling_text);
-  opt.occlusion_tolerance_mm = occlusion_tol;
-  opt.max_radius_mm = max_radius > 0 ? max_radius : std::numeric_limits<double>::infinity();
-  if (!levels_text.empty()) opt.levels = parse_levels(levels_text);
+// Both bones in one PolyData: the femur posed by R, then the pelvis; arrays gap_mm, level, body.
+void write_frame_vtp(const std::string& path, const Setup& s, const PoseResult& res, const Eigen::Matrix3d& R) {
+  const JointBody& b = s.joint->ball();
+  const JointBody& p = s.joint->socket();
+  const Eigen::Index nb = b.mesh.V.rows(), np = p.mesh.V.rows();
+  Vertices V(nb + np, 3);
+  V.topRows(nb) = posed_input(s, b, R);
+  V.bottomRows(np) = posed_input(s, p, Eigen::Matrix3d::Identity());
+  Faces F(b.mesh.F.rows() + p.mesh.F.rows(), 3);
+  F.topRows(b.mesh.F.rows()) = b.mesh.F;
+  F.bottomRows(p.mesh.F.rows()) = p.mesh.F.array() + static_cast<int>(nb);
+  PointArray gap{"gap_mm", {}, {}}, level{"level", {}, {}}, body{"body", {}, {}};
+  gap.f32 = res.ball_gaps.gap_mm;
+  gap.f32.insert(gap.f32.end(), res.socket_gaps.gap_mm.begin(), res.socket_gaps.gap_mm.end());
+  level.u8 = levels_of(res.ball_gaps, s.options.levels);
+  const auto ls = levels_of(res.socket_gaps, s.options.levels);
+  level.u8.insert(level.u8.end(), ls.begin(), ls.end());
+  body.u8.assign(static_cast<std::size_t>(nb), 0);
+  body.u8.resize(static_cast<std::size_t>(nb + np), 1);
+  write_vtp(path, V, F, {gap, level, body});
+}
+
+// ---- commands -----------------------------------------------------------------------------
+
+int run_distance(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo, const std::string& pose_text,
+                 const std::string& out_dir) {
   const PoseAngles pose = parse_pose(pose_text);
-  const Eigen::Matrix3d R = pose_rotation(pose, side);
-
-  TriangleMesh ball = load_mesh(ball_path), socket = load_mesh(socket_path);
-  const Eigen::Matrix3d M = to_anatomical(frame);
-  transform_vertices(ball.V, M);
-  transform_vertices(socket.V, M);
-
-  SphereFitResult fit;
-  std::string cor_method;
-  if (!head_region.empty()) {
-    const auto v = parse_number_list(head_region, "--head-region", 4);
-    fit = fit_sphere_in_region(ball, M * Eigen::Vector3d(v[0], v[1], v[2]), v[3]);
-    cor_method = "sphere fit in region";
-  } else if (cor_text == "auto") {
-    fit = fit_femoral_head(ball);
-    cor_method = "automatic sphere fit (RANSAC + geometric)";
-  } else {
-    const auto v = parse_number_list(cor_text, "--cor", 3);
-    fit.centre = M * Eigen::Vector3d(v[0], v[1], v[2]);
-    fit.radius = std::numeric_limits<double>::quiet_NaN();
-    fit.rms_residual = std::numeric_limits<double>::quiet_NaN();
-    cor_method = "given";
-  }
-  const Joint joint(std::move(ball), std::move(socket), fit.centre, opt);
-  const PoseResult res = joint.detect(R);
+  const Setup s = set_up(in, mo, fo);
+  const Eigen::Matrix3d R = femur_pose(s, pose);
+  const PoseResult res = s.joint->detect(R);
 
   fs::create_directories(out_dir);
-  const Eigen::Matrix3d to_input = M.transpose();
-  write_body_ply((fs::path(out_dir) / "ball_gaps.ply").string(), joint.ball(), res.ball_gaps, R, fit.centre, to_input,
-                 opt.levels, true);
-  write_body_ply((fs::path(out_dir) / "socket_gaps.ply").string(), joint.socket(), res.socket_gaps,
-                 Eigen::Matrix3d::Identity(), fit.centre, to_input, opt.levels, false);
-  write_map_png((fs::path(out_dir) / "ball_map.png").string(), joint.ball().map);
-  write_map_png((fs::path(out_dir) / "socket_map.png").string(), joint.socket().map);
+  write_body_ply((fs::path(out_dir) / "ball_gaps.ply").string(), s, s.joint->ball(), res.ball_gaps, R, true);
+  write_body_ply((fs::path(out_dir) / "socket_gaps.ply").string(), s, s.joint->socket(), res.socket_gaps,
+                 Eigen::Matrix3d::Identity(), false);
+  write_map_png((fs::path(out_dir) / "ball_map.png").string(), s.joint->ball().map);
+  write_map_png((fs::path(out_dir) / "socket_map.png").string(), s.joint->socket().map);
 
-  auto num_or_null = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
-  const Eigen::Vector3d cor_in = to_input * fit.centre;
-  nlohmann::json j;
-  j["ball_file"] = ball_path;
-  j["socket_file"] = socket_path;
-  j["side"] = side == Side::right ? "right" : "left";
-  j["input_frame"] = frame == FrameConvention::LPS ? "LPS" : "RAS";
-  j["cor_mm"] = {cor_in.x(), cor_in.y(), cor_in.z()};
-  j["cor_method"] = cor_method;
-  j["head_radius_mm"] = num_or_null(fit.radius);
-  j["sphere_fit_rms_mm"] = num_or_null(fit.rms_residual);
-  j["sphere_fit_points"] = fit.points_used;
-  const auto* grid = dynamic_cast<const EquiangularGrid*>(opt.scheme.get());
-  j["scheme"] = opt.scheme->name();
-  j[opt.scheme->resolution_name()] = opt.scheme->resolution();
-  j["precision_deg"] = grid ? nlohmann::json(grid->precision_deg()) : nlohmann::json(nullptr);
-  j["max_node_spacing_deg"] = opt.scheme->max_node_spacing() * kRadToDeg;
-  j["sampling_method"] = to_string(joint.ball().sampling.method);
-  j["mode"] = to_string(opt.mode);
-  j["pose_deg"] = {pose.flexion_deg, pose.abduction_deg, pose.rotation_deg};
-  j["pose_axes"] = "flexion about medio-lateral, abduction about antero-posterior, rotation about superior-inferior";
-  j["levels_thresholds_mm"] = opt.levels.thresholds_mm;
-  j["occlusion_tolerance_mm"] = opt.occlusion_tolerance_mm;
-  j["ball"] = scan_json(joint.ball(), res.ball, res.ball_detection_ms, opt.levels);
-  j["socket"] = scan_json(joint.socket(), res.socket, res.socket_detection_ms, opt.levels);
-  std::ofstream os(fs::path(out_dir) / "summary.json");
-  require(os.good(), out_dir + "/summary.json: cannot open for writing");
-  os << j.dump(2) << "\n";
+  nlohmann::json j = setup_json(s);
+  j["pose_deg"] = {pose.flexion_deg, pose.adduction_deg, pose.internal_rotation_deg};
+  j["pose_names"] = {"flexion", "adduction", "internal_rotation"};
+  j["ball"] = scan_json(s.joint->ball(), res.ball, res.ball_detection_ms, s.options.levels);
+  j["socket"] = scan_json(s.joint->socket(), res.socket, res.socket_detection_ms, s.options.levels);
+  write_json((fs::path(out_dir) / "summary.json").string(), j);
   std::cout << "ball: " << res.ball.vertices_tested << " tested, min gap " << res.ball.min_gap_mm << " mm, "
             << res.ball.vertices_penetrating << " penetrating; socket: " << res.socket.vertices_tested
             << " tested, min gap " << res.socket.min_gap_mm << " mm, " << res.socket.vertices_penetrating
             << " penetrating; written to " << out_dir << "\n";
+  return 0;
+}
+
+struct MotionOutput {
+  int vtp_every = 0;  // 0: automatic (every frame up to 100 frames, else at most 100 files)
+  bool quiet = false;
+};
+
+int run_motion(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo, const std::string& motion_path,
+               const MotionOutput& mout, const std::string& out_dir) {
+  const auto t_start = Clock::now();
+  require(!in.subject.empty() || (!in.ball.empty() && !in.socket.empty()), "motion: --subject (or --ball and --socket) is required");
+  // The motion file is read (and fully checked) before anything is built or written.
+  Side side = parse_side(in.side, "--side");
+  if (!in.subject.empty()) side = load_subject(in.subject).side;
+  const Motion motion = load_motion(motion_path, side);
+  require(mout.vtp_every >= 0, "--vtp-every must be >= 0");
+  const auto t_setup = Clock::now();
+  const Setup s = set_up(in, mo, fo);
+  const double setup_ms = ms_since(t_setup);
+
+  fs::create_directories(fs::path(out_dir) / "gaps");
+  const std::size_t n = motion.frames();
+  const int every = mout.vtp_every > 0 ? mout.vtp_every : static_cast<int>((n + 99) / 100);
+  const ImpingementLevels& levels = s.options.levels;
+  std::ofstream csv(fs::path(out_dir) / "frames.csv");
+  require(csv.good(), out_dir + "/frames.csv: cannot open for writing");
+  csv << "frame,time_s,flexion_deg,adduction_deg,internal_rotation_deg,ball_min_gap_mm,socket_min_gap_mm,"
+         "penetrating_area_mm2,ball_penetrating_area_mm2";
+  for (int k = 0; k < levels.count(); ++k) csv << ",socket_level" << k << "_area_mm2";
+  csv << ",socket_closest_x_mm,socket_closest_y_mm,socket_closest_z_mm,detection_ms\n";
+  csv << std::setprecision(9);
+  std::vector<PvdEntry> pvd;
+  const bool bar = !mout.quiet && isatty(fileno(stderr));
+  double detect_ms = 0, write_ms = 0;
+  const JointBody& socket = s.joint->socket();
+  for (std::size_t f = 0; f < n; ++f) {
+    const Eigen::Matrix3d R = femur_pose(s, motion.angles[f]);
+    auto t0 = Clock::now();
+    const PoseResult res = s.joint->detect(R);
+    const double dms = ms_since(t0);
+    detect_ms += dms;
+    t0 = Clock::now();
+    // Closest socket vertex (in the pelvic frame when anatomical, else the input frame).
+    Eigen::Vector3d closest = Eigen::Vector3d::Constant(std::nan(""));
+    float best = std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i < res.socket_gaps.gap_mm.size(); ++i)
+      if (res.socket_gaps.gap_mm[i] < best) best = res.socket_gaps.gap_mm[i], closest = socket.mesh.V.row(static_cast<Eigen::Index>(i)).transpose();
+    if (std::isfinite(best))
+      closest = s.frames ? s.frames->pelvis.to_local(closest) : Eigen::Vector3d(s.to_working.transpose() * closest);
+    const PoseAngles& a = motion.angles[f];
+    csv << f << ',' << motion.time_s[f] << ',' << a.flexion_deg << ',' << a.adduction_deg << ','
+        << a.internal_rotation_deg << ',' << res.ball.min_gap_mm << ',' << res.socket.min_gap_mm << ','
+        << res.socket.area_penetrating_mm2 << ',' << res.ball.area_penetrating_mm2;
+    for (double area : res.socket.level_area_mm2) csv << ',' << area;
+    csv << ',' << closest.x() << ',' << closest.y() << ',' << closest.z() << ',' << dms << '\n';
+    if (f % static_cast<std::size_t>(every) == 0) {
+      std::ostringstream name;
+      name << "gaps/frame_" << std::setw(6) << std::setfill('0') << f << ".vtp";
+      write_frame_vtp((fs::path(out_dir) / name.str()).string(), s, res, R);
+      pvd.push_back({motion.time_s[f], name.str()});
+    }
+    write_ms += ms_since(t0);
+    if (bar && (f % 10 == 0 || f + 1 == n)) {
+      const int w = 40, done = static_cast<int>(w * (f + 1) / n);
+      std::fprintf(stderr, "\r[%s%s] %zu/%zu frames", std::string(static_cast<std::size_t>(done), '#').c_str(),
+                   std::string(static_cast<std::size_t>(w - done), ' ').c_str(), f + 1, n);
+      if (f + 1 == n) std::fprintf(stderr, "\n");
+    }
+  }
+  require(csv.good(), out_dir + "/frames.csv: write failed");
+  write_pvd((fs::path(out_dir) / "gaps.pvd").string(), pvd);
+  nlohmann::json j = setup_json(s);
+  j["motion_file"] = motion_path;
+  j["motion_format"] = motion.format;
+  j["motion_frames"] = n;
+  j["vtp_every"] = every;
+  j["vtp_files"] = pvd.size();
+  j["timings_ms"] = {{"setup_total", setup_ms},
+                     {"ball_sampling", s.joint->ball().sampling_ms},
+                     {"socket_sampling", s.joint->socket().sampling_ms},
+                     {"frames", s.frames_ms},
+                     {"detection_total", detect_ms},
+                     {"detection_per_frame", n ? detect_ms / static_cast<double>(n) : 0.0},
+                     {"output", write_ms},
+                     {"total", ms_since(t_start)}};
+  write_json((fs::path(out_dir) / "summary.json").string(), j);
+  if (!mout.quiet)
+    std::cout << "motion: " << n << " frames in " << std::fixed << std::setprecision(1) << ms_since(t_start)
+              << " ms (setup " << setup_ms << " ms, detection " << detect_ms << " ms); written to " << out_dir << "\n";
   return 0;
 }
 
@@ -191,13 +505,12 @@ int run_generate(int triangles, double cam, double coverage, const std::string& 
                       {"femur", "femur_r.ply"},
                       {"pelvis", "pelvis.ply"},
                       {"generated", true},
+                      {"neutral", "scan"},
                       {"true_cor_mm", {h.cor.x(), h.cor.y(), h.cor.z()}},
                       {"head_radius_mm", o.head_radius_mm}};
-  std::ofstream os(fs::path(out_dir) / "subject.json");
-  require(os.good(), out_dir + "/subject.json: cannot open for writing");
-  os << s.dump(2) << "\n";
+  write_json((fs::path(out_dir) / "subject.json").string(), s);
   std::cout << "generated hip model: " << h.ball.F.rows() << " + " << h.socket.F.rows() << " triangles in " << out_dir
-            << "\n";
+            << " (a proximal femur and a cup: neutral is the scan pose)\n";
   return 0;
 }
 
@@ -205,51 +518,36 @@ int run_generate(int triangles, double cam, double coverage, const std::string& 
 
 int main(int argc, char** argv) {
   CLI::App app{"impinge: impingement detection in ball-and-socket joints by spherical distance maps"};
+  app.set_version_flag("--version", std::string("impinge ") + IMPINGE_VERSION);
   app.require_subcommand(1);
 
+  InputOptions in;
+  MapOptions maps;
+  FrameOptions frames;
+  std::string pose = "0,0,0", out;
   auto* dist = app.add_subcommand("distance", "Per-vertex gap between ball (femur) and socket (pelvis) at one pose");
-  std::string ball, socket, subject, cor = "auto", head_region, mode = "exact", pose = "0,0,0", out, side = "right",
-                                     frame = "RAS", levels, scheme = "equiangular", sampling = "auto";
-  double precision = 0.5, turns = 0, resolution = 0, occlusion_tol = 1.0, max_radius = 0;
-  dist->add_option("--ball", ball, "Ball mesh (femur): PLY, STL, OBJ or OFF, mm");
-  dist->add_option("--socket", socket, "Socket mesh (pelvis): PLY, STL, OBJ or OFF, mm");
-  dist->add_option("--subject", subject,
-                   "subject.json giving side and frame (LPS or RAS); supplies --ball/--socket when omitted");
-  dist->add_option("--cor", cor,
-                   "Centre of rotation: 'auto' (sphere fit of the femoral head) or X,Y,Z in mm in the "
-                   "input files' frame")
-      ->capture_default_str();
-  dist->add_option("--head-region", head_region,
-                   "X,Y,Z,R: fit the head sphere to femur vertices within R mm of (X,Y,Z), input frame");
-  std::string registered;
-  for (const auto& [name, res] : scheme_names())
-    registered += (registered.empty() ? "" : ", ") + name + " (" + res + ")";
-  dist->add_option("--scheme", scheme, "Sampling scheme of the maps: " + registered)->capture_default_str();
-  dist->add_option("--resolution", resolution, "Resolution parameter of the scheme (any scheme)");
-  dist->add_option("--precision", precision,
-                   "Equiangular precision p in degrees (180/p integral); the resolution "
-                   "when neither --resolution nor --turns is given")
-      ->capture_default_str();
-  dist->add_option("--turns", turns, "Helix turns k (w = k^2 nodes; thesis Table 6: 229, 458, 2292, 4584)");
-  dist->add_option("--sampling", sampling, "auto, rasterize, resample or ray-cast (naive, small meshes only)")
-      ->capture_default_str();
-  dist->add_option("--mode", mode, "Distance mode: 'linear' (thesis Alg. 1) or 'exact' (ray-plane)")
-      ->capture_default_str();
-  dist->add_option("--pose", pose,
-                   "FLEX,ABD,ROT in degrees about the subject's anatomical axes through the COR: flexion about the "
-                   "medio-lateral axis (+ = knee forward), abduction about the antero-posterior axis (+ = knee "
-                   "outward), rotation about the superior-inferior axis (+ = internal). Applied to the ball as "
-                   "R = Rx(flex) Ry(abd) Rz(rot), mirrored for the left side")
-      ->capture_default_str();
-  dist->add_option("--side", side, "right or left (overridden by --subject)")->capture_default_str();
-  dist->add_option("--frame", frame, "Input frame LPS or RAS (overridden by --subject)")->capture_default_str();
-  dist->add_option("--levels", levels, "Impingement thresholds in mm, decreasing, e.g. 4,2.667,1.333,0");
-  dist->add_option("--occlusion-tolerance", occlusion_tol,
-                   "mm: vertices farther than their own first surface plus this are skipped (beyond reach)")
-      ->capture_default_str();
-  dist->add_option("--max-radius", max_radius, "mm: test only vertices within this distance of the COR (0 = all)")
-      ->capture_default_str();
+  add_input_options(dist, in);
+  add_map_options(dist, maps);
+  add_frame_options(dist, frames);
+  dist->add_option("--pose", pose, kPoseHelp)->capture_default_str();
   dist->add_option("--out", out, "Output folder")->required();
+
+  std::string motion_file, motion_out;
+  MotionOutput mout;
+  auto* mot = app.add_subcommand(
+      "motion", "Both scans at every frame of a motion (CSV: time_s, flexion_deg, adduction_deg, "
+                "internal_rotation_deg; or OpenSim .mot/.sto with hip_flexion_r|l, hip_adduction_r|l, "
+                "hip_rotation_r|l); maps built once. Writes frames.csv, gaps.pvd (ParaView) and summary.json");
+  add_input_options(mot, in);
+  add_map_options(mot, maps);
+  add_frame_options(mot, frames);
+  mot->add_option("--motion", motion_file, "Motion file: .csv, .mot or .sto")->required();
+  mot->add_option("--vtp-every", mout.vtp_every,
+                  "Write the posed bones (gaps/frame_N.vtp) every N frames; 0 = every frame up to 100 frames, "
+                  "else at most 100 files")
+      ->capture_default_str();
+  mot->add_flag("--quiet", mout.quiet, "No progress bar or final line");
+  mot->add_option("--out", motion_out, "Output folder")->required();
 
   auto* gen = app.add_subcommand("generate", "Write a generated hip model (femur_r.ply, pelvis.ply, subject.json)");
   int triangles = 3000;
@@ -266,10 +564,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   try {
-    if (*dist)
-      return run_distance(ball, socket, subject, cor, head_region, scheme,
-                          resolution > 0 ? resolution : (turns > 0 ? turns : precision), sampling, mode, pose, side,
-                          frame, levels, occlusion_tol, max_radius, out);
+    if (*dist) return run_distance(in, maps, frames, pose, out);
+    if (*mot) return run_motion(in, maps, frames, motion_file, mout, motion_out);
     if (*gen) return run_generate(triangles, cam, coverage, gen_out);
   } catch (const std::exception& e) {
     std::cerr << "impinge: error: " << e.what() << "\n";

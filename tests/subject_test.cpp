@@ -39,5 +39,22 @@ TEST(Subject, BadFilesNameFileAndKey) {
   expect(R"({"side": "up", "frame": "LPS", "femur": "f", "pelvis": "p"})", "side 'up'");
   expect(R"({"side": "right", "frame": "XYZ", "femur": "f", "pelvis": "p"})", "frame 'XYZ'");
   expect(R"({"side": "right", "frame": "RAS", "units": "cm", "femur": "f", "pelvis": "p"})", "units");
+  expect(R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p", "landmarks": {"asis": [1, 2, 3]}})",
+         "unknown name 'asis'");
+  expect(R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p", "landmarks": {"asis_left": [1, 2]}})",
+         "'asis_left' must be three finite numbers");
+  expect(R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p", "landmarks": [1]})", "'landmarks'");
+  expect(R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p", "neutral": "supine"})",
+         "neutral 'supine'");
   EXPECT_THROW(load_subject(d + "/absent.json"), Error);
+}
+
+TEST(Subject, LandmarksAreReadInTheFilesFrame) {
+  const std::string d = test::temp_dir("subject_landmarks");
+  test::write_text(d + "/subject.json", R"({"side": "right", "frame": "LPS", "femur": "f.ply", "pelvis": "p.ply",
+      "landmarks": {"asis_right": [-10.5, 2, 3], "hip_centre": [0, 0, 1e2]}})");
+  const SubjectInfo s = load_subject(d + "/subject.json");
+  ASSERT_EQ(s.landmarks.size(), 2u);
+  EXPECT_EQ(s.landmarks.at("asis_right"), Eigen::Vector3d(-10.5, 2, 3));
+  EXPECT_EQ(s.landmarks.at("hip_centre"), Eigen::Vector3d(0, 0, 100));
 }

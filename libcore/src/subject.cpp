@@ -5,6 +5,8 @@
 #include <nlohmann/json.hpp>
 
 #include "impinge/error.hpp"
+#include "impinge/femur_frame.hpp"
+#include "impinge/pelvis_frame.hpp"
 
 namespace impinge {
 
@@ -43,6 +45,28 @@ SubjectInfo load_subject(const std::string& json_path) {
   if (j.contains("units")) require(str("units") == "mm", json_path + ": units must be 'mm'");
   s.femur_path = (dir / str("femur")).string();
   s.pelvis_path = (dir / str("pelvis")).string();
+  if (j.contains("neutral")) {
+    s.neutral = str("neutral");
+    parse_neutral(s.neutral, json_path + ": key 'neutral'");
+  }
+  if (j.contains("landmarks")) {
+    const auto& lm = j["landmarks"];
+    require(lm.is_object(), json_path + ": key 'landmarks' must be an object {name: [x, y, z]}");
+    for (const auto& [name, value] : lm.items()) {
+      bool known = name == "hip_centre";
+      for (const char* n : kPelvisLandmarkNames) known = known || name == n;
+      for (const char* n : kFemurLandmarkNames) known = known || name == n;
+      require(known, json_path + ": landmarks: unknown name '" + name + "'");
+      bool ok = value.is_array() && value.size() == 3;
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      for (std::size_t k = 0; ok && k < 3; ++k) {
+        ok = value[k].is_number();
+        if (ok) p[static_cast<Eigen::Index>(k)] = value[k].get<double>();
+      }
+      require(ok && p.allFinite(), json_path + ": landmarks: '" + name + "' must be three finite numbers [x, y, z] (mm)");
+      s.landmarks[name] = p;
+    }
+  }
   return s;
 }
 

@@ -145,4 +145,9 @@ std::shared_ptr<const SamplingScheme> make_scheme(const std::string& name, doubl
 /// "precision_deg"}.
 std::vector<std::pair<std::string, std::string>> scheme_names();
 
+/// The default resolution of the registered scheme `name` (its own unit): the equivalent of an
+/// equiangular grid at 0.5 deg. Throws impinge::Error naming the registered schemes when
+/// `name` is unknown.
+double default_resolution(const std::string& name);
+
 }  // namespace impinge
