@@ -21,6 +21,7 @@
 #include "impinge/error.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/hip_frames.hpp"
+#include "impinge/hip_joint.hpp"
 #include "impinge/joint.hpp"
 #include "impinge/map_image.hpp"
 #include "impinge/mesh_io.hpp"
@@ -121,13 +122,12 @@ struct Setup {
   Side side = Side::right;
   FrameConvention frame = FrameConvention::RAS;
   Eigen::Matrix3d to_working = Eigen::Matrix3d::Identity();  // input frame -> working frame
-  JointOptions options;
-  Neutral neutral = Neutral::anatomical;
+  HipJointOptions options;
   SphereFitResult fit;
   std::string cor_method;
-  std::optional<HipFrames> frames;
-  std::optional<Joint> joint;
-  double frames_ms = 0;
+  std::optional<HipJoint> hip;
+  const Joint& joint() const { return hip->joint(); }
+  const JointOptions& joint_options() const { return options.joint; }
 };
 
 double scheme_resolution(const MapOptions& m) {
@@ -143,7 +143,7 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
   s.socket_path = in.socket;
   s.side = parse_side(in.side, "--side");
   s.frame = parse_frame(in.frame, "--frame");
-  if (!fo.neutral.empty()) s.neutral = parse_neutral(fo.neutral, "--neutral");
+  if (!fo.neutral.empty()) s.options.neutral = parse_neutral(fo.neutral, "--neutral");
   Landmarks given;
   if (!in.subject.empty()) {
     const SubjectInfo info = load_subject(in.subject);
@@ -152,20 +152,20 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
     if (s.ball_path.empty()) s.ball_path = info.femur_path;
     if (s.socket_path.empty()) s.socket_path = info.pelvis_path;
     given = info.landmarks;
-    if (fo.neutral.empty() && !info.neutral.empty()) s.neutral = parse_neutral(info.neutral, in.subject);
+    if (fo.neutral.empty() && !info.neutral.empty()) s.options.neutral = parse_neutral(info.neutral, in.subject);
   }
   require(!s.ball_path.empty(), "--ball is required (or --subject)");
   require(!s.socket_path.empty(), "--socket is required (or --subject)");
-  HipFrameOptions hfo;
-  hfo.pelvis = parse_pelvis_frame_kind(fo.pelvis_frame, "--pelvis-frame");
-  hfo.femur = parse_femur_frame_kind(fo.femur_frame, "--femur-frame");
+  s.options.frames.pelvis = parse_pelvis_frame_kind(fo.pelvis_frame, "--pelvis-frame");
+  s.options.frames.femur = parse_femur_frame_kind(fo.femur_frame, "--femur-frame");
   // Validate the cheap options before the expensive work.
-  s.options.scheme = make_scheme(mo.scheme, scheme_resolution(mo));
-  s.options.mode = parse_distance_mode(mo.mode);
-  s.options.sampling = parse_sampling_method(mo.sampling);
-  s.options.occlusion_tolerance_mm = mo.occlusion_tolerance;
-  s.options.max_radius_mm = mo.max_radius > 0 ? mo.max_radius : std::numeric_limits<double>::infinity();
-  if (!mo.levels.empty()) s.options.levels = parse_levels(mo.levels);
+  JointOptions& jo = s.options.joint;
+  jo.scheme = make_scheme(mo.scheme, scheme_resolution(mo));
+  jo.mode = parse_distance_mode(mo.mode);
+  jo.sampling = parse_sampling_method(mo.sampling);
+  jo.occlusion_tolerance_mm = mo.occlusion_tolerance;
+  jo.max_radius_mm = mo.max_radius > 0 ? mo.max_radius : std::numeric_limits<double>::infinity();
+  if (!mo.levels.empty()) jo.levels = parse_levels(mo.levels);
 
   TriangleMesh ball = load_mesh(s.ball_path), socket = load_mesh(s.socket_path);
   s.to_working = to_anatomical(s.frame);
@@ -191,27 +191,15 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
     s.fit.radius = s.fit.rms_residual = std::nan("");
     s.cor_method = "given";
   }
-  if (s.neutral == Neutral::anatomical) {
-    const auto t0 = Clock::now();
-    given["hip_centre"] = s.fit.centre;  // frames share the COR chosen above
-    try {
-      s.frames = find_hip_frames(ball, socket, s.side, given, hfo);
-    } catch (const Error& e) {
-      throw Error(std::string(e.what()) +
-                  " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; --neutral scan "
-                  "uses the scan pose instead]");
-    }
-    s.frames->head = s.fit;
-    s.frames->femur.quality_mm = s.fit.rms_residual;
-    s.frames_ms = ms_since(t0);
+  try {
+    s.hip.emplace(std::move(ball), std::move(socket), s.side, s.fit.centre, given, s.options);
+  } catch (const Error& e) {
+    if (s.options.neutral != Neutral::anatomical) throw;
+    throw Error(std::string(e.what()) +
+                " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; --neutral scan "
+                "uses the scan pose instead]");
   }
-  s.joint.emplace(std::move(ball), std::move(socket), s.fit.centre, s.options);
   return s;
-}
-
-Eigen::Matrix3d femur_pose(const Setup& s, const PoseAngles& a) {
-  return s.neutral == Neutral::anatomical ? femur_rotation(s.frames->pelvis, s.frames->femur, a, s.side)
-                                          : pose_rotation(a, s.side);
 }
 
 // ---- JSON ---------------------------------------------------------------------------------
@@ -269,7 +257,7 @@ nlohmann::json frame_json(const AnatomicalFrame& f, const Eigen::Matrix3d& to_in
 // The parts of summary.json every command writes: inputs, COR, maps, frames.
 nlohmann::json setup_json(const Setup& s) {
   const Eigen::Matrix3d to_input = s.to_working.transpose();
-  const JointOptions& opt = s.options;
+  const JointOptions& opt = s.joint_options();
   nlohmann::json j;
   j["impinge_version"] = IMPINGE_VERSION;
   j["ball_file"] = s.ball_path;
@@ -284,23 +272,25 @@ nlohmann::json setup_json(const Setup& s) {
   j["scheme"] = opt.scheme->name();
   j[opt.scheme->resolution_name()] = opt.scheme->resolution();
   j["max_node_spacing_deg"] = opt.scheme->max_node_spacing() * kRadToDeg;
-  j["sampling_method"] = to_string(s.joint->ball().sampling.method);
+  j["sampling_method"] = to_string(s.joint().ball().sampling.method);
   j["mode"] = to_string(opt.mode);
   j["levels_thresholds_mm"] = opt.levels.thresholds_mm;
   j["occlusion_tolerance_mm"] = opt.occlusion_tolerance_mm;
-  j["neutral"] = s.neutral == Neutral::anatomical ? "anatomical" : "scan";
+  j["neutral"] = s.options.neutral == Neutral::anatomical ? "anatomical" : "scan";
   j["pose_convention"] =
       "ISB joint coordinate system (Wu et al. 2002): flexion about the pelvic Z axis, adduction about the floating "
       "axis, internal rotation about the femoral y axis; flexion, adduction and internal rotation positive; left "
       "hips mirrored";
-  if (s.frames) {
+  if (const auto& frames = s.hip->frames()) {
     nlohmann::json f;
-    f["pelvis"] = frame_json(s.frames->pelvis, to_input, "app_out_of_plane_mm");
-    f["femur"] = frame_json(s.frames->femur, to_input, "head_fit_rms_mm");
-    f["scan_pose_deg"] = {{"flexion", s.frames->scan_pose.flexion_deg},
-                          {"adduction", s.frames->scan_pose.adduction_deg},
-                          {"internal_rotation", s.frames->scan_pose.internal_rotation_deg}};
-    f["frames_ms"] = s.frames_ms;
+    AnatomicalFrame femur = frames->femur;
+    femur.quality_mm = s.fit.rms_residual;
+    f["pelvis"] = frame_json(frames->pelvis, to_input, "app_out_of_plane_mm");
+    f["femur"] = frame_json(femur, to_input, "head_fit_rms_mm");
+    f["scan_pose_deg"] = {{"flexion", frames->scan_pose.flexion_deg},
+                          {"adduction", frames->scan_pose.adduction_deg},
+                          {"internal_rotation", frames->scan_pose.internal_rotation_deg}};
+    f["frames_ms"] = s.hip->frames_ms();
     f["axes_note"] = "axes and positions in the input files' frame; x anterior, y superior, z right (ISB)";
     j["frames"] = f;
   }
@@ -316,13 +306,11 @@ void write_json(const std::string& path, const nlohmann::json& j) {
 
 // ---- meshes out ---------------------------------------------------------------------------
 
-// Vertices of `body` posed by R about the COR, in the input frame.
-Vertices posed_input(const Setup& s, const JointBody& body, const Eigen::Matrix3d& R) {
-  const Eigen::Matrix3d A = s.to_working.transpose() * R;
-  const Eigen::Vector3d c = s.to_working.transpose() * s.fit.centre;
-  Vertices V = (body.relative * A.transpose()).rowwise() + c.transpose();
-  return V;
+// Femur posed by R (joint frame) or the pelvis, in the input frame.
+Vertices femur_input(const Setup& s, const Eigen::Matrix3d& R) {
+  return (s.hip->posed_femur(R) * s.to_working).eval();  // rows: v^T M = (M^T v)^T, M^T = input <- working
 }
+Vertices pelvis_input(const Setup& s) { return (s.hip->pelvis_vertices() * s.to_working).eval(); }
 
 std::vector<std::uint8_t> levels_of(const ScanGaps& g, const ImpingementLevels& levels) {
   std::vector<std::uint8_t> out(g.gap_mm.size());
@@ -332,8 +320,8 @@ std::vector<std::uint8_t> levels_of(const ScanGaps& g, const ImpingementLevels& 
 }
 
 void write_body_ply(const std::string& path, const Setup& s, const JointBody& body, const ScanGaps& gaps,
-                    const Eigen::Matrix3d& R, bool is_ball) {
-  const ImpingementLevels& levels = s.options.levels;
+                    const Vertices& V, bool is_ball) {
+  const ImpingementLevels& levels = s.joint_options().levels;
   const Eigen::Index n = body.mesh.V.rows();
   const std::vector<std::uint8_t> lv = levels_of(gaps, levels);
   Eigen::VectorXf gap(n);
@@ -346,25 +334,25 @@ void write_body_ply(const std::string& path, const Setup& s, const JointBody& bo
     const auto c = level_colour(level[i], levels.count(), is_ball);
     rgb.row(i) << c[0], c[1], c[2];
   }
-  write_gap_ply(path, posed_input(s, body, R), body.mesh.F, gap, level, rgb);
+  write_gap_ply(path, V, body.mesh.F, gap, level, rgb);
 }
 
 // Both bones in one PolyData: the femur posed by R, then the pelvis; arrays gap_mm, level, body.
 void write_frame_vtp(const std::string& path, const Setup& s, const PoseResult& res, const Eigen::Matrix3d& R) {
-  const JointBody& b = s.joint->ball();
-  const JointBody& p = s.joint->socket();
+  const JointBody& b = s.joint().ball();
+  const JointBody& p = s.joint().socket();
   const Eigen::Index nb = b.mesh.V.rows(), np = p.mesh.V.rows();
   Vertices V(nb + np, 3);
-  V.topRows(nb) = posed_input(s, b, R);
-  V.bottomRows(np) = posed_input(s, p, Eigen::Matrix3d::Identity());
+  V.topRows(nb) = femur_input(s, R);
+  V.bottomRows(np) = pelvis_input(s);
   Faces F(b.mesh.F.rows() + p.mesh.F.rows(), 3);
   F.topRows(b.mesh.F.rows()) = b.mesh.F;
   F.bottomRows(p.mesh.F.rows()) = p.mesh.F.array() + static_cast<int>(nb);
   PointArray gap{"gap_mm", {}, {}}, level{"level", {}, {}}, body{"body", {}, {}};
   gap.f32 = res.ball_gaps.gap_mm;
   gap.f32.insert(gap.f32.end(), res.socket_gaps.gap_mm.begin(), res.socket_gaps.gap_mm.end());
-  level.u8 = levels_of(res.ball_gaps, s.options.levels);
-  const auto ls = levels_of(res.socket_gaps, s.options.levels);
+  level.u8 = levels_of(res.ball_gaps, s.joint_options().levels);
+  const auto ls = levels_of(res.socket_gaps, s.joint_options().levels);
   level.u8.insert(level.u8.end(), ls.begin(), ls.end());
   body.u8.assign(static_cast<std::size_t>(nb), 0);
   body.u8.resize(static_cast<std::size_t>(nb + np), 1);
@@ -377,21 +365,22 @@ int run_distance(const InputOptions& in, const MapOptions& mo, const FrameOption
                  const std::string& out_dir) {
   const PoseAngles pose = parse_pose(pose_text);
   const Setup s = set_up(in, mo, fo);
-  const Eigen::Matrix3d R = femur_pose(s, pose);
-  const PoseResult res = s.joint->detect(R);
+  const Eigen::Matrix3d R = s.hip->femur_rotation(pose);
+  const PoseResult res = s.joint().detect(R);
 
   fs::create_directories(out_dir);
-  write_body_ply((fs::path(out_dir) / "ball_gaps.ply").string(), s, s.joint->ball(), res.ball_gaps, R, true);
-  write_body_ply((fs::path(out_dir) / "socket_gaps.ply").string(), s, s.joint->socket(), res.socket_gaps,
-                 Eigen::Matrix3d::Identity(), false);
-  write_map_png((fs::path(out_dir) / "ball_map.png").string(), s.joint->ball().map);
-  write_map_png((fs::path(out_dir) / "socket_map.png").string(), s.joint->socket().map);
+  write_body_ply((fs::path(out_dir) / "ball_gaps.ply").string(), s, s.joint().ball(), res.ball_gaps,
+                 femur_input(s, R), true);
+  write_body_ply((fs::path(out_dir) / "socket_gaps.ply").string(), s, s.joint().socket(), res.socket_gaps,
+                 pelvis_input(s), false);
+  write_map_png((fs::path(out_dir) / "ball_map.png").string(), s.joint().ball().map);
+  write_map_png((fs::path(out_dir) / "socket_map.png").string(), s.joint().socket().map);
 
   nlohmann::json j = setup_json(s);
   j["pose_deg"] = {pose.flexion_deg, pose.adduction_deg, pose.internal_rotation_deg};
   j["pose_names"] = {"flexion", "adduction", "internal_rotation"};
-  j["ball"] = scan_json(s.joint->ball(), res.ball, res.ball_detection_ms, s.options.levels);
-  j["socket"] = scan_json(s.joint->socket(), res.socket, res.socket_detection_ms, s.options.levels);
+  j["ball"] = scan_json(s.joint().ball(), res.ball, res.ball_detection_ms, s.joint_options().levels);
+  j["socket"] = scan_json(s.joint().socket(), res.socket, res.socket_detection_ms, s.joint_options().levels);
   write_json((fs::path(out_dir) / "summary.json").string(), j);
   std::cout << "ball: " << res.ball.vertices_tested << " tested, min gap " << res.ball.min_gap_mm << " mm, "
             << res.ball.vertices_penetrating << " penetrating; socket: " << res.socket.vertices_tested
@@ -421,7 +410,7 @@ int run_motion(const InputOptions& in, const MapOptions& mo, const FrameOptions&
   fs::create_directories(fs::path(out_dir) / "gaps");
   const std::size_t n = motion.frames();
   const int every = mout.vtp_every > 0 ? mout.vtp_every : static_cast<int>((n + 99) / 100);
-  const ImpingementLevels& levels = s.options.levels;
+  const ImpingementLevels& levels = s.joint_options().levels;
   std::ofstream csv(fs::path(out_dir) / "frames.csv");
   require(csv.good(), out_dir + "/frames.csv: cannot open for writing");
   csv << "frame,time_s,flexion_deg,adduction_deg,internal_rotation_deg,ball_min_gap_mm,socket_min_gap_mm,"
@@ -432,11 +421,12 @@ int run_motion(const InputOptions& in, const MapOptions& mo, const FrameOptions&
   std::vector<PvdEntry> pvd;
   const bool bar = !mout.quiet && isatty(fileno(stderr));
   double detect_ms = 0, write_ms = 0;
-  const JointBody& socket = s.joint->socket();
+  const JointBody& socket = s.joint().socket();
+  PoseResult res;
   for (std::size_t f = 0; f < n; ++f) {
-    const Eigen::Matrix3d R = femur_pose(s, motion.angles[f]);
+    const Eigen::Matrix3d R = s.hip->femur_rotation(motion.angles[f]);
     auto t0 = Clock::now();
-    const PoseResult res = s.joint->detect(R);
+    s.joint().detect(R, Eigen::Vector3d::Zero(), res);
     const double dms = ms_since(t0);
     detect_ms += dms;
     t0 = Clock::now();
@@ -444,9 +434,13 @@ int run_motion(const InputOptions& in, const MapOptions& mo, const FrameOptions&
     Eigen::Vector3d closest = Eigen::Vector3d::Constant(std::nan(""));
     float best = std::numeric_limits<float>::infinity();
     for (std::size_t i = 0; i < res.socket_gaps.gap_mm.size(); ++i)
-      if (res.socket_gaps.gap_mm[i] < best) best = res.socket_gaps.gap_mm[i], closest = socket.mesh.V.row(static_cast<Eigen::Index>(i)).transpose();
-    if (std::isfinite(best))
-      closest = s.frames ? s.frames->pelvis.to_local(closest) : Eigen::Vector3d(s.to_working.transpose() * closest);
+      if (res.socket_gaps.gap_mm[i] < best)
+        best = res.socket_gaps.gap_mm[i], closest = socket.relative.row(static_cast<Eigen::Index>(i)).transpose();
+    if (std::isfinite(best)) {
+      closest = s.hip->to_working(closest);
+      closest = s.hip->frames() ? s.hip->frames()->pelvis.to_local(closest)
+                                : Eigen::Vector3d(s.to_working.transpose() * closest);
+    }
     const PoseAngles& a = motion.angles[f];
     csv << f << ',' << motion.time_s[f] << ',' << a.flexion_deg << ',' << a.adduction_deg << ','
         << a.internal_rotation_deg << ',' << res.ball.min_gap_mm << ',' << res.socket.min_gap_mm << ','
@@ -476,9 +470,9 @@ int run_motion(const InputOptions& in, const MapOptions& mo, const FrameOptions&
   j["vtp_every"] = every;
   j["vtp_files"] = pvd.size();
   j["timings_ms"] = {{"setup_total", setup_ms},
-                     {"ball_sampling", s.joint->ball().sampling_ms},
-                     {"socket_sampling", s.joint->socket().sampling_ms},
-                     {"frames", s.frames_ms},
+                     {"ball_sampling", s.joint().ball().sampling_ms},
+                     {"socket_sampling", s.joint().socket().sampling_ms},
+                     {"frames", s.hip->frames_ms()},
                      {"detection_total", detect_ms},
                      {"detection_per_frame", n ? detect_ms / static_cast<double>(n) : 0.0},
                      {"output", write_ms},

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "impinge/joint.hpp"
 #include "impinge/mesh_io.hpp"
@@ -184,3 +185,122 @@ TEST_P(SchemesAgree, HelixAndEquiangularGapsAgree) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, SchemesAgree, ::testing::Values("lhdl-ct", "mc22", "tlem2-mri", "generated"));
+
+// ---- impinge motion -----------------------------------------------------------------------
+
+namespace {
+struct FrameRow {
+  double ball_min, socket_min;
+};
+std::vector<FrameRow> read_frames_csv(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.rfind("frame,time_s,flexion_deg,adduction_deg,internal_rotation_deg,ball_min_gap_mm,"
+                       "socket_min_gap_mm,penetrating_area_mm2",
+                       0),
+            0u)
+      << line;
+  std::vector<FrameRow> rows;
+  while (std::getline(in, line)) {
+    std::vector<std::string> c;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) c.push_back(cell);
+    rows.push_back({std::stod(c[5]), std::stod(c[6])});
+  }
+  return rows;
+}
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+// Per-frame min gaps of `motion` equal `impinge distance --pose` at the same angles.
+void expect_motion_equals_distance(const std::string& subject_args, const std::string& motion_file,
+                                   const std::vector<std::string>& poses, const std::string& d) {
+  std::string out;
+  ASSERT_EQ(run("motion " + subject_args + " --motion " + motion_file + " --quiet --out " + d + "/motion", &out), 0)
+      << out;
+  const auto rows = read_frames_csv(d + "/motion/frames.csv");
+  ASSERT_EQ(rows.size(), poses.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const std::string od = d + "/pose" + std::to_string(k);
+    ASSERT_EQ(run("distance " + subject_args + " --pose=" + poses[k] + " --out " + od, &out), 0) << out;
+    const nlohmann::json j = read_json(od + "/summary.json");
+    EXPECT_NEAR(rows[k].ball_min, j["ball"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
+    EXPECT_NEAR(rows[k].socket_min, j["socket"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
+  }
+}
+}  // namespace
+
+TEST(EndToEnd, MotionCsvOnAGeneratedSubjectEqualsDistanceAtEachPose) {
+  const std::string d = test::temp_dir("e2e_motion");
+  ASSERT_EQ(run("generate --triangles 3000 --cam 2 --out " + d + "/subject"), 0);
+  test::write_text(d + "/m.csv",
+                   "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,0,0,0\n0.1,20,5,-5\n0.2,40,-10,10\n");
+  expect_motion_equals_distance("--subject " + d + "/subject/subject.json --precision 1", d + "/m.csv",
+                                {"0,0,0", "20,5,-5", "40,-10,10"}, d);
+  const nlohmann::json j = read_json(d + "/motion/summary.json");
+  EXPECT_EQ(j["neutral"], "scan");  // the generated subject says so
+  EXPECT_EQ(j["motion_frames"], 3);
+  for (const char* key : {"ball_sampling", "socket_sampling", "detection_total", "total"})
+    EXPECT_TRUE(j["timings_ms"].contains(key)) << key;
+  EXPECT_TRUE(fs::exists(d + "/motion/gaps.pvd"));
+  EXPECT_TRUE(fs::exists(d + "/motion/gaps/frame_000002.vtp"));
+}
+
+TEST(EndToEnd, BadMotionFilesWriteNothing) {
+  const std::string d = test::temp_dir("e2e_motion_bad");
+  ASSERT_EQ(run("generate --triangles 300 --out " + d + "/s"), 0);
+  const std::string subject = " --subject " + d + "/s/subject.json --precision 2 ";
+  auto check = [&](const std::string& name, const std::string& text, const std::string& expect) {
+    test::write_text(d + "/" + name, text);
+    std::string out;
+    const std::string od = d + "/out_" + name;
+    EXPECT_NE(run("motion" + subject + "--motion " + d + "/" + name + " --out " + od, &out), 0);
+    EXPECT_NE(out.find(expect), std::string::npos) << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+    EXPECT_FALSE(fs::exists(od)) << "output written for a bad motion file";
+  };
+  check("nan.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,1,2,3\n1,nan,2,3\n",
+        "nan.csv:3: column 'flexion_deg'");
+  check("unit.mot", "x\ninDegrees=perhaps\nendheader\ntime\thip_flexion_r\n", "unit.mot:2: unknown unit");
+  check("col.mot", "x\ninDegrees=yes\nendheader\ntime\thip_flexion_r\thip_adduction_r\n0\t1\t2\n",
+        "col.mot:4: missing column 'hip_rotation_r'");
+  check("empty.csv", "", "empty motion file");
+}
+
+TEST(EndToEnd, MotionOnARealSubjectEqualsDistanceAndLoadsInVtk) {
+  const std::string json = std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/subject.json";
+  if (!fs::exists(json)) GTEST_SKIP() << "shared data absent";
+  const std::string d = test::temp_dir("e2e_motion_real");
+  test::write_text(d + "/rom.mot",
+                   "rom\nversion=1\nnRows=4\nnColumns=4\ninDegrees=no\nendheader\n"
+                   "time\thip_flexion_r\thip_adduction_r\thip_rotation_r\thip_flexion_l\n"
+                   "0\t0\t0\t0\t9\n0.5\t1.5707963267948966\t0\t0\t9\n1\t1.5707963267948966\t0.17453292519943295\t"
+                   "0.3490658503988659\t9\n1.5\t0\t-0.5235987755982988\t0\t9\n");
+  expect_motion_equals_distance("--subject " + json + " --precision 0.5", d + "/rom.mot",
+                                {"0,0,0", "90,0,0", "90,10,20", "0,-30,0"}, d);
+  const nlohmann::json j = read_json(d + "/motion/summary.json");
+  EXPECT_EQ(j["neutral"], "anatomical");
+  for (const char* lm : {"asis_right", "asis_left", "psis_right", "psis_left", "pubic_tubercle_right"})
+    EXPECT_EQ(j["frames"]["pelvis"]["landmarks"][lm]["source"], "found") << lm;
+  for (const char* lm : {"head_centre", "epicondyle_lateral", "epicondyle_medial"})
+    EXPECT_TRUE(j["frames"]["femur"]["landmarks"].contains(lm)) << lm;
+  // ParaView's reader: every file of the collection loads with VTK (Debian's python3-vtk9), has both
+  // bones' vertices and a gap_mm array whose minimum is the frame's min gap.
+  const TriangleMesh femur = load_mesh(std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/femur_r.ply");
+  const TriangleMesh pelvis = load_mesh(std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/pelvis.ply");
+  const auto rows = read_frames_csv(d + "/motion/frames.csv");
+  std::string expect_min;
+  for (const auto& r : rows) expect_min += std::to_string(std::min(r.ball_min, r.socket_min)) + ",";
+  const std::string cmd = "/usr/bin/python3 " + std::string(IMPINGE_SOURCE_DIR) + "/tests/check_pvd.py " + d +
+                          "/motion/gaps.pvd " + std::to_string(femur.V.rows() + pelvis.V.rows()) + " " +
+                          std::to_string(femur.F.rows() + pelvis.F.rows()) + " " + expect_min + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[512];
+  while (fgets(buf, sizeof buf, p) != nullptr) out += buf;
+  EXPECT_EQ(WEXITSTATUS(pclose(p)), 0) << out;
+  EXPECT_NE(out.find("4 frames ok"), std::string::npos) << out;
+}

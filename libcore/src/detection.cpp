@@ -120,9 +120,17 @@ std::vector<std::uint8_t> first_surface_mask(const Vertices& P, const RadialDist
 
 ScanSummary summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const ImpingementLevels& levels) {
   ScanSummary s;
-  s.vertices = static_cast<std::int64_t>(g.gap_mm.size());
+  summarize_scan(g, area, levels, s);
+  return s;
+}
+
+void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const ImpingementLevels& levels, ScanSummary& s) {
   s.level_vertices.assign(static_cast<std::size_t>(levels.count()), 0);
   s.level_area_mm2.assign(static_cast<std::size_t>(levels.count()), 0.0);
+  s.vertices_tested = s.vertices_no_surface = s.vertices_beyond_reach = s.vertices_penetrating = 0;
+  s.area_penetrating_mm2 = 0;
+  s.min_gap_mm = std::numeric_limits<double>::quiet_NaN();
+  s.vertices = static_cast<std::int64_t>(g.gap_mm.size());
   double min_gap = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
     if (g.status[i] == ScanGaps::beyond_reach) {
@@ -146,7 +154,6 @@ ScanSummary summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const
     s.level_area_mm2[lv] += a;
   }
   if (s.vertices_tested > 0) s.min_gap_mm = min_gap;
-  return s;
 }
 
 template void scan_gaps<float>(const Vertices&, const Eigen::Matrix3d&, const std::vector<std::uint8_t>&,

@@ -41,7 +41,13 @@ JointBody Joint::build(TriangleMesh mesh) const {
 
 PoseResult Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const {
   PoseResult res;
-  std::vector<float> gaps(static_cast<std::size_t>(std::max(ball_.scan_set.size(), socket_.scan_set.size())));
+  detect(R, t, res);
+  return res;
+}
+
+void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& res) const {
+  std::vector<float>& gaps = res.compact_gaps;
+  gaps.resize(static_cast<std::size_t>(std::max(ball_.scan_set.size(), socket_.scan_set.size())));
   auto t0 = std::chrono::steady_clock::now();
   scan_gaps_compact(ball_.scan_set, R, t, socket_.map, ScanSide::inside, gaps.data());
   res.ball_detection_ms = ms_since(t0);
@@ -52,9 +58,8 @@ PoseResult Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) con
                     ScanSide::outside, gaps.data());
   res.socket_detection_ms = ms_since(t0);
   expand_scan(socket_.scan_set, gaps.data(), res.socket_gaps);
-  res.ball = summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels);
-  res.socket = summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels);
-  return res;
+  summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels, res.ball);
+  summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels, res.socket);
 }
 
 }  // namespace impinge

@@ -97,4 +97,8 @@ std::vector<std::uint8_t> first_surface_mask(const Vertices& P, const RadialDist
 /// (`vertex_area`: n values, mm^2).
 ScanSummary summarize_scan(const ScanGaps& gaps, const Eigen::VectorXd& vertex_area, const ImpingementLevels& levels);
 
+/// The same into `out`, reusing its level vectors (no allocation once they have the size).
+void summarize_scan(const ScanGaps& gaps, const Eigen::VectorXd& vertex_area, const ImpingementLevels& levels,
+                    ScanSummary& out);
+
 }  // namespace impinge

@@ -47,6 +47,7 @@ struct PoseResult {
   ScanGaps ball_gaps, socket_gaps;
   ScanSummary ball, socket;
   double ball_detection_ms = 0, socket_detection_ms = 0;
+  std::vector<float> compact_gaps;  ///< scratch of detect (the compact scans), kept to reuse its storage
 };
 
 /// Ball (femur) and socket (pelvis) about a fixed COR.
@@ -61,6 +62,10 @@ class Joint {
   /// frame; zero for a pure ball-and-socket motion, nonzero to push the head into the cup).
   /// Thesis Algorithm 2 applied twice, through scan_gaps_compact.
   PoseResult detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) const;
+
+  /// The same into `out`, reusing its vectors: after the first pose, no allocation per pose
+  /// (for motions and ROM searches over many poses).
+  void detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& out) const;
 
   const JointBody& ball() const { return ball_; }
   const JointBody& socket() const { return socket_; }

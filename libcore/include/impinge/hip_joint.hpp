@@ -1,0 +1,75 @@
+#pragma once
+/// @file hip_joint.hpp
+/// A hip ready for clinical poses: the anatomical frames found from the bones, and the Joint
+/// (both radial distance maps) built in the pelvic frame, so that a pose is three clinical angles
+/// and the results do not depend on how the subject lay in the scanner.
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "impinge/hip_frames.hpp"
+#include "impinge/joint.hpp"
+#include "impinge/pose.hpp"
+
+namespace impinge {
+
+/// Options of a HipJoint.
+struct HipJointOptions {
+  JointOptions joint;                     ///< maps, mode, levels
+  Neutral neutral = Neutral::anatomical;  ///< what zero angles mean
+  HipFrameOptions frames;                 ///< which pelvic and femoral frames (anatomical neutral only)
+};
+
+/// Femur (ball) and pelvis (socket) of one hip about the centre of rotation, posed by clinical
+/// angles. The joint frame, in which the maps are built and detect() works, has its origin at the
+/// COR and axes:
+/// - anatomical neutral: the pelvic frame's, arranged as the thesis' scan frame (x = pelvic Z
+///   right, y = pelvic X anterior, z = pelvic Y superior; the maps' pole superior), so the maps
+///   and gaps are the same for any placement of the subject in the scanner;
+/// - scan neutral: the working frame's (the maps as the thesis built them).
+class HipJoint {
+ public:
+  /// Build the frames (anatomical neutral: find_hip_frames with "hip_centre" = `cor`) and both
+  /// maps. `femur`, `pelvis`: whole bones in the working frame (RAS, mm); `cor`: mm, working
+  /// frame; `given`: landmarks that replace found ones (mm, working frame). Throws
+  /// impinge::Error naming the mesh and step that failed (for example no whole pelvis with
+  /// anatomical neutral: use scan neutral or give the landmarks).
+  HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Eigen::Vector3d& cor, const Landmarks& given,
+           const HipJointOptions& options);
+
+  /// Rotation (3 x 3, joint frame) of the femur about the COR at `angles` (degrees, ISB signs).
+  Eigen::Matrix3d femur_rotation(const PoseAngles& angles) const;
+
+  /// Both scans at `angles` (Joint::detect with femur_rotation(angles)); into `out`, reusing
+  /// its storage.
+  void detect(const PoseAngles& angles, PoseResult& out) const;
+  PoseResult detect(const PoseAngles& angles) const;
+
+  /// Working-frame position (mm) of a joint-frame point p (mm): cor + A^T p.
+  Eigen::Vector3d to_working(const Eigen::Vector3d& p) const { return cor_ + joint_to_working_ * p; }
+  /// Rotation from joint-frame to working-frame directions (3 x 3, orthonormal).
+  const Eigen::Matrix3d& joint_to_working() const { return joint_to_working_; }
+  /// Vertices (n x 3, mm, working frame) of the femur posed by R (joint frame) or of the pelvis.
+  Vertices posed_femur(const Eigen::Matrix3d& R) const;
+  Vertices pelvis_vertices() const;
+
+  const Joint& joint() const { return *joint_; }
+  /// The anatomical frames in the working frame (empty with scan neutral).
+  const std::optional<HipFrames>& frames() const { return frames_; }
+  const Eigen::Vector3d& cor() const { return cor_; }
+  Side side() const { return side_; }
+  Neutral neutral() const { return neutral_; }
+  double frames_ms() const { return frames_ms_; }
+
+ private:
+  Side side_;
+  Neutral neutral_;
+  Eigen::Vector3d cor_;
+  Eigen::Matrix3d joint_to_working_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d femur_axes_joint_ = Eigen::Matrix3d::Identity();  // femoral frame axes in the joint frame
+  std::optional<HipFrames> frames_;
+  std::optional<Joint> joint_;
+  double frames_ms_ = 0;
+};
+
+}  // namespace impinge
