@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include <optional>
 #include <sstream>
 
+#include "impinge/clock_face.hpp"
 #include "impinge/error.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/hip_frames.hpp"
@@ -53,6 +55,7 @@ struct MapOptions {
 };
 struct FrameOptions {
   std::string neutral;  // empty: subject.json's "neutral", else anatomical
+  bool reseat = false;
   std::string pelvis_frame = "isb", femur_frame = "epicondyles";
 };
 
@@ -103,6 +106,10 @@ void add_frame_options(CLI::App* app, FrameOptions& o) {
                   "Pelvic axes: 'isb' (Wu et al. 2002: ASIS and PSIS) or 'app' (anterior pelvic plane: ASIS and "
                   "pubic tubercles, as clinical ROM tools)")
       ->capture_default_str();
+  app->add_flag("--reseat", o.reseat,
+                "Move the femur so that its head centre lies on the acetabular sphere centre (Puls et al. 2010's "
+                "equidistant method), for segmentations whose bones overlap at the scan pose; the translation is "
+                "reported in summary.json (anatomical neutral only)");
   app->add_option("--femur-frame", o.femur_frame,
                   "Femoral medio-lateral axis: 'epicondyles' (ISB) or 'posterior-condyles' (posterior condylar axis)")
       ->capture_default_str();
@@ -126,6 +133,7 @@ struct Setup {
   SphereFitResult fit;
   std::string cor_method;
   std::optional<HipJoint> hip;
+  double scan_pose_min_gap_mm = 0;  // least gap of both scans with the bones as scanned (after any re-seating)
   const Joint& joint() const { return hip->joint(); }
   const JointOptions& joint_options() const { return options.joint; }
 };
@@ -156,6 +164,7 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
   }
   require(!s.ball_path.empty(), "--ball is required (or --subject)");
   require(!s.socket_path.empty(), "--socket is required (or --subject)");
+  s.options.reseat = fo.reseat;
   s.options.frames.pelvis = parse_pelvis_frame_kind(fo.pelvis_frame, "--pelvis-frame");
   s.options.frames.femur = parse_femur_frame_kind(fo.femur_frame, "--femur-frame");
   // Validate the cheap options before the expensive work.
@@ -192,13 +201,20 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
     s.cor_method = "given";
   }
   try {
-    s.hip.emplace(std::move(ball), std::move(socket), s.side, s.fit.centre, given, s.options);
+    s.hip.emplace(std::move(ball), std::move(socket), s.side, s.fit, given, s.options);
   } catch (const Error& e) {
-    if (s.options.neutral != Neutral::anatomical) throw;
+    if (s.options.neutral != Neutral::anatomical || fo.reseat) throw;
     throw Error(std::string(e.what()) +
                 " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; --neutral scan "
                 "uses the scan pose instead]");
   }
+  // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).
+  const PoseResult scan = s.joint().detect(Eigen::Matrix3d::Identity());
+  s.scan_pose_min_gap_mm = std::fmin(scan.ball.min_gap_mm, scan.socket.min_gap_mm);
+  if (s.scan_pose_min_gap_mm < 0)
+    std::cerr << "impinge: warning: the bones overlap by " << -s.scan_pose_min_gap_mm
+              << " mm at the scan pose (a segmentation overlap, not an impingement)"
+              << (s.options.reseat ? "" : "; --reseat seats the head on the acetabular centre") << "\n";
   return s;
 }
 
@@ -208,8 +224,20 @@ nlohmann::json num_or_null(double x) { return std::isfinite(x) ? nlohmann::json(
 nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double detection_ms,
-                         const ImpingementLevels& levels) {
+                         const ImpingementLevels& levels, const ClockSummary* clock) {
   nlohmann::json j;
+  if (clock != nullptr) {
+    j["closest_clock_h"] = num_or_null(clock->closest_hour);
+    nlohmann::json sectors = nlohmann::json::array();
+    for (int k = 0; k < 12; ++k) {
+      nlohmann::json row = nlohmann::json::array();
+      for (int l = 0; l < levels.count(); ++l)
+        row.push_back(clock->sector_level_area_mm2[static_cast<std::size_t>(k * levels.count() + l)]);
+      sectors.push_back(row);
+    }
+    j["clock_sector_level_area_mm2"] = sectors;
+    j["clock_sector_note"] = "row k: hours (k, k+1]; column l: impingement level l; vertex area in mm^2";
+  }
   j["vertices"] = s.vertices;
   j["vertices_tested"] = s.vertices_tested;
   j["vertices_no_surface"] = s.vertices_no_surface;
@@ -264,7 +292,7 @@ nlohmann::json setup_json(const Setup& s) {
   j["socket_file"] = s.socket_path;
   j["side"] = s.side == Side::right ? "right" : "left";
   j["input_frame"] = s.frame == FrameConvention::LPS ? "LPS" : "RAS";
-  j["cor_mm"] = vec(to_input * s.fit.centre);
+  j["cor_mm"] = vec(to_input * s.hip->cor());
   j["cor_method"] = s.cor_method;
   j["head_radius_mm"] = num_or_null(s.fit.radius);
   j["sphere_fit_rms_mm"] = num_or_null(s.fit.rms_residual);
@@ -277,6 +305,8 @@ nlohmann::json setup_json(const Setup& s) {
   j["levels_thresholds_mm"] = opt.levels.thresholds_mm;
   j["occlusion_tolerance_mm"] = opt.occlusion_tolerance_mm;
   j["neutral"] = s.options.neutral == Neutral::anatomical ? "anatomical" : "scan";
+  j["scan_pose_min_gap_mm"] = num_or_null(s.scan_pose_min_gap_mm);
+  j["overlap_at_scan_pose"] = s.scan_pose_min_gap_mm < 0;
   j["pose_convention"] =
       "ISB joint coordinate system (Wu et al. 2002): flexion about the pelvic Z axis, adduction about the floating "
       "axis, internal rotation about the femoral y axis; flexion, adduction and internal rotation positive; left "
@@ -291,6 +321,27 @@ nlohmann::json setup_json(const Setup& s) {
                           {"adduction", frames->scan_pose.adduction_deg},
                           {"internal_rotation", frames->scan_pose.internal_rotation_deg}};
     f["frames_ms"] = s.hip->frames_ms();
+    const Acetabulum& A = *s.hip->acetabulum();
+    const Eigen::Vector3d n = frames->pelvis.axes.transpose() * A.opening;
+    const double m = s.side == Side::right ? 1.0 : -1.0;
+    f["acetabulum"] = {
+        {"sphere_centre_mm", vec(to_input * A.sphere.centre)},
+        {"sphere_radius_mm", A.sphere.radius},
+        {"sphere_fit_rms_mm", A.sphere.rms_residual},
+        {"rim_centre_mm", vec(to_input * A.rim_centre)},
+        {"rim_radius_mm", A.rim_radius_mm},
+        {"rim_plane_rms_mm", A.rim_plane_rms_mm},
+        {"opening", vec(to_input * A.opening)},
+        {"radiographic_inclination_deg", std::atan2(m * n.z(), -n.y()) * kRadToDeg},
+        {"radiographic_anteversion_deg", std::asin(std::clamp(n.x(), -1.0, 1.0)) * kRadToDeg},
+        {"clock_twelve", vec(to_input * A.clock.twelve)},
+        {"clock_three", vec(to_input * A.clock.three)},
+        {"notch_coverage_deg", A.notch_coverage_deg},
+        {"median_coverage_deg", A.median_coverage_deg},
+        {"convention", "12 superior, 3 anterior on both sides, 6 at the acetabular notch (Blankenbaker et al. 2007); "
+                       "inclination and anteversion radiographic (Murray 1993) in the pelvic frame"}};
+    f["reseat_translation_mm"] = vec(to_input * s.hip->reseat_translation());
+    f["reseat_distance_mm"] = s.hip->reseat_translation().norm();
     f["axes_note"] = "axes and positions in the input files' frame; x anterior, y superior, z right (ISB)";
     j["frames"] = f;
   }
@@ -379,8 +430,13 @@ int run_distance(const InputOptions& in, const MapOptions& mo, const FrameOption
   nlohmann::json j = setup_json(s);
   j["pose_deg"] = {pose.flexion_deg, pose.adduction_deg, pose.internal_rotation_deg};
   j["pose_names"] = {"flexion", "adduction", "internal_rotation"};
-  j["ball"] = scan_json(s.joint().ball(), res.ball, res.ball_detection_ms, s.joint_options().levels);
-  j["socket"] = scan_json(s.joint().socket(), res.socket, res.socket_detection_ms, s.joint_options().levels);
+  ClockSummary ball_clock, socket_clock;
+  s.hip->clocks(res, ball_clock, socket_clock);
+  const bool clocks = s.hip->socket_clock().has_value();
+  j["ball"] = scan_json(s.joint().ball(), res.ball, res.ball_detection_ms, s.joint_options().levels,
+                        clocks ? &ball_clock : nullptr);
+  j["socket"] = scan_json(s.joint().socket(), res.socket, res.socket_detection_ms, s.joint_options().levels,
+                          clocks ? &socket_clock : nullptr);
   write_json((fs::path(out_dir) / "summary.json").string(), j);
   std::cout << "ball: " << res.ball.vertices_tested << " tested, min gap " << res.ball.min_gap_mm << " mm, "
             << res.ball.vertices_penetrating << " penetrating; socket: " << res.socket.vertices_tested
@@ -416,7 +472,10 @@ int run_motion(const InputOptions& in, const MapOptions& mo, const FrameOptions&
   csv << "frame,time_s,flexion_deg,adduction_deg,internal_rotation_deg,ball_min_gap_mm,socket_min_gap_mm,"
          "penetrating_area_mm2,ball_penetrating_area_mm2";
   for (int k = 0; k < levels.count(); ++k) csv << ",socket_level" << k << "_area_mm2";
-  csv << ",socket_closest_x_mm,socket_closest_y_mm,socket_closest_z_mm,detection_ms\n";
+  csv << ",socket_closest_clock_h,femur_closest_clock_h,socket_closest_x_mm,socket_closest_y_mm,socket_closest_z_mm,"
+         "detection_ms\n";
+  ClockSummary ball_clock, socket_clock;
+  ball_clock.closest_hour = socket_clock.closest_hour = std::nan("");
   csv << std::setprecision(9);
   std::vector<PvdEntry> pvd;
   const bool bar = !mout.quiet && isatty(fileno(stderr));
@@ -446,6 +505,8 @@ int run_motion(const InputOptions& in, const MapOptions& mo, const FrameOptions&
         << a.internal_rotation_deg << ',' << res.ball.min_gap_mm << ',' << res.socket.min_gap_mm << ','
         << res.socket.area_penetrating_mm2 << ',' << res.ball.area_penetrating_mm2;
     for (double area : res.socket.level_area_mm2) csv << ',' << area;
+    s.hip->clocks(res, ball_clock, socket_clock);
+    csv << ',' << socket_clock.closest_hour << ',' << ball_clock.closest_hour;
     csv << ',' << closest.x() << ',' << closest.y() << ',' << closest.z() << ',' << dms << '\n';
     if (f % static_cast<std::size_t>(every) == 0) {
       std::ostringstream name;

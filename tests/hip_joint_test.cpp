@@ -45,8 +45,7 @@ TEST(HipJoint, SameMinimumGapsForAnyScanPlacement) {
     }
     const Side side = left ? Side::left : Side::right;
     auto gaps = [&](const TriangleMesh& femur, const TriangleMesh& pelvis) {
-      const Eigen::Vector3d cor = locate_femoral_head(femur).centre;
-      const HipJoint hip(femur, pelvis, side, cor, {}, options(0.25));
+      const HipJoint hip(femur, pelvis, side, locate_femoral_head(femur), {}, options(0.25));
       std::vector<std::pair<double, double>> out;
       for (const PoseAngles& a : kClinicalPoses) {
         const PoseResult r = hip.detect(a);
@@ -75,7 +74,10 @@ TEST(HipJoint, ScanNeutralIsThePlainJointPosedByPoseRotation) {
   const HipModel h = make_hip_model(mo);
   HipJointOptions o = options(1.0);
   o.neutral = Neutral::scan;
-  const HipJoint hip(h.ball, h.socket, Side::right, h.cor, {}, o);
+  SphereFitResult head;
+  head.centre = h.cor;
+  head.radius = mo.head_radius_mm;
+  const HipJoint hip(h.ball, h.socket, Side::right, head, {}, o);
   const Joint plain(h.ball, h.socket, h.cor, o.joint);
   for (const PoseAngles& a : kClinicalPoses) {
     const PoseResult r = hip.detect(a), q = plain.detect(pose_rotation(a, Side::right));
@@ -86,13 +88,13 @@ TEST(HipJoint, ScanNeutralIsThePlainJointPosedByPoseRotation) {
   }
   // The generated model is a proximal femur and a cup: anatomical neutral is refused clearly.
   HipJointOptions anat = options(1.0);
-  EXPECT_THROW(HipJoint(h.ball, h.socket, Side::right, h.cor, {}, anat), Error);
+  EXPECT_THROW(HipJoint(h.ball, h.socket, Side::right, head, {}, anat), Error);
 }
 
 TEST(HipJoint, PosedFemurIsFemurRotationInTheWorkingFrame) {
   auto j = test::load_real_joint("lhdl-ct");
   if (!j) GTEST_SKIP() << "shared data absent";
-  const HipJoint hip(j->femur, j->pelvis, Side::right, j->cor, {}, options(1.0));
+  const HipJoint hip(j->femur, j->pelvis, Side::right, fit_femoral_head(j->femur), {}, options(1.0));
   const PoseAngles a{60, -10, 15};
   const Vertices V = hip.posed_femur(hip.femur_rotation(a));
   const Eigen::Matrix3d Rw = femur_rotation(hip.frames()->pelvis, hip.frames()->femur, a, Side::right);

@@ -1,31 +1,72 @@
 #include "impinge/hip_joint.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <vector>
 
 #include "impinge/error.hpp"
 
 namespace impinge {
 
-HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Eigen::Vector3d& cor,
+namespace {
+double median_radius(const Vertices& V, const Eigen::Vector3d& c) {
+  std::vector<double> d;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const double r = (V.row(i).transpose() - c).norm();
+    if (r < 35) d.push_back(r);
+  }
+  require(d.size() >= 10, "hip joint: fewer than 10 femur vertices within 35 mm of the centre of rotation");
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+}  // namespace
+
+HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const SphereFitResult& head,
                    const Landmarks& given, const HipJointOptions& options)
-    : side_(side), neutral_(options.neutral), cor_(cor) {
-  require(cor.allFinite(), "hip joint: centre of rotation is not finite");
+    : side_(side), neutral_(options.neutral), cor_(head.centre) {
+  require(cor_.allFinite(), "hip joint: centre of rotation is not finite");
+  require(!options.reseat || neutral_ == Neutral::anatomical,
+          "hip joint: re-seating the head needs anatomical neutral (the acetabulum's frame)");
+  head_radius_ = std::isfinite(head.radius) ? head.radius : median_radius(femur.V, cor_);
   const Eigen::Matrix3d S = scan_axes();
   if (neutral_ == Neutral::anatomical) {
     const auto t0 = std::chrono::steady_clock::now();
     Landmarks g = given;
-    g["hip_centre"] = cor;
+    g["hip_centre"] = cor_;
     frames_ = find_hip_frames(femur, pelvis, side, g, options.frames);
+    acetabulum_ = find_acetabulum(pelvis, cor_, head_radius_, frames_->pelvis);
+    const ClockFace femoral = femoral_clock_face(femur, cor_, head_radius_, frames_->femur);
+    if (options.reseat) {
+      // The femur, its frame and clock move with the head onto the acetabular centre.
+      reseat_ = acetabulum_->sphere.centre - cor_;
+      femur.V.rowwise() += reseat_.transpose();
+      cor_ = acetabulum_->sphere.centre;
+      g["hip_centre"] = cor_;
+      for (const char* name : kFemurLandmarkNames) g[name] = frames_->femur_landmarks.as_map().at(name) + reseat_;
+      frames_ = find_hip_frames(femur, pelvis, side, g, options.frames);
+    }
     frames_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     // Joint frame: pelvic axes arranged as the scan frame, p_joint = S P^T (p - cor).
     joint_to_working_ = frames_->pelvis.axes * S.transpose();
     femur_axes_joint_ = joint_to_working_.transpose() * frames_->femur.axes;
+    const Eigen::Matrix3d A = joint_to_working_.transpose();
+    socket_clock_ = acetabulum_->clock.transformed(A, -A * cor_);
+    ball_clock_ = femoral.transformed(A, A * (reseat_ - cor_));
   } else {
     femur_axes_joint_ = S;  // scan neutral: both frames are the scan axes
   }
   const Eigen::Matrix3d to_joint = joint_to_working_.transpose();
-  for (TriangleMesh* m : {&femur, &pelvis}) m->V = ((m->V.rowwise() - cor.transpose()) * to_joint.transpose()).eval();
+  for (TriangleMesh* m : {&femur, &pelvis}) m->V = ((m->V.rowwise() - cor_.transpose()) * to_joint.transpose()).eval();
   joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint);
+}
+
+void HipJoint::clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& socket) const {
+  if (!socket_clock_) return;
+  const JointOptions& o = joint_->options();
+  clock_summary(res.ball_gaps, joint_->ball().relative, joint_->ball().vertex_area, *ball_clock_, o.levels, ball);
+  clock_summary(res.socket_gaps, joint_->socket().relative, joint_->socket().vertex_area, *socket_clock_, o.levels,
+                socket);
 }
 
 Eigen::Matrix3d HipJoint::femur_rotation(const PoseAngles& angles) const {

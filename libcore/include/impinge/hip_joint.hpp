@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <optional>
 
+#include "impinge/clock_face.hpp"
 #include "impinge/hip_frames.hpp"
 #include "impinge/joint.hpp"
 #include "impinge/pose.hpp"
@@ -18,6 +19,10 @@ struct HipJointOptions {
   JointOptions joint;                     ///< maps, mode, levels
   Neutral neutral = Neutral::anatomical;  ///< what zero angles mean
   HipFrameOptions frames;                 ///< which pelvic and femoral frames (anatomical neutral only)
+  /// Re-seat the head (anatomical neutral only): translate the femur so that its head centre lies on
+  /// the acetabular sphere centre (the lunate zone's sphere; Puls et al. 2010, Comput Aided Surg
+  /// 15:75, equidistant method), for segmentations whose bones overlap at the scan pose.
+  bool reseat = false;
 };
 
 /// Femur (ball) and pelvis (socket) of one hip about the centre of rotation, posed by clinical
@@ -29,12 +34,15 @@ struct HipJointOptions {
 /// - scan neutral: the working frame's (the maps as the thesis built them).
 class HipJoint {
  public:
-  /// Build the frames (anatomical neutral: find_hip_frames with "hip_centre" = `cor`) and both
-  /// maps. `femur`, `pelvis`: whole bones in the working frame (RAS, mm); `cor`: mm, working
-  /// frame; `given`: landmarks that replace found ones (mm, working frame). Throws
-  /// impinge::Error naming the mesh and step that failed (for example no whole pelvis with
-  /// anatomical neutral: use scan neutral or give the landmarks).
-  HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Eigen::Vector3d& cor, const Landmarks& given,
+  /// Build the frames (anatomical neutral: find_hip_frames with "hip_centre" = head.centre; the
+  /// acetabulum and both clock faces) and both maps. `femur`, `pelvis`: whole bones in the
+  /// working frame (RAS, mm); `head`: the femoral head sphere (mm, working frame; its centre is
+  /// the COR; a NaN radius is estimated as the median distance of the femur's vertices within
+  /// 35 mm of the centre); `given`: landmarks that replace found ones (mm, working frame).
+  /// With options.reseat the femur is first translated by reseat_translation() and the COR is the
+  /// acetabular centre. Throws impinge::Error naming the mesh and step that failed (for example
+  /// no whole pelvis with anatomical neutral: use scan neutral or give the landmarks).
+  HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const SphereFitResult& head, const Landmarks& given,
            const HipJointOptions& options);
 
   /// Rotation (3 x 3, joint frame) of the femur about the COR at `angles` (degrees, ISB signs).
@@ -56,6 +64,18 @@ class HipJoint {
   const Joint& joint() const { return *joint_; }
   /// The anatomical frames in the working frame (empty with scan neutral).
   const std::optional<HipFrames>& frames() const { return frames_; }
+  /// The acetabulum (working frame, before any re-seating; empty with scan neutral).
+  const std::optional<Acetabulum>& acetabulum() const { return acetabulum_; }
+  /// Clock faces in the joint frame (socket: acetabular; ball: femoral head-neck, on the unposed
+  /// femur); empty with scan neutral.
+  const std::optional<ClockFace>& socket_clock() const { return socket_clock_; }
+  const std::optional<ClockFace>& ball_clock() const { return ball_clock_; }
+  /// Where each scan of `res` lies on its clock face (anatomical neutral only; else untouched).
+  void clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& socket) const;
+  /// The femur's translation by re-seating (mm, working frame; zero without it).
+  const Eigen::Vector3d& reseat_translation() const { return reseat_; }
+  /// Head radius used for the acetabulum and clocks (mm).
+  double head_radius_mm() const { return head_radius_; }
   const Eigen::Vector3d& cor() const { return cor_; }
   Side side() const { return side_; }
   Neutral neutral() const { return neutral_; }
@@ -68,6 +88,10 @@ class HipJoint {
   Eigen::Matrix3d joint_to_working_ = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d femur_axes_joint_ = Eigen::Matrix3d::Identity();  // femoral frame axes in the joint frame
   std::optional<HipFrames> frames_;
+  std::optional<Acetabulum> acetabulum_;
+  std::optional<ClockFace> socket_clock_, ball_clock_;
+  Eigen::Vector3d reseat_ = Eigen::Vector3d::Zero();
+  double head_radius_ = 0;
   std::optional<Joint> joint_;
   double frames_ms_ = 0;
 };
