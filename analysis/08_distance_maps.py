@@ -1,8 +1,9 @@
 """08_distance_maps: gap statistics on the real joints and the generated model, map images
 (thesis Fig. 31), colour-mapped renders of both bones (Fig. 41-42), RSID beside USID (Fig. 50).
 
-Reads RESULTS/08_distance_maps/gap_statistics.csv and vertex_gaps.csv; writes table_finest.tex,
-table_convergence.tex, min_gap.pdf, levels.pdf, render_<subject>.pdf, macros.tex."""
+Reads RESULTS/08_distance_maps/gap_statistics.csv, vertex_gaps.csv, clock_faces.csv and the
+render_<subject>_<body>.ply meshes the driver wrote; writes table_finest.tex, table_convergence.tex,
+table_acetabulum.tex, min_gap.pdf, levels.pdf, render_<subject>.pdf (shaded, with the clock face), macros.tex."""
 import json
 import os
 
@@ -10,6 +11,7 @@ import numpy as np
 import matplotlib.pyplot as plt
 
 from common import experiment_dir, read_csv, save, write_macros, write_table
+from render import draw, read_gap_ply
 
 d = experiment_dir("08_distance_maps")
 allst = read_csv(d, "gap_statistics.csv")
@@ -84,30 +86,39 @@ ax.set_ylabel("tested vertices")
 ax.legend(fontsize=6, ncol=5)
 save(fig, d, "levels")
 
-# Renders: vertices within 45 mm of the COR, coloured by impingement level (grey: not tested).
-thr = meta["parameters"]["levels_thresholds_mm"]
+# Acetabular orientation and scan pose per real subject (clock_faces.csv).
+clk = read_csv(d, "clock_faces.csv")
+anat = clk[clk.neutral == "anatomical"]
+write_table(d, "table_acetabulum",
+            ["subject", "head $r$", "acetabular $r$", "rim $r$", "inclination", "anteversion", "scan flexion",
+             "scan adduction", "scan IR"],
+            [[r.subject, f"{r.head_radius_mm:.1f}", f"{r.acetabular_radius_mm:.1f}", f"{r.rim_radius_mm:.1f}",
+              f"{r.inclination_deg:.1f}", f"{r.anteversion_deg:.1f}", f"{r.scan_flexion_deg:.1f}",
+              f"{r.scan_adduction_deg:.1f}", f"{r.scan_internal_rotation_deg:.1f}"] for r in anat.itertuples()])
 
-
-def level_colour(g, scan):
-    """Thesis sec. 3.4 colours: green (ball) / blue (socket) for no impingement, then yellow,
-    orange, red, purple; grey where untested."""
-    if np.isnan(g):
-        return "#c8c8c8"
-    if g <= thr[-1]:
-        return colours[4]
-    k = sum(1 for t in thr[:-1] if g < t)
-    return ("#3264dc" if scan == "socket" else colours[0]) if k == 0 else colours[k]
-
-
+# Shaded renders (render.py): both bones at the scan pose in the pelvic frame, anterior and lateral
+# views, and the socket's medial view with the acetabular clock face (thesis Fig. 42-43, Tables 12-13).
 for s in subjects:
-    fig = plt.figure(figsize=(8, 4))
-    for k, scan in enumerate(("socket", "ball")):
-        g = vg[(vg.subject == s) & (vg.scan == scan)]
-        ax = fig.add_subplot(1, 2, k + 1, projection="3d")
-        ax.scatter(g.x_mm, g.y_mm, g.z_mm, c=[level_colour(x, scan) for x in g.gap_mm], s=0.6, depthshade=False)
-        ax.set_title(f"{s}: {'pelvis (socket)' if scan == 'socket' else 'femur (ball)'}", fontsize=8)
-        ax.view_init(elev=10, azim=0 if scan == "socket" else 180)  # lateral view of the acetabulum
-        ax.set_axis_off()
+    row = clk[clk.subject == s].iloc[0]
+    clock = None
+    if row.neutral == "anatomical":
+        clock = {"centre": [row.centre_x_mm, row.centre_y_mm, row.centre_z_mm],
+                 "twelve": [row.twelve_x, row.twelve_y, row.twelve_z],
+                 "three": [row.three_x, row.three_y, row.three_z], "radius_mm": row.rim_radius_mm}
+    bodies = {}
+    for b in ("ball", "socket"):
+        V, F, rgb, _ = read_gap_ply(os.path.join(d, f"render_{s}_{b}.ply"))
+        if row.neutral == "scan":  # generated: scan axes (RAS) -> (X anterior, Y superior, Z right)
+            V = V[:, [1, 2, 0]]
+        bodies[b] = (V, F, rgb)
+    cup = (row.rim_radius_mm + 3.0) if clock else row.head_radius_mm + 8.0
+    fig = plt.figure(figsize=(10, 3.6))
+    for k, (view, names) in enumerate((("anterior", ("ball", "socket")), ("lateral", ("ball", "socket")),
+                                       ("socket_medial", ("socket",)))):
+        ax = fig.add_subplot(1, 3, k + 1, projection="3d")
+        draw(ax, [bodies[n] for n in names], view, row.side, clock if view != "anterior" else None,
+             radius=cup if view == "socket_medial" else 60.0)
+    fig.suptitle(f"{s}: impingement levels at the scan pose", fontsize=9)
     save(fig, d, f"render_{s}")
 
 # RSID beside USID (thesis Fig. 50): same precision (helix at the matched k), same mode.
@@ -143,4 +154,7 @@ write_macros(d, "macros", {
     "DMfinest": f"{finest:g}",
     "DMsubjects": str(len(subjects)),
     "DMpenetratingSubjects": str(int((pen.vertices_penetrating > 0).sum())),
+    "DMinclinationRange": (f"{anat.inclination_deg.min():.0f}--{anat.inclination_deg.max():.0f}" if len(anat) else "n/a"),
+    "DMrimRmsRange": (f"{anat.rim_plane_rms_mm.min():.1f}--{anat.rim_plane_rms_mm.max():.1f}" if len(anat) else "n/a"),
+    "DManteversionRange": (f"{anat.anteversion_deg.min():.0f}--{anat.anteversion_deg.max():.0f}" if len(anat) else "n/a"),
 })

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -412,8 +413,23 @@ void write_frame_vtp(const std::string& path, const Setup& s, const PoseResult& 
 
 // ---- commands -----------------------------------------------------------------------------
 
+// Shaded renders of an output folder by analysis/render_hip.py (matplotlib; Debian's python3-matplotlib).
+void render(const std::string& out_dir) {
+  const char* env = std::getenv("IMPINGE_ANALYSIS_DIR");
+  const std::string script = std::string(env != nullptr ? env : IMPINGE_ANALYSIS_DIR) + "/render_hip.py";
+  require(fs::exists(script), script + ": render script not found (set IMPINGE_ANALYSIS_DIR to impinge's analysis/ folder)");
+  auto quote = [](const std::string& x) {
+    std::string q = "'";
+    for (char c : x) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+  };
+  const int rc = std::system(("/usr/bin/python3 " + quote(script) + " " + quote(out_dir)).c_str());
+  require(rc == 0, out_dir + ": --render failed (needs /usr/bin/python3 with numpy and matplotlib; "
+                             "tools/install-deps installs them)");
+}
+
 int run_distance(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo, const std::string& pose_text,
-                 const std::string& out_dir) {
+                 bool do_render, const std::string& out_dir) {
   const PoseAngles pose = parse_pose(pose_text);
   const Setup s = set_up(in, mo, fo);
   const Eigen::Matrix3d R = s.hip->femur_rotation(pose);
@@ -438,6 +454,7 @@ int run_distance(const InputOptions& in, const MapOptions& mo, const FrameOption
   j["socket"] = scan_json(s.joint().socket(), res.socket, res.socket_detection_ms, s.joint_options().levels,
                           clocks ? &socket_clock : nullptr);
   write_json((fs::path(out_dir) / "summary.json").string(), j);
+  if (do_render) render(out_dir);
   std::cout << "ball: " << res.ball.vertices_tested << " tested, min gap " << res.ball.min_gap_mm << " mm, "
             << res.ball.vertices_penetrating << " penetrating; socket: " << res.socket.vertices_tested
             << " tested, min gap " << res.socket.min_gap_mm << " mm, " << res.socket.vertices_penetrating
@@ -585,6 +602,10 @@ int main(int argc, char** argv) {
   add_map_options(dist, maps);
   add_frame_options(dist, frames);
   dist->add_option("--pose", pose, kPoseHelp)->capture_default_str();
+  bool do_render = false;
+  dist->add_flag("--render", do_render,
+                 "Also write shaded renders (render.png: anterior, lateral and the socket's medial view with the "
+                 "acetabular clock face) with matplotlib");
   dist->add_option("--out", out, "Output folder")->required();
 
   std::string motion_file, motion_out;
@@ -619,7 +640,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   try {
-    if (*dist) return run_distance(in, maps, frames, pose, out);
+    if (*dist) return run_distance(in, maps, frames, pose, do_render, out);
     if (*mot) return run_motion(in, maps, frames, motion_file, mout, motion_out);
     if (*gen) return run_generate(triangles, cam, coverage, gen_out);
   } catch (const std::exception& e) {

@@ -8,6 +8,10 @@
 //                       sampling_ms describe the scanned body's own map; COR in the RAS frame
 //   vertex_gaps.csv     per-vertex gaps within 45 mm of the COR at the finest precision, exact mode
 //   map_<subject>_<body>.png  the maps at 0.5 deg (theta across, phi down); *_helix.png at k = 458
+//   render_<subject>_<body>.ply  both bones within 60 mm of the COR at the scan pose, in the pelvic
+//                       frame (ISB; generated models: the scan's anatomical axes), with gaps, levels
+//                       and colours, at 0.25 deg exact mode (HipJoint), for the shaded renders
+//   clock_faces.csv     one row per subject: the acetabular clock face and orientation in that frame
 //   meta.json
 // Command: build/experiments/exp_08_distance_maps --out results --data ../shared/data/hips [--quick]
 // Precisions 1, 0.5, 0.1 and (outside quick mode) 0.05 deg, each with the helix of matched turns
@@ -18,7 +22,10 @@
 #include <map>
 
 #include "experiment_support.hpp"
+#include "impinge/clock_face.hpp"
 #include "impinge/helix_scheme.hpp"
+#include "impinge/hip_joint.hpp"
+#include "impinge/mesh_io.hpp"
 #include "impinge/joint.hpp"
 #include "impinge/map_image.hpp"
 #include "impinge/sampling.hpp"
@@ -179,6 +186,79 @@ int main(int argc, char** argv) {
       }
     }
   }
+  // Shaded-render data: the hip region of both bones at the scan pose, in the pelvic frame.
+  CsvWriter clocks(dir + "/clock_faces.csv",
+                   {"subject", "side", "neutral", "centre_x_mm", "centre_y_mm", "centre_z_mm", "twelve_x", "twelve_y",
+                    "twelve_z", "three_x", "three_y", "three_z", "rim_radius_mm", "rim_plane_rms_mm", "inclination_deg",
+                    "anteversion_deg", "head_radius_mm", "acetabular_radius_mm", "scan_flexion_deg",
+                    "scan_adduction_deg", "scan_internal_rotation_deg"});
+  const double render_precision = 0.25, render_radius = 60;
+  for (const Subject& s : subjects) {
+    HipJointOptions ho;
+    ho.joint.scheme = make_scheme("equiangular", render_precision);
+    ho.joint.mode = DistanceMode::exact;
+    ho.neutral = s.generated ? Neutral::scan : Neutral::anatomical;
+    SphereFitResult head = s.generated ? SphereFitResult{} : locate_femoral_head(s.femur);
+    if (s.generated) head.centre = s.true_cor, head.radius = std::nan("");
+    const HipJoint hip(s.femur, s.pelvis, s.side, head, {}, ho);
+    const PoseResult res = hip.joint().detect(Eigen::Matrix3d::Identity());
+    // Joint frame -> pelvic frame: p_pelvic = S^T p_joint (S = scan_axes()).
+    const Eigen::Matrix3d to_pelvic = scan_axes().transpose();
+    const JointBody* bodies[2] = {&hip.joint().ball(), &hip.joint().socket()};
+    const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};
+    for (int b = 0; b < 2; ++b) {
+      const JointBody& body = *bodies[b];
+      std::vector<int> index(static_cast<std::size_t>(body.relative.rows()), -1);
+      std::vector<Eigen::Index> kept;
+      std::vector<Eigen::Vector3i> faces;
+      for (Eigen::Index f = 0; f < body.mesh.F.rows(); ++f) {
+        bool in = true;
+        for (int c = 0; c < 3; ++c) in = in && body.relative.row(body.mesh.F(f, c)).norm() <= render_radius;
+        if (!in) continue;
+        Eigen::Vector3i g;
+        for (int c = 0; c < 3; ++c) {
+          int& k = index[static_cast<std::size_t>(body.mesh.F(f, c))];
+          if (k < 0) k = static_cast<int>(kept.size()), kept.push_back(body.mesh.F(f, c));
+          g[c] = k;
+        }
+        faces.push_back(g);
+      }
+      const auto n = static_cast<Eigen::Index>(kept.size());
+      Vertices V(n, 3);
+      Faces F(static_cast<Eigen::Index>(faces.size()), 3);
+      Eigen::VectorXf gap(n);
+      Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
+      Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
+      const ImpingementLevels& lv = ho.joint.levels;
+      for (Eigen::Index k = 0; k < n; ++k) {
+        const auto i = static_cast<std::size_t>(kept[static_cast<std::size_t>(k)]);
+        V.row(k) = (to_pelvic * body.relative.row(static_cast<Eigen::Index>(i)).transpose()).transpose();
+        gap[k] = gaps[b]->gap_mm[i];
+        level[k] = std::isnan(gap[k]) ? 255 : lv.level(gap[k]);
+        const auto c = level_colour(level[k], lv.count(), b == 0);
+        rgb.row(k) << c[0], c[1], c[2];
+      }
+      for (std::size_t k = 0; k < faces.size(); ++k) F.row(static_cast<Eigen::Index>(k)) = faces[k].transpose();
+      write_gap_ply(dir + "/render_" + s.name + (b == 0 ? "_ball.ply" : "_socket.ply"), V, F, gap, level, rgb);
+    }
+    if (hip.socket_clock()) {
+      const ClockFace c = hip.socket_clock()->transformed(to_pelvic, Eigen::Vector3d::Zero());
+      const Acetabulum& A = *hip.acetabulum();
+      const Eigen::Vector3d n = hip.frames()->pelvis.axes.transpose() * A.opening;
+      const double m = s.side == Side::right ? 1.0 : -1.0;
+      const PoseAngles& sp = hip.frames()->scan_pose;
+      clocks.row(s.name, s.side == Side::right ? "right" : "left", "anatomical", c.centre.x(), c.centre.y(),
+                 c.centre.z(), c.twelve.x(), c.twelve.y(), c.twelve.z(), c.three.x(), c.three.y(), c.three.z(),
+                 A.rim_radius_mm, A.rim_plane_rms_mm, std::atan2(m * n.z(), -n.y()) * kRadToDeg,
+                 std::asin(std::clamp(n.x(), -1.0, 1.0)) * kRadToDeg, hip.head_radius_mm(), A.sphere.radius,
+                 sp.flexion_deg, sp.adduction_deg, sp.internal_rotation_deg);
+    } else {
+      const double nan = std::nan("");
+      clocks.row(s.name, s.side == Side::right ? "right" : "left", "scan", nan, nan, nan, nan, nan, nan, nan, nan,
+                 nan, nan, nan, nan, nan, hip.head_radius_mm(), nan, 0.0, 0.0, 0.0);
+    }
+  }
+
   nlohmann::json subj = nlohmann::json::array();
   for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
   write_meta(dir, args,
@@ -189,6 +269,9 @@ int main(int argc, char** argv) {
               {"subjects", subj},
               {"cor", "fit_femoral_head defaults (RANSAC + geometric sphere fit)"},
               {"vertex_gaps_region_mm", 45},
+              {"render", {{"precision_deg", render_precision}, {"mode", "exact"}, {"region_mm", render_radius},
+                          {"frame", "pelvic (ISB, Wu et al. 2002) for real subjects; scan axes for generated"},
+                          {"pose", "scan pose"}}},
               {"occlusion_tolerance_mm", JointOptions{}.occlusion_tolerance_mm},
               {"levels_thresholds_mm", ImpingementLevels{}.thresholds_mm}});
   return 0;

@@ -71,6 +71,11 @@ TEST(EndToEnd, CliOnGeneratedSubject) {
   EXPECT_EQ(load_mesh(d + "/out/ball_gaps.ply").F, femur.F);
   EXPECT_TRUE(fs::file_size(d + "/out/ball_map.png") > 100);
   EXPECT_TRUE(fs::file_size(d + "/out/socket_map.png") > 100);
+  // Shaded renders.
+  ASSERT_EQ(run("distance --subject " + d + "/subject/subject.json --precision 2 --render --out " + d + "/r", &out), 0)
+      << out;
+  for (const char* f : {"render.png", "render_anterior.png", "render_lateral.png", "render_socket_medial.png"})
+    EXPECT_GT(fs::file_size(d + "/r/" + f), 10000u) << f;
 }
 
 TEST(EndToEnd, CliErrorsAreOneLine) {

@@ -1,0 +1,119 @@
+"""Shaded renders of a hip: both bones as lit triangle surfaces coloured by impingement level, from
+the standard views, with the acetabular clock face (matplotlib's 3-D polygons; no hand-written
+rasteriser). Used by `impinge distance --render` (render_hip.py) and experiment 08.
+
+Coordinates are the pelvic frame's (ISB: X anterior, Y superior, Z right; origin at the hip centre;
+mm). Views: anterior (from +X), lateral (from the hip's side), and the medial view of the socket
+that the thesis uses for Tables 12-13 (from the midline, socket region only, femur hidden)."""
+import numpy as np
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+PLY_TYPES = {"float": "<f4", "float32": "<f4", "double": "<f8", "uchar": "u1", "uint8": "u1", "int": "<i4",
+             "int32": "<i4", "uint": "<u4", "char": "i1", "short": "<i2", "ushort": "<u2"}
+
+
+def read_gap_ply(path):
+    """Read a binary little-endian PLY as written by impinge (x y z gap_mm quality level red green
+    blue; triangles). Returns V (n x 3), F (m x 3), rgb (n x 3, 0-1) and gap (n, NaN untested)."""
+    with open(path, "rb") as f:
+        props, n, m = [], 0, 0
+        elem = None
+        while True:
+            line = f.readline().decode("ascii").strip()
+            if line == "end_header":
+                break
+            t = line.split()
+            if t[:1] == ["format"] and t[1] != "binary_little_endian":
+                raise ValueError(f"{path}: only binary little-endian PLY is read")
+            if t[:1] == ["element"]:
+                elem = t[1]
+                if elem == "vertex":
+                    n = int(t[2])
+                elif elem == "face":
+                    m = int(t[2])
+            elif t[:1] == ["property"] and elem == "vertex":
+                props.append((t[2], PLY_TYPES[t[1]]))
+        vert = np.frombuffer(f.read(n * np.dtype(props).itemsize), dtype=np.dtype(props), count=n)
+        face = np.frombuffer(f.read(m * 13), dtype=np.dtype([("k", "u1"), ("i", "<i4", 3)]), count=m)
+    if m and (face["k"] != 3).any():
+        raise ValueError(f"{path}: non-triangle faces")
+    V = np.stack([vert["x"], vert["y"], vert["z"]], axis=1).astype(float)
+    names = vert.dtype.names
+    rgb = (np.stack([vert["red"], vert["green"], vert["blue"]], axis=1) / 255.0 if "red" in names
+           else np.full((n, 3), 0.8))
+    gap = vert["gap_mm"].astype(float) if "gap_mm" in names else np.full(n, np.nan)
+    return V, face["i"].astype(np.int64), rgb, gap
+
+
+def to_frame(V, origin, axes):
+    """Points V (n x 3, input frame) into a frame given by its origin and axes (columns X, Y, Z)."""
+    return (V - origin) @ axes
+
+
+# Plot coordinates: (Z right, X anterior, Y superior), so that matplotlib's vertical axis is superior.
+def _plot(P):
+    return P[:, [2, 0, 1]]
+
+
+VIEWS = {
+    # name: (azimuth for a right hip, elevation, title)
+    "anterior": (90, 5, "anterior"),
+    "lateral": (0, 5, "lateral"),
+    "socket_medial": (180, 5, "socket, medial view"),
+}
+
+
+def _crop(V, F, centre, radius):
+    keep = np.linalg.norm(V[F] - centre, axis=2).max(axis=1) <= radius
+    return F[keep]
+
+
+def draw(ax, bodies, view, side="right", clock=None, radius=60.0):
+    """Draw on a 3-D axes `ax`. bodies: list of (V, F, rgb) in the pelvic frame (mm); view: a key of
+    VIEWS; side: "right" or "left" (lateral and medial views swap); clock: optional dict with
+    centre, twelve, three (pelvic frame) and radius_mm of the acetabular clock face; radius: only
+    triangles within this distance of the hip centre are drawn (mm; the socket's medial view uses
+    the cup alone, as the thesis' Tables 12-13 hide the pelvis outside the socket region)."""
+    azim, elev, title = VIEWS[view]
+    if side == "left" and view != "anterior":
+        azim = 180 - azim
+    a, e = np.radians(azim), np.radians(elev)
+    toward_eye = np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])  # plot coordinates
+    light = toward_eye + np.array([0.0, 0.0, 0.6])
+    light /= np.linalg.norm(light)
+    # All bodies in one collection, so that mplot3d depth-sorts their triangles together.
+    tris, cols = [], []
+    for V, F, rgb in bodies:
+        F = _crop(V, F, np.zeros(3), radius)
+        if len(F) == 0:
+            continue
+        tri = _plot(V)[F]
+        nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
+        lam = 0.3 + 0.7 * np.abs(nrm @ light)  # two-sided Lambert
+        tris.append(tri)
+        cols.append(np.clip(rgb[F].mean(axis=1) * lam[:, None], 0, 1))
+    if tris:
+        c = np.concatenate(cols)
+        poly = Poly3DCollection(np.concatenate(tris), facecolors=c, edgecolors=c, linewidths=0.15, antialiased=False)
+        poly.set_rasterized(True)  # PDFs embed the surface as an image: small files
+        ax.add_collection3d(poly)
+    if clock is not None:
+        c, u, v, r = (np.asarray(clock[k], float) for k in ("centre", "twelve", "three", "radius_mm"))
+        t = np.linspace(0, 2 * np.pi, 121)
+        ring = c + r * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))
+        ring = _plot(ring)
+        ax.add_collection3d(Line3DCollection([ring], colors="k", linewidths=0.8, zorder=10))
+        for h in (12, 3, 6, 9):
+            ang = np.radians(30 * h)
+            p = _plot((c + 1.18 * r * (np.cos(ang) * u + np.sin(ang) * v))[None])[0]
+            ax.text(p[0], p[1], p[2], str(h), fontsize=7, ha="center", va="center", zorder=11,
+                    color="k", fontweight="bold")
+    lim = min(radius, 60.0) * 0.85
+    ax.set_xlim(-lim, lim)
+    ax.set_ylim(-lim, lim)
+    ax.set_zlim(-lim, lim)
+    ax.set_box_aspect((1, 1, 1))
+    ax.view_init(elev=elev, azim=azim)
+    ax.set_axis_off()
+    ax.set_title(title, fontsize=8)
