@@ -121,6 +121,27 @@ for s in subjects:
     fig.suptitle(f"{s}: impingement levels at the scan pose", fontsize=9)
     save(fig, d, f"render_{s}")
 
+# The clinical angles (README figure): one real femur posed from anatomical neutral, pelvic frame.
+if os.path.exists(os.path.join(d, "poses.csv")) and len(read_csv(d, "poses.csv")):
+    ps = read_csv(d, "poses.csv")
+    subj = next(s for s in subjects if os.path.exists(os.path.join(d, f"poses_{s}_pelvis.ply")))
+    side = clk[clk.subject == subj].iloc[0].side
+    Vp, Fp, _, _ = read_gap_ply(os.path.join(d, f"poses_{subj}_pelvis.ply"))
+    pelvis = (Vp, Fp, np.full((len(Vp), 3), 0.82))
+    fig = plt.figure(figsize=(11, 5.6))
+    for k, r in enumerate(ps.itertuples()):
+        Vf, Ff, _, _ = read_gap_ply(os.path.join(d, f"poses_{subj}_{r.pose}.ply"))
+        femur = (Vf, Ff, np.tile([0.86, 0.72, 0.52], (len(Vf), 1)))
+        for row, view in enumerate(("anterior", "lateral")):
+            ax = fig.add_subplot(2, len(ps), row * len(ps) + k + 1, projection="3d")
+            label = (f"flexion {r.flexion_deg:g}, adduction {r.adduction_deg:g}, IR {r.internal_rotation_deg:g}"
+                     if row == 0 else "")
+            draw(ax, [pelvis, femur], view, side, None, radius=260.0, extent=170.0,
+                 title=(label + "\n" if label else "") + f"{view} view")
+    fig.suptitle(f"{subj} ({side} hip): clinical angles from anatomical neutral (ISB joint coordinate system); "
+                 "femur tan, pelvis grey", fontsize=9)
+    save(fig, d, f"poses_{subj}")
+
 # RSID beside USID (thesis Fig. 50): same precision (helix at the matched k), same mode.
 rows = []
 for s_ in subjects:

@@ -68,13 +68,14 @@ def _crop(V, F, centre, radius):
     return F[keep]
 
 
-def draw(ax, bodies, view, side="right", clock=None, radius=60.0):
+def draw(ax, bodies, view, side="right", clock=None, radius=60.0, extent=None, title=None):
     """Draw on a 3-D axes `ax`. bodies: list of (V, F, rgb) in the pelvic frame (mm); view: a key of
     VIEWS; side: "right" or "left" (lateral and medial views swap); clock: optional dict with
     centre, twelve, three (pelvic frame) and radius_mm of the acetabular clock face; radius: only
     triangles within this distance of the hip centre are drawn (mm; the socket's medial view uses
-    the cup alone, as the thesis' Tables 12-13 hide the pelvis outside the socket region)."""
-    azim, elev, title = VIEWS[view]
+    the cup alone, as the thesis' Tables 12-13 hide the pelvis outside the socket region); extent:
+    half-width of the shown cube (mm; default 0.85 x min(radius, 60)); title: default the view's name."""
+    azim, elev, _ = VIEWS[view]
     if side == "left" and view != "anterior":
         azim = 180 - azim
     a, e = np.radians(azim), np.radians(elev)
@@ -109,11 +110,11 @@ def draw(ax, bodies, view, side="right", clock=None, radius=60.0):
             p = _plot((c + 1.18 * r * (np.cos(ang) * u + np.sin(ang) * v))[None])[0]
             ax.text(p[0], p[1], p[2], str(h), fontsize=7, ha="center", va="center", zorder=11,
                     color="k", fontweight="bold")
-    lim = min(radius, 60.0) * 0.85
+    lim = extent if extent is not None else min(radius, 60.0) * 0.85
     ax.set_xlim(-lim, lim)
     ax.set_ylim(-lim, lim)
     ax.set_zlim(-lim, lim)
     ax.set_box_aspect((1, 1, 1))
     ax.view_init(elev=elev, azim=azim)
     ax.set_axis_off()
-    ax.set_title(title, fontsize=8)
+    ax.set_title(title if title is not None else VIEWS[view][2], fontsize=8)

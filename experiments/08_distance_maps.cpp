@@ -12,6 +12,10 @@
 //                       frame (ISB; generated models: the scan's anatomical axes), with gaps, levels
 //                       and colours, at 0.25 deg exact mode (HipJoint), for the shaded renders
 //   clock_faces.csv     one row per subject: the acetabular clock face and orientation in that frame
+//   poses_<subject>_<pose>.ply  (first real subject) the femur within 250 mm of the COR, posed by the
+//                       clinical angles of poses.csv, and the pelvis within 150 mm, in the pelvic frame:
+//                       the README's figure of the ISB angles
+//   poses.csv           pose, flexion_deg, adduction_deg, internal_rotation_deg
 //   meta.json
 // Command: build/experiments/exp_08_distance_maps --out results --data ../shared/data/hips [--quick]
 // Precisions 1, 0.5, 0.1 and (outside quick mode) 0.05 deg, each with the helix of matched turns
@@ -193,6 +197,46 @@ int main(int argc, char** argv) {
                     "anteversion_deg", "head_radius_mm", "acetabular_radius_mm", "scan_flexion_deg",
                     "scan_adduction_deg", "scan_internal_rotation_deg"});
   const double render_precision = 0.25, render_radius = 60;
+  CsvWriter poses(dir + "/poses.csv", {"pose", "flexion_deg", "adduction_deg", "internal_rotation_deg"});
+  const std::vector<std::pair<std::string, PoseAngles>> figure_poses{
+      {"neutral", {0, 0, 0}}, {"flexion90", {90, 0, 0}}, {"adduction30", {0, 30, 0}}, {"internal30", {0, 0, 30}}};
+  bool wrote_poses = false;
+  // The part of `body` within `radius` mm of the COR, its vertices mapped by R (joint frame -> output),
+  // with gaps (or none: untested grey) as a gap PLY.
+  auto write_region = [](const std::string& path, const JointBody& body, const Eigen::Matrix3d& R, double radius,
+                         const ScanGaps* g, const ImpingementLevels& lv, bool is_ball) {
+    std::vector<int> index(static_cast<std::size_t>(body.relative.rows()), -1);
+    std::vector<Eigen::Index> kept;
+    std::vector<Eigen::Vector3i> faces;
+    for (Eigen::Index f = 0; f < body.mesh.F.rows(); ++f) {
+      bool in = true;
+      for (int c = 0; c < 3; ++c) in = in && body.relative.row(body.mesh.F(f, c)).norm() <= radius;
+      if (!in) continue;
+      Eigen::Vector3i idx;
+      for (int c = 0; c < 3; ++c) {
+        int& k = index[static_cast<std::size_t>(body.mesh.F(f, c))];
+        if (k < 0) k = static_cast<int>(kept.size()), kept.push_back(body.mesh.F(f, c));
+        idx[c] = k;
+      }
+      faces.push_back(idx);
+    }
+    const auto n = static_cast<Eigen::Index>(kept.size());
+    Vertices V(n, 3);
+    Faces F(static_cast<Eigen::Index>(faces.size()), 3);
+    Eigen::VectorXf gap(n);
+    Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
+    Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      const auto i = static_cast<std::size_t>(kept[static_cast<std::size_t>(k)]);
+      V.row(k) = (R * body.relative.row(static_cast<Eigen::Index>(i)).transpose()).transpose();
+      gap[k] = g != nullptr ? g->gap_mm[i] : std::nanf("");
+      level[k] = std::isnan(gap[k]) ? 255 : lv.level(gap[k]);
+      const auto c = level_colour(level[k], lv.count(), is_ball);
+      rgb.row(k) << c[0], c[1], c[2];
+    }
+    for (std::size_t k = 0; k < faces.size(); ++k) F.row(static_cast<Eigen::Index>(k)) = faces[k].transpose();
+    write_gap_ply(path, V, F, gap, level, rgb);
+  };
   for (const Subject& s : subjects) {
     HipJointOptions ho;
     ho.joint.scheme = make_scheme("equiangular", render_precision);
@@ -206,40 +250,18 @@ int main(int argc, char** argv) {
     const Eigen::Matrix3d to_pelvic = scan_axes().transpose();
     const JointBody* bodies[2] = {&hip.joint().ball(), &hip.joint().socket()};
     const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};
-    for (int b = 0; b < 2; ++b) {
-      const JointBody& body = *bodies[b];
-      std::vector<int> index(static_cast<std::size_t>(body.relative.rows()), -1);
-      std::vector<Eigen::Index> kept;
-      std::vector<Eigen::Vector3i> faces;
-      for (Eigen::Index f = 0; f < body.mesh.F.rows(); ++f) {
-        bool in = true;
-        for (int c = 0; c < 3; ++c) in = in && body.relative.row(body.mesh.F(f, c)).norm() <= render_radius;
-        if (!in) continue;
-        Eigen::Vector3i g;
-        for (int c = 0; c < 3; ++c) {
-          int& k = index[static_cast<std::size_t>(body.mesh.F(f, c))];
-          if (k < 0) k = static_cast<int>(kept.size()), kept.push_back(body.mesh.F(f, c));
-          g[c] = k;
-        }
-        faces.push_back(g);
+    for (int b = 0; b < 2; ++b)
+      write_region(dir + "/render_" + s.name + (b == 0 ? "_ball.ply" : "_socket.ply"), *bodies[b], to_pelvic,
+                   render_radius, gaps[b], ho.joint.levels, b == 0);
+    if (!s.generated && !wrote_poses) {  // the README's figure of the clinical angles
+      wrote_poses = true;
+      for (const auto& [name, a] : figure_poses) {
+        write_region(dir + "/poses_" + s.name + "_" + name + ".ply", hip.joint().ball(),
+                     to_pelvic * hip.femur_rotation(a), 250, nullptr, ho.joint.levels, true);
+        poses.row(name, a.flexion_deg, a.adduction_deg, a.internal_rotation_deg);
       }
-      const auto n = static_cast<Eigen::Index>(kept.size());
-      Vertices V(n, 3);
-      Faces F(static_cast<Eigen::Index>(faces.size()), 3);
-      Eigen::VectorXf gap(n);
-      Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
-      Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
-      const ImpingementLevels& lv = ho.joint.levels;
-      for (Eigen::Index k = 0; k < n; ++k) {
-        const auto i = static_cast<std::size_t>(kept[static_cast<std::size_t>(k)]);
-        V.row(k) = (to_pelvic * body.relative.row(static_cast<Eigen::Index>(i)).transpose()).transpose();
-        gap[k] = gaps[b]->gap_mm[i];
-        level[k] = std::isnan(gap[k]) ? 255 : lv.level(gap[k]);
-        const auto c = level_colour(level[k], lv.count(), b == 0);
-        rgb.row(k) << c[0], c[1], c[2];
-      }
-      for (std::size_t k = 0; k < faces.size(); ++k) F.row(static_cast<Eigen::Index>(k)) = faces[k].transpose();
-      write_gap_ply(dir + "/render_" + s.name + (b == 0 ? "_ball.ply" : "_socket.ply"), V, F, gap, level, rgb);
+      write_region(dir + "/poses_" + s.name + "_pelvis.ply", hip.joint().socket(), to_pelvic, 150, nullptr,
+                   ho.joint.levels, false);
     }
     if (hip.socket_clock()) {
       const ClockFace c = hip.socket_clock()->transformed(to_pelvic, Eigen::Vector3d::Zero());
