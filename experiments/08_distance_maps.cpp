@@ -205,37 +205,24 @@ int main(int argc, char** argv) {
   // with gaps (or none: untested grey) as a gap PLY.
   auto write_region = [](const std::string& path, const JointBody& body, const Eigen::Matrix3d& R, double radius,
                          const ScanGaps* g, const ImpingementLevels& lv, bool is_ball) {
-    std::vector<int> index(static_cast<std::size_t>(body.relative.rows()), -1);
+    std::vector<std::uint8_t> keep(static_cast<std::size_t>(body.relative.rows()));
+    for (Eigen::Index i = 0; i < body.relative.rows(); ++i)
+      keep[static_cast<std::size_t>(i)] = body.relative.row(i).norm() <= radius;
     std::vector<Eigen::Index> kept;
-    std::vector<Eigen::Vector3i> faces;
-    for (Eigen::Index f = 0; f < body.mesh.F.rows(); ++f) {
-      bool in = true;
-      for (int c = 0; c < 3; ++c) in = in && body.relative.row(body.mesh.F(f, c)).norm() <= radius;
-      if (!in) continue;
-      Eigen::Vector3i idx;
-      for (int c = 0; c < 3; ++c) {
-        int& k = index[static_cast<std::size_t>(body.mesh.F(f, c))];
-        if (k < 0) k = static_cast<int>(kept.size()), kept.push_back(body.mesh.F(f, c));
-        idx[c] = k;
-      }
-      faces.push_back(idx);
-    }
+    TriangleMesh region = submesh(body.mesh, keep, &kept);
     const auto n = static_cast<Eigen::Index>(kept.size());
-    Vertices V(n, 3);
-    Faces F(static_cast<Eigen::Index>(faces.size()), 3);
     Eigen::VectorXf gap(n);
     Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
     Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
     for (Eigen::Index k = 0; k < n; ++k) {
-      const auto i = static_cast<std::size_t>(kept[static_cast<std::size_t>(k)]);
-      V.row(k) = (R * body.relative.row(static_cast<Eigen::Index>(i)).transpose()).transpose();
-      gap[k] = g != nullptr ? g->gap_mm[i] : std::nanf("");
+      const Eigen::Index i = kept[static_cast<std::size_t>(k)];
+      region.V.row(k) = (R * body.relative.row(i).transpose()).transpose();
+      gap[k] = g != nullptr ? g->gap_mm[static_cast<std::size_t>(i)] : std::nanf("");
       level[k] = std::isnan(gap[k]) ? 255 : lv.level(gap[k]);
       const auto c = level_colour(level[k], lv.count(), is_ball);
       rgb.row(k) << c[0], c[1], c[2];
     }
-    for (std::size_t k = 0; k < faces.size(); ++k) F.row(static_cast<Eigen::Index>(k)) = faces[k].transpose();
-    write_gap_ply(path, V, F, gap, level, rgb);
+    write_gap_ply(path, region.V, region.F, gap, level, rgb);
   };
   for (const Subject& s : subjects) {
     HipJointOptions ho;

@@ -200,29 +200,12 @@ TEST(HipFrames, GivenLandmarksReplaceFoundOnes) {
   EXPECT_THROW(find_hip_frames(j->femur, j->pelvis, Side::right, given), Error);
 }
 
-// The part of `m` whose faces have every corner with `keep(vertex)` true, reindexed.
+// The part of `m` whose faces have every corner with `keep(vertex)` true.
 template <typename Keep>
 TriangleMesh sub_mesh(const TriangleMesh& m, Keep keep) {
-  std::vector<int> map(static_cast<std::size_t>(m.V.rows()), -1);
-  std::vector<Eigen::Index> verts;
-  std::vector<Eigen::Vector3i> faces;
-  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
-    if (!keep(m.V.row(m.F(f, 0))) || !keep(m.V.row(m.F(f, 1))) || !keep(m.V.row(m.F(f, 2)))) continue;
-    Eigen::Vector3i g;
-    for (int c = 0; c < 3; ++c) {
-      int& k = map[static_cast<std::size_t>(m.F(f, c))];
-      if (k < 0) k = static_cast<int>(verts.size()), verts.push_back(m.F(f, c));
-      g[c] = k;
-    }
-    faces.push_back(g);
-  }
-  TriangleMesh out;
-  out.source = m.source + " (part)";
-  out.V.resize(static_cast<Eigen::Index>(verts.size()), 3);
-  for (std::size_t k = 0; k < verts.size(); ++k) out.V.row(static_cast<Eigen::Index>(k)) = m.V.row(verts[k]);
-  out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
-  for (std::size_t k = 0; k < faces.size(); ++k) out.F.row(static_cast<Eigen::Index>(k)) = faces[k].transpose();
-  return out;
+  std::vector<std::uint8_t> k(static_cast<std::size_t>(m.V.rows()));
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) k[static_cast<std::size_t>(i)] = keep(m.V.row(i));
+  return submesh(m, k);
 }
 
 TEST(HipFrames, AHalfPelvisOrACutFemurIsAClearError) {

@@ -61,4 +61,34 @@ Eigen::VectorXd vertex_areas(const TriangleMesh& mesh) {
   return area;
 }
 
+TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>& keep_vertex,
+                     std::vector<Eigen::Index>* kept) {
+  require(keep_vertex.size() == static_cast<std::size_t>(mesh.V.rows()),
+          mesh.source + ": submesh: the vertex selection has " + std::to_string(keep_vertex.size()) +
+              " entries for " + std::to_string(mesh.V.rows()) + " vertices");
+  std::vector<int> index(keep_vertex.size(), -1);
+  std::vector<Eigen::Index> used;
+  std::vector<Eigen::Vector3i> faces;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    bool in = true;
+    for (int c = 0; c < 3; ++c) in = in && keep_vertex[static_cast<std::size_t>(mesh.F(f, c))] != 0;
+    if (!in) continue;
+    Eigen::Vector3i idx;
+    for (int c = 0; c < 3; ++c) {
+      int& k = index[static_cast<std::size_t>(mesh.F(f, c))];
+      if (k < 0) k = static_cast<int>(used.size()), used.push_back(mesh.F(f, c));
+      idx[c] = k;
+    }
+    faces.push_back(idx);
+  }
+  TriangleMesh out;
+  out.source = mesh.source;
+  out.V.resize(static_cast<Eigen::Index>(used.size()), 3);
+  for (std::size_t k = 0; k < used.size(); ++k) out.V.row(static_cast<Eigen::Index>(k)) = mesh.V.row(used[k]);
+  out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (std::size_t k = 0; k < faces.size(); ++k) out.F.row(static_cast<Eigen::Index>(k)) = faces[k].transpose();
+  if (kept != nullptr) *kept = std::move(used);
+  return out;
+}
+
 }  // namespace impinge

@@ -4,7 +4,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace impinge {
 
@@ -29,6 +31,12 @@ void validate_mesh(const TriangleMesh& mesh);
 /// Remove triangles whose area is below `min_area_mm2` or which repeat a vertex index;
 /// returns how many were removed and adds that to `mesh.degenerate_faces_skipped`.
 int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2 = 1e-12);
+
+/// The part of `mesh` made of the triangles whose three corners have keep_vertex[i] != 0,
+/// with its vertices renumbered in order of first use. `kept` (optional) receives, for each new
+/// vertex, its index in `mesh`. Throws impinge::Error when keep_vertex.size() != n.
+TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>& keep_vertex,
+                     std::vector<Eigen::Index>* kept = nullptr);
 
 /// Per-vertex area (mm^2): one third of the area of every incident triangle (barycentric dual
 /// area), so the sum over vertices equals the surface area. Returns n values.
