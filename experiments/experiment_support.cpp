@@ -121,8 +121,11 @@ void write_meta(const std::string& dir, const Args& args, nlohmann::json params)
   m["timing"] = "median wall time after one warm-up run, single thread";
   m["data_folder"] = args.data;
   const std::string commit = command_output("git -C '" IMPINGE_SOURCE_DIR "' rev-parse HEAD 2>/dev/null");
-  const std::string dirty =
-      command_output("git -C '" IMPINGE_SOURCE_DIR "' status --porcelain --untracked-files=no 2>/dev/null");
+  // Dirty = a tracked source file differs from the commit. The results folder is left out: a
+  // reproduction rewrites it as it goes, which would otherwise mark every experiment after the first.
+  const std::string dirty = command_output("git -C '" IMPINGE_SOURCE_DIR
+                                           "' status --porcelain --untracked-files=no -- . ':(exclude)results' "
+                                           "2>/dev/null");
   m["git_commit"] = commit.empty() ? "unknown" : commit + (dirty.empty() ? "" : "-dirty");
   m["compiler"] = IMPINGE_COMPILER;
   m["cpu_model"] = command_output("grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'");

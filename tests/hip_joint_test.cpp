@@ -83,7 +83,9 @@ TEST(HipJoint, ScanNeutralIsThePlainJointPosedByPoseRotation) {
     const PoseResult r = hip.detect(a), q = plain.detect(pose_rotation(a, Side::right));
     EXPECT_EQ(r.ball_gaps.status, q.ball_gaps.status);
     for (std::size_t i = 0; i < r.ball_gaps.gap_mm.size(); ++i)
-      if (!std::isnan(q.ball_gaps.gap_mm[i])) EXPECT_EQ(r.ball_gaps.gap_mm[i], q.ball_gaps.gap_mm[i]) << i;
+      if (!std::isnan(q.ball_gaps.gap_mm[i])) {
+        EXPECT_EQ(r.ball_gaps.gap_mm[i], q.ball_gaps.gap_mm[i]) << i;
+      }
     EXPECT_EQ(r.socket.min_gap_mm, q.socket.min_gap_mm);
   }
   // The generated model is a proximal femur and a cup: anatomical neutral is refused clearly.

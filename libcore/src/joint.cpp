@@ -23,16 +23,34 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options)
     : cor_(cor), options_(checked(options, cor)), ball_(build(std::move(ball))), socket_(build(std::move(socket))) {}
 
-JointBody Joint::build(TriangleMesh mesh) const {
+Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options,
+             RadialDistanceMap ball_map, RadialDistanceMap socket_map)
+    : cor_(cor),
+      options_(checked(options, cor)),
+      ball_(build(std::move(ball), std::move(ball_map))),
+      socket_(build(std::move(socket), std::move(socket_map))) {}
+
+JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given) const {
   validate_mesh(mesh);
   JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0};
   b.relative = b.mesh.V.rowwise() - cor_.transpose();
-  SamplingOptions so;
-  so.mode = options_.mode;
-  so.method = options_.sampling;
-  const auto t0 = std::chrono::steady_clock::now();
-  b.sampling = sample_surface(b.mesh, cor_, so, b.map);
-  b.sampling_ms = ms_since(t0);
+  if (given) {
+    const SamplingScheme& want = *options_.scheme;
+    const SamplingScheme& have = given->scheme();
+    require(have.name() == want.name() && have.resolution() == want.resolution() &&
+                given->num_nodes() == want.num_nodes(),
+            b.mesh.source + ": the given map is " + have.name() + " at " + std::to_string(have.resolution()) +
+                ", the joint's scheme is " + want.name() + " at " + std::to_string(want.resolution()));
+    b.map = std::move(*given);
+    b.sampling.nodes_covered = b.map.nodes_covered();
+  } else {
+    SamplingOptions so;
+    so.mode = options_.mode;
+    so.method = options_.sampling;
+    const auto t0 = std::chrono::steady_clock::now();
+    b.sampling = sample_surface(b.mesh, cor_, so, b.map);
+    b.sampling_ms = ms_since(t0);
+  }
   b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);
   b.scan_set = make_scan_set(b.relative, b.mask);
   b.vertex_area = vertex_areas(b.mesh);

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "impinge/detection.hpp"
@@ -57,6 +58,13 @@ class Joint {
   /// surface masks. Throws impinge::Error on invalid options or a non-finite COR.
   Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options);
 
+  /// The same with both maps given (for example loaded with load_map) instead of sampled: no
+  /// rasterisation. The maps must be about `cor` in the meshes' frame and of options.scheme's
+  /// scheme and resolution. Throws impinge::Error when a map's scheme, resolution or node count
+  /// differs from options.scheme.
+  Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options,
+        RadialDistanceMap ball_map, RadialDistanceMap socket_map);
+
   /// Both scans (ball vertices against the socket map, socket vertices against the ball map)
   /// with the ball rotated by R (3 x 3) about the COR and then translated by t (mm, socket
   /// frame; zero for a pure ball-and-socket motion, nonzero to push the head into the cup).
@@ -73,7 +81,7 @@ class Joint {
   const JointOptions& options() const { return options_; }
 
  private:
-  JointBody build(TriangleMesh mesh) const;
+  JointBody build(TriangleMesh mesh, std::optional<RadialDistanceMap> map = std::nullopt) const;
   Eigen::Vector3d cor_;
   JointOptions options_;
   JointBody ball_, socket_;

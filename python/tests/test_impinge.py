@@ -1,0 +1,161 @@
+"""The Python module against the CLI and the C++ library. Invariants: gaps from Python equal the
+CLI's on a generated hip, bit for bit; maps are numpy views with the documented shapes; bad
+arrays (wrong shape, NaN, bad indices, wrong dtype) raise impinge.Error naming the array;
+motion() equals detect_pose() frame by frame."""
+import json
+import os
+import struct
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+import impinge
+
+CLI = os.environ.get("IMPINGE_CLI", "build/impinge")
+DATA = os.environ.get("IMPINGE_SHARED_DATA", "../shared/data/hips")
+
+
+def read_gaps(path):
+    """gap_mm per vertex of a PLY written by impinge (x y z gap_mm quality: floats; level r g b: uchar)."""
+    with open(path, "rb") as f:
+        n = 0
+        while True:
+            line = f.readline().decode().strip()
+            if line.startswith("element vertex"):
+                n = int(line.split()[2])
+            if line == "end_header":
+                break
+        rec = np.frombuffer(f.read(n * 24), dtype=np.dtype([("f", "<f4", 5), ("b", "u1", 4)]), count=n)
+    return rec["f"][:, 3]
+
+
+@pytest.fixture(scope="module")
+def generated():
+    d = tempfile.mkdtemp(prefix="impinge_py_")
+    subprocess.run([CLI, "generate", "--triangles", "3000", "--cam", "2", "--out", d + "/s"], check=True,
+                   capture_output=True)
+    return d
+
+
+def test_gaps_equal_the_cli_on_a_generated_hip(generated):
+    d = generated
+    subprocess.run([CLI, "distance", "--subject", d + "/s/subject.json", "--precision", "1", "--pose=30,-10,5",
+                    "--out", d + "/cli"], check=True, capture_output=True)
+    cli_ball, cli_socket = read_gaps(d + "/cli/ball_gaps.ply"), read_gaps(d + "/cli/socket_gaps.ply")
+    with open(d + "/cli/summary.json") as f:
+        cor = json.load(f)["cor_mm"]
+    ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
+    j = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0)
+    r = j.detect_pose(30, -10, 5)
+    assert r["ball_gap_mm"].dtype == np.float32 and r["ball_gap_mm"].shape == (len(ball[0]),)
+    np.testing.assert_array_equal(r["ball_gap_mm"], cli_ball)
+    np.testing.assert_array_equal(r["socket_gap_mm"], cli_socket)
+    # The same pose as a rotation matrix.
+    R = j.femur_rotation(30, -10, 5)
+    np.testing.assert_array_equal(j.detect(R)["ball_gap_mm"], cli_ball)
+    s = r["summary"]["ball"]
+    assert s["vertices_tested"] == int(np.count_nonzero(r["ball_status"] == 0))
+    assert s["min_gap_mm"] == pytest.approx(float(np.nanmin(r["ball_gap_mm"])))
+
+
+def test_motion_equals_detect_pose_and_maps_are_views(generated):
+    d = generated
+    ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
+    j = impinge.Joint(ball, socket, neutral="scan", resolution=2.0)
+    angles = np.array([[0, 0, 0], [20, 5, -5], [40, -10, 10]], dtype=float)
+    m = j.motion(angles)
+    for k, a in enumerate(angles):
+        r = j.detect_pose(*a)
+        assert m["ball_min_gap_mm"][k] == r["summary"]["ball"]["min_gap_mm"]
+        assert m["socket_min_gap_mm"][k] == r["summary"]["socket"]["min_gap_mm"]
+    mp = j.socket_map
+    v = mp.values
+    assert v.dtype == np.float32 and v.shape == (mp.num_nodes,) and not v.flags.writeable
+    assert mp.num_nodes == (180 // 2 + 1) * (360 // 2)
+    assert int(np.isfinite(v).sum()) == mp.nodes_covered
+    u = mp.node_directions()
+    np.testing.assert_allclose(np.linalg.norm(u, axis=1), 1.0, atol=1e-12)
+    assert j.frames is None
+
+
+def test_bad_arrays_raise_clear_errors(generated):
+    d = generated
+    V, F = impinge.load_mesh(d + "/s/femur_r.ply")
+    S = impinge.load_mesh(d + "/s/pelvis.ply")
+    cases = [
+        ((V[:, :2], F), "shape (n, 3)"),
+        ((V.astype(np.complex128), F), "dtype complex128"),
+        ((V, F.astype(np.float64)), "not an integer type"),
+        ((np.where(np.arange(len(V))[:, None] == 7, np.nan, V), F), "vertex 7 has a non-finite"),
+        ((V, np.where(F == F.max(), len(V) + 5, F)), "outside [0, %d)" % len(V)),
+        ((V, F[:, ::-1][:, :2]), "shape (n, 3)"),
+        (([1, 2, 3], F), "expected a numpy array"),
+    ]
+    for ball, fragment in cases:
+        with pytest.raises(impinge.Error) as e:
+            impinge.Joint(ball, S, neutral="scan", resolution=2.0)
+        assert fragment in str(e.value), str(e.value)
+    j = impinge.Joint((V, F), S, neutral="scan", resolution=2.0)
+    with pytest.raises(impinge.Error, match="rotation"):
+        j.detect(np.ones((3, 3)))
+    with pytest.raises(impinge.Error, match=r"shape \(k, 3\)"):
+        j.motion(np.zeros((4, 2)))
+    with pytest.raises(impinge.Error, match="not finite"):
+        j.motion(np.array([[0, np.nan, 0]]))
+    with pytest.raises(impinge.Error, match="sampling scheme 'hexagon'"):
+        impinge.Joint((V, F), S, neutral="scan", scheme="hexagon")
+    with pytest.raises(impinge.Error, match="nope.ply"):
+        impinge.load_mesh(d + "/nope.ply")
+    # A generated hip is no whole pelvis: anatomical neutral says so.
+    with pytest.raises(impinge.Error, match="not a whole femur|whole pelvis"):
+        impinge.Joint((V, F), S)
+
+
+def test_long_calls_release_the_gil(generated):
+    """While one thread is inside motion(), another Python thread keeps running."""
+    import threading
+    d = generated
+    j = impinge.Joint(impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply"),
+                      neutral="scan", resolution=1.0)
+    angles = np.column_stack([np.linspace(0, 90, 20000), np.zeros(20000), np.zeros(20000)])
+    inside, done = threading.Event(), threading.Event()
+
+    def work():
+        inside.set()
+        j.motion(angles)
+        done.set()
+
+    count = 0
+    th = threading.Thread(target=work)
+    th.start()
+    inside.wait()
+    while not done.is_set():
+        count += 1
+    th.join()
+    assert count > 1000, f"the main thread ran only {count} iterations while motion() worked"
+
+
+def test_fit_sphere_recovers_an_analytic_sphere():
+    rng = np.random.default_rng(5)
+    u = rng.normal(size=(500, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    u = u[u[:, 2] > 0.3]  # a cap, as a femoral head
+    s = impinge.fit_sphere(np.array([10.0, -20.0, 30.0]) + 23.5 * u)
+    np.testing.assert_allclose(s["centre"], [10, -20, 30], atol=1e-9)
+    assert s["radius"] == pytest.approx(23.5, abs=1e-9)
+
+
+@pytest.mark.skipif(not os.path.exists(os.path.join(DATA, "lhdl-ct", "subject.json")), reason="shared data absent")
+def test_real_subject_anatomical_frames():
+    femur = impinge.load_mesh(os.path.join(DATA, "lhdl-ct", "femur_r.ply"))
+    pelvis = impinge.load_mesh(os.path.join(DATA, "lhdl-ct", "pelvis.ply"))
+    lps = np.diag([-1.0, -1.0, 1.0])  # the subject is LPS: to RAS
+    ball, socket = (femur[0] @ lps, femur[1]), (pelvis[0] @ lps, pelvis[1])
+    j = impinge.Joint(ball, socket, resolution=0.5)
+    f = j.frames
+    assert set(f) == {"pelvis", "femur", "scan_pose"}
+    np.testing.assert_allclose(f["pelvis"]["axes"].T @ f["pelvis"]["axes"], np.eye(3), atol=1e-12)
+    m = j.motion(np.array([[0, 0, 0], [90, 0, 0]]))
+    assert np.all(np.isfinite(m["ball_min_gap_mm"]))
