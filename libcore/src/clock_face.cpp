@@ -24,7 +24,7 @@ ClockFace ClockFace::transformed(const Eigen::Matrix3d& R, const Eigen::Vector3d
   return ClockFace{R * centre + t, R * axis, R * twelve, R * three};
 }
 
-void clock_summary(const ScanGaps& gaps, const Vertices& V, const Eigen::VectorXd& area, const ClockFace& clock,
+void clock_summary(const ScanGaps& gaps, PointsRef V, const Eigen::VectorXd& area, const ClockFace& clock,
                    const ImpingementLevels& levels, ClockSummary& out) {
   out.sector_level_area_mm2.assign(static_cast<std::size_t>(12 * levels.count()), 0.0);
   out.closest_hour = std::nan("");

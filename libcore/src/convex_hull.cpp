@@ -17,7 +17,7 @@ namespace impinge {
 #ifdef IMPINGE_HAVE_CGAL
 bool have_convex_hull() { return true; }
 
-ConvexHull convex_hull(const Vertices& P) {
+ConvexHull convex_hull(PointsRef P) {
   using K = CGAL::Exact_predicates_inexact_constructions_kernel;
   using Point = K::Point_3;
   require(P.rows() >= 4, "convex hull: needs at least 4 points, got " + std::to_string(P.rows()));
@@ -59,7 +59,7 @@ ConvexHull convex_hull(const Vertices& P) {
 }
 #else
 bool have_convex_hull() { return false; }
-ConvexHull convex_hull(const Vertices&) {
+ConvexHull convex_hull(PointsRef) {
   throw Error("convex hull: this build has no CGAL (tools/install-deps installs libcgal-dev)");
 }
 #endif

@@ -9,7 +9,7 @@
 
 namespace impinge {
 
-ScanSet make_scan_set(const Vertices& P, const std::vector<std::uint8_t>& mask) {
+ScanSet make_scan_set(PointsRef P, const std::vector<std::uint8_t>& mask) {
   require(
       static_cast<Eigen::Index>(mask.size()) == P.rows(),
       "scan set: mask has " + std::to_string(mask.size()) + " entries for " + std::to_string(P.rows()) + " vertices");
@@ -74,7 +74,7 @@ void scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen
 }
 
 template <typename Scalar>
-void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
+void scan_gaps(PointsRef P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
                const RadialDistanceMapT<Scalar>& map, ScanSide side, ScanGaps& out) {
   const ScanSet set = make_scan_set(P, mask);
   std::vector<float> gaps(static_cast<std::size_t>(set.size()));
@@ -94,7 +94,7 @@ void expand_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out) {
 }
 
 template <typename Scalar>
-std::vector<std::uint8_t> first_surface_mask(const Vertices& P, const RadialDistanceMapT<Scalar>& own_map,
+std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMapT<Scalar>& own_map,
                                              double tolerance_mm, double max_radius_mm) {
   std::vector<std::uint8_t> mask(static_cast<std::size_t>(P.rows()), 0);
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
@@ -156,17 +156,17 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
   if (s.vertices_tested > 0) s.min_gap_mm = min_gap;
 }
 
-template void scan_gaps<float>(const Vertices&, const Eigen::Matrix3d&, const std::vector<std::uint8_t>&,
+template void scan_gaps<float>(PointsRef, const Eigen::Matrix3d&, const std::vector<std::uint8_t>&,
                                const RadialDistanceMapT<float>&, ScanSide, ScanGaps&);
-template void scan_gaps<double>(const Vertices&, const Eigen::Matrix3d&, const std::vector<std::uint8_t>&,
+template void scan_gaps<double>(PointsRef, const Eigen::Matrix3d&, const std::vector<std::uint8_t>&,
                                 const RadialDistanceMapT<double>&, ScanSide, ScanGaps&);
 template void scan_gaps_compact<float>(const ScanSet&, const Eigen::Matrix3d&, const Eigen::Vector3d&,
                                        const RadialDistanceMapT<float>&, ScanSide, float*);
 template void scan_gaps_compact<double>(const ScanSet&, const Eigen::Matrix3d&, const Eigen::Vector3d&,
                                         const RadialDistanceMapT<double>&, ScanSide, float*);
-template std::vector<std::uint8_t> first_surface_mask<float>(const Vertices&, const RadialDistanceMapT<float>&, double,
+template std::vector<std::uint8_t> first_surface_mask<float>(PointsRef, const RadialDistanceMapT<float>&, double,
                                                              double);
-template std::vector<std::uint8_t> first_surface_mask<double>(const Vertices&, const RadialDistanceMapT<double>&,
+template std::vector<std::uint8_t> first_surface_mask<double>(PointsRef, const RadialDistanceMapT<double>&,
                                                               double, double);
 
 }  // namespace impinge

@@ -18,7 +18,7 @@ Landmarks FemurLandmarks::as_map() const {
           {"posterior_condyle_medial", posterior_condyle_medial}};
 }
 
-Eigen::Vector3d femur_long_axis(const Vertices& V, const Eigen::Vector3d& proximal_hint) {
+Eigen::Vector3d femur_long_axis(PointsRef V, const Eigen::Vector3d& proximal_hint) {
   require(V.rows() >= 4, "femur long axis: too few vertices");
   const Eigen::RowVector3d c = V.colwise().mean();
   const Eigen::MatrixXd D = V.rowwise() - c;

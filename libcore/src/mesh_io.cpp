@@ -108,7 +108,7 @@ void write_faces(std::ofstream& os, const Faces& F) {
 }
 }  // namespace
 
-void write_gap_ply(const std::string& path, const Vertices& V, const Faces& F, const Eigen::VectorXf& gap_mm,
+void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const Eigen::VectorXf& gap_mm,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 1>& level,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor>& rgb) {
   require(gap_mm.size() == V.rows() && level.size() == V.rows() && rgb.rows() == V.rows(),

@@ -14,10 +14,10 @@
 
 namespace impinge {
 
-using PointMatrix = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+using PointMatrix = Vertices;
 
 namespace {
-double rms_of(const PointMatrix& P, const Eigen::Vector3d& c, double r) {
+double rms_of(PointsRef P, const Eigen::Vector3d& c, double r) {
   double s = 0;
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
     const double e = (P.row(i).transpose() - c).norm() - r;
@@ -27,7 +27,7 @@ double rms_of(const PointMatrix& P, const Eigen::Vector3d& c, double r) {
 }
 
 int residual_f(const gsl_vector* x, void* data, gsl_vector* f) {
-  const auto& P = *static_cast<const PointMatrix*>(data);
+  const auto& P = *static_cast<const PointsRef*>(data);
   const Eigen::Vector3d c(gsl_vector_get(x, 0), gsl_vector_get(x, 1), gsl_vector_get(x, 2));
   const double r = gsl_vector_get(x, 3);
   for (Eigen::Index i = 0; i < P.rows(); ++i)
@@ -36,7 +36,7 @@ int residual_f(const gsl_vector* x, void* data, gsl_vector* f) {
 }
 
 int residual_df(const gsl_vector* x, void* data, gsl_matrix* J) {
-  const auto& P = *static_cast<const PointMatrix*>(data);
+  const auto& P = *static_cast<const PointsRef*>(data);
   const Eigen::Vector3d c(gsl_vector_get(x, 0), gsl_vector_get(x, 1), gsl_vector_get(x, 2));
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
     const Eigen::Vector3d d = P.row(i).transpose() - c;
@@ -49,7 +49,7 @@ int residual_df(const gsl_vector* x, void* data, gsl_matrix* J) {
 }
 }  // namespace
 
-SphereFitResult fit_sphere_algebraic(const PointMatrix& P) {
+SphereFitResult fit_sphere_algebraic(PointsRef P) {
   require(P.rows() >= 4, "sphere fit: needs at least 4 points, got " + std::to_string(P.rows()));
   // Centre the data for conditioning.
   const Eigen::RowVector3d mean = P.colwise().mean();
@@ -78,7 +78,7 @@ SphereFitResult fit_sphere_algebraic(const PointMatrix& P) {
   return res;
 }
 
-SphereFitResult fit_sphere_geometric(const PointMatrix& P) {
+SphereFitResult fit_sphere_geometric(PointsRef P) {
   SphereFitResult start = fit_sphere_algebraic(P);
   const gsl_multifit_nlinear_type* T = gsl_multifit_nlinear_trust;
   gsl_multifit_nlinear_parameters params = gsl_multifit_nlinear_default_parameters();
@@ -90,7 +90,7 @@ SphereFitResult fit_sphere_geometric(const PointMatrix& P) {
   fdf.fvv = nullptr;
   fdf.n = n;
   fdf.p = p;
-  fdf.params = const_cast<PointMatrix*>(&P);
+  fdf.params = const_cast<PointsRef*>(&P);
   gsl_vector* x0 = gsl_vector_alloc(p);
   for (int k = 0; k < 3; ++k) gsl_vector_set(x0, static_cast<std::size_t>(k), start.centre[k]);
   gsl_vector_set(x0, 3, start.radius);

@@ -22,7 +22,7 @@ std::vector<char> as_bytes(const std::vector<T>& v) {
 }
 }  // namespace
 
-void write_vtp(const std::string& path, const Vertices& V, const Faces& F, const std::vector<PointArray>& arrays) {
+void write_vtp(const std::string& path, PointsRef V, const Faces& F, const std::vector<PointArray>& arrays) {
   const Eigen::Index n = V.rows(), m = F.rows();
   require(F.size() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < n),
           path + ": a triangle indexes a vertex outside [0, " + std::to_string(n) + ")");

@@ -45,7 +45,7 @@ struct ClockSummary {
 
 /// Clock summary of one scan: `gaps` (n vertices), their positions V (n x 3, mm, the frame of
 /// `clock`, unposed: the clock moves with its bone), vertex areas (n, mm^2). Into `out`.
-void clock_summary(const ScanGaps& gaps, const Vertices& V, const Eigen::VectorXd& area, const ClockFace& clock,
+void clock_summary(const ScanGaps& gaps, PointsRef V, const Eigen::VectorXd& area, const ClockFace& clock,
                    const ImpingementLevels& levels, ClockSummary& out);
 
 /// The acetabulum of a pelvis: its sphere, rim and clock face.

@@ -24,6 +24,6 @@ bool have_convex_hull();
 /// the order or rigid placement of the points beyond rounding of the input coordinates.
 /// Throws impinge::Error when n < 4, the points are coplanar, a coordinate is not finite,
 /// or the build has no CGAL.
-ConvexHull convex_hull(const Vertices& P);
+ConvexHull convex_hull(PointsRef P);
 
 }  // namespace impinge

@@ -49,7 +49,7 @@ struct ScanSummary {
 /// and call scan_gaps_compact. `out` is resized to n. Vertices at the COR itself are reported
 /// as no surface.
 template <typename Scalar>
-void scan_gaps(const Vertices& P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
+void scan_gaps(PointsRef P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
                const RadialDistanceMapT<Scalar>& map, ScanSide side, ScanGaps& out);
 
 /// The vertices of one body that a scan looks up, prepared once (pose-invariant): the indices
@@ -66,7 +66,7 @@ struct ScanSet {
 
 /// ScanSet of the vertices P (n x 3, mm, relative to the COR) with mask[i] != 0. Throws
 /// impinge::Error when mask.size() != n or n exceeds 2^31 - 1.
-ScanSet make_scan_set(const Vertices& P, const std::vector<std::uint8_t>& mask);
+ScanSet make_scan_set(PointsRef P, const std::vector<std::uint8_t>& mask);
 
 /// The fast scan (issue 4): for every vertex j of `set`, q = R * p_j + t in the map's frame
 /// (R: 3 x 3 rotation, t: translation, mm; the identity and 0 when the bodies share the COR),
@@ -90,7 +90,7 @@ void expand_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out);
 /// wall behind the acetabulum) are not represented by a radial map and would give a spurious
 /// gap against the other map.
 template <typename Scalar>
-std::vector<std::uint8_t> first_surface_mask(const Vertices& P, const RadialDistanceMapT<Scalar>& own_map,
+std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMapT<Scalar>& own_map,
                                              double tolerance_mm, double max_radius_mm);
 
 /// Summary of a scan: counts, minimum gap, penetration and levels weighted by vertex area

@@ -36,7 +36,7 @@ inline const char* const kFemurLandmarkNames[] = {"epicondyle_lateral", "epicond
 
 /// Long axis of a femur: the principal axis of largest variance of its vertices (n x 3, mm),
 /// unit, pointing towards `proximal_hint` (mm; for example the head centre) when it is finite.
-Eigen::Vector3d femur_long_axis(const Vertices& V, const Eigen::Vector3d& proximal_hint);
+Eigen::Vector3d femur_long_axis(PointsRef V, const Eigen::Vector3d& proximal_hint);
 
 /// Femoral head sphere on a whole femur in any orientation: the long axis (principal axis), then
 /// fit_femoral_head with each end in turn taken as proximal; the end whose sphere has more

@@ -14,6 +14,12 @@ namespace impinge {
 using Vertices = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;  ///< V: n x 3, mm
 using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;        ///< F: m x 3, 0-based
 
+/// The array convention at the API: a point set is a read-only reference to a row-major n x 3
+/// double matrix (mm). A Vertices binds to it without a copy, and so does an Eigen::Map of a
+/// C-contiguous float64 (n, 3) numpy array (the Python module's layout); any other layout (a
+/// column-major matrix, a block) is copied into a temporary by Eigen.
+using PointsRef = Eigen::Ref<const Vertices>;
+
 /// A triangle mesh. Invariants after `validate_mesh`: n >= 3 vertices, every coordinate
 /// finite, every index in [0, n), m >= 1 triangles.
 struct TriangleMesh {

@@ -31,7 +31,7 @@ TriangleMesh load_mesh(const std::string& path);
 /// `V` (n x 3, mm) replaces mesh.V so callers can write a posed copy; `gap_mm`, `level` and
 /// `rgb` (n x 3) give one entry per vertex. Throws impinge::Error if the file cannot be written
 /// or the sizes disagree.
-void write_gap_ply(const std::string& path, const Vertices& V, const Faces& F, const Eigen::VectorXf& gap_mm,
+void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const Eigen::VectorXf& gap_mm,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 1>& level,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor>& rgb);
 

@@ -25,13 +25,13 @@ struct SphereFitResult {
 /// P: k x 3 points, mm, k >= 4 and not coplanar. Throws impinge::Error when k < 4 or the
 /// system is singular (coplanar points). Fast, biased on partial spheres: use it to start
 /// the geometric fit.
-SphereFitResult fit_sphere_algebraic(const Eigen::Matrix<double, Eigen::Dynamic, 3>& P);
+SphereFitResult fit_sphere_algebraic(PointsRef P);
 
 /// Geometric sphere fit minimising E(c, r) = sum (|p_i - c| - r)^2 (Eberly 1999, the fit of
 /// thesis sec. 3.4), solved by GSL's Levenberg-Marquardt trust region (gsl_multifit_nlinear)
 /// from the algebraic fit. P: k x 3 points, mm, k >= 4. Throws impinge::Error on too few or
 /// coplanar points.
-SphereFitResult fit_sphere_geometric(const Eigen::Matrix<double, Eigen::Dynamic, 3>& P);
+SphereFitResult fit_sphere_geometric(PointsRef P);
 
 /// Options of the automatic femoral-head fit.
 struct HeadFitOptions {

@@ -24,7 +24,7 @@ struct PointArray {
 /// binary): points V (n x 3, mm, written as float32), triangles F (m x 3, 0-based), and the
 /// point arrays (each n values). Throws impinge::Error naming the file on a bad index, an array
 /// of the wrong length, or an I/O error.
-void write_vtp(const std::string& path, const Vertices& V, const Faces& F, const std::vector<PointArray>& arrays);
+void write_vtp(const std::string& path, PointsRef V, const Faces& F, const std::vector<PointArray>& arrays);
 
 /// One entry of a .pvd collection: a time step (s) and a file path relative to the .pvd.
 struct PvdEntry {
