@@ -38,7 +38,6 @@ class Map:
     nodes_covered: int
     bytes: int
     def node_directions(self) -> npt.NDArray[np.float64]: ...
-    def save(self, path: str) -> None: ...
 
 class Joint:
     """Femur (ball) and pelvis (socket) with both maps built once."""
@@ -47,7 +46,9 @@ class Joint:
                  scheme: str = "equiangular", resolution: float = 0.0, mode: str = "exact", sampling: str = "auto",
                  occlusion_tolerance_mm: float = 1.0, max_radius_mm: float = 0.0,
                  levels: Optional[Sequence[float]] = None, reseat: bool = False, pelvis_frame: str = "isb",
-                 femur_frame: str = "epicondyles") -> None: ...
+                 femur_frame: str = "epicondyles", maps: Optional[Tuple[str, str]] = None) -> None: ...
+    def save_maps(self, ball_path: str, socket_path: str) -> None:
+        """Save both maps for Joint(..., maps=(ball_path, socket_path))."""
     def detect(self, R: Optional[npt.ArrayLike] = None, t: Optional[Sequence[float]] = None) -> Dict[str, Any]:
         """Both scans, femur rotated by R about the COR and translated by t -> dict(ball_gap_mm,
         socket_gap_mm (float32, NaN untested), ball_status, socket_status (uint8), summary)."""

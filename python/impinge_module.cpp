@@ -151,7 +151,7 @@ PyJoint make_joint(const py::handle& ball, const py::handle& socket, const py::h
                    const std::string& neutral, const std::string& scheme, double resolution, const std::string& mode,
                    const std::string& sampling, double occlusion_tolerance_mm, double max_radius_mm,
                    const std::optional<std::vector<double>>& levels, bool reseat, const std::string& pelvis_frame,
-                   const std::string& femur_frame) {
+                   const std::string& femur_frame, const std::optional<std::pair<std::string, std::string>>& maps) {
   TriangleMesh b = to_mesh(ball, "ball"), s = to_mesh(socket, "socket");
   HipJointOptions o;
   o.joint.scheme = make_scheme(scheme, resolution > 0 ? resolution : default_resolution(scheme));
@@ -167,6 +167,7 @@ PyJoint make_joint(const py::handle& ball, const py::handle& socket, const py::h
   o.reseat = reseat;
   o.frames.pelvis = parse_pelvis_frame_kind(pelvis_frame, "pelvis_frame");
   o.frames.femur = parse_femur_frame_kind(femur_frame, "femur_frame");
+  if (maps) o.ball_map_file = maps->first, o.socket_map_file = maps->second;
   PyJoint j;
   j.side = parse_side(side, "side");
   SphereFitResult head;
@@ -371,10 +372,7 @@ PYBIND11_MODULE(impinge, m) {
       .def_property_readonly("resolution", [](const MapView& v) { return v.map->scheme().resolution(); })
       .def_property_readonly("num_nodes", [](const MapView& v) { return v.map->num_nodes(); })
       .def_property_readonly("nodes_covered", [](const MapView& v) { return v.map->nodes_covered(); })
-      .def_property_readonly("bytes", [](const MapView& v) { return v.map->bytes(); })
-      .def(
-          "save", [](const MapView& v, const std::string& path) { save_map(path, *v.map, Eigen::Vector3d::Zero()); },
-          py::arg("path"), "Save the map (impinge map file, see map_io.hpp). Raises impinge.Error on I/O errors.");
+      .def_property_readonly("bytes", [](const MapView& v) { return v.map->bytes(); });
 
   py::class_<PyJoint>(m, "Joint",
                       "A hip: femur (ball) and pelvis (socket) in one frame (mm), both radial distance maps built "
@@ -384,13 +382,14 @@ PYBIND11_MODULE(impinge, m) {
            py::arg("resolution") = 0.0, py::arg("mode") = "exact", py::arg("sampling") = "auto",
            py::arg("occlusion_tolerance_mm") = 1.0, py::arg("max_radius_mm") = 0.0,
            py::arg("levels") = py::none(), py::arg("reseat") = false, py::arg("pelvis_frame") = "isb",
-           py::arg("femur_frame") = "epicondyles",
+           py::arg("femur_frame") = "epicondyles", py::arg("maps") = py::none(),
            "ball, socket: (V (n, 3) float, F (m, 3) int) in one frame, mm (RAS-like: x right, y anterior, z "
            "superior for neutral='scan'). cor: centre of rotation (3,), mm; None fits the femoral head. "
            "neutral: 'anatomical' (ISB frames found on whole bones) or 'scan'. scheme/resolution: sampling "
            "scheme and its resolution (0: the scheme's default, 0.5 deg equivalent). mode: 'exact' or 'linear'. "
-           "levels: impingement thresholds (mm, decreasing). Builds both maps (the GIL is released). Raises "
-           "impinge.Error on bad arrays or options.")
+           "levels: impingement thresholds (mm, decreasing). maps: (ball_path, socket_path) saved by save_maps() "
+           "to load instead of sampling. Builds both maps (the GIL is released). Raises impinge.Error on bad "
+           "arrays, options or map files.")
       .def(
           "detect",
           [](const PyJoint& j, const py::handle& R, const py::handle& t) {
@@ -425,6 +424,12 @@ PYBIND11_MODULE(impinge, m) {
            "Both scans at every row of angles (k, 3): flexion, adduction, internal rotation in degrees -> "
            "dict of float64 (k,) arrays: ball_min_gap_mm, socket_min_gap_mm, ball_penetrating_area_mm2, "
            "socket_penetrating_area_mm2. One call; the GIL is released.")
+      .def(
+          "save_maps", [](const PyJoint& j, const std::string& ball, const std::string& socket) {
+            j.hip->save_maps(ball, socket);
+          },
+          py::arg("ball_path"), py::arg("socket_path"),
+          "Save both maps (impinge map files with scheme, resolution, COR and checksum) for Joint(..., maps=...).")
       .def(
           "femur_rotation",
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {

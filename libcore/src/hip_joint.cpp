@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "impinge/error.hpp"
+#include "impinge/map_io.hpp"
 
 namespace impinge {
 
@@ -58,7 +59,29 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   }
   const Eigen::Matrix3d to_joint = joint_to_working_.transpose();
   for (TriangleMesh* m : {&femur, &pelvis}) m->V = ((m->V.rowwise() - cor_.transpose()) * to_joint.transpose()).eval();
-  joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint);
+  if (options.ball_map_file.empty() != options.socket_map_file.empty())
+    throw Error("hip joint: give both map files (ball and socket) or neither");
+  if (options.ball_map_file.empty()) {
+    joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint);
+  } else {
+    auto load = [&](const std::string& path) {
+      Eigen::Vector3d c;
+      RadialDistanceMap m = load_map<float>(path, &c);
+      require((c - cor_).norm() <= 1e-6, path + ": saved about the COR (" + std::to_string(c.x()) + ", " +
+                                             std::to_string(c.y()) + ", " + std::to_string(c.z()) +
+                                             ") mm, this joint's is (" + std::to_string(cor_.x()) + ", " +
+                                             std::to_string(cor_.y()) + ", " + std::to_string(cor_.z()) +
+                                             "): another subject or COR");
+      return m;
+    };
+    joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint,
+                   load(options.ball_map_file), load(options.socket_map_file));
+  }
+}
+
+void HipJoint::save_maps(const std::string& ball_path, const std::string& socket_path) const {
+  save_map(ball_path, joint_->ball().map, cor_);
+  save_map(socket_path, joint_->socket().map, cor_);
 }
 
 void HipJoint::clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& socket) const {

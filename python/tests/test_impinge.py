@@ -80,6 +80,28 @@ def test_motion_equals_detect_pose_and_maps_are_views(generated):
     assert j.frames is None
 
 
+def test_maps_saved_and_loaded_give_the_same_gaps(generated):
+    d = generated
+    ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
+    j = impinge.Joint(ball, socket, neutral="scan", resolution=1.0)
+    j.save_maps(d + "/b.map", d + "/s.map")
+    k = impinge.Joint(ball, socket, neutral="scan", resolution=1.0, maps=(d + "/b.map", d + "/s.map"))
+    np.testing.assert_array_equal(k.socket_map.values, j.socket_map.values)
+    np.testing.assert_array_equal(k.detect_pose(20, 5, 5)["ball_gap_mm"], j.detect_pose(20, 5, 5)["ball_gap_mm"])
+    with pytest.raises(impinge.Error, match="another subject or COR"):
+        impinge.Joint(ball, socket, cor=j.cor + [0.5, 0, 0], neutral="scan", resolution=1.0,
+                      maps=(d + "/b.map", d + "/s.map"))
+    with pytest.raises(impinge.Error, match="the joint's scheme is equiangular at 2"):
+        impinge.Joint(ball, socket, neutral="scan", resolution=2.0, maps=(d + "/b.map", d + "/s.map"))
+    with open(d + "/b.map", "r+b") as f:
+        f.seek(100)
+        byte = f.read(1)
+        f.seek(100)
+        f.write(bytes([byte[0] ^ 0x10]))
+    with pytest.raises(impinge.Error, match="checksum mismatch"):
+        impinge.Joint(ball, socket, neutral="scan", resolution=1.0, maps=(d + "/b.map", d + "/s.map"))
+
+
 def test_bad_arrays_raise_clear_errors(generated):
     d = generated
     V, F = impinge.load_mesh(d + "/s/femur_r.ply")

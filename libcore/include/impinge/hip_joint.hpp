@@ -23,6 +23,10 @@ struct HipJointOptions {
   /// the acetabular sphere centre (the lunate zone's sphere; Puls et al. 2010, Comput Aided Surg
   /// 15:75, equidistant method), for segmentations whose bones overlap at the scan pose.
   bool reseat = false;
+  /// Map files (save_map) to use instead of sampling: {ball, socket}; empty = sample. They must
+  /// have been saved from a HipJoint of the same meshes and options (save_maps): their stored COR
+  /// (working frame) must equal this joint's within 1e-6 mm and their scheme joint.scheme's.
+  std::string ball_map_file, socket_map_file;
 };
 
 /// Femur (ball) and pelvis (socket) of one hip about the centre of rotation, posed by clinical
@@ -74,6 +78,9 @@ class HipJoint {
   void clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& socket) const;
   /// The femur's translation by re-seating (mm, working frame; zero without it).
   const Eigen::Vector3d& reseat_translation() const { return reseat_; }
+  /// Save both maps (map_io.hpp) with the working-frame COR, for options.ball_map_file and
+  /// socket_map_file of a later HipJoint. Throws impinge::Error on I/O errors.
+  void save_maps(const std::string& ball_path, const std::string& socket_path) const;
   /// Head radius used for the acetabulum and clocks (mm).
   double head_radius_mm() const { return head_radius_; }
   const Eigen::Vector3d& cor() const { return cor_; }
