@@ -30,6 +30,7 @@
 #include "impinge/mesh_io.hpp"
 #include "impinge/motion.hpp"
 #include "impinge/parse.hpp"
+#include "impinge/rom.hpp"
 #include "impinge/pose.hpp"
 #include "impinge/sampling.hpp"
 #include "impinge/sphere_fit.hpp"
@@ -562,6 +563,96 @@ int run_motion(const InputOptions& in, const MapOptions& mo, const FrameOptions&
   return 0;
 }
 
+struct RomCliOptions {
+  double threshold_mm = 0, step_deg = 2, max_deg = 150;
+  bool no_map = false;
+};
+
+int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo, const RomCliOptions& ro,
+            const std::string& out_dir) {
+  const auto t_start = Clock::now();
+  RomOptions o;
+  o.threshold_mm = ro.threshold_mm;
+  o.step_deg = ro.step_deg;
+  o.max_deg = ro.max_deg;
+  const Setup s = set_up(in, mo, fo);
+  const double setup_ms = ms_since(t_start);
+  const HipJoint& hip = *s.hip;
+  const Eigen::Matrix3d to_input = s.to_working.transpose();
+  // Pre-existing overlap at neutral (a segmentation's) is excluded, not taken for a limit.
+  const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), o);
+  if (base.excluded_vertices > 0)
+    std::cerr << "impinge: warning: " << base.excluded_vertices << " vertices are within " << o.threshold_mm
+              << " mm at neutral (overlap before any motion); they are not counted in the limits\n";
+  fs::create_directories(out_dir);
+  auto t0 = Clock::now();
+  std::ofstream lim(fs::path(out_dir) / "rom_limits.csv");
+  require(lim.good(), out_dir + "/rom_limits.csv: cannot open for writing");
+  lim << "motion,limit_deg,limited_by,socket_clock_h,femur_clock_h,min_gap_at_limit_mm,monotone,"
+         "contact_at_start,"
+         "contact_x_mm,contact_y_mm,contact_z_mm,evaluations\n"
+      << std::setprecision(9);
+  int evaluations = 0;
+  std::int64_t looked_up = 0, skipped = 0;
+  nlohmann::json limits = nlohmann::json::array();
+  const std::vector<StandardMotion> motions = standard_motions();
+  const std::vector<RomLimit> found = find_rom_limits(hip, motions, o, base);
+  for (std::size_t k = 0; k < motions.size(); ++k) {
+    const StandardMotion& m = motions[k];
+    const RomLimit& l = found[k];
+    evaluations += l.evaluations;
+    looked_up += l.vertices_looked_up;
+    skipped += l.vertices_skipped;
+    const Eigen::Vector3d c = to_input * l.contact_mm;
+    lim << m.name << ',' << l.limit_deg << ',' << l.limited_by << ',' << l.socket_clock_h << ',' << l.femur_clock_h
+        << ',' << l.min_gap_at_limit_mm << ',' << (l.monotone ? 1 : 0) << ','
+        << (l.contact_at_start ? 1 : 0) << ','
+        << c.x() << ',' << c.y() << ',' << c.z() << ',' << l.evaluations << '\n';
+    limits.push_back({{"motion", m.name}, {"limit_deg", num_or_null(l.limit_deg)}, {"limited_by", l.limited_by},
+                      {"monotone", l.monotone}});
+  }
+  const double limits_ms = ms_since(t0);
+  double map_ms = 0;
+  std::size_t map_cells = 0;
+  if (!ro.no_map) {
+    t0 = Clock::now();
+    std::vector<double> flex, add;
+    for (int f = 0; f <= 120; f += 5) flex.push_back(f);
+    for (int a = -20; a <= 40; a += 5) add.push_back(a);
+    const std::vector<RomMapCell> cells = rom_map(hip, flex, add, o, base);
+    map_ms = ms_since(t0);
+    map_cells = cells.size();
+    for (const RomMapCell& c : cells) looked_up += c.vertices_looked_up, skipped += c.vertices_skipped;
+    std::ofstream map(fs::path(out_dir) / "rom_map.csv");
+    require(map.good(), out_dir + "/rom_map.csv: cannot open for writing");
+    map << "flexion_deg,adduction_deg,max_internal_rotation_deg,status\n" << std::setprecision(9);
+    for (const RomMapCell& c : cells)
+      map << c.flexion_deg << ',' << c.adduction_deg << ',' << c.max_internal_rotation_deg << ',' << c.status << '\n';
+  }
+  nlohmann::json j = setup_json(s);
+  j["threshold_mm"] = o.threshold_mm;
+  j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
+  j["neutral_min_gap_mm"] = num_or_null(base.min_gap_mm);
+  j["excluded_vertices"] = base.excluded_vertices;
+  j["limits"] = limits;
+  j["timings_ms"] = {{"setup_total", setup_ms},
+                     {"ball_sampling", s.joint().ball().sampling_ms},
+                     {"socket_sampling", s.joint().socket().sampling_ms},
+                     {"limits", limits_ms},
+                     {"rom_map", map_ms},
+                     {"total", ms_since(t_start)}};
+  j["rom_map_cells"] = map_cells;
+  j["limit_evaluations"] = evaluations;
+  j["vertices_looked_up"] = looked_up;
+  j["vertices_skipped_by_bounds"] = skipped;
+  j["share_skipped"] = looked_up + skipped > 0 ? double(skipped) / double(looked_up + skipped) : 0.0;
+  write_json((fs::path(out_dir) / "summary.json").string(), j);
+  std::cout << "rom: " << standard_motions().size() << " limits in " << std::fixed << std::setprecision(0)
+            << limits_ms << " ms, ROM map (" << map_cells << " cells) in " << map_ms << " ms, total "
+            << ms_since(t_start) << " ms; written to " << out_dir << "\n";
+  return 0;
+}
+
 int run_generate(int triangles, double cam, double coverage, const std::string& out_dir) {
   HipModelOptions o;
   o.target_triangles = triangles;
@@ -625,6 +716,23 @@ int main(int argc, char** argv) {
   mot->add_flag("--quiet", mout.quiet, "No progress bar or final line");
   mot->add_option("--out", motion_out, "Output folder")->required();
 
+  RomCliOptions rom_opts;
+  std::string rom_out;
+  auto* rom = app.add_subcommand(
+      "rom", "Range-of-motion limits from neutral for the standard motions (rom_limits.csv) and the ROM map: the "
+             "largest internal rotation over flexion 0..120 x adduction -20..40 deg, step 5 (rom_map.csv)");
+  add_input_options(rom, in);
+  add_map_options(rom, maps);
+  add_frame_options(rom, frames);
+  rom->add_option("--threshold", rom_opts.threshold_mm,
+                  "mm: the bones meet when the minimum gap is <= this (0: bone contact; a cartilage offset > 0)")
+      ->capture_default_str();
+  rom->add_option("--step", rom_opts.step_deg, "Coarse search step, deg (then bisection to 0.1 deg)")
+      ->capture_default_str();
+  rom->add_option("--max", rom_opts.max_deg, "Search no farther than this from the start, deg")->capture_default_str();
+  rom->add_flag("--no-map", rom_opts.no_map, "Limits only, no ROM map");
+  rom->add_option("--out", rom_out, "Output folder")->required();
+
   auto* gen = app.add_subcommand("generate", "Write a generated hip model (femur_r.ply, pelvis.ply, subject.json)");
   int triangles = 3000;
   double cam = 0, coverage = 100;
@@ -642,6 +750,7 @@ int main(int argc, char** argv) {
   try {
     if (*dist) return run_distance(in, maps, frames, pose, do_render, out);
     if (*mot) return run_motion(in, maps, frames, motion_file, mout, motion_out);
+    if (*rom) return run_rom(in, maps, frames, rom_opts, rom_out);
     if (*gen) return run_generate(triangles, cam, coverage, gen_out);
   } catch (const std::exception& e) {
     std::cerr << "impinge: error: " << e.what() << "\n";

@@ -1,0 +1,113 @@
+#pragma once
+/// @file rom.hpp
+/// Range-of-motion limits (thesis sec. 5.2; issue 14): from neutral along a motion, the first
+/// angle at which the bones meet (minimum gap <= threshold), found by steps and bisection, with
+/// where they meet; and the ROM map of clinical planning tools (Tannast et al. 2007,
+/// Kubiak-Langer et al. 2007): the largest internal rotation over flexion x adduction.
+
+#include <Eigen/Core>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "impinge/hip_joint.hpp"
+#include "impinge/pose.hpp"
+
+namespace impinge {
+
+/// Options of a ROM search.
+struct RomOptions {
+  double threshold_mm = 0;       ///< contact when the minimum gap <= this (0: bone contact; a cartilage offset > 0)
+  double step_deg = 2;           ///< coarse step along the motion, deg
+  double max_deg = 150;          ///< search no farther than this from neutral, deg
+  double tolerance_deg = 0.1;    ///< bisection until the bracket is this narrow, deg
+  bool use_bounds = true;        ///< skip vertex clusters whose bound cannot reach the threshold (same results,
+                                 ///< fewer look-ups; equiangular maps)
+  double intra_articular_margin_mm = 10;  ///< contacts within the acetabular rim radius plus this of the COR are
+                                          ///< intra-articular, farther ones extra-articular
+};
+
+/// A standard motion: angles(theta) for theta >= 0 from its start (degrees).
+struct StandardMotion {
+  std::string name;
+  std::function<PoseAngles(double)> angles;
+};
+
+/// The standard motions of clinical ROM tests: flexion, extension, abduction, adduction,
+/// internal_rotation, external_rotation (from neutral), internal_rotation_90_flexion,
+/// external_rotation_90_flexion (from 90 deg flexion) and fadir (internal rotation at 90 deg
+/// flexion and 10 deg adduction).
+std::vector<StandardMotion> standard_motions();
+
+/// Where and how a motion is limited.
+struct RomLimit {
+  double limit_deg = std::numeric_limits<double>::quiet_NaN();  ///< first contact angle (upper end of the final
+                                                                 ///< bracket), NaN when none within max_deg
+  double min_gap_at_limit_mm = std::numeric_limits<double>::quiet_NaN();
+  double min_gap_at_start_mm = std::numeric_limits<double>::quiet_NaN();  ///< over the counted vertices
+  bool monotone = true;            ///< the bones are still in contact one step beyond the limit (false: a transient
+                                   ///< touch; the gap curve crosses the threshold again)
+  bool limited_by_ball = false;    ///< the least gap was a femur vertex (else a pelvis vertex)
+  std::string limited_by;          ///< "intra_articular" or "extra_articular" ("" without a limit)
+  Eigen::Vector3d contact_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+                                   ///< the contact vertex at the limit, working frame (pelvis fixed), mm
+  double socket_clock_h = std::numeric_limits<double>::quiet_NaN();  ///< contact on the acetabular clock
+  double femur_clock_h = std::numeric_limits<double>::quiet_NaN();   ///< contact on the femoral head-neck clock
+  std::int64_t excluded_vertices = 0;  ///< vertices within the threshold at the baseline pose (pre-existing
+                                       ///< overlap, e.g. of the segmentation): not counted
+  bool contact_at_start = false;       ///< the counted gap is already within the threshold at theta = 0 (limit 0)
+  int evaluations = 0;                 ///< poses evaluated
+  std::int64_t vertices_looked_up = 0;  ///< map look-ups made over the search
+  std::int64_t vertices_skipped = 0;    ///< first-surface vertices skipped by the cluster bounds
+};
+
+/// The vertices not counted in ROM searches: those within the threshold at a baseline pose
+/// (anatomical neutral for clinical motions), so that a segmentation's overlap is reported and not
+/// taken for a limit.
+struct RomBaseline {
+  std::vector<std::uint8_t> skip_ball, skip_socket;  ///< 1 = not counted (per vertex of each body)
+  std::int64_t excluded_vertices = 0;
+  double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< least gap of all vertices at the baseline
+};
+
+/// The baseline at the femur rotation R (joint frame), e.g. hip.femur_rotation({}) for neutral.
+RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const RomOptions& options = {});
+
+/// Search one motion of `hip`: evaluate both scans at theta = 0, step_deg, 2 step_deg, ... up to
+/// max_deg until the minimum gap over the counted vertices (those not in `baseline`) is <=
+/// threshold, then bisect the last step to tolerance_deg. Only the minimum is computed: the
+/// first-surface vertices are taken in clusters of 32 (Z order) with a cone of directions and a
+/// radius range, and a cluster is skipped when a bound of the other map over its cone (a pyramid
+/// of minima or maxima over the equiangular map) shows that none of its gaps can reach the
+/// threshold; the others are looked up exactly, so the result is the full scan's. Throws
+/// impinge::Error on invalid options.
+RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(double)>& motion,
+                        const RomOptions& options, const RomBaseline& baseline);
+
+/// The same for any path of femur rotations (joint frame) `rotation(theta)`, e.g. a rotation
+/// about a fixed axis for analytic tests.
+RomLimit find_rom_limit(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation,
+                        const RomOptions& options, const RomBaseline& baseline);
+
+/// Every motion of `motions`, on all cores (OpenMP), sharing one set of bounds.
+std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
+                                      const RomOptions& options, const RomBaseline& baseline);
+
+/// One cell of a ROM map: the largest internal rotation at (flexion, adduction).
+struct RomMapCell {
+  double flexion_deg = 0, adduction_deg = 0;
+  double max_internal_rotation_deg = std::numeric_limits<double>::quiet_NaN();  ///< NaN: see status
+  std::string status;  ///< "limited", "free" (no contact up to max_deg), "contact_at_zero" (in contact
+                       ///< already without rotation)
+  std::int64_t vertices_looked_up = 0, vertices_skipped = 0;  ///< over its search
+};
+
+/// The ROM map: for every flexion x adduction of the grids (degrees), the largest internal
+/// rotation before contact (find_rom_limit along internal rotation from zero, `baseline` as for
+/// the standard motions). Cells are independent and run on all cores (OpenMP).
+std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& flexion_deg,
+                                const std::vector<double>& adduction_deg, const RomOptions& options,
+                                const RomBaseline& baseline);
+
+}  // namespace impinge

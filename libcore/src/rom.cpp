@@ -1,0 +1,373 @@
+#include "impinge/rom.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "impinge/detection.hpp"
+#include "impinge/equiangular_grid.hpp"
+#include "impinge/error.hpp"
+
+namespace impinge {
+
+std::vector<StandardMotion> standard_motions() {
+  return {
+      {"flexion", [](double t) { return PoseAngles{t, 0, 0}; }},
+      {"extension", [](double t) { return PoseAngles{-t, 0, 0}; }},
+      {"abduction", [](double t) { return PoseAngles{0, -t, 0}; }},
+      {"adduction", [](double t) { return PoseAngles{0, t, 0}; }},
+      {"internal_rotation", [](double t) { return PoseAngles{0, 0, t}; }},
+      {"external_rotation", [](double t) { return PoseAngles{0, 0, -t}; }},
+      {"internal_rotation_90_flexion", [](double t) { return PoseAngles{90, 0, t}; }},
+      {"external_rotation_90_flexion", [](double t) { return PoseAngles{90, 0, -t}; }},
+      {"fadir", [](double t) { return PoseAngles{90, 10, t}; }},
+  };
+}
+
+namespace {
+
+void check(const RomOptions& o) {
+  require(std::isfinite(o.threshold_mm), "rom: threshold must be finite");
+  require(o.step_deg > 0 && o.max_deg > 0 && o.tolerance_deg > 0 && o.tolerance_deg <= o.step_deg,
+          "rom: need step > 0, max > 0 and 0 < tolerance <= step (degrees)");
+}
+
+// ---- bounds ----------------------------------------------------------------------------------
+// A pyramid of minima (or maxima) over an equiangular map: at level L, block (i, j) holds the min
+// (max) of the finite node values in fine rows [i 2^L, (i+1) 2^L] and columns [j 2^L, (j+1) 2^L]
+// (boundaries shared, columns periodic); +inf (-inf) when none is finite. A fine bilinear value
+// whose four nodes are finite is >= (<=) the bound of any block range covering those nodes; a
+// stencil with an infinite node gives NaN, no gap, so infinite nodes can be ignored.
+class BoundPyramid {
+ public:
+  static constexpr int kFirstLevel = 2;
+  BoundPyramid(const RadialDistanceMap& map, bool lower) : lower_(lower) {
+    const auto* g = dynamic_cast<const EquiangularGrid*>(&map.scheme());
+    if (g == nullptr) return;  // bounds for equiangular maps only; other schemes scan every vertex
+    rows_ = g->rows(), cols_ = g->columns(), step_ = g->step();
+    const float none = lower ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+    for (int L = kFirstLevel;; ++L) {
+      const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b;
+      std::vector<float> v(static_cast<std::size_t>(br) * bc, none);
+      for (int i = 0; i < br; ++i)
+        for (int j = 0; j < bc; ++j) {
+          float m = none;
+          if (L == kFirstLevel) {
+            for (int r = i * b; r <= std::min((i + 1) * b, rows_ - 1); ++r)
+              for (int c = j * b; c <= (j + 1) * b; ++c) {
+                const float d = map.at(std::int64_t(r) * cols_ + (c % cols_));
+                if (std::isfinite(d)) m = lower ? std::min(m, d) : std::max(m, d);
+              }
+          } else {
+            const std::vector<float>& p = levels_.back();
+            const int pbr = (rows_ - 1 + b / 2 - 1) / (b / 2), pbc = (cols_ + b / 2 - 1) / (b / 2);
+            for (int di = 0; di < 2; ++di)
+              for (int dj = 0; dj < 2; ++dj) {
+                const int pi = 2 * i + di, pj = 2 * j + dj;
+                if (pi >= pbr) continue;
+                const float d = p[static_cast<std::size_t>(pi) * pbc + (pj % pbc)];
+                m = lower ? std::min(m, d) : std::max(m, d);
+              }
+          }
+          v[static_cast<std::size_t>(i) * bc + j] = m;
+        }
+      levels_.push_back(std::move(v));
+      if (br <= 2 && bc <= 2) break;
+    }
+  }
+  bool valid() const { return !levels_.empty(); }
+  // Bound of the map over every stencil node of the directions within angle rho of unit u.
+  float cap(const Eigen::Vector3d& u, double rho) const {
+    const double phi = std::acos(std::clamp(u.z(), -1.0, 1.0));
+    double r_lo = (phi - rho) / step_, r_hi = (phi + rho) / step_ + 1;
+    int c_lo = 0, c_hi = cols_;  // whole rows when the cap holds a pole or is wide
+    if (phi - rho > 0 && phi + rho < M_PI) {
+      const double half = std::asin(std::min(1.0, std::sin(rho) / std::sin(phi)));
+      double theta = std::atan2(u.y(), u.x());
+      if (theta < 0) theta += 2 * M_PI;
+      if (half < M_PI / 2) {
+        c_lo = static_cast<int>(std::floor((theta - half) / step_)) - 1;
+        c_hi = static_cast<int>(std::floor((theta + half) / step_)) + 2;
+      }
+    }
+    const int r0 = std::max(0, static_cast<int>(std::floor(r_lo)) - 1);
+    const int r1 = std::min(rows_ - 1, static_cast<int>(std::floor(r_hi)) + 1);
+    const int span = std::max(r1 - r0, c_hi - c_lo);
+    int L = kFirstLevel;
+    while ((1 << L) < span && L - kFirstLevel + 1 < static_cast<int>(levels_.size())) ++L;
+    const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b;
+    const std::vector<float>& v = levels_[static_cast<std::size_t>(L - kFirstLevel)];
+    float m = lower_ ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+    const int i0 = r0 / b, i1 = std::min(br - 1, r1 / b);
+    const bool all_cols = c_hi - c_lo >= cols_;
+    const int j0 = all_cols ? 0 : static_cast<int>(std::floor(double(c_lo) / b));
+    const int j1 = all_cols ? bc - 1 : static_cast<int>(std::floor(double(c_hi) / b));
+    for (int i = i0; i <= i1; ++i)
+      for (int j = j0; j <= j1; ++j) {
+        const float d = v[static_cast<std::size_t>(i) * bc + static_cast<std::size_t>(((j % bc) + bc) % bc)];
+        m = lower_ ? std::min(m, d) : std::max(m, d);
+      }
+    return m;
+  }
+
+ private:
+  bool lower_;
+  int rows_ = 0, cols_ = 0;
+  double step_ = 0;
+  std::vector<std::vector<float>> levels_;
+};
+
+// Clusters of a scan set: 32 consecutive vertices (Z order: neighbours on the sphere), their
+// directions' cone (unit axis, half-angle) and radius range, in the body's frame.
+struct Cluster {
+  std::int64_t first = 0, count = 0;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double rho = 0, r_min = 0, r_max = 0;
+};
+std::vector<Cluster> clusters_of(const ScanSet& s) {
+  constexpr std::int64_t kSize = 32;
+  std::vector<Cluster> out;
+  for (std::int64_t f = 0; f < s.size(); f += kSize) {
+    Cluster c;
+    c.first = f;
+    c.count = std::min(kSize, s.size() - f);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    c.r_min = std::numeric_limits<double>::infinity();
+    for (std::int64_t k = f; k < f + c.count; ++k) {
+      const Eigen::Vector3d p(s.x[k], s.y[k], s.z[k]);
+      sum += p.normalized();
+      c.r_min = std::min(c.r_min, p.norm());
+      c.r_max = std::max(c.r_max, p.norm());
+    }
+    c.axis = sum.norm() > 1e-9 ? Eigen::Vector3d(sum.normalized()) : Eigen::Vector3d::UnitZ();
+    for (std::int64_t k = f; k < f + c.count; ++k)
+      c.rho = std::max(c.rho, std::acos(std::clamp(Eigen::Vector3d(s.x[k], s.y[k], s.z[k]).normalized().dot(c.axis),
+                                                   -1.0, 1.0)));
+    c.rho += 1e-9;  // rounding of the angles
+    out.push_back(c);
+  }
+  return out;
+}
+
+// The least gap over the counted vertices of both scans at a femur rotation. Clusters whose bound
+// cannot reach the threshold are skipped; the others are looked up exactly (a search needs only the
+// minimum: no per-vertex expansion or summary). Shared, read-only, by every search of a joint.
+struct Least {
+  double gap = std::numeric_limits<double>::infinity();
+  bool ball = false;
+  std::size_t vertex = 0;
+};
+struct RomBounds {
+  RomBounds(const Joint& j) : socket_min(j.socket().map, true), ball_max(j.ball().map, false),
+                              ball_clusters(clusters_of(j.ball().scan_set)),
+                              socket_clusters(clusters_of(j.socket().scan_set)) {}
+  BoundPyramid socket_min, ball_max;
+  std::vector<Cluster> ball_clusters, socket_clusters;
+};
+class CompactScanner {
+ public:
+  CompactScanner(const Joint& joint, const RomBaseline& base, const RomBounds* bounds, double threshold)
+      : joint_(joint), bounds_(bounds), threshold_(threshold) {
+    const ScanSet& b = joint.ball().scan_set;
+    const ScanSet& s = joint.socket().scan_set;
+    for (std::int32_t i : b.index) skip_ball_.push_back(base.skip_ball[static_cast<std::size_t>(i)]);
+    for (std::int32_t i : s.index) skip_socket_.push_back(base.skip_socket[static_cast<std::size_t>(i)]);
+    buf_.resize(static_cast<std::size_t>(std::max(b.size(), s.size())));
+  }
+  // The least counted gap at rotation R. exact: the true minimum; otherwise the true minimum when it
+  // is <= the threshold, and some value > the threshold when it is not (clusters above it are skipped).
+  Least operator()(const Eigen::Matrix3d& R, bool exact) {
+    Least l;
+    const double cut = exact ? std::numeric_limits<double>::infinity() : threshold_;
+    scan(R, joint_.ball().scan_set, joint_.socket().map, ScanSide::inside, skip_ball_, true, cut, l);
+    scan(R.transpose(), joint_.socket().scan_set, joint_.ball().map, ScanSide::outside, skip_socket_, false, cut, l);
+    return l;
+  }
+  std::int64_t vertices_looked_up = 0, vertices_skipped = 0;
+
+ private:
+  void scan(const Eigen::Matrix3d& R, const ScanSet& set, const RadialDistanceMap& map, ScanSide side,
+            const std::vector<std::uint8_t>& skip, bool ball, double cut, Least& l) {
+    const BoundPyramid* pyr = bounds_ == nullptr ? nullptr : ball ? &bounds_->socket_min : &bounds_->ball_max;
+    if (pyr == nullptr || !pyr->valid()) {
+      scan_gaps_compact(set, R, Eigen::Vector3d::Zero(), map, side, buf_.data());
+      take(set, skip, 0, set.size(), ball, l);
+      vertices_looked_up += set.size();
+      return;
+    }
+    const std::vector<Cluster>& cl = ball ? bounds_->ball_clusters : bounds_->socket_clusters;
+    for (const Cluster& c : cl) {
+      const float bound = pyr->cap(R * c.axis, c.rho);
+      // Lower bound of every gap in the cluster: inside, d - r >= min d - r_max; outside, r - d >= r_min - max d.
+      const double lb = ball ? double(bound) - c.r_max : c.r_min - double(bound);
+      if (lb > cut || lb > l.gap) {
+        vertices_skipped += c.count;
+        continue;
+      }
+      double x[32], y[32], z[32], d[32];
+      for (std::int64_t k = 0; k < c.count; ++k) {
+        const Eigen::Vector3d q = R * Eigen::Vector3d(set.x[c.first + k], set.y[c.first + k], set.z[c.first + k]);
+        x[k] = q.x(), y[k] = q.y(), z[k] = q.z();
+      }
+      map.sample_many_soa(x, y, z, c.count, d);
+      for (std::int64_t k = 0; k < c.count; ++k) {
+        const double r = std::sqrt(x[k] * x[k] + y[k] * y[k] + z[k] * z[k]);
+        buf_[static_cast<std::size_t>(c.first + k)] = static_cast<float>(static_cast<double>(side) * (d[k] - r));
+      }
+      take(set, skip, c.first, c.first + c.count, ball, l);
+      vertices_looked_up += c.count;
+    }
+  }
+  void take(const ScanSet& set, const std::vector<std::uint8_t>& skip, std::int64_t from, std::int64_t to, bool ball,
+            Least& l) const {
+    for (std::int64_t j = from; j < to; ++j)
+      if (!skip[static_cast<std::size_t>(j)] && buf_[static_cast<std::size_t>(j)] < l.gap)
+        l.gap = buf_[static_cast<std::size_t>(j)], l.ball = ball, l.vertex = static_cast<std::size_t>(set.index[j]);
+  }
+  const Joint& joint_;
+  const RomBounds* bounds_;
+  double threshold_;
+  std::vector<std::uint8_t> skip_ball_, skip_socket_;
+  std::vector<float> buf_;
+};
+
+}  // namespace
+
+RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const RomOptions& o) {
+  check(o);
+  PoseResult r;
+  hip.joint().detect(R, Eigen::Vector3d::Zero(), r);
+  RomBaseline b;
+  b.skip_ball.resize(r.ball_gaps.gap_mm.size());
+  b.skip_socket.resize(r.socket_gaps.gap_mm.size());
+  for (std::size_t i = 0; i < b.skip_ball.size(); ++i) b.skip_ball[i] = r.ball_gaps.gap_mm[i] <= o.threshold_mm;
+  for (std::size_t i = 0; i < b.skip_socket.size(); ++i) b.skip_socket[i] = r.socket_gaps.gap_mm[i] <= o.threshold_mm;
+  for (auto s : b.skip_ball) b.excluded_vertices += s;
+  for (auto s : b.skip_socket) b.excluded_vertices += s;
+  b.min_gap_mm = std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);
+  return b;
+}
+
+namespace {
+RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation, const RomOptions& o,
+                const RomBaseline& base, const RomBounds* bounds) {
+  const Joint& joint = hip.joint();
+  require(base.skip_ball.size() == static_cast<std::size_t>(joint.ball().relative.rows()) &&
+              base.skip_socket.size() == static_cast<std::size_t>(joint.socket().relative.rows()),
+          "rom: the baseline belongs to another joint");
+  RomLimit out;
+  out.excluded_vertices = base.excluded_vertices;
+  CompactScanner scan(joint, base, bounds, o.threshold_mm);
+  auto gap_at = [&](double t, bool exact = false) {
+    ++out.evaluations;
+    return scan(rotation(t), exact);
+  };
+  double lo = 0, hi = 0;
+  out.min_gap_at_start_mm = gap_at(0, true).gap;
+  bool found = out.min_gap_at_start_mm <= o.threshold_mm;
+  out.contact_at_start = found;
+  for (int k = 1; !found; ++k) {
+    const double t = std::min(o.max_deg, k * o.step_deg);
+    const double g = gap_at(t).gap;
+    if (g <= o.threshold_mm) {
+      found = true, hi = t;
+    } else {
+      lo = t;
+      if (t >= o.max_deg) return out;
+    }
+  }
+  while (hi - lo > o.tolerance_deg) {
+    const double mid = 0.5 * (lo + hi);
+    (gap_at(mid).gap <= o.threshold_mm ? hi : lo) = mid;
+  }
+  const Least l = gap_at(hi);
+  // A transient touch: the bones part again one step farther.
+  if (hi + o.step_deg <= o.max_deg) out.monotone = gap_at(hi + o.step_deg).gap <= o.threshold_mm;
+  out.vertices_looked_up = scan.vertices_looked_up;
+  out.vertices_skipped = scan.vertices_skipped;
+  out.limit_deg = hi;
+  out.min_gap_at_limit_mm = l.gap;
+  out.limited_by_ball = l.ball;
+  // The contact point: the vertex, posed, in the joint frame (the pelvis does not move).
+  const Eigen::Matrix3d R = rotation(hi);
+  const Eigen::Vector3d p_joint =
+      l.ball ? Eigen::Vector3d(R * joint.ball().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose())
+             : Eigen::Vector3d(joint.socket().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose());
+  out.contact_mm = hip.to_working(p_joint);
+  const double rim = hip.acetabulum() ? hip.acetabulum()->rim_radius_mm : hip.head_radius_mm() + 5;
+  out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? "intra_articular" : "extra_articular";
+  if (hip.socket_clock()) {
+    // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.
+    out.socket_clock_h = hip.socket_clock()->hour(p_joint);
+    out.femur_clock_h = hip.ball_clock()->hour(R.transpose() * p_joint);
+  }
+  return out;
+}
+
+}  // namespace
+
+RomLimit find_rom_limit(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation,
+                        const RomOptions& o, const RomBaseline& base) {
+  check(o);
+  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint()) : nullptr;
+  return search(hip, rotation, o, base, bounds.get());
+}
+
+RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(double)>& motion, const RomOptions& o,
+                        const RomBaseline& base) {
+  return find_rom_limit(
+      hip, std::function<Eigen::Matrix3d(double)>([&](double t) { return hip.femur_rotation(motion(t)); }), o, base);
+}
+
+std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
+                                      const RomOptions& o, const RomBaseline& base) {
+  check(o);
+  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint()) : nullptr;
+  std::vector<RomLimit> out(motions.size());
+  std::vector<std::string> errors(motions.size());
+  const auto n = static_cast<std::int64_t>(motions.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t k = 0; k < n; ++k) {
+    try {
+      const auto& m = motions[static_cast<std::size_t>(k)];
+      out[static_cast<std::size_t>(k)] = search(
+          hip, std::function<Eigen::Matrix3d(double)>([&](double t) { return hip.femur_rotation(m.angles(t)); }), o,
+          base, bounds.get());
+    } catch (const std::exception& e) {
+      errors[static_cast<std::size_t>(k)] = e.what();
+    }
+  }
+  for (const auto& e : errors) require(e.empty(), e);
+  return out;
+}
+
+std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& flexion,
+                                const std::vector<double>& adduction, const RomOptions& o, const RomBaseline& base) {
+  check(o);
+  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint()) : nullptr;
+  std::vector<RomMapCell> cells;
+  for (double f : flexion)
+    for (double a : adduction) cells.push_back({f, a, std::numeric_limits<double>::quiet_NaN(), ""});
+  const auto n = static_cast<std::int64_t>(cells.size());
+  std::vector<std::string> errors(cells.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t k = 0; k < n; ++k) {
+    RomMapCell& c = cells[static_cast<std::size_t>(k)];
+    try {
+      const RomLimit l = search(hip, std::function<Eigen::Matrix3d(double)>([&](double t) {
+                                  return hip.femur_rotation(PoseAngles{c.flexion_deg, c.adduction_deg, t});
+                                }),
+                                o, base, bounds.get());
+      c.vertices_looked_up = l.vertices_looked_up;
+      c.vertices_skipped = l.vertices_skipped;
+      c.max_internal_rotation_deg = l.contact_at_start ? std::numeric_limits<double>::quiet_NaN() : l.limit_deg;
+      c.status = l.contact_at_start ? "contact_at_zero" : std::isnan(l.limit_deg) ? "free" : "limited";
+    } catch (const std::exception& e) {
+      errors[static_cast<std::size_t>(k)] = e.what();
+    }
+  }
+  for (const auto& e : errors) require(e.empty(), e);
+  return cells;
+}
+
+}  // namespace impinge

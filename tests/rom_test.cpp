@@ -1,0 +1,175 @@
+// ROM limits (rom.cpp). Invariants:
+// - analytic oracle: a sphere head with a cylindrical neck of radius n in a concentric cup of inner
+//   radius R whose rim lies at polar angle beta from its pole; rotating the femur about the axis
+//   that turns the neck away from the opening's axis, the neck's surface first meets the rim's
+//   inner edge when the angle between neck and opening axes reaches (180 - beta) - asin(n / R)
+//   (the rim point at angle gamma from the neck axis is R sin(gamma) from it). The search finds it
+//   within 0.2 deg, at several cup coverages and in both rotation senses about the axis;
+// - a right hip and its mirrored left copy give the same limits within 0.2 deg;
+// - pre-existing overlap at the baseline is excluded and reported, not taken for a limit;
+// - bad options are errors.
+#include "impinge/rom.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <memory>
+
+#include "impinge/error.hpp"
+#include "impinge/generated_models.hpp"
+#include "test_support.hpp"
+
+using namespace impinge;
+
+namespace {
+HipJointOptions scan_options(double precision_deg) {
+  HipJointOptions o;
+  o.neutral = Neutral::scan;
+  o.joint.scheme = make_scheme("equiangular", precision_deg);
+  return o;
+}
+}  // namespace
+
+TEST(Rom, NeckMeetsTheRimWhereTheClosedFormSays) {
+  for (const double coverage : {95.0, 100.0, 110.0}) {
+    SCOPED_TRACE(coverage);
+    HipModelOptions mo;
+    mo.target_triangles = 20000;
+    mo.cup_coverage_deg = coverage;
+    const HipModel h = make_hip_model(mo);
+    SphereFitResult head;
+    head.centre = h.cor;
+    head.radius = mo.head_radius_mm;
+    const HipJoint hip(h.ball, h.socket, Side::right, head, {}, scan_options(0.1));
+    // The generator's axes (generated_models.cpp): neck direction and cup pole.
+    const Eigen::Vector3d neck = Eigen::Vector3d(0.80, 0.25, -0.55).normalized();
+    const Eigen::Vector3d opening = -Eigen::Vector3d(-0.65, -0.2, 0.73).normalized();
+    const double psi0 = std::acos(neck.dot(opening)) * 180 / M_PI;
+    const double inner = mo.head_radius_mm + mo.cartilage_gap_mm;
+    const double psi_contact = (180 - coverage) - std::asin(mo.neck_radius_mm / inner) * 180 / M_PI;
+    const Eigen::Vector3d k = opening.cross(neck).normalized();  // turns the neck away from the opening axis
+    RomOptions ro;
+    ro.step_deg = 1;
+    const RomBaseline base = rom_baseline(hip, Eigen::Matrix3d::Identity(), ro);
+    EXPECT_EQ(base.excluded_vertices, 0);
+    const RomLimit l = find_rom_limit(
+        hip, std::function<Eigen::Matrix3d(double)>([&](double t) {
+          return Eigen::AngleAxisd(t * M_PI / 180, k).toRotationMatrix();
+        }),
+        ro, base);
+    EXPECT_NEAR(l.limit_deg, psi_contact - psi0, 0.2) << "psi0 " << psi0;
+    EXPECT_LE(l.min_gap_at_limit_mm, 0);
+    EXPECT_TRUE(l.monotone);
+    EXPECT_EQ(l.limited_by, "intra_articular");
+    // The contact lies on the rim's inner edge: R from the COR, at the rim's polar angle.
+    EXPECT_NEAR((l.contact_mm - h.cor).norm(), inner, 0.3);
+    // Turning the other way about the same axis the neck first crosses the opening axis, then meets the
+    // rim on the far side: psi falls to 0 and rises again, so the limit is psi0 + psi_contact.
+    const RomLimit back = find_rom_limit(
+        hip, std::function<Eigen::Matrix3d(double)>([&](double t) {
+          return Eigen::AngleAxisd(-t * M_PI / 180, k).toRotationMatrix();
+        }),
+        ro, base);
+    EXPECT_NEAR(back.limit_deg, psi_contact + psi0, 0.2);
+  }
+}
+
+TEST(Rom, MirroredLeftHipHasTheSameLimits) {
+  auto j = test::load_real_joint("lhdl-ct");
+  if (!j) GTEST_SKIP() << "shared data absent";
+  TriangleMesh fl = j->femur, pl = j->pelvis;
+  for (TriangleMesh* m : {&fl, &pl}) {
+    m->V.col(0) *= -1;
+    m->F.col(1).swap(m->F.col(2));
+  }
+  HipJointOptions o;
+  o.joint.scheme = make_scheme("equiangular", 0.25);
+  const HipJoint right(j->femur, j->pelvis, Side::right, locate_femoral_head(j->femur), {}, o);
+  const HipJoint left(fl, pl, Side::left, locate_femoral_head(fl), {}, o);
+  RomOptions ro;
+  const RomBaseline br = rom_baseline(right, right.femur_rotation({}), ro);
+  const RomBaseline bl = rom_baseline(left, left.femur_rotation({}), ro);
+  int limited = 0;
+  for (const StandardMotion& m : standard_motions()) {
+    if (m.name != "flexion" && m.name != "internal_rotation_90_flexion" && m.name != "fadir" &&
+        m.name != "abduction")
+      continue;
+    SCOPED_TRACE(m.name);
+    const RomLimit a = find_rom_limit(right, m.angles, ro, br), b = find_rom_limit(left, m.angles, ro, bl);
+    EXPECT_EQ(std::isnan(a.limit_deg), std::isnan(b.limit_deg));
+    if (!std::isnan(a.limit_deg)) {
+      ++limited;
+      EXPECT_NEAR(a.limit_deg, b.limit_deg, 0.2);
+      EXPECT_NEAR(a.socket_clock_h, b.socket_clock_h, 0.05);
+    }
+  }
+  EXPECT_GT(limited, 1);
+}
+
+TEST(Rom, PreExistingOverlapIsExcludedAndBadOptionsAreErrors) {
+  HipModelOptions mo;
+  mo.target_triangles = 3000;
+  const HipModel h = make_hip_model(mo);
+  SphereFitResult head;
+  head.centre = h.cor;
+  head.radius = mo.head_radius_mm;
+  const HipJoint hip(h.ball, h.socket, Side::right, head, {}, scan_options(1.0));
+  RomOptions ro;
+  ro.threshold_mm = mo.cartilage_gap_mm + 0.5;  // the whole head is "in contact" at the baseline
+  const RomBaseline base = rom_baseline(hip, Eigen::Matrix3d::Identity(), ro);
+  EXPECT_GT(base.excluded_vertices, 100);
+  EXPECT_LT(base.min_gap_mm, ro.threshold_mm);
+  const RomLimit l = find_rom_limit(hip, std::function<PoseAngles(double)>([](double t) { return PoseAngles{t, 0, 0}; }),
+                                    ro, base);
+  EXPECT_FALSE(l.contact_at_start);
+  EXPECT_EQ(l.excluded_vertices, base.excluded_vertices);
+  RomOptions bad;
+  bad.tolerance_deg = 5;
+  bad.step_deg = 1;
+  EXPECT_THROW(rom_baseline(hip, Eigen::Matrix3d::Identity(), bad), Error);
+}
+
+TEST(Rom, ClusterBoundsGiveTheFullScansResults) {
+  // The bounds only skip clusters that cannot reach the threshold: limits and ROM map equal the
+  // search that looks up every first-surface vertex (generated hip with a cam, and lhdl-ct when present).
+  HipModelOptions mo;
+  mo.target_triangles = 12000;
+  mo.cam_height_mm = 2;
+  const HipModel h = make_hip_model(mo);
+  SphereFitResult head;
+  head.centre = h.cor;
+  head.radius = mo.head_radius_mm;
+  std::vector<std::unique_ptr<HipJoint>> hips;
+  hips.push_back(std::make_unique<HipJoint>(h.ball, h.socket, Side::right, head, Landmarks{}, scan_options(0.25)));
+  if (auto j = test::load_real_joint("lhdl-ct")) {
+    HipJointOptions o;
+    o.joint.scheme = make_scheme("equiangular", 0.25);
+    hips.push_back(std::make_unique<HipJoint>(j->femur, j->pelvis, Side::right, locate_femoral_head(j->femur),
+                                              Landmarks{}, o));
+  }
+  for (const auto& hip : hips) {
+    RomOptions with, without;
+    without.use_bounds = false;
+    const RomBaseline base = rom_baseline(*hip, hip->femur_rotation({}), with);
+    const auto a = find_rom_limits(*hip, standard_motions(), with, base);
+    const auto b = find_rom_limits(*hip, standard_motions(), without, base);
+    std::int64_t skipped = 0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(std::isnan(a[k].limit_deg), std::isnan(b[k].limit_deg)) << k;
+      if (!std::isnan(a[k].limit_deg)) {
+        EXPECT_EQ(a[k].limit_deg, b[k].limit_deg) << k;
+      }
+      EXPECT_EQ(b[k].vertices_skipped, 0);
+      skipped += a[k].vertices_skipped;
+    }
+    EXPECT_GT(skipped, 0);
+    const std::vector<double> flex{0, 45, 90}, add{-10, 10};
+    const auto ma = rom_map(*hip, flex, add, with, base), mb = rom_map(*hip, flex, add, without, base);
+    for (std::size_t k = 0; k < ma.size(); ++k) {
+      EXPECT_EQ(ma[k].status, mb[k].status);
+      if (ma[k].status == "limited") {
+        EXPECT_EQ(ma[k].max_internal_rotation_deg, mb[k].max_internal_rotation_deg);
+      }
+    }
+  }
+}
