@@ -1,0 +1,128 @@
+"""09_rom_observation: thesis sec. 5.2 (Tables 11-13) on our hips, ROM limits with an exact check,
+ROM maps, published values beside ours, sensitivity and cost.
+
+Reads RESULTS/09_rom_observation/*.csv (and the observation_*.ply cup meshes); writes
+table_observation.tex, table_limits.tex, table_published.tex, table_sensitivity.tex,
+rom_map.pdf, medial_<subject>_<patient>.pdf (Tables 12-13's panels), macros.tex."""
+import os
+
+import numpy as np
+import matplotlib.pyplot as plt
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+from render import draw, read_gap_ply
+
+d = experiment_dir("09_rom_observation")
+obs = read_csv(d, "observation.csv")
+lim = read_csv(d, "rom_limits.csv")
+rmap = read_csv(d, "rom_map.csv")
+sens = read_csv(d, "sensitivity.csv")
+tim = read_csv(d, "timing.csv")
+pub = read_csv(d, "published.csv")
+t11 = read_csv(d, "thesis_table11.csv")
+subjects = list(dict.fromkeys(lim.subject))
+
+
+def f(x, n=1):
+    return "--" if np.isnan(x) else f"{x:.{n}f}"
+
+
+# Table 11's extremities on our hips (thesis Tables 12-13: red < 2 mm, blue > 6 mm).
+rows = []
+for r in obs.itertuples():
+    red = r.socket_area_0to2_mm2 + r.socket_area_penetrating_mm2
+    rows.append([r.subject, r.patient, r.motion.replace("_", " "), f(r.angle_deg),
+                 f(min(r.ball_min_gap_mm, r.socket_min_gap_mm), 2), f(red, 0), f(r.socket_area_over6_mm2, 0),
+                 f(r.socket_closest_clock_h)])
+write_table(d, "table_observation", ["subject", "patient", "extremity", "angle", "min gap", "red mm$^2$",
+                                     "blue mm$^2$", "clock h"], rows, align="lllrrrrr")
+
+# Limits with the exact check.
+rows = []
+for r in lim.itertuples():
+    rows.append([r.subject, r.motion.replace("_", " "), f(r.limit_deg), r.limited_by if isinstance(r.limited_by, str) else "",
+                 f(r.socket_clock_h), f(r.femur_clock_h), f(r.exact_gap_before_mm, 3), f(r.exact_gap_after_mm, 3),
+                 r.validated])
+write_table(d, "table_limits", ["subject", "motion", "limit", "where", "socket h", "femur h", "exact $-0.5^\\circ$",
+                                "exact $+0.5^\\circ$", "confirmed"], rows, align="llrlrrrrl")
+
+# Published values beside ours.
+rows = []
+for p in pub.itertuples():
+    for s in subjects:
+        ours = lim[(lim.subject == s) & (lim.motion == p.compare_with)].limit_deg.iloc[0]
+        rows.append([p.group, f(p.value_deg), s, f(ours), p.source])
+write_table(d, "table_published", ["group (published)", "IR deg", "subject", "ours deg", "source"], rows,
+            align="lrlrl")
+
+# Sensitivity: largest |change| of a limit per subject and variant kind.
+rows = []
+for s in subjects:
+    g = sens[(sens.subject == s)]
+    for kind, sel in (("COR $\\pm$1 mm", g.variant.str.startswith("cor")), ("resolution", g.variant.str.startswith("res"))):
+        v = g[sel].delta_deg.abs()
+        rows.append([s, kind, f(v.median(), 2), f(v.max(), 2), str(int(sel.sum()))])
+write_table(d, "table_sensitivity", ["subject", "perturbation", "median $|\\Delta|$ deg", "max $|\\Delta|$ deg", "runs"],
+            rows, align="llrrr")
+
+# ROM maps.
+fig, axes = plt.subplots(1, len(subjects), figsize=(4 * len(subjects), 3.4), squeeze=False)
+for ax, s in zip(axes[0], subjects):
+    g = rmap[rmap.subject == s]
+    fl, ad = sorted(g.flexion_deg.unique()), sorted(g.adduction_deg.unique())
+    Z = np.full((len(ad), len(fl)), np.nan)
+    for r in g.itertuples():
+        Z[ad.index(r.adduction_deg), fl.index(r.flexion_deg)] = r.max_internal_rotation_deg
+    im = ax.imshow(Z, origin="lower", aspect="auto", extent=[fl[0] - 2.5, fl[-1] + 2.5, ad[0] - 2.5, ad[-1] + 2.5],
+                   cmap="viridis", vmin=0, vmax=np.nanmax(rmap.max_internal_rotation_deg))
+    ax.set_title(f"{s}: largest internal rotation (deg)", fontsize=8)
+    ax.set_xlabel("flexion (deg)")
+    ax.set_ylabel("adduction (deg)")
+    fig.colorbar(im, ax=ax, shrink=0.8)
+save(fig, d, "rom_map")
+
+# Tables 12-13's panels: the cup from the medial side at each extremity, with the clock face.
+clk = read_csv(d, "clock_faces.csv")
+for s in clk.subject:
+    row = clk[clk.subject == s].iloc[0]
+    clock = {"centre": [row.centre_x_mm, row.centre_y_mm, row.centre_z_mm],
+             "twelve": [row.twelve_x, row.twelve_y, row.twelve_z], "three": [row.three_x, row.three_y, row.three_z],
+             "radius_mm": row.rim_radius_mm}
+    for patient in ("A", "B"):
+        files = [os.path.join(d, f"observation_{s}_{patient}_{m}.ply") for m in t11[t11.patient == patient].motion]
+        if not all(os.path.exists(p) for p in files):
+            continue
+        fig = plt.figure(figsize=(9, 6))
+        order = ["abduction", "internal_rotation", "extension", "adduction", "external_rotation", "flexion"]
+        for k, m in enumerate(order):
+            V, F, rgb, _ = read_gap_ply(os.path.join(d, f"observation_{s}_{patient}_{m}.ply"))
+            ang = t11[(t11.patient == patient) & (t11.motion == m)].angle_deg.iloc[0]
+            ax = fig.add_subplot(2, 3, k + 1, projection="3d")
+            draw(ax, [(V, F, rgb)], "socket_medial", row.side, clock, radius=row.rim_radius_mm + 3,
+                 title=f"{m.replace('_', ' ')} {ang:g} deg")
+        fig.suptitle(f"{s} at patient {patient}'s extremities (thesis Table {12 if patient == 'A' else 13}): "
+                     "blue > 6, yellow 4-6, orange 2-4, red 0-2 mm, purple penetrating", fontsize=9)
+        save(fig, d, f"medial_{s}_{patient}")
+
+ok = lim[lim.validated != "no_limit"]
+t0 = tim.iloc[0]
+first = subjects[0]
+ir90 = lim[(lim.subject == first) & (lim.motion == "internal_rotation_90_flexion")].limit_deg.iloc[0]
+write_macros(d, "macros", {
+    "ROMresolution": f"{tim.resolution_deg.iloc[0]:g}",
+    "ROMconfirmed": str(int((ok.validated == "yes").sum())),
+    "ROMchecked": str(len(ok)),
+    "ROMfirst": first,
+    "ROMfirstSearchMs": f"{t0.search_ms:.0f}",
+    "ROMfirstSamplingMs": f"{t0.sampling_ms:.0f}",
+    "ROMfirstEvaluations": f"{int(t0.evaluations)}",
+    "ROMfirstPosesPerSecond": f"{t0.poses_per_second:.0f}",
+    "ROMfirstSkipped": f"{100 * t0.share_skipped:.0f}",
+    "ROMfirstFclMs": f"{t0.fcl_collide_ms_per_pose:.2f}",
+    "ROMfirstFclRatio": f"{t0.fcl_over_ours:.0f}",
+    "ROMfclRatioRange": f"{tim.fcl_over_ours.min():.0f}--{tim.fcl_over_ours.max():.0f}",
+    "ROMthreads": str(int(t0.threads)),
+    "ROMfirstIRninety": f(ir90),
+    "ROMexcludedMax": str(int(tim.excluded_vertices.max())),
+    "ROMsubjects": str(len(subjects)),
+})

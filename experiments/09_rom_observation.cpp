@@ -1,0 +1,297 @@
+// 09_rom_observation -- thesis sec. 5.2, Tables 11-13, Fig. 60-63: the thesis' recorded ROM
+// extremities applied to our hips, ROM limits and ROM maps with where the bones meet, checked
+// against an exact reference, with their sensitivity and cost.
+//
+// Inputs: every real subject under --data (anatomical frames found from the bones); without real
+// subjects, the generated 12k hip with a 2 mm cam (scan neutral) for the limits only. The thesis'
+// Table 11 and the published values compared with are read from experiments/09_*.csv.
+// Outputs: OUT/09_rom_observation/
+//   observation.csv   subject x patient (A, B) x motion: Table 11's extremity as a pose from anatomical
+//                     neutral; both scans' minimum gap, the socket's area per level (thresholds 6, 4,
+//                     2, 0 mm: thesis sec. 5.2's blue > 6 mm and red < 2 mm), the closest point's clock hour
+//   observation_<subject>_<patient>_<motion>.ply  (first real subject) the cup region with gaps, for the
+//                     medial views of Tables 12-13
+//   rom_limits.csv    subject x motion: limit, where limited, exact-reference check 0.5 deg either side
+//   rom_map.csv       subject x flexion x adduction: the largest internal rotation
+//   sensitivity.csv   subject x variant (COR moved 1 mm along each pelvic axis, resolutions) x motion
+//   timing.csv        subject: sampling, limits, map, evaluations, poses per second, share of vertices
+//                     skipped by the bounds, FCL collide per pose and its extrapolated search time
+//   clock_faces.csv   the acetabular clock face of each real subject in its pelvic frame
+//   thesis_table11.csv, published.csv   copies of the inputs the analysis compares with
+//   meta.json
+// Command: build/experiments/exp_09_rom_observation --out results --data ../shared/data/hips [--quick]
+#include <omp.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "experiment_support.hpp"
+#include "impinge/clock_face.hpp"
+#include "impinge/error.hpp"
+#include "impinge/exact_reference.hpp"
+#include "impinge/fcl_collision.hpp"
+#include "impinge/hip_joint.hpp"
+#include "impinge/mesh_io.hpp"
+#include "impinge/rom.hpp"
+#include "impinge/sphere_fit.hpp"
+
+using namespace impinge;
+using namespace impinge::experiment;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+struct Table11Row {
+  std::string patient, hip, motion;
+  double angle = 0;
+};
+std::vector<Table11Row> read_table11(const std::string& path) {
+  std::ifstream in(path);
+  require(in.good(), path + ": cannot open");
+  std::string line;
+  std::getline(in, line);
+  std::vector<Table11Row> rows;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    Table11Row r;
+    std::string angle;
+    std::getline(ss, r.patient, ',');
+    std::getline(ss, r.hip, ',');
+    std::getline(ss, r.motion, ',');
+    std::getline(ss, angle, ',');
+    r.angle = std::stod(angle);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+PoseAngles extremity(const std::string& motion, double a) {
+  if (motion == "abduction") return {0, -a, 0};
+  if (motion == "adduction") return {0, a, 0};
+  if (motion == "external_rotation") return {0, 0, -a};
+  if (motion == "internal_rotation") return {0, 0, a};
+  if (motion == "extension") return {-a, 0, 0};
+  if (motion == "flexion") return {a, 0, 0};
+  throw Error("09: unknown motion " + motion);
+}
+
+// Exact least gap (CGAL ray casts from the COR) over the counted first-surface vertices of both bodies
+// at femur rotation R (joint frame): ball vertices against the pelvis, pelvis vertices against the
+// posed femur.
+double exact_least_gap(const Joint& j, const ExactReference& pelvis, const ExactReference& femur,
+                       const RomBaseline& base, const Eigen::Matrix3d& R) {
+  double least = std::numeric_limits<double>::infinity();
+  const ScanSet& b = j.ball().scan_set;
+  for (std::int64_t k = 0; k < b.size(); ++k) {
+    if (base.skip_ball[static_cast<std::size_t>(b.index[k])]) continue;
+    const Eigen::Vector3d q = R * Eigen::Vector3d(b.x[k], b.y[k], b.z[k]);
+    const auto hit = pelvis.first_hit(Eigen::Vector3d::Zero(), q.normalized());
+    if (hit) least = std::min(least, *hit - q.norm());
+  }
+  const ScanSet& s = j.socket().scan_set;
+  for (std::int64_t k = 0; k < s.size(); ++k) {
+    if (base.skip_socket[static_cast<std::size_t>(s.index[k])]) continue;
+    const Eigen::Vector3d p(s.x[k], s.y[k], s.z[k]);
+    const auto hit = femur.first_hit(Eigen::Vector3d::Zero(), (R.transpose() * p).normalized());
+    if (hit) least = std::min(least, p.norm() - *hit);
+  }
+  return least;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv, "09_rom_observation: thesis sec. 5.2 ROM observation, ROM limits and maps");
+  const std::string dir = experiment_dir(args, "09_rom_observation");
+  const std::string src = IMPINGE_EXPERIMENTS_DIR;
+  fs::copy_file(src + "/09_thesis_table11.csv", dir + "/thesis_table11.csv", fs::copy_options::overwrite_existing);
+  fs::copy_file(src + "/09_published.csv", dir + "/published.csv", fs::copy_options::overwrite_existing);
+  const std::vector<Table11Row> table11 = read_table11(src + "/09_thesis_table11.csv");
+  std::vector<Subject> subjects = load_subjects(args, {});
+  bool generated = false;
+  if (subjects.empty()) {
+    subjects = load_subjects(args, {12000});
+    generated = true;
+  }
+  const double resolution = args.quick ? 0.25 : 0.1;
+  const std::vector<double> sens_resolutions = args.quick ? std::vector<double>{0.5, 0.25} : std::vector<double>{0.5, 0.25, 0.1};
+  RomOptions ro;
+  ImpingementLevels observation_levels;
+  observation_levels.thresholds_mm = {6, 4, 2, 0};
+
+  CsvWriter obs(dir + "/observation.csv",
+                {"subject", "patient", "motion", "angle_deg", "flexion_deg", "adduction_deg", "internal_rotation_deg",
+                 "ball_min_gap_mm", "socket_min_gap_mm", "socket_closest_clock_h", "socket_area_over6_mm2",
+                 "socket_area_4to6_mm2", "socket_area_2to4_mm2", "socket_area_0to2_mm2", "socket_area_penetrating_mm2"});
+  CsvWriter lim(dir + "/rom_limits.csv",
+                {"subject", "motion", "limit_deg", "limited_by", "socket_clock_h", "femur_clock_h", "min_gap_at_limit_mm",
+                 "monotone", "contact_at_start", "exact_gap_before_mm", "exact_gap_after_mm", "validated"});
+  CsvWriter map(dir + "/rom_map.csv", {"subject", "flexion_deg", "adduction_deg", "max_internal_rotation_deg", "status"});
+  CsvWriter clocks(dir + "/clock_faces.csv", {"subject", "side", "centre_x_mm", "centre_y_mm", "centre_z_mm", "twelve_x",
+                                              "twelve_y", "twelve_z", "three_x", "three_y", "three_z", "rim_radius_mm"});
+  CsvWriter sens(dir + "/sensitivity.csv", {"subject", "variant", "motion", "limit_deg", "delta_deg"});
+  CsvWriter tim(dir + "/timing.csv",
+                {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "evaluations",
+                 "poses_per_second", "share_skipped", "fcl_collide_ms_per_pose", "fcl_poses_timed",
+                 "fcl_search_ms_extrapolated", "fcl_over_ours", "excluded_vertices", "neutral_min_gap_mm"});
+  const int threads = omp_get_max_threads();
+  const int total = static_cast<int>(subjects.size());
+  int done = 0;
+  bool wrote_renders = false;
+  for (const Subject& s : subjects) {
+    progress("09_rom_observation", ++done, total, s.name);
+    HipJointOptions ho;
+    ho.joint.scheme = make_scheme("equiangular", resolution);
+    ho.joint.levels = observation_levels;
+    ho.neutral = s.generated ? Neutral::scan : Neutral::anatomical;
+    SphereFitResult head = s.generated ? SphereFitResult{} : locate_femoral_head(s.femur);
+    if (s.generated) head.centre = s.true_cor, head.radius = std::nan("");
+    const HipJoint hip(s.femur, s.pelvis, s.side, head, {}, ho);
+    const Joint& joint = hip.joint();
+
+    // Table 11's extremities (real subjects: clinical angles from anatomical neutral).
+    if (!s.generated) {
+      const ClockFace c = hip.socket_clock()->transformed(scan_axes().transpose(), Eigen::Vector3d::Zero());
+      clocks.row(s.name, s.side == Side::right ? "right" : "left", c.centre.x(), c.centre.y(), c.centre.z(),
+                 c.twelve.x(), c.twelve.y(), c.twelve.z(), c.three.x(), c.three.y(), c.three.z(),
+                 hip.acetabulum()->rim_radius_mm);
+      for (const Table11Row& t : table11) {
+        const PoseAngles a = extremity(t.motion, t.angle);
+        const PoseResult r = hip.detect(a);
+        ClockSummary bc, sc;
+        hip.clocks(r, bc, sc);
+        const auto& L = r.socket.level_area_mm2;
+        obs.row(s.name, t.patient, t.motion, t.angle, a.flexion_deg, a.adduction_deg, a.internal_rotation_deg,
+                r.ball.min_gap_mm, r.socket.min_gap_mm, sc.closest_hour, L[0], L[1], L[2], L[3], L[4]);
+        if (!wrote_renders) {
+          // The cup region (within the rim radius + 3 mm of the COR), pelvic frame, with gaps.
+          const JointBody& body = joint.socket();
+          const double radius = hip.acetabulum()->rim_radius_mm + 3;
+          std::vector<std::uint8_t> keep(static_cast<std::size_t>(body.relative.rows()));
+          for (Eigen::Index i = 0; i < body.relative.rows(); ++i)
+            keep[static_cast<std::size_t>(i)] = body.relative.row(i).norm() <= radius;
+          std::vector<Eigen::Index> kept;
+          TriangleMesh cup = submesh(body.mesh, keep, &kept);
+          const auto n = static_cast<Eigen::Index>(kept.size());
+          Eigen::VectorXf gap(n);
+          Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
+          Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
+          for (Eigen::Index k = 0; k < n; ++k) {
+            const Eigen::Index i = kept[static_cast<std::size_t>(k)];
+            cup.V.row(k) = (scan_axes().transpose() * body.relative.row(i).transpose()).transpose();
+            gap[k] = r.socket_gaps.gap_mm[static_cast<std::size_t>(i)];
+            level[k] = std::isnan(gap[k]) ? 255 : observation_levels.level(gap[k]);
+            const auto c = level_colour(level[k], observation_levels.count(), false);
+            rgb.row(k) << c[0], c[1], c[2];
+          }
+          write_gap_ply(dir + "/observation_" + s.name + "_" + t.patient + "_" + t.motion + ".ply", cup.V, cup.F, gap,
+                        level, rgb);
+        }
+      }
+      wrote_renders = true;
+    }
+
+    // ROM limits and map, timed (the search after the maps exist; sampling reported beside).
+    const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), ro);
+    auto t0 = Clock::now();
+    const std::vector<StandardMotion> motions = standard_motions();
+    const std::vector<RomLimit> limits = find_rom_limits(hip, motions, ro, base);
+    const double limits_ms = ms_since(t0);
+    std::vector<double> flex, add;
+    for (int f = 0; f <= 120; f += 5) flex.push_back(f);
+    for (int a = -20; a <= 40; a += 5) add.push_back(a);
+    t0 = Clock::now();
+    const std::vector<RomMapCell> cells = rom_map(hip, flex, add, ro, base);
+    const double map_ms = ms_since(t0);
+    std::int64_t evaluations = 0, looked = 0, skipped = 0;
+    for (const RomLimit& l : limits) evaluations += l.evaluations, looked += l.vertices_looked_up, skipped += l.vertices_skipped;
+    for (const RomMapCell& c : cells) {
+      map.row(s.name, c.flexion_deg, c.adduction_deg, c.max_internal_rotation_deg, c.status);
+      looked += c.vertices_looked_up, skipped += c.vertices_skipped;
+    }
+    // Evaluations of the map: estimated from the look-ups per evaluation of the limits (both count
+    // every first-surface vertex once per evaluation, looked up or skipped).
+    const double per_eval = double(joint.ball().scan_set.size() + joint.socket().scan_set.size());
+    const auto map_evals = static_cast<std::int64_t>(std::llround(
+        double(looked + skipped) / per_eval)) - evaluations;
+    const std::int64_t all_evals = evaluations + map_evals;
+
+    // Exact check 0.5 deg either side of each limit (CGAL ray casts).
+    const ExactReference ex_pelvis(joint.socket().mesh), ex_femur(joint.ball().mesh);
+    for (std::size_t k = 0; k < motions.size(); ++k) {
+      const RomLimit& l = limits[k];
+      double before = std::nan(""), after = std::nan("");
+      std::string validated = "no_limit";
+      if (!std::isnan(l.limit_deg) && !l.contact_at_start) {
+        before = exact_least_gap(joint, ex_pelvis, ex_femur, base,
+                                 hip.femur_rotation(motions[k].angles(std::max(0.0, l.limit_deg - 0.5))));
+        after = exact_least_gap(joint, ex_pelvis, ex_femur, base, hip.femur_rotation(motions[k].angles(l.limit_deg + 0.5)));
+        validated = before > ro.threshold_mm && after <= ro.threshold_mm ? "yes" : "no";
+      }
+      lim.row(s.name, motions[k].name, l.limit_deg, l.limited_by, l.socket_clock_h, l.femur_clock_h,
+              l.min_gap_at_limit_mm, l.monotone ? 1 : 0, l.contact_at_start ? 1 : 0, before, after, validated);
+    }
+
+    // FCL collide on a subset of the map's poses (flexion 45, adduction 10, internal rotation 0..58 step 2).
+    double fcl_ms = std::nan("");
+    int fcl_poses = 0;
+    if (have_fcl()) {
+      const FclJoint fj(joint.ball().mesh, joint.socket().mesh, Eigen::Vector3d::Zero());
+      std::vector<double> ts;
+      for (int ir = 0; ir < 60; ir += 2) {
+        const Eigen::Matrix3d R = hip.femur_rotation({45, 10, double(ir)});
+        const auto t1 = Clock::now();
+        fj.collide(R, Eigen::Vector3d::Zero(), 1);
+        ts.push_back(ms_since(t1));
+      }
+      std::sort(ts.begin(), ts.end());
+      fcl_ms = ts[ts.size() / 2];
+      fcl_poses = static_cast<int>(ts.size());
+    }
+    const double search_ms = limits_ms + map_ms;
+    const double fcl_total = fcl_ms * double(all_evals);
+    tim.row(s.name, resolution, threads, joint.ball().sampling_ms + joint.socket().sampling_ms, limits_ms, map_ms,
+            search_ms, all_evals, double(all_evals) / (search_ms / 1000), double(skipped) / double(looked + skipped),
+            fcl_ms, fcl_poses, fcl_total, fcl_total / search_ms, base.excluded_vertices, base.min_gap_mm);
+
+    // Sensitivity: the COR moved 1 mm along each pelvic axis; other resolutions.
+    auto limits_of = [&](const SphereFitResult& h, double res) {
+      HipJointOptions o2 = ho;
+      o2.joint.scheme = make_scheme("equiangular", res);
+      const HipJoint hj(s.femur, s.pelvis, s.side, h, {}, o2);
+      return find_rom_limits(hj, motions, ro, rom_baseline(hj, hj.femur_rotation({}), ro));
+    };
+    auto record = [&](const std::string& variant, const std::vector<RomLimit>& v) {
+      for (std::size_t k = 0; k < motions.size(); ++k)
+        sens.row(s.name, variant, motions[k].name, v[k].limit_deg, v[k].limit_deg - limits[k].limit_deg);
+    };
+    const Eigen::Matrix3d axes = hip.frames() ? hip.frames()->pelvis.axes : scan_axes();
+    const char* axis_name[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a)
+      for (const double sign : {1.0, -1.0}) {
+        SphereFitResult h = head;
+        h.centre += sign * axes.col(a);
+        record(std::string("cor_") + (sign > 0 ? "+" : "-") + axis_name[a] + "_1mm", limits_of(h, resolution));
+      }
+    for (double res : sens_resolutions)
+      if (res != resolution) record("resolution_" + std::to_string(res).substr(0, 4), limits_of(head, res));
+  }
+  nlohmann::json subj = nlohmann::json::array();
+  for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
+  write_meta(dir, args,
+             {{"resolution_deg", resolution},
+              {"sensitivity_resolutions_deg", sens_resolutions},
+              {"threshold_mm", ro.threshold_mm},
+              {"step_deg", ro.step_deg},
+              {"tolerance_deg", ro.tolerance_deg},
+              {"observation_levels_mm", observation_levels.thresholds_mm},
+              {"neutral", generated ? "scan (generated model)" : "anatomical (ISB frames from the bones)"},
+              {"rom_map", "flexion 0..120 step 5 x adduction -20..40 step 5"},
+              {"exact_check", "CGAL ray casts from the COR for every counted first-surface vertex, 0.5 deg "
+                              "before and after each limit; hidden vertices are not checked"},
+              {"subjects", subj}});
+  return 0;
+}
