@@ -57,6 +57,12 @@ class Joint:
         """Both scans at clinical angles (degrees, ISB)."""
     def motion(self, angles: npt.ArrayLike) -> Dict[str, npt.NDArray[np.float64]]:
         """Both scans at every row of angles (k, 3) -> per-frame min gaps and penetrating areas."""
+    def rom_limits(self, threshold_mm: float = 0.0, step_deg: float = 2.0,
+                   max_deg: float = 150.0) -> Dict[str, Any]:
+        """ROM limits from neutral for the standard motions -> dict motion -> dict(limit_deg, limited_by, ...)."""
+    def rom_map(self, flexion: Sequence[float], adduction: Sequence[float],
+                threshold_mm: float = 0.0) -> npt.NDArray[np.float64]:
+        """Largest internal rotation before contact, (len(flexion), len(adduction)) degrees."""
     def femur_rotation(self, flexion: float = 0.0, adduction: float = 0.0,
                        internal_rotation: float = 0.0) -> npt.NDArray[np.float64]: ...
     cor: npt.NDArray[np.float64]

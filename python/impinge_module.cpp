@@ -23,6 +23,7 @@
 #include "impinge/map_io.hpp"
 #include "impinge/mesh.hpp"
 #include "impinge/mesh_io.hpp"
+#include "impinge/rom.hpp"
 #include "impinge/sampling.hpp"
 #include "impinge/sampling_scheme.hpp"
 #include "impinge/sphere_fit.hpp"
@@ -430,6 +431,63 @@ PYBIND11_MODULE(impinge, m) {
           },
           py::arg("ball_path"), py::arg("socket_path"),
           "Save both maps (impinge map files with scheme, resolution, COR and checksum) for Joint(..., maps=...).")
+      .def(
+          "rom_limits",
+          [](const PyJoint& j, double threshold_mm, double step_deg, double max_deg) {
+            RomOptions o;
+            o.threshold_mm = threshold_mm;
+            o.step_deg = step_deg;
+            o.max_deg = max_deg;
+            const std::vector<StandardMotion> motions = standard_motions();
+            std::vector<RomLimit> limits;
+            RomBaseline base;
+            {
+              py::gil_scoped_release release;
+              base = rom_baseline(*j.hip, j.hip->femur_rotation({}), o);
+              limits = find_rom_limits(*j.hip, motions, o, base);
+            }
+            py::dict d;
+            for (std::size_t k = 0; k < motions.size(); ++k) {
+              const RomLimit& l = limits[k];
+              py::dict e;
+              e["limit_deg"] = l.limit_deg;
+              e["limited_by"] = l.limited_by;
+              e["socket_clock_h"] = l.socket_clock_h;
+              e["femur_clock_h"] = l.femur_clock_h;
+              e["min_gap_at_limit_mm"] = l.min_gap_at_limit_mm;
+              e["contact_mm"] = l.contact_mm;
+              e["monotone"] = l.monotone;
+              e["contact_at_start"] = l.contact_at_start;
+              d[py::str(motions[k].name)] = e;
+            }
+            d["excluded_vertices"] = base.excluded_vertices;
+            return d;
+          },
+          py::arg("threshold_mm") = 0.0, py::arg("step_deg") = 2.0, py::arg("max_deg") = 150.0,
+          "ROM limits from neutral for the standard motions (flexion, extension, abduction, adduction, internal and "
+          "external rotation, both rotations at 90 deg flexion, FADIR) -> dict motion -> dict(limit_deg (NaN: none "
+          "within max_deg), limited_by, socket_clock_h, femur_clock_h, min_gap_at_limit_mm, contact_mm (input "
+          "frame), monotone, contact_at_start); and excluded_vertices (in contact at neutral, not counted).")
+      .def(
+          "rom_map",
+          [](const PyJoint& j, const std::vector<double>& flexion, const std::vector<double>& adduction,
+             double threshold_mm) {
+            RomOptions o;
+            o.threshold_mm = threshold_mm;
+            std::vector<RomMapCell> cells;
+            {
+              py::gil_scoped_release release;
+              const RomBaseline base = rom_baseline(*j.hip, j.hip->femur_rotation({}), o);
+              cells = rom_map(*j.hip, flexion, adduction, o, base);
+            }
+            std::vector<double> ir(cells.size());
+            for (std::size_t k = 0; k < cells.size(); ++k) ir[k] = cells[k].max_internal_rotation_deg;
+            return own(std::move(ir), {py::ssize_t(flexion.size()), py::ssize_t(adduction.size())});
+          },
+          py::arg("flexion"), py::arg("adduction"), py::arg("threshold_mm") = 0.0,
+          "ROM map: the largest internal rotation (deg) before contact for every flexion x adduction (deg) -> "
+          "float64 (len(flexion), len(adduction)); NaN where in contact already without rotation or free up to "
+          "150 deg.")
       .def(
           "femur_rotation",
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
