@@ -201,29 +201,6 @@ int main(int argc, char** argv) {
   const std::vector<std::pair<std::string, PoseAngles>> figure_poses{
       {"neutral", {0, 0, 0}}, {"flexion90", {90, 0, 0}}, {"adduction30", {0, 30, 0}}, {"internal30", {0, 0, 30}}};
   bool wrote_poses = false;
-  // The part of `body` within `radius` mm of the COR, its vertices mapped by R (joint frame -> output),
-  // with gaps (or none: untested grey) as a gap PLY.
-  auto write_region = [](const std::string& path, const JointBody& body, const Eigen::Matrix3d& R, double radius,
-                         const ScanGaps* g, const ImpingementLevels& lv, bool is_ball) {
-    std::vector<std::uint8_t> keep(static_cast<std::size_t>(body.relative.rows()));
-    for (Eigen::Index i = 0; i < body.relative.rows(); ++i)
-      keep[static_cast<std::size_t>(i)] = body.relative.row(i).norm() <= radius;
-    std::vector<Eigen::Index> kept;
-    TriangleMesh region = submesh(body.mesh, keep, &kept);
-    const auto n = static_cast<Eigen::Index>(kept.size());
-    Eigen::VectorXf gap(n);
-    Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
-    Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
-    for (Eigen::Index k = 0; k < n; ++k) {
-      const Eigen::Index i = kept[static_cast<std::size_t>(k)];
-      region.V.row(k) = (R * body.relative.row(i).transpose()).transpose();
-      gap[k] = g != nullptr ? g->gap_mm[static_cast<std::size_t>(i)] : std::nanf("");
-      level[k] = std::isnan(gap[k]) ? 255 : lv.level(gap[k]);
-      const auto c = level_colour(level[k], lv.count(), is_ball);
-      rgb.row(k) << c[0], c[1], c[2];
-    }
-    write_gap_ply(path, region.V, region.F, gap, level, rgb);
-  };
   for (const Subject& s : subjects) {
     HipJointOptions ho;
     ho.joint.scheme = make_scheme("equiangular", render_precision);
@@ -238,16 +215,16 @@ int main(int argc, char** argv) {
     const JointBody* bodies[2] = {&hip.joint().ball(), &hip.joint().socket()};
     const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};
     for (int b = 0; b < 2; ++b)
-      write_region(dir + "/render_" + s.name + (b == 0 ? "_ball.ply" : "_socket.ply"), *bodies[b], to_pelvic,
+      write_region_ply(dir + "/render_" + s.name + (b == 0 ? "_ball.ply" : "_socket.ply"), *bodies[b], to_pelvic,
                    render_radius, gaps[b], ho.joint.levels, b == 0);
     if (!s.generated && !wrote_poses) {  // the README's figure of the clinical angles
       wrote_poses = true;
       for (const auto& [name, a] : figure_poses) {
-        write_region(dir + "/poses_" + s.name + "_" + name + ".ply", hip.joint().ball(),
+        write_region_ply(dir + "/poses_" + s.name + "_" + name + ".ply", hip.joint().ball(),
                      to_pelvic * hip.femur_rotation(a), 250, nullptr, ho.joint.levels, true);
         poses.row(name, a.flexion_deg, a.adduction_deg, a.internal_rotation_deg);
       }
-      write_region(dir + "/poses_" + s.name + "_pelvis.ply", hip.joint().socket(), to_pelvic, 150, nullptr,
+      write_region_ply(dir + "/poses_" + s.name + "_pelvis.ply", hip.joint().socket(), to_pelvic, 150, nullptr,
                    ho.joint.levels, false);
     }
     if (hip.socket_clock()) {

@@ -168,27 +168,9 @@ int main(int argc, char** argv) {
                 r.ball.min_gap_mm, r.socket.min_gap_mm, sc.closest_hour, L[0], L[1], L[2], L[3], L[4]);
         if (!wrote_renders) {
           // The cup region (within the rim radius + 3 mm of the COR), pelvic frame, with gaps.
-          const JointBody& body = joint.socket();
-          const double radius = hip.acetabulum()->rim_radius_mm + 3;
-          std::vector<std::uint8_t> keep(static_cast<std::size_t>(body.relative.rows()));
-          for (Eigen::Index i = 0; i < body.relative.rows(); ++i)
-            keep[static_cast<std::size_t>(i)] = body.relative.row(i).norm() <= radius;
-          std::vector<Eigen::Index> kept;
-          TriangleMesh cup = submesh(body.mesh, keep, &kept);
-          const auto n = static_cast<Eigen::Index>(kept.size());
-          Eigen::VectorXf gap(n);
-          Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
-          Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
-          for (Eigen::Index k = 0; k < n; ++k) {
-            const Eigen::Index i = kept[static_cast<std::size_t>(k)];
-            cup.V.row(k) = (scan_axes().transpose() * body.relative.row(i).transpose()).transpose();
-            gap[k] = r.socket_gaps.gap_mm[static_cast<std::size_t>(i)];
-            level[k] = std::isnan(gap[k]) ? 255 : observation_levels.level(gap[k]);
-            const auto c = level_colour(level[k], observation_levels.count(), false);
-            rgb.row(k) << c[0], c[1], c[2];
-          }
-          write_gap_ply(dir + "/observation_" + s.name + "_" + t.patient + "_" + t.motion + ".ply", cup.V, cup.F, gap,
-                        level, rgb);
+          write_region_ply(dir + "/observation_" + s.name + "_" + t.patient + "_" + t.motion + ".ply", joint.socket(),
+                           scan_axes().transpose(), hip.acetabulum()->rim_radius_mm + 3, &r.socket_gaps,
+                           observation_levels, false);
         }
       }
       wrote_renders = true;

@@ -149,4 +149,26 @@ void progress(const std::string& experiment, int done, int total, const std::str
   std::cerr << "[" << experiment << "] " << done << "/" << total << " " << what << std::endl;
 }
 
+void write_region_ply(const std::string& path, const JointBody& body, const Eigen::Matrix3d& R, double radius_mm,
+                      const ScanGaps* gaps, const ImpingementLevels& levels, bool is_ball) {
+  std::vector<std::uint8_t> keep(static_cast<std::size_t>(body.relative.rows()));
+  for (Eigen::Index i = 0; i < body.relative.rows(); ++i)
+    keep[static_cast<std::size_t>(i)] = body.relative.row(i).norm() <= radius_mm;
+  std::vector<Eigen::Index> kept;
+  TriangleMesh region = submesh(body.mesh, keep, &kept);
+  const auto n = static_cast<Eigen::Index>(kept.size());
+  Eigen::VectorXf gap(n);
+  Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
+  Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Eigen::Index i = kept[static_cast<std::size_t>(k)];
+    region.V.row(k) = (R * body.relative.row(i).transpose()).transpose();
+    gap[k] = gaps != nullptr ? gaps->gap_mm[static_cast<std::size_t>(i)] : std::nanf("");
+    level[k] = std::isnan(gap[k]) ? 255 : levels.level(gap[k]);
+    const auto c = level_colour(level[k], levels.count(), is_ball);
+    rgb.row(k) << c[0], c[1], c[2];
+  }
+  write_gap_ply(path, region.V, region.F, gap, level, rgb);
+}
+
 }  // namespace impinge::experiment

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "impinge/generated_models.hpp"
+#include "impinge/joint.hpp"
 #include "impinge/mesh.hpp"
 #include "impinge/pose.hpp"
 #include "impinge/sphere_fit.hpp"
@@ -87,6 +88,12 @@ class CsvWriter {
   }
   std::ofstream os_;
 };
+
+/// Write the part of `body` within `radius_mm` of the COR as a gap PLY (write_gap_ply): its vertices
+/// mapped by R (3 x 3, joint frame -> output frame), each vertex's gap from `gaps` (nullptr: untested,
+/// grey), level and colour under `levels`. For the shaded renders of experiments 08 and 09.
+void write_region_ply(const std::string& path, const JointBody& body, const Eigen::Matrix3d& R, double radius_mm,
+                      const ScanGaps* gaps, const ImpingementLevels& levels, bool is_ball);
 
 /// Print a progress line to stderr ("[08_distance_maps] 3/24 lhdl-ct p=0.1 exact").
 void progress(const std::string& experiment, int done, int total, const std::string& what);
