@@ -50,6 +50,7 @@ double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std
 
 struct InputOptions {
   std::string ball, socket, subject, side = "right", frame = "RAS", cor = "auto", head_region;
+  bool allow_any_cor = false;
 };
 struct MapOptions {
   std::string scheme = "equiangular", sampling = "auto", mode = "exact", levels;
@@ -72,6 +73,9 @@ void add_input_options(CLI::App* app, InputOptions& o) {
                   "Centre of rotation: 'auto' (sphere fit of the femoral head, in any scan orientation) or X,Y,Z "
                   "in mm in the input files' frame")
       ->capture_default_str();
+  app->add_flag("--allow-any-cor", o.allow_any_cor,
+                "Accept a --cor outside the femoral head (research; otherwise an error naming the COR and the "
+                "fitted head centre)");
   app->add_option("--head-region", o.head_region,
                   "X,Y,Z,R: fit the head sphere to femur vertices within R mm of (X,Y,Z), input frame");
 }
@@ -201,7 +205,22 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
     s.fit.centre = M * Eigen::Vector3d(v[0], v[1], v[2]);
     s.fit.radius = s.fit.rms_residual = std::nan("");
     s.cor_method = "given";
+    if (!in.allow_any_cor) {
+      // A given COR must lie in the femoral head: compare with the head the bone itself shows.
+      const SphereFitResult head = locate_femoral_head(ball);
+      const double d = (s.fit.centre - head.centre).norm();
+      if (d > head.radius) {
+        const Eigen::Vector3d hc = M.transpose() * head.centre;
+        std::ostringstream msg;
+        msg << "--cor (" << v[0] << ", " << v[1] << ", " << v[2] << ") mm is " << d
+            << " mm from the fitted femoral head centre (" << hc.x() << ", " << hc.y() << ", " << hc.z()
+            << ") mm, farther than the head radius " << head.radius
+            << " mm: the COR must lie in the head (input frame, mm); --allow-any-cor accepts it";
+        throw Error(msg.str());
+      }
+    }
   }
+  s.options.allow_cor_outside_ball = in.allow_any_cor;
   try {
     s.hip.emplace(std::move(ball), std::move(socket), s.side, s.fit, given, s.options);
   } catch (const Error& e) {
@@ -210,6 +229,7 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
                 " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; --neutral scan "
                 "uses the scan pose instead]");
   }
+  for (const std::string& w : s.hip->warnings()) std::cerr << "impinge: warning: " << w << "\n";
   // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).
   const PoseResult scan = s.joint().detect(Eigen::Matrix3d::Identity());
   s.scan_pose_min_gap_mm = std::fmin(scan.ball.min_gap_mm, scan.socket.min_gap_mm);
@@ -307,6 +327,7 @@ nlohmann::json setup_json(const Setup& s) {
   j["levels_thresholds_mm"] = opt.levels.thresholds_mm;
   j["occlusion_tolerance_mm"] = opt.occlusion_tolerance_mm;
   j["neutral"] = s.options.neutral == Neutral::anatomical ? "anatomical" : "scan";
+  j["warnings"] = s.hip->warnings();
   j["scan_pose_min_gap_mm"] = num_or_null(s.scan_pose_min_gap_mm);
   j["overlap_at_scan_pose"] = s.scan_pose_min_gap_mm < 0;
   j["pose_convention"] =

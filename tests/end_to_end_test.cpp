@@ -90,6 +90,21 @@ TEST(EndToEnd, CliErrorsAreOneLine) {
   EXPECT_NE(run("distance --subject " + d + "/s/subject.json --pose 1,2 --out " + d + "/o", &out), 0);
   EXPECT_NE(run("distance --subject " + d + "/s/subject.json --mode cubic --out " + d + "/o", &out), 0);
   EXPECT_NE(out.find("cubic"), std::string::npos) << out;
+  // A given COR far from the femoral head is an error naming it and the head centre (the generated
+  // subject's head is at true_cor_mm); --allow-any-cor accepts it.
+  std::ifstream sj(d + "/s/subject.json");
+  const nlohmann::json subject = nlohmann::json::parse(sj);
+  const auto c = subject["true_cor_mm"];
+  const std::string far = std::to_string(c[0].get<double>() - 40) + "," + std::to_string(c[1].get<double>()) + "," +
+                          std::to_string(c[2].get<double>());
+  EXPECT_NE(run("distance --subject " + d + "/s/subject.json --precision 2 --cor=" + far + " --out " + d + "/o", &out), 0);
+  EXPECT_NE(out.find("from the fitted femoral head centre"), std::string::npos) << out;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  EXPECT_EQ(run("distance --subject " + d + "/s/subject.json --precision 2 --cor=" + far + " --allow-any-cor --out " + d +
+                    "/o",
+                &out),
+            0)
+      << out;
 }
 
 class RealSubject : public ::testing::TestWithParam<std::string> {};

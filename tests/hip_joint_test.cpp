@@ -115,3 +115,37 @@ TEST(HipJoint, PosedFemurIsFemurRotationInTheWorkingFrame) {
   EXPECT_EQ(reused.socket.min_gap_mm, fresh.socket.min_gap_mm);
   EXPECT_EQ(reused.ball.level_area_mm2, fresh.ball.level_area_mm2);
 }
+
+TEST(HipJoint, CorOutsideTheFemurIsAnErrorUnlessAllowedAndWrongUnitsWarn) {
+  HipModelOptions mo;
+  mo.target_triangles = 3000;
+  const HipModel h = make_hip_model(mo);
+  HipJointOptions o = options(2.0);
+  o.neutral = Neutral::scan;
+  SphereFitResult outside;
+  outside.centre = h.cor + Eigen::Vector3d(-40, 0, 0);  // beside the head, away from the neck
+  outside.radius = mo.head_radius_mm;
+  try {
+    HipJoint(h.ball, h.socket, Side::right, outside, {}, o);
+    ADD_FAILURE() << "a COR outside the femur was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("outside the femur mesh"), std::string::npos) << e.what();
+  }
+  o.allow_cor_outside_ball = true;
+  EXPECT_NO_THROW(HipJoint(h.ball, h.socket, Side::right, outside, {}, o));
+  // The same hip in metres' worth of numbers scaled up: a 2.2 m head warns about the units.
+  o.allow_cor_outside_ball = false;
+  TriangleMesh big_ball = h.ball, big_socket = h.socket;
+  big_ball.V *= 100;
+  big_socket.V *= 100;
+  SphereFitResult big;
+  big.centre = 100 * h.cor;
+  big.radius = 100 * mo.head_radius_mm;
+  const HipJoint scaled(big_ball, big_socket, Side::right, big, {}, o);
+  ASSERT_EQ(scaled.warnings().size(), 1u);
+  EXPECT_NE(scaled.warnings()[0].find("millimetres"), std::string::npos) << scaled.warnings()[0];
+  SphereFitResult head;
+  head.centre = h.cor;
+  head.radius = mo.head_radius_mm;
+  EXPECT_TRUE(HipJoint(h.ball, h.socket, Side::right, head, {}, o).warnings().empty());
+}

@@ -4,8 +4,20 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+
+#include "impinge/embree_ray_caster.hpp"
 #include "impinge/error.hpp"
+#include "impinge/exact_reference.hpp"
+#include "impinge/face_culling.hpp"
+#include "impinge/fcl_collision.hpp"
+#include "impinge/femur_frame.hpp"
 #include "impinge/generated_models.hpp"
+#include "impinge/joint.hpp"
+#include "impinge/mesh_io.hpp"
+#include "impinge/naive_sampling.hpp"
+#include "impinge/sampling.hpp"
+#include "test_support.hpp"
 
 using namespace impinge;
 
@@ -34,4 +46,43 @@ TEST(Mesh, SubmeshKeepsTrianglesWhoseCornersAreAllKept) {
   EXPECT_EQ(b.F.rows(), expect);
   EXPECT_NO_THROW(validate_mesh(b));
   EXPECT_GT(b.V.col(2).minCoeff(), h.cor.z());
+}
+
+TEST(Mesh, EveryEntryPointThatIndexesFacesRefusesABadIndex) {
+  // A face index outside [0, n) is an impinge::Error naming the mesh at every entry point that reads
+  // faces, never an out-of-bounds read (the sanitizer build checks the latter).
+  const HipModel h = make_hip_model({});
+  TriangleMesh bad = h.ball;
+  bad.source = "bad-mesh";
+  bad.F(bad.F.rows() / 2, 1) = static_cast<int>(bad.V.rows()) + 5;
+  auto expect_error = [&](const char* what, const std::function<void()>& call) {
+    try {
+      call();
+      ADD_FAILURE() << what << ": no error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("bad-mesh"), std::string::npos) << what << ": " << e.what();
+    }
+  };
+  expect_error("vertex_areas", [&] { vertex_areas(bad); });
+  expect_error("remove_degenerate_faces", [&] {
+    TriangleMesh m = bad;
+    remove_degenerate_faces(m);
+  });
+  expect_error("submesh", [&] { submesh(bad, std::vector<std::uint8_t>(static_cast<std::size_t>(bad.V.rows()), 1)); });
+  expect_error("write_ply", [&] { write_ply(test::temp_dir("mesh_bad") + "/m.ply", bad); });
+  expect_error("sample_surface", [&] {
+    RadialDistanceMap map(make_scheme("equiangular", 2.0));
+    sample_surface(bad, h.cor, SamplingOptions{}, map);
+  });
+  expect_error("sample_naive", [&] {
+    RadialDistanceMap map(make_scheme("equiangular", 10.0));
+    sample_naive(bad, h.cor, map);
+  });
+  expect_error("cast_ray_naive", [&] { cast_ray_naive(bad, h.cor, Eigen::Vector3d::UnitX()); });
+  expect_error("analyse_face_culling", [&] { analyse_face_culling(bad, h.cor); });
+  expect_error("Joint", [&] { Joint(bad, h.socket, h.cor, JointOptions{}); });
+  expect_error("locate_femoral_head", [&] { locate_femoral_head(bad); });
+  if (have_exact_reference()) expect_error("ExactReference", [&] { ExactReference r(bad); });
+  if (have_fcl()) expect_error("FclJoint", [&] { FclJoint f(bad, h.socket, h.cor); });
+  if (have_embree()) expect_error("EmbreeRayCaster", [&] { EmbreeRayCaster e(bad, h.cor); });
 }

@@ -17,7 +17,7 @@ double median_radius(const Vertices& V, const Eigen::Vector3d& c) {
     const double r = (V.row(i).transpose() - c).norm();
     if (r < 35) d.push_back(r);
   }
-  require(d.size() >= 10, "hip joint: fewer than 10 femur vertices within 35 mm of the centre of rotation");
+  if (d.size() < 10) return std::nan("");  // no head around the COR
   std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
   return d[d.size() / 2];
 }
@@ -30,6 +30,14 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   require(!options.reseat || neutral_ == Neutral::anatomical,
           "hip joint: re-seating the head needs anatomical neutral (the acetabulum's frame)");
   head_radius_ = std::isfinite(head.radius) ? head.radius : median_radius(femur.V, cor_);
+  require(std::isfinite(head_radius_) || neutral_ == Neutral::scan,
+          femur.source + ": fewer than 10 femur vertices within 35 mm of the centre of rotation: no femoral head "
+                         "there for the acetabulum and clock faces");
+  if (!std::isfinite(head_radius_))
+    warnings_.push_back(femur.source + ": no femoral head within 35 mm of the centre of rotation");
+  else if (!(head_radius_ >= 5 && head_radius_ <= 60))
+    warnings_.push_back(femur.source + ": the femoral head radius is " + std::to_string(head_radius_) +
+                        " mm, outside 5-60 mm: are the meshes in millimetres?");
   const Eigen::Matrix3d S = scan_axes();
   if (neutral_ == Neutral::anatomical) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -77,6 +85,14 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint,
                    load(options.ball_map_file), load(options.socket_map_file));
   }
+  // The COR must lie inside the femur: then every ray from it meets the femur's surface.
+  const RadialDistanceMap& bm = joint_->ball().map;
+  const double uncovered = 1.0 - double(bm.nodes_covered()) / double(bm.num_nodes());
+  if (uncovered > 1e-4 && !options.allow_cor_outside_ball)
+    throw Error(joint_->ball().mesh.source + ": the centre of rotation (" + std::to_string(cor_.x()) + ", " +
+                std::to_string(cor_.y()) + ", " + std::to_string(cor_.z()) + ") mm is outside the femur mesh (" +
+                std::to_string(100 * uncovered) + " % of the directions from it meet no femur surface): a COR "
+                "in the wrong frame or units? allow_cor_outside_ball (CLI: --allow-any-cor) accepts it");
 }
 
 void HipJoint::save_maps(const std::string& ball_path, const std::string& socket_path) const {

@@ -35,6 +35,7 @@ void validate_mesh(const TriangleMesh& mesh) {
 }
 
 int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2) {
+  validate_mesh(mesh);
   Faces kept(mesh.F.rows(), 3);
   Eigen::Index k = 0;
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
@@ -52,6 +53,7 @@ int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2) {
 }
 
 Eigen::VectorXd vertex_areas(const TriangleMesh& mesh) {
+  validate_mesh(mesh);
   Eigen::VectorXd area = Eigen::VectorXd::Zero(mesh.V.rows());
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
     const Eigen::Vector3d pa = mesh.V.row(mesh.F(f, 0)), pb = mesh.V.row(mesh.F(f, 1)), pc = mesh.V.row(mesh.F(f, 2));
@@ -63,6 +65,7 @@ Eigen::VectorXd vertex_areas(const TriangleMesh& mesh) {
 
 TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>& keep_vertex,
                      std::vector<Eigen::Index>* kept) {
+  validate_mesh(mesh);
   require(keep_vertex.size() == static_cast<std::size_t>(mesh.V.rows()),
           mesh.source + ": submesh: the vertex selection has " + std::to_string(keep_vertex.size()) +
               " entries for " + std::to_string(mesh.V.rows()) + " vertices");

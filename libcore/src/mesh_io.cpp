@@ -133,6 +133,7 @@ void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const E
 }
 
 void write_ply(const std::string& path, const TriangleMesh& mesh) {
+  validate_mesh(mesh);
   std::ofstream os(path, std::ios::binary);
   require(os.good(), path + ": cannot open for writing");
   os << "ply\nformat binary_little_endian 1.0\nelement vertex " << mesh.V.rows() << "\n"

@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
+
+#include "impinge/error.hpp"
 
 namespace impinge {
 
@@ -9,7 +12,13 @@ std::optional<std::pair<double, std::int64_t>> cast_ray_naive(const TriangleMesh
                                                               const Eigen::Vector3d& u) {
   double best = std::numeric_limits<double>::infinity();
   std::int64_t best_f = -1;
+  const Eigen::Index n = mesh.V.rows();
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    // A bad index is an error, never an out-of-bounds read (one compare per corner; the ray is O(m) anyway).
+    for (int c = 0; c < 3; ++c)
+      if (mesh.F(f, c) < 0 || mesh.F(f, c) >= n)
+        throw Error(mesh.source + ": face " + std::to_string(f) + " has vertex index " + std::to_string(mesh.F(f, c)) +
+                    " outside [0, " + std::to_string(n) + ")");
     const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)).transpose() - cor;
     const Eigen::Vector3d e1 = mesh.V.row(mesh.F(f, 1)).transpose() - cor - p0;
     const Eigen::Vector3d e2 = mesh.V.row(mesh.F(f, 2)).transpose() - cor - p0;
@@ -36,6 +45,7 @@ std::optional<std::pair<double, std::int64_t>> cast_ray_naive(const TriangleMesh
 template <typename Scalar>
 void sample_naive(const TriangleMesh& mesh, const Eigen::Vector3d& cor, RadialDistanceMapT<Scalar>& map,
                   std::vector<std::int64_t>* triangle_of_node) {
+  validate_mesh(mesh);
   const std::int64_t n = map.num_nodes();
   if (triangle_of_node != nullptr) triangle_of_node->assign(static_cast<std::size_t>(n), -1);
   for (std::int64_t i = 0; i < n; ++i) {

@@ -907,6 +907,7 @@ template <typename Scalar>
 SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, DistanceMode mode,
                         RadialDistanceMapT<Scalar>& map, const FaceCulling* culling, bool row_spans, MapStart start) {
   require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
+  validate_mesh(mesh);  // a bad index is an error before anything is read or changed
   (void)map.grid();  // throws for a map that is not equiangular, before anything is changed
   const bool planned = culling != nullptr && mode == DistanceMode::exact;
   // The plan's cones: the kept triangles (all when culling is disabled), set up once.

@@ -27,6 +27,9 @@ struct HipJointOptions {
   /// have been saved from a HipJoint of the same meshes and options (save_maps): their stored COR
   /// (working frame) must equal this joint's within 1e-6 mm and their scheme joint.scheme's.
   std::string ball_map_file, socket_map_file;
+  /// Accept a centre of rotation outside the femur (ball) mesh, for research; otherwise that is an
+  /// error (the gaps would be measured along rays that leave the head: silently wrong numbers).
+  bool allow_cor_outside_ball = false;
 };
 
 /// Femur (ball) and pelvis (socket) of one hip about the centre of rotation, posed by clinical
@@ -45,7 +48,10 @@ class HipJoint {
   /// 35 mm of the centre); `given`: landmarks that replace found ones (mm, working frame).
   /// With options.reseat the femur is first translated by reseat_translation() and the COR is the
   /// acetabular centre. Throws impinge::Error naming the mesh and step that failed (for example
-  /// no whole pelvis with anatomical neutral: use scan neutral or give the landmarks).
+  /// no whole pelvis with anatomical neutral: use scan neutral or give the landmarks), and naming
+  /// the COR when it lies outside the femur mesh (its map leaves more than 1e-4 of the directions
+  /// without surface) unless options.allow_cor_outside_ball. A head radius outside 5-60 mm (metres
+  /// instead of mm?) adds a warning (warnings()).
   HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const SphereFitResult& head, const Landmarks& given,
            const HipJointOptions& options);
 
@@ -81,6 +87,8 @@ class HipJoint {
   /// Save both maps (map_io.hpp) with the working-frame COR, for options.ball_map_file and
   /// socket_map_file of a later HipJoint. Throws impinge::Error on I/O errors.
   void save_maps(const std::string& ball_path, const std::string& socket_path) const;
+  /// Warnings about the input (e.g. an implausible head radius: wrong units?), one line each.
+  const std::vector<std::string>& warnings() const { return warnings_; }
   /// Head radius used for the acetabulum and clocks (mm).
   double head_radius_mm() const { return head_radius_; }
   const Eigen::Vector3d& cor() const { return cor_; }
@@ -99,6 +107,7 @@ class HipJoint {
   std::optional<ClockFace> socket_clock_, ball_clock_;
   Eigen::Vector3d reseat_ = Eigen::Vector3d::Zero();
   double head_radius_ = 0;
+  std::vector<std::string> warnings_;
   std::optional<Joint> joint_;
   double frames_ms_ = 0;
 };

@@ -35,17 +35,20 @@ struct TriangleMesh {
 void validate_mesh(const TriangleMesh& mesh);
 
 /// Remove triangles whose area is below `min_area_mm2` or which repeat a vertex index;
-/// returns how many were removed and adds that to `mesh.degenerate_faces_skipped`.
+/// returns how many were removed and adds that to `mesh.degenerate_faces_skipped`. Validates the
+/// mesh first (validate_mesh throws impinge::Error on a bad index or coordinate).
 int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2 = 1e-12);
 
 /// The part of `mesh` made of the triangles whose three corners have keep_vertex[i] != 0,
 /// with its vertices renumbered in order of first use. `kept` (optional) receives, for each new
-/// vertex, its index in `mesh`. Throws impinge::Error when keep_vertex.size() != n.
+/// vertex, its index in `mesh`. Throws impinge::Error when keep_vertex.size() != n or the mesh is
+/// invalid (validate_mesh).
 TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>& keep_vertex,
                      std::vector<Eigen::Index>* kept = nullptr);
 
 /// Per-vertex area (mm^2): one third of the area of every incident triangle (barycentric dual
-/// area), so the sum over vertices equals the surface area. Returns n values.
+/// area), so the sum over vertices equals the surface area. Returns n values. Validates the mesh
+/// first (impinge::Error on a bad index or coordinate).
 Eigen::VectorXd vertex_areas(const TriangleMesh& mesh);
 
 }  // namespace impinge

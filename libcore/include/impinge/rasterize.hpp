@@ -64,7 +64,8 @@ enum class MapStart {
 /// `culling` (exact mode only; ignored in linear mode): the plan of analyse_face_culling for
 /// this mesh and COR. Its cones are rasterised (set up once; the kept triangles when culling is
 /// enabled, about half of a closed mesh, else all). Throws impinge::Error naming the mesh when
-/// the plan was made for another mesh or COR (mesh_fingerprint).
+/// the plan was made for another mesh or COR (mesh_fingerprint), or the mesh is invalid
+/// (validate_mesh, checked before the map is touched).
 /// `row_spans` (exact mode): test only the columns of each row that the cone can cover
 /// (triangle_cone.hpp) instead of the whole box; the map is the same node for node (tested), so
 /// false is only the reference for that test. The row kernels run in vectorised clones
