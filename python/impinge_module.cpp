@@ -249,13 +249,11 @@ py::dict motion(const PyJoint& j, const py::handle& angles_obj) {
     py::gil_scoped_release release;
     m = run_motion(*j.hip, poses);
   }
-  std::vector<double>&ball_min = m.ball_min, &socket_min = m.socket_min, &ball_pen = m.ball_pen,
-  &socket_pen = m.socket_pen;
   py::dict d;
-  d["ball_min_gap_mm"] = own(std::move(ball_min), {k});
-  d["socket_min_gap_mm"] = own(std::move(socket_min), {k});
-  d["ball_penetrating_area_mm2"] = own(std::move(ball_pen), {k});
-  d["socket_penetrating_area_mm2"] = own(std::move(socket_pen), {k});
+  d["ball_min_gap_mm"] = own(std::move(m.ball_min), {k});
+  d["socket_min_gap_mm"] = own(std::move(m.socket_min), {k});
+  d["ball_penetrating_area_mm2"] = own(std::move(m.ball_pen), {k});
+  d["socket_penetrating_area_mm2"] = own(std::move(m.socket_pen), {k});
   return d;
 }
 

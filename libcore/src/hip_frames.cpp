@@ -26,7 +26,6 @@ HipFrames find_hip_frames(const TriangleMesh& femur, const TriangleMesh& pelvis,
   h.pelvis = pelvis_frame(h.pelvis_landmarks, h.head.centre, options.pelvis);
   h.femur = femur_frame(h.femur_landmarks, side, options.femur);
   h.femur.quality_mm = h.head.rms_residual;
-  h.scan_to_neutral = femur_rotation(h.pelvis, h.femur, PoseAngles{}, side);
   h.scan_pose = jcs_angles(h.pelvis.axes.transpose() * h.femur.axes, side);
   return h;
 }

@@ -48,12 +48,20 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     const ClockFace femoral = femoral_clock_face(femur, cor_, head_radius_, frames_->femur);
     if (options.reseat) {
       // The femur, its frame and clock move with the head onto the acetabular centre.
+      // Translation only: the pelvic landmarks stay, the femoral ones move with the femur, both frames
+      // keep their axes and take the new COR as origin.
       reseat_ = acetabulum_->sphere.centre - cor_;
       femur.V.rowwise() += reseat_.transpose();
       cor_ = acetabulum_->sphere.centre;
-      g["hip_centre"] = cor_;
-      for (const char* name : kFemurLandmarkNames) g[name] = frames_->femur_landmarks.as_map().at(name) + reseat_;
-      frames_ = find_hip_frames(femur, pelvis, side, g, options.frames);
+      FemurLandmarks& fl = frames_->femur_landmarks;
+      for (Eigen::Vector3d* p : {&fl.head_centre, &fl.epicondyle_lateral, &fl.epicondyle_medial,
+                                 &fl.posterior_condyle_lateral, &fl.posterior_condyle_medial})
+        *p += reseat_;
+      frames_->head.centre = cor_;
+      const double quality = frames_->femur.quality_mm;
+      frames_->pelvis = pelvis_frame(frames_->pelvis_landmarks, cor_, options.frames.pelvis);
+      frames_->femur = femur_frame(fl, side, options.frames.femur);
+      frames_->femur.quality_mm = quality;
     }
     frames_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     // Joint frame: pelvic axes arranged as the scan frame, p_joint = S P^T (p - cor).

@@ -28,9 +28,6 @@ struct HipFrames {
   PelvisLandmarks pelvis_landmarks;
   FemurLandmarks femur_landmarks;
   AnatomicalFrame pelvis, femur;
-  /// Rotation (working frame) from the scan pose to anatomical neutral: femur_rotation at zero
-  /// angles, and its angle in degrees (how far from neutral the subject lay in the scanner).
-  Eigen::Matrix3d scan_to_neutral = Eigen::Matrix3d::Identity();
   PoseAngles scan_pose;  ///< the scan pose as clinical angles (jcs_angles of the femur relative to the pelvis)
 };
 
