@@ -74,6 +74,39 @@ void scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen
 }
 
 template <typename Scalar>
+std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                               const RadialDistanceMapT<Scalar>& map, ScanSide side, float* gap_mm,
+                               const FirstHitCaster* exact) {
+  if (exact == nullptr) {
+    scan_gaps_compact(set, R, t, map, side, gap_mm);
+    return 0;
+  }
+  const double s = static_cast<double>(static_cast<int>(side));
+  const double Rt[12] = {R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2),
+                         R(2, 0), R(2, 1), R(2, 2), t.x(),   t.y(),   t.z()};
+  constexpr std::int64_t kBlock = 256;
+  double qx[kBlock], qy[kBlock], qz[kBlock], radius[kBlock], d[kBlock];
+  const std::int64_t n = set.size();
+  std::int64_t refined = 0;
+  for (std::int64_t b = 0; b < n; b += kBlock) {
+    const int m = static_cast<int>(std::min(kBlock, n - b));
+    pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt, qx, qy, qz, radius);
+    map.sample_many_soa_marked(qx, qy, qz, m, d);
+    float* g = gap_mm + b;
+    gap_block(d, radius, s, m, g);
+    // Marked stencils came back as -inf, so their gaps are +-inf: resolve them by the ray cast.
+    for (int j = 0; j < m; ++j) {
+      if (!std::isinf(g[j])) continue;
+      ++refined;
+      const double h = exact->first_hit(Eigen::Vector3d(qx[j], qy[j], qz[j]));
+      g[j] = std::isfinite(h) && radius[j] > 0 ? static_cast<float>(s * (h - radius[j]))
+                                               : std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+  return refined;
+}
+
+template <typename Scalar>
 void scan_gaps(PointsRef P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
                const RadialDistanceMapT<Scalar>& map, ScanSide side, ScanGaps& out) {
   const ScanSet set = make_scan_set(P, mask);
@@ -86,6 +119,7 @@ void expand_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out) {
   const auto n = static_cast<std::size_t>(set.vertices);
   out.gap_mm.assign(n, std::numeric_limits<float>::quiet_NaN());
   out.status.assign(n, ScanGaps::beyond_reach);
+  out.refined = 0;
   for (std::size_t j = 0; j < set.index.size(); ++j) {
     const auto i = static_cast<std::size_t>(set.index[j]);
     out.gap_mm[i] = gap_mm[j];
@@ -118,6 +152,34 @@ std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMa
   return mask;
 }
 
+template <typename Scalar>
+std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMapT<Scalar>& own_map,
+                                             double tolerance_mm, double max_radius_mm,
+                                             const FirstHitCaster& own_exact) {
+  std::vector<std::uint8_t> mask(static_cast<std::size_t>(P.rows()), 0);
+  const SamplingScheme& scheme = own_map.scheme();
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const Eigen::Vector3d p = P.row(i).transpose();
+    const double r = p.norm();
+    if (!(r > 0) || r > max_radius_mm) continue;
+    const Stencil st = scheme.interpolate(p / r);
+    bool decidable = true;
+    for (int k = 0; k < 4; ++k) {
+      const Scalar v = own_map.at(st.nodes[k]);
+      decidable = decidable && std::isfinite(v) && !has_discontinuity_mark(v);
+    }
+    double d;
+    if (decidable) {
+      d = 0;
+      for (int k = 0; k < 4; ++k) d += st.weights[k] * double(own_map.at(st.nodes[k]));
+    } else {
+      d = own_exact.first_hit(p);  // +inf on a miss: nothing in front of the vertex
+    }
+    if (r <= d + tolerance_mm) mask[static_cast<std::size_t>(i)] = 1;
+  }
+  return mask;
+}
+
 ScanSummary summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const ImpingementLevels& levels) {
   ScanSummary s;
   summarize_scan(g, area, levels, s);
@@ -131,6 +193,7 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
   s.area_penetrating_mm2 = 0;
   s.min_gap_mm = std::numeric_limits<double>::quiet_NaN();
   s.vertices = static_cast<std::int64_t>(g.gap_mm.size());
+  s.vertices_refined = g.refined;
   double min_gap = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
     if (g.status[i] == ScanGaps::beyond_reach) {
@@ -166,6 +229,16 @@ template void scan_gaps_compact<double>(const ScanSet&, const Eigen::Matrix3d&, 
                                         const RadialDistanceMapT<double>&, ScanSide, float*);
 template std::vector<std::uint8_t> first_surface_mask<float>(PointsRef, const RadialDistanceMapT<float>&, double,
                                                              double);
+template std::vector<std::uint8_t> first_surface_mask<float>(PointsRef, const RadialDistanceMapT<float>&, double,
+                                                             double, const FirstHitCaster&);
+template std::vector<std::uint8_t> first_surface_mask<double>(PointsRef, const RadialDistanceMapT<double>&, double,
+                                                              double, const FirstHitCaster&);
+template std::int64_t scan_gaps_compact<float>(const ScanSet&, const Eigen::Matrix3d&, const Eigen::Vector3d&,
+                                               const RadialDistanceMapT<float>&, ScanSide, float*,
+                                               const FirstHitCaster*);
+template std::int64_t scan_gaps_compact<double>(const ScanSet&, const Eigen::Matrix3d&, const Eigen::Vector3d&,
+                                                const RadialDistanceMapT<double>&, ScanSide, float*,
+                                                const FirstHitCaster*);
 template std::vector<std::uint8_t> first_surface_mask<double>(PointsRef, const RadialDistanceMapT<double>&,
                                                               double, double);
 

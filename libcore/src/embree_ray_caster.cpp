@@ -29,7 +29,7 @@ struct EmbreeRayCaster::Impl {
   }
 };
 
-EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin)
+EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin, bool robust)
     : impl_(std::make_unique<Impl>()) {
   validate_mesh(mesh);
   require(origin.allFinite(), "embree: origin is not finite (" + mesh.source + ")");
@@ -49,6 +49,8 @@ EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d
   rtcAttachGeometry(impl_->scene, g);
   rtcReleaseGeometry(g);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  if (robust) rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+
   rtcCommitScene(impl_->scene);
   impl_->check("building the scene of " + mesh.source);
 }
@@ -171,7 +173,7 @@ std::int64_t EmbreeRayCaster::fill_map(RadialDistanceMapT<Scalar>& map) const {
 #else
 bool have_embree() { return false; }
 struct EmbreeRayCaster::Impl {};
-EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d&) {
+EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d&, bool) {
   require(false, "embree: this build has no Embree 3 (install libembree-dev and reconfigure); mesh " + mesh.source);
 }
 EmbreeRayCaster::~EmbreeRayCaster() = default;

@@ -159,9 +159,21 @@ bool mark_no_surface(double* __restrict out, const double* __restrict t, const d
   }
   return edge != 0;
 }
+/// Points whose four nodes include a marked one (depth discontinuity) get -inf. The loads hit the
+/// cache lines the interpolation has just read.
+template <typename Scalar>
+void apply_marks(const Scalar* __restrict values, const std::int32_t* __restrict base, const std::int32_t* __restrict dc,
+                 int n, int cols, double* __restrict out) {
+  for (int j = 0; j < n; ++j) {
+    const std::int32_t b = base[j], d = dc[j];
+    if (has_discontinuity_mark(values[b]) | has_discontinuity_mark(values[b + d]) |
+        has_discontinuity_mark(values[b + cols]) | has_discontinuity_mark(values[b + cols + d]))
+      out[j] = -std::numeric_limits<double>::infinity();
+  }
+}
 }  // namespace
 
-template <typename Scalar>
+template <typename Scalar, bool kMarked>
 void EquiangularGrid::lookup_soa(const Scalar* values, const double* x, const double* y, const double* z,
                                  std::int64_t n, double* out) const {
   constexpr int kChunk = 128;
@@ -175,6 +187,7 @@ void EquiangularGrid::lookup_soa(const Scalar* values, const double* x, const do
     // node's weight is exactly 0 (a direction exactly on a row or column), which goes to the
     // exact slow path. The first loop is branch-free; the second almost never does anything.
     const bool any_edge = mark_no_surface(out + b, t, s, m);
+    if constexpr (kMarked) apply_marks(values, base, dc, m, cols_, out + b);
     if (!any_edge) continue;
     for (int j = 0; j < m; ++j) {
       if (!std::isnan(out[b + j]) || (t[j] > 0 && t[j] < 1 && s[j] > 0 && s[j] < 1)) continue;
@@ -192,6 +205,14 @@ void EquiangularGrid::interpolate_many_soa(const float* values, const double* x,
 void EquiangularGrid::interpolate_many_soa(const double* values, const double* x, const double* y, const double* z,
                                            std::int64_t n, double* out) const {
   lookup_soa(values, x, y, z, n, out);
+}
+void EquiangularGrid::interpolate_many_soa_marked(const float* values, const double* x, const double* y,
+                                                  const double* z, std::int64_t n, double* out) const {
+  lookup_soa<float, true>(values, x, y, z, n, out);
+}
+void EquiangularGrid::interpolate_many_soa_marked(const double* values, const double* x, const double* y,
+                                                  const double* z, std::int64_t n, double* out) const {
+  lookup_soa<double, true>(values, x, y, z, n, out);
 }
 
 }  // namespace impinge

@@ -132,7 +132,7 @@ void helix_along(const double* __restrict s, int n, double inv_dx, double last, 
 }
 }  // namespace
 
-template <typename Scalar>
+template <typename Scalar, bool kMarked>
 void HelixScheme::lookup_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
                              double* out) const {
   constexpr int kChunk = 128;
@@ -147,6 +147,13 @@ void HelixScheme::lookup_soa(const Scalar* values, const double* x, const double
     helix_along(sa, m, inv_dx_, last, ia, ta);
     helix_along(sb, m, inv_dx_, last, ib, tb);
     for (int j = 0; j < m; ++j) {
+      if constexpr (kMarked) {
+        if (has_discontinuity_mark(values[ia[j]]) || has_discontinuity_mark(values[ia[j] + 1]) ||
+            has_discontinuity_mark(values[ib[j]]) || has_discontinuity_mark(values[ib[j] + 1])) {
+          out[b + j] = -std::numeric_limits<double>::infinity();
+          continue;
+        }
+      }
       const double wa = 1 - u[j], wb = u[j];
       const double v = wa * ((1 - ta[j]) * values[ia[j]] + ta[j] * values[ia[j] + 1]) +
                        wb * ((1 - tb[j]) * values[ib[j]] + tb[j] * values[ib[j] + 1]);
@@ -178,6 +185,16 @@ void HelixScheme::interpolate_many_soa(const double* values, const double* x, co
                                        std::int64_t n, double* out) const {
   if (locate_ == TraveledDistance::exact) return lookup_soa(values, x, y, z, n, out);
   SchemeImpl<HelixScheme>::interpolate_many_soa(values, x, y, z, n, out);
+}
+void HelixScheme::interpolate_many_soa_marked(const float* values, const double* x, const double* y, const double* z,
+                                              std::int64_t n, double* out) const {
+  if (locate_ == TraveledDistance::exact) return lookup_soa<float, true>(values, x, y, z, n, out);
+  SchemeImpl<HelixScheme>::interpolate_many_soa_marked(values, x, y, z, n, out);
+}
+void HelixScheme::interpolate_many_soa_marked(const double* values, const double* x, const double* y, const double* z,
+                                              std::int64_t n, double* out) const {
+  if (locate_ == TraveledDistance::exact) return lookup_soa<double, true>(values, x, y, z, n, out);
+  SchemeImpl<HelixScheme>::interpolate_many_soa_marked(values, x, y, z, n, out);
 }
 
 }  // namespace impinge

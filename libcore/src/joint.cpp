@@ -1,7 +1,9 @@
 #include "impinge/joint.hpp"
 
 #include <chrono>
+#include <cmath>
 
+#include "impinge/depth_discontinuity.hpp"
 #include "impinge/error.hpp"
 
 namespace impinge {
@@ -12,6 +14,8 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
   require(cor.allFinite(), "joint: centre of rotation is not finite");
   require(o.occlusion_tolerance_mm >= 0, "joint: occlusion tolerance must be >= 0 mm");
   require(o.max_radius_mm > 0, "joint: region radius must be > 0 mm");
+  require(!o.exact_at_discontinuities || (std::isfinite(o.discontinuity_tolerance_mm) && o.discontinuity_tolerance_mm > 0),
+          "joint: the depth-discontinuity tolerance must be > 0 mm and finite");
   o.levels.validate();
   return o;
 }
@@ -32,7 +36,7 @@ Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor,
 
 JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given) const {
   validate_mesh(mesh);
-  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0};
+  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0};
   b.relative = b.mesh.V.rowwise() - cor_.transpose();
   if (given) {
     const SamplingScheme& want = *options_.scheme;
@@ -51,7 +55,16 @@ JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given
     b.sampling = sample_surface(b.mesh, cor_, so, b.map);
     b.sampling_ms = ms_since(t0);
   }
-  b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);
+  if (options_.exact_at_discontinuities && FirstHitCaster::available()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    b.nodes_marked = mark_depth_discontinuities(b.map, options_.discontinuity_tolerance_mm);
+    b.exact = std::make_shared<const FirstHitCaster>(b.mesh, cor_);
+    b.marking_ms = ms_since(t0);
+    b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm, *b.exact);
+  } else {
+    clear_depth_discontinuities(b.map);  // a given map may carry marks
+    b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);
+  }
   b.scan_set = make_scan_set(b.relative, b.mask);
   b.vertex_area = vertex_areas(b.mesh);
   return b;
@@ -67,15 +80,19 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
   std::vector<float>& gaps = res.compact_gaps;
   gaps.resize(static_cast<std::size_t>(std::max(ball_.scan_set.size(), socket_.scan_set.size())));
   auto t0 = std::chrono::steady_clock::now();
-  scan_gaps_compact(ball_.scan_set, R, t, socket_.map, ScanSide::inside, gaps.data());
+  const std::int64_t ball_refined =
+      scan_gaps_compact(ball_.scan_set, R, t, socket_.map, ScanSide::inside, gaps.data(), socket_.exact.get());
   res.ball_detection_ms = ms_since(t0);
   expand_scan(ball_.scan_set, gaps.data(), res.ball_gaps);
+  res.ball_gaps.refined = ball_refined;
   // Socket vertices in the ball's frame: R^T (p - t).
   t0 = std::chrono::steady_clock::now();
-  scan_gaps_compact(socket_.scan_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), ball_.map,
-                    ScanSide::outside, gaps.data());
+  const std::int64_t socket_refined =
+      scan_gaps_compact(socket_.scan_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), ball_.map,
+                        ScanSide::outside, gaps.data(), ball_.exact.get());
   res.socket_detection_ms = ms_since(t0);
   expand_scan(socket_.scan_set, gaps.data(), res.socket_gaps);
+  res.socket_gaps.refined = socket_refined;
   summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels, res.ball);
   summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels, res.socket);
 }

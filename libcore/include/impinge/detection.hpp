@@ -9,6 +9,7 @@
 #include <limits>
 #include <vector>
 
+#include "impinge/first_hit_caster.hpp"
 #include "impinge/impingement_levels.hpp"
 #include "impinge/mesh.hpp"
 #include "impinge/radial_distance_map.hpp"
@@ -26,6 +27,7 @@ struct ScanGaps {
   enum Status : std::uint8_t { tested = 0, no_surface = 1, beyond_reach = 2 };
   std::vector<float> gap_mm;         ///< n gaps, mm
   std::vector<std::uint8_t> status;  ///< n statuses
+  std::int64_t refined = 0;          ///< look-ups at a depth discontinuity resolved by an exact ray cast
 };
 
 /// Statistics of a scan (thesis sec. 3.4 colour levels; counts so nothing is dropped silently).
@@ -36,6 +38,8 @@ struct ScanSummary {
   std::int64_t vertices_beyond_reach = 0;                        ///< skipped: not on their body's first surface seen
                                                                  ///< from the COR, or beyond the region radius
   double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< NaN when none tested
+  std::int64_t vertices_refined = 0;                             ///< tested by an exact ray cast instead of the map
+                                                                 ///< (their stencil straddles a depth discontinuity)
   std::int64_t vertices_penetrating = 0;                         ///< gap <= 0
   double area_penetrating_mm2 = 0;                               ///< their vertex area
   std::vector<std::int64_t> level_vertices;                      ///< count per impingement level
@@ -77,6 +81,16 @@ template <typename Scalar>
 void scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                        const RadialDistanceMapT<Scalar>& map, ScanSide side, float* gap_mm);
 
+/// scan_gaps_compact with exact look-ups at depth discontinuities (issue 15): with `exact` given
+/// (the ray caster of the map's mesh about the same COR, in the map's frame) and the map's nodes
+/// marked (mark_depth_discontinuities), a vertex whose stencil holds a marked node gets
+/// gap_mm[j] = side * (exact->first_hit(q) - |q|) (NaN on a miss) instead of the interpolated
+/// gap. Returns the number of vertices so resolved. With `exact` null, the plain scan (returns 0).
+template <typename Scalar>
+std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                               const RadialDistanceMapT<Scalar>& map, ScanSide side, float* gap_mm,
+                               const FirstHitCaster* exact);
+
 /// Expand a compact scan into per-vertex ScanGaps (n entries): vertices outside the set are
 /// beyond reach, NaN gaps of the set are no surface.
 void expand_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out);
@@ -92,6 +106,15 @@ void expand_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out);
 template <typename Scalar>
 std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMapT<Scalar>& own_map,
                                              double tolerance_mm, double max_radius_mm);
+
+/// first_surface_mask decided exactly where the map cannot decide it: a vertex whose stencil in
+/// `own_map` holds a node with the depth-discontinuity mark or without surface is tested by a ray
+/// cast of its own mesh (`own_exact`, about the same COR): on the first surface when the ray's
+/// first hit is at least |p| - tolerance_mm away, or the ray misses.
+template <typename Scalar>
+std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMapT<Scalar>& own_map,
+                                             double tolerance_mm, double max_radius_mm,
+                                             const FirstHitCaster& own_exact);
 
 /// Summary of a scan: counts, minimum gap, penetration and levels weighted by vertex area
 /// (`vertex_area`: n values, mm^2).

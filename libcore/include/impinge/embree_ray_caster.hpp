@@ -24,9 +24,12 @@ bool have_embree();
 /// ("threads=1"): every figure of this project is single thread unless it says otherwise.
 class EmbreeRayCaster {
  public:
-  /// Build the scene (BVH) of `mesh` (mm) about `origin` (mm). Throws impinge::Error when
-  /// Embree is not in this build, the mesh is invalid, or Embree reports an error.
-  EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin);
+  /// Build the scene (BVH) of `mesh` (mm) about `origin` (mm). `robust`: Embree's watertight
+  /// mode (RTC_SCENE_FLAG_ROBUST), so that a ray through a shared vertex or edge cannot slip
+  /// between the triangles (slower; leave out triangles edge-on to the origin first, whose hits it
+  /// gets wrong). Throws impinge::Error when Embree is not in this build, the mesh is invalid, or
+  /// Embree reports an error.
+  EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin, bool robust = false);
   ~EmbreeRayCaster();
   EmbreeRayCaster(EmbreeRayCaster&&) noexcept;
   EmbreeRayCaster& operator=(EmbreeRayCaster&&) noexcept;

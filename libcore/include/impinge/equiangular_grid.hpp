@@ -85,9 +85,13 @@ class EquiangularGrid : public SchemeImpl<EquiangularGrid> {
                             double* out) const override;
   void interpolate_many_soa(const double* values, const double* x, const double* y, const double* z, std::int64_t n,
                             double* out) const override;
+  void interpolate_many_soa_marked(const float* values, const double* x, const double* y, const double* z,
+                                   std::int64_t n, double* out) const override;
+  void interpolate_many_soa_marked(const double* values, const double* x, const double* y, const double* z,
+                                   std::int64_t n, double* out) const override;
 
  private:
-  template <typename Scalar>
+  template <typename Scalar, bool kMarked = false>
   void lookup_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
                   double* out) const;
   double precision_deg_;

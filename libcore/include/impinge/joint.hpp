@@ -5,10 +5,12 @@
 
 #include <Eigen/Core>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "impinge/detection.hpp"
+#include "impinge/first_hit_caster.hpp"
 #include "impinge/impingement_levels.hpp"
 #include "impinge/mesh.hpp"
 #include "impinge/radial_distance_map.hpp"
@@ -29,6 +31,13 @@ struct JointOptions {
   double max_radius_mm = std::numeric_limits<double>::infinity();  ///< region of interest about
                                                                    ///< the COR, mm
   ImpingementLevels levels;                                        ///< gap classes
+  /// Exact look-ups at depth discontinuities (issue 15): mark each map's nodes where its
+  /// interpolation may be off by more than discontinuity_tolerance_mm (mark_depth_discontinuities)
+  /// and resolve every look-up whose stencil holds one by a ray cast of the other mesh
+  /// (FirstHitCaster), and every first-surface decision of such a vertex by a ray cast of its own.
+  /// Off, or in a build without Embree or CGAL, the maps answer alone (the thesis' algorithm).
+  bool exact_at_discontinuities = true;
+  double discontinuity_tolerance_mm = 0.05;  ///< see exact_at_discontinuities, mm (> 0)
 };
 
 /// One body of the joint after preprocessing.
@@ -41,6 +50,10 @@ struct JointBody {
   Eigen::VectorXd vertex_area;     ///< n, mm^2
   SamplingReport sampling;         ///< how the map was filled, with counts
   double sampling_ms = 0;          ///< wall time of filling the map, ms
+  /// Ray caster of the mesh about the COR when exact_at_discontinuities is on (else null).
+  std::shared_ptr<const FirstHitCaster> exact;
+  std::int64_t nodes_marked = 0;   ///< map nodes with the depth-discontinuity mark
+  double marking_ms = 0;           ///< wall time of marking them and building the ray caster, ms
 };
 
 /// Result of both scans at one pose.

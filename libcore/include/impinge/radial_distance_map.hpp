@@ -66,6 +66,11 @@ class RadialDistanceMapT {
   void sample_many_soa(const double* x, const double* y, const double* z, std::int64_t n, double* out) const {
     scheme_->interpolate_many_soa(distance_.data(), x, y, z, n, out);
   }
+  /// sample_many_soa, except that a point whose stencil holds a node with the depth-discontinuity
+  /// mark (mark_depth_discontinuities) gets -infinity: the caller resolves it exactly.
+  void sample_many_soa_marked(const double* x, const double* y, const double* z, std::int64_t n, double* out) const {
+    scheme_->interpolate_many_soa_marked(distance_.data(), x, y, z, n, out);
+  }
 
  private:
   std::shared_ptr<const SamplingScheme> scheme_;

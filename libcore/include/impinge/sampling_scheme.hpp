@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <string>
@@ -61,7 +62,29 @@ class SamplingScheme {
                                     std::int64_t n, double* out) const = 0;
   virtual void interpolate_many_soa(const double* values, const double* x, const double* y, const double* z,
                                     std::int64_t n, double* out) const = 0;
+  /// As interpolate_many_soa on a map whose nodes carry depth-discontinuity marks (the least
+  /// significant bit of a node's value, depth_discontinuity.hpp): a point whose stencil holds a
+  /// marked node, with any weight, gets -infinity instead of its value, so that the caller
+  /// resolves it exactly. The other points get exactly what interpolate_many_soa gives.
+  virtual void interpolate_many_soa_marked(const float* values, const double* x, const double* y, const double* z,
+                                           std::int64_t n, double* out) const = 0;
+  virtual void interpolate_many_soa_marked(const double* values, const double* x, const double* y, const double* z,
+                                           std::int64_t n, double* out) const = 0;
 };
+
+/// True when the node value `d` carries the depth-discontinuity mark: its least significant bit
+/// (a change of at most one unit in the last place, 2e-6 mm at 30 mm in float). +inf (no surface)
+/// is never marked.
+inline bool has_discontinuity_mark(float d) {
+  std::uint32_t b;
+  std::memcpy(&b, &d, sizeof b);
+  return (b & 1u) != 0;
+}
+inline bool has_discontinuity_mark(double d) {
+  std::uint64_t b;
+  std::memcpy(&b, &d, sizeof b);
+  return (b & 1u) != 0;
+}
 
 /// Base of concrete schemes: implements interpolate_many once, inlining Derived's
 ///   void stencil_at(double x, double y, double z, std::int64_t nodes[4], double w[4]) const
@@ -83,6 +106,14 @@ class SchemeImpl : public SamplingScheme {
                             double* out) const override {
     run_soa(values, x, y, z, n, out);
   }
+  void interpolate_many_soa_marked(const float* values, const double* x, const double* y, const double* z,
+                                   std::int64_t n, double* out) const override {
+    run_soa<float, true>(values, x, y, z, n, out);
+  }
+  void interpolate_many_soa_marked(const double* values, const double* x, const double* y, const double* z,
+                                   std::int64_t n, double* out) const override {
+    run_soa<double, true>(values, x, y, z, n, out);
+  }
   Stencil interpolate(const Eigen::Vector3d& u) const override {
     Stencil s;
     static_cast<const Derived*>(this)->stencil_at(u.x(), u.y(), u.z(), s.nodes.data(), s.weights.data());
@@ -92,7 +123,7 @@ class SchemeImpl : public SamplingScheme {
  private:
   /// Two passes per chunk of 64 points: all stencils first (pure arithmetic, no loads), then
   /// the loads, so the cache misses of many points are in flight at once.
-  template <typename Scalar>
+  template <typename Scalar, bool kMarked = false>
   void run(const Scalar* values, const double* pts, std::int64_t n, double* out) const {
     const Derived& self = *static_cast<const Derived*>(this);
     constexpr std::int64_t kChunk = 64;
@@ -107,10 +138,15 @@ class SchemeImpl : public SamplingScheme {
         const double* u = w + 4 * j;
         const double v = u[0] * values[q[0]] + u[1] * values[q[1]] + u[2] * values[q[2]] + u[3] * values[q[3]];
         out[b + j] = std::isfinite(v) ? v : slow_path(values, q, u);
+        if constexpr (kMarked) {
+          if (has_discontinuity_mark(values[q[0]]) || has_discontinuity_mark(values[q[1]]) ||
+              has_discontinuity_mark(values[q[2]]) || has_discontinuity_mark(values[q[3]]))
+            out[b + j] = -std::numeric_limits<double>::infinity();
+        }
       }
     }
   }
-  template <typename Scalar>
+  template <typename Scalar, bool kMarked = false>
   void run_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
                double* out) const {
     constexpr std::int64_t kChunk = 64;
@@ -118,7 +154,7 @@ class SchemeImpl : public SamplingScheme {
     for (std::int64_t b = 0; b < n; b += kChunk) {
       const std::int64_t m = std::min(kChunk, n - b);
       for (std::int64_t j = 0; j < m; ++j) p[3 * j] = x[b + j], p[3 * j + 1] = y[b + j], p[3 * j + 2] = z[b + j];
-      run(values, p, m, out + b);
+      run<Scalar, kMarked>(values, p, m, out + b);
     }
   }
 
