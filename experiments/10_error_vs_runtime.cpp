@@ -25,8 +25,10 @@
 // the matched k = round(720 / (pi p)) (thesis Table 6).
 #include <algorithm>
 #include <iostream>
+#include <optional>
 
 #include "experiment_support.hpp"
+#include "impinge/depth_discontinuity.hpp"
 #include "impinge/detection.hpp"
 #include "impinge/embree_ray_caster.hpp"
 #include "impinge/error.hpp"
@@ -40,6 +42,7 @@ using namespace impinge::experiment;
 
 namespace {
 constexpr double kRegionMm = 45;
+constexpr double kDiscontinuityToleranceMm = 0.05;  // JointOptions' default
 
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return std::nan("");
@@ -98,6 +101,8 @@ int main(int argc, char** argv) {
     const Eigen::Vector3d cor = subject_cor(s);
     const Eigen::Vector3d push = 3.0 * push_direction(s.pelvis, cor, kRegionMm);
     const ExactReference ref_f(s.femur), ref_p(s.pelvis);
+    std::optional<std::pair<FirstHitCaster, FirstHitCaster>> casters;
+    if (FirstHitCaster::available()) casters.emplace(FirstHitCaster(s.femur, cor), FirstHitCaster(s.pelvis, cor));
     const ScanSet fset = exact_scan_set(s.femur, ref_f, cor), pset = exact_scan_set(s.pelvis, ref_p, cor);
     const std::int64_t nv = fset.size() + pset.size();
     const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
@@ -203,6 +208,32 @@ int main(int argc, char** argv) {
             const Errors e = evaluate(pose, g, &fm, &pm, dump);
             put(pose == 0 ? "rest" : "pushed_3mm", name, to_string(mode), res, p, e, tq * 1e6 / double(nv), ts,
                 double(fm.bytes() + pm.bytes()));
+          }
+          // Exact look-ups at depth discontinuities (issue 15): the same maps with their marks, the
+          // marked look-ups resolved by ray casts. Sampling time includes the marking.
+          if (mode == DistanceMode::exact && casters) {
+            RadialDistanceMap fmr = fm, pmr = pm;
+            const double tm = median_ms(
+                [&] {
+                  mark_depth_discontinuities(fmr, kDiscontinuityToleranceMm);
+                  mark_depth_discontinuities(pmr, kDiscontinuityToleranceMm);
+                },
+                p < 0.1 ? std::min(reps, 3) : reps);
+            for (int pose = 0; pose < 2; ++pose) {
+              const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
+              std::vector<float> g[2] = {std::vector<float>(std::size_t(fset.size())),
+                                         std::vector<float>(std::size_t(pset.size()))};
+              const double tq = median_ms(
+                  [&] {
+                    scan_gaps_compact(fset, I, t, pmr, ScanSide::inside, g[0].data(), &casters->second);
+                    scan_gaps_compact(pset, I, Eigen::Vector3d(-t), fmr, ScanSide::outside, g[1].data(),
+                                      &casters->first);
+                  },
+                  reps);
+              put(pose == 0 ? "rest" : "pushed_3mm", name, "exact_refined", res, p,
+                  evaluate(pose, g, &fmr, &pmr, false), tq * 1e6 / double(nv), ts + tm,
+                  double(fmr.bytes() + pmr.bytes()));
+            }
           }
         }
       }

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "impinge/equiangular_grid.hpp"
 #include "impinge/error.hpp"
 
 namespace impinge {
@@ -33,6 +34,27 @@ std::int64_t mark_depth_discontinuities(RadialDistanceMapT<Scalar>& map, double 
   std::vector<std::uint8_t> mark(static_cast<std::size_t>(n), 0);
   constexpr std::int64_t kChunk = 1024;
   const Scalar* values = map.data();
+  auto is_marked = [tolerance_mm](double d, double a, double b, double c, double e) {
+    const double dp = a - 2 * d + b, dt = c - 2 * d + e;  // NaN / inf next to "no surface"
+    return !(std::abs(dp) <= tolerance_mm && std::abs(dt) <= tolerance_mm);
+  };
+  if (const auto* grid = dynamic_cast<const EquiangularGrid*>(&scheme)) {
+    // The grid's own neighbours (the nodes its bilinear stencils join): rows r +- 1 and columns
+    // c +- 1 (wrapping); at a pole row, the polar neighbours are the next row at c and c + 180 deg.
+    const int rows = grid->rows(), cols = grid->columns();
+    auto at = [&](int r, int c) { return double(values[std::int64_t(r) * cols + c]); };
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        const double d = at(r, c);
+        if (!std::isfinite(d)) continue;
+        const int cl = c == 0 ? cols - 1 : c - 1, cr = c + 1 == cols ? 0 : c + 1, co = (c + cols / 2) % cols;
+        const double up = r == 0 ? at(1, co) : at(r - 1, c);
+        const double down = r == rows - 1 ? at(rows - 2, co) : at(r + 1, c);
+        if (is_marked(d, up, down, at(r, cl), at(r, cr))) mark[static_cast<std::size_t>(std::int64_t(r) * cols + c)] = 1;
+      }
+    }
+  } else
 #pragma omp parallel
   {
     std::vector<double> phi(kChunk), theta(kChunk), pts(4 * 3 * kChunk), nb(4 * kChunk);
@@ -54,9 +76,7 @@ std::int64_t mark_depth_discontinuities(RadialDistanceMapT<Scalar>& map, double 
         const double d = values[first + j];
         if (!std::isfinite(d)) continue;
         const double* v = nb.data() + 4 * j;
-        const double dp = v[0] - 2 * d + v[1], dt = v[2] - 2 * d + v[3];  // NaN next to "no surface"
-        if (!(std::abs(dp) <= tolerance_mm && std::abs(dt) <= tolerance_mm))
-          mark[static_cast<std::size_t>(first + j)] = 1;
+        if (is_marked(d, v[0], v[1], v[2], v[3])) mark[static_cast<std::size_t>(first + j)] = 1;
       }
     }
   }

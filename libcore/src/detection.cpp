@@ -88,21 +88,30 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
   double qx[kBlock], qy[kBlock], qz[kBlock], radius[kBlock], d[kBlock];
   const std::int64_t n = set.size();
   std::int64_t refined = 0;
+  struct Pending {
+    std::int64_t j;
+    Eigen::Vector3d q;
+    double radius;
+  };
+  thread_local std::vector<Pending> pending;  // reused: no allocation per scan once grown
+  pending.clear();
   for (std::int64_t b = 0; b < n; b += kBlock) {
     const int m = static_cast<int>(std::min(kBlock, n - b));
     pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt, qx, qy, qz, radius);
     map.sample_many_soa_marked(qx, qy, qz, m, d);
     float* g = gap_mm + b;
     gap_block(d, radius, s, m, g);
-    // Marked stencils came back as -inf, so their gaps are +-inf: resolve them by the ray cast.
-    for (int j = 0; j < m; ++j) {
-      if (!std::isinf(g[j])) continue;
-      ++refined;
-      const double h = exact->first_hit(Eigen::Vector3d(qx[j], qy[j], qz[j]));
-      g[j] = std::isfinite(h) && radius[j] > 0 ? static_cast<float>(s * (h - radius[j]))
-                                               : std::numeric_limits<float>::quiet_NaN();
-    }
+    // Marked stencils came back as -inf, so their gaps are +-inf: noted here, resolved by the ray
+    // cast after the scan, all together (the BVH stays in cache from one ray to the next).
+    for (int j = 0; j < m; ++j)
+      if (std::isinf(g[j])) pending.push_back({b + j, Eigen::Vector3d(qx[j], qy[j], qz[j]), radius[j]});
   }
+  for (const Pending& q : pending) {
+    const double h = exact->first_hit(q.q);
+    gap_mm[q.j] = std::isfinite(h) && q.radius > 0 ? static_cast<float>(s * (h - q.radius))
+                                                   : std::numeric_limits<float>::quiet_NaN();
+  }
+  refined = static_cast<std::int64_t>(pending.size());
   return refined;
 }
 

@@ -1,5 +1,6 @@
 #include "impinge/embree_ray_caster.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -93,6 +94,33 @@ float EmbreeRayCaster::first_hit(float dx, float dy, float dz) const {
   return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? std::numeric_limits<float>::infinity() : rh.ray.tfar;
 }
 
+float EmbreeRayCaster::least_hit(const float* dirs, int k) const {
+  require(k >= 1 && k <= 4, "embree: least_hit takes 1 to 4 rays");
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  alignas(16) int valid[4] = {0, 0, 0, 0};
+  alignas(16) RTCRayHit4 rh;
+  for (int j = 0; j < 4; ++j) {
+    const int i = j < k ? j : 0;
+    const float x = dirs[3 * i], y = dirs[3 * i + 1], z = dirs[3 * i + 2];
+    const float len = std::sqrt(x * x + y * y + z * z);
+    rh.ray.org_x[j] = rh.ray.org_y[j] = rh.ray.org_z[j] = 0.f;
+    rh.ray.dir_x[j] = x / len, rh.ray.dir_y[j] = y / len, rh.ray.dir_z[j] = z / len;
+    rh.ray.tnear[j] = 0.f;
+    rh.ray.tfar[j] = std::numeric_limits<float>::infinity();
+    rh.ray.mask[j] = 0xFFFFFFFFu;
+    rh.ray.flags[j] = 0;
+    rh.ray.time[j] = 0.f;
+    rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+    valid[j] = j < k ? -1 : 0;
+  }
+  rtcIntersect4(valid, impl_->scene, &ctx, &rh);
+  float best = std::numeric_limits<float>::infinity();
+  for (int j = 0; j < k; ++j)
+    if (rh.hit.geomID[j] != RTC_INVALID_GEOMETRY_ID) best = std::min(best, rh.ray.tfar[j]);
+  return best;
+}
+
 void EmbreeRayCaster::scan_gaps(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, ScanSide side,
                                 float* gap_mm, bool packet8) const {
   const double s = static_cast<double>(static_cast<int>(side));
@@ -177,6 +205,7 @@ EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d
   require(false, "embree: this build has no Embree 3 (install libembree-dev and reconfigure); mesh " + mesh.source);
 }
 EmbreeRayCaster::~EmbreeRayCaster() = default;
+float EmbreeRayCaster::least_hit(const float*, int) const { return std::numeric_limits<float>::quiet_NaN(); }
 EmbreeRayCaster::EmbreeRayCaster(EmbreeRayCaster&&) noexcept = default;
 EmbreeRayCaster& EmbreeRayCaster::operator=(EmbreeRayCaster&&) noexcept = default;
 float EmbreeRayCaster::first_hit(float, float, float) const { return 0; }

@@ -83,31 +83,42 @@ void locate_cells(const double* __restrict x, const double* __restrict y, const 
 
 /// Pass 2: bilinear interpolation of the four nodes of each cell (gathers when vectorised).
 /// Non-finite results (a node without surface) are resolved by the caller.
-template <typename Scalar>
+template <typename Scalar, bool kMarked = false>
 inline void bilinear_body(const Scalar* __restrict values, const std::int32_t* __restrict base,
                           const std::int32_t* __restrict dc, const double* __restrict t, const double* __restrict s,
                           int n, int cols, double* __restrict out) {
   for (int j = 0; j < n; ++j) {
-    const double v0 = values[base[j]], v1 = values[base[j] + dc[j]], v2 = values[base[j] + cols],
-                 v3 = values[base[j] + cols + dc[j]];
+    const Scalar u0 = values[base[j]], u1 = values[base[j] + dc[j]], u2 = values[base[j] + cols],
+                 u3 = values[base[j] + cols + dc[j]];
+    const double v0 = u0, v1 = u1, v2 = u2, v3 = u3;
     const double w0 = (1 - t[j]) * (1 - s[j]), w1 = (1 - t[j]) * s[j], w2 = t[j] * (1 - s[j]), w3 = t[j] * s[j];
     out[j] = w0 * v0 + w1 * v1 + w2 * v2 + w3 * v3;
+    if constexpr (kMarked) {
+      // A marked node (depth discontinuity): -inf, for the caller to resolve exactly.
+      if (has_discontinuity_mark(u0) | has_discontinuity_mark(u1) | has_discontinuity_mark(u2) |
+          has_discontinuity_mark(u3))
+        out[j] = -std::numeric_limits<double>::infinity();
+    }
   }
 }
+template <bool kMarked>
 void bilinear_generic(const float* values, const std::int32_t* base, const std::int32_t* dc, const double* t,
                       const double* s, int n, int cols, double* out) {
-  bilinear_body(values, base, dc, t, s, n, cols, out);
+  bilinear_body<float, kMarked>(values, base, dc, t, s, n, cols, out);
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
 /// bilinear_body for float maps with AVX2 gathers (vgatherdps): 8 points at a time, the four
 /// node values gathered, the weights and the sum in double in two 4-lane halves, in the same
 /// operation order as the generic body (so the same values).
+template <bool kMarked>
 __attribute__((target("avx2,fma"))) void bilinear_avx2(const float* values, const std::int32_t* base,
                                                        const std::int32_t* dc, const double* t, const double* s, int n,
                                                        int cols, double* out) {
   const __m256i vcols = _mm256_set1_epi32(cols);
   const __m256d one = _mm256_set1_pd(1.0);
+  const __m256d minus_inf = _mm256_set1_pd(-std::numeric_limits<double>::infinity());
+  const __m256i lsb = _mm256_set1_epi32(1);
   int j = 0;
   for (; j + 8 <= n; j += 8) {
     const __m256i b = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(base + j));
@@ -115,6 +126,12 @@ __attribute__((target("avx2,fma"))) void bilinear_avx2(const float* values, cons
     const __m256i b2 = _mm256_add_epi32(b, vcols);
     const __m256 v0 = _mm256_i32gather_ps(values, b, 4), v1 = _mm256_i32gather_ps(values, _mm256_add_epi32(b, d), 4),
                  v2 = _mm256_i32gather_ps(values, b2, 4), v3 = _mm256_i32gather_ps(values, _mm256_add_epi32(b2, d), 4);
+    __m256i marked = _mm256_setzero_si256();
+    if constexpr (kMarked) {  // lanes with a marked node: all ones
+      const __m256i any = _mm256_or_si256(_mm256_or_si256(_mm256_castps_si256(v0), _mm256_castps_si256(v1)),
+                                          _mm256_or_si256(_mm256_castps_si256(v2), _mm256_castps_si256(v3)));
+      marked = _mm256_cmpeq_epi32(_mm256_and_si256(any, lsb), lsb);
+    }
     for (int h = 0; h < 2; ++h) {
       const __m256d a0 = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(v0, 1) : _mm256_castps256_ps128(v0));
       const __m256d a1 = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(v1, 1) : _mm256_castps256_ps128(v1));
@@ -127,24 +144,32 @@ __attribute__((target("avx2,fma"))) void bilinear_avx2(const float* values, cons
       const __m256d r = _mm256_add_pd(
           _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(w0, a0), _mm256_mul_pd(w1, a1)), _mm256_mul_pd(w2, a2)),
           _mm256_mul_pd(w3, a3));
-      _mm256_storeu_pd(out + j + 4 * h, r);
+      if constexpr (kMarked) {
+        const __m256d mh = _mm256_castsi256_pd(
+            _mm256_cvtepi32_epi64(h ? _mm256_extracti128_si256(marked, 1) : _mm256_castsi256_si128(marked)));
+        _mm256_storeu_pd(out + j + 4 * h, _mm256_blendv_pd(r, minus_inf, mh));
+      } else {
+        _mm256_storeu_pd(out + j + 4 * h, r);
+      }
     }
   }
-  if (j < n) bilinear_body(values, base + j, dc + j, t + j, s + j, n - j, cols, out + j);
+  if (j < n) bilinear_body<float, kMarked>(values, base + j, dc + j, t + j, s + j, n - j, cols, out + j);
 }
 #endif
 
+template <bool kMarked>
 void bilinear(const float* values, const std::int32_t* base, const std::int32_t* dc, const double* t, const double* s,
               int n, int cols, double* out) {
 #if defined(__GNUC__) && defined(__x86_64__)
   static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  if (avx2) return bilinear_avx2(values, base, dc, t, s, n, cols, out);
+  if (avx2) return bilinear_avx2<kMarked>(values, base, dc, t, s, n, cols, out);
 #endif
-  bilinear_generic(values, base, dc, t, s, n, cols, out);
+  bilinear_generic<kMarked>(values, base, dc, t, s, n, cols, out);
 }
+template <bool kMarked>
 void bilinear(const double* values, const std::int32_t* base, const std::int32_t* dc, const double* t, const double* s,
               int n, int cols, double* out) {
-  bilinear_body(values, base, dc, t, s, n, cols, out);
+  bilinear_body<double, kMarked>(values, base, dc, t, s, n, cols, out);
 }
 /// Non-finite interpolated values become NaN; returns true when one of them lies on a row or
 /// column of the grid (a zero weight: the caller's exact slow path decides). Branch-free.
@@ -153,23 +178,12 @@ bool mark_no_surface(double* __restrict out, const double* __restrict t, const d
   int edge = 0;
   for (int j = 0; j < n; ++j) {
     const int bad = !(std::abs(out[j]) <= std::numeric_limits<double>::max());  // inf or NaN
+    if (out[j] == -std::numeric_limits<double>::infinity()) continue;  // a marked look-up (never a sum)
     const int interior = (t[j] > 0) & (t[j] < 1) & (s[j] > 0) & (s[j] < 1);
     edge |= bad & (1 - interior);
     out[j] = bad ? std::numeric_limits<double>::quiet_NaN() : out[j];
   }
   return edge != 0;
-}
-/// Points whose four nodes include a marked one (depth discontinuity) get -inf. The loads hit the
-/// cache lines the interpolation has just read.
-template <typename Scalar>
-void apply_marks(const Scalar* __restrict values, const std::int32_t* __restrict base, const std::int32_t* __restrict dc,
-                 int n, int cols, double* __restrict out) {
-  for (int j = 0; j < n; ++j) {
-    const std::int32_t b = base[j], d = dc[j];
-    if (has_discontinuity_mark(values[b]) | has_discontinuity_mark(values[b + d]) |
-        has_discontinuity_mark(values[b + cols]) | has_discontinuity_mark(values[b + cols + d]))
-      out[j] = -std::numeric_limits<double>::infinity();
-  }
 }
 }  // namespace
 
@@ -182,12 +196,11 @@ void EquiangularGrid::lookup_soa(const Scalar* values, const double* x, const do
   for (std::int64_t b = 0; b < n; b += kChunk) {
     const int m = static_cast<int>(std::min<std::int64_t>(kChunk, n - b));
     locate_cells(x + b, y + b, z + b, m, inv_step_, rows_, cols_, base, dc, t, s);
-    bilinear(values, base, dc, t, s, m, cols_, out + b);
+    bilinear<kMarked>(values, base, dc, t, s, m, cols_, out + b);
     // A node without surface (+inf) makes the sum non-finite: the result is NaN, unless that
     // node's weight is exactly 0 (a direction exactly on a row or column), which goes to the
     // exact slow path. The first loop is branch-free; the second almost never does anything.
     const bool any_edge = mark_no_surface(out + b, t, s, m);
-    if constexpr (kMarked) apply_marks(values, base, dc, m, cols_, out + b);
     if (!any_edge) continue;
     for (int j = 0; j < m; ++j) {
       if (!std::isnan(out[b + j]) || (t[j] > 0 && t[j] < 1 && s[j] > 0 && s[j] < 1)) continue;

@@ -129,11 +129,10 @@ double FirstHitCaster::first_hit(const Eigen::Vector3d& direction) const {
     // and two rays 1e-6 rad beside it (2.5e-5 mm at 25 mm) closes such slits.
     const Eigen::Vector3d u = direction.normalized();
     const Eigen::Vector3d a = u.unitOrthogonal(), b = u.cross(a);
-    const auto cast = [&](const Eigen::Vector3d& d) {
-      return double(impl_->embree->first_hit(static_cast<float>(d.x()), static_cast<float>(d.y()),
-                                             static_cast<float>(d.z())));
-    };
-    h = std::min({cast(u), cast(u + 1e-6 * a), cast(u + 1e-6 * (b * 0.866 - a * 0.5))});
+    const Eigen::Vector3d d1 = u + 1e-6 * a, d2 = u + 1e-6 * (b * 0.866 - a * 0.5);
+    const float dirs[9] = {float(u.x()),  float(u.y()),  float(u.z()),  float(d1.x()), float(d1.y()),
+                           float(d1.z()), float(d2.x()), float(d2.y()), float(d2.z())};
+    h = impl_->embree->least_hit(dirs, 3);
   } else {
     const std::optional<double> c = impl_->cgal->first_hit(impl_->origin, direction.normalized());
     h = c ? *c : std::numeric_limits<double>::infinity();

@@ -27,8 +27,10 @@ namespace impinge {
 /// threshold on the node distances themselves: steep but smooth surfaces (large first, small
 /// second differences) are not marked.
 ///
-/// Cost: four interpolations per node (OpenMP over nodes). Throws impinge::Error unless
-/// tolerance_mm > 0 and finite.
+/// The neighbours: for an equiangular grid its own (rows r +- 1, columns c +- 1: the nodes its
+/// stencils join; one pass over the map); for any other scheme the map interpolated at u cos h +-
+/// e sin h along the polar and azimuthal tangents e (four interpolations per node). OpenMP over
+/// nodes. Throws impinge::Error unless tolerance_mm > 0 and finite.
 template <typename Scalar>
 std::int64_t mark_depth_discontinuities(RadialDistanceMapT<Scalar>& map, double tolerance_mm);
 
