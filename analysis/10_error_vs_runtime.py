@@ -59,7 +59,7 @@ for xcol, stem, xlabel in [("query_ns_per_vertex", "pareto_time", "query time (n
     for (scheme, mode), g in g0.groupby(["scheme", "mode"]):
         g = g.sort_values("precision_deg")
         ax.loglog(g[xcol], g.p95_abs_mm.clip(lower=1e-7), marker=markers.get(scheme, "o"),
-                  ls="-" if mode == "exact" else "--", markersize=4, label=f"{scheme} {mode}")
+                  ls={"exact": "-", "exact_refined": ":"}.get(mode, "--"), markersize=4, label=f"{scheme} {mode}")
     if xcol == "query_ns_per_vertex":
         for pname, mk in (("embree_radial", "P"), ("cgal_radial", "X")):
             g = t[(t.subject == subj) & (t.pose == "rest") & (t.scheme == pname)]
@@ -113,5 +113,32 @@ macros["ErrLargeTotal"] = f"{int(tot.large_errors.sum()):,}"
 macros["ErrJumpTotal"] = f"{int(tot.at_discontinuity.sum()):,}"
 macros["ErrPoleTotal"] = f"{int(tot.near_pole.sum()):,}"
 macros["ErrSeamTotal"] = f"{int(tot.near_seam.sum()):,}"
+# Exact look-ups at depth discontinuities (issue 15): maps alone against maps + ray casts, 0.1 deg.
+fine = maps[np.isclose(maps.precision_deg, 0.1)]  # every scheme at its 0.1 deg equivalent
+ex = fine[fine["mode"] == "exact"]
+rf = fine[fine["mode"] == "exact_refined"]
+if len(rf):
+    rows = []
+    for (s_, scheme), g in fine.groupby(["subject", "scheme"], sort=False):
+        a, b = g[g["mode"] == "exact"], g[g["mode"] == "exact_refined"]
+        if not len(a) or not len(b):
+            continue
+        rows.append([s_, scheme, e(a.max_abs_mm.max()), e(b.max_abs_mm.max()), f"{int(a.mismatched.sum())}",
+                     f"{int(b.mismatched.sum())}", f"{a.query_ns_per_vertex.median():.1f}",
+                     f"{b.query_ns_per_vertex.median():.1f}",
+                     f"{b.query_ns_per_vertex.median() / a.query_ns_per_vertex.median():.2f}"])
+    write_table(d, "table_refined", ["subject", "scheme", "max, maps", "max, refined", "mism., maps",
+                                     "mism., refined", "ns, maps", "ns, refined", "ratio"], rows,
+                align="llrrrrrrr")
+    eq_a, eq_b = ex[ex.scheme == "equiangular"], rf[rf.scheme == "equiangular"]
+    ratio = (eq_b.groupby("subject").query_ns_per_vertex.median() /
+             eq_a.groupby("subject").query_ns_per_vertex.median()).dropna()
+    real = ~fine.subject.str.startswith("generated")
+    macros.update({
+        "RefMapsMaxMax": e(ex[real[ex.index]].max_abs_mm.max()),
+        "RefMaxMax": e(rf.max_abs_mm.max()),
+        "RefRatioMin": f"{ratio.min():.2f}", "RefRatioMax": f"{ratio.max():.2f}",
+        "RefMismatchedMaps": f"{int(ex.mismatched.sum())}", "RefMismatchedRefined": f"{int(rf.mismatched.sum())}",
+    })
 write_macros(d, "macros", macros)
 print(f"10_error_vs_runtime: wrote tables and figures to {d}")

@@ -55,6 +55,8 @@ struct InputOptions {
 struct MapOptions {
   std::string scheme = "equiangular", sampling = "auto", mode = "exact", levels;
   double resolution = 0, precision = 0, turns = 0, occlusion_tolerance = 1.0, max_radius = 0;
+  double discontinuity_tolerance = 0.05;  // mm
+  bool maps_only = false;                 // no exact look-ups at depth discontinuities
 };
 struct FrameOptions {
   std::string neutral;  // empty: subject.json's "neutral", else anatomical
@@ -100,6 +102,12 @@ void add_map_options(CLI::App* app, MapOptions& o) {
       ->capture_default_str();
   app->add_option("--max-radius", o.max_radius, "mm: test only vertices within this distance of the COR (0 = all)")
       ->capture_default_str();
+  app->add_option("--discontinuity-tolerance", o.discontinuity_tolerance,
+                  "mm: look-ups whose stencil may be off by more than this (depth discontinuities: rims, coverage "
+                  "edges) are resolved by an exact ray cast")
+      ->capture_default_str();
+  app->add_flag("--maps-only", o.maps_only,
+                "No exact look-ups at depth discontinuities: the maps answer alone (the thesis' algorithm)");
 }
 
 void add_frame_options(CLI::App* app, FrameOptions& o) {
@@ -179,6 +187,8 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
   jo.mode = parse_distance_mode(mo.mode);
   jo.sampling = parse_sampling_method(mo.sampling);
   jo.occlusion_tolerance_mm = mo.occlusion_tolerance;
+  jo.exact_at_discontinuities = !mo.maps_only;
+  jo.discontinuity_tolerance_mm = mo.discontinuity_tolerance;
   jo.max_radius_mm = mo.max_radius > 0 ? mo.max_radius : std::numeric_limits<double>::infinity();
   if (!mo.levels.empty()) jo.levels = parse_levels(mo.levels);
 
@@ -264,6 +274,7 @@ nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double det
   j["vertices_tested"] = s.vertices_tested;
   j["vertices_no_surface"] = s.vertices_no_surface;
   j["vertices_beyond_reach"] = s.vertices_beyond_reach;
+  j["vertices_refined"] = s.vertices_refined;
   j["min_gap_mm"] = num_or_null(s.min_gap_mm);
   j["vertices_penetrating"] = s.vertices_penetrating;
   j["area_penetrating_mm2"] = s.area_penetrating_mm2;
@@ -326,6 +337,9 @@ nlohmann::json setup_json(const Setup& s) {
   j["mode"] = to_string(opt.mode);
   j["levels_thresholds_mm"] = opt.levels.thresholds_mm;
   j["occlusion_tolerance_mm"] = opt.occlusion_tolerance_mm;
+  j["exact_at_discontinuities"] = opt.exact_at_discontinuities && s.joint().ball().exact != nullptr;
+  j["discontinuity_tolerance_mm"] = opt.discontinuity_tolerance_mm;
+  j["nodes_marked"] = {{"ball", s.joint().ball().nodes_marked}, {"socket", s.joint().socket().nodes_marked}};
   j["neutral"] = s.options.neutral == Neutral::anatomical ? "anatomical" : "scan";
   j["warnings"] = s.hip->warnings();
   j["scan_pose_min_gap_mm"] = num_or_null(s.scan_pose_min_gap_mm);

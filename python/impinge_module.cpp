@@ -128,6 +128,7 @@ py::dict summary_dict(const ScanSummary& s) {
   d["vertices_tested"] = s.vertices_tested;
   d["vertices_no_surface"] = s.vertices_no_surface;
   d["vertices_beyond_reach"] = s.vertices_beyond_reach;
+  d["vertices_refined"] = s.vertices_refined;
   d["min_gap_mm"] = s.min_gap_mm;
   d["vertices_penetrating"] = s.vertices_penetrating;
   d["area_penetrating_mm2"] = s.area_penetrating_mm2;
