@@ -1,0 +1,179 @@
+// 11_extreme_cases (issue 15): stiff and extreme cases, each against its exact reference.
+// Case 1, depth discontinuities: every first-surface vertex of every subject, at rest and at ten
+// poses to 110 deg flexion, every scheme at its 0.1 deg equivalent, exact mode, the maps alone and
+// with exact look-ups at depth discontinuities: the largest |gap error| against CGAL, the first-
+// surface vertices skipped or added against the exact mask, and the query time of both, timed
+// interleaved (alternating runs, medians).
+// Writes discontinuities.csv and meta.json.
+#include <algorithm>
+#include <chrono>
+#include <iostream>
+
+#include "experiment_support.hpp"
+#include "impinge/exact_reference.hpp"
+#include "impinge/femur_frame.hpp"
+#include "impinge/first_hit_caster.hpp"
+#include "impinge/helix_scheme.hpp"
+#include "impinge/hip_joint.hpp"
+
+using namespace impinge;
+using namespace impinge::experiment;
+
+namespace {
+constexpr double kOcclusionMm = 1.0;  // JointOptions' default
+
+// The mesh without triangles edge-on to o: CGAL's ray-triangle intersection gives meaningless
+// distances for a ray inside their plane, and every ray meets their points on their neighbours.
+TriangleMesh without_edge_on(const TriangleMesh& m, const Eigen::Vector3d& o) {
+  TriangleMesh r = m;
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    const Eigen::Vector3d a = m.V.row(m.F(f, 0)).transpose() - o, b = m.V.row(m.F(f, 1)).transpose() - o,
+                          c = m.V.row(m.F(f, 2)).transpose() - o;
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() > 0 && std::abs(n.normalized().dot(a)) > 1e-6 * a.norm()) keep.push_back(f);
+  }
+  r.F.resize(Eigen::Index(keep.size()), 3);
+  for (std::size_t k = 0; k < keep.size(); ++k) r.F.row(Eigen::Index(k)) = m.F.row(keep[k]);
+  return r;
+}
+
+// Oracle first hit along u from o: the least of five CGAL rays within 1e-6 rad (a vertex exactly
+// behind another one, as on generated meshes whose shells share an angular grid, is hidden).
+double oracle_hit(const ExactReference& ref, const Eigen::Vector3d& o, const Eigen::Vector3d& dir) {
+  const Eigen::Vector3d u = dir.normalized(), e1 = u.unitOrthogonal(), e2 = u.cross(e1);
+  double h = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& d : {u, Eigen::Vector3d(u + 1e-6 * e1), Eigen::Vector3d(u - 1e-6 * e1),
+                                   Eigen::Vector3d(u + 1e-6 * e2), Eigen::Vector3d(u - 1e-6 * e2)}) {
+    const auto hit = ref.first_hit(o, d.normalized());
+    if (hit) h = std::min(h, *hit);
+  }
+  return h;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? std::nan("") : v[v.size() / 2];
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv, "11_extreme_cases: stiff and extreme cases against exact references");
+  const std::string dir = experiment_dir(args, "11_extreme_cases");
+  if (!have_exact_reference() || !FirstHitCaster::available()) {
+    std::cerr << "11_extreme_cases: skipped: this build has no CGAL or no ray caster\n";
+    write_meta(dir, args, {{"skipped", "no CGAL or ray caster in this build"}});
+    return 0;
+  }
+  const std::vector<Subject> subjects = load_subjects(args, {3000});
+  const double p = 0.1;
+  std::vector<std::pair<std::string, double>> schemes{{"equiangular", p}, {"helix", matched_helix_turns(p)}};
+  if (!args.quick) schemes.insert(schemes.end(), {{"helix-eq10", matched_helix_turns(p)}, {"conchoid", p}});
+  std::vector<double> flexions{0};
+  for (int k = 1; k <= 10; ++k) flexions.push_back(11.0 * k);
+  if (args.quick) flexions = {0, 55, 110};
+  const int reps = args.quick ? 5 : 2 * args.repetitions + 1;
+
+  CsvWriter csv(dir + "/discontinuities.csv",
+                {"subject", "generated", "scheme", "resolution", "precision_deg", "method", "poses", "compared",
+                 "max_abs_mm", "p99_abs_mm", "over_tolerance", "mask_skipped", "mask_added", "surface_mismatched",
+                 "refined_per_pose", "nodes_marked", "marking_ms", "query_ns_per_vertex"});
+  int done = 0;
+  const int total = static_cast<int>(subjects.size() * schemes.size());
+  for (const Subject& s : subjects) {
+    SphereFitResult head = s.generated ? SphereFitResult{} : locate_femoral_head(s.femur);
+    if (s.generated) head.centre = s.true_cor, head.radius = std::nan("");
+    for (const auto& [name, res] : schemes) {
+      progress("11_extreme_cases", ++done, total, s.name + " " + name);
+      std::optional<HipJoint> hips[2];  // 0: maps alone, 1: exact look-ups at discontinuities
+      for (int m = 0; m < 2; ++m) {
+        HipJointOptions ho;
+        ho.joint.scheme = make_scheme(name, res);
+        ho.joint.exact_at_discontinuities = m == 1;
+        ho.neutral = s.generated ? Neutral::scan : Neutral::anatomical;
+        hips[m].emplace(s.femur, s.pelvis, s.side, head, Landmarks{}, ho);
+      }
+      const Joint& j0 = hips[0]->joint();
+      const ExactReference ef(without_edge_on(j0.ball().mesh, j0.cor())),
+          ep(without_edge_on(j0.socket().mesh, j0.cor()));
+      // The exact first-surface masks (same 1 mm tolerance as the joints').
+      std::vector<std::uint8_t> exact_mask[2];
+      for (int b = 0; b < 2; ++b) {
+        const JointBody& body = b == 0 ? j0.ball() : j0.socket();
+        const ExactReference& own = b == 0 ? ef : ep;
+        exact_mask[b].assign(std::size_t(body.relative.rows()), 0);
+        for (Eigen::Index i = 0; i < body.relative.rows(); ++i) {
+          const Eigen::Vector3d q = body.relative.row(i).transpose();
+          const double r = q.norm();
+          if (r > 0) exact_mask[b][std::size_t(i)] = oracle_hit(own, j0.cor(), q) >= r - kOcclusionMm;
+        }
+      }
+      // Interleaved timing of both joints over the poses.
+      std::vector<double> ns[2];
+      PoseResult scratch;
+      for (int rep = 0; rep < reps; ++rep)
+        for (int m = 0; m < 2; ++m) {
+          const auto t0 = std::chrono::steady_clock::now();
+          for (double f : flexions) hips[m]->detect(PoseAngles{f, 0, 0}, scratch);
+          const double dt = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
+          const Joint& jm = hips[m]->joint();
+          ns[m].push_back(dt / double(flexions.size()) / double(jm.ball().scan_set.size() + jm.socket().scan_set.size()));
+        }
+      for (int m = 0; m < 2; ++m) {
+        const HipJoint& hip = *hips[m];
+        const Joint& jm = hip.joint();
+        std::int64_t skipped = 0, added = 0, compared = 0, over = 0, mismatched = 0, refined = 0;
+        for (int b = 0; b < 2; ++b) {
+          const std::vector<std::uint8_t>& mk = (b == 0 ? jm.ball() : jm.socket()).mask;
+          for (std::size_t i = 0; i < mk.size(); ++i)
+            skipped += exact_mask[b][i] && !mk[i], added += !exact_mask[b][i] && mk[i];
+        }
+        std::vector<double> errors;
+        for (double f : flexions) {
+          const PoseAngles a{f, 0, 0};
+          PoseResult r;
+          hip.detect(a, r);
+          refined += r.ball.vertices_refined + r.socket.vertices_refined;
+          const Eigen::Matrix3d R = hip.femur_rotation(a);
+          for (int b = 0; b < 2; ++b) {
+            const JointBody& body = b == 0 ? jm.ball() : jm.socket();
+            const ScanGaps& g = b == 0 ? r.ball_gaps : r.socket_gaps;
+            for (Eigen::Index i = 0; i < body.relative.rows(); ++i) {
+              if (!exact_mask[b][std::size_t(i)] || g.status[std::size_t(i)] == ScanGaps::beyond_reach) continue;
+              const Eigen::Vector3d v = body.relative.row(i).transpose();
+              const Eigen::Vector3d q = b == 0 ? Eigen::Vector3d(R * v) : Eigen::Vector3d(R.transpose() * v);
+              const double h = oracle_hit(b == 0 ? ep : ef, jm.cor(), q);
+              const double gap = g.gap_mm[std::size_t(i)];
+              if (std::isinf(h) || std::isnan(gap)) {
+                mismatched += std::isinf(h) != std::isnan(gap);
+                continue;
+              }
+              const double err = std::abs(gap - (b == 0 ? h - q.norm() : q.norm() - h));
+              errors.push_back(err);
+              over += err > 0.05;
+            }
+          }
+        }
+        compared = std::int64_t(errors.size());
+        std::sort(errors.begin(), errors.end());
+        const double mx = errors.empty() ? std::nan("") : errors.back();
+        const double p99 = errors.empty() ? std::nan("") : errors[std::size_t(0.99 * double(errors.size() - 1))];
+        csv.row(s.name, int(s.generated), name, res, p, m == 0 ? "maps" : "refined", flexions.size(), compared, mx, p99,
+                over, skipped, added, mismatched, double(refined) / double(flexions.size()),
+                jm.ball().nodes_marked + jm.socket().nodes_marked, jm.ball().marking_ms + jm.socket().marking_ms,
+                median(ns[m]));
+      }
+    }
+  }
+  write_meta(dir, args,
+             {{"case", "depth discontinuities"},
+              {"precision_deg", p},
+              {"flexions_deg", flexions},
+              {"discontinuity_tolerance_mm", JointOptions{}.discontinuity_tolerance_mm},
+              {"occlusion_tolerance_mm", kOcclusionMm},
+              {"timing", "both joints alternately, median over " + std::to_string(reps) + " runs of all poses"},
+              {"oracle",
+               "CGAL AABB_tree::first_intersection (Simple_cartesian<double>), triangles edge-on to the COR left "
+               "out, least of five rays within 1e-6 rad"}});
+  return 0;
+}
