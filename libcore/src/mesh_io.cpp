@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "impinge/error.hpp"
+#include "mesh_readers.hpp"
 
 namespace impinge {
 
@@ -24,16 +25,36 @@ std::string lower_extension(const std::string& path) {
 }
 }  // namespace
 
+namespace {
+// load_mesh's checks on a mesh read by any reader: valid, degenerate faces removed, some left.
+TriangleMesh checked(TriangleMesh mesh, const std::string& path) {
+  mesh.source = path;
+  require(mesh.V.rows() > 0, path + ": mesh has no vertices");
+  require(mesh.F.rows() > 0, path + ": mesh has no triangles");
+  validate_mesh(mesh);
+  remove_degenerate_faces(mesh);
+  require(mesh.F.rows() > 0, path + ": every triangle is degenerate (zero area)");
+  return mesh;
+}
+}  // namespace
+
 TriangleMesh load_mesh(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   require(fs::exists(path, ec), path + ": file does not exist");
   require(fs::is_regular_file(path, ec), path + ": not a regular file");
+  const std::string ext = lower_extension(path);
+  if (ext == ".ply" || ext == ".off") {
+    std::ifstream in(path, std::ios::binary);
+    require(in.good(), path + ": cannot open file for reading");
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return checked(ext == ".ply" ? detail::read_ply(path, bytes.str()) : detail::read_off(path, bytes.str()), path);
+  }
   {
     std::ifstream probe(path, std::ios::binary);
     require(probe.good(), path + ": cannot open file for reading");
   }
-  const std::string ext = lower_extension(path);
   unsigned flags = 0;
   Assimp::Importer importer;
   if (ext == ".stl" || ext == ".obj") {
@@ -56,7 +77,6 @@ TriangleMesh load_mesh(const std::string& path) {
   require(nf > 0, path + ": mesh has no triangles");
 
   TriangleMesh mesh;
-  mesh.source = path;
   mesh.V.resize(static_cast<Eigen::Index>(nv), 3);
   mesh.F.resize(static_cast<Eigen::Index>(nf), 3);
   Eigen::Index vo = 0, fo = 0;
@@ -88,10 +108,7 @@ TriangleMesh load_mesh(const std::string& path) {
     vo += am->mNumVertices;
     fo += am->mNumFaces;
   }
-  validate_mesh(mesh);
-  remove_degenerate_faces(mesh);
-  require(mesh.F.rows() > 0, path + ": every triangle is degenerate (zero area)");
-  return mesh;
+  return checked(std::move(mesh), path);
 }
 
 namespace {

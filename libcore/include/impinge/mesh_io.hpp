@@ -9,8 +9,10 @@
 
 namespace impinge {
 
-/// Load a triangle mesh from `path` (PLY, STL, OBJ or OFF; format by content/extension, read
-/// by assimp). Coordinates are taken as millimetres in the file's own frame.
+/// Load a triangle mesh from `path`. Coordinates are taken as millimetres in the file's own frame.
+/// Format by extension: `.ply` (ascii or binary) and `.off` by impinge's own strict readers (Debian
+/// 12's assimp 5.2.4 hangs or writes out of bounds on some malformed files of these two formats,
+/// found by fuzzing), every other extension (STL, OBJ, ...) by assimp.
 ///
 /// Vertex order: PLY and OFF keep the file's vertices in order and count. STL and OBJ store
 /// corners per face; their identical corners are welded (assimp JoinIdenticalVertices), so
@@ -18,8 +20,8 @@ namespace impinge {
 /// Degenerate triangles (repeated index or zero area) are removed and counted in
 /// `degenerate_faces_skipped`. Several meshes in one file are concatenated.
 ///
-/// Throws impinge::Error naming `path` and the element for: a missing or unreadable file, a
-/// file assimp cannot parse, no vertices or no triangles, a non-triangle face ("face 7 has 4
+/// Throws impinge::Error naming `path` and the element (line, byte offset, vertex or face) for: a
+/// missing or unreadable file, a malformed or truncated file (header, count, type, value), no vertices or no triangles, a non-triangle face ("face 7 has 4
 /// vertices"), an out-of-range index, a non-finite coordinate, or no triangle left after
 /// removing the degenerate ones.
 TriangleMesh load_mesh(const std::string& path);
