@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "impinge/kernels.hpp"
 #include "impinge/error.hpp"
 #include "impinge/mesh_io.hpp"
 #include "impinge/subject.hpp"
@@ -129,6 +130,7 @@ void write_meta(const std::string& dir, const Args& args, nlohmann::json params)
   m["git_commit"] = commit.empty() ? "unknown" : commit + (dirty.empty() ? "" : "-dirty");
   m["compiler"] = IMPINGE_COMPILER;
   m["cpu_model"] = command_output("grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'");
+  m["kernels"] = kernel_description();  // which dispatched kernels ran (IMPINGE_KERNELS)
   m["cores"] = command_output("nproc");
   const std::time_t now = std::time(nullptr);
   char buf[64];

@@ -11,6 +11,7 @@
 
 #include "impinge/error.hpp"
 #include "impinge/spherical_frame.hpp"
+#include "cpu_dispatch.hpp"
 #include "simd_clones.hpp"
 
 namespace impinge {
@@ -161,8 +162,7 @@ template <bool kMarked>
 void bilinear(const float* values, const std::int32_t* base, const std::int32_t* dc, const double* t, const double* s,
               int n, int cols, double* out) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  if (avx2) return bilinear_avx2<kMarked>(values, base, dc, t, s, n, cols, out);
+  if (detail::use_avx2_fma()) return bilinear_avx2<kMarked>(values, base, dc, t, s, n, cols, out);
 #endif
   bilinear_generic<kMarked>(values, base, dc, t, s, n, cols, out);
 }

@@ -12,6 +12,7 @@
 #include "impinge/error.hpp"
 #include "impinge/fast_angles.hpp"
 #include "impinge/spherical_frame.hpp"
+#include "cpu_dispatch.hpp"
 #include "simd_clones.hpp"
 
 namespace impinge {
@@ -214,15 +215,6 @@ std::int64_t row_spans_scalar(const SpanSetup& P, int r0, int r1, const double* 
   return nodes;
 }
 
-#if defined(__GNUC__) && defined(__x86_64__)
-/// Whether this CPU runs the AVX-512 (F, VL, DQ) kernels; asked once.
-bool cpu_has_avx512() {
-  static const bool yes =
-      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
-  return yes;
-}
-#endif
-
 /// The first min(n, 8) of 8 lanes (n >= 1): the mask of a vector step with n items left.
 inline std::uint8_t first_lanes(int n) { return n >= 8 ? std::uint8_t(0xff) : std::uint8_t((1u << n) - 1); }
 
@@ -311,7 +303,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t row_spans_avx5
 std::int64_t row_spans(const SpanSetup& P, int r0, int r1, const double* cot_phi, const double* rsqrt_sin_phi, int* lo,
                        int* hi, std::uint8_t* sure) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  if (cpu_has_avx512()) return row_spans_avx512(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi, sure);
+  if (detail::use_avx512()) return row_spans_avx512(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi, sure);
 #endif
   return row_spans_scalar(P, r0, r1, cot_phi, rsqrt_sin_phi, lo, hi, sure);
 }
@@ -588,7 +580,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
 
 std::int64_t exact_rows(float* map, int cols, const SpanRows& S, const GridTables& T) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  if (cpu_has_avx512()) return exact_rows_avx512(map, cols, S, T);
+  if (detail::use_avx512()) return exact_rows_avx512(map, cols, S, T);
 #endif
   return exact_rows_generic(map, cols, S, T);
 }
