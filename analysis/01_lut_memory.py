@@ -67,4 +67,7 @@ fine = match.iloc[-1]
 write_macros(d, "macros", {
     "LMeqOne": f"{int(eq1.nodes):,}", "LMhxOne": f"{int(hx1.nodes):,}",
     "LMratioFine": f"{fine.node_ratio:.4f}", "LMkFine": f"{int(fine.turns):,}",
+    "LMratioMin": f"{match.node_ratio.min():.2f}", "LMratioMax": f"{match.node_ratio.max():.2f}",
+    "LMhxEquatorFiner": f"{match.iloc[-2].helix_equator_nodes:,.1f}",
+    "LMhxEquatorFinest": f"{fine.helix_equator_nodes:,.1f}",
 })

@@ -5,7 +5,7 @@ thesis' level), table_real.tex (real bones, every method), sampling_time.pdf/png
 import numpy as np
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, read_csv, save, write_macros, write_table
+from common import experiment_dir, read_csv, save, session_figures, write_macros, write_table
 
 d = experiment_dir("02_sampling_time")
 t = read_csv(d, "sampling_time.csv")
@@ -104,5 +104,78 @@ g3 = gen[gen.precision_deg == gen.precision_deg.min()]
 macros["SampGenFinest"] = f"{gen.precision_deg.min():g}"
 macros["SampGenRsidMs"] = fmt(cell(g3, "rsid_linear", "pelvis"))
 macros["SampGenUsidMs"] = fmt(cell(g3, "usid_accelerated", "pelvis"))
+
+# Against the thesis on the generated 3k model (pelvis = socket model), every precision the thesis timed.
+def ratios(num, den):
+    out = []
+    for p in sorted(gen.precision_deg.unique()):
+        g = gen[(gen.precision_deg == p) & (gen.body == "pelvis")]
+        a = g[g.method == num[0]][num[1]]
+        b = g[g.method == den[0]][den[1]]
+        if len(a) and len(b) and np.isfinite(a.iloc[0]) and np.isfinite(b.iloc[0]) and b.iloc[0] > 0:
+            out.append(a.iloc[0] / b.iloc[0])
+    return out
+
+
+def span(values, fmt_):
+    return (fmt_(min(values)), fmt_(max(values))) if values else ("n/a", "n/a")
+
+
+pair_thesis = ratios(("pairwise", "thesis_ms"), ("pairwise", "time_ms"))
+pair_over_rsid = ratios(("pairwise", "time_ms"), ("rsid_exact_culled", "time_ms"))
+usid_thesis = ratios(("usid_accelerated", "thesis_ms"), ("usid_accelerated", "time_ms"))
+macros["SampPairThesisMin"], macros["SampPairThesisMax"] = span(pair_thesis, lambda v: f"{v:.0f}")
+macros["SampPairOrdersMin"], macros["SampPairOrdersMax"] = span([np.log10(v) for v in pair_over_rsid],
+                                                                lambda v: f"{v:.1f}")
+macros["SampUsidThesisMin"], macros["SampUsidThesisMax"] = span(usid_thesis, lambda v: f"{v:.0f}")
+macros["SampRsidThesisFinestMs"] = fmt(g3[(g3.method == "rsid_linear") & (g3.body == "pelvis")].thesis_ms.iloc[0]) \
+    if len(g3[(g3.method == "rsid_linear") & (g3.body == "pelvis")]) else "n/a"
+
+# The thesis' times are whole numbers of Windows clock ticks (15.625 ms): each less than 1 ms (its
+# truncation or rounding to whole ms: 15 and 16 both stand for one tick) from a multiple of the tick.
+TICK = 15.625
+th = t[np.isfinite(t.thesis_ms) & (t.subject == "generated-3k")].drop_duplicates(["precision_deg", "method"])
+ticks = th.thesis_ms / TICK
+on_tick = (np.abs(th.thesis_ms - np.round(ticks) * TICK) < 1.0)
+macros["SampThesisTimes"] = f"{len(th)}"
+macros["SampThesisOnTick"] = f"{int(on_tick.sum())}"
+small = sorted(th.thesis_ms[th.thesis_ms < 250].unique())
+macros["SampThesisSmallTimes"] = ", ".join(f"{v:g}" for v in small)
+macros["SampThesisSmallTicks"] = ", ".join(f"{round(v / TICK):d}" for v in small)
+
+# Real bones at the finest precision: other pelvises, femurs, map size, fills across the run.
+fin_rows = maps[(~maps.generated.astype(bool)) & (maps.precision_deg == fin)]
+def per_body(body, subjects):
+    out = []
+    for s_ in subjects:
+        g_ = fin_rows[(fin_rows.subject == s_) & (fin_rows.body == body)]
+        c_, f_ = cell(g_, "rsid_exact_culled", body), cell(g_, "fill", body)
+        if np.isfinite(c_) and np.isfinite(f_):
+            out.append((c_, c_ / f_))
+    return out
+others = per_body("pelvis", [x for x in fin_rows.subject.unique() if x != subj])
+femurs = per_body("femur", list(fin_rows.subject.unique()))
+macros["SampOtherPelvisOverFillMin"], macros["SampOtherPelvisOverFillMax"] = span([r for _, r in others], lambda v: f"{v:.1f}")
+macros["SampFemurMsMin"], macros["SampFemurMsMax"] = span([c for c, _ in femurs], lambda v: f"{v:.0f}")
+macros["SampFemurOverFillMin"], macros["SampFemurOverFillMax"] = span([r for _, r in femurs], lambda v: f"{v:.1f}")
+fills = fin_rows[fin_rows.method == "fill"].time_ms
+macros["SampFillMinMs"], macros["SampFillMaxMs"] = span(list(fills), lambda v: f"{v:.1f}")
+prow = g[g.method == "rsid_exact_culled"]
+if len(prow):
+    macros["SampNodesM"] = f"{prow.nodes.iloc[0] / 1e6:.1f}"
+    macros["SampPelvisCoveredM"] = f"{prow.nodes_covered.iloc[0] / 1e6:.0f}"
+    macros["SampMapMB"] = f"{prow.nodes.iloc[0] * 4 / 1e6:.0f}"
+
+# Benchmark-session figures (benchmarks/sessions.csv), quoted in the section's account of the work.
+sess = session_figures("02_sampling_time")
+for key, name in (("start_culled_ms", "SessStartMs"), ("start_over_fill", "SessStartOverFill"),
+                  ("start_embree_over", "SessStartEmbree"), ("spans_culled_ms", "SessSpansMs"),
+                  ("spans_over_fill", "SessSpansOverFill"), ("spans_embree_over", "SessSpansEmbree"),
+                  ("sure_before_low_ms", "SessSureBeforeLow"), ("sure_before_high_ms", "SessSureBeforeHigh"),
+                  ("sure_after_low_ms", "SessSureAfterLow"), ("sure_after_high_ms", "SessSureAfterHigh"),
+                  ("session_fill_low_ms", "SessFillLow"), ("session_fill_high_ms", "SessFillHigh"),
+                  ("probe_saved_low_ms", "SessProbeLow"), ("probe_saved_high_ms", "SessProbeHigh"),
+                  ("cone_prefetch_saved_ms", "SessPrefetchMs")):
+    macros[name] = sess.get(key, "n/a")
 write_macros(d, "macros", macros)
 print(f"02_sampling_time: wrote tables and figure to {d}")

@@ -108,5 +108,40 @@ if len(real):
                    "DetCgalOverRsid": f"{cg / rs:.0f}", "DetUsidMs": fmt(get(g, "usid", k_table)),
                    "DetFclDistance": f"{get(g0, 'fcl_distance', col='result'):.3f}",
                    "DetRsidMinGapRest": f"{get(g0, 'rsid', 0.1, 'result'):.3f}"})
+# Against the thesis (generated levels, pushed pose): RSID at the table's precision, USID over RSID.
+gen_p = t[t.generated.astype(bool) & (t.pose == "pushed_3mm")]
+rsid_vs_thesis, usid_over_rsid = [], []
+for s_, g in gen_p.groupby("subject", sort=False):
+    ours, theirs = get(g, "rsid", p_table), get(g, "rsid", col="thesis_ms")
+    if np.isfinite(ours) and np.isfinite(theirs) and ours > 0:
+        rsid_vs_thesis.append(theirs / ours)
+pushed = t[t.pose == "pushed_3mm"]
+for s_, g in pushed.groupby("subject", sort=False):
+    u, r_ = get(g, "usid", k_table), get(g, "rsid", p_table)
+    if np.isfinite(u) and np.isfinite(r_) and r_ > 0:
+        usid_over_rsid.append(u / r_)
+g12 = gen_p[gen_p.subject == "generated-12k"]
+th_ratio = get(g12, "usid", col="thesis_ms") / get(g12, "rsid", col="thesis_ms") if len(g12) else np.nan
+macros["DetRsidThesisMin"] = f"{min(rsid_vs_thesis):.0f}" if rsid_vs_thesis else "n/a"
+macros["DetRsidThesisMax"] = f"{max(rsid_vs_thesis):.0f}" if rsid_vs_thesis else "n/a"
+macros["DetUsidOverRsidMin"] = f"{min(usid_over_rsid):.1f}" if usid_over_rsid else "n/a"
+macros["DetUsidOverRsidMax"] = f"{max(usid_over_rsid):.1f}" if usid_over_rsid else "n/a"
+macros["DetThesisUsidOverRsid"] = f"{th_ratio:.1f}" if np.isfinite(th_ratio) else "n/a"
+# Random poses against one repeated pose (cold against warm cache lines), and two threads.
+for res, name in ((0.1, "Fine"), (0.5, "Coarse")):
+    cold, warm = [], []
+    for s_, g in thr[(thr.method == "rsid") & np.isclose(thr.resolution, res) & (thr.threads == 1)].groupby("subject"):
+        w = get(t[(t.subject == s_) & (t.pose == "pushed_3mm")], "rsid", res)
+        if np.isfinite(w) and w > 0:
+            cold.append(1000.0 / g.poses_per_s.iloc[0] / w)
+    macros[f"DetColdOverWarm{name}Min"] = f"{min(cold):.1f}" if cold else "n/a"
+    macros[f"DetColdOverWarm{name}Max"] = f"{max(cold):.1f}" if cold else "n/a"
+    nodes = (180 / res + 1) * (360 / res)
+    macros[f"DetMapMB{name}"] = f"{nodes * 4 / 1e6:.0f}"
+ups = []
+for (s_, m, r_), g in thr.groupby(["subject", "method", "resolution"], sort=False):
+    ups.append(g[g.threads == 2].poses_per_s.iloc[0] / g[g.threads == 1].poses_per_s.iloc[0])
+macros["DetTwoThreadsMin"] = f"{min(ups):.1f}" if ups else "n/a"
+macros["DetTwoThreadsMax"] = f"{max(ups):.1f}" if ups else "n/a"
 write_macros(d, "macros", macros)
 print(f"03_detection_time: wrote tables and figure to {d}")

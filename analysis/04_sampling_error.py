@@ -87,4 +87,5 @@ write_macros(d, "macros", {
     "SEexHeadPninetyfive": (f"{ex_heads.p95_mm.min():.1e}--{ex_heads.p95_mm.max():.1e}" if len(ex_heads) else "n/a"),
     "SEanalyticWithin": f"{100 * rad[rad.scheme == 'equiangular'].fraction_within_bound.min():.3f}",
     "SEhelixWithin": f"{100 * rad[rad.scheme == 'helix'].fraction_within_bound.min():.2f}",
+    "SEeqSevenOne": f"{t5[t5.precision_deg == 1].eq7_mm.iloc[0]:.2f}" if (t5.precision_deg == 1).any() else "n/a",
 })

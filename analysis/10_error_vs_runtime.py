@@ -108,6 +108,42 @@ if len(lin):
     f = lin[lin.precision_deg == lin.precision_deg.min()].iloc[0]
     macros["ErrLinearFinestPninetyFive"] = e(f.p95_abs_mm)
     macros["ErrFinest"] = f"{f.precision_deg:g}"
+# The headline configuration on every subject and pose: error and speed against the peers.
+heads, emb_r, cg_r, emb_err = [], [], [], []
+for (s_, pose), g in t.groupby(["subject", "pose"], sort=False):
+    r_ = g[(g.scheme == "equiangular") & (g["mode"] == "exact") & np.isclose(g.precision_deg, 0.1)]
+    if not len(r_):
+        continue
+    heads.append(r_.p95_abs_mm.iloc[0])
+    for peer, out in (("embree_radial", emb_r), ("cgal_radial", cg_r)):
+        pr = g[g.scheme == peer]
+        if len(pr):
+            out.append(pr.query_ns_per_vertex.iloc[0] / r_.query_ns_per_vertex.iloc[0])
+    pe = g[g.scheme == "embree_radial"]
+    if len(pe):
+        emb_err.append(pe.p95_abs_mm.iloc[0])
+if heads:
+    macros["ErrPninetyFiveMin"], macros["ErrPninetyFiveMax"] = e(min(heads)), e(max(heads))
+    macros["ErrTargetOrders"] = f"{np.floor(np.log10(0.05 / max(heads))):.0f}"
+if emb_r:
+    macros["ErrEmbreeRatioMin"], macros["ErrEmbreeRatioMax"] = f"{min(emb_r):.1f}", f"{max(emb_r):.1f}"
+if cg_r:
+    macros["ErrCgalRatioMin"], macros["ErrCgalRatioMax"] = f"{min(cg_r):.0f}", f"{max(cg_r):.0f}"
+if emb_err:
+    macros["ErrEmbreeOwnPninetyFiveMax"] = e(max(emb_err))
+# Helix against the equiangular grid at matched resolutions (exact mode, every subject and pose).
+hx_mem, hx_ns = [], []
+for (s_, pose), g in maps[maps["mode"] == "exact"].groupby(["subject", "pose"], sort=False):
+    for p_ in g[g.scheme == "equiangular"].precision_deg.unique():
+        a_ = g[(g.scheme == "equiangular") & np.isclose(g.precision_deg, p_)]
+        b_ = g[(g.scheme == "helix") & np.isclose(g.precision_deg, p_)]
+        if len(a_) and len(b_):
+            hx_mem.append(b_.bytes.iloc[0] / a_.bytes.iloc[0])
+            hx_ns.append(b_.query_ns_per_vertex.iloc[0] / a_.query_ns_per_vertex.iloc[0])
+if hx_mem:
+    macros["ErrHelixSavesPercentMin"] = f"{100 * (1 - max(hx_mem)):.0f}"
+    macros["ErrHelixSavesPercentMax"] = f"{100 * (1 - min(hx_mem)):.0f}"
+    macros["ErrHelixNsRatioMin"], macros["ErrHelixNsRatioMax"] = f"{min(hx_ns):.1f}", f"{max(hx_ns):.1f}"
 tot = maps[maps.pose == "rest"]
 macros["ErrLargeTotal"] = f"{int(tot.large_errors.sum()):,}"
 macros["ErrJumpTotal"] = f"{int(tot.at_discontinuity.sum()):,}"

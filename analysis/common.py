@@ -56,3 +56,18 @@ def write_macros(d, stem, values):
     with open(os.path.join(d, stem + ".tex"), "w") as f:
         for k, v in values.items():
             f.write("\\newcommand{\\%s}{%s}\n" % (k, v))
+
+
+def session_figures(experiment):
+    """Figures measured in benchmark sessions outside the reference run, for the prose of one
+    experiment's section: {key: value as typed in benchmarks/sessions.csv} (the CSV records unit, date,
+    commit and command of each)."""
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks", "sessions.csv")
+    out = {}
+    with open(path) as f:
+        rows = list(__import__("csv").DictReader(f))
+    for r in rows:
+        if r["experiment"] == experiment:
+            out[r["key"]] = r["value"]
+    return out
+
