@@ -37,36 +37,65 @@ for r in rad.itertuples():
 write_table(d, "table_radial", ["shape", "scheme", "mode", "res.", "max (mm)", "p95 (mm)", "median (mm)",
                                 "Eq. 7 (mm)", "bound (mm)", "within bound (\\%)"], rows, align="llllrrrrrr")
 
-shapes = list(dict.fromkeys(rad["shape"]))
-fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), sharey=True)
+shapes = list(dict.fromkeys(list(rad["shape"]) + list(cov["shape"])))
+# One colour per shape, one line style per scheme and mode, and a legend for each: the colours
+# alone say which shape, the styles alone which configuration.
+colour = {sh: plt.get_cmap("tab10")(i % 10) for i, sh in enumerate(shapes)}
+styles = {("equiangular", "exact"): ("-", "o"), ("equiangular", "linear"): (":", "s"), ("helix", "exact"): ("--", "^")}
+FLOOR = 1e-8  # mm; errors below it (rounding only) are drawn at it
+
+
+def legends(ax, configs, loc_shapes, loc_configs):
+    from matplotlib.lines import Line2D
+    h1 = [Line2D([], [], color=colour[sh], lw=2) for sh in shapes]
+    l1 = ax.legend(h1, [sh.replace("_", " ") for sh in shapes], fontsize=6, loc=loc_shapes, title="shape",
+                   title_fontsize=6)
+    ax.add_artist(l1)
+    h2 = [Line2D([], [], color="0.3", ls=styles[c][0], marker=styles[c][1], markersize=3) for c in configs]
+    ax.legend(h2, [f"{a} {b}" for a, b in configs], fontsize=6, loc=loc_configs, title="scheme, mode",
+              title_fontsize=6)
+
+
+fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
 for ax, stat in zip(axes, ("max_mm", "p95_mm")):
     for shape in shapes:
-        for (scheme, mode), ls in ((("equiangular", "exact"), "-"), (("equiangular", "linear"), ":"),
-                                   (("helix", "exact"), "--")):
-            g = rad[(rad["shape"] == shape) & (rad.scheme == scheme) & (rad["mode"] == mode)]
+        for cfg, (ls, mk) in styles.items():
+            g = rad[(rad["shape"] == shape) & (rad.scheme == cfg[0]) & (rad["mode"] == cfg[1])]
             if len(g):
-                ax.loglog(g.precision_deg, g[stat], ls, marker=".", label=f"{shape} {scheme} {mode}")
+                ax.loglog(g.precision_deg, np.maximum(g[stat], FLOOR), ls=ls, marker=mk, markersize=3,
+                          color=colour[shape], lw=1)
     g = rad[(rad["shape"] == shapes[0]) & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]
-    ax.loglog(g.precision_deg, g.eq7_mm, "k-", lw=2, label="Eq. 7 (r = 22 mm)")
+    ax.loglog(g.precision_deg, g.eq7_mm, "k-", lw=2.5, alpha=0.6)
+    ax.annotate("Eq. 7 (r = 22 mm)", (g.precision_deg.iloc[-1], g.eq7_mm.iloc[-1]), fontsize=6,
+                xytext=(0, 5), textcoords="offset points", ha="right")
     ax.set_xlabel("precision p (deg; helix matched)")
     ax.set_title({"max_mm": "max", "p95_mm": "95th percentile"}[stat] + " |interpolated - exact| radial distance",
                  fontsize=8)
     ax.invert_xaxis()
-    ax.grid(True, which="both", alpha=0.3)
-axes[0].set_ylabel("mm")
-axes[1].legend(fontsize=5, ncol=2)
+    ax.set_ylim(FLOOR / 2, None)
+    ax.grid(True, which="major", alpha=0.3)
+axes[0].set_ylabel(f"mm (below {FLOOR:g} drawn at {FLOOR:g})")
+legends(axes[1], list(styles), "lower left", "lower right")
 save(fig, d, "radial")
 
-fig, ax = plt.subplots(figsize=(5.5, 3.4))
+fig, ax = plt.subplots(figsize=(5.8, 3.6))
 for (shape, scheme), g in cov.groupby(["shape", "scheme"], sort=False):
     m = g.groupby("precision_deg").apply(lambda x: (x.max_nearest_mm / x.eq7_mm).max())
-    ax.semilogx(m.index, m.values, marker="o" if scheme == "equiangular" else "^", label=f"{shape} {scheme}")
+    ls, mk = styles[(scheme, "exact")]
+    ax.semilogx(m.index, m.values, ls=ls, marker=mk, color=colour[shape], markersize=4)
 ax.axhline(1, color="k", lw=1)
 ax.set_xlabel("precision p (deg; helix matched)")
 ax.set_ylabel("max nearest-sample distance / Eq. 7")
 ax.invert_xaxis()
 ax.grid(True, alpha=0.3)
-ax.legend(fontsize=6)
+from matplotlib.lines import Line2D
+h1 = [Line2D([], [], color=colour[sh], lw=2) for sh in shapes]
+l1 = ax.legend(h1, [sh.replace("_", " ") for sh in shapes], fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.65),
+               title="shape", title_fontsize=6)
+ax.add_artist(l1)
+ax.legend([Line2D([], [], color="0.3", ls=styles[(sc, "exact")][0], marker=styles[(sc, "exact")][1]) for sc in ("equiangular", "helix")],
+          ["equiangular", "helix"], fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.15), title="scheme",
+          title_fontsize=6)
 save(fig, d, "covering")
 
 sph = rad[(rad["shape"] == "sphere") & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]

@@ -3,7 +3,7 @@
 
 Reads RESULTS/08_distance_maps/gap_statistics.csv, vertex_gaps.csv, clock_faces.csv and the
 render_<subject>_<body>.ply meshes the driver wrote; writes table_finest.tex, table_convergence.tex,
-table_acetabulum.tex, min_gap.pdf, levels.pdf, render_<subject>.pdf (shaded, with the clock face), macros.tex."""
+table_acetabulum.tex, min_gap.pdf, levels.pdf, maps_<subject>.pdf (map images with colour bars), render_<subject>.pdf (shaded, with the clock face), macros.tex."""
 import json
 import os
 
@@ -85,6 +85,35 @@ ax.set_xticklabels(labels, fontsize=6)
 ax.set_ylabel("tested vertices")
 ax.legend(fontsize=6, ncol=5)
 save(fig, d, "levels")
+
+# Map images (thesis Fig. 31) with axes and colour bars: the driver's grey PNGs turned back into
+# distances by their scale (map_images.csv: grey 40 = nearest_mm, 255 = farthest_mm, 0 = no surface).
+if os.path.exists(os.path.join(d, "map_images.csv")):
+    import matplotlib.image as mpimg
+    imgs = read_csv(d, "map_images.csv")
+    for s_, g in imgs[imgs.scheme == "equiangular"].groupby("subject", sort=False):
+        fig, axes = plt.subplots(1, 2, figsize=(9.5, 2.7))
+        for ax, body, title in zip(axes, ("socket", "ball"), ("pelvis (socket) map", "femur (ball) map")):
+            r = g[g.body == body]
+            if not len(r):
+                ax.axis("off")
+                continue
+            r = r.iloc[0]
+            grey = np.round(mpimg.imread(os.path.join(d, r.file)) * 255.0)
+            if grey.ndim == 3:
+                grey = grey[..., 0]
+            dist = np.ma.masked_where(grey == 0, r.nearest_mm + (grey - 40.0) / 215.0 * (r.farthest_mm - r.nearest_mm))
+            cmap = plt.get_cmap("viridis").copy()
+            cmap.set_bad("0.85")
+            im = ax.imshow(dist, cmap=cmap, extent=(0, 360, 180, 0), aspect="auto", interpolation="nearest",
+                           vmin=r.nearest_mm, vmax=r.farthest_mm)
+            ax.set_xlabel("azimuth theta (deg)")
+            ax.set_ylabel("polar angle phi (deg)")
+            ax.set_xticks(range(0, 361, 90))
+            ax.set_yticks(range(0, 181, 45))
+            ax.set_title(f"{s_}: {title}, {r.resolution:g} deg (grey: no surface)", fontsize=8)
+            fig.colorbar(im, ax=ax, label="radial distance (mm)")
+        save(fig, d, f"maps_{s_}")
 
 # Acetabular orientation and scan pose per real subject (clock_faces.csv).
 clk = read_csv(d, "clock_faces.csv")

@@ -4,7 +4,8 @@
 // Inputs: none. Outputs: OUT/01_lut_memory/
 //   lut_memory.csv    one row per scheme x resolution x storage (float / double)
 //   helix_match.csv   Table 6: k matched to the equator's node count of each precision
-//   density.csv       nodes per steradian in 1-deg latitude bands, both schemes at 1 deg / k = 229
+//   density.csv       nodes per steradian in 1-deg latitude bands centred on whole degrees, both schemes at
+//                     1 deg / k = 229
 //   meta.json
 // Command: build/experiments/exp_01_lut_memory --out results
 #include <unistd.h>
@@ -89,24 +90,27 @@ int main(int argc, char** argv) {
     measure<double>(csv, hx, w, t.helix_nodes, t.helix_mb, t.p);
   }
   // Node density against latitude (Fig. 49 compares the two at 1 deg): nodes per steradian in
-  // 1-deg bands of phi.
+  // 1-deg bands of phi centred on whole degrees ([b - 0.5, b + 0.5), halved at the poles), so that
+  // the equiangular rows, which lie on whole degrees, sit mid-band and rounding cannot move a row into
+  // the next band (bands with edges on whole degrees showed empty and doubled bands).
   {
     CsvWriter dens(dir + "/density.csv",
                    {"scheme", "resolution", "phi_low_deg", "phi_high_deg", "nodes", "band_sr", "nodes_per_sr"});
     const EquiangularGrid eq(1);
     const HelixScheme hx(229);
     for (const SamplingScheme* s : std::initializer_list<const SamplingScheme*>{&eq, &hx}) {
-      std::vector<std::int64_t> count(180, 0);
+      std::vector<std::int64_t> count(181, 0);
       std::vector<double> phi(4096), theta(4096);
       for (std::int64_t first = 0; first < s->num_nodes(); first += 4096) {
         const std::int64_t c = std::min<std::int64_t>(4096, s->num_nodes() - first);
         s->node_angles(first, c, phi.data(), theta.data());
         for (std::int64_t j = 0; j < c; ++j)
-          ++count[std::min<std::size_t>(179, static_cast<std::size_t>(phi[j] * kRadToDeg))];
+          ++count[std::min<std::size_t>(180, static_cast<std::size_t>(std::floor(phi[j] * kRadToDeg + 0.5)))];
       }
-      for (int b = 0; b < 180; ++b) {
-        const double sr = 2 * kPi * (std::cos(b * kDegToRad) - std::cos((b + 1) * kDegToRad));
-        dens.row(s->name(), s->resolution(), b, b + 1, count[b], sr, double(count[b]) / sr);
+      for (int b = 0; b <= 180; ++b) {
+        const double lo = std::max(0.0, b - 0.5), hi = std::min(180.0, b + 0.5);
+        const double sr = 2 * kPi * (std::cos(lo * kDegToRad) - std::cos(hi * kDegToRad));
+        dens.row(s->name(), s->resolution(), lo, hi, count[b], sr, double(count[b]) / sr);
       }
     }
   }

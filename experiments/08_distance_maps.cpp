@@ -8,6 +8,7 @@
 //                       sampling_ms describe the scanned body's own map; COR in the RAS frame
 //   vertex_gaps.csv     per-vertex gaps within 45 mm of the COR at the finest precision, exact mode
 //   map_<subject>_<body>.png  the maps at 0.5 deg (theta across, phi down); *_helix.png at k = 458
+//   map_images.csv    each map image's grey scale (grey 40 = nearest_mm, 255 = farthest_mm), for colour bars
 //   render_<subject>_<body>.ply  both bones within 60 mm of the COR at the scan pose, in the pelvic
 //                       frame (ISB; generated models: the scan's anatomical axes), with gaps, levels
 //                       and colours, at 0.25 deg exact mode (HipJoint), for the shaded renders
@@ -82,6 +83,8 @@ int main(int argc, char** argv) {
                                                 "vs_equiangular_p95_abs_mm",
                                                 "vs_equiangular_max_abs_mm",
                                                 "vs_equiangular_compared"});
+  CsvWriter map_images(dir + "/map_images.csv",
+                       {"subject", "body", "scheme", "resolution", "file", "nearest_mm", "farthest_mm"});
   CsvWriter vertices(dir + "/vertex_gaps.csv", {"subject", "scan", "vertex", "x_mm", "y_mm", "z_mm", "gap_mm"});
 
   const int total = static_cast<int>(subjects.size() * precisions.size() * 4);
@@ -173,8 +176,12 @@ int main(int argc, char** argv) {
           }
           if (p == 0.5 && mode == DistanceMode::exact) {
             const std::string suffix = helix ? "_helix.png" : ".png";
-            write_map_png(dir + "/map_" + s.name + "_ball" + suffix, joint.ball().map);
-            write_map_png(dir + "/map_" + s.name + "_socket" + suffix, joint.socket().map);
+            for (int b = 0; b < 2; ++b) {
+              const std::string body = b == 0 ? "ball" : "socket";
+              const std::string file = "map_" + s.name + "_" + body + suffix;
+              const MapImageScale sc = write_map_png(dir + "/" + file, b == 0 ? joint.ball().map : joint.socket().map);
+              map_images.row(s.name, body, scheme->name(), scheme->resolution(), file, sc.nearest_mm, sc.farthest_mm);
+            }
           }
           if (p == finest && mode == DistanceMode::exact && !helix) {
             const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};

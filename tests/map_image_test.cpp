@@ -1,4 +1,5 @@
-// The map PNG has columns x rows pixels (theta across, phi down): checked in the IHDR chunk.
+// The map PNG has columns x rows pixels (theta across, phi down): checked in the IHDR chunk; the
+// returned grey scale spans the covered values.
 #include "impinge/map_image.hpp"
 
 #include <gtest/gtest.h>
@@ -15,7 +16,9 @@ TEST(MapImage, DimensionsAndErrors) {
   RadialDistanceMap map{EquiangularGrid(2)};
   for (std::int64_t i = 0; i < map.num_nodes() / 3; ++i) map.data()[i] = 10 + i % 7;
   const std::string d = test::temp_dir("map_image");
-  write_map_png(d + "/m.png", map);
+  const MapImageScale sc = write_map_png(d + "/m.png", map);
+  EXPECT_EQ(sc.nearest_mm, 10);  // the covered values are 10 .. 16 mm
+  EXPECT_EQ(sc.farthest_mm, 16);
   std::ifstream in(d + "/m.png", std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(bytes.size(), 33u);

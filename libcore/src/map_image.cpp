@@ -36,7 +36,7 @@ void write_grey_png(const std::string& path, const unsigned char* pixels, int w,
 }
 }  // namespace
 
-void write_map_png(const std::string& path, const RadialDistanceMap& map) {
+MapImageScale write_map_png(const std::string& path, const RadialDistanceMap& map) {
   // Pixel values: the node values of an equiangular map, else the map interpolated at the
   // nodes of an equiangular image grid matched to the scheme's spacing (at most 3600 x 1801).
   std::vector<double> value;
@@ -62,6 +62,7 @@ void write_map_png(const std::string& path, const RadialDistanceMap& map) {
   for (std::size_t i = 0; i < value.size(); ++i)
     pixels[i] = std::isfinite(value[i]) ? static_cast<unsigned char>(40 + 215.0 * (value[i] - lo) / span) : 0;
   write_grey_png(path, pixels.data(), w, h);
+  return {std::isfinite(lo) ? lo : 0.0, hi};
 }
 
 }  // namespace impinge
