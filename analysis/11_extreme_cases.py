@@ -1,8 +1,12 @@
 """11_extreme_cases: stiff and extreme cases against exact references (issue 15).
 
 Case 1, depth discontinuities: reads RESULTS/11_extreme_cases/discontinuities.csv; writes
-table_discontinuities.tex and macros.tex."""
+table_discontinuities.tex. Cases 2-6, the catalogue: reads cases.csv; writes table_cases.tex (one row
+per case and variant: rows, rows passed, the largest error against its bound). Both write macros.tex."""
+import os
+
 import numpy as np
+import pandas as pd
 
 from common import experiment_dir, read_csv, write_macros, write_table
 
@@ -33,7 +37,7 @@ eq = real[real.scheme == "equiangular"]
 ratio = (eq[eq.method == "refined"].set_index("subject").query_ns_per_vertex /
          eq[eq.method == "maps"].set_index("subject").query_ns_per_vertex)
 allref = t[t.method == "refined"]
-write_macros(d, "macros", {
+macros = {
     "ExtPoses": f"{int(t.poses.max())}",
     "ExtMapsMaxMin": e(maps.max_abs_mm.min()), "ExtMapsMaxMax": e(maps.max_abs_mm.max()),
     "ExtRefMax": e(ref.max_abs_mm.max()), "ExtRefMaxAll": e(allref.max_abs_mm.max()),
@@ -47,5 +51,40 @@ write_macros(d, "macros", {
     "ExtCompared": f"{int(ref.compared.sum()):,}",
     "ExtPass": f"{int(((allref.max_abs_mm <= 0.05) & (allref.mask_skipped == 0)).sum())}",
     "ExtRows": f"{len(allref)}",
-})
+}
+
+# The catalogue: per case and variant, the rows passed and the row nearest its bound.
+if os.path.exists(os.path.join(d, "cases.csv")):
+    c = pd.read_csv(os.path.join(d, "cases.csv"))
+    c["ratio"] = c.max_abs / c.bound
+    rows = []
+    for (case, variant), g in c.groupby(["case", "variant"], sort=False):
+        w = g.loc[g.ratio.idxmax()]
+        what = " ".join(str(x) for x in (w.scheme, w["mode"], w.storage) if str(x) != "-")
+        rows.append([case.split(" ", 1)[1] if case[0].isdigit() else case, variant, f"{len(g)}", f"{int(g['pass'].sum())}",
+                     f"{int(g.holes.sum())}", f"{w.max_abs:.2g}", f"{w.bound:.2g}", w.unit, what])
+    write_table(d, "table_cases", ["case", "variant", "rows", "pass", "holes", "largest error", "its bound", "unit",
+                                   "where (scheme, mode, storage)"], rows, align="llrrrrrll")
+    geo = c[c.case.str[0].isin(["2", "3", "4"])]
+    touch = c[c.case.str.startswith("5")]
+    fits = c[c.case.str.contains("sphere fit")]
+    helix = c[c.case.str.contains("helix arc")]
+    small = touch[touch.variant.str.startswith("gap 1e-6")]
+    wrong = small.note.str.extract(r"(\d+) gaps of the wrong sign")[0].astype(float)
+    macros.update({
+        "ExtCaseRows": f"{len(c)}", "ExtCasePass": f"{int(c['pass'].sum())}",
+        "ExtCaseFail": f"{int((c['pass'] == 0).sum())}", "ExtCaseHoles": f"{int(c.holes.sum())}",
+        "ExtGeoRows": f"{len(geo)}", "ExtGeoWorstRatio": f"{geo.ratio.max():.3f}",
+        "ExtGeoExactWorstRatio": f"{geo[geo['mode'] == 'exact'].ratio.max():.2f}",
+        "ExtTouchSmallMaxErr": f"{small.max_abs.min():.1g}",
+        "ExtTouchWrongSignMin": f"{wrong.min():.0f}", "ExtTouchWrongSignMax": f"{wrong.max():.0f}",
+        "ExtTouchVertices": f"{int(small.compared.max()):,}",
+        "ExtFitWorstRatio": f"{fits.ratio.max():.2f}",
+        "ExtFitCapFiveRms": f"{fits[fits.variant.str.contains('cap 5 ') & fits.variant.str.contains('0.1 mm')].max_abs.max():.2f}",
+        "ExtHelixWorst": f"{helix.max_abs.max():.1e}", "ExtHelixWorstBound": f"{helix.loc[helix.max_abs.idxmax()].bound:.1e}",
+    })
+    fails = c[c["pass"] == 0]
+    macros["ExtCaseFailList"] = ("none" if fails.empty else
+                                 "; ".join(f"{r.variant} ({r.scheme} {r['mode']} {r.storage})" for _, r in fails.iterrows()))
+write_macros(d, "macros", macros)
 print(f"11_extreme_cases: wrote tables to {d}")

@@ -72,8 +72,14 @@ class CsvWriter {
   }
 
  private:
-  static std::string cell(const std::string& s) { return s; }
-  static std::string cell(const char* s) { return s; }
+  // Text with a comma, quote or line break is quoted (RFC 4180), so a note cannot shift the columns.
+  static std::string cell(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string q = "\"";
+    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
+  }
+  static std::string cell(const char* s) { return cell(std::string(s)); }
   template <typename N>
   static std::string cell(N x) {
     if constexpr (std::is_floating_point_v<N>) {

@@ -377,3 +377,25 @@ TEST(Rasterize, PlanOfAnotherMeshOrCorIsRefused) {
   // Linear mode does not use the plan's cones (the thesis' algorithm on every triangle).
   EXPECT_NO_THROW(rasterize(h.ball, h.cor, DistanceMode::linear, map, &plan));
 }
+
+TEST(Rasterize, NodesThroughSharedVerticesAreCovered) {
+  // A UV sphere of 5 deg about the COR has every vertex on a node direction at 1, 0.5 and 0.25 deg,
+  // and its meridian edges along node columns. The edge functions of the triangles around a vertex
+  // are rounded independently; without the edge tolerance (kEdgeAngleTolerance) 40 nodes at 0.5 deg
+  // were covered by no triangle. The mesh is closed about the COR: every node must be covered, in
+  // both modes, float and double, with and without a culling plan, in any orientation of the axis.
+  for (const Eigen::Vector3d axis : {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()}) {
+    const TriangleMesh m = make_uv_sphere(22, Eigen::Vector3d::Zero(), 72, 36, axis);
+    const FaceCulling plan = analyse_face_culling(m, Eigen::Vector3d::Zero());
+    for (double p : {1.0, 0.5, 0.25})
+      for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear})
+        for (const FaceCulling* pl : {static_cast<const FaceCulling*>(nullptr), &plan}) {
+          RadialDistanceMap f{EquiangularGrid(p)};
+          RadialDistanceMapDouble d{EquiangularGrid(p)};
+          rasterize(m, Eigen::Vector3d::Zero(), mode, f, pl);
+          rasterize(m, Eigen::Vector3d::Zero(), mode, d, pl);
+          EXPECT_EQ(f.nodes_covered(), f.num_nodes()) << "p=" << p << " " << to_string(mode) << " axis " << axis.x();
+          EXPECT_EQ(d.nodes_covered(), d.num_nodes()) << "p=" << p << " " << to_string(mode) << " axis " << axis.x();
+        }
+  }
+}

@@ -93,6 +93,7 @@ TriangleCone make_cone(const Corner& ka, const Corner& kb, const Corner& kc, dou
     t.alpha[k] = t.span_edge[k] ? fast_azimuth(e[k].y(), e[k].x()) : 0.0;
     t.k[k] = t.span_edge[k] ? -e[k].z() / rho : 0.0;
     t.pad[k] = t.span_edge[k] ? 2e-7 / std::sqrt(rho / norm) : 1.0;
+    t.bias[k] = kEdgeAngleTolerance * norm;
   }
   t.adet = std::abs(det);
   t.north = north, t.south = south;
@@ -324,7 +325,7 @@ inline int segments(int lo, int hi, int cols, int (&seg)[3][2]) {
 struct WrappedBox {
   int r0, r1, nseg, seg[3][2];
   int seg_offset[3];  ///< the box's own (unwrapped) column = stored column + offset, per segment
-  double e[9], adet;
+  double e[9], bias[3], adet;
 };
 
 /// The box of rows r0..r1 and unwrapped columns c0..c1 (c0 may be negative, c1 may reach past the
@@ -340,24 +341,26 @@ WrappedBox make_box(const Box& bx, int cols, const TriangleCone& t) {
   add(std::max(c0, 0), std::min(c1, cols - 1), 0);
   if (c1 >= cols) add(0, c1 - cols, cols);
   std::copy(t.e, t.e + 9, b.e);
+  std::copy(t.bias, t.bias + 3, b.bias);
   b.adet = t.adet;
   return b;
 }
 
-/// The three edge functions of one row (coefficients folded with sin and cos of its phi).
+/// The three edge functions of one row (coefficients folded with sin and cos of its phi), each
+/// raised by its tolerance `bias` (kEdgeAngleTolerance).
 struct RowEdges {
   double a0, b0, c0, a1, b1, c1, a2, b2, c2;
-  RowEdges(const double* e, double sp, double cp)
+  RowEdges(const double* e, const double* bias, double sp, double cp)
       : a0(sp * e[0]),
         b0(sp * e[1]),
-        c0(cp * e[2]),
+        c0(cp * e[2] + bias[0]),
         a1(sp * e[3]),
         b1(sp * e[4]),
-        c1(cp * e[5]),
+        c1(cp * e[5] + bias[1]),
         a2(sp * e[6]),
         b2(sp * e[7]),
-        c2(cp * e[8]) {}
-  /// Inside the cone (all three >= 0); `sum` = f0 + f1 + f2 (the ray-plane denominator).
+        c2(cp * e[8] + bias[2]) {}
+  /// Inside the cone (all three >= 0, each within its tolerance); `sum` = f0 + f1 + f2.
   bool inside(double ct, double st, double& sum) const {
     const double f0 = a0 * ct + b0 * st + c0, f1 = a1 * ct + b1 * st + c1, f2 = a2 * ct + b2 * st + c2;
     sum = f0 + f1 + f2;
@@ -382,7 +385,7 @@ inline double node_distance(double adet, double sum, double) { return adet / sum
 /// Per-row and per-column trigonometry of one grid, made once per thread and precision.
 struct GridTables {
   double step = 0;
-  std::vector<double> sin_phi, cos_phi, cot_phi, rsqrt_sin_phi, cos_theta, sin_theta;
+  std::vector<double> sin_phi, cos_phi, cot_phi, rsqrt_sin_phi, inv_sin_phi, cos_theta, sin_theta;
 };
 const GridTables& grid_tables(const EquiangularGrid& grid) {
   thread_local GridTables t;
@@ -391,6 +394,7 @@ const GridTables& grid_tables(const EquiangularGrid& grid) {
   const double h = grid.step();
   t.step = h;
   t.sin_phi.resize(rows), t.cos_phi.resize(rows), t.cot_phi.resize(rows), t.rsqrt_sin_phi.resize(rows);
+  t.inv_sin_phi.resize(rows);
   for (int r = 0; r < rows; ++r) {
     t.sin_phi[r] = std::sin(r * h);
     t.cos_phi[r] = std::cos(r * h);
@@ -403,6 +407,7 @@ const GridTables& grid_tables(const EquiangularGrid& grid) {
     const bool pole = t.sin_phi[r] <= 0;  // the pole rows keep the whole box (row_spans)
     t.cot_phi[r] = pole ? 0.0 : t.cos_phi[r] / t.sin_phi[r];
     t.rsqrt_sin_phi[r] = pole ? std::numeric_limits<double>::infinity() : 1 / std::sqrt(t.sin_phi[r]);
+    t.inv_sin_phi[r] = pole ? 1.0 : 1 / t.sin_phi[r];  // scales the edge tolerance like the edge functions
   }
   t.cos_theta.resize(cols), t.sin_theta.resize(cols);
   for (int c = 0; c < cols; ++c) {
@@ -422,6 +427,7 @@ struct SpanRows {
   const int* hi;
   const std::uint8_t* sure;
   const double* e;
+  const double* bias;  ///< the cone's edge tolerances (kEdgeAngleTolerance |e_k|)
   const double* n;
   double adet;
 };
@@ -429,7 +435,7 @@ struct SpanRows {
 /// Exact mode over a cone's row spans. For a node of row r (polar angle phi, sin phi > 0) and
 /// column c the three edge functions, divided by sin phi (which keeps their signs), are
 /// f_k = e_k.x cos(theta_c) + e_k.y sin(theta_c) + cot(phi_r) e_k.z; the node is inside the cone
-/// when all are >= 0, and its distance is (adet / sin phi) / g with g = n.x cos(theta_c) +
+/// when all are >= -bias_k / sin phi (kEdgeAngleTolerance), and its distance is (adet / sin phi) / g with g = n.x cos(theta_c) +
 /// n.y sin(theta_c) + cot(phi_r) n.z, where the ray meets the plane (double g, division in the
 /// map's precision); the nearer value is kept. The two pole rows (sin phi = 0: one direction,
 /// (0, 0, +-1)) use f_k = cos(phi) e_k.z, g = cos(phi) n.z and adet. A negated edge normal
@@ -441,6 +447,7 @@ struct SpanRows {
 template <typename Scalar>
 inline std::int64_t exact_rows_body(Scalar* __restrict map, int cols, const SpanRows& S, const GridTables& T) {
   const double* e = S.e;
+  const double* bias = S.bias;
   const double* n = S.n;
   const double* __restrict cos_theta = T.cos_theta.data();
   const double* __restrict sin_theta = T.sin_theta.data();
@@ -450,8 +457,10 @@ inline std::int64_t exact_rows_body(Scalar* __restrict map, int cols, const Span
     const bool pole = sp <= 0;
     const double ex = pole ? 0.0 : 1.0;  // pole rows: no azimuth term
     const double ez = pole ? T.cos_phi[r] : T.cot_phi[r];
-    const double a0 = ex * e[0], b0 = ex * e[1], c0 = ez * e[2], a1 = ex * e[3], b1 = ex * e[4], c1 = ez * e[5],
-                 a2 = ex * e[6], b2 = ex * e[7], c2 = ez * e[8], an = ex * n[0], bn = ex * n[1], cn = ez * n[2];
+    const double ib = T.inv_sin_phi[r];
+    const double a0 = ex * e[0], b0 = ex * e[1], c0 = ez * e[2] + ib * bias[0], a1 = ex * e[3], b1 = ex * e[4],
+                 c1 = ez * e[5] + ib * bias[1], a2 = ex * e[6], b2 = ex * e[7], c2 = ez * e[8] + ib * bias[2],
+                 an = ex * n[0], bn = ex * n[1], cn = ez * n[2];
     const double adet = pole ? S.adet : S.adet / sp;
     Scalar* __restrict row = map + std::int64_t(r) * cols;
     const int i = r - S.r0;
@@ -559,7 +568,9 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) std::int64_t exact_rows_avx
       newly += exact_run_avx512<false>(row, lo, hi, cos_theta, sin_theta, R);
       continue;
     }
-    R.c0 = _mm512_set1_pd(ez * e2), R.c1 = _mm512_set1_pd(ez * e5), R.c2 = _mm512_set1_pd(ez * e8);
+    const double ib = T.inv_sin_phi[r];
+    R.c0 = _mm512_set1_pd(ez * e2 + ib * S.bias[0]), R.c1 = _mm512_set1_pd(ez * e5 + ib * S.bias[1]),
+    R.c2 = _mm512_set1_pd(ez * e8 + ib * S.bias[2]);
     if (plain) {
       newly += exact_run_avx512<true>(row, lo, hi, cos_theta, sin_theta, R);
       continue;
@@ -604,7 +615,7 @@ inline std::int64_t linear_rows_body(Scalar* __restrict map, int cols, const Lin
   const WrappedBox& box = L.box;
   std::int64_t newly = 0;
   for (int r = box.r0; r <= box.r1; ++r) {
-    const RowEdges edges(box.e, sin_phi[r], cos_phi[r]);
+    const RowEdges edges(box.e, box.bias, sin_phi[r], cos_phi[r]);
     const double phi = r * L.h;
     Scalar* __restrict row = map + std::int64_t(r) * cols;
     for (int g = 0; g < box.nseg; ++g)
@@ -761,7 +772,7 @@ class Rasterizer {
       std::fill(hi_.begin(), hi_.begin() + std::ptrdiff_t(n), b.c1);
       stats_.node_tests += std::int64_t(n) * (b.c1 - b.c0 + 1);
     }
-    const SpanRows S{b.r0, b.r1, lo_.data(), hi_.data(), sure, t.e, t.n, t.adet};
+    const SpanRows S{b.r0, b.r1, lo_.data(), hi_.data(), sure, t.e, t.bias, t.n, t.adet};
     newly_covered_ += exact_rows(map_.data(), cols, S, t_);
   }
 
