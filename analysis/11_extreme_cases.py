@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pandas as pd
 
-from common import experiment_dir, read_csv, write_macros, write_table
+from common import experiment_dir, read_csv, session_figures, write_macros, write_table
 
 d = experiment_dir("11_extreme_cases")
 t = read_csv(d, "discontinuities.csv")
@@ -43,8 +43,9 @@ macros = {
     "ExtRefMax": e(ref.max_abs_mm.max()), "ExtRefMaxAll": e(allref.max_abs_mm.max()),
     "ExtMapsSkipped": f"{int(maps.mask_skipped.sum())}", "ExtRefSkipped": f"{int(ref.mask_skipped.sum())}",
     "ExtRefOver": f"{int(allref.over_tolerance.sum())}",
-    "ExtRatioMin": f"{ratio.min():.2f}", "ExtRatioMax": f"{ratio.max():.2f}",
-    "ExtRatioWorst": ratio.idxmax(),
+    "ExtRatioMin": f"{ratio.min():.2f}" if len(ratio) else "--",
+    "ExtRatioMax": f"{ratio.max():.2f}" if len(ratio) else "--",
+    "ExtRatioWorst": ratio.idxmax() if len(ratio) else "--",
     "ExtMarkMsMax": f"{eq[eq.method == 'refined'].marking_ms.max():.0f}",
     "ExtMarkMsGenericMax": f"{real[(real.method == 'refined') & (real.scheme != 'equiangular')].marking_ms.max():.0f}"
     if len(real[(real.method == 'refined') & (real.scheme != 'equiangular')]) else "--",
@@ -76,15 +77,29 @@ if os.path.exists(os.path.join(d, "cases.csv")):
         "ExtCaseFail": f"{int((c['pass'] == 0).sum())}", "ExtCaseHoles": f"{int(c.holes.sum())}",
         "ExtGeoRows": f"{len(geo)}", "ExtGeoWorstRatio": f"{geo.ratio.max():.3f}",
         "ExtGeoExactWorstRatio": f"{geo[geo['mode'] == 'exact'].ratio.max():.2f}",
-        "ExtTouchSmallMaxErr": f"{small.max_abs.min():.1g}",
         "ExtTouchWrongSignMin": f"{wrong.min():.0f}", "ExtTouchWrongSignMax": f"{wrong.max():.0f}",
         "ExtTouchVertices": f"{int(small.compared.max()):,}",
         "ExtFitWorstRatio": f"{fits.ratio.max():.2f}",
         "ExtFitCapFiveRms": f"{fits[fits.variant.str.contains('cap 5 ') & fits.variant.str.contains('0.1 mm')].max_abs.max():.2f}",
         "ExtHelixWorst": f"{helix.max_abs.max():.1e}", "ExtHelixWorstBound": f"{helix.loc[helix.max_abs.idxmax()].bound:.1e}",
     })
+    macros["SessVertexHoles"] = session_figures("11_extreme_cases").get("vertex_holes_before_fix", "n/a")
     fails = c[c["pass"] == 0]
     macros["ExtCaseFailList"] = ("none" if fails.empty else
                                  "; ".join(f"{r.variant} ({r.scheme} {r['mode']} {r.storage})" for _, r in fails.iterrows()))
+# The fuzz runs (benchmarks/fuzz_runs.csv, written from tools/fuzz's summary) and the inputs found
+# (tests/fuzz/regressions/TARGET/, each a regression test).
+root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+fz_path = os.path.join(root, "benchmarks", "fuzz_runs.csv")
+if os.path.exists(fz_path):
+    fz = pd.read_csv(fz_path)
+    last = fz[fz.date == fz.date.max()]
+    macros.update({"FuzzInputs": f"{int(last.inputs.sum()):,}", "FuzzCrashes": f"{int(last.crashes.sum())}",
+                   "FuzzTimeouts": f"{int(last.timeouts.sum())}", "FuzzMinutes": f"{last.seconds.sum() / 60:.0f}",
+                   "FuzzMeshInputs": f"{int(last[last.target == 'mesh'].inputs.sum()):,}",
+                   "FuzzCommit": str(last.commit.iloc[0])})
+reg = os.path.join(root, "tests", "fuzz", "regressions")
+found = sum(len(os.listdir(os.path.join(reg, t))) for t in ("mesh", "subject", "motion") if os.path.isdir(os.path.join(reg, t)))
+macros["FuzzFound"] = f"{found}"
 write_macros(d, "macros", macros)
 print(f"11_extreme_cases: wrote tables to {d}")
