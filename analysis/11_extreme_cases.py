@@ -1,7 +1,8 @@
 """11_extreme_cases: stiff and extreme cases against exact references (issue 15).
 
 Case 1, depth discontinuities: reads RESULTS/11_extreme_cases/discontinuities.csv; writes
-table_discontinuities.tex. Cases 2-6, the catalogue: reads cases.csv; writes table_cases.tex (one row
+table_discontinuities.tex. Case 7, user-facing outputs: reads outputs.csv; writes table_outputs.tex. Cases 2-6, the catalogue:
+reads cases.csv; writes table_cases.tex (one row
 per case and variant: rows, rows passed, the largest error against its bound). Both write macros.tex."""
 import os
 
@@ -84,9 +85,33 @@ if os.path.exists(os.path.join(d, "cases.csv")):
         "ExtHelixWorst": f"{helix.max_abs.max():.1e}", "ExtHelixWorstBound": f"{helix.loc[helix.max_abs.idxmax()].bound:.1e}",
     })
     macros["SessVertexHoles"] = session_figures("11_extreme_cases").get("vertex_holes_before_fix", "n/a")
+    cor = c[c.case.str.startswith("8")]
+    inside = cor[cor.variant.str.contains("inside")]
+    surface = cor[~cor.variant.str.contains("inside")]
+    macros.update({"CorInsideWorst": f"{inside.max_abs.max():.3f}" if len(inside) else "--",
+                   "CorSurfaceUncoveredMin": f"{surface.max_abs.min():.2f}" if len(surface) else "--",
+                   "CorSurfaceUncoveredMax": f"{surface.max_abs.max():.2f}" if len(surface) else "--"})
     fails = c[c["pass"] == 0]
     macros["ExtCaseFailList"] = ("none" if fails.empty else
                                  "; ".join(f"{r.variant} ({r.scheme} {r['mode']} {r.storage})" for _, r in fails.iterrows()))
+# Case 7: user-facing outputs at ROM-extreme poses against the exact gaps' summaries.
+if os.path.exists(os.path.join(d, "outputs.csv")):
+    o = pd.read_csv(os.path.join(d, "outputs.csv"))
+    rows = []
+    for s_, g in o.groupby("subject", sort=False):
+        mg, pa, la = g[g.quantity == "min gap"], g[g.quantity == "penetrating area"], g[g.quantity == "level areas"]
+        rows.append([s_, f"{g.pose.nunique()}", f"{mg.error.max():.1e}", f"{pa.error.max():.2g}",
+                     f"{pa.bound.max():.3g}", f"{la.error.max():.2g}", f"{la.bound.max():.3g}",
+                     f"{int(g['pass'].sum())} of {len(g)}"])
+    write_table(d, "table_outputs", ["subject", "poses", "min gap error (mm)", "penetrating area error (mm$^2$)",
+                                     "its bound, largest", "level areas error (mm$^2$)", "its bound, largest",
+                                     "pass"], rows, align="lrrrrrrr")
+    mg = o[o.quantity == "min gap"]
+    macros.update({"OutRows": f"{len(o)}", "OutPass": f"{int(o['pass'].sum())}", "OutPoses": f"{o.pose.nunique()}",
+                   "OutMinGapMaxErr": f"{mg.error.max():.1e}",
+                   "OutAreaMaxErr": f"{o[o.quantity != 'min gap'].error.max():.2g}",
+                   "OutDeepest": f"{mg.exact.min():.1f}"})
+
 # The fuzz runs (benchmarks/fuzz_runs.csv, written from tools/fuzz's summary) and the inputs found
 # (tests/fuzz/regressions/TARGET/, each a regression test).
 root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
