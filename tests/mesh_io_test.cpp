@@ -150,6 +150,12 @@ TEST(MeshIo, PlyEncodingsAndTypesGiveTheSameMesh) {
         EXPECT_EQ(m.V, ref.V) << p;
         EXPECT_EQ(m.F, ref.F) << p;
       }
+  // An element without properties holds no data, whatever its count (no loop over two billion).
+  test::write_text(d + "/empty_element.ply",
+                   "ply\nformat ascii 1.0\nelement marker 2000000000\nelement vertex 4\nproperty float x\n"
+                   "property float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+                   "end_header\n" + kVerts + "3 0 1 2\n3 0 1 3\n");
+  EXPECT_EQ(load_mesh(d + "/empty_element.ply").F, ref.F);
   // CRLF header lines, as Windows tools write them.
   std::string crlf = binary_ply(false, false, false);
   for (std::size_t at = crlf.find('\n'); at < crlf.find("end_header") + 11; at = crlf.find('\n', at + 2))

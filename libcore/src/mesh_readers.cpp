@@ -296,6 +296,7 @@ TriangleMesh read_ply(const std::string& path, const std::string& bytes) {
   for (std::size_t e = 0; e < elements.size(); ++e) {
     const PlyElement& el = elements[e];
     const bool is_vertex = static_cast<int>(e) == vertex_el, is_face = static_cast<int>(e) == face_el;
+    if (el.properties.empty()) continue;  // no data, however large its count
     if (is_vertex) mesh.V.resize(static_cast<Eigen::Index>(el.count), 3);
     if (is_face) mesh.F.resize(static_cast<Eigen::Index>(el.count), 3);
     for (std::uint64_t i = 0; i < el.count; ++i) {
