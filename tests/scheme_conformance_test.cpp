@@ -1,0 +1,172 @@
+// Conformance of every registered sampling scheme (scheme_names(), scheme_registry.cpp) at several
+// resolutions, so that a new scheme is checked with no test code of its own (issue 12):
+//  - node(node_direction(i)) == i, or a node of exactly the same direction (the equiangular grid's
+//    pole rows repeat the pole), for every node at coarse resolutions and a sample at fine ones;
+//  - stencils: node indices in range, weights >= 0 summing to 1, at random directions and at
+//    directions at and near both poles and across the seam;
+//  - the single look-up (interpolate and the weighted sum), the batch (interpolate_many) and the
+//    structure-of-arrays batch (interpolate_many_soa) give the same values within the rounding of
+//    their angle computations, float and double maps;
+//  - max_node_spacing() against brute force (CGAL kd-tree over the node directions): no direction
+//    is farther than it from its nearest node, and it is not overstated (the largest such distance
+//    is at least a quarter of it).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "impinge/exact_reference.hpp"
+#include "impinge/helix_scheme.hpp"
+#include "impinge/sampling_scheme.hpp"
+
+using namespace impinge;
+
+namespace {
+
+// Resolutions with node spacings of about 2, 1 and 0.5 deg, in the scheme's own unit: degrees of
+// precision for the "_deg" schemes, matched helix turns for the "turns" ones.
+std::vector<double> resolutions(const std::string& name, const std::string& unit) {
+  std::vector<double> out;
+  for (double p : {2.0, 1.0}) out.push_back(unit == "turns" ? matched_helix_turns(p) : p);
+  out.push_back(default_resolution(name));
+  return out;
+}
+
+std::vector<Eigen::Vector3d> directions(std::mt19937_64& rng, int n) {
+  std::normal_distribution<double> g(0, 1);
+  std::vector<Eigen::Vector3d> out{Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(),
+                                   Eigen::Vector3d(1, -1e-15, 0).normalized(), Eigen::Vector3d(1, 1e-15, 0).normalized(),
+                                   Eigen::Vector3d(1e-9, 0, 1).normalized(), Eigen::Vector3d(0, 1e-9, -1).normalized()};
+  for (int i = 0; i < n; ++i) out.push_back(Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized());
+  for (int i = 0; i < n / 10; ++i)  // near the poles and the seam
+    out.push_back(Eigen::Vector3d(1e-3 * g(rng), 1e-3 * g(rng), i % 2 ? 1 : -1).normalized()),
+        out.push_back(Eigen::Vector3d(1, 1e-4 * g(rng), g(rng)).normalized());
+  return out;
+}
+
+struct Case {
+  std::string name;
+  double resolution;
+};
+
+std::vector<Case> cases() {
+  std::vector<Case> out;
+  for (const auto& [name, unit] : scheme_names())
+    for (double r : resolutions(name, unit)) out.push_back({name, r});
+  return out;
+}
+
+}  // namespace
+
+class SchemeConformance : public ::testing::TestWithParam<Case> {};
+
+TEST_P(SchemeConformance, NodeOfItsOwnDirectionIsItself) {
+  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const std::int64_t n = s->num_nodes();
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<std::int64_t> pick(0, n - 1);
+  const bool all = n <= 300000;
+  std::int64_t wrong = 0, checked = 0;
+  for (std::int64_t k = 0; k < (all ? n : 200000); ++k) {
+    const std::int64_t i = all ? k : pick(rng);
+    // A scheme may store one direction several times (the equiangular grid's pole rows hold
+    // 360/p copies of each pole): then any node of that direction is the right answer.
+    const Eigen::Vector3d d = s->node_direction(i);
+    const std::int64_t j = s->node(d);
+    wrong += j != i && s->node_direction(j) != d;
+    ++checked;
+  }
+  EXPECT_EQ(wrong, 0) << s->name() << " " << s->resolution() << ": of " << checked;
+}
+
+TEST_P(SchemeConformance, StencilsAreConvexCombinationsOfValidNodes) {
+  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  std::mt19937_64 rng(5);
+  for (const Eigen::Vector3d& u : directions(rng, 20000)) {
+    const Stencil st = s->interpolate(u);
+    double sum = 0;
+    for (int k = 0; k < 4; ++k) {
+      ASSERT_GE(st.nodes[k], 0) << s->name() << " at " << u.transpose();
+      ASSERT_LT(st.nodes[k], s->num_nodes()) << s->name() << " at " << u.transpose();
+      ASSERT_GE(st.weights[k], 0) << s->name() << " at " << u.transpose();
+      sum += st.weights[k];
+    }
+    ASSERT_NEAR(sum, 1.0, 1e-12) << s->name() << " at " << u.transpose();
+  }
+}
+
+TEST_P(SchemeConformance, SingleBatchAndSoaLookUpsAgree) {
+  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> val(20, 30);
+  std::vector<double> vd(std::size_t(s->num_nodes()));
+  std::vector<float> vf(vd.size());
+  for (std::size_t i = 0; i < vd.size(); ++i) vd[i] = val(rng), vf[i] = float(vd[i]);
+  const std::vector<Eigen::Vector3d> dirs = directions(rng, 5000);
+  const std::int64_t n = std::int64_t(dirs.size());
+  std::vector<double> unit, scaled, x, y, z;
+  for (const Eigen::Vector3d& u : dirs) {
+    unit.insert(unit.end(), {u.x(), u.y(), u.z()});
+    const Eigen::Vector3d p = 17.5 * u;  // any length: only the direction matters
+    scaled.insert(scaled.end(), {p.x(), p.y(), p.z()});
+    x.push_back(u.x()), y.push_back(u.y()), z.push_back(u.z());
+  }
+  for (int storage = 0; storage < 2; ++storage) {
+    std::vector<double> batch(static_cast<std::size_t>(n)), soa(static_cast<std::size_t>(n)),
+        far(static_cast<std::size_t>(n));
+    if (storage == 0) {
+      s->interpolate_many(vf.data(), unit.data(), n, batch.data());
+      s->interpolate_many(vf.data(), scaled.data(), n, far.data());
+      s->interpolate_many_soa(vf.data(), x.data(), y.data(), z.data(), n, soa.data());
+    } else {
+      s->interpolate_many(vd.data(), unit.data(), n, batch.data());
+      s->interpolate_many(vd.data(), scaled.data(), n, far.data());
+      s->interpolate_many_soa(vd.data(), x.data(), y.data(), z.data(), n, soa.data());
+    }
+    for (std::int64_t j = 0; j < n; ++j) {
+      const Stencil st = s->interpolate(dirs[std::size_t(j)]);
+      double single = 0;
+      for (int k = 0; k < 4; ++k)
+        single += st.weights[k] * (storage == 0 ? double(vf[std::size_t(st.nodes[k])]) : vd[std::size_t(st.nodes[k])]);
+      // The same direction through the single stencil, the batch and the SoA batch: the same
+      // stencil, so the same value up to the rounding of the sum.
+      ASSERT_NEAR(batch[std::size_t(j)], single, 1e-12 * single) << s->name() << " storage " << storage << " point " << j;
+      // The SoA kernels may turn directions into angles with polynomials (fast_angles.hpp, within
+      // 1e-13 rad): a weight moves by at most 1e-13 / h per unit (h the node spacing), a look-up by
+      // at most 4e-13 / h times the spread of the values (10 mm here).
+      const double tol = 4e-13 / s->max_node_spacing() * 10 + 1e-12 * single;
+      ASSERT_NEAR(soa[std::size_t(j)], batch[std::size_t(j)], tol) << s->name() << " point " << j;
+      // Only the direction matters: a point 17.5 mm out along it gives the same value up to the
+      // rounding of its angles (1e-9 relative is far below any sampling error).
+      ASSERT_NEAR(far[std::size_t(j)], batch[std::size_t(j)], 1e-9 * single) << s->name() << " point " << j;
+    }
+  }
+}
+
+TEST_P(SchemeConformance, MaxNodeSpacingAgainstBruteForce) {
+  if (!have_exact_reference()) GTEST_SKIP() << "no CGAL in this build";
+  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  if (s->num_nodes() > 300000) GTEST_SKIP() << "brute force at the coarse resolutions only";
+  std::vector<Eigen::Vector3d> nodes;
+  for (std::int64_t i = 0; i < s->num_nodes(); ++i) nodes.push_back(s->node_direction(i));
+  const PointCloudIndex index(nodes);
+  double largest_gap = 0;  // largest distance from a random direction to its nearest node (chord)
+  std::mt19937_64 rng(9);
+  for (const Eigen::Vector3d& u : directions(rng, 50000)) largest_gap = std::max(largest_gap, index.nearest_distance(u));
+  const double spacing = s->max_node_spacing();
+  const double gap_angle = 2 * std::asin(std::min(1.0, largest_gap / 2));
+  // Every direction lies within the spacing of a node (a covering radius above the largest spacing
+  // between neighbours would leave a hole between them).
+  EXPECT_LE(gap_angle, spacing * (1 + 1e-9)) << s->name() << " " << s->resolution();
+  // And the stated spacing is not overstated: the covering radius of a grid of spacing h is at
+  // least h / 2 (half the largest gap between neighbours).
+  EXPECT_GE(gap_angle, 0.5 * spacing / 2) << s->name() << " " << s->resolution();
+}
+
+INSTANTIATE_TEST_SUITE_P(Registered, SchemeConformance, ::testing::ValuesIn(cases()),
+                         [](const ::testing::TestParamInfo<Case>& i) {
+                           std::string n = i.param.name + "_" + std::to_string(int(std::lround(i.param.resolution * 100)));
+                           for (char& c : n)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return n;
+                         });
