@@ -54,7 +54,7 @@ struct InputOptions {
 };
 struct MapOptions {
   std::string scheme = "equiangular", sampling = "auto", mode = "exact", levels;
-  double resolution = 0, precision = 0, turns = 0, occlusion_tolerance = 1.0, max_radius = 0;
+  double resolution = 0, precision = 0, turns = 0, spacing = 0, occlusion_tolerance = 1.0, max_radius = 0;
   double discontinuity_tolerance = 0.05;  // mm
   bool maps_only = false;                 // no exact look-ups at depth discontinuities
 };
@@ -92,6 +92,9 @@ void add_map_options(CLI::App* app, MapOptions& o) {
                   "of 0.5 deg node spacing");
   app->add_option("--precision", o.precision, "Alias of --resolution for equiangular grids: precision p in degrees");
   app->add_option("--turns", o.turns, "Alias of --resolution for the helix: k turns (w = k^2 nodes)");
+  app->add_option("--spacing", o.spacing,
+                  "Largest node spacing wanted, degrees, for any scheme: the coarsest resolution that reaches it "
+                  "(instead of --resolution)");
   app->add_option("--sampling", o.sampling, "auto, rasterize, resample or ray-cast (naive, small meshes only)")
       ->capture_default_str();
   app->add_option("--mode", o.mode, "Distance mode: 'linear' (thesis Alg. 1) or 'exact' (ray-plane)")
@@ -153,6 +156,9 @@ struct Setup {
 };
 
 double scheme_resolution(const MapOptions& m) {
+  const int given = (m.resolution > 0) + (m.precision > 0) + (m.turns > 0) + (m.spacing > 0);
+  require(given <= 1, "give one of --resolution, --precision, --turns and --spacing");
+  if (m.spacing > 0) return resolution_for_spacing(m.scheme, m.spacing);
   if (m.resolution > 0) return m.resolution;
   if (m.precision > 0) return m.precision;
   if (m.turns > 0) return m.turns;

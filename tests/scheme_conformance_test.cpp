@@ -9,12 +9,14 @@
 //    their angle computations, float and double maps;
 //  - max_node_spacing() against brute force (CGAL kd-tree over the node directions): no direction
 //    is farther than it from its nearest node, and it is not overstated (the largest such distance
-//    is at least a quarter of it).
+//    is at least a quarter of it);
+//  - resolution_for_spacing gives the coarsest resolution that reaches a node spacing.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include "impinge/error.hpp"
 #include "impinge/exact_reference.hpp"
 #include "impinge/helix_scheme.hpp"
 #include "impinge/sampling_scheme.hpp"
@@ -161,6 +163,34 @@ TEST_P(SchemeConformance, MaxNodeSpacingAgainstBruteForce) {
   // And the stated spacing is not overstated: the covering radius of a grid of spacing h is at
   // least h / 2 (half the largest gap between neighbours).
   EXPECT_GE(gap_angle, 0.5 * spacing / 2) << s->name() << " " << s->resolution();
+}
+
+TEST_P(SchemeConformance, ResolutionForSpacingIsTheCoarsestThatReachesIt) {
+  // resolution_for_spacing(name, s): max_node_spacing <= s, and the next coarser resolution does not
+  // reach s (minimal), for spacings around this case's own.
+  const auto here = make_scheme(GetParam().name, GetParam().resolution);
+  const double s_deg = here->max_node_spacing() * 180 / M_PI * 1.05;
+  const double r = resolution_for_spacing(GetParam().name, s_deg);
+  const auto s = make_scheme(GetParam().name, r);
+  EXPECT_LE(s->max_node_spacing() * 180 / M_PI, s_deg * (1 + 1e-9)) << s->name() << " " << r;
+  // The next coarser resolution the scheme accepts: one turn fewer, or the next p = 180 / n.
+  std::shared_ptr<const SamplingScheme> coarser;
+  if (s->resolution_name() == "turns") {
+    if (r > 2) coarser = make_scheme(GetParam().name, r - 1);
+  } else {
+    for (long n = std::lround(180.0 / r) - 1; n >= 2 && !coarser; --n) {
+      try {
+        coarser = make_scheme(GetParam().name, 180.0 / double(n));
+      } catch (const Error&) {
+      }
+    }
+  }
+  if (coarser)
+    EXPECT_GT(coarser->max_node_spacing() * 180 / M_PI, s_deg)
+        << s->name() << ": " << coarser->resolution() << " also reaches " << s_deg << " deg";
+  EXPECT_THROW(resolution_for_spacing(GetParam().name, 0), Error);
+  EXPECT_THROW(resolution_for_spacing(GetParam().name, -1), Error);
+  EXPECT_THROW(resolution_for_spacing("no-such-scheme", 1), Error);
 }
 
 INSTANTIATE_TEST_SUITE_P(Registered, SchemeConformance, ::testing::ValuesIn(cases()),

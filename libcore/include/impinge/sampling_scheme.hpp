@@ -186,4 +186,11 @@ std::vector<std::pair<std::string, std::string>> scheme_names();
 /// `name` is unknown.
 double default_resolution(const std::string& name);
 
+/// The coarsest resolution of the registered scheme `name` (its own unit) whose largest node
+/// spacing (max_node_spacing) is at most `spacing_deg` degrees: the way to compare schemes at
+/// equal spacing (CLI --spacing). Equiangular-like schemes take p = 180 / n, counted schemes
+/// (helix turns) a whole number >= 2. Throws impinge::Error naming the scheme for an unknown name
+/// or a spacing outside (0, 90] degrees. Source: issue 12.
+double resolution_for_spacing(const std::string& name, double spacing_deg);
+
 }  // namespace impinge
