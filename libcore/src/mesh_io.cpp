@@ -23,9 +23,7 @@ std::string lower_extension(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
-}  // namespace
 
-namespace {
 // load_mesh's checks on a mesh read by any reader: valid, degenerate faces removed, some left.
 TriangleMesh checked(TriangleMesh mesh, const std::string& path) {
   mesh.source = path;
@@ -43,18 +41,15 @@ TriangleMesh load_mesh(const std::string& path) {
   std::error_code ec;
   require(fs::exists(path, ec), path + ": file does not exist");
   require(fs::is_regular_file(path, ec), path + ": not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  require(in.good(), path + ": cannot open file for reading");
   const std::string ext = lower_extension(path);
   if (ext == ".ply" || ext == ".off") {
-    std::ifstream in(path, std::ios::binary);
-    require(in.good(), path + ": cannot open file for reading");
     std::ostringstream bytes;
     bytes << in.rdbuf();
     return checked(ext == ".ply" ? detail::read_ply(path, bytes.str()) : detail::read_off(path, bytes.str()), path);
   }
-  {
-    std::ifstream probe(path, std::ios::binary);
-    require(probe.good(), path + ": cannot open file for reading");
-  }
+  in.close();  // assimp opens the file itself
   unsigned flags = 0;
   Assimp::Importer importer;
   if (ext == ".stl" || ext == ".obj") {
