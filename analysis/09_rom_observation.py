@@ -59,7 +59,7 @@ write_table(d, "table_published", ["group (published)", "IR deg", "subject", "ou
 rows = []
 for s in subjects:
     g = sens[(sens.subject == s)]
-    for kind, sel in (("COR $\\pm$1 mm", g.variant.str.startswith("cor")), ("resolution", g.variant.str.startswith("res"))):
+    for kind, sel in (("COR moved 1 mm", g.variant.str.startswith("cor")), ("resolution", g.variant.str.startswith("res"))):
         v = g[sel].delta_deg.abs()
         rows.append([s, kind, f(v.median(), 2), f(v.max(), 2), str(int(sel.sum()))])
 write_table(d, "table_sensitivity", ["subject", "perturbation", "median $|\\Delta|$ deg", "max $|\\Delta|$ deg", "runs"],
