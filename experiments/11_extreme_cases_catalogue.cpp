@@ -191,7 +191,7 @@ struct SphereCase {
   double first_surface_radius = 0;  ///< R of the sphere the rays meet first; 0: the farthest vertex
 };
 
-int run_sphere_case(CsvWriter& csv, const std::string& case_name, const SphereCase& c, int probes,
+void run_sphere_case(CsvWriter& csv, const std::string& case_name, const SphereCase& c, int probes,
                     std::mt19937_64& rng) {
   const ExactReference ref(c.mesh);
   const double inner = ref.closest_distance(c.cor);
@@ -210,7 +210,6 @@ int run_sphere_case(CsvWriter& csv, const std::string& case_name, const SphereCa
     exact.push_back(*h);
     pts.insert(pts.end(), {u.x(), u.y(), u.z()});
   }
-  int rows = 0;
   for (const auto& [scheme, res] : c.schemes)
     for (DistanceMode mode : c.modes)
       for (int storage = 0; storage < 2; ++storage) {
@@ -233,18 +232,15 @@ int run_sphere_case(CsvWriter& csv, const std::string& case_name, const SphereCa
         csv.row(case_name, c.variant, scheme, res, to_string(mode), storage == 0 ? "float" : "double", c.mesh.F.rows(),
                 got.size(), holes, worst, bound, "mm", int(holes == 0 && worst <= bound),
                 c.note.empty() ? "sagitta " + fmt(sagitta) + " mm" : c.note + "; sagitta " + fmt(sagitta) + " mm");
-        ++rows;
       }
-  return rows;
 }
 
 // Case 5: touching (gap 1e-6 and 0 mm) and deeply penetrating (10 mm) bones: a ball sphere of
 // radius R and a socket sphere of radius R + g with the same tessellation about the COR, so the exact
 // radial gap of every vertex is g (its ray meets the other mesh at a vertex). Claimed: every gap
 // within max(s_ball, s_socket) + float rounding of g (the maps are float in a Joint).
-int run_touching(CsvWriter& csv, const Schemes& schemes) {
+void run_touching(CsvWriter& csv, const Schemes& schemes) {
   const double R = 22;
-  int rows = 0;
   for (double g : {1e-6, 0.0, -10.0}) {
     const TriangleMesh ball = make_uv_sphere(R, Eigen::Vector3d::Zero(), 72, 36);
     const TriangleMesh socket = make_uv_sphere(R + g, Eigen::Vector3d::Zero(), 72, 36);
@@ -280,10 +276,8 @@ int run_touching(CsvWriter& csv, const Schemes& schemes) {
              << " gaps of the wrong sign";
         csv.row("5 touching and penetrating bones", variant, scheme, res, to_string(mode), "float", ball.F.rows(),
                 compared, holes, worst, bound, "mm", int(holes == 0 && worst <= bound), note.str());
-        ++rows;
       }
   }
-  return rows;
 }
 
 // Case 8: the COR near the ball's surface: 1 mm inside a ball sphere (R = 22 mm, socket sphere
@@ -291,7 +285,7 @@ int run_touching(CsvWriter& csv, const Schemes& schemes) {
 // the ball (no hole) and every tested gap must be within 0.05 mm of the exact radial gap (CGAL on
 // both meshes from the COR), at 0.1 deg; on the surface about half the directions meet no ball, which
 // HipJoint refuses (more than 1e-4 of the nodes uncovered): the row passes when the map shows it.
-int run_cor_cases(CsvWriter& csv, const Schemes& schemes) {
+void run_cor_cases(CsvWriter& csv, const Schemes& schemes) {
   const double R = 22;
   const Eigen::Vector3d c = Eigen::Vector3d::Zero();
   const TriangleMesh ball = make_uv_sphere(R, c, 72, 36), socket = make_uv_sphere(R + 2, c, 72, 36);
@@ -308,10 +302,9 @@ int run_cor_cases(CsvWriter& csv, const Schemes& schemes) {
       {"0.01 mm inside the ball mesh (below a face)", face - 0.01 * face_normal},
       {"on a face of the ball", face},
       {"at a vertex of the ball", top}};
-  int rows = 0;
+  const ExactReference eb(ball), es(socket);  // about any origin: built once for every COR
   for (const auto& [variant, cor] : cors) {
     const bool inside = variant.find("inside") != std::string::npos;
-    const ExactReference eb(ball), es(socket);
     for (const auto& [scheme, res] : schemes) {
       JointOptions o;
       o.scheme = make_scheme(scheme, res);
@@ -321,7 +314,6 @@ int run_cor_cases(CsvWriter& csv, const Schemes& schemes) {
         csv.row("8 COR near the ball's surface", variant, scheme, res, "exact", "float", ball.F.rows(),
                 j.ball().map.num_nodes(), 0, uncovered, 1e-4, "fraction uncovered", int(uncovered > 1e-4),
                 "HipJoint refuses a COR with more than 1e-4 of the directions uncovered");
-        ++rows;
         continue;
       }
       const PoseResult r = j.detect(Eigen::Matrix3d::Identity());
@@ -347,23 +339,20 @@ int run_cor_cases(CsvWriter& csv, const Schemes& schemes) {
       note << "fraction of directions without ball surface " << fmt(uncovered);
       csv.row("8 COR near the ball's surface", variant, scheme, res, "exact", "float", ball.F.rows(), compared, holes,
               worst, 0.05, "mm", int(holes == 0 && worst <= 0.05 && uncovered <= 1e-4), note.str());
-      ++rows;
     }
   }
-  return rows;
 }
 
 // Case 6a: the geometric sphere fit on caps of 5 to 45 deg: the RMS centre error over trials against
 // its first-order prediction sigma * sqrt(trace of the centre block of (J^T J)^-1), J the Jacobian of
 // the residuals |p - c| - r at the true sphere; claimed within 1.5 times the prediction (plus 1e-9 R
 // for the noise-free fit), and cond(J^T J) reported.
-int run_sphere_fits(CsvWriter& csv, bool quick) {
+void run_sphere_fits(CsvWriter& csv, bool quick) {
   const double R = 22;
   const int n = 2000, trials = quick ? 10 : 50;
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u01(0, 1);
   std::normal_distribution<double> gauss(0, 1);
-  int rows = 0;
   for (double cap : {5.0, 10.0, 20.0, 45.0})
     for (double sigma : {0.0, 0.1}) {
       double sum2 = 0, cond = 0, predicted = 0;
@@ -393,9 +382,7 @@ int run_sphere_fits(CsvWriter& csv, bool quick) {
            << " trials";
       csv.row("6 stiff numerics: sphere fit", variant.str(), "-", n, "geometric", "double", 0, trials, 0, rms, bound,
               "mm", int(rms <= bound), note.str());
-      ++rows;
     }
-  return rows;
 }
 
 // Case 6b: the helix arc length s(phi) (Carlson form and the tabulated fast form) against GSL's
@@ -420,10 +407,9 @@ double quadrature(double k, double phi, gsl_integration_workspace* ws) {
   return result;
 }
 
-int run_helix_arc(CsvWriter& csv, bool quick) {
+void run_helix_arc(CsvWriter& csv, bool quick) {
   gsl_set_error_handler_off();
   gsl_integration_workspace* ws = gsl_integration_workspace_alloc(1000);
-  int rows = 0;
   for (double k : {2.0, 10.0, 229.0, 4584.0, 1e5}) {
     const HelixArcLength arc(k);
     std::vector<double> phis;
@@ -445,18 +431,15 @@ int run_helix_arc(CsvWriter& csv, bool quick) {
       csv.row("6 stiff numerics: helix arc length", variant.str(), "helix", k, form == 0 ? "Carlson" : "tabulated",
               "double", 0, phis.size(), 0, w, bound, "node spacings", int(w <= bound),
               "against GSL QAG (Gauss-Kronrod 61) in pieces of 0.05 rad; angles to 1e-8 rad from the poles");
-      ++rows;
     }
   }
   gsl_integration_workspace_free(ws);
-  return rows;
 }
 
 // Case 6c: the conchoid's inversion phi(s) at its end points: on a circle (b = 0, s = a phi exactly)
 // against the closed form, and on Menschik's conchoid by the forward length (|L(phi(s)) - s| / r,
 // an angle). Claimed: within 1e-12 rad.
-int run_conchoid_inversion(CsvWriter& csv) {
-  int rows = 0;
+void run_conchoid_inversion(CsvWriter& csv) {
   for (int which = 0; which < 2; ++which) {
     const Conchoid c = which == 0 ? Conchoid(20.0, 0.0) : Conchoid(kMenschikA, kMenschikB);
     const double phi_max = M_PI / 2, L = c.arc_length(phi_max);
@@ -471,9 +454,7 @@ int run_conchoid_inversion(CsvWriter& csv) {
     csv.row("6 stiff numerics: conchoid inversion", which == 0 ? "circle (b = 0), closed form" : "Menschik's conchoid",
             "conchoid", 0, "Brent", "double", 0, fractions.size(), 0, worst, 1e-12, "rad", int(worst <= 1e-12),
             "s at 0, 1e-15 .. 1e-3, 0.5 of the length and as near its end");
-    ++rows;
   }
-  return rows;
 }
 
 }  // namespace
@@ -510,16 +491,16 @@ int run_extreme_case_catalogue(const Args& args, const std::string& dir) {
       {"duplicate and inverted faces", with_duplicates(base), O, all, ""},
       {"non-manifold edges (outward fins)", with_fins(base, O), O, all, "", {DistanceMode::exact, DistanceMode::linear}, R},
       {"self-intersecting (two tessellations)", with_second_tessellation(base, O), O, all, ""}};
-  int rows = 0;
+  int steps = 0;
   for (const SphereCase& c : geometry) {
-    progress("11_extreme_cases catalogue", ++rows, 17, "2 triangles: " + c.variant);
+    progress("11_extreme_cases catalogue", ++steps, 17, "2 triangles: " + c.variant);
     run_sphere_case(csv, "2 triangles: poles, seam, slivers, duplicates, non-manifold, self-intersecting", c, probes, rng);
   }
   // Case 3: scales and placement.
   const Eigen::Vector3d far(1e5, -1e5, 1e5);
   TriangleMesh far_float = make_uv_sphere(R, far, 72, 36);
   double quantum = 0;
-  for (Eigen::Index i = 0; i < far_float.V.rows(); ++i)
+  for (Eigen::Index i = 0; i < far_float.V.steps(); ++i)
     for (int d = 0; d < 3; ++d) {
       const double v = far_float.V(i, d), f = double(float(v));
       quantum = std::max(quantum, std::abs(f - v));
@@ -532,7 +513,7 @@ int run_extreme_case_catalogue(const Args& args, const std::string& dir) {
       {"1e5 mm from the origin, float input", far_float, far, all,
        "float coordinates moved the vertices by up to " + fmt(quantum) + " mm; the oracle is the float mesh"}};
   for (const SphereCase& c : placement) {
-    progress("11_extreme_cases catalogue", ++rows, 17, "3 scale: " + c.variant);
+    progress("11_extreme_cases catalogue", ++steps, 17, "3 scale: " + c.variant);
     run_sphere_case(csv, "3 scales and placement", c, probes, rng);
   }
   // Case 4: size of the problem: a million triangles at 0.1 deg; precision 0.01 deg (0.05 quick).
@@ -543,22 +524,22 @@ int run_extreme_case_catalogue(const Args& args, const std::string& dir) {
     const int nt = args.quick ? 502 : 1002, np = args.quick ? 250 : 500;
     SphereCase million{args.quick ? "250k triangles, 0.1 deg" : "a million triangles, 0.1 deg",
                        make_uv_sphere(R, O, nt, np), O, fine, ""};
-    progress("11_extreme_cases catalogue", ++rows, 17, "4 size: a million triangles");
+    progress("11_extreme_cases catalogue", ++steps, 17, "4 size: a million triangles");
     run_sphere_case(csv, "4 problem size", million, probes, rng);
     const double pmin = args.quick ? 0.05 : 0.01;
     SphereCase finest{"precision " + fmt(pmin) + " deg", base, O, {{"equiangular", pmin}}, ""};
-    progress("11_extreme_cases catalogue", ++rows, 17, "4 size: precision " + fmt(pmin));
+    progress("11_extreme_cases catalogue", ++steps, 17, "4 size: precision " + fmt(pmin));
     run_sphere_case(csv, "4 problem size", finest, probes, rng);
   }
-  progress("11_extreme_cases catalogue", ++rows, 17, "5 touching and penetrating bones");
+  progress("11_extreme_cases catalogue", ++steps, 17, "5 touching and penetrating bones");
   run_touching(csv, {{"equiangular", 0.1}, {"helix", matched_helix_turns(0.1)}, {"conchoid", 0.1}});
-  progress("11_extreme_cases catalogue", ++rows, 17, "8 COR near the ball's surface");
+  progress("11_extreme_cases catalogue", ++steps, 17, "8 COR near the ball's surface");
   run_cor_cases(csv, {{"equiangular", 0.1}, {"helix", matched_helix_turns(0.1)}, {"conchoid", 0.1}});
-  progress("11_extreme_cases catalogue", ++rows, 17, "6 stiff numerics");
+  progress("11_extreme_cases catalogue", ++steps, 17, "6 stiff numerics");
   run_sphere_fits(csv, args.quick);
   run_helix_arc(csv, args.quick);
   run_conchoid_inversion(csv);
-  return rows;
+  return steps;
 }
 
 }  // namespace impinge::experiment

@@ -14,7 +14,8 @@
 namespace impinge::experiment {
 
 /// Run the catalogue into DIR/cases.csv (header: case, variant, scheme, resolution, mode, storage,
-/// triangles, compared, holes, max_abs, bound, unit, pass, note). Returns the number of rows.
+/// triangles, compared, holes, max_abs, bound, unit, pass, note). Returns the number of steps run
+/// (the progress count recorded in meta.json).
 int run_extreme_case_catalogue(const Args& args, const std::string& dir);
 
 }  // namespace impinge::experiment
