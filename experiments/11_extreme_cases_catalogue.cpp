@@ -500,7 +500,7 @@ int run_extreme_case_catalogue(const Args& args, const std::string& dir) {
   const Eigen::Vector3d far(1e5, -1e5, 1e5);
   TriangleMesh far_float = make_uv_sphere(R, far, 72, 36);
   double quantum = 0;
-  for (Eigen::Index i = 0; i < far_float.V.steps(); ++i)
+  for (Eigen::Index i = 0; i < far_float.V.rows(); ++i)
     for (int d = 0; d < 3; ++d) {
       const double v = far_float.V(i, d), f = double(float(v));
       quantum = std::max(quantum, std::abs(f - v));
