@@ -18,20 +18,27 @@
 
 #include "impinge/error.hpp"
 #include "impinge/exact_reference.hpp"
-#include "impinge/helix_scheme.hpp"
+#include "impinge/generated_models.hpp"
+#include "impinge/sampling.hpp"
 #include "impinge/sampling_scheme.hpp"
 
 using namespace impinge;
 
 namespace {
 
-// Resolutions with node spacings of about 2, 1 and 0.5 deg, in the scheme's own unit: degrees of
-// precision for the "_deg" schemes, matched helix turns for the "turns" ones.
-std::vector<double> resolutions(const std::string& name, const std::string& unit) {
+// Resolutions with node spacings of at most 2 and 1 deg (resolution_for_spacing) and the scheme's
+// default, in the scheme's own unit.
+std::vector<double> resolutions(const std::string& name) {
   std::vector<double> out;
-  for (double p : {2.0, 1.0}) out.push_back(unit == "turns" ? matched_helix_turns(p) : p);
+  for (double p : {2.0, 1.0}) out.push_back(resolution_for_spacing(name, p));
   out.push_back(default_resolution(name));
   return out;
+}
+
+// Resolutions in degrees ("precision_deg") are finer when smaller; every other resolution is a
+// whole count (turns, cells, nside) that is finer when larger.
+bool resolution_in_degrees(const std::string& unit) {
+  return unit.size() > 4 && unit.compare(unit.size() - 4, 4, "_deg") == 0;
 }
 
 std::vector<Eigen::Vector3d> directions(std::mt19937_64& rng, int n) {
@@ -54,7 +61,7 @@ struct Case {
 std::vector<Case> cases() {
   std::vector<Case> out;
   for (const auto& [name, unit] : scheme_names())
-    for (double r : resolutions(name, unit)) out.push_back({name, r});
+    for (double r : resolutions(name)) out.push_back({name, r});
   return out;
 }
 
@@ -79,6 +86,26 @@ TEST_P(SchemeConformance, NodeOfItsOwnDirectionIsItself) {
     ++checked;
   }
   EXPECT_EQ(wrong, 0) << s->name() << " " << s->resolution() << ": of " << checked;
+}
+
+TEST_P(SchemeConformance, NodeAnglesAreThoseOfNodeDirections) {
+  // node_angles (the resampling fast path, overridden by most schemes) against the angles of
+  // node_direction, on every node at coarse resolutions and a run of nodes at fine ones.
+  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const std::int64_t n = std::min<std::int64_t>(s->num_nodes(), 300000);
+  std::vector<double> phi(static_cast<std::size_t>(n)), theta(phi.size());
+  s->node_angles(0, n, phi.data(), theta.data());
+  for (std::int64_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d d = s->node_direction(i);
+    const double sp = std::sin(phi[std::size_t(i)]);
+    const Eigen::Vector3d a(sp * std::cos(theta[std::size_t(i)]), sp * std::sin(theta[std::size_t(i)]),
+                            std::cos(phi[std::size_t(i)]));
+    // Schemes may invert their node placement iteratively (the helix's arc length by Newton): a
+    // billionth of the node spacing moves a resampled value by nothing measurable.
+    ASSERT_LT((a - d).norm(), 1e-9 * s->max_node_spacing()) << s->name() << " node " << i;
+    ASSERT_GE(theta[std::size_t(i)], 0) << s->name() << " node " << i;
+    ASSERT_LT(theta[std::size_t(i)], 2 * M_PI) << s->name() << " node " << i;
+  }
 }
 
 TEST_P(SchemeConformance, StencilsAreConvexCombinationsOfValidNodes) {
@@ -173,9 +200,9 @@ TEST_P(SchemeConformance, ResolutionForSpacingIsTheCoarsestThatReachesIt) {
   const double r = resolution_for_spacing(GetParam().name, s_deg);
   const auto s = make_scheme(GetParam().name, r);
   EXPECT_LE(s->max_node_spacing() * 180 / M_PI, s_deg * (1 + 1e-9)) << s->name() << " " << r;
-  // The next coarser resolution the scheme accepts: one turn fewer, or the next p = 180 / n.
+  // The next coarser resolution the scheme accepts: one count fewer, or the next p = 180 / n.
   std::shared_ptr<const SamplingScheme> coarser;
-  if (s->resolution_name() == "turns") {
+  if (!resolution_in_degrees(s->resolution_name())) {
     if (r > 2) coarser = make_scheme(GetParam().name, r - 1);
   } else {
     for (long n = std::lround(180.0 / r) - 1; n >= 2 && !coarser; --n) {
@@ -185,12 +212,48 @@ TEST_P(SchemeConformance, ResolutionForSpacingIsTheCoarsestThatReachesIt) {
       }
     }
   }
-  if (coarser)
+  if (coarser) {
     EXPECT_GT(coarser->max_node_spacing() * 180 / M_PI, s_deg)
         << s->name() << ": " << coarser->resolution() << " also reaches " << s_deg << " deg";
+  }
   EXPECT_THROW(resolution_for_spacing(GetParam().name, 0), Error);
   EXPECT_THROW(resolution_for_spacing(GetParam().name, -1), Error);
   EXPECT_THROW(resolution_for_spacing("no-such-scheme", 1), Error);
+}
+
+TEST_P(SchemeConformance, SampledSphereAgreesWithTheExactReference) {
+  // Every scheme's map of a sphere 3 mm off the COR (radius 22 mm, 2-deg facets), filled by ray
+  // casting (exact node values) and by its default method (rasterised, or resampled from a
+  // rasterised equiangular map), looked up at random directions against CGAL's first hit on the
+  // same mesh. Bound: bilinear or barycentric interpolation over nodes within 2 h of the point
+  // (h = max_node_spacing) of a radius function whose second derivative is below 7 mm, plus twice
+  // the facet sagitta; resampling adds the same bound at the temporary grid's spacing.
+  if (!have_exact_reference()) GTEST_SKIP() << "no CGAL in this build";
+  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  if (s->num_nodes() > 30000) GTEST_SKIP() << "ray casting at the coarse resolutions only";
+  const TriangleMesh mesh = make_uv_sphere(22, Eigen::Vector3d(1.5, -2.0, 1.6), 180, 90, Eigen::Vector3d(0.2, 0.1, 0.97));
+  const ExactReference exact(mesh);
+  RadialDistanceMap cast(s), fast(s);
+  SamplingOptions o;
+  const SamplingReport rep = sample_surface(mesh, Eigen::Vector3d::Zero(), o, fast);
+  o.method = SamplingMethod::ray_cast;
+  sample_surface(mesh, Eigen::Vector3d::Zero(), o, cast);
+  auto bound = [](double h) { return (2 * h) * (2 * h) / 8 * 7; };
+  const double sagitta = 22 * (1 - std::cos(std::sqrt(2.0) * 2 * M_PI / 180));
+  const double h = s->max_node_spacing();
+  const double cast_bound = bound(h) + 2 * sagitta + 1e-5;  // + float rounding of the node values
+  const double fast_bound = cast_bound + bound(std::sqrt(2.0) * rep.resample_precision_deg * M_PI / 180);
+  std::mt19937_64 rng(11);
+  double worst_cast = 0, worst_fast = 0;
+  for (const Eigen::Vector3d& u : directions(rng, 2000)) {
+    const auto r = exact.first_hit(Eigen::Vector3d::Zero(), u);
+    ASSERT_TRUE(r.has_value());
+    worst_cast = std::max(worst_cast, std::abs(cast.sample(u) - *r));
+    worst_fast = std::max(worst_fast, std::abs(fast.sample(u) - *r));
+  }
+  EXPECT_LT(worst_cast, cast_bound) << s->name() << " " << s->resolution();
+  EXPECT_LT(worst_fast, fast_bound) << s->name() << " " << s->resolution() << " (" << to_string(rep.method) << ")";
+  EXPECT_GT(worst_cast, 0);  // an interpolation, not a copy of the oracle
 }
 
 INSTANTIATE_TEST_SUITE_P(Registered, SchemeConformance, ::testing::ValuesIn(cases()),

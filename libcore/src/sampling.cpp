@@ -101,7 +101,11 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
       break;
     case SamplingMethod::resample: {
       double p = o.resample_precision_deg;
-      if (p <= 0) p = matched_equiangular_precision(map.scheme().max_node_spacing());
+      if (p <= 0) {
+        require(o.resample_oversampling >= 1, mesh.source + ": resample oversampling " +
+                                                   std::to_string(o.resample_oversampling) + " must be >= 1");
+        p = matched_equiangular_precision(map.scheme().max_node_spacing() / o.resample_oversampling);
+      }
       rep.resample_precision_deg = p;
       {
         RadialDistanceMap tmp{EquiangularGrid(p)};

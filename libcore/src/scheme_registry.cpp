@@ -5,7 +5,9 @@
 #include "impinge/conchoid_grid.hpp"
 #include "impinge/equiangular_grid.hpp"
 #include "impinge/error.hpp"
+#include "impinge/healpix_scheme.hpp"
 #include "impinge/helix_scheme.hpp"
+#include "impinge/octahedral_scheme.hpp"
 #include "impinge/sampling_scheme.hpp"
 #include "impinge/spherical_frame.hpp"
 
@@ -20,7 +22,7 @@ enum class Resolution {
 struct Entry {
   const char* name;
   const char* resolution_name;
-  double default_resolution;  // the scheme's equivalent of 0.5 deg node spacing
+  double default_resolution;  // the scheme's equivalent of 0.5 deg node spacing; 0: resolution_for_spacing(0.5)
   Resolution kind;
   std::function<std::shared_ptr<const SamplingScheme>(double)> make;
 };
@@ -34,6 +36,10 @@ const std::vector<Entry>& registry() {
        [](double k) { return std::make_shared<HelixScheme>(k, TraveledDistance::fitted); }},
       {"conchoid", "precision_deg", 0.5, Resolution::degrees_dividing_180,
        [](double p) { return std::make_shared<ConchoidGrid>(p); }},
+      {"octahedral", "cells_per_side", 0, Resolution::whole_count,
+       [](double n) { return std::make_shared<OctahedralScheme>(n); }},
+      {"healpix", "nside", 0, Resolution::whole_count,
+       [](double n) { return std::make_shared<HealpixScheme>(n); }},
   };
   return entries;
 }
@@ -52,7 +58,10 @@ std::shared_ptr<const SamplingScheme> make_scheme(const std::string& name, doubl
   return entry(name).make(resolution);
 }
 
-double default_resolution(const std::string& name) { return entry(name).default_resolution; }
+double default_resolution(const std::string& name) {
+  const Entry& e = entry(name);
+  return e.default_resolution > 0 ? e.default_resolution : resolution_for_spacing(name, 0.5);
+}
 
 double resolution_for_spacing(const std::string& name, double spacing_deg) {
   const Entry& e = entry(name);

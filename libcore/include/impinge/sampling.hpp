@@ -32,6 +32,11 @@ struct SamplingOptions {
   double resample_precision_deg = 0;  ///< temporary equiangular precision for `resample`; 0 picks
                                       ///< 180 / round(180 / node spacing in degrees), the precision
                                       ///< whose equator count matches the scheme's (thesis Table 6)
+  /// `resample` with resample_precision_deg = 0: the temporary equiangular precision is the matched
+  /// one divided by this (>= 1). 1 is the thesis' accelerated sampling (sec. 4.2.2); its bilinear
+  /// error adds to the scheme's own, so comparisons of schemes at equal error use 2 (a quarter of
+  /// that error, at four times the rasterisation). Source: issue 12.
+  int resample_oversampling = 1;
   /// Exact mode: skip the triangles that can never be the nearest hit (face_culling.hpp).
   /// With `culling` null, the analysis is made here (O(m), counted in culling_ms); culling
   /// turns itself off, and says why, on meshes where it would not be exact.
