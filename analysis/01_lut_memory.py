@@ -61,6 +61,15 @@ ax.grid(True, alpha=0.3)
 ax.legend(fontsize=8)
 save(fig, d, "density")
 
+# Every registered scheme at equal largest node spacing (schemes.csv, issue 12).
+sch = read_csv(d, "schemes.csv")
+rows = []
+for (name, unit), g in sch.groupby(["scheme", "resolution_name"], sort=False):
+    g = g.set_index("spacing_deg")
+    rows.append([name, unit.replace("_", " ")] + [f"{g.resolution[p]:g}" for p in (1.0, 0.1)] +
+                [f"{int(g.nodes[p]):,}" for p in (1.0, 0.1)] + [f"{g.nodes_over_equiangular[0.1]:.2f}"])
+write_table(d, "table_schemes", ["scheme", "resolution", "at 1 deg", "at 0.1 deg", "nodes, 1 deg", "nodes, 0.1 deg",
+                                 "/ equiangular"], rows, align="llrrrrr")
 eq1 = df[(df.scheme == "equiangular") & (df.matched_precision_deg == 1)].iloc[0]
 hx1 = df[(df.scheme == "helix") & (df.matched_precision_deg == 1)].iloc[0]
 fine = match.iloc[-1]
@@ -70,4 +79,6 @@ write_macros(d, "macros", {
     "LMratioMin": f"{match.node_ratio.min():.2f}", "LMratioMax": f"{match.node_ratio.max():.2f}",
     "LMhxEquatorFiner": f"{match.iloc[-2].helix_equator_nodes:,.1f}",
     "LMhxEquatorFinest": f"{fine.helix_equator_nodes:,.1f}",
+    "LMoctOverEq": f"{sch[(sch.scheme == 'octahedral') & (sch.spacing_deg == 0.1)].nodes_over_equiangular.iloc[0]:.2f}",
+    "LMhpxOverEq": f"{sch[(sch.scheme == 'healpix') & (sch.spacing_deg == 0.1)].nodes_over_equiangular.iloc[0]:.2f}",
 })

@@ -3,7 +3,17 @@ and memory, for every scheme, mode and resolution; Pareto figures; where the err
 
 Reads RESULTS/10_error_vs_runtime/error_runtime.csv and vertex_errors.csv; writes table_main.tex
 (first real subject, rest pose, every configuration), table_peers.tex, pareto_time.pdf,
-pareto_memory.pdf, error_map.pdf (per-vertex errors over the sphere), macros.tex."""
+pareto_memory.pdf, pareto_sampling.pdf, error_map.pdf (per-vertex errors over the sphere),
+equal_error.csv with table_equal_error.tex (every scheme at equal error, issue 12), macros.tex.
+
+equal_error.csv: for every real subject, scheme, storage, mode (exact: the maps alone;
+exact_refined: with the exact look-ups at depth discontinuities), metric (p95 or max |gap error| at
+the scan pose) and target (1e-2, 1e-3, 1e-4 mm), the bytes of both maps, the query ns per vertex and
+the sampling ms at which the scheme reaches the target. The resolutions are a sweep, so these are
+interpolated between the two resolutions that bracket the target, log-linearly in error against
+bytes (query and sampling time at the same fraction of the step, log-linearly too); `how` says
+`interpolated`, `coarsest` (already met at the coarsest resolution: an upper bound) or `not_reached`
+(not met at the finest: empty values). Storage is `dense` (sparse maps are not built yet)."""
 import numpy as np
 import matplotlib.pyplot as plt
 
@@ -52,9 +62,11 @@ write_table(d, "table_peers", ["subject", "pose", "vertices", "p95 (mm)", "max (
             align="llrrrrrrrrr")
 
 # Pareto figures: p95 error against query time and against memory, rest pose, first subject.
-markers = {"equiangular": "o", "helix": "s", "helix-eq10": "v", "conchoid": "^"}
+markers = {"equiangular": "o", "helix": "s", "helix-eq10": "v", "conchoid": "^", "octahedral": "D",
+           "healpix": "h"}
 for xcol, stem, xlabel in [("query_ns_per_vertex", "pareto_time", "query time (ns per vertex)"),
-                           ("bytes", "pareto_memory", "memory of both maps (bytes)")]:
+                           ("bytes", "pareto_memory", "memory of both maps (bytes)"),
+                           ("sampling_ms", "pareto_sampling", "sampling both maps (ms)")]:
     fig, ax = plt.subplots(figsize=(6, 3.8))
     for (scheme, mode), g in g0.groupby(["scheme", "mode"]):
         g = g.sort_values("precision_deg")
@@ -176,5 +188,73 @@ if len(rf):
         "RefRatioMin": f"{ratio.min():.2f}", "RefRatioMax": f"{ratio.max():.2f}",
         "RefMismatchedMaps": f"{int(ex.mismatched.sum())}", "RefMismatchedRefined": f"{int(rf.mismatched.sum())}",
     })
+# Every scheme at equal error (issue 12): interpolated between the resolutions of the sweep.
+TARGETS = (1e-2, 1e-3, 1e-4)
+eq_rows = []
+rest = maps[(maps.pose == "rest") & ~maps.generated.astype(bool) & maps["mode"].isin(["exact", "exact_refined"])]
+for (s_, scheme, mode), g in rest.groupby(["subject", "scheme", "mode"], sort=False):
+    g = g.sort_values("bytes")
+    for metric, col in (("p95", "p95_abs_mm"), ("max", "max_abs_mm")):
+        err = g[col].to_numpy(float)
+        by, ns, sm = (g[c].to_numpy(float) for c in ("bytes", "query_ns_per_vertex", "sampling_ms"))
+        for target in TARGETS:
+            row = dict(subject=s_, scheme=scheme, storage="dense", mode=mode, metric=metric, target_mm=target,
+                       bytes=np.nan, query_ns_per_vertex=np.nan, sampling_ms=np.nan, how="not_reached")
+            if len(err) and err[0] <= target:
+                row.update(bytes=by[0], query_ns_per_vertex=ns[0], sampling_ms=sm[0], how="coarsest")
+            else:
+                for i in range(1, len(err)):
+                    if err[i - 1] > target >= err[i]:
+                        f = (np.log(target) - np.log(err[i - 1])) / (np.log(max(err[i], 1e-12)) - np.log(err[i - 1]))
+
+                        def lerp(a):
+                            return float(np.exp(np.log(a[i - 1]) + f * (np.log(a[i]) - np.log(a[i - 1]))))
+                        row.update(bytes=lerp(by), query_ns_per_vertex=lerp(ns), sampling_ms=lerp(sm),
+                                   how="interpolated")
+                        break
+            eq_rows.append(row)
+if eq_rows:
+    import pandas as pd
+    eqe = pd.DataFrame(eq_rows)
+    eqe.to_csv(f"{d}/equal_error.csv", index=False)
+    # Table: at p95 <= 1e-3 mm, maps alone (exact), every subject: each scheme against the equiangular grid.
+    rows, best = [], {}
+    sel = eqe[(eqe["mode"] == "exact") & (eqe.metric == "p95") & np.isclose(eqe.target_mm, 1e-3)]
+    for s_, g in sel.groupby("subject", sort=False):
+        ref = g[g.scheme == "equiangular"]
+        if not len(ref) or ref.how.iloc[0] == "not_reached":
+            continue
+        rb, rn = ref.bytes.iloc[0], ref.query_ns_per_vertex.iloc[0]
+        for _, r in g.sort_values("bytes").iterrows():
+            if r.how == "not_reached":
+                rows.append([s_, r.scheme, "--", "--", "--", "--", "--"])
+                continue
+            rows.append([s_, r.scheme, f"{r.bytes / 2**20:.1f}", f"{r.bytes / rb:.2f}", f"{r.query_ns_per_vertex:.1f}",
+                         f"{r.query_ns_per_vertex / rn:.2f}", f"{r.sampling_ms:.0f}"])
+            if r.scheme not in ("equiangular", "helix", "helix-eq10", "conchoid"):
+                best.setdefault(s_, []).append((r.bytes / rb, r.query_ns_per_vertex / rn, r.scheme))
+    write_table(d, "table_equal_error", ["subject", "scheme", "MiB", "/ equiangular", "ns/vertex", "/ equiangular",
+                                         "sampling ms"], rows, align="llrrrrr")
+    if subj in best:
+        b = min(best[subj])
+        macros.update({"EqErrBestNewScheme": b[2], "EqErrBestNewBytesRatio": f"{b[0]:.2f}",
+                       "EqErrBestNewNsRatio": f"{b[1]:.2f}"})
+    allb = [x for v_ in best.values() for x in v_]
+    if allb:
+        macros["EqErrNewBytesRatioMin"] = f"{min(x[0] for x in allb):.2f}"
+        macros["EqErrNewBytesRatioMax"] = f"{max(x[0] for x in allb):.2f}"
+        macros["EqErrNewNsRatioMin"] = f"{min(x[1] for x in allb):.1f}"
+        macros["EqErrNewNsRatioMax"] = f"{max(x[1] for x in allb):.1f}"
+    # The helix at equal error: bytes and query time against the equiangular grid, every subject.
+    hx = []
+    for s_, g in sel.groupby("subject", sort=False):
+        a_, b_ = g[g.scheme == "equiangular"], g[g.scheme == "helix"]
+        if len(a_) and len(b_) and (a_.how.iloc[0] != "not_reached") and (b_.how.iloc[0] != "not_reached"):
+            hx.append((b_.bytes.iloc[0] / a_.bytes.iloc[0], b_.query_ns_per_vertex.iloc[0] / a_.query_ns_per_vertex.iloc[0]))
+    if hx:
+        macros["EqErrHelixBytesRatioMin"] = f"{min(x[0] for x in hx):.2f}"
+        macros["EqErrHelixBytesRatioMax"] = f"{max(x[0] for x in hx):.2f}"
+        macros["EqErrHelixNsRatioMin"] = f"{min(x[1] for x in hx):.1f}"
+        macros["EqErrHelixNsRatioMax"] = f"{max(x[1] for x in hx):.1f}"
 write_macros(d, "macros", macros)
 print(f"10_error_vs_runtime: wrote tables and figures to {d}")

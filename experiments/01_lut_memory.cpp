@@ -4,6 +4,9 @@
 // Inputs: none. Outputs: OUT/01_lut_memory/
 //   lut_memory.csv    one row per scheme x resolution x storage (float / double)
 //   helix_match.csv   Table 6: k matched to the equator's node count of each precision
+//   schemes.csv       every registered scheme at the coarsest resolution whose largest node spacing is at
+//                     most 1, 0.5, 0.1 and 0.05 deg (resolution_for_spacing): nodes, float bytes, node
+//                     count relative to the equiangular grid of that spacing (issue 12)
 //   density.csv       nodes per steradian in 1-deg latitude bands centred on whole degrees, both schemes at
 //                     1 deg / k = 229
 //   meta.json
@@ -88,6 +91,20 @@ int main(int argc, char** argv) {
     const std::int64_t w = std::int64_t(k) * std::int64_t(k);
     measure<float>(csv, hx, w, t.helix_nodes, t.helix_mb, t.p);
     measure<double>(csv, hx, w, t.helix_nodes, t.helix_mb, t.p);
+  }
+  // Every registered scheme at equal largest node spacing (issue 12): a new scheme appears here with no
+  // change to this file.
+  {
+    CsvWriter sc(dir + "/schemes.csv", {"spacing_deg", "scheme", "resolution_name", "resolution", "nodes",
+                                        "max_node_spacing_deg", "float_bytes", "nodes_over_equiangular"});
+    for (double p : {1.0, 0.5, 0.1, 0.05}) {
+      const double eq_nodes = double(make_scheme("equiangular", resolution_for_spacing("equiangular", p))->num_nodes());
+      for (const auto& [name, unit] : scheme_names()) {
+        const auto s = make_scheme(name, resolution_for_spacing(name, p));
+        sc.row(p, name, unit, s->resolution(), s->num_nodes(), s->max_node_spacing() * kRadToDeg,
+               s->num_nodes() * std::int64_t(sizeof(float)), double(s->num_nodes()) / eq_nodes);
+      }
+    }
   }
   // Node density against latitude (Fig. 49 compares the two at 1 deg): nodes per steradian in
   // 1-deg bands of phi centred on whole degrees ([b - 0.5, b + 0.5), halved at the poles), so that
