@@ -54,7 +54,15 @@ TEST(Sampling, MethodChoiceAndErrors) {
   o.method = SamplingMethod::automatic;
   EXPECT_EQ(sample_surface(s, Eigen::Vector3d(0.1, 0.2, 0.3), o, hx).nodes_covered, hx.num_nodes());
   EXPECT_THROW(parse_sampling_method("fast"), Error);
-  EXPECT_THROW(make_scheme("healpix", 8), Error);
+  EXPECT_THROW(make_scheme("no-such-scheme", 8), Error);
+  o.resample_oversampling = 0;  // a temporary map coarser than matched: refused, naming the mesh
+  EXPECT_THROW(sample_surface(s, Eigen::Vector3d::Zero(), o, hx), Error);
+  // Oversampling 2 resamples from a grid at half the matched precision.
+  o.resample_oversampling = 1;
+  const double p1 = sample_surface(s, Eigen::Vector3d::Zero(), o, hx).resample_precision_deg;
+  o.resample_oversampling = 2;
+  const double p2 = sample_surface(s, Eigen::Vector3d::Zero(), o, hx).resample_precision_deg;
+  EXPECT_NEAR(p2, p1 / 2, 0.05 * p1);  // both rounded to some 180 / n
 }
 
 TEST(Sampling, RasterizingIntoAUsedMapGivesAFreshMap) {
