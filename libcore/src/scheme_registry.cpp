@@ -1,10 +1,12 @@
 // The registry of sampling schemes: one line per scheme.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
 #include "impinge/conchoid_grid.hpp"
 #include "impinge/equiangular_grid.hpp"
 #include "impinge/error.hpp"
+#include "impinge/fibonacci_scheme.hpp"
 #include "impinge/healpix_scheme.hpp"
 #include "impinge/helix_scheme.hpp"
 #include "impinge/octahedral_scheme.hpp"
@@ -40,6 +42,8 @@ const std::vector<Entry>& registry() {
        [](double n) { return std::make_shared<OctahedralScheme>(n); }},
       {"healpix", "nside", 0, Resolution::whole_count,
        [](double n) { return std::make_shared<HealpixScheme>(n); }},
+      {"fibonacci", "nodes", 0, Resolution::whole_count,
+       [](double n) { return std::make_shared<FibonacciScheme>(n); }},
   };
   return entries;
 }
@@ -85,13 +89,52 @@ double resolution_for_spacing(const std::string& name, double spacing_deg) {
               "sampling scheme '" + name + "': no resolution reaches a node spacing of " + std::to_string(spacing_deg) + " deg");
     }
   }
-  // A whole count k >= 2: from the estimate k ~ (k0 s(k0)) / target, step to the smallest k that
-  // reaches the target (the spacing falls as k grows).
-  const double k0 = std::max(2.0, matched_helix_turns(spacing_deg));
-  double k = std::max(2.0, std::ceil(k0 * spacing(k0) / target));
-  while (spacing(k) > target) ++k;
-  while (k > 2 && spacing(k - 1) <= target) --k;
-  return k;
+  // A whole count k (turns, cells, nside, nodes; finer when larger), from the smallest the scheme
+  // accepts. Bracket the target by doubling, then narrow the bracket [lo, hi] (spacing(lo) > target >=
+  // spacing(hi)) with power-law guesses (spacings fall as k^-a: a = 1 for turns and cells, 1/2 for node
+  // counts) until hi = lo + 1. The bracket, not monotonicity, makes hi the coarsest that reaches it.
+  double lo = 2;
+  double s_lo = 0;
+  for (;; lo *= 2) {
+    try {
+      s_lo = spacing(lo);
+      break;
+    } catch (const Error&) {
+      require(lo < 1e9, "sampling scheme '" + name + "': accepts no whole-count resolution");
+    }
+  }
+  if (s_lo <= target) return lo;
+  double hi = lo, s_hi = s_lo;
+  while (s_hi > target) {
+    lo = hi, s_lo = s_hi;
+    hi *= 2;
+    require(hi < 1e12, "sampling scheme '" + name + "': no resolution reaches a node spacing of " +
+                           std::to_string(spacing_deg) + " deg");
+    s_hi = spacing(hi);
+  }
+  while (hi - lo > 1) {
+    const double a = std::log(s_lo / s_hi) / std::log(hi / lo);
+    double k = a > 0 ? std::round(lo * std::pow(s_lo / target, 1 / a)) : std::round((lo + hi) / 2);
+    k = std::clamp(k, lo + 1, hi - 1);
+    const double s_k = spacing(k);
+    if (s_k <= target) {
+      hi = k, s_hi = s_k;
+      // The guess tends to land just inside: test its coarser neighbour before guessing again.
+      if (hi - lo > 1) {
+        const double s_below = spacing(hi - 1);
+        if (s_below > target) return hi;
+        hi = hi - 1, s_hi = s_below;
+      }
+    } else {
+      lo = k, s_lo = s_k;
+      if (hi - lo > 1) {
+        const double s_above = spacing(lo + 1);
+        if (s_above <= target) return lo + 1;
+        lo = lo + 1, s_lo = s_above;
+      }
+    }
+  }
+  return hi;
 }
 
 std::vector<std::pair<std::string, std::string>> scheme_names() {
