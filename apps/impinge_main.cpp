@@ -54,7 +54,8 @@ struct InputOptions {
 };
 struct MapOptions {
   std::string scheme = "equiangular", sampling = "auto", mode = "exact", levels;
-  double resolution = 0, precision = 0, turns = 0, spacing = 0, occlusion_tolerance = 1.0, max_radius = 0;
+  double resolution = 0, precision = 0, turns = 0, spacing = 0, occlusion_tolerance = 1.0, max_radius = 0,
+         sparse_region = 0;
   double discontinuity_tolerance = 0.05;  // mm
   bool maps_only = false;                 // no exact look-ups at depth discontinuities
 };
@@ -104,6 +105,10 @@ void add_map_options(CLI::App* app, MapOptions& o) {
                   "mm: vertices farther than their own first surface plus this are skipped (beyond reach)")
       ->capture_default_str();
   app->add_option("--max-radius", o.max_radius, "mm: test only vertices within this distance of the COR (0 = all)")
+      ->capture_default_str();
+  app->add_option("--sparse", o.sparse_region,
+                  "mm: store both maps sparse, in tiles, keeping only tiles with a surface within this distance of the "
+                  "COR ('inf': any surface, the same gaps bit for bit; 0 = dense maps)")
       ->capture_default_str();
   app->add_option("--discontinuity-tolerance", o.discontinuity_tolerance,
                   "mm: look-ups whose stencil may be off by more than this (depth discontinuities: rims, coverage "
@@ -196,6 +201,10 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
   jo.exact_at_discontinuities = !mo.maps_only;
   jo.discontinuity_tolerance_mm = mo.discontinuity_tolerance;
   jo.max_radius_mm = mo.max_radius > 0 ? mo.max_radius : std::numeric_limits<double>::infinity();
+  require(!(mo.sparse_region < 0) && !std::isnan(mo.sparse_region),
+          "--sparse " + std::to_string(mo.sparse_region) + ": must be a distance in mm >= 0, or inf");
+  jo.sparse_maps = mo.sparse_region > 0;
+  if (jo.sparse_maps) jo.sparse_region_mm = mo.sparse_region;
   if (!mo.levels.empty()) jo.levels = parse_levels(mo.levels);
 
   TriangleMesh ball = load_mesh(s.ball_path), socket = load_mesh(s.socket_path);
@@ -296,6 +305,9 @@ nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double det
   j["sampling_method"] = to_string(body.sampling.method);
   if (body.sampling.resample_precision_deg > 0) j["resample_precision_deg"] = body.sampling.resample_precision_deg;
   j["map_bytes"] = body.map.bytes();
+  j["map_sparse"] = body.map.sparse();
+  j["map_tiles_stored"] = body.map.tiles_stored();
+  j["map_tiles_total"] = body.map.tiles_total();
   j["triangles"] = body.mesh.F.rows();
   j["degenerate_triangles_skipped"] = body.mesh.degenerate_faces_skipped;
   j["triangles_edge_on"] = body.sampling.raster.triangles_edge_on;

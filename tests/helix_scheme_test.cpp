@@ -150,8 +150,8 @@ TEST(HelixScheme, Eq10LocatingDisagreesSometimes) {
   EXPECT_LT(differ, total);
 }
 
-// The vectorised look-up (interpolate_many_soa) against the scalar stencil (stencil_at through
-// interpolate_many), on random values with holes (no surface), at random directions, directions
+// The vectorised look-up (block stencils_soa through a map) against the scalar stencil (stencil_at
+// through interpolate, combined here), on random values with holes (no surface), at random directions, directions
 // in the first and last turns, and node directions themselves: the same value (to rounding) and
 // the same no-surface verdict, except at node directions whose zero-weight neighbour has no surface.
 TEST(HelixScheme, VectorisedLookUpEqualsTheScalarStencil) {
@@ -159,9 +159,12 @@ TEST(HelixScheme, VectorisedLookUpEqualsTheScalarStencil) {
   std::normal_distribution<double> g;
   std::uniform_real_distribution<double> val(20, 60), unit(0, 1);
   for (double k : {3.0, 229.0, 2292.0}) {
-    const HelixScheme h(k);
-    std::vector<float> values(static_cast<std::size_t>(h.num_nodes()));
-    for (auto& v : values) v = unit(rng) < 0.1 ? std::numeric_limits<float>::infinity() : float(val(rng));
+    const auto hp = std::make_shared<HelixScheme>(k);
+    const HelixScheme& h = *hp;
+    RadialDistanceMap map(hp);
+    float* values = map.data();
+    for (std::int64_t i = 0; i < map.num_nodes(); ++i)
+      values[i] = unit(rng) < 0.1 ? std::numeric_limits<float>::infinity() : float(val(rng));
     std::vector<double> x, y, z;
     for (int i = 0; i < 4000; ++i) {
       Eigen::Vector3d d(g(rng), g(rng), g(rng));
@@ -173,8 +176,17 @@ TEST(HelixScheme, VectorisedLookUpEqualsTheScalarStencil) {
     const auto n = static_cast<std::int64_t>(x.size());
     std::vector<double> pts, soa(static_cast<std::size_t>(n)), aos(static_cast<std::size_t>(n));
     for (std::int64_t i = 0; i < n; ++i) pts.insert(pts.end(), {x[i], y[i], z[i]});
-    h.interpolate_many_soa(values.data(), x.data(), y.data(), z.data(), n, soa.data());
-    h.interpolate_many(values.data(), pts.data(), n, aos.data());
+    map.sample_many_soa(x.data(), y.data(), z.data(), n, soa.data());
+    for (std::int64_t i = 0; i < n; ++i) {
+      const Stencil st = h.interpolate(Eigen::Vector3d(x[i], y[i], z[i]));
+      double v = 0;
+      for (int j = 0; j < 4; ++j) {
+        if (st.weights[j] == 0) continue;
+        const double d = values[st.nodes[j]];
+        v = std::isfinite(d) ? v + st.weights[j] * d : std::numeric_limits<double>::quiet_NaN();
+      }
+      aos[std::size_t(i)] = v;
+    }
     int nan = 0, knife_edge = 0;
     for (std::int64_t i = 0; i < n; ++i) {
       if (std::isnan(soa[i]) != std::isnan(aos[i])) {

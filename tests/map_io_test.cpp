@@ -39,7 +39,7 @@ TEST(MapIo, RoundTripEveryRegisteredSchemeBitForBit) {
   const std::string d = test::temp_dir("map_io");
   for (const auto& [name, res_name] : scheme_names()) {
     SCOPED_TRACE(name);
-    const double res = name.rfind("helix", 0) == 0 ? 101 : 2.0;
+    const double res = resolution_for_spacing(name, 2.0);
     const RadialDistanceMap m = sampled(name, res);
     ASSERT_GT(m.nodes_covered(), 0);
     const Eigen::Vector3d cor(1.5, -2.25, 1e3);
@@ -51,6 +51,15 @@ TEST(MapIo, RoundTripEveryRegisteredSchemeBitForBit) {
     EXPECT_EQ(c, cor);
     ASSERT_EQ(l.num_nodes(), m.num_nodes());
     EXPECT_EQ(std::memcmp(l.data(), m.data(), sizeof(float) * static_cast<std::size_t>(m.num_nodes())), 0);
+    // A sparse map saves as the same file.
+    RadialDistanceMap sp = m;
+    sp.make_sparse(25.0);
+    save_map(d + "/s.map", sp, cor);
+    const RadialDistanceMap ls = load_map<float>(d + "/s.map");
+    for (std::int64_t i = 0; i < m.num_nodes(); ++i) {
+      const float a = ls.at(i), b = sp.at(i);
+      ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << name << " node " << i;
+    }
   }
   // Double maps, and the value type must match.
   RadialDistanceMapDouble dm(make_scheme("equiangular", 5.0));

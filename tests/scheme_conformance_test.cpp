@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "impinge/error.hpp"
@@ -128,9 +129,9 @@ TEST_P(SchemeConformance, SingleBatchAndSoaLookUpsAgree) {
   const auto s = make_scheme(GetParam().name, GetParam().resolution);
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> val(20, 30);
-  std::vector<double> vd(std::size_t(s->num_nodes()));
-  std::vector<float> vf(vd.size());
-  for (std::size_t i = 0; i < vd.size(); ++i) vd[i] = val(rng), vf[i] = float(vd[i]);
+  RadialDistanceMap mf(s);
+  RadialDistanceMapDouble md(s);
+  for (std::int64_t i = 0; i < s->num_nodes(); ++i) md.data()[i] = val(rng), mf.data()[i] = float(md.data()[i]);
   const std::vector<Eigen::Vector3d> dirs = directions(rng, 5000);
   const std::int64_t n = std::int64_t(dirs.size());
   std::vector<double> unit, scaled, x, y, z;
@@ -144,32 +145,139 @@ TEST_P(SchemeConformance, SingleBatchAndSoaLookUpsAgree) {
     std::vector<double> batch(static_cast<std::size_t>(n)), soa(static_cast<std::size_t>(n)),
         far(static_cast<std::size_t>(n));
     if (storage == 0) {
-      s->interpolate_many(vf.data(), unit.data(), n, batch.data());
-      s->interpolate_many(vf.data(), scaled.data(), n, far.data());
-      s->interpolate_many_soa(vf.data(), x.data(), y.data(), z.data(), n, soa.data());
+      mf.sample_many(unit.data(), n, batch.data());
+      mf.sample_many(scaled.data(), n, far.data());
+      mf.sample_many_soa(x.data(), y.data(), z.data(), n, soa.data());
     } else {
-      s->interpolate_many(vd.data(), unit.data(), n, batch.data());
-      s->interpolate_many(vd.data(), scaled.data(), n, far.data());
-      s->interpolate_many_soa(vd.data(), x.data(), y.data(), z.data(), n, soa.data());
+      md.sample_many(unit.data(), n, batch.data());
+      md.sample_many(scaled.data(), n, far.data());
+      md.sample_many_soa(x.data(), y.data(), z.data(), n, soa.data());
     }
     for (std::int64_t j = 0; j < n; ++j) {
       const Stencil st = s->interpolate(dirs[std::size_t(j)]);
       double single = 0;
-      for (int k = 0; k < 4; ++k)
-        single += st.weights[k] * (storage == 0 ? double(vf[std::size_t(st.nodes[k])]) : vd[std::size_t(st.nodes[k])]);
-      // The same direction through the single stencil, the batch and the SoA batch: the same
-      // stencil, so the same value up to the rounding of the sum.
-      ASSERT_NEAR(batch[std::size_t(j)], single, 1e-12 * single) << s->name() << " storage " << storage << " point " << j;
-      // The SoA kernels may turn directions into angles with polynomials (fast_angles.hpp, within
-      // 1e-13 rad): a weight moves by at most 1e-13 / h per unit (h the node spacing), a look-up by
-      // at most 4e-13 / h times the spread of the values (10 mm here).
+      for (int k = 0; k < 4; ++k) single += st.weights[k] * (storage == 0 ? double(mf.at(st.nodes[k])) : md.at(st.nodes[k]));
+      // The block stencils may turn directions into angles with polynomials (fast_angles.hpp,
+      // within 1e-13 rad): a weight moves by at most 1e-13 / h per unit (h the node spacing), a
+      // look-up by at most 4e-13 / h times the spread of the values (10 mm here).
       const double tol = 4e-13 / s->max_node_spacing() * 10 + 1e-12 * single;
-      ASSERT_NEAR(soa[std::size_t(j)], batch[std::size_t(j)], tol) << s->name() << " point " << j;
+      ASSERT_NEAR(batch[std::size_t(j)], single, tol) << s->name() << " storage " << storage << " point " << j;
+      // The row-major batch and the structure-of-arrays batch are the same block look-up.
+      ASSERT_EQ(soa[std::size_t(j)], batch[std::size_t(j)]) << s->name() << " point " << j;
       // Only the direction matters: a point 17.5 mm out along it gives the same value up to the
       // rounding of its angles (1e-9 relative is far below any sampling error).
       ASSERT_NEAR(far[std::size_t(j)], batch[std::size_t(j)], 1e-9 * single) << s->name() << " point " << j;
     }
   }
+}
+
+TEST_P(SchemeConformance, BlockStencilsAreConvexCombinationsOfValidNodes) {
+  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  std::mt19937_64 rng(13);
+  const std::vector<Eigen::Vector3d> dirs = directions(rng, 3000);
+  std::vector<double> x, y, z;
+  for (const Eigen::Vector3d& u : dirs) x.push_back(u.x()), y.push_back(u.y()), z.push_back(u.z());
+  std::int32_t nd[4 * kStencilBlock];
+  double w[4 * kStencilBlock];
+  for (std::size_t b = 0; b < x.size(); b += kStencilBlock) {
+    const int m = int(std::min<std::size_t>(kStencilBlock, x.size() - b));
+    s->stencils_soa(x.data() + b, y.data() + b, z.data() + b, m, nd, w);
+    for (int j = 0; j < m; ++j) {
+      double sum = 0;
+      for (int k = 0; k < 4; ++k) {
+        ASSERT_GE(nd[k * m + j], 0) << s->name() << " at " << dirs[b + j].transpose();
+        ASSERT_LT(nd[k * m + j], s->num_nodes()) << s->name() << " at " << dirs[b + j].transpose();
+        ASSERT_GE(w[k * m + j], 0) << s->name() << " at " << dirs[b + j].transpose();
+        sum += w[k * m + j];
+      }
+      ASSERT_NEAR(sum, 1.0, 1e-12) << s->name() << " at " << dirs[b + j].transpose();
+    }
+  }
+}
+
+TEST_P(SchemeConformance, SparseMapsGiveTheDenseMapsBits) {
+  // A map with holes (no surface) and depth-discontinuity marks, dense against its sparse copies:
+  // with the whole map as region every look-up has the same bits, plain and marked, float and
+  // double; with a region of 25 mm, the same bits wherever every weighted node is within it, and
+  // NaN (no surface within the region) wherever a weighted node lies in an absent tile.
+  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  std::mt19937_64 rng(15);
+  std::uniform_real_distribution<double> val(20, 30), unit(0, 1);
+  RadialDistanceMap mf(s);
+  RadialDistanceMapDouble md(s);
+  // Surfaces over a cap (z > 0.8, a tenth of the sphere), with holes and marks; nothing elsewhere.
+  for (std::int64_t i = 0; i < s->num_nodes(); ++i) {
+    if (s->node_direction(i).z() <= 0.8 || unit(rng) < 0.02) continue;
+    double v = val(rng);
+    float f = float(v);
+    if (unit(rng) < 0.05) {  // a marked node: least significant bit set
+      std::uint32_t bits;
+      std::memcpy(&bits, &f, 4);
+      bits |= 1u;
+      std::memcpy(&f, &bits, 4);
+    }
+    mf.data()[i] = f, md.data()[i] = v;
+  }
+  const std::vector<Eigen::Vector3d> dirs = directions(rng, 5000);
+  const std::int64_t n = std::int64_t(dirs.size());
+  std::vector<double> x, y, z;
+  for (const Eigen::Vector3d& u : dirs) x.push_back(u.x()), y.push_back(u.y()), z.push_back(u.z());
+  auto bits_equal = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  auto check = [&](const auto& dense, auto sparse) {
+    const auto un = static_cast<std::size_t>(n);
+    std::vector<double> a(un), b(un), am(un), bm(un);
+    const std::size_t dense_bytes = dense.bytes();
+    sparse.make_sparse();
+    EXPECT_TRUE(sparse.sparse());
+    // How many tiles a cap touches depends on the node order (a tile is kTileNodes consecutive
+    // indices): rows of a grid, turns of a helix, rings of HEALPix, rows of the octahedral square.
+    EXPECT_LT(sparse.bytes(), dense_bytes * 3 / 4) << s->name() << ": nine tenths of the sphere have no surface";
+    EXPECT_EQ(sparse.nodes_covered(), dense.nodes_covered());
+    EXPECT_THROW((void)sparse.data(), Error);
+    dense.sample_many_soa(x.data(), y.data(), z.data(), n, a.data());
+    sparse.sample_many_soa(x.data(), y.data(), z.data(), n, b.data());
+    dense.sample_many_soa_marked(x.data(), y.data(), z.data(), n, am.data());
+    sparse.sample_many_soa_marked(x.data(), y.data(), z.data(), n, bm.data());
+    int nan = 0, marked = 0;
+    for (std::int64_t j = 0; j < n; ++j) {
+      ASSERT_TRUE(bits_equal(a[j], b[j])) << s->name() << " point " << j << ": " << a[j] << " vs " << b[j];
+      ASSERT_TRUE(bits_equal(am[j], bm[j])) << s->name() << " point " << j << ": " << am[j] << " vs " << bm[j];
+      nan += std::isnan(a[j]), marked += am[j] == -std::numeric_limits<double>::infinity();
+    }
+    EXPECT_GT(nan, n / 4) << "the empty part is looked up";
+    EXPECT_GT(marked, 0) << "marks are looked up";
+    for (std::int64_t i = 0; i < dense.num_nodes(); i += 97) ASSERT_TRUE(bits_equal(dense.at(i), sparse.at(i)));
+    // A copy of a sparse map is a sparse map with its own tiles.
+    const auto copy = sparse;
+    std::vector<double> c(un);
+    copy.sample_many_soa(x.data(), y.data(), z.data(), n, c.data());
+    for (std::int64_t j = 0; j < n; ++j) ASSERT_TRUE(bits_equal(a[j], c[j]));
+  };
+  check(mf, mf);
+  check(md, md);
+  // A region of 25 mm keeps the tiles with a node within it.
+  RadialDistanceMap near = mf;
+  near.make_sparse(25.0);
+  std::vector<double> a(static_cast<std::size_t>(n)), b(static_cast<std::size_t>(n));
+  mf.sample_many_soa(x.data(), y.data(), z.data(), n, a.data());
+  near.sample_many_soa(x.data(), y.data(), z.data(), n, b.data());
+  int same = 0;
+  for (std::int64_t j = 0; j < n; ++j) {
+    const Stencil st = s->interpolate(dirs[std::size_t(j)]);
+    bool all_kept = true;
+    for (int k = 0; k < 4; ++k)
+      if (st.weights[k] > 1e-9 && !(near.at(st.nodes[k]) == mf.at(st.nodes[k]))) all_kept = false;
+    if (all_kept) {
+      ASSERT_TRUE(bits_equal(a[j], b[j]) || (std::isnan(a[j]) && std::isnan(b[j]))) << s->name() << " point " << j;
+      ++same;
+    } else {
+      ASSERT_TRUE(std::isnan(b[j])) << s->name() << " point " << j;
+    }
+  }
+  EXPECT_GT(same, 0);
+  EXPECT_THROW(near.make_sparse(std::nan("")), Error);
+  RadialDistanceMap bad(s);
+  EXPECT_THROW(bad.make_sparse(0), Error);
 }
 
 TEST_P(SchemeConformance, MaxNodeSpacingAgainstBruteForce) {

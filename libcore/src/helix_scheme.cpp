@@ -132,69 +132,27 @@ void helix_along(const double* __restrict s, int n, double inv_dx, double last, 
 }
 }  // namespace
 
-template <typename Scalar, bool kMarked>
-void HelixScheme::lookup_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
-                             double* out) const {
-  constexpr int kChunk = 128;
-  double pa[kChunk], pb[kChunk], u[kChunk], sa[kChunk], sb[kChunk], ta[kChunk], tb[kChunk];
-  std::int32_t ia[kChunk], ib[kChunk];
+void HelixScheme::stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
+                               double* w) const {
+  if (locate_ != TraveledDistance::exact) return SchemeImpl<HelixScheme>::stencils_soa(x, y, z, n, nodes, w);
+  double pa[kStencilBlock], pb[kStencilBlock], u[kStencilBlock], sa[kStencilBlock], sb[kStencilBlock],
+      ta[kStencilBlock], tb[kStencilBlock];
+  std::int32_t ia[kStencilBlock], ib[kStencilBlock];
   const double last = static_cast<double>(w_ - 1);
-  for (std::int64_t b = 0; b < n; b += kChunk) {
-    const int m = static_cast<int>(std::min<std::int64_t>(kChunk, n - b));
+  for (int b = 0; b < n; b += kStencilBlock) {  // callers pass at most one block; any n works
+    const int m = std::min(kStencilBlock, n - b);
     helix_crossings(x + b, y + b, z + b, m, k_, inv_2k_, kPiOverK_, pa, pb, u);
     arc_.evaluate_many(pa, m, sa);
     arc_.evaluate_many(pb, m, sb);
     helix_along(sa, m, inv_dx_, last, ia, ta);
     helix_along(sb, m, inv_dx_, last, ib, tb);
     for (int j = 0; j < m; ++j) {
-      if constexpr (kMarked) {
-        if (has_discontinuity_mark(values[ia[j]]) || has_discontinuity_mark(values[ia[j] + 1]) ||
-            has_discontinuity_mark(values[ib[j]]) || has_discontinuity_mark(values[ib[j] + 1])) {
-          out[b + j] = -std::numeric_limits<double>::infinity();
-          continue;
-        }
-      }
-      const double wa = 1 - u[j], wb = u[j];
-      const double v = wa * ((1 - ta[j]) * values[ia[j]] + ta[j] * values[ia[j] + 1]) +
-                       wb * ((1 - tb[j]) * values[ib[j]] + tb[j] * values[ib[j] + 1]);
-      if (std::isfinite(v)) {
-        out[b + j] = v;
-        continue;
-      }
-      // A node without surface: NaN unless its weight is exactly 0 (the pole crossings, a
-      // direction on a node): the exact scalar stencil decides.
-      const bool zero_weight = u[j] == 0 || u[j] == 1 || ta[j] == 0 || ta[j] == 1 || tb[j] == 0 || tb[j] == 1;
-      if (!zero_weight) {
-        out[b + j] = std::numeric_limits<double>::quiet_NaN();
-        continue;
-      }
-      std::int64_t nd[4];
-      double w[4];
-      stencil_at(x[b + j], y[b + j], z[b + j], nd, w);
-      out[b + j] = slow_path(values, nd, w);
+      const int q = b + j;
+      nodes[q] = ia[j], nodes[n + q] = ia[j] + 1, nodes[2 * n + q] = ib[j], nodes[3 * n + q] = ib[j] + 1;
+      w[q] = (1 - u[j]) * (1 - ta[j]), w[n + q] = (1 - u[j]) * ta[j];
+      w[2 * n + q] = u[j] * (1 - tb[j]), w[3 * n + q] = u[j] * tb[j];
     }
   }
-}
-
-void HelixScheme::interpolate_many_soa(const float* values, const double* x, const double* y, const double* z,
-                                       std::int64_t n, double* out) const {
-  if (locate_ == TraveledDistance::exact) return lookup_soa(values, x, y, z, n, out);
-  SchemeImpl<HelixScheme>::interpolate_many_soa(values, x, y, z, n, out);
-}
-void HelixScheme::interpolate_many_soa(const double* values, const double* x, const double* y, const double* z,
-                                       std::int64_t n, double* out) const {
-  if (locate_ == TraveledDistance::exact) return lookup_soa(values, x, y, z, n, out);
-  SchemeImpl<HelixScheme>::interpolate_many_soa(values, x, y, z, n, out);
-}
-void HelixScheme::interpolate_many_soa_marked(const float* values, const double* x, const double* y, const double* z,
-                                              std::int64_t n, double* out) const {
-  if (locate_ == TraveledDistance::exact) return lookup_soa<float, true>(values, x, y, z, n, out);
-  SchemeImpl<HelixScheme>::interpolate_many_soa_marked(values, x, y, z, n, out);
-}
-void HelixScheme::interpolate_many_soa_marked(const double* values, const double* x, const double* y, const double* z,
-                                              std::int64_t n, double* out) const {
-  if (locate_ == TraveledDistance::exact) return lookup_soa<double, true>(values, x, y, z, n, out);
-  SchemeImpl<HelixScheme>::interpolate_many_soa_marked(values, x, y, z, n, out);
 }
 
 }  // namespace impinge

@@ -95,7 +95,8 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   }
   // The COR must lie inside the femur: then every ray from it meets the femur's surface.
   const RadialDistanceMap& bm = joint_->ball().map;
-  const double uncovered = 1.0 - double(bm.nodes_covered()) / double(bm.num_nodes());
+  // (Counted when the map was filled: a sparse map with a finite region reads "no surface" beyond it.)
+  const double uncovered = 1.0 - double(joint_->ball().sampling.nodes_covered) / double(bm.num_nodes());
   if (uncovered > 1e-4 && !options.allow_cor_outside_ball)
     throw Error(joint_->ball().mesh.source + ": the centre of rotation (" + std::to_string(cor_.x()) + ", " +
                 std::to_string(cor_.y()) + ", " + std::to_string(cor_.z()) + ") mm is outside the femur mesh (" +

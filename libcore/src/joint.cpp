@@ -14,6 +14,7 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
   require(cor.allFinite(), "joint: centre of rotation is not finite");
   require(o.occlusion_tolerance_mm >= 0, "joint: occlusion tolerance must be >= 0 mm");
   require(o.max_radius_mm > 0, "joint: region radius must be > 0 mm");
+  require(o.sparse_region_mm > 0, "joint: sparse region must be > 0 mm");
   require(!o.exact_at_discontinuities || (std::isfinite(o.discontinuity_tolerance_mm) && o.discontinuity_tolerance_mm > 0),
           "joint: the depth-discontinuity tolerance must be > 0 mm and finite");
   o.levels.validate();
@@ -65,6 +66,7 @@ JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given
     clear_depth_discontinuities(b.map);  // a given map may carry marks
     b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);
   }
+  if (options_.sparse_maps) b.map.make_sparse(options_.sparse_region_mm);
   b.scan_set = make_scan_set(b.relative, b.mask);
   b.vertex_area = vertex_areas(b.mesh);
   return b;

@@ -43,7 +43,8 @@ MapImageScale write_map_png(const std::string& path, const RadialDistanceMap& ma
   int w, h;
   if (const auto* g = dynamic_cast<const EquiangularGrid*>(&map.scheme())) {
     w = g->columns(), h = g->rows();
-    value.assign(map.data(), map.data() + map.num_nodes());
+    value.resize(static_cast<std::size_t>(map.num_nodes()));
+    for (std::int64_t i = 0; i < map.num_nodes(); ++i) value[static_cast<std::size_t>(i)] = map.at(i);  // dense or sparse
   } else {
     const EquiangularGrid img(
         matched_equiangular_precision(std::max(map.scheme().max_node_spacing(), 0.1 * kDegToRad)));

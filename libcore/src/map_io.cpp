@@ -54,8 +54,12 @@ void save_map(const std::string& path, const RadialDistanceMapT<Scalar>& map, co
   put(b, static_cast<std::uint32_t>(sizeof(Scalar)));
   put(b, static_cast<std::int64_t>(map.num_nodes()));
   for (int c = 0; c < 3; ++c) put(b, cor[c]);
-  const char* v = reinterpret_cast<const char*>(map.data());
-  b.insert(b.end(), v, v + map.num_nodes() * static_cast<std::int64_t>(sizeof(Scalar)));
+  if (!map.sparse()) {
+    const char* v = reinterpret_cast<const char*>(map.data());
+    b.insert(b.end(), v, v + map.num_nodes() * static_cast<std::int64_t>(sizeof(Scalar)));
+  } else {  // the same file as the dense map: every node, absent tiles as "no surface"
+    for (std::int64_t i = 0; i < map.num_nodes(); ++i) put(b, map.at(i));
+  }
   put(b, fnv1a64(b.data(), b.size()));
   std::ofstream os(path, std::ios::binary);
   require(os.good(), path + ": cannot open for writing");

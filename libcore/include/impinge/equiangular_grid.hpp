@@ -78,22 +78,13 @@ class EquiangularGrid : public SchemeImpl<EquiangularGrid> {
     w[3] = t * s;
   }
 
-  /// Vectorised look-up (AVX2 clone chosen at run time when the CPU has it): for each point,
-  /// the fast angles, the cell and its weights in one pass over the block, the four loads in a
-  /// second. Same values as interpolate_many up to the rounding of the weights (< 1e-12 mm).
-  void interpolate_many_soa(const float* values, const double* x, const double* y, const double* z, std::int64_t n,
-                            double* out) const override;
-  void interpolate_many_soa(const double* values, const double* x, const double* y, const double* z, std::int64_t n,
-                            double* out) const override;
-  void interpolate_many_soa_marked(const float* values, const double* x, const double* y, const double* z,
-                                   std::int64_t n, double* out) const override;
-  void interpolate_many_soa_marked(const double* values, const double* x, const double* y, const double* z,
-                                   std::int64_t n, double* out) const override;
+  /// Block stencils (SamplingScheme::stencils_soa): the fast angles, the cell and its weights in
+  /// one branch-free pass (cloned for AVX-512 and AVX2, chosen at run time), then the node indices.
+  /// The same stencils as stencil_at up to the rounding of the angles (one division for both).
+  void stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
+                    double* w) const override;
 
  private:
-  template <typename Scalar, bool kMarked = false>
-  void lookup_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
-                  double* out) const;
   double precision_deg_;
   double step_;
   double inv_step_;

@@ -105,22 +105,14 @@ class HelixScheme : public SchemeImpl<HelixScheme> {
     w[0] *= 1 - u, w[1] *= 1 - u, w[2] *= u, w[3] *= u;
   }
 
-  /// Vectorised look-up (exact locator; the Eq. 10 locator uses the generic path): the angles
-  /// and both bracketing crossings of a block in one pass, the arc lengths of the crossings in
-  /// a second, the stencils in a third, then the loads. Same stencil as stencil_at.
-  void interpolate_many_soa(const float* values, const double* x, const double* y, const double* z, std::int64_t n,
-                            double* out) const override;
-  void interpolate_many_soa(const double* values, const double* x, const double* y, const double* z, std::int64_t n,
-                            double* out) const override;
-  void interpolate_many_soa_marked(const float* values, const double* x, const double* y, const double* z,
-                                   std::int64_t n, double* out) const override;
-  void interpolate_many_soa_marked(const double* values, const double* x, const double* y, const double* z,
-                                   std::int64_t n, double* out) const override;
+  /// Block stencils (exact locator; the Eq. 10 locator uses stencil_at): the angles and both
+  /// bracketing crossings of a block in one pass, the arc lengths of the crossings in a second, the
+  /// nodes along the curve in a third; vectorised clones. Same stencils as stencil_at up to rounding
+  /// (at the south pole the last node is reached as node w - 2 with weight 0 and w - 1 with 1).
+  void stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
+                    double* w) const override;
 
  private:
-  template <typename Scalar, bool kMarked = false>
-  void lookup_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
-                  double* out) const;
   /// Polar angle of node i by Newton from `guess` (radians; <= 0 for a closed-form start).
   double phi_of_node(std::int64_t i, double guess) const;
   /// The two nodes bracketing the helix point at phi along the curve, with linear weights.

@@ -38,6 +38,12 @@ struct JointOptions {
   /// Off, or in a build without Embree or CGAL, the maps answer alone (the thesis' algorithm).
   bool exact_at_discontinuities = true;
   double discontinuity_tolerance_mm = 0.05;  ///< see exact_at_discontinuities, mm (> 0)
+  /// Store both maps sparse (RadialDistanceMapT::make_sparse) once they are filled and marked: only
+  /// the tiles with a surface within sparse_region_mm of the COR (default: any surface, which gives
+  /// every gap bit for bit as the dense maps; a finite region answers "no surface" beyond it).
+  /// Source: issue 12.
+  bool sparse_maps = false;
+  double sparse_region_mm = std::numeric_limits<double>::infinity();  ///< see sparse_maps, mm (> 0)
 };
 
 /// One body of the joint after preprocessing.

@@ -50,27 +50,23 @@ class SamplingScheme {
   virtual Stencil interpolate(const Eigen::Vector3d& u) const = 0;
   /// Largest great-circle distance between neighbouring nodes, radians (feeds error bounds).
   virtual double max_node_spacing() const = 0;
-  /// Interpolated values at n points (pts: n x 3 row-major, any nonzero length; only the
-  /// direction matters) of a map whose node values are `values` (+inf = no surface): out[j] is
-  /// NaN when a node with nonzero weight has no surface. The batch form is the per-scan
-  /// dispatch: one virtual call per block of vertices, the per-point work inlined.
-  virtual void interpolate_many(const float* values, const double* pts, std::int64_t n, double* out) const = 0;
-  virtual void interpolate_many(const double* values, const double* pts, std::int64_t n, double* out) const = 0;
-  /// As interpolate_many with the points in structure-of-arrays form (x, y, z: n values each),
-  /// the layout of the fast scan; schemes may override it with a vectorised kernel.
-  virtual void interpolate_many_soa(const float* values, const double* x, const double* y, const double* z,
-                                    std::int64_t n, double* out) const = 0;
-  virtual void interpolate_many_soa(const double* values, const double* x, const double* y, const double* z,
-                                    std::int64_t n, double* out) const = 0;
-  /// As interpolate_many_soa on a map whose nodes carry depth-discontinuity marks (the least
-  /// significant bit of a node's value, depth_discontinuity.hpp): a point whose stencil holds a
-  /// marked node, with any weight, gets -infinity instead of its value, so that the caller
-  /// resolves it exactly. The other points get exactly what interpolate_many_soa gives.
-  virtual void interpolate_many_soa_marked(const float* values, const double* x, const double* y, const double* z,
-                                           std::int64_t n, double* out) const = 0;
-  virtual void interpolate_many_soa_marked(const double* values, const double* x, const double* y, const double* z,
-                                           std::int64_t n, double* out) const = 0;
+  /// Interpolation stencils of n <= kStencilBlock directions given in structure-of-arrays form (x,
+  /// y, z: n values each, any nonzero length; only the direction matters): node k (k = 0..3) of
+  /// direction j in nodes[k * n + j] and its weight in w[k * n + j], weights >= 0 summing to 1 (unused
+  /// entries weight 0 with a valid node). The one per-block virtual call of a look-up: the scheme
+  /// computes where to look, the map (radial_distance_map.hpp) loads and combines the values, so a
+  /// scheme knows nothing of the map's value type or storage (issue 12). May differ from
+  /// interpolate() by the rounding of its angle computations (a vectorised kernel may use
+  /// fast_angles.hpp). Source: thesis Algorithms 2 and 3 (the look-ups), split for the plug-in.
+  virtual void stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
+                            double* w) const = 0;
 };
+
+/// Largest block of stencils_soa (directions per call).
+inline constexpr int kStencilBlock = 128;
+
+/// Largest node count of a scheme usable by a map: block stencils hold 32-bit node indices.
+inline constexpr std::int64_t kMaxMapNodes = (std::int64_t(1) << 31) - 1;
 
 /// True when the node value `d` carries the depth-discontinuity mark: its least significant bit
 /// (a change of at most one unit in the last place, 2e-6 mm at 30 mm in float). +inf (no surface)
@@ -86,90 +82,27 @@ inline bool has_discontinuity_mark(double d) {
   return (b & 1u) != 0;
 }
 
-/// Base of concrete schemes: implements interpolate_many once, inlining Derived's
+/// Base of concrete schemes: implements interpolate() and stencils_soa() once from Derived's
 ///   void stencil_at(double x, double y, double z, std::int64_t nodes[4], double w[4]) const
-/// so each scheme writes only its stencil and its node geometry.
+/// (inlined), so each scheme writes only its stencil and its node geometry; a scheme with a faster
+/// block form overrides stencils_soa.
 template <typename Derived>
 class SchemeImpl : public SamplingScheme {
  public:
-  void interpolate_many(const float* values, const double* pts, std::int64_t n, double* out) const override {
-    run(values, pts, n, out);
-  }
-  void interpolate_many(const double* values, const double* pts, std::int64_t n, double* out) const override {
-    run(values, pts, n, out);
-  }
-  void interpolate_many_soa(const float* values, const double* x, const double* y, const double* z, std::int64_t n,
-                            double* out) const override {
-    run_soa(values, x, y, z, n, out);
-  }
-  void interpolate_many_soa(const double* values, const double* x, const double* y, const double* z, std::int64_t n,
-                            double* out) const override {
-    run_soa(values, x, y, z, n, out);
-  }
-  void interpolate_many_soa_marked(const float* values, const double* x, const double* y, const double* z,
-                                   std::int64_t n, double* out) const override {
-    run_soa<float, true>(values, x, y, z, n, out);
-  }
-  void interpolate_many_soa_marked(const double* values, const double* x, const double* y, const double* z,
-                                   std::int64_t n, double* out) const override {
-    run_soa<double, true>(values, x, y, z, n, out);
-  }
   Stencil interpolate(const Eigen::Vector3d& u) const override {
     Stencil s;
     static_cast<const Derived*>(this)->stencil_at(u.x(), u.y(), u.z(), s.nodes.data(), s.weights.data());
     return s;
   }
-
- private:
-  /// Two passes per chunk of 64 points: all stencils first (pure arithmetic, no loads), then
-  /// the loads, so the cache misses of many points are in flight at once.
-  template <typename Scalar, bool kMarked = false>
-  void run(const Scalar* values, const double* pts, std::int64_t n, double* out) const {
+  void stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
+                    double* w) const override {
     const Derived& self = *static_cast<const Derived*>(this);
-    constexpr std::int64_t kChunk = 64;
-    std::int64_t nd[4 * kChunk];
-    double w[4 * kChunk];
-    for (std::int64_t b = 0; b < n; b += kChunk) {
-      const std::int64_t m = std::min(kChunk, n - b);
-      const double* p = pts + 3 * b;
-      for (std::int64_t j = 0; j < m; ++j) self.stencil_at(p[3 * j], p[3 * j + 1], p[3 * j + 2], nd + 4 * j, w + 4 * j);
-      for (std::int64_t j = 0; j < m; ++j) {
-        const std::int64_t* q = nd + 4 * j;
-        const double* u = w + 4 * j;
-        const double v = u[0] * values[q[0]] + u[1] * values[q[1]] + u[2] * values[q[2]] + u[3] * values[q[3]];
-        out[b + j] = std::isfinite(v) ? v : slow_path(values, q, u);
-        if constexpr (kMarked) {
-          if (has_discontinuity_mark(values[q[0]]) || has_discontinuity_mark(values[q[1]]) ||
-              has_discontinuity_mark(values[q[2]]) || has_discontinuity_mark(values[q[3]]))
-            out[b + j] = -std::numeric_limits<double>::infinity();
-        }
-      }
+    for (int j = 0; j < n; ++j) {
+      std::int64_t nd[4];
+      double wj[4];
+      self.stencil_at(x[j], y[j], z[j], nd, wj);
+      for (int k = 0; k < 4; ++k) nodes[k * n + j] = static_cast<std::int32_t>(nd[k]), w[k * n + j] = wj[k];
     }
-  }
-  template <typename Scalar, bool kMarked = false>
-  void run_soa(const Scalar* values, const double* x, const double* y, const double* z, std::int64_t n,
-               double* out) const {
-    constexpr std::int64_t kChunk = 64;
-    double p[3 * kChunk];
-    for (std::int64_t b = 0; b < n; b += kChunk) {
-      const std::int64_t m = std::min(kChunk, n - b);
-      for (std::int64_t j = 0; j < m; ++j) p[3 * j] = x[b + j], p[3 * j + 1] = y[b + j], p[3 * j + 2] = z[b + j];
-      run<Scalar, kMarked>(values, p, m, out + b);
-    }
-  }
-
- protected:
-  /// A node with no surface (+inf): NaN unless all such nodes have weight exactly 0.
-  template <typename Scalar>
-  static double slow_path(const Scalar* values, const std::int64_t* nd, const double* w) {
-    double acc = 0;
-    for (int k = 0; k < 4; ++k) {
-      if (w[k] == 0) continue;
-      const double d = values[nd[k]];
-      if (!std::isfinite(d)) return std::numeric_limits<double>::quiet_NaN();
-      acc += w[k] * d;
-    }
-    return acc;
   }
 };
 
