@@ -70,6 +70,20 @@ for (name, unit), g in sch.groupby(["scheme", "resolution_name"], sort=False):
                 [f"{int(g.nodes[p]):,}" for p in (1.0, 0.1)] + [f"{g.nodes_over_equiangular[0.1]:.2f}"])
 write_table(d, "table_schemes", ["scheme", "resolution", "at 1 deg", "at 0.1 deg", "nodes, 1 deg", "nodes, 0.1 deg",
                                  "/ equiangular"], rows, align="llrrrrr")
+# Dense against sparse storage (sparse.csv, issue 12): the pelvis and femur maps of every subject.
+spr = read_csv(d, "sparse.csv")
+spr["ratio"] = spr.sparse_bytes / spr.dense_bytes
+fin = spr.spacing_deg.min()
+rows = []
+for (sub, body), g in spr[spr.spacing_deg == fin].groupby(["subject", "body"], sort=False):
+    g = g.set_index("scheme")
+    rows.append([sub, body] + [f"{g.ratio[sc]:.2f}" if sc in g.index else "--" for sc in sch.scheme.unique()] +
+                [f"{g.nodes_covered['equiangular'] / g.nodes['equiangular']:.2f}"])
+write_table(d, "table_sparse", ["subject", "body"] + list(sch.scheme.unique()) + ["covered"], rows,
+            align="ll" + "r" * (len(sch.scheme.unique()) + 1))
+pel = spr[(spr.body == "pelvis") & (spr.scheme == "equiangular") & (spr.spacing_deg == fin) &
+          ~spr.subject.str.startswith("generated")]
+fem = spr[(spr.body == "femur") & (spr.spacing_deg == fin)]
 eq1 = df[(df.scheme == "equiangular") & (df.matched_precision_deg == 1)].iloc[0]
 hx1 = df[(df.scheme == "helix") & (df.matched_precision_deg == 1)].iloc[0]
 fine = match.iloc[-1]
@@ -81,4 +95,10 @@ write_macros(d, "macros", {
     "LMhxEquatorFinest": f"{fine.helix_equator_nodes:,.1f}",
     "LMoctOverEq": f"{sch[(sch.scheme == 'octahedral') & (sch.spacing_deg == 0.1)].nodes_over_equiangular.iloc[0]:.2f}",
     "LMhpxOverEq": f"{sch[(sch.scheme == 'healpix') & (sch.spacing_deg == 0.1)].nodes_over_equiangular.iloc[0]:.2f}",
+    "LMspFinest": f"{fin:g}",
+    "LMspPelvisMin": f"{pel.ratio.min():.2f}" if len(pel) else "--",
+    "LMspPelvisMax": f"{pel.ratio.max():.2f}" if len(pel) else "--",
+    "LMspFemurMin": f"{fem.ratio.min():.2f}",
+    "LMspAllMin": f"{spr[spr.spacing_deg == fin].ratio.min():.2f}",
+    "LMspAllMax": f"{spr[spr.spacing_deg == fin].ratio.max():.2f}",
 })

@@ -7,10 +7,14 @@
 //   schemes.csv       every registered scheme at the coarsest resolution whose largest node spacing is at
 //                     most 1, 0.5, 0.1 and 0.05 deg (resolution_for_spacing): nodes, float bytes, node
 //                     count relative to the equiangular grid of that spacing (issue 12)
+//   sparse.csv        every subject (the real ones under --data and a generated 3k hip) x body x registered
+//                     scheme at largest node spacings 0.5, 0.1 and 0.05 deg: the map's dense bytes and its
+//                     sparse bytes (make_sparse: only the 256-node tiles that hold a surface, any distance;
+//                     the same look-ups bit for bit), tiles stored of all, nodes with a surface (issue 12)
 //   density.csv       nodes per steradian in 1-deg latitude bands centred on whole degrees, both schemes at
 //                     1 deg / k = 229
 //   meta.json
-// Command: build/experiments/exp_01_lut_memory --out results
+// Command: build/experiments/exp_01_lut_memory --out results [--data ../shared/data/hips] [--quick]
 #include <unistd.h>
 
 #include <fstream>
@@ -19,6 +23,7 @@
 #include "impinge/equiangular_grid.hpp"
 #include "impinge/helix_scheme.hpp"
 #include "impinge/radial_distance_map.hpp"
+#include "impinge/sampling.hpp"
 #include "impinge/spherical_frame.hpp"
 
 using namespace impinge;
@@ -104,6 +109,31 @@ int main(int argc, char** argv) {
         sc.row(p, name, unit, s->resolution(), s->num_nodes(), s->max_node_spacing() * kRadToDeg,
                s->num_nodes() * std::int64_t(sizeof(float)), double(s->num_nodes()) / eq_nodes);
       }
+    }
+  }
+  // Dense against sparse storage of real maps (issue 12).
+  {
+    CsvWriter sp(dir + "/sparse.csv", {"subject", "body", "scheme", "resolution", "spacing_deg", "nodes",
+                                       "nodes_covered", "tiles_stored", "tiles_total", "dense_bytes", "sparse_bytes"});
+    const std::vector<Subject> subjects = load_subjects(args, {3000});
+    std::vector<double> spacings{0.5, 0.1};
+    if (!args.quick) spacings.push_back(0.05);
+    int done = 0;
+    for (const Subject& sub : subjects) {
+      progress("01_lut_memory", ++done, int(subjects.size()), "sparse maps of " + sub.name);
+      const Eigen::Vector3d cor = subject_cor(sub);
+      for (double p : spacings)
+        for (const auto& [name, unit] : scheme_names()) {
+          const auto scheme = make_scheme(name, resolution_for_spacing(name, p));
+          for (int body = 0; body < 2; ++body) {
+            RadialDistanceMap m(scheme);
+            sample_surface(body == 0 ? sub.femur : sub.pelvis, cor, SamplingOptions{}, m);
+            const std::size_t dense = m.bytes();
+            m.make_sparse();
+            sp.row(sub.name, body == 0 ? "femur" : "pelvis", name, scheme->resolution(), p, m.num_nodes(),
+                   m.nodes_covered(), m.tiles_stored(), m.tiles_total(), std::int64_t(dense), std::int64_t(m.bytes()));
+          }
+        }
     }
   }
   // Node density against latitude (Fig. 49 compares the two at 1 deg): nodes per steradian in

@@ -16,7 +16,9 @@
 //     at_discontinuity (the four stencil nodes span > 2 mm: a depth jump such as the
 //     acetabular rim), near_pole (phi < 2 or > 178 deg in the map's frame), near_seam (theta
 //     within 1 deg of 0/360); resample_precision_deg: the temporary equiangular map of a resampled
-//     scheme (half its matched precision), 0 when rasterised
+//     scheme (half its matched precision), 0 when rasterised; storage: dense, or sparse (exact mode:
+//     the same maps with only the tiles that hold a surface, make_sparse; sampling_ms includes the
+//     conversion; the gaps are checked to equal the dense maps' bit for bit)
 //   vertex_errors.csv  per-vertex errors of the equiangular map at 0.1 deg, exact mode, rest pose
 //     (x, y, z relative to the COR in the map's frame, phi, theta, stencil spread, error)
 //   meta.json
@@ -26,6 +28,7 @@
 // scheme at the coarsest resolution that reaches p (resolution_for_spacing, issue 12), so a new
 // scheme joins with no change here.
 #include <algorithm>
+#include <cstring>
 #include <iostream>
 #include <optional>
 
@@ -93,7 +96,7 @@ int main(int argc, char** argv) {
                  "resolution",  "precision_deg", "vertices",     "compared",         "mismatched",
                  "max_abs_mm",  "p99_abs_mm",    "p95_abs_mm",   "median_abs_mm",    "query_ns_per_vertex",
                  "sampling_ms", "bytes",         "large_errors", "at_discontinuity", "near_pole",
-                 "near_seam",   "resample_precision_deg"});
+                 "near_seam",   "resample_precision_deg", "storage"});
   CsvWriter vcsv(dir + "/vertex_errors.csv",
                  {"subject", "scan", "x_mm", "y_mm", "z_mm", "phi_deg", "theta_deg", "stencil_spread_mm", "error_mm"});
   const auto schemes = scheme_names();
@@ -169,9 +172,10 @@ int main(int argc, char** argv) {
       return e;
     };
     auto put = [&](const std::string& pose, const std::string& scheme, const std::string& mode, double res, double p,
-                   const Errors& e, double ns, double sampling_ms, double bytes, double resample_p) {
+                   const Errors& e, double ns, double sampling_ms, double bytes, double resample_p,
+                   const char* storage = "dense") {
       csv.row(s.name, int(s.generated), pose, scheme, mode, res, p, nv, e.compared, e.mismatched, e.max, e.p99, e.p95,
-              e.median, ns, sampling_ms, bytes, e.large, e.discontinuity, e.pole, e.seam, resample_p);
+              e.median, ns, sampling_ms, bytes, e.large, e.discontinuity, e.pole, e.seam, resample_p, storage);
     };
 
     for (double p : precisions) {
@@ -217,6 +221,37 @@ int main(int argc, char** argv) {
             const Errors e = evaluate(pose, g, &fm, &pm, dump);
             put(pose == 0 ? "rest" : "pushed_3mm", name, to_string(mode), res, p, e, tq * 1e6 / double(nv), ts,
                 double(fm.bytes() + pm.bytes()), resample_p);
+          }
+          // Sparse storage (issue 12): the same maps with only the tiles that hold a surface; the gaps
+          // are the dense maps' bit for bit (checked here), the bytes and the query time are not.
+          if (mode == DistanceMode::exact) {
+            RadialDistanceMap fms = fm, pms = pm;
+            const double tsp = median_ms(
+                [&] {
+                  fms = fm, pms = pm;
+                  fms.make_sparse();
+                  pms.make_sparse();
+                },
+                p < 0.1 ? std::min(reps, 3) : reps);
+            for (int pose = 0; pose < 2; ++pose) {
+              const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
+              std::vector<float> g[2] = {std::vector<float>(std::size_t(fset.size())),
+                                         std::vector<float>(std::size_t(pset.size()))};
+              std::vector<float> d[2] = {g[0], g[1]};
+              const double tq = median_ms(
+                  [&] {
+                    scan_gaps_compact(fset, I, t, pms, ScanSide::inside, g[0].data());
+                    scan_gaps_compact(pset, I, Eigen::Vector3d(-t), fms, ScanSide::outside, g[1].data());
+                  },
+                  reps);
+              scan_gaps_compact(fset, I, t, pm, ScanSide::inside, d[0].data());
+              scan_gaps_compact(pset, I, Eigen::Vector3d(-t), fm, ScanSide::outside, d[1].data());
+              for (int k = 0; k < 2; ++k)
+                require(std::memcmp(g[k].data(), d[k].data(), g[k].size() * sizeof(float)) == 0,
+                        "10_error_vs_runtime: " + s.name + " " + name + ": sparse gaps differ from dense");
+              put(pose == 0 ? "rest" : "pushed_3mm", name, to_string(mode), res, p, evaluate(pose, g, &fms, &pms, false),
+                  tq * 1e6 / double(nv), ts + tsp, double(fms.bytes() + pms.bytes()), resample_p, "sparse");
+            }
           }
           // Exact look-ups at depth discontinuities (issue 15): the same maps with their marks, the
           // marked look-ups resolved by ray casts. Sampling time includes the marking.
