@@ -13,7 +13,8 @@ the sampling ms at which the scheme reaches the target. The resolutions are a sw
 interpolated between the two resolutions that bracket the target, log-linearly in error against
 bytes (query and sampling time at the same fraction of the step, log-linearly too); `how` says
 `interpolated`, `coarsest` (already met at the coarsest resolution: an upper bound) or `not_reached`
-(not met at the finest: empty values). Storage is `dense` (sparse maps are not built yet)."""
+(not met at the finest: empty values). Storage `dense` or `sparse` (exact mode only: the same errors,
+other bytes and query times)."""
 import numpy as np
 import matplotlib.pyplot as plt
 
@@ -22,8 +23,11 @@ from common import experiment_dir, read_csv, save, write_macros, write_table
 d = experiment_dir("10_error_vs_runtime")
 t = read_csv(d, "error_runtime.csv")
 v = read_csv(d, "vertex_errors.csv")
+if "storage" not in t:
+    t["storage"] = "dense"
 peers = ("embree_radial", "embree_radial_packet8", "cgal_radial")
-maps = t[~t.scheme.isin(peers)]
+maps_all = t[~t.scheme.isin(peers)]
+maps = maps_all[maps_all.storage == "dense"]  # the tables and figures below; sparse rows: equal_error
 real = t[~t.generated.astype(bool)]
 subj = real.subject.iloc[0] if len(real) else t.subject.iloc[0]
 
@@ -63,7 +67,7 @@ write_table(d, "table_peers", ["subject", "pose", "vertices", "p95 (mm)", "max (
 
 # Pareto figures: p95 error against query time and against memory, rest pose, first subject.
 markers = {"equiangular": "o", "helix": "s", "helix-eq10": "v", "conchoid": "^", "octahedral": "D",
-           "healpix": "h"}
+           "healpix": "h", "fibonacci": "*"}
 for xcol, stem, xlabel in [("query_ns_per_vertex", "pareto_time", "query time (ns per vertex)"),
                            ("bytes", "pareto_memory", "memory of both maps (bytes)"),
                            ("sampling_ms", "pareto_sampling", "sampling both maps (ms)")]:
@@ -191,14 +195,15 @@ if len(rf):
 # Every scheme at equal error (issue 12): interpolated between the resolutions of the sweep.
 TARGETS = (1e-2, 1e-3, 1e-4)
 eq_rows = []
-rest = maps[(maps.pose == "rest") & ~maps.generated.astype(bool) & maps["mode"].isin(["exact", "exact_refined"])]
-for (s_, scheme, mode), g in rest.groupby(["subject", "scheme", "mode"], sort=False):
+rest = maps_all[(maps_all.pose == "rest") & ~maps_all.generated.astype(bool) &
+                maps_all["mode"].isin(["exact", "exact_refined"])]
+for (s_, scheme, mode, storage), g in rest.groupby(["subject", "scheme", "mode", "storage"], sort=False):
     g = g.sort_values("bytes")
     for metric, col in (("p95", "p95_abs_mm"), ("max", "max_abs_mm")):
         err = g[col].to_numpy(float)
         by, ns, sm = (g[c].to_numpy(float) for c in ("bytes", "query_ns_per_vertex", "sampling_ms"))
         for target in TARGETS:
-            row = dict(subject=s_, scheme=scheme, storage="dense", mode=mode, metric=metric, target_mm=target,
+            row = dict(subject=s_, scheme=scheme, storage=storage, mode=mode, metric=metric, target_mm=target,
                        bytes=np.nan, query_ns_per_vertex=np.nan, sampling_ms=np.nan, how="not_reached")
             if len(err) and err[0] <= target:
                 row.update(bytes=by[0], query_ns_per_vertex=ns[0], sampling_ms=sm[0], how="coarsest")
@@ -218,23 +223,32 @@ if eq_rows:
     eqe = pd.DataFrame(eq_rows)
     eqe.to_csv(f"{d}/equal_error.csv", index=False)
     # Table: at p95 <= 1e-3 mm, maps alone (exact), every subject: each scheme against the equiangular grid.
-    rows, best = [], {}
+    rows, best, best_any = [], {}, {}
     sel = eqe[(eqe["mode"] == "exact") & (eqe.metric == "p95") & np.isclose(eqe.target_mm, 1e-3)]
     for s_, g in sel.groupby("subject", sort=False):
-        ref = g[g.scheme == "equiangular"]
+        ref = g[(g.scheme == "equiangular") & (g.storage == "dense")]
         if not len(ref) or ref.how.iloc[0] == "not_reached":
             continue
         rb, rn = ref.bytes.iloc[0], ref.query_ns_per_vertex.iloc[0]
         for _, r in g.sort_values("bytes").iterrows():
             if r.how == "not_reached":
-                rows.append([s_, r.scheme, "--", "--", "--", "--", "--"])
+                rows.append([s_, r.scheme, r.storage, "--", "--", "--", "--", "--"])
                 continue
-            rows.append([s_, r.scheme, f"{r.bytes / 2**20:.1f}", f"{r.bytes / rb:.2f}", f"{r.query_ns_per_vertex:.1f}",
-                         f"{r.query_ns_per_vertex / rn:.2f}", f"{r.sampling_ms:.0f}"])
-            if r.scheme not in ("equiangular", "helix", "helix-eq10", "conchoid"):
+            rows.append([s_, r.scheme, r.storage, f"{r.bytes / 2**20:.1f}", f"{r.bytes / rb:.2f}",
+                         f"{r.query_ns_per_vertex:.1f}", f"{r.query_ns_per_vertex / rn:.2f}", f"{r.sampling_ms:.0f}"])
+            if r.scheme not in ("equiangular", "helix", "helix-eq10", "conchoid") and r.storage == "dense":
                 best.setdefault(s_, []).append((r.bytes / rb, r.query_ns_per_vertex / rn, r.scheme))
-    write_table(d, "table_equal_error", ["subject", "scheme", "MiB", "/ equiangular", "ns/vertex", "/ equiangular",
-                                         "sampling ms"], rows, align="llrrrrr")
+            if r.scheme != "equiangular" or r.storage != "dense":
+                best_any.setdefault(s_, []).append((r.bytes / rb, r.query_ns_per_vertex / rn, f"{r.scheme} ({r.storage})"))
+    write_table(d, "table_equal_error", ["subject", "scheme", "storage", "MiB", "/ equiangular", "ns/vertex",
+                                         "/ equiangular", "sampling ms"], rows, align="lllrrrrr")
+    if subj in best_any:
+        b = min(best_any[subj])
+        macros.update({"EqErrBestAny": b[2], "EqErrBestAnyBytesRatio": f"{b[0]:.2f}",
+                       "EqErrBestAnyNsRatio": f"{b[1]:.2f}"})
+        sp = [x for x in best_any[subj] if x[2] == "equiangular (sparse)"]
+        if sp:
+            macros.update({"EqErrEqSparseBytesRatio": f"{sp[0][0]:.2f}", "EqErrEqSparseNsRatio": f"{sp[0][1]:.2f}"})
     if subj in best:
         b = min(best[subj])
         macros.update({"EqErrBestNewScheme": b[2], "EqErrBestNewBytesRatio": f"{b[0]:.2f}",
@@ -248,6 +262,7 @@ if eq_rows:
     # The helix at equal error: bytes and query time against the equiangular grid, every subject.
     hx = []
     for s_, g in sel.groupby("subject", sort=False):
+        g = g[g.storage == "dense"]
         a_, b_ = g[g.scheme == "equiangular"], g[g.scheme == "helix"]
         if len(a_) and len(b_) and (a_.how.iloc[0] != "not_reached") and (b_.how.iloc[0] != "not_reached"):
             hx.append((b_.bytes.iloc[0] / a_.bytes.iloc[0], b_.query_ns_per_vertex.iloc[0] / a_.query_ns_per_vertex.iloc[0]))
