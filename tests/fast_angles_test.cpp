@@ -97,7 +97,7 @@ TEST(FastAngles, EdgeCases) {
 namespace {
 /// Reference gap with libm trigonometry and the grid's own bilinear stencil.
 double reference_gap(const RadialDistanceMap& map, const Eigen::Vector3d& q, double side) {
-  const auto& grid = map.grid();
+  const auto& grid = equiangular_grid_of(map.scheme());
   const double r = q.norm();
   const double phi = std::acos(std::clamp(q.z() / r, -1.0, 1.0));
   double theta = std::atan2(q.y(), q.x());

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "impinge/equiangular_grid.hpp"
 #include "impinge/error.hpp"
 #include "test_support.hpp"
 

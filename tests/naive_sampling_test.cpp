@@ -7,6 +7,7 @@
 
 #include <random>
 
+#include "impinge/equiangular_grid.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/spherical_frame.hpp"
 #include "test_support.hpp"

@@ -58,6 +58,8 @@ struct Case {
   std::string name;
   double resolution;
 };
+// Readable names in test output (gtest prints unknown types as bytes).
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name << " at " << c.resolution; }
 
 std::vector<Case> cases() {
   std::vector<Case> out;

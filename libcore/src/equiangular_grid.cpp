@@ -12,6 +12,12 @@
 
 namespace impinge {
 
+const EquiangularGrid& equiangular_grid_of(const SamplingScheme& scheme) {
+  const auto* g = dynamic_cast<const EquiangularGrid*>(&scheme);
+  require(g != nullptr, "this operation needs an equiangular map; the map uses the '" + scheme.name() + "' scheme");
+  return *g;
+}
+
 double matched_equiangular_precision(double spacing_rad) {
   return 180.0 / std::max(1.0, std::round(180.0 / (spacing_rad * kRadToDeg)));
 }

@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "impinge/equiangular_grid.hpp"
 #include "impinge/error.hpp"
 #include "impinge/spherical_frame.hpp"
 

@@ -157,13 +157,6 @@ RadialDistanceMapT<Scalar>::RadialDistanceMapT(std::shared_ptr<const SamplingSch
 }
 
 template <typename Scalar>
-const EquiangularGrid& RadialDistanceMapT<Scalar>::grid() const {
-  const auto* g = dynamic_cast<const EquiangularGrid*>(scheme_.get());
-  require(g != nullptr, "this operation needs an equiangular map; the map uses the '" + scheme_->name() + "' scheme");
-  return *g;
-}
-
-template <typename Scalar>
 Scalar* RadialDistanceMapT<Scalar>::data() {
   require(tiles_.empty(), "radial distance map: a sparse map is read-only (fill a dense map, then make_sparse)");
   return distance_.data();

@@ -659,7 +659,7 @@ class Rasterizer {
       : map_(map),
         mode_(mode),
         stats_(stats),
-        grid_(map.grid()),
+        grid_(equiangular_grid_of(map.scheme())),
         keep_sign_(keep_sign),
         row_spans_(row_spans),
         t_(grid_tables(grid_)),
@@ -911,7 +911,7 @@ SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, Di
                         RadialDistanceMapT<Scalar>& map, const FaceCulling* culling, bool row_spans, MapStart start) {
   require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
   validate_mesh(mesh);  // a bad index is an error before anything is read or changed
-  (void)map.grid();  // throws for a map that is not equiangular, before anything is changed
+  (void)equiangular_grid_of(map.scheme());  // throws for a map that is not equiangular, before anything is changed
   const bool planned = culling != nullptr && mode == DistanceMode::exact;
   // The plan's cones: the kept triangles (all when culling is disabled), set up once.
   if (planned && (culling->cor != cor || culling->mesh_fingerprint != mesh_fingerprint(mesh)))

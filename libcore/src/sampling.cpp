@@ -40,7 +40,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 template <typename Scalar>
 void resample(const RadialDistanceMap& source, RadialDistanceMapT<Scalar>& target) {
-  const EquiangularGrid& g = source.grid();
+  const EquiangularGrid& g = equiangular_grid_of(source.scheme());
   const SamplingScheme& scheme = target.scheme();
   const float* src = source.data();
   Scalar* dst = target.data();
@@ -95,7 +95,7 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
   switch (rep.method) {
     case SamplingMethod::rasterize:
       // A fresh map, as documented (with a plan the reset is fused with the drawing).
-      rep.raster = rasterize(mesh, cor, o.mode, map, cull, true, MapStart::reset);  // throws via map.grid()
+      rep.raster = rasterize(mesh, cor, o.mode, map, cull, true, MapStart::reset);  // throws via equiangular_grid_of
                                                                                       // when not equiangular
       rep.rasterize_ms = ms_since(t0);
       break;

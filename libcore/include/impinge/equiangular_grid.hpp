@@ -92,4 +92,8 @@ class EquiangularGrid : public SchemeImpl<EquiangularGrid> {
   int cols_;
 };
 
+/// `scheme` as an equiangular grid, for the operations that need one (rasterisation, the
+/// resampling source). Throws impinge::Error naming the scheme when it is another.
+const EquiangularGrid& equiangular_grid_of(const SamplingScheme& scheme);
+
 }  // namespace impinge

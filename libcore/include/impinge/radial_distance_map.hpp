@@ -12,7 +12,6 @@
 #include <type_traits>
 #include <vector>
 
-#include "impinge/equiangular_grid.hpp"
 #include "impinge/huge_page_allocator.hpp"
 #include "impinge/sampling_scheme.hpp"
 
@@ -53,8 +52,6 @@ class RadialDistanceMapT {
 
   const SamplingScheme& scheme() const { return *scheme_; }
   const std::shared_ptr<const SamplingScheme>& scheme_ptr() const { return scheme_; }
-  /// The scheme as an equiangular grid; throws impinge::Error when it is another scheme.
-  const EquiangularGrid& grid() const;
   std::int64_t num_nodes() const { return num_nodes_; }
   /// Distance (mm) at node i, or +inf for no surface.
   Scalar at(std::int64_t i) const {

@@ -8,6 +8,7 @@
 
 #include "impinge/face_culling.hpp"
 #include "impinge/mesh.hpp"
+#include "impinge/equiangular_grid.hpp"
 #include "impinge/radial_distance_map.hpp"
 
 namespace impinge {
