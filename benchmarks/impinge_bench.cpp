@@ -3,7 +3,8 @@
 // Subject: lhdl-ct from ../shared/data/hips when present (IMPINGE_BENCH_SUBJECT overrides the
 // folder), else the generated 12k hip model. Meshes and maps are built once.
 // Scheme index: 0-3 equiangular at p = 1, 0.5, 0.1, 0.05 deg; 4-7 helix at the matched turns
-// k = 229, 458, 2292, 4584 (thesis Table 6).
+// k = 229, 458, 2292, 4584 (thesis Table 6). BM_RegisteredSchemeQuery takes every registered scheme
+// (scheme_names()) at a largest node spacing of 0.1 deg, dense and sparse, with no list here.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -181,6 +182,49 @@ void BM_Query(benchmark::State& st) {
 }
 BENCHMARK(BM_Query)
     ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}, {0, 1}})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+// Every registered scheme (args: index into scheme_names(), storage 0 dense / 1 sparse) at its
+// resolution for a largest node spacing of 0.1 deg: both hip-region scans (vertices within 45 mm of
+// the COR) against the other map, exact mode. Items = look-ups.
+void BM_RegisteredSchemeQuery(benchmark::State& st) {
+  const auto names = scheme_names();
+  if (st.range(0) >= std::int64_t(names.size())) return st.SkipWithError("no such registered scheme");
+  const std::string name = names[std::size_t(st.range(0))].first;
+  static std::map<std::string, std::unique_ptr<Built>> cache;
+  auto& b = cache[name];
+  const Scene& s = scene();
+  if (!b) {
+    const auto scheme = make_scheme(name, resolution_for_spacing(name, 0.1));
+    b = std::make_unique<Built>(Built{RadialDistanceMap(scheme), RadialDistanceMap(scheme), {}, {}, {}, {}, {}, {}});
+    sample_surface(s.femur, s.cor, SamplingOptions{}, b->femur_map);
+    sample_surface(s.pelvis, s.cor, SamplingOptions{}, b->pelvis_map);
+    auto hip = [](const Vertices& P, const RadialDistanceMap& m) {
+      std::vector<std::uint8_t> mask = first_surface_mask(P, m, 1.0, 45.0);
+      return make_scan_set(P, mask);
+    };
+    b->femur_hip = hip(s.femur_rel, b->femur_map);
+    b->pelvis_hip = hip(s.pelvis_rel, b->pelvis_map);
+  }
+  RadialDistanceMap fm = b->femur_map, pm = b->pelvis_map;
+  if (st.range(1)) fm.make_sparse(), pm.make_sparse();
+  std::vector<float> g1(std::size_t(b->femur_hip.size())), g2(std::size_t(b->pelvis_hip.size()));
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  for (auto _ : st) {
+    scan_gaps_compact(b->femur_hip, I, Eigen::Vector3d::Zero(), pm, ScanSide::inside, g1.data());
+    scan_gaps_compact(b->pelvis_hip, I, Eigen::Vector3d::Zero(), fm, ScanSide::outside, g2.data());
+    benchmark::DoNotOptimize(g1.data());
+    benchmark::DoNotOptimize(g2.data());
+  }
+  const auto lookups = b->femur_hip.size() + b->pelvis_hip.size();
+  st.counters["ns_per_lookup"] = benchmark::Counter(double(lookups) * double(st.iterations()),
+                                                    benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["MiB"] = double(fm.bytes() + pm.bytes()) / (1 << 20);
+  st.SetLabel(s.name + " " + name + " " + std::to_string(fm.scheme().resolution()) + (st.range(1) ? " sparse" : " dense"));
+}
+BENCHMARK(BM_RegisteredSchemeQuery)
+    ->ArgsProduct({{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}, {0, 1}})
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
 

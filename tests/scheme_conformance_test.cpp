@@ -4,13 +4,16 @@
 //    pole rows repeat the pole), for every node at coarse resolutions and a sample at fine ones;
 //  - stencils: node indices in range, weights >= 0 summing to 1, at random directions and at
 //    directions at and near both poles and across the seam;
-//  - the single look-up (interpolate and the weighted sum), the batch (interpolate_many) and the
-//    structure-of-arrays batch (interpolate_many_soa) give the same values within the rounding of
+//  - the single look-up (interpolate and the weighted sum), the map's row-major batch (sample_many)
+//    and its structure-of-arrays batch (sample_many_soa) give the same values within the rounding of
 //    their angle computations, float and double maps;
 //  - max_node_spacing() against brute force (CGAL kd-tree over the node directions): no direction
 //    is farther than it from its nearest node, and it is not overstated (the largest such distance
 //    is at least a quarter of it);
-//  - resolution_for_spacing gives the coarsest resolution that reaches a node spacing.
+//  - resolution_for_spacing gives the coarsest resolution that reaches a node spacing;
+//  - node_angles matches node_direction; block stencils (stencils_soa) are convex combinations;
+//  - sparse maps give the dense maps' bits (plain and marked look-ups, float and double);
+//  - a sampled sphere agrees with CGAL's exact first hit within the interpolation bound.
 #include <gtest/gtest.h>
 
 #include <cmath>
