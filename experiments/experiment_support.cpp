@@ -16,6 +16,8 @@ namespace impinge::experiment {
 
 namespace fs = std::filesystem;
 
+const std::string& source_commit();  // below; read when the driver starts
+
 Args parse_args(int argc, char** argv, const std::string& description) {
   CLI::App app{description};
   Args a;
@@ -30,6 +32,7 @@ Args parse_args(int argc, char** argv, const std::string& description) {
     std::exit(app.exit(e));
   }
   a.repetitions = reps > 0 ? reps : (a.quick ? 3 : 5);
+  (void)source_commit();  // the commit this run is made from (meta.json)
   return a;
 }
 
@@ -114,6 +117,21 @@ std::string command_output(const std::string& cmd) {
 }
 }  // namespace
 
+/// The commit of the source tree, "-dirty" when a tracked source file differs from it (the results
+/// folder left out: a reproduction rewrites it as it goes, which would otherwise mark every experiment
+/// after the first). Read once, when the driver starts: the commit the run is made from, not whatever
+/// the tree holds when it ends.
+const std::string& source_commit() {
+  static const std::string c = [] {
+    const std::string commit = command_output("git -C '" IMPINGE_SOURCE_DIR "' rev-parse HEAD 2>/dev/null");
+    const std::string dirty = command_output("git -C '" IMPINGE_SOURCE_DIR
+                                             "' status --porcelain --untracked-files=no -- . ':(exclude)results' "
+                                             "2>/dev/null");
+    return commit.empty() ? std::string("unknown") : commit + (dirty.empty() ? "" : "-dirty");
+  }();
+  return c;
+}
+
 void write_meta(const std::string& dir, const Args& args, nlohmann::json params) {
   nlohmann::json m;
   m["parameters"] = std::move(params);
@@ -121,13 +139,7 @@ void write_meta(const std::string& dir, const Args& args, nlohmann::json params)
   m["repetitions"] = args.repetitions;
   m["timing"] = "median wall time after one warm-up run, single thread";
   m["data_folder"] = args.data;
-  const std::string commit = command_output("git -C '" IMPINGE_SOURCE_DIR "' rev-parse HEAD 2>/dev/null");
-  // Dirty = a tracked source file differs from the commit. The results folder is left out: a
-  // reproduction rewrites it as it goes, which would otherwise mark every experiment after the first.
-  const std::string dirty = command_output("git -C '" IMPINGE_SOURCE_DIR
-                                           "' status --porcelain --untracked-files=no -- . ':(exclude)results' "
-                                           "2>/dev/null");
-  m["git_commit"] = commit.empty() ? "unknown" : commit + (dirty.empty() ? "" : "-dirty");
+  m["git_commit"] = source_commit();
   m["compiler"] = IMPINGE_COMPILER;
   m["cpu_model"] = command_output("grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'");
   m["kernels"] = kernel_description();  // which dispatched kernels ran (IMPINGE_KERNELS)
