@@ -44,21 +44,23 @@ double slow_path(const Values& values, const std::int32_t* nd, const double* w, 
   return acc;
 }
 
-/// Combine the block stencils (nodes[k n + j], w[k n + j]) with the node values: out[j] =
+/// Combine block stencil j (nodes[k n + j], w[k n + j]) with the node values: out[j] =
 /// w0 d0 + w1 d1 + w2 d2 + w3 d3 in that order (no fused multiply-add), the slow path for a
 /// non-finite sum, -inf for a marked node (kMarked).
 template <bool kMarked, typename Values>
-void combine_generic(const Values& values, const std::int32_t* nd, const double* w, int n, double* out) {
-  for (int j = 0; j < n; ++j) {
-    const auto u0 = values[nd[j]], u1 = values[nd[n + j]], u2 = values[nd[2 * n + j]], u3 = values[nd[3 * n + j]];
-    const double v = w[j] * double(u0) + w[n + j] * double(u1) + w[2 * n + j] * double(u2) + w[3 * n + j] * double(u3);
-    out[j] = std::isfinite(v) ? v : slow_path(values, nd, w, n, j);
-    if constexpr (kMarked) {
-      if (has_discontinuity_mark(u0) | has_discontinuity_mark(u1) | has_discontinuity_mark(u2) |
-          has_discontinuity_mark(u3))
-        out[j] = -std::numeric_limits<double>::infinity();
-    }
+inline void combine_one(const Values& values, const std::int32_t* nd, const double* w, int n, int j, double* out) {
+  const auto u0 = values[nd[j]], u1 = values[nd[n + j]], u2 = values[nd[2 * n + j]], u3 = values[nd[3 * n + j]];
+  const double v = w[j] * double(u0) + w[n + j] * double(u1) + w[2 * n + j] * double(u2) + w[3 * n + j] * double(u3);
+  out[j] = std::isfinite(v) ? v : slow_path(values, nd, w, n, j);
+  if constexpr (kMarked) {
+    if (has_discontinuity_mark(u0) | has_discontinuity_mark(u1) | has_discontinuity_mark(u2) |
+        has_discontinuity_mark(u3))
+      out[j] = -std::numeric_limits<double>::infinity();
   }
+}
+template <bool kMarked, typename Values>
+void combine_generic(const Values& values, const std::int32_t* nd, const double* w, int n, double* out) {
+  for (int j = 0; j < n; ++j) combine_one<kMarked>(values, nd, w, n, j, out);
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -117,17 +119,7 @@ __attribute__((target("avx2"))) void combine_avx2(const float* values, const std
       if (!std::isfinite(out[i])) out[i] = slow_path(DenseValues<float>{values}, nd, w, n, i);
     }
   }
-  for (; j < n; ++j) {  // the tail, one at a time in the generic order
-    const DenseValues<float> vals{values};
-    const float u0 = vals[nd[j]], u1 = vals[nd[n + j]], u2 = vals[nd[2 * n + j]], u3 = vals[nd[3 * n + j]];
-    const double v = w[j] * double(u0) + w[n + j] * double(u1) + w[2 * n + j] * double(u2) + w[3 * n + j] * double(u3);
-    out[j] = std::isfinite(v) ? v : slow_path(vals, nd, w, n, j);
-    if constexpr (kMarked) {
-      if (has_discontinuity_mark(u0) | has_discontinuity_mark(u1) | has_discontinuity_mark(u2) |
-          has_discontinuity_mark(u3))
-        out[j] = -std::numeric_limits<double>::infinity();
-    }
-  }
+  for (; j < n; ++j) combine_one<kMarked>(DenseValues<float>{values}, nd, w, n, j, out);  // the tail
 }
 #endif
 
