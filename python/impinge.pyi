@@ -37,6 +37,7 @@ class Map:
     num_nodes: int
     nodes_covered: int
     bytes: int
+    sparse: bool
     def node_directions(self) -> npt.NDArray[np.float64]: ...
 
 class Joint:
@@ -46,7 +47,8 @@ class Joint:
                  scheme: str = "equiangular", resolution: float = 0.0, mode: str = "exact", sampling: str = "auto",
                  occlusion_tolerance_mm: float = 1.0, max_radius_mm: float = 0.0,
                  levels: Optional[Sequence[float]] = None, reseat: bool = False, pelvis_frame: str = "isb",
-                 femur_frame: str = "epicondyles", maps: Optional[Tuple[str, str]] = None) -> None: ...
+                 femur_frame: str = "epicondyles", maps: Optional[Tuple[str, str]] = None,
+                 sparse: float = 0.0) -> None: ...
     def save_maps(self, ball_path: str, socket_path: str) -> None:
         """Save both maps for Joint(..., maps=(ball_path, socket_path))."""
     def detect(self, R: Optional[npt.ArrayLike] = None, t: Optional[Sequence[float]] = None) -> Dict[str, Any]:

@@ -153,7 +153,8 @@ PyJoint make_joint(const py::handle& ball, const py::handle& socket, const py::h
                    const std::string& neutral, const std::string& scheme, double resolution, const std::string& mode,
                    const std::string& sampling, double occlusion_tolerance_mm, double max_radius_mm,
                    const std::optional<std::vector<double>>& levels, bool reseat, const std::string& pelvis_frame,
-                   const std::string& femur_frame, const std::optional<std::pair<std::string, std::string>>& maps) {
+                   const std::string& femur_frame, const std::optional<std::pair<std::string, std::string>>& maps,
+                   double sparse) {
   TriangleMesh b = to_mesh(ball, "ball"), s = to_mesh(socket, "socket");
   HipJointOptions o;
   o.joint.scheme = make_scheme(scheme, resolution > 0 ? resolution : default_resolution(scheme));
@@ -161,6 +162,9 @@ PyJoint make_joint(const py::handle& ball, const py::handle& socket, const py::h
   o.joint.sampling = parse_sampling_method(sampling);
   o.joint.occlusion_tolerance_mm = occlusion_tolerance_mm;
   o.joint.max_radius_mm = max_radius_mm > 0 ? max_radius_mm : std::numeric_limits<double>::infinity();
+  require(!std::isnan(sparse) && sparse >= 0, "Joint: sparse " + std::to_string(sparse) + " must be >= 0 mm or inf");
+  o.joint.sparse_maps = sparse > 0;
+  if (sparse > 0) o.joint.sparse_region_mm = sparse;
   if (levels) {
     o.joint.levels.thresholds_mm = *levels;
     o.joint.levels.validate();
@@ -350,12 +354,20 @@ PYBIND11_MODULE(impinge, m) {
       .def_property_readonly(
           "values",
           [](const MapView& v) {
+            if (v.map->sparse()) {  // no dense array to view: a copy, absent tiles as inf
+              py::array_t<float> a(py::ssize_t(v.map->num_nodes()));
+              float* out = a.mutable_data();
+              for (std::int64_t i = 0; i < v.map->num_nodes(); ++i) out[i] = v.map->at(i);
+              py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+              return a;
+            }
             py::array_t<float> a({py::ssize_t(v.map->num_nodes())}, {py::ssize_t(sizeof(float))}, v.map->data(),
                                  py::cast(v));
             py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
             return a;
           },
-          "Node distances, float32 (num_nodes,), mm; a read-only view of the map (no copy).")
+          "Node distances, float32 (num_nodes,), mm; a read-only view of the map (no copy), or a read-only copy "
+          "of a sparse map.")
       .def(
           "node_directions",
           [](const MapView& v) {
@@ -372,7 +384,8 @@ PYBIND11_MODULE(impinge, m) {
       .def_property_readonly("resolution", [](const MapView& v) { return v.map->scheme().resolution(); })
       .def_property_readonly("num_nodes", [](const MapView& v) { return v.map->num_nodes(); })
       .def_property_readonly("nodes_covered", [](const MapView& v) { return v.map->nodes_covered(); })
-      .def_property_readonly("bytes", [](const MapView& v) { return v.map->bytes(); });
+      .def_property_readonly("bytes", [](const MapView& v) { return v.map->bytes(); })
+      .def_property_readonly("sparse", [](const MapView& v) { return v.map->sparse(); });
 
   py::class_<PyJoint>(m, "Joint",
                       "A hip: femur (ball) and pelvis (socket) in one frame (mm), both radial distance maps built "
@@ -382,13 +395,14 @@ PYBIND11_MODULE(impinge, m) {
            py::arg("resolution") = 0.0, py::arg("mode") = "exact", py::arg("sampling") = "auto",
            py::arg("occlusion_tolerance_mm") = 1.0, py::arg("max_radius_mm") = 0.0,
            py::arg("levels") = py::none(), py::arg("reseat") = false, py::arg("pelvis_frame") = "isb",
-           py::arg("femur_frame") = "epicondyles", py::arg("maps") = py::none(),
+           py::arg("femur_frame") = "epicondyles", py::arg("maps") = py::none(), py::arg("sparse") = 0.0,
            "ball, socket: (V (n, 3) float, F (m, 3) int) in one frame, mm (RAS-like: x right, y anterior, z "
            "superior for neutral='scan'). cor: centre of rotation (3,), mm; None fits the femoral head. "
            "neutral: 'anatomical' (ISB frames found on whole bones) or 'scan'. scheme/resolution: sampling "
            "scheme and its resolution (0: the scheme's default, 0.5 deg equivalent). mode: 'exact' or 'linear'. "
            "levels: impingement thresholds (mm, decreasing). maps: (ball_path, socket_path) saved by save_maps() "
-           "to load instead of sampling. Builds both maps (the GIL is released). Raises impinge.Error on bad "
+           "to load instead of sampling. sparse: store the maps sparse, keeping the tiles with a surface within this "
+           "many mm of the COR (inf: any surface, the same gaps bit for bit; 0: dense). Builds both maps (the GIL is released). Raises impinge.Error on bad "
            "arrays, options or map files.")
       .def(
           "detect",

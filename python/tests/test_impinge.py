@@ -102,6 +102,22 @@ def test_maps_saved_and_loaded_give_the_same_gaps(generated):
         impinge.Joint(ball, socket, neutral="scan", resolution=1.0, maps=(d + "/b.map", d + "/s.map"))
 
 
+def test_sparse_maps_give_the_same_gaps(generated):
+    d = generated
+    ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
+    dense = impinge.Joint(ball, socket, neutral="scan", resolution=0.5)
+    sparse = impinge.Joint(ball, socket, neutral="scan", resolution=0.5, sparse=float("inf"))
+    assert sparse.socket_map.sparse and not dense.socket_map.sparse
+    assert sparse.socket_map.bytes < dense.socket_map.bytes
+    np.testing.assert_array_equal(sparse.socket_map.values, dense.socket_map.values)
+    for pose in ((0, 0, 0), (30, -10, 5), (90, 10, 25)):
+        a, b = dense.detect_pose(*pose), sparse.detect_pose(*pose)
+        np.testing.assert_array_equal(a["ball_gap_mm"], b["ball_gap_mm"])
+        np.testing.assert_array_equal(a["socket_gap_mm"], b["socket_gap_mm"])
+    with pytest.raises(impinge.Error, match="sparse"):
+        impinge.Joint(ball, socket, neutral="scan", resolution=2.0, sparse=-1.0)
+
+
 def test_bad_arrays_raise_clear_errors(generated):
     d = generated
     V, F = impinge.load_mesh(d + "/s/femur_r.ply")
