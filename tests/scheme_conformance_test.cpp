@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include "impinge/error.hpp"
@@ -367,6 +368,20 @@ TEST_P(SchemeConformance, SampledSphereAgreesWithTheExactReference) {
   EXPECT_LT(worst_cast, cast_bound) << s->name() << " " << s->resolution();
   EXPECT_LT(worst_fast, fast_bound) << s->name() << " " << s->resolution() << " (" << to_string(rep.method) << ")";
   EXPECT_GT(worst_cast, 0);  // an interpolation, not a copy of the oracle
+}
+
+TEST_P(SchemeConformance, BadResolutionsAreRefusedByName) {
+  // NaN, negative, zero and absurdly fine or coarse resolutions: an impinge::Error naming the scheme,
+  // never a crash, a hang or a map too large to hold.
+  const std::string name = GetParam().name;
+  for (double r : {std::nan(""), -1.0, 0.0, 1e12, -1e12, std::numeric_limits<double>::infinity()}) {
+    try {
+      const auto s = make_scheme(name, r);
+      ADD_FAILURE() << name << " accepted resolution " << r << " (" << s->num_nodes() << " nodes)";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(name.substr(0, 5)), std::string::npos) << e.what();
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Registered, SchemeConformance, ::testing::ValuesIn(cases()),

@@ -51,8 +51,8 @@ double metric2(double da, double dz, double z) {
 
 FibonacciScheme::FibonacciScheme(double nodes) {
   std::ostringstream os;
-  os << "fibonacci scheme: node count " << nodes << " must be a whole number in [16, 2^31]";
-  require(std::isfinite(nodes) && nodes >= 16 && nodes <= 2147483648.0 && nodes == std::round(nodes), os.str());
+  os << "fibonacci scheme: node count " << nodes << " must be a whole number in [16, 2^31 - 1]";
+  require(std::isfinite(nodes) && nodes >= 16 && nodes <= 2147483647.0 && nodes == std::round(nodes), os.str());
   n_ = static_cast<std::int64_t>(nodes);
   inv_n_ = 1.0 / double(n_);
   // Longest triangle edge: both basis steps and the shorter diagonal, at 4,096 latitudes between the

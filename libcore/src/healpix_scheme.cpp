@@ -15,9 +15,9 @@ struct HealpixScheme::Base : T_Healpix_Base<int64> {
 
 HealpixScheme::HealpixScheme(double nside) {
   std::ostringstream os;
-  os << "healpix scheme: nside " << nside << " must be a whole number in [2, 2^28]";
-  require(std::isfinite(nside) && nside >= 2 && nside <= double(std::int64_t(1) << 28) && nside == std::round(nside),
-          os.str());
+  os << "healpix scheme: nside " << nside << " must be a whole number in [2, 13377] (12 nside^2 nodes; a map holds "
+     << "at most 2^31 - 1)";
+  require(std::isfinite(nside) && nside >= 2 && nside <= 13377 && nside == std::round(nside), os.str());
   nside_ = static_cast<std::int64_t>(nside);
   base_ = std::make_shared<const Base>(nside_);
   max_spacing_ = std::sqrt(2.0) * base_->max_pixrad();

@@ -28,8 +28,9 @@ double arc(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 OctahedralScheme::OctahedralScheme(double cells_per_side) {
   std::ostringstream os;
-  os << "octahedral scheme: cells per side " << cells_per_side << " must be a whole number in [2, 1e5]";
-  require(std::isfinite(cells_per_side) && cells_per_side >= 2 && cells_per_side <= 1e5 &&
+  os << "octahedral scheme: cells per side " << cells_per_side
+     << " must be a whole number in [2, 46340] (a map holds at most 2^31 - 1 nodes)";
+  require(std::isfinite(cells_per_side) && cells_per_side >= 2 && cells_per_side <= 46340 &&
               cells_per_side == std::round(cells_per_side),
           os.str());
   n_ = static_cast<int>(cells_per_side);

@@ -59,7 +59,14 @@ const Entry& entry(const std::string& name) {
 }  // namespace
 
 std::shared_ptr<const SamplingScheme> make_scheme(const std::string& name, double resolution) {
-  return entry(name).make(resolution);
+  const Entry& e = entry(name);
+  try {
+    return e.make(resolution);
+  } catch (const Error& err) {  // name the scheme in every refusal
+    const std::string what = err.what();
+    if (what.find(name) != std::string::npos) throw;
+    throw Error("sampling scheme '" + name + "': " + what);
+  }
 }
 
 double default_resolution(const std::string& name) {

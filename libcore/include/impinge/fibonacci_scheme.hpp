@@ -28,7 +28,7 @@ namespace impinge {
 
 class FibonacciScheme : public SchemeImpl<FibonacciScheme> {
  public:
-  /// n >= 16 integral nodes, at most 2^31. Throws impinge::Error otherwise.
+  /// n >= 16 integral nodes, at most 2^31 - 1 (what a map holds). Throws impinge::Error otherwise.
   explicit FibonacciScheme(double nodes);
 
   std::string name() const override { return "fibonacci"; }

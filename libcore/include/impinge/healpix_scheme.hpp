@@ -20,8 +20,7 @@ namespace impinge {
 
 class HealpixScheme : public SchemeImpl<HealpixScheme> {
  public:
-  /// N_side >= 2 integral, at most 2^28 (the library's limit for 64-bit pixel indices). Throws
-  /// impinge::Error otherwise.
+  /// N_side in [2, 13377] integral (12 N_side^2 nodes fit a map). Throws impinge::Error otherwise.
   explicit HealpixScheme(double nside);
 
   std::string name() const override { return "healpix"; }

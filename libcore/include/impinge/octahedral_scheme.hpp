@@ -44,7 +44,8 @@ Eigen::Vector3d octahedral_to_direction(double u, double v);
 /// column, row along v, column along u, centres at -1 + (2 i + 1) / N.
 class OctahedralScheme : public SchemeImpl<OctahedralScheme> {
  public:
-  /// N >= 2 integral cells per side of the square. Throws impinge::Error otherwise.
+  /// N in [2, 46340] integral cells per side of the square (N^2 nodes fit a map). Throws impinge::Error
+  /// otherwise.
   explicit OctahedralScheme(double cells_per_side);
 
   std::string name() const override { return "octahedral"; }
