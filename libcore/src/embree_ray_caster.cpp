@@ -20,6 +20,7 @@ bool have_embree() { return true; }
 struct EmbreeRayCaster::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
+  bool filterable = false;
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
@@ -50,7 +51,9 @@ EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d
   rtcAttachGeometry(impl_->scene, g);
   rtcReleaseGeometry(g);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
-  if (robust) rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+  if (robust)
+    rtcSetSceneFlags(impl_->scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
+  impl_->filterable = robust;
 
   rtcCommitScene(impl_->scene);
   impl_->check("building the scene of " + mesh.source);
@@ -119,6 +122,34 @@ float EmbreeRayCaster::least_hit(const float* dirs, int k) const {
   for (int j = 0; j < k; ++j)
     if (rh.hit.geomID[j] != RTC_INVALID_GEOMETRY_ID) best = std::min(best, rh.ray.tfar[j]);
   return best;
+}
+
+namespace {
+/// The intersect context of all_hits: Embree's context first, so the filter can reach the list.
+struct AllHitsContext {
+  RTCIntersectContext context;
+  std::vector<std::pair<float, unsigned>>* out;
+};
+void record_and_reject(const RTCFilterFunctionNArguments* args) {
+  auto* c = reinterpret_cast<const AllHitsContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    c->out->emplace_back(RTCRayN_tfar(args->ray, args->N, i), RTCHitN_primID(args->hit, args->N, i));
+    args->valid[i] = 0;  // rejected: the traversal goes on to the next candidate
+  }
+}
+}  // namespace
+
+void EmbreeRayCaster::all_hits(float dx, float dy, float dz, std::vector<std::pair<float, unsigned>>& out) const {
+  require(impl_->filterable, "embree: all_hits needs a scene built with robust = true");
+  const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
+  AllHitsContext c;
+  rtcInitIntersectContext(&c.context);
+  c.context.filter = record_and_reject;
+  c.out = &out;
+  RTCRayHit rh;
+  init_ray(rh, dx / len, dy / len, dz / len);
+  rtcIntersect1(impl_->scene, &c.context, &rh);
 }
 
 void EmbreeRayCaster::scan_gaps(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, ScanSide side,
@@ -209,6 +240,7 @@ float EmbreeRayCaster::least_hit(const float*, int) const { return std::numeric_
 EmbreeRayCaster::EmbreeRayCaster(EmbreeRayCaster&&) noexcept = default;
 EmbreeRayCaster& EmbreeRayCaster::operator=(EmbreeRayCaster&&) noexcept = default;
 float EmbreeRayCaster::first_hit(float, float, float) const { return 0; }
+void EmbreeRayCaster::all_hits(float, float, float, std::vector<std::pair<float, unsigned>>&) const {}
 void EmbreeRayCaster::scan_gaps(const ScanSet&, const Eigen::Matrix3d&, const Eigen::Vector3d&, ScanSide, float*,
                                 bool) const {}
 template <typename Scalar>

@@ -10,6 +10,8 @@
 #include <CGAL/Search_traits_3.h>
 #include <CGAL/Simple_cartesian.h>
 
+#include <algorithm>
+#include <iterator>
 #include <vector>
 #endif
 
@@ -58,6 +60,29 @@ std::optional<double> ExactReference::first_hit(const Eigen::Vector3d& origin, c
   return std::nullopt;
 }
 
+std::vector<std::pair<double, double>> ExactReference::all_hits(const Eigen::Vector3d& origin,
+                                                               const Eigen::Vector3d& direction) const {
+  const K::Ray_3 ray(pt(origin), K::Vector_3(direction.x(), direction.y(), direction.z()));
+  std::vector<Tree::Intersection_and_primitive_id<K::Ray_3>::Type> hits;
+  impl_->tree.all_intersections(ray, std::back_inserter(hits));
+  std::vector<std::pair<double, double>> out;
+  for (const auto& h : hits) {
+    const Triangle& t = *h.second;
+    const K::Vector_3 n = CGAL::cross_product(t.vertex(1) - t.vertex(0), t.vertex(2) - t.vertex(0));
+    const double cosine =
+        (n.x() * direction.x() + n.y() * direction.y() + n.z() * direction.z()) / std::sqrt(n.squared_length());
+    if (const K::Point_3* p = boost::get<K::Point_3>(&h.first)) {
+      out.emplace_back(std::sqrt(CGAL::squared_distance(*p, ray.source())), cosine);
+    } else if (const K::Segment_3* s = boost::get<K::Segment_3>(&h.first)) {
+      out.emplace_back(std::sqrt(std::min(CGAL::squared_distance(s->source(), ray.source()),
+                                          CGAL::squared_distance(s->target(), ray.source()))),
+                       0.0);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 double ExactReference::closest_distance(const Eigen::Vector3d& p) const {
   return std::sqrt(impl_->tree.squared_distance(pt(p)));
 }
@@ -97,6 +122,9 @@ std::optional<double> ExactReference::first_hit(const Eigen::Vector3d&, const Ei
   return std::nullopt;
 }
 double ExactReference::closest_distance(const Eigen::Vector3d&) const { return 0; }
+std::vector<std::pair<double, double>> ExactReference::all_hits(const Eigen::Vector3d&, const Eigen::Vector3d&) const {
+  return {};
+}
 #endif
 
 PointCloudIndex::~PointCloudIndex() = default;

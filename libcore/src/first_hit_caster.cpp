@@ -23,6 +23,7 @@ struct FirstHitCaster::Impl {
   std::vector<Eigen::Matrix3d> edge_on;  ///< columns: the corners relative to the origin
   std::optional<EmbreeRayCaster> embree;
   std::optional<ExactReference> cgal;
+  std::vector<Eigen::Vector3f> normals;  ///< unit normal of each triangle given to Embree (crossings)
 };
 
 bool FirstHitCaster::available() { return have_embree() || have_exact_reference(); }
@@ -74,12 +75,38 @@ FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& 
     for (std::size_t k = 0; k < keep.size(); ++k) F.row(static_cast<Eigen::Index>(k)) = clean.F.row(keep[k]);
     clean.F = std::move(F);
   }
+  {
+    // Orientation by the signed volume of the triangles kept (a closed mesh's edge-on triangles
+    // add no volume about the origin, which lies in their plane).
+    double volume = 0;
+    impl_->normals.reserve(static_cast<std::size_t>(clean.F.rows()));
+    for (Eigen::Index f = 0; f < clean.F.rows(); ++f) {
+      const Eigen::Vector3d a = clean.V.row(clean.F(f, 0)).transpose() - origin,
+                            b = clean.V.row(clean.F(f, 1)).transpose() - origin,
+                            c = clean.V.row(clean.F(f, 2)).transpose() - origin;
+      volume += a.dot(b.cross(c)) / 6;
+      impl_->normals.push_back((b - a).cross(c - a).normalized().cast<float>());
+    }
+    orientation_ = volume >= 0 ? 1 : -1;
+  }
   if (have_embree()) {
     impl_->embree.emplace(clean, origin, /*robust=*/true);
     impl_->backend = "embree";
   } else {
     impl_->cgal.emplace(clean);
     impl_->backend = "cgal";
+  }
+  // Whether the origin lies inside the solid: the majority over 13 rays of whether the first crossing
+  // leaves it (a ray that misses says outside).
+  {
+    int inside = 0;
+    std::vector<RayCrossing> c;
+    for (int k = 0; k < 13; ++k) {
+      const double z = 1 - (2 * k + 1) / 13.0, rho = std::sqrt(1 - z * z), az = 2.399963229728653 * k + 0.1;
+      raw_crossings(Eigen::Vector3d(rho * std::cos(az), rho * std::sin(az), z), c);
+      inside += !c.empty() && !c.front().entering;
+    }
+    origin_inside_ = 2 * inside > 13;
   }
 }
 
@@ -142,6 +169,63 @@ double FirstHitCaster::first_hit(const Eigen::Vector3d& direction) const {
     for (const Eigen::Matrix3d& T : impl_->edge_on) h = std::min(h, edge_on_hit(T, u));
   }
   return h;
+}
+
+namespace {
+/// A closed surface seen from a fixed origin: crossings alternate, end leaving the solid, and start
+/// entering it exactly when the origin lies outside.
+bool consistent(const std::vector<RayCrossing>& c, bool origin_inside) {
+  if (c.empty()) return !origin_inside;
+  if (c.front().entering == origin_inside || c.back().entering) return false;
+  for (std::size_t k = 1; k < c.size(); ++k)
+    if (c[k].entering == c[k - 1].entering) return false;
+  return true;
+}
+}  // namespace
+
+void FirstHitCaster::crossings(const Eigen::Vector3d& direction, std::vector<RayCrossing>& out) const {
+  const Eigen::Vector3d u = direction.normalized();
+  raw_crossings(u, out);
+  if (consistent(out, origin_inside_)) return;
+  // Embree's float intersection is not watertight at a shared vertex: a ray exactly through one can
+  // slip between its triangles and lose a crossing (a closed mesh then reads inconsistently). Two rays
+  // 1e-6 rad beside it (2.5e-5 mm at 25 mm) decide; when neither is consistent either (a mesh that is
+  // not closed), the ray's own crossings stand.
+  const Eigen::Vector3d a = u.unitOrthogonal(), b = u.cross(a);
+  thread_local std::vector<RayCrossing> other;
+  for (const Eigen::Vector3d& d : {Eigen::Vector3d(u + 1e-6 * a), Eigen::Vector3d(u + 1e-6 * (0.866 * b - 0.5 * a))}) {
+    raw_crossings(d.normalized(), other);
+    if (consistent(other, origin_inside_)) {
+      out.swap(other);
+      return;
+    }
+  }
+}
+
+void FirstHitCaster::raw_crossings(const Eigen::Vector3d& u, std::vector<RayCrossing>& out) const {
+  out.clear();
+  // (distance, facing cosine with the winding's normal), any order.
+  thread_local std::vector<std::pair<double, double>> raw;
+  raw.clear();
+  if (impl_->embree) {
+    thread_local std::vector<std::pair<float, unsigned>> hits;
+    hits.clear();
+    impl_->embree->all_hits(float(u.x()), float(u.y()), float(u.z()), hits);
+    for (const auto& [t, f] : hits) raw.emplace_back(double(t), double(impl_->normals[f].cast<double>().dot(u)));
+  } else {
+    for (const auto& h : impl_->cgal->all_hits(impl_->origin, u)) raw.push_back(h);
+  }
+  std::sort(raw.begin(), raw.end());
+  for (std::size_t i = 0; i < raw.size();) {
+    // A group of hits within 1e-4 mm of its first: one crossing by the majority of the facings.
+    std::size_t j = i;
+    int facing = 0;
+    for (; j < raw.size() && raw[j].first - raw[i].first <= 1e-4; ++j)
+      facing += raw[j].second < 0 ? -1 : raw[j].second > 0 ? 1 : 0;
+    facing *= orientation_;
+    if (facing != 0) out.push_back({raw[i].first, facing < 0});
+    i = j;
+  }
 }
 
 const std::string& FirstHitCaster::backend() const { return impl_->backend; }

@@ -10,6 +10,8 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "impinge/detection.hpp"
 #include "impinge/mesh.hpp"
@@ -27,7 +29,7 @@ class EmbreeRayCaster {
   /// Build the scene (BVH) of `mesh` (mm) about `origin` (mm). `robust`: Embree's watertight
   /// mode (RTC_SCENE_FLAG_ROBUST), so that a ray through a shared vertex or edge cannot slip
   /// between the triangles (slower; leave out triangles edge-on to the origin first, whose hits it
-  /// gets wrong). Throws impinge::Error when Embree is not in this build, the mesh is invalid, or
+  /// gets wrong); a robust scene also answers all_hits (RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION). Throws impinge::Error when Embree is not in this build, the mesh is invalid, or
   /// Embree reports an error.
   EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin, bool robust = false);
   ~EmbreeRayCaster();
@@ -40,6 +42,13 @@ class EmbreeRayCaster {
   /// The least first_hit of k <= 4 rays (dirs: k x 3, row-major, any nonzero lengths) in one
   /// rtcIntersect4 call: cheaper than k single rays when they are close together.
   float least_hit(const float* dirs, int k) const;
+
+  /// Every hit of the ray from the origin along (dx, dy, dz) (any nonzero length), in one traversal
+  /// (a context filter records each candidate and rejects it): appends (distance along the unit
+  /// direction in mm, triangle index in the mesh given to the constructor) to `out`, unsorted; a ray
+  /// through a shared edge may report both triangles. Throws impinge::Error on a scene built
+  /// without `robust`. Source: issue 14 (layered maps).
+  void all_hits(float dx, float dy, float dz, std::vector<std::pair<float, unsigned>>& out) const;
 
   /// The radial scan through Embree, the peer of scan_gaps_compact: for vertex j of `set`,
   /// q = R p_j + t, gap_mm[j] = side * (nearest hit along q - |q|), NaN on a miss.

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "impinge/mesh.hpp"
@@ -30,6 +31,12 @@ class ExactReference {
   /// Distance (mm) from `origin` along unit `direction` to the nearest intersection with the
   /// mesh, or nullopt when the ray misses (CGAL AABB_tree::first_intersection).
   std::optional<double> first_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
+  /// Every crossing of the ray from `origin` along unit `direction` with the mesh, sorted by
+  /// distance: (distance mm, cosine of the angle between the triangle's normal (corner order
+  /// a, b, c: (b - a) x (c - a), normalised) and the direction), one per triangle met
+  /// (AABB_tree::all_intersections); a ray in a triangle's plane gives the nearer end of the segment
+  /// and cosine 0. Empty when the ray misses. Source: issue 14 (layered maps).
+  std::vector<std::pair<double, double>> all_hits(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
   /// Distance (mm) from `p` to the closest point of the mesh (AABB_tree::closest_point).
   double closest_distance(const Eigen::Vector3d& p) const;
 

@@ -9,10 +9,18 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "impinge/mesh.hpp"
 
 namespace impinge {
+
+/// Where a ray from the origin crosses a mesh's surface: distance (mm) and whether it enters the
+/// solid there (the surface faces the ray) or leaves it. Source: issue 14 (layered maps).
+struct RayCrossing {
+  double distance_mm = 0;
+  bool entering = false;
+};
 
 /// Rays from a fixed origin (the COR) against one mesh. Queries are const and thread-safe.
 class FirstHitCaster {
@@ -29,6 +37,21 @@ class FirstHitCaster {
   /// Distance (mm) from the origin along `direction` (any nonzero length) to the nearest hit of
   /// the mesh; +infinity when the ray misses.
   double first_hit(const Eigen::Vector3d& direction) const;
+  /// Every crossing of the ray from the origin along `direction` (any nonzero length) with the
+  /// surface, nearest first, into `out` (cleared first). Hits within 1e-4 mm of each other (a ray
+  /// through a shared edge or vertex, or grazing a silhouette) are merged into one crossing whose
+  /// side is the majority of their facings, or dropped when the facings cancel (a graze touches the
+  /// surface without crossing it). Facing is by the triangles' winding, made outward by the sign of
+  /// the mesh's volume (so a mesh wound inward is read the right way round). Triangles edge-on to
+  /// the origin are met only in their plane and are left out. A ray whose crossings cannot be those of a
+  /// closed surface (not alternating, not ending outside, or starting on the wrong side of the origin:
+  /// Embree can lose a crossing where the ray passes exactly through a shared vertex) is replaced by
+  /// the first of two rays 1e-6 rad beside it that reads consistently, if any. Thread-safe.
+  void crossings(const Eigen::Vector3d& direction, std::vector<RayCrossing>& out) const;
+  /// +1 when the mesh is wound outward (signed volume >= 0), -1 when crossings() flips its facings.
+  int orientation() const { return orientation_; }
+  /// Whether the origin lies inside the solid (the majority of 13 rays' first crossings).
+  bool origin_inside() const { return origin_inside_; }
   /// "embree" or "cgal".
   const std::string& backend() const;
   /// Triangles whose plane passes through the origin (to 1e-6 of their distance): a ray from the
@@ -39,6 +62,9 @@ class FirstHitCaster {
 
  private:
   std::int64_t edge_on_ = 0;
+  int orientation_ = 1;
+  bool origin_inside_ = false;
+  void raw_crossings(const Eigen::Vector3d& unit_direction, std::vector<RayCrossing>& out) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
