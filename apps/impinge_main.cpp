@@ -58,6 +58,8 @@ struct MapOptions {
          sparse_region = 0;
   double discontinuity_tolerance = 0.05;  // mm
   bool maps_only = false;                 // no exact look-ups at depth discontinuities
+  int layers = 0;                         // layered maps (extra-articular), 0 = off
+  double extra_articular_radius = 150;    // mm
 };
 struct FrameOptions {
   std::string neutral;  // empty: subject.json's "neutral", else anatomical
@@ -113,6 +115,14 @@ void add_map_options(CLI::App* app, MapOptions& o) {
   app->add_option("--discontinuity-tolerance", o.discontinuity_tolerance,
                   "mm: look-ups whose stencil may be off by more than this (depth discontinuities: rims, coverage "
                   "edges) are resolved by an exact ray cast")
+      ->capture_default_str();
+  app->add_option("--layers", o.layers,
+                  "N: also a layered map of N crossings per node for each bone, so that vertices hidden behind their "
+                  "own bone's nearer surface (trochanters, shaft, ilium) are tested too: extra-articular impingement "
+                  "(0 = off, the thesis' single-layer maps)")
+      ->capture_default_str();
+  app->add_option("--extra-articular-radius", o.extra_articular_radius,
+                  "mm: with --layers, test hidden vertices within this distance of the COR")
       ->capture_default_str();
   app->add_flag("--maps-only", o.maps_only,
                 "No exact look-ups at depth discontinuities: the maps answer alone (the thesis' algorithm)");
@@ -206,6 +216,11 @@ Setup set_up(const InputOptions& in, const MapOptions& mo, const FrameOptions& f
   jo.sparse_maps = mo.sparse_region > 0;
   if (jo.sparse_maps) jo.sparse_region_mm = mo.sparse_region;
   if (!mo.levels.empty()) jo.levels = parse_levels(mo.levels);
+  require(mo.layers >= 0 && mo.layers <= LayeredMap::kMaxLayers,
+          "--layers " + std::to_string(mo.layers) + ": must be 0 (off) to " + std::to_string(LayeredMap::kMaxLayers));
+  require(mo.extra_articular_radius > 0, "--extra-articular-radius must be > 0 mm");
+  jo.layers = mo.layers;
+  jo.extra_articular_radius_mm = mo.extra_articular_radius;
 
   TriangleMesh ball = load_mesh(s.ball_path), socket = load_mesh(s.socket_path);
   s.to_working = to_anatomical(s.frame);
@@ -290,6 +305,8 @@ nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double det
   j["vertices_no_surface"] = s.vertices_no_surface;
   j["vertices_beyond_reach"] = s.vertices_beyond_reach;
   j["vertices_refined"] = s.vertices_refined;
+  j["vertices_tested_layered"] = s.vertices_tested_layered;
+  j["min_gap_layered_mm"] = num_or_null(s.min_gap_layered_mm);
   j["min_gap_mm"] = num_or_null(s.min_gap_mm);
   j["vertices_penetrating"] = s.vertices_penetrating;
   j["area_penetrating_mm2"] = s.area_penetrating_mm2;
@@ -308,6 +325,16 @@ nlohmann::json scan_json(const JointBody& body, const ScanSummary& s, double det
   j["map_sparse"] = body.map.sparse();
   j["map_tiles_stored"] = body.map.tiles_stored();
   j["map_tiles_total"] = body.map.tiles_total();
+  if (body.layered) {
+    j["layers"] = body.layered->layers();
+    j["layered_map_bytes"] = body.layered->bytes();
+    j["layered_nodes_covered"] = body.layered_sampling.nodes_covered;
+    j["layered_nodes_truncated"] = body.layered_sampling.nodes_truncated;
+    j["layered_nodes_not_alternating"] = body.layered_sampling.nodes_not_alternating;
+    j["layered_max_crossings"] = body.layered_sampling.max_crossings;
+    j["layered_sampling_ms"] = body.layered_sampling.sampling_ms;
+    j["hidden_vertices"] = body.hidden_set.size();
+  }
   j["triangles"] = body.mesh.F.rows();
   j["degenerate_triangles_skipped"] = body.mesh.degenerate_faces_skipped;
   j["triangles_edge_on"] = body.sampling.raster.triangles_edge_on;

@@ -27,15 +27,6 @@
 using namespace impinge;
 
 namespace {
-TriangleMesh concatenated(const TriangleMesh& a, const TriangleMesh& b) {
-  TriangleMesh m;
-  m.source = "two spheres";
-  m.V.resize(a.V.rows() + b.V.rows(), 3);
-  m.V << a.V, b.V;
-  m.F.resize(a.F.rows() + b.F.rows(), 3);
-  m.F << a.F, (b.F.array() + static_cast<int>(a.V.rows())).matrix();
-  return m;
-}
 struct Sphere {
   Eigen::Vector3d c;
   double r;
@@ -96,7 +87,7 @@ TEST(LayeredMap, RefusesBadLayerCounts) {
 TEST(LayeredMap, CrossingsOfTwoSpheresAgreeWithCgalAndTheAnalyticOnes) {
   if (!FirstHitCaster::available() || !have_exact_reference()) GTEST_SKIP() << "no ray caster in this build";
   const std::vector<Sphere> spheres = {{{30, 2, -1}, 10}, {{62, 5, 3}, 8}};
-  const TriangleMesh mesh = concatenated(make_uv_sphere(10, spheres[0].c, 256, 128, Eigen::Vector3d(0.3, 0.5, 0.81).normalized()),
+  const TriangleMesh mesh = test::concatenated(make_uv_sphere(10, spheres[0].c, 256, 128, Eigen::Vector3d(0.3, 0.5, 0.81).normalized()),
                                          make_uv_sphere(8, spheres[1].c, 256, 128));
   const FirstHitCaster caster(mesh, Eigen::Vector3d::Zero());
   const ExactReference ref(mesh);
@@ -154,7 +145,7 @@ TEST(LayeredMap, RaysThroughSharedVerticesGiveOneCrossingPerSurface) {
 TEST(LayeredMap, InterpolatedSignedDistanceAgreesWithTheAnalyticOne) {
   if (!FirstHitCaster::available()) GTEST_SKIP() << "no ray caster in this build";
   const std::vector<Sphere> spheres = {{{30, 2, -1}, 10}, {{62, 5, 3}, 8}};
-  const TriangleMesh mesh = concatenated(make_uv_sphere(10, spheres[0].c, 256, 128), make_uv_sphere(8, spheres[1].c, 256, 128));
+  const TriangleMesh mesh = test::concatenated(make_uv_sphere(10, spheres[0].c, 256, 128), make_uv_sphere(8, spheres[1].c, 256, 128));
   const FirstHitCaster caster(mesh, Eigen::Vector3d::Zero());
   const ExactReference ref(mesh);
   for (const char* name : {"equiangular", "helix", "healpix"}) {
@@ -247,7 +238,7 @@ TEST(LayeredMap, FromInsideAHeadAndOnAMeshThatIsNotClosed) {
 TEST(LayeredMap, OccupancyCoversTheSolid) {
   if (!FirstHitCaster::available()) GTEST_SKIP() << "no ray caster in this build";
   const std::vector<Sphere> spheres = {{{30, 2, -1}, 10}, {{62, 5, 3}, 8}};
-  const TriangleMesh mesh = concatenated(make_uv_sphere(10, spheres[0].c, 128, 64), make_uv_sphere(8, spheres[1].c, 128, 64));
+  const TriangleMesh mesh = test::concatenated(make_uv_sphere(10, spheres[0].c, 128, 64), make_uv_sphere(8, spheres[1].c, 128, 64));
   const FirstHitCaster caster(mesh, Eigen::Vector3d::Zero());
   LayeredMap map(make_scheme("equiangular", 1.0), 4);
   map.sample(caster);

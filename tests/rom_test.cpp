@@ -5,6 +5,9 @@
 //   inner edge when the angle between neck and opening axes reaches (180 - beta) - asin(n / R)
 //   (the rim point at angle gamma from the neck axis is R sin(gamma) from it). The search finds it
 //   within 0.2 deg, at several cup coverages and in both rotation senses about the axis;
+// - extra-articular oracle: a trochanter block hidden behind the head meets an iliac plate hidden
+//   behind the cup at the closed-form angle (within 0.2 deg) with layered maps, and is invisible
+//   without them; with layers, the occupancy bounds give the full scan's limits;
 // - a right hip and its mirrored left copy give the same limits within 0.2 deg;
 // - pre-existing overlap at the baseline is excluded and reported, not taken for a limit;
 // - bad options are errors.
@@ -16,6 +19,7 @@
 #include <memory>
 
 #include "impinge/error.hpp"
+#include "impinge/first_hit_caster.hpp"
 #include "impinge/generated_models.hpp"
 #include "test_support.hpp"
 
@@ -172,4 +176,88 @@ TEST(Rom, ClusterBoundsGiveTheFullScansResults) {
       }
     }
   }
+}
+
+TEST(Rom, TrochanterMeetsTheIliacPlateWhereTheClosedFormSays) {
+  // Extra-articular path (issue 14): a femur of a head sphere (radius 22 mm about the COR) and a
+  // trochanter block, x in [35, 50], y in [-8, 8], z in [5, 20] mm, hidden behind the head from the COR;
+  // a pelvis of a cup (24.5 to 30.5 mm, covering 80 deg about +z) and an iliac plate, x in [10, 60],
+  // y in [-20, 20], z in [45, 55] mm, hidden behind the cup. Rotating the femur by theta about -y
+  // (x turns towards +z), block corner (x, z) reaches the plate's lower face z = 45 when
+  // x sin(theta) + z cos(theta) = 45, i.e. theta = asin(45 / rho) - atan2(z, x), rho = |(x, z)|;
+  // a convex block meets a plane first at a corner, so the limit is the least over the corners. No
+  // other part can meet: the head and the cup are concentric, the block stays beyond 36 mm, the cup
+  // within 30.5 mm. Without layered maps the hidden block is not tested and there is no limit.
+  if (!FirstHitCaster::available()) GTEST_SKIP() << "no ray caster in this build";
+  const Eigen::Vector3d cor(60, -20, 30);
+  const Eigen::Vector3d c = cor;
+  const TriangleMesh femur = test::concatenated(make_uv_sphere(22, cor, 96, 48, Eigen::Vector3d(0.3, 0.2, 0.93).normalized()),
+                                                test::make_box(c + Eigen::Vector3d(35, -8, 5), c + Eigen::Vector3d(50, 8, 20)));
+  const TriangleMesh pelvis =
+      test::concatenated(make_cup(24.5, 30.5, 80, cor, Eigen::Vector3d::UnitZ(), 96, 40),
+                         test::make_box(c + Eigen::Vector3d(10, -20, 45), c + Eigen::Vector3d(60, 20, 55)));
+  double want = 1e9;
+  for (const double x : {35.0, 50.0})
+    for (const double z : {5.0, 20.0}) {
+      const double rho = std::hypot(x, z);
+      if (rho > 45) want = std::min(want, (std::asin(45 / rho) - std::atan2(z, x)) * 180 / M_PI);
+    }
+  SphereFitResult head;
+  head.centre = cor;
+  head.radius = 22;
+  const auto rotation = std::function<Eigen::Matrix3d(double)>(
+      [](double t) { return Eigen::AngleAxisd(t * M_PI / 180, -Eigen::Vector3d::UnitY()).toRotationMatrix(); });
+  RomOptions ro;
+  ro.step_deg = 1;
+  for (const int layers : {0, 4}) {
+    SCOPED_TRACE(layers);
+    HipJointOptions o = scan_options(0.25);
+    o.joint.layers = layers;
+    const HipJoint hip(femur, pelvis, Side::right, head, {}, o);
+    const RomBaseline base = rom_baseline(hip, Eigen::Matrix3d::Identity(), ro);
+    EXPECT_EQ(base.excluded_vertices, 0);
+    for (const bool bounds : {true, false}) {
+      ro.use_bounds = bounds;
+      const RomLimit l = find_rom_limit(hip, rotation, ro, base);
+      if (layers == 0) {
+        EXPECT_TRUE(std::isnan(l.limit_deg)) << l.limit_deg;  // the thesis' maps cannot see it
+        continue;
+      }
+      EXPECT_NEAR(l.limit_deg, want, 0.2) << "closed form " << want;
+      EXPECT_EQ(l.limited_by, "extra_articular");
+      EXPECT_TRUE(l.limited_by_hidden_vertex);
+      EXPECT_TRUE(l.limited_by_ball);
+      if (bounds) {
+        EXPECT_GT(l.vertices_skipped, 0);
+      }
+    }
+  }
+}
+
+TEST(Rom, LayeredClusterBoundsGiveTheFullScansResults) {
+  // With layered maps, the occupancy bounds skip only hidden clusters that cannot reach the threshold:
+  // the limits equal those of the search that looks up every hidden vertex (tlem2-mri, whose adduction
+  // is limited outside the joint).
+  auto j = test::load_real_joint("tlem2-mri");
+  if (!j) GTEST_SKIP() << "shared data absent";
+  if (!FirstHitCaster::available()) GTEST_SKIP() << "no ray caster in this build";
+  HipJointOptions o;
+  o.joint.scheme = make_scheme("equiangular", 0.5);
+  o.joint.layers = 4;
+  const HipJoint hip(j->femur, j->pelvis, Side::right, locate_femoral_head(j->femur), {}, o);
+  RomOptions with, without;
+  without.use_bounds = false;
+  const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), with);
+  const auto a = find_rom_limits(hip, standard_motions(), with, base);
+  const auto b = find_rom_limits(hip, standard_motions(), without, base);
+  int extra = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(std::isnan(a[k].limit_deg), std::isnan(b[k].limit_deg)) << k;
+    if (!std::isnan(a[k].limit_deg)) {
+      EXPECT_EQ(a[k].limit_deg, b[k].limit_deg) << k;
+      EXPECT_EQ(a[k].limited_by, b[k].limited_by) << k;
+    }
+    extra += a[k].limited_by_hidden_vertex;
+  }
+  EXPECT_GT(extra, 0);
 }

@@ -53,4 +53,31 @@ double ray_sphere_far(const Eigen::Vector3d& o, const Eigen::Vector3d& u, const 
   return -b + std::sqrt(b * b - cc);
 }
 
+TriangleMesh concatenated(const TriangleMesh& a, const TriangleMesh& b) {
+  TriangleMesh m;
+  m.source = a.source + " + " + b.source;
+  m.V.resize(a.V.rows() + b.V.rows(), 3);
+  m.V << a.V, b.V;
+  m.F.resize(a.F.rows() + b.F.rows(), 3);
+  m.F << a.F, (b.F.array() + static_cast<int>(a.V.rows())).matrix();
+  return m;
+}
+
+TriangleMesh make_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  TriangleMesh m;
+  m.source = "box";
+  m.V.resize(8, 3);
+  for (int k = 0; k < 8; ++k)
+    m.V.row(k) << ((k & 1) ? hi.x() : lo.x()), ((k & 2) ? hi.y() : lo.y()), ((k & 4) ? hi.z() : lo.z());
+  m.F.resize(12, 3);
+  // Faces x = lo, x = hi, y = lo, y = hi, z = lo, z = hi, each as two triangles wound outward.
+  m.F << 0, 4, 6, 0, 6, 2,  //
+      1, 3, 7, 1, 7, 5,     //
+      0, 1, 5, 0, 5, 4,     //
+      2, 6, 7, 2, 7, 3,     //
+      0, 2, 3, 0, 3, 1,     //
+      4, 5, 7, 4, 7, 6;
+  return m;
+}
+
 }  // namespace impinge::test

@@ -24,6 +24,10 @@ struct RealJoint {
   Eigen::Vector3d cor;
 };
 std::optional<RealJoint> load_real_joint(const std::string& name);
+/// One mesh of both meshes' triangles (a body of several closed parts).
+TriangleMesh concatenated(const TriangleMesh& a, const TriangleMesh& b);
+/// Closed axis-aligned box [lo, hi] (mm), 12 triangles wound outward.
+TriangleMesh make_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 /// Analytic oracle: distance from origin o along unit u to the sphere (c, r), far root.
 double ray_sphere_far(const Eigen::Vector3d& o, const Eigen::Vector3d& u, const Eigen::Vector3d& c, double r);
 

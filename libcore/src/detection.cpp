@@ -115,6 +115,41 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
   return refined;
 }
 
+std::int64_t scan_layered(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const LayeredMap& map,
+                          float* gap_mm, const FirstHitCaster* exact) {
+  const double Rt[12] = {R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2),
+                         R(2, 0), R(2, 1), R(2, 2), t.x(),   t.y(),   t.z()};
+  constexpr std::int64_t kBlock = 256;
+  double qx[kBlock], qy[kBlock], qz[kBlock], radius[kBlock], d[kBlock];
+  std::uint8_t flag[kBlock];
+  const std::int64_t n = set.size();
+  std::int64_t refined = 0;
+  for (std::int64_t b = 0; b < n; b += kBlock) {
+    const int m = static_cast<int>(std::min(kBlock, n - b));
+    pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt, qx, qy, qz, radius);
+    map.signed_distance_many_soa(qx, qy, qz, m, d, exact != nullptr ? flag : nullptr);
+    for (int j = 0; j < m; ++j) {
+      double g = d[j];
+      if (exact != nullptr && flag[j]) {
+        g = signed_radial_distance_exact(*exact, Eigen::Vector3d(qx[j], qy[j], qz[j]));
+        ++refined;
+      }
+      gap_mm[b + j] = std::isfinite(g) ? static_cast<float>(g) : std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+  return refined;
+}
+
+void expand_layered_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out) {
+  require(out.gap_mm.size() == static_cast<std::size_t>(set.vertices) && out.status.size() == out.gap_mm.size(),
+          "layered scan: expand the body's first-surface scan first");
+  for (std::size_t j = 0; j < set.index.size(); ++j) {
+    const auto i = static_cast<std::size_t>(set.index[j]);
+    out.gap_mm[i] = gap_mm[j];
+    out.status[i] = std::isnan(gap_mm[j]) ? ScanGaps::no_surface : ScanGaps::tested_layered;
+  }
+}
+
 template <typename Scalar>
 void scan_gaps(PointsRef P, const Eigen::Matrix3d& R, const std::vector<std::uint8_t>& mask,
                const RadialDistanceMapT<Scalar>& map, ScanSide side, ScanGaps& out) {
@@ -199,6 +234,9 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
   s.level_vertices.assign(static_cast<std::size_t>(levels.count()), 0);
   s.level_area_mm2.assign(static_cast<std::size_t>(levels.count()), 0.0);
   s.vertices_tested = s.vertices_no_surface = s.vertices_beyond_reach = s.vertices_penetrating = 0;
+  s.vertices_tested_layered = 0;
+  s.min_gap_layered_mm = std::numeric_limits<double>::quiet_NaN();
+  double min_layered = std::numeric_limits<double>::infinity();
   s.area_penetrating_mm2 = 0;
   s.min_gap_mm = std::numeric_limits<double>::quiet_NaN();
   s.vertices = static_cast<std::int64_t>(g.gap_mm.size());
@@ -215,6 +253,10 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
     }
     ++s.vertices_tested;
     const double gap = g.gap_mm[i];
+    if (g.status[i] == ScanGaps::tested_layered) {
+      ++s.vertices_tested_layered;
+      min_layered = std::min(min_layered, gap);
+    }
     const double a = area[static_cast<Eigen::Index>(i)];
     min_gap = std::min(min_gap, gap);
     if (gap <= 0) {
@@ -226,6 +268,7 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
     s.level_area_mm2[lv] += a;
   }
   if (s.vertices_tested > 0) s.min_gap_mm = min_gap;
+  if (s.vertices_tested_layered > 0) s.min_gap_layered_mm = min_layered;
 }
 
 template void scan_gaps<float>(PointsRef, const Eigen::Matrix3d&, const std::vector<std::uint8_t>&,

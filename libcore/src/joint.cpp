@@ -17,6 +17,12 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
   require(o.sparse_region_mm > 0, "joint: sparse region must be > 0 mm");
   require(!o.exact_at_discontinuities || (std::isfinite(o.discontinuity_tolerance_mm) && o.discontinuity_tolerance_mm > 0),
           "joint: the depth-discontinuity tolerance must be > 0 mm and finite");
+  require(o.layers >= 0 && o.layers <= LayeredMap::kMaxLayers,
+          "joint: layers must be 0 (off) to " + std::to_string(LayeredMap::kMaxLayers) + ", not " +
+              std::to_string(o.layers));
+  require(o.layers == 0 || FirstHitCaster::available(),
+          "joint: layered maps need a ray caster (Embree or CGAL), and this build has neither");
+  require(o.extra_articular_radius_mm > 0, "joint: the extra-articular radius must be > 0 mm");
   o.levels.validate();
   return o;
 }
@@ -37,7 +43,7 @@ Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor,
 
 JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given) const {
   validate_mesh(mesh);
-  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0};
+  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0, nullptr, nullptr, {}, {}};
   b.relative = b.mesh.V.rowwise() - cor_.transpose();
   if (given) {
     const SamplingScheme& want = *options_.scheme;
@@ -69,6 +75,18 @@ JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given
   if (options_.sparse_maps) b.map.make_sparse(options_.sparse_region_mm);
   b.scan_set = make_scan_set(b.relative, b.mask);
   b.vertex_area = vertex_areas(b.mesh);
+  if (options_.layers > 0) {
+    b.caster = b.exact != nullptr ? b.exact : std::make_shared<const FirstHitCaster>(b.mesh, cor_);
+    auto layered = std::make_shared<LayeredMap>(options_.scheme, options_.layers);
+    b.layered_sampling = layered->sample(*b.caster);
+    b.layered = std::move(layered);
+    std::vector<std::uint8_t> hidden(b.mask.size(), 0);
+    for (std::size_t i = 0; i < hidden.size(); ++i) {
+      const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
+      hidden[i] = !b.mask[i] && r > 0 && r <= options_.extra_articular_radius_mm;
+    }
+    b.hidden_set = make_scan_set(b.relative, hidden);
+  }
   return b;
 }
 
@@ -87,6 +105,12 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
   res.ball_detection_ms = ms_since(t0);
   expand_scan(ball_.scan_set, gaps.data(), res.ball_gaps);
   res.ball_gaps.refined = ball_refined;
+  if (socket_.layered) {
+    gaps.resize(std::max(gaps.size(), static_cast<std::size_t>(ball_.hidden_set.size())));
+    res.ball_gaps.refined += scan_layered(ball_.hidden_set, R, t, *socket_.layered, gaps.data(), socket_.caster.get());
+    expand_layered_scan(ball_.hidden_set, gaps.data(), res.ball_gaps);
+    res.ball_detection_ms = ms_since(t0);
+  }
   // Socket vertices in the ball's frame: R^T (p - t).
   t0 = std::chrono::steady_clock::now();
   const std::int64_t socket_refined =
@@ -95,6 +119,13 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
   res.socket_detection_ms = ms_since(t0);
   expand_scan(socket_.scan_set, gaps.data(), res.socket_gaps);
   res.socket_gaps.refined = socket_refined;
+  if (ball_.layered) {
+    gaps.resize(std::max(gaps.size(), static_cast<std::size_t>(socket_.hidden_set.size())));
+    res.socket_gaps.refined += scan_layered(socket_.hidden_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)),
+                                            *ball_.layered, gaps.data(), ball_.caster.get());
+    expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
+    res.socket_detection_ms = ms_since(t0);
+  }
   summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels, res.ball);
   summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels, res.socket);
 }

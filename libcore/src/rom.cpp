@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "impinge/detection.hpp"
 #include "impinge/equiangular_grid.hpp"
@@ -38,35 +39,34 @@ void check(const RomOptions& o) {
 // (boundaries shared, columns periodic); +inf (-inf) when none is finite. A fine bilinear value
 // whose four nodes are finite is >= (<=) the bound of any block range covering those nodes; a
 // stencil with an infinite node gives NaN, no gap, so infinite nodes can be ignored.
-class BoundPyramid {
+template <typename V>
+class BlockPyramid {
  public:
   static constexpr int kFirstLevel = 2;
-  BoundPyramid(const RadialDistanceMap& map, bool lower) : lower_(lower) {
-    const auto* g = dynamic_cast<const EquiangularGrid*>(&map.scheme());
+  // value(i): node i's value; none: the identity of `combine` (the value of an empty block).
+  template <typename Value, typename Combine>
+  BlockPyramid(const SamplingScheme& scheme, Value value, V none, Combine combine) : none_(none) {
+    const auto* g = dynamic_cast<const EquiangularGrid*>(&scheme);
     if (g == nullptr) return;  // bounds for equiangular maps only; other schemes scan every vertex
+    combine_ = combine;
     rows_ = g->rows(), cols_ = g->columns(), step_ = g->step();
-    const float none = lower ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
     for (int L = kFirstLevel;; ++L) {
       const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b;
-      std::vector<float> v(static_cast<std::size_t>(br) * bc, none);
+      std::vector<V> v(static_cast<std::size_t>(br) * bc, none);
       for (int i = 0; i < br; ++i)
         for (int j = 0; j < bc; ++j) {
-          float m = none;
+          V m = none;
           if (L == kFirstLevel) {
             for (int r = i * b; r <= std::min((i + 1) * b, rows_ - 1); ++r)
-              for (int c = j * b; c <= (j + 1) * b; ++c) {
-                const float d = map.at(std::int64_t(r) * cols_ + (c % cols_));
-                if (std::isfinite(d)) m = lower ? std::min(m, d) : std::max(m, d);
-              }
+              for (int c = j * b; c <= (j + 1) * b; ++c) m = combine(m, value(std::int64_t(r) * cols_ + (c % cols_)));
           } else {
-            const std::vector<float>& p = levels_.back();
+            const std::vector<V>& p = levels_.back();
             const int pbr = (rows_ - 1 + b / 2 - 1) / (b / 2), pbc = (cols_ + b / 2 - 1) / (b / 2);
             for (int di = 0; di < 2; ++di)
               for (int dj = 0; dj < 2; ++dj) {
                 const int pi = 2 * i + di, pj = 2 * j + dj;
                 if (pi >= pbr) continue;
-                const float d = p[static_cast<std::size_t>(pi) * pbc + (pj % pbc)];
-                m = lower ? std::min(m, d) : std::max(m, d);
+                m = combine(m, p[static_cast<std::size_t>(pi) * pbc + (pj % pbc)]);
               }
           }
           v[static_cast<std::size_t>(i) * bc + j] = m;
@@ -76,8 +76,8 @@ class BoundPyramid {
     }
   }
   bool valid() const { return !levels_.empty(); }
-  // Bound of the map over every stencil node of the directions within angle rho of unit u.
-  float cap(const Eigen::Vector3d& u, double rho) const {
+  // Combined value over every stencil node of the directions within angle rho of unit u.
+  V cap(const Eigen::Vector3d& u, double rho) const {
     const double phi = std::acos(std::clamp(u.z(), -1.0, 1.0));
     double r_lo = (phi - rho) / step_, r_hi = (phi + rho) / step_ + 1;
     int c_lo = 0, c_hi = cols_;  // whole rows when the cap holds a pole or is wide
@@ -96,26 +96,60 @@ class BoundPyramid {
     int L = kFirstLevel;
     while ((1 << L) < span && L - kFirstLevel + 1 < static_cast<int>(levels_.size())) ++L;
     const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b;
-    const std::vector<float>& v = levels_[static_cast<std::size_t>(L - kFirstLevel)];
-    float m = lower_ ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+    const std::vector<V>& v = levels_[static_cast<std::size_t>(L - kFirstLevel)];
+    V m = none_;
     const int i0 = r0 / b, i1 = std::min(br - 1, r1 / b);
     const bool all_cols = c_hi - c_lo >= cols_;
     const int j0 = all_cols ? 0 : static_cast<int>(std::floor(double(c_lo) / b));
     const int j1 = all_cols ? bc - 1 : static_cast<int>(std::floor(double(c_hi) / b));
     for (int i = i0; i <= i1; ++i)
-      for (int j = j0; j <= j1; ++j) {
-        const float d = v[static_cast<std::size_t>(i) * bc + static_cast<std::size_t>(((j % bc) + bc) % bc)];
-        m = lower_ ? std::min(m, d) : std::max(m, d);
-      }
+      for (int j = j0; j <= j1; ++j)
+        m = combine_(m, v[static_cast<std::size_t>(i) * bc + static_cast<std::size_t>(((j % bc) + bc) % bc)]);
     return m;
   }
 
  private:
-  bool lower_;
+  V none_;
+  std::function<V(V, V)> combine_;
   int rows_ = 0, cols_ = 0;
   double step_ = 0;
-  std::vector<std::vector<float>> levels_;
+  std::vector<std::vector<V>> levels_;
 };
+
+// A pyramid of minima (or maxima) over an equiangular map: at level L, block (i, j) holds the min
+// (max) of the finite node values in fine rows [i 2^L, (i+1) 2^L] and columns [j 2^L, (j+1) 2^L]
+// (boundaries shared, columns periodic); +inf (-inf) when none is finite. A fine bilinear value
+// whose four nodes are finite is >= (<=) the bound of any block range covering those nodes; a
+// stencil with an infinite node gives NaN, no gap, so infinite nodes can be ignored.
+BlockPyramid<float> bound_pyramid(const RadialDistanceMap& map, bool lower) {
+  const float none = lower ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+  return BlockPyramid<float>(
+      map.scheme(),
+      [&map, none](std::int64_t i) {
+        const float d = map.at(i);
+        return std::isfinite(d) ? d : none;
+      },
+      none, [lower](float a, float b) { return lower ? std::min(a, b) : std::max(a, b); });
+}
+
+// The radial shells a layered map's solid meets (LayeredMap::occupancy), OR-ed over blocks: a cluster
+// none of whose radii lies within the threshold of a set shell over its cone is apart from the bone.
+constexpr double kOccupancyBinMm = 2.5;
+BlockPyramid<std::uint64_t> occupancy_pyramid(const LayeredMap& map) {
+  return BlockPyramid<std::uint64_t>(
+      map.scheme(), [&map](std::int64_t i) { return map.occupancy(i, kOccupancyBinMm); }, std::uint64_t(0),
+      [](std::uint64_t a, std::uint64_t b) { return a | b; });
+}
+// The shells [lo, hi] (mm) meets.
+std::uint64_t shells(double lo, double hi) {
+  auto bin = [](double r) {
+    const double b = r / kOccupancyBinMm;
+    return b >= 63 ? 63 : b > 0 ? static_cast<int>(b) : 0;
+  };
+  std::uint64_t m = 0;
+  for (int k = bin(lo); k <= bin(hi); ++k) m |= std::uint64_t(1) << k;
+  return m;
+}
 
 // Clusters of a scan set: 32 consecutive vertices (Z order: neighbours on the sphere), their
 // directions' cone (unit axis, half-angle) and radius range, in the body's frame.
@@ -155,14 +189,28 @@ std::vector<Cluster> clusters_of(const ScanSet& s) {
 struct Least {
   double gap = std::numeric_limits<double>::infinity();
   bool ball = false;
+  bool hidden = false;  ///< a hidden vertex, tested by the other body's layered map
   std::size_t vertex = 0;
 };
 struct RomBounds {
-  RomBounds(const Joint& j) : socket_min(j.socket().map, true), ball_max(j.ball().map, false),
-                              ball_clusters(clusters_of(j.ball().scan_set)),
-                              socket_clusters(clusters_of(j.socket().scan_set)) {}
-  BoundPyramid socket_min, ball_max;
+  RomBounds(const Joint& j)
+      : socket_min(bound_pyramid(j.socket().map, true)),
+        ball_max(bound_pyramid(j.ball().map, false)),
+        ball_clusters(clusters_of(j.ball().scan_set)),
+        socket_clusters(clusters_of(j.socket().scan_set)) {
+    if (j.socket().layered) {
+      socket_occupancy.emplace(occupancy_pyramid(*j.socket().layered));
+      ball_hidden_clusters = clusters_of(j.ball().hidden_set);
+    }
+    if (j.ball().layered) {
+      ball_occupancy.emplace(occupancy_pyramid(*j.ball().layered));
+      socket_hidden_clusters = clusters_of(j.socket().hidden_set);
+    }
+  }
+  BlockPyramid<float> socket_min, ball_max;
   std::vector<Cluster> ball_clusters, socket_clusters;
+  std::optional<BlockPyramid<std::uint64_t>> socket_occupancy, ball_occupancy;
+  std::vector<Cluster> ball_hidden_clusters, socket_hidden_clusters;
 };
 class CompactScanner {
  public:
@@ -172,7 +220,12 @@ class CompactScanner {
     const ScanSet& s = joint.socket().scan_set;
     for (std::int32_t i : b.index) skip_ball_.push_back(base.skip_ball[static_cast<std::size_t>(i)]);
     for (std::int32_t i : s.index) skip_socket_.push_back(base.skip_socket[static_cast<std::size_t>(i)]);
-    buf_.resize(static_cast<std::size_t>(std::max(b.size(), s.size())));
+    for (std::int32_t i : joint.ball().hidden_set.index)
+      skip_ball_hidden_.push_back(base.skip_ball[static_cast<std::size_t>(i)]);
+    for (std::int32_t i : joint.socket().hidden_set.index)
+      skip_socket_hidden_.push_back(base.skip_socket[static_cast<std::size_t>(i)]);
+    buf_.resize(static_cast<std::size_t>(std::max({b.size(), s.size(), joint.ball().hidden_set.size(),
+                                                   joint.socket().hidden_set.size()})));
   }
   // The least counted gap at rotation R. exact: the true minimum; otherwise the true minimum when it
   // is <= the threshold, and some value > the threshold when it is not (clusters above it are skipped).
@@ -181,6 +234,12 @@ class CompactScanner {
     const double cut = exact ? std::numeric_limits<double>::infinity() : threshold_;
     scan(R, joint_.ball().scan_set, joint_.socket().map, ScanSide::inside, skip_ball_, true, cut, l);
     scan(R.transpose(), joint_.socket().scan_set, joint_.ball().map, ScanSide::outside, skip_socket_, false, cut, l);
+    if (joint_.socket().layered)
+      scan_hidden(R, joint_.ball().hidden_set, *joint_.socket().layered, joint_.socket().caster.get(), skip_ball_hidden_,
+                  true, cut, l);
+    if (joint_.ball().layered)
+      scan_hidden(R.transpose(), joint_.socket().hidden_set, *joint_.ball().layered, joint_.ball().caster.get(),
+                  skip_socket_hidden_, false, cut, l);
     return l;
   }
   std::int64_t vertices_looked_up = 0, vertices_skipped = 0;
@@ -188,7 +247,7 @@ class CompactScanner {
  private:
   void scan(const Eigen::Matrix3d& R, const ScanSet& set, const RadialDistanceMap& map, ScanSide side,
             const std::vector<std::uint8_t>& skip, bool ball, double cut, Least& l) {
-    const BoundPyramid* pyr = bounds_ == nullptr ? nullptr : ball ? &bounds_->socket_min : &bounds_->ball_max;
+    const BlockPyramid<float>* pyr = bounds_ == nullptr ? nullptr : ball ? &bounds_->socket_min : &bounds_->ball_max;
     if (pyr == nullptr || !pyr->valid()) {
       scan_gaps_compact(set, R, Eigen::Vector3d::Zero(), map, side, buf_.data());
       take(set, skip, 0, set.size(), ball, l);
@@ -218,17 +277,49 @@ class CompactScanner {
       vertices_looked_up += c.count;
     }
   }
+  // Hidden vertices of one body against the other's layered map: a cluster is skipped when no radial
+  // shell of the other bone over its cone lies within min(cut, least gap so far) of its radii.
+  void scan_hidden(const Eigen::Matrix3d& R, const ScanSet& set, const LayeredMap& map, const FirstHitCaster* exact,
+                   const std::vector<std::uint8_t>& skip, bool ball, double cut, Least& l) {
+    const BlockPyramid<std::uint64_t>* pyr =
+        bounds_ == nullptr ? nullptr : ball ? &*bounds_->socket_occupancy : &*bounds_->ball_occupancy;
+    const std::vector<Cluster>* cl =
+        bounds_ == nullptr ? nullptr : ball ? &bounds_->ball_hidden_clusters : &bounds_->socket_hidden_clusters;
+    if (pyr == nullptr || !pyr->valid()) {
+      scan_layered(set, R, Eigen::Vector3d::Zero(), map, buf_.data(), exact);
+      take(set, skip, 0, set.size(), ball, l, true);
+      vertices_looked_up += set.size();
+      return;
+    }
+    for (const Cluster& c : *cl) {
+      const double reach = std::max(0.0, std::min(cut, l.gap));
+      if (std::isfinite(reach) && (pyr->cap(R * c.axis, c.rho) & shells(c.r_min - reach, c.r_max + reach)) == 0) {
+        vertices_skipped += c.count;
+        continue;
+      }
+      ScanSet& part = part_;
+      part.index.assign(set.index.begin() + c.first, set.index.begin() + c.first + c.count);
+      part.x.assign(set.x.begin() + c.first, set.x.begin() + c.first + c.count);
+      part.y.assign(set.y.begin() + c.first, set.y.begin() + c.first + c.count);
+      part.z.assign(set.z.begin() + c.first, set.z.begin() + c.first + c.count);
+      scan_layered(part, R, Eigen::Vector3d::Zero(), map, buf_.data() + c.first, exact);
+      take(set, skip, c.first, c.first + c.count, ball, l, true);
+      vertices_looked_up += c.count;
+    }
+  }
   void take(const ScanSet& set, const std::vector<std::uint8_t>& skip, std::int64_t from, std::int64_t to, bool ball,
-            Least& l) const {
+            Least& l, bool hidden = false) const {
     for (std::int64_t j = from; j < to; ++j)
       if (!skip[static_cast<std::size_t>(j)] && buf_[static_cast<std::size_t>(j)] < l.gap)
-        l.gap = buf_[static_cast<std::size_t>(j)], l.ball = ball, l.vertex = static_cast<std::size_t>(set.index[j]);
+        l.gap = buf_[static_cast<std::size_t>(j)], l.ball = ball, l.hidden = hidden,
+        l.vertex = static_cast<std::size_t>(set.index[j]);
   }
   const Joint& joint_;
   const RomBounds* bounds_;
   double threshold_;
-  std::vector<std::uint8_t> skip_ball_, skip_socket_;
+  std::vector<std::uint8_t> skip_ball_, skip_socket_, skip_ball_hidden_, skip_socket_hidden_;
   std::vector<float> buf_;
+  ScanSet part_;  ///< one cluster of a hidden set (scratch)
 };
 
 }  // namespace
@@ -295,7 +386,9 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
              : Eigen::Vector3d(joint.socket().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose());
   out.contact_mm = hip.to_working(p_joint);
   const double rim = hip.acetabulum() ? hip.acetabulum()->rim_radius_mm : hip.head_radius_mm() + 5;
-  out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? "intra_articular" : "extra_articular";
+  out.limited_by =
+      !l.hidden && p_joint.norm() <= rim + o.intra_articular_margin_mm ? "intra_articular" : "extra_articular";
+  out.limited_by_hidden_vertex = l.hidden;
   if (hip.socket_clock()) {
     // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.
     out.socket_clock_h = hip.socket_clock()->hour(p_joint);

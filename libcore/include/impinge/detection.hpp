@@ -11,6 +11,7 @@
 
 #include "impinge/first_hit_caster.hpp"
 #include "impinge/impingement_levels.hpp"
+#include "impinge/layered_map.hpp"
 #include "impinge/mesh.hpp"
 #include "impinge/radial_distance_map.hpp"
 
@@ -24,7 +25,9 @@ enum class ScanSide { inside = 1, outside = -1 };
 /// Per-vertex result of one scan. gap_mm[i] is NaN where vertex i was not tested (masked
 /// out) or the other map has no surface in its direction; status[i] tells which.
 struct ScanGaps {
-  enum Status : std::uint8_t { tested = 0, no_surface = 1, beyond_reach = 2 };
+  /// tested: by the single-layer map (first-surface vertices); tested_layered: a vertex hidden behind its
+  /// own body's nearer surface, tested by the other body's layered map (extra-articular; issue 14).
+  enum Status : std::uint8_t { tested = 0, no_surface = 1, beyond_reach = 2, tested_layered = 3 };
   std::vector<float> gap_mm;         ///< n gaps, mm
   std::vector<std::uint8_t> status;  ///< n statuses
   std::int64_t refined = 0;          ///< look-ups at a depth discontinuity resolved by an exact ray cast
@@ -33,11 +36,15 @@ struct ScanGaps {
 /// Statistics of a scan (thesis sec. 3.4 colour levels; counts so nothing is dropped silently).
 struct ScanSummary {
   std::int64_t vertices = 0;                                     ///< vertices in the mesh
-  std::int64_t vertices_tested = 0;                              ///< looked up and gap computed
+  std::int64_t vertices_tested = 0;                              ///< looked up and gap computed (either map)
+  std::int64_t vertices_tested_layered = 0;                      ///< of them, hidden vertices tested by the other
+                                                                 ///< body's layered map (JointOptions::layers)
   std::int64_t vertices_no_surface = 0;                          ///< the other map has no surface in their direction
   std::int64_t vertices_beyond_reach = 0;                        ///< skipped: not on their body's first surface seen
                                                                  ///< from the COR, or beyond the region radius
   double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< NaN when none tested
+  double min_gap_layered_mm = std::numeric_limits<double>::quiet_NaN();  ///< over the hidden vertices tested by
+                                                                         ///< the layered map; NaN when none
   std::int64_t vertices_refined = 0;                             ///< tested by an exact ray cast instead of the map
                                                                  ///< (their stencil straddles a depth discontinuity)
   std::int64_t vertices_penetrating = 0;                         ///< gap <= 0
@@ -90,6 +97,20 @@ template <typename Scalar>
 std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                const RadialDistanceMapT<Scalar>& map, ScanSide side, float* gap_mm,
                                const FirstHitCaster* exact);
+
+/// The layered scan (issue 14): for every vertex j of `set`, q = R p_j + t in the map's frame (as
+/// scan_gaps_compact), gap_mm[j] = the layered map's signed radial distance at q (mm; > 0 apart, < 0
+/// inside the other bone), NaN where the other bone is nowhere along q's ray or the answer is unknown
+/// (a truncated node). With `exact` given (the other mesh's caster about the same COR, in the map's
+/// frame), a vertex whose stencil straddles an edge of the bone or a depth jump (exact_needed of
+/// LayeredMap::signed_distance_many_soa) gets the exact signed_radial_distance_exact instead. Returns the
+/// number so resolved. `gap_mm` must hold set.size() floats.
+std::int64_t scan_layered(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const LayeredMap& map,
+                          float* gap_mm, const FirstHitCaster* exact);
+
+/// Write a layered scan's gaps into `out` (already expanded by expand_scan for the same body): vertex
+/// set.index[j] gets gap_mm[j] with status tested_layered, or no_surface when NaN.
+void expand_layered_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out);
 
 /// Expand a compact scan into per-vertex ScanGaps (n entries): vertices outside the set are
 /// beyond reach, NaN gaps of the set are no surface.

@@ -12,6 +12,7 @@
 #include "impinge/detection.hpp"
 #include "impinge/first_hit_caster.hpp"
 #include "impinge/impingement_levels.hpp"
+#include "impinge/layered_map.hpp"
 #include "impinge/mesh.hpp"
 #include "impinge/radial_distance_map.hpp"
 #include "impinge/rasterize.hpp"
@@ -44,6 +45,15 @@ struct JointOptions {
   /// Source: issue 12.
   bool sparse_maps = false;
   double sparse_region_mm = std::numeric_limits<double>::infinity();  ///< see sparse_maps, mm (> 0)
+  /// Layered maps (issue 14): with layers = N > 0, each body also gets a LayeredMap of the same scheme
+  /// with N crossings per node (filled by ray casts, all cores), and the vertices hidden behind their
+  /// own body's nearer surface (not in the first-surface mask) within extra_articular_radius_mm of the
+  /// COR are tested against the other body's layered map: the trochanters, the shaft and the neck
+  /// against the ilium, ischium and AIIS (extra-articular impingement). First-surface vertices keep the
+  /// single-layer look-up (intra-articular results are unchanged, bit for bit). 0: off (the thesis).
+  /// Needs a ray caster (Embree or CGAL). Memory per map: nodes * (4 N + 1) bytes.
+  int layers = 0;
+  double extra_articular_radius_mm = 150;  ///< hidden vertices farther from the COR are not tested, mm (> 0)
 };
 
 /// One body of the joint after preprocessing.
@@ -60,13 +70,20 @@ struct JointBody {
   std::shared_ptr<const FirstHitCaster> exact;
   std::int64_t nodes_marked = 0;   ///< map nodes with the depth-discontinuity mark
   double marking_ms = 0;           ///< wall time of marking them and building the ray caster, ms
+  /// With JointOptions::layers > 0 (else null / empty): the layered map about the COR, the ray caster
+  /// that filled it (also resolves layered look-ups across edges of the bone), and the hidden vertices
+  /// tested against the other body's layered map.
+  std::shared_ptr<const LayeredMap> layered;
+  std::shared_ptr<const FirstHitCaster> caster;
+  ScanSet hidden_set;
+  LayeredSamplingReport layered_sampling;
 };
 
 /// Result of both scans at one pose.
 struct PoseResult {
   ScanGaps ball_gaps, socket_gaps;
   ScanSummary ball, socket;
-  double ball_detection_ms = 0, socket_detection_ms = 0;
+  double ball_detection_ms = 0, socket_detection_ms = 0;  ///< both include the layered scans when on
   std::vector<float> compact_gaps;  ///< scratch of detect (the compact scans), kept to reuse its storage
 };
 
@@ -87,7 +104,8 @@ class Joint {
   /// Both scans (ball vertices against the socket map, socket vertices against the ball map)
   /// with the ball rotated by R (3 x 3) about the COR and then translated by t (mm, socket
   /// frame; zero for a pure ball-and-socket motion, nonzero to push the head into the cup).
-  /// Thesis Algorithm 2 applied twice, through scan_gaps_compact.
+  /// Thesis Algorithm 2 applied twice, through scan_gaps_compact; with layers, the hidden vertices of
+  /// each body against the other's layered map too (scan_layered; status tested_layered).
   PoseResult detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) const;
 
   /// The same into `out`, reusing its vectors: after the first pose, no allocation per pose

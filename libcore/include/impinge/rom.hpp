@@ -6,6 +6,7 @@
 /// Kubiak-Langer et al. 2007): the largest internal rotation over flexion x adduction.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <string>
@@ -49,7 +50,11 @@ struct RomLimit {
   bool monotone = true;            ///< the bones are still in contact one step beyond the limit (false: a transient
                                    ///< touch; the gap curve crosses the threshold again)
   bool limited_by_ball = false;    ///< the least gap was a femur vertex (else a pelvis vertex)
-  std::string limited_by;          ///< "intra_articular" or "extra_articular" ("" without a limit)
+  bool limited_by_hidden_vertex = false;  ///< that vertex is hidden behind its own body's nearer surface and was
+                                          ///< tested by the other body's layered map (JointOptions::layers)
+  std::string limited_by;          ///< "intra_articular" or "extra_articular" ("" without a limit): extra when
+                                   ///< the contact is a hidden vertex or lies beyond the rim radius plus
+                                   ///< RomOptions::intra_articular_margin_mm from the COR
   Eigen::Vector3d contact_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
                                    ///< the contact vertex at the limit, working frame (pelvis fixed), mm
   double socket_clock_h = std::numeric_limits<double>::quiet_NaN();  ///< contact on the acetabular clock
