@@ -2,7 +2,8 @@
 ROM maps, published values beside ours, sensitivity and cost.
 
 Reads RESULTS/09_rom_observation/*.csv (and the observation_*.ply cup meshes); writes
-table_observation.tex, table_limits.tex, table_published.tex, table_sensitivity.tex,
+table_observation.tex, table_limits.tex, table_published.tex, table_sensitivity.tex, table_extra.tex,
+table_layered.tex,
 rom_map.pdf, medial_<subject>_<patient>.pdf (Tables 12-13's panels), macros.tex."""
 import os
 
@@ -18,6 +19,8 @@ lim = read_csv(d, "rom_limits.csv")
 rmap = read_csv(d, "rom_map.csv")
 sens = read_csv(d, "sensitivity.csv")
 tim = read_csv(d, "timing.csv")
+xa = read_csv(d, "extra_articular.csv")
+lay = read_csv(d, "layered.csv")
 pub = read_csv(d, "published.csv")
 t11 = read_csv(d, "thesis_table11.csv")
 subjects = list(dict.fromkeys(lim.subject))
@@ -104,6 +107,33 @@ for s in clk.subject:
                      "blue > 6, yellow 4-6, orange 2-4, red 0-2 mm, purple penetrating", fontsize=9)
         save(fig, d, f"medial_{s}_{patient}")
 
+# Extra-articular impingement with layered maps (issue 14): the first contact of hidden vertices per
+# motion, where it is, and the exact check; beside it the limit counting every vertex.
+rows = []
+for r in xa[xa.counted == "hidden"].itertuples():
+    a = xa[(xa.counted == "all") & (xa.subject == r.subject) & (xa.motion == r.motion)].iloc[0]
+    rows.append([r.subject, r.motion.replace("_", " "), f(a.limit_deg), a.limited_by if isinstance(a.limited_by, str) else "",
+                 "--" if r.contact_at_start else f(r.limit_deg), r.limited_by if isinstance(r.limited_by, str) else "",
+                 "femur" if r.ball_vertex else "pelvis", f(r.contact_radius_mm), f(r.exact_gap_before_mm, 2),
+                 f(r.exact_gap_after_mm, 2), r.validated])
+write_table(d, "table_extra", ["subject", "motion", "limit", "where", "hidden", "where", "vertex of", "radius mm",
+                               "exact $-0.5^\\circ$", "exact $+0.5^\\circ$", "confirmed"], rows, align="llrlrllrrrl")
+rows = []
+for r in lay.itertuples():
+    rows.append([r.subject, r.body, str(int(r.layers)), f"{r.layered_bytes / 2**20:.1f}", f"{r.single_bytes / 2**20:.1f}",
+                 f(r.layered_sampling_ms, 0), f(r.single_sampling_ms, 0), str(int(r.max_crossings)),
+                 f"{100 * r.nodes_truncated / r.nodes:.2f}", str(int(r.nodes_not_alternating)), str(int(r.hidden_vertices))])
+write_table(d, "table_layered", ["subject", "bone", "layers", "MiB", "single MiB", "ms", "single ms", "most crossings",
+                                 "truncated \\%", "not alternating", "hidden vertices"], rows, align="llrrrrrrrrr")
+hid = xa[(xa.counted == "hidden") & (xa.validated != "no_limit")]
+far = hid[hid.limited_by == "extra_articular"]
+far_ok = far[far.validated == "yes"]
+xmotions = far_ok[far_ok.motion.str.contains("abduction|extension")]
+by_layers = xa[xa.counted == "all"]
+lim_all = by_layers[(by_layers.validated != "no_limit")]
+first_lay = lay[lay.subject == lay.subject.iloc[0]]
+slow = lay.groupby("subject").first()
+
 ok = lim[lim.validated != "no_limit"]
 t0 = tim.iloc[0]
 first = subjects[0]
@@ -125,4 +155,23 @@ write_macros(d, "macros", {
     "ROMfirstIRninety": f(ir90),
     "ROMexcludedMax": str(int(tim.excluded_vertices.max())),
     "ROMsubjects": str(len(subjects)),
+    "ROMlayers": str(int(lay.layers.iloc[0])),
+    "ROMhiddenChecked": str(len(hid)),
+    "ROMhiddenConfirmed": str(int((hid.validated == "yes").sum())),
+    "ROMextraFound": str(len(far)),
+    "ROMextraConfirmed": str(len(far_ok)),
+    "ROMextraSubjects": str(far_ok.subject.nunique()),
+    "ROMextraAbdExtConfirmed": str(len(xmotions)),
+    "ROMextraAbdExtSubjects": str(xmotions.subject.nunique()),
+    "ROMextraAbdExtList": ", ".join(f"\\texttt{{{r.subject}}} {r.motion.replace('_', ' ')} at {r.limit_deg:.1f}$^\\circ$"
+                                    for r in xmotions.itertuples()) or "none",
+    "ROMallLimitsExtra": str(int((lim_all.limited_by == "extra_articular").sum())),
+    "ROMallLimitsChecked": str(len(lim_all)),
+    "ROMallLimitsConfirmed": str(int((lim_all.validated == "yes").sum())),
+    "ROMlayeredBytesRatio": f"{(lay.layered_bytes / lay.single_bytes).min():.1f}",
+    "ROMlayeredSamplingMs": f"{lay.layered_sampling_ms.min():.0f}--{lay.layered_sampling_ms.max():.0f}",
+    "ROMlayeredSlowdown": f"{(slow.limits_ms_layered / slow.limits_ms_single).min():.1f}--"
+                          f"{(slow.limits_ms_layered / slow.limits_ms_single).max():.1f}",
+    "ROMlayeredNotAlternating": str(int(lay.nodes_not_alternating.sum())),
+    "ROMlayeredTruncatedMax": f"{100 * (lay.nodes_truncated / lay.nodes).max():.1f}",
 })

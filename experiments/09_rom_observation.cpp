@@ -16,6 +16,11 @@
 //   sensitivity.csv   subject x variant (COR moved 1 mm along each pelvic axis, resolutions) x motion
 //   timing.csv        subject: sampling, limits, map, evaluations, poses per second, share of vertices
 //                     skipped by the bounds, FCL collide per pose and its extrapolated search time
+//   extra_articular.csv  subject x motion x counted vertices (all, hidden): with layered maps (4 crossings
+//                     per node), the limit, where limited, and the exact check 0.5 deg either side (CGAL
+//                     all-intersection rays for the hidden vertices, first hits for the others)
+//   layered.csv       subject x body: layered map nodes, bytes and sampling time beside the single-layer
+//                     map's; hidden vertices; the nine limits' search time with and without layers
 //   clock_faces.csv   the acetabular clock face of each real subject in its pelvic frame
 //   thesis_table11.csv, published.csv   copies of the inputs the analysis compares with
 //   meta.json
@@ -32,7 +37,9 @@
 #include "impinge/error.hpp"
 #include "impinge/exact_reference.hpp"
 #include "impinge/fcl_collision.hpp"
+#include "impinge/first_hit_caster.hpp"
 #include "impinge/hip_joint.hpp"
+#include "impinge/layered_map.hpp"
 #include "impinge/mesh_io.hpp"
 #include "impinge/rom.hpp"
 #include "impinge/sphere_fit.hpp"
@@ -101,6 +108,42 @@ double exact_least_gap(const Joint& j, const ExactReference& pelvis, const Exact
   }
   return least;
 }
+
+// Exact least signed distance (CGAL all-intersection rays from the COR) over the counted hidden vertices
+// of both bodies at femur rotation R: ball hidden vertices against the pelvis, pelvis hidden vertices
+// against the posed femur (issue 14's oracle for the layered maps).
+double exact_least_hidden(const Joint& j, const ExactReference& pelvis, const ExactReference& femur,
+                          const RomBaseline& base, const Eigen::Matrix3d& R) {
+  double least = std::numeric_limits<double>::infinity();
+  auto signed_distance = [](const ExactReference& ref, int orientation, const Eigen::Vector3d& q) {
+    const std::vector<RayCrossing> c = crossings_from_hits(ref.all_hits(Eigen::Vector3d::Zero(), q.normalized()), orientation);
+    return signed_radial_distance(c.data(), static_cast<int>(c.size()), true, q.norm());
+  };
+  const ScanSet& b = j.ball().hidden_set;
+  for (std::int64_t k = 0; k < b.size(); ++k) {
+    if (base.skip_ball[static_cast<std::size_t>(b.index[k])]) continue;
+    const double d = signed_distance(pelvis, j.socket().caster->orientation(), R * Eigen::Vector3d(b.x[k], b.y[k], b.z[k]));
+    if (!std::isnan(d)) least = std::min(least, d);
+  }
+  const ScanSet& s = j.socket().hidden_set;
+  for (std::int64_t k = 0; k < s.size(); ++k) {
+    if (base.skip_socket[static_cast<std::size_t>(s.index[k])]) continue;
+    const double d =
+        signed_distance(femur, j.ball().caster->orientation(), R.transpose() * Eigen::Vector3d(s.x[k], s.y[k], s.z[k]));
+    if (!std::isnan(d)) least = std::min(least, d);
+  }
+  return least;
+}
+
+// Motions searched for extra-articular contacts beside the standard ones: abduction and extension from
+// neutral with external rotation growing at half their rate (the trochanter towards the ilium, the
+// neck and lesser trochanter towards the ischium).
+std::vector<StandardMotion> extra_articular_motions() {
+  std::vector<StandardMotion> m = standard_motions();
+  m.push_back({"abduction_external_rotation", [](double t) { return PoseAngles{0, -t, -t / 2}; }});
+  m.push_back({"extension_external_rotation", [](double t) { return PoseAngles{-t, 0, -t / 2}; }});
+  return m;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -132,6 +175,14 @@ int main(int argc, char** argv) {
   CsvWriter map(dir + "/rom_map.csv", {"subject", "flexion_deg", "adduction_deg", "max_internal_rotation_deg", "status"});
   CsvWriter clocks(dir + "/clock_faces.csv", {"subject", "side", "centre_x_mm", "centre_y_mm", "centre_z_mm", "twelve_x",
                                               "twelve_y", "twelve_z", "three_x", "three_y", "three_z", "rim_radius_mm"});
+  CsvWriter extra(dir + "/extra_articular.csv",
+                  {"subject", "motion", "counted", "limit_deg", "limited_by", "hidden_vertex", "ball_vertex",
+                   "socket_clock_h", "contact_radius_mm", "min_gap_at_limit_mm", "contact_at_start",
+                   "exact_gap_before_mm", "exact_gap_after_mm", "validated"});
+  CsvWriter layered(dir + "/layered.csv",
+                    {"subject", "body", "layers", "nodes", "layered_bytes", "single_bytes", "layered_sampling_ms",
+                     "single_sampling_ms", "nodes_covered", "nodes_truncated", "nodes_not_alternating",
+                     "max_crossings", "hidden_vertices", "limits_ms_single", "limits_ms_layered"});
   CsvWriter sens(dir + "/sensitivity.csv", {"subject", "variant", "motion", "limit_deg", "delta_deg"});
   CsvWriter tim(dir + "/timing.csv",
                 {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "evaluations",
@@ -217,6 +268,52 @@ int main(int argc, char** argv) {
               l.min_gap_at_limit_mm, l.monotone ? 1 : 0, l.contact_at_start ? 1 : 0, before, after, validated);
     }
 
+    // Extra-articular impingement (issue 14): layered maps of 4 crossings per node; the standard motions
+    // and two with external rotation, counting every vertex (the limit) and the hidden ones only (the
+    // first extra-articular contact), each checked exactly 0.5 deg either side.
+    {
+      HipJointOptions lo = ho;
+      lo.joint.layers = 4;
+      const HipJoint lhip(s.femur, s.pelvis, s.side, head, {}, lo);
+      const Joint& lj = lhip.joint();
+      const RomBaseline lbase = rom_baseline(lhip, lhip.femur_rotation({}), ro);
+      const std::vector<StandardMotion> xm = extra_articular_motions();
+      auto t1 = Clock::now();
+      find_rom_limits(lhip, motions, ro, lbase);
+      const double limits_layered_ms = ms_since(t1);
+      for (const RomVertices counted : {RomVertices::all, RomVertices::hidden}) {
+        RomOptions xo = ro;
+        xo.vertices = counted;
+        const std::vector<RomLimit> xl = find_rom_limits(lhip, xm, xo, lbase);
+        for (std::size_t k = 0; k < xm.size(); ++k) {
+          const RomLimit& l = xl[k];
+          double before = std::nan(""), after = std::nan("");
+          std::string validated = "no_limit";
+          auto exact = [&](double t) {
+            const Eigen::Matrix3d R = lhip.femur_rotation(xm[k].angles(t));
+            const double h = exact_least_hidden(lj, ex_pelvis, ex_femur, lbase, R);
+            return counted == RomVertices::hidden ? h : std::min(h, exact_least_gap(lj, ex_pelvis, ex_femur, lbase, R));
+          };
+          if (!std::isnan(l.limit_deg) && !l.contact_at_start) {
+            before = exact(std::max(0.0, l.limit_deg - 0.5));
+            after = exact(l.limit_deg + 0.5);
+            validated = before > ro.threshold_mm && after <= ro.threshold_mm ? "yes" : "no";
+          }
+          extra.row(s.name, xm[k].name, counted == RomVertices::all ? "all" : "hidden", l.limit_deg, l.limited_by,
+                    l.limited_by_hidden_vertex ? 1 : 0, l.limited_by_ball ? 1 : 0, l.socket_clock_h,
+                    l.contact_mm.allFinite() ? (l.contact_mm - lhip.to_working(Eigen::Vector3d::Zero())).norm()
+                                             : std::nan(""),
+                    l.min_gap_at_limit_mm, l.contact_at_start ? 1 : 0, before, after, validated);
+        }
+      }
+      for (const JointBody* b : {&lj.ball(), &lj.socket()})
+        layered.row(s.name, b == &lj.ball() ? "femur" : "pelvis", lo.joint.layers, b->layered->num_nodes(),
+                    b->layered->bytes(), b->map.bytes(), b->layered_sampling.sampling_ms, b->sampling_ms,
+                    b->layered_sampling.nodes_covered, b->layered_sampling.nodes_truncated,
+                    b->layered_sampling.nodes_not_alternating, b->layered_sampling.max_crossings, b->hidden_set.size(),
+                    limits_ms, limits_layered_ms);
+    }
+
     // FCL collide on a subset of the map's poses (flexion 45, adduction 10, internal rotation 0..58 step 2).
     double fcl_ms = std::nan("");
     int fcl_poses = 0;
@@ -274,6 +371,9 @@ int main(int argc, char** argv) {
               {"rom_map", "flexion 0..120 step 5 x adduction -20..40 step 5"},
               {"exact_check", "CGAL ray casts from the COR for every counted first-surface vertex, 0.5 deg "
                               "before and after each limit; hidden vertices are not checked"},
+              {"layers", 4},
+              {"extra_articular_check", "CGAL all-intersection rays from the COR for every counted hidden vertex "
+                                        "(signed radial distance), plus the first-hit check when all vertices count"},
               {"subjects", subj}});
   return 0;
 }

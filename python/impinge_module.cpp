@@ -129,6 +129,8 @@ py::dict summary_dict(const ScanSummary& s) {
   d["vertices_no_surface"] = s.vertices_no_surface;
   d["vertices_beyond_reach"] = s.vertices_beyond_reach;
   d["vertices_refined"] = s.vertices_refined;
+  d["vertices_tested_layered"] = s.vertices_tested_layered;
+  d["min_gap_layered_mm"] = s.min_gap_layered_mm;
   d["min_gap_mm"] = s.min_gap_mm;
   d["vertices_penetrating"] = s.vertices_penetrating;
   d["area_penetrating_mm2"] = s.area_penetrating_mm2;
@@ -154,7 +156,7 @@ PyJoint make_joint(const py::handle& ball, const py::handle& socket, const py::h
                    const std::string& sampling, double occlusion_tolerance_mm, double max_radius_mm,
                    const std::optional<std::vector<double>>& levels, bool reseat, const std::string& pelvis_frame,
                    const std::string& femur_frame, const std::optional<std::pair<std::string, std::string>>& maps,
-                   double sparse) {
+                   double sparse, int layers) {
   TriangleMesh b = to_mesh(ball, "ball"), s = to_mesh(socket, "socket");
   HipJointOptions o;
   o.joint.scheme = make_scheme(scheme, resolution > 0 ? resolution : default_resolution(scheme));
@@ -165,6 +167,7 @@ PyJoint make_joint(const py::handle& ball, const py::handle& socket, const py::h
   require(!std::isnan(sparse) && sparse >= 0, "Joint: sparse " + std::to_string(sparse) + " must be >= 0 mm or inf");
   o.joint.sparse_maps = sparse > 0;
   if (sparse > 0) o.joint.sparse_region_mm = sparse;
+  o.joint.layers = layers;  // checked by Joint
   if (levels) {
     o.joint.levels.thresholds_mm = *levels;
     o.joint.levels.validate();
@@ -396,13 +399,16 @@ PYBIND11_MODULE(impinge, m) {
            py::arg("occlusion_tolerance_mm") = 1.0, py::arg("max_radius_mm") = 0.0,
            py::arg("levels") = py::none(), py::arg("reseat") = false, py::arg("pelvis_frame") = "isb",
            py::arg("femur_frame") = "epicondyles", py::arg("maps") = py::none(), py::arg("sparse") = 0.0,
+           py::arg("layers") = 0,
            "ball, socket: (V (n, 3) float, F (m, 3) int) in one frame, mm (RAS-like: x right, y anterior, z "
            "superior for neutral='scan'). cor: centre of rotation (3,), mm; None fits the femoral head. "
            "neutral: 'anatomical' (ISB frames found on whole bones) or 'scan'. scheme/resolution: sampling "
            "scheme and its resolution (0: the scheme's default, 0.5 deg equivalent). mode: 'exact' or 'linear'. "
            "levels: impingement thresholds (mm, decreasing). maps: (ball_path, socket_path) saved by save_maps() "
            "to load instead of sampling. sparse: store the maps sparse, keeping the tiles with a surface within this "
-           "many mm of the COR (inf: any surface, the same gaps bit for bit; 0: dense). Builds both maps (the GIL is released). Raises impinge.Error on bad "
+           "many mm of the COR (inf: any surface, the same gaps bit for bit; 0: dense). layers: N > 0 also tests "
+           "the vertices hidden behind their own bone against the other bone's layered map of N crossings per node "
+           "(extra-articular impingement; their gaps appear with the others). Builds both maps (the GIL is released). Raises impinge.Error on bad "
            "arrays, options or map files.")
       .def(
           "detect",

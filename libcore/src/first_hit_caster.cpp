@@ -172,6 +172,7 @@ double FirstHitCaster::first_hit(const Eigen::Vector3d& direction) const {
 }
 
 namespace {
+void merge_hits(std::vector<std::pair<double, double>>& raw, int orientation, std::vector<RayCrossing>& out);
 /// A closed surface seen from a fixed origin: crossings alternate, end leaving the solid, and start
 /// entering it exactly when the origin lies outside.
 bool consistent(const std::vector<RayCrossing>& c, bool origin_inside) {
@@ -215,6 +216,18 @@ void FirstHitCaster::raw_crossings(const Eigen::Vector3d& u, std::vector<RayCros
   } else {
     for (const auto& h : impl_->cgal->all_hits(impl_->origin, u)) raw.push_back(h);
   }
+  merge_hits(raw, orientation_, out);
+}
+
+std::vector<RayCrossing> crossings_from_hits(std::vector<std::pair<double, double>> hits, int orientation) {
+  std::vector<RayCrossing> out;
+  merge_hits(hits, orientation, out);
+  return out;
+}
+
+namespace {
+void merge_hits(std::vector<std::pair<double, double>>& raw, int orientation, std::vector<RayCrossing>& out) {
+  out.clear();
   std::sort(raw.begin(), raw.end());
   for (std::size_t i = 0; i < raw.size();) {
     // A group of hits within 1e-4 mm of its first: one crossing by the majority of the facings.
@@ -222,11 +235,12 @@ void FirstHitCaster::raw_crossings(const Eigen::Vector3d& u, std::vector<RayCros
     int facing = 0;
     for (; j < raw.size() && raw[j].first - raw[i].first <= 1e-4; ++j)
       facing += raw[j].second < 0 ? -1 : raw[j].second > 0 ? 1 : 0;
-    facing *= orientation_;
+    facing *= orientation;
     if (facing != 0) out.push_back({raw[i].first, facing < 0});
     i = j;
   }
 }
+}  // namespace
 
 const std::string& FirstHitCaster::backend() const { return impl_->backend; }
 

@@ -214,8 +214,9 @@ struct RomBounds {
 };
 class CompactScanner {
  public:
-  CompactScanner(const Joint& joint, const RomBaseline& base, const RomBounds* bounds, double threshold)
-      : joint_(joint), bounds_(bounds), threshold_(threshold) {
+  CompactScanner(const Joint& joint, const RomBaseline& base, const RomBounds* bounds, double threshold,
+                 RomVertices counted)
+      : joint_(joint), bounds_(bounds), threshold_(threshold), counted_(counted) {
     const ScanSet& b = joint.ball().scan_set;
     const ScanSet& s = joint.socket().scan_set;
     for (std::int32_t i : b.index) skip_ball_.push_back(base.skip_ball[static_cast<std::size_t>(i)]);
@@ -232,8 +233,11 @@ class CompactScanner {
   Least operator()(const Eigen::Matrix3d& R, bool exact) {
     Least l;
     const double cut = exact ? std::numeric_limits<double>::infinity() : threshold_;
-    scan(R, joint_.ball().scan_set, joint_.socket().map, ScanSide::inside, skip_ball_, true, cut, l);
-    scan(R.transpose(), joint_.socket().scan_set, joint_.ball().map, ScanSide::outside, skip_socket_, false, cut, l);
+    if (counted_ != RomVertices::hidden) {
+      scan(R, joint_.ball().scan_set, joint_.socket().map, ScanSide::inside, skip_ball_, true, cut, l);
+      scan(R.transpose(), joint_.socket().scan_set, joint_.ball().map, ScanSide::outside, skip_socket_, false, cut, l);
+    }
+    if (counted_ == RomVertices::first_surface) return l;
     if (joint_.socket().layered)
       scan_hidden(R, joint_.ball().hidden_set, *joint_.socket().layered, joint_.socket().caster.get(), skip_ball_hidden_,
                   true, cut, l);
@@ -317,6 +321,7 @@ class CompactScanner {
   const Joint& joint_;
   const RomBounds* bounds_;
   double threshold_;
+  RomVertices counted_;
   std::vector<std::uint8_t> skip_ball_, skip_socket_, skip_ball_hidden_, skip_socket_hidden_;
   std::vector<float> buf_;
   ScanSet part_;  ///< one cluster of a hidden set (scratch)
@@ -348,7 +353,9 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
           "rom: the baseline belongs to another joint");
   RomLimit out;
   out.excluded_vertices = base.excluded_vertices;
-  CompactScanner scan(joint, base, bounds, o.threshold_mm);
+  require(o.vertices != RomVertices::hidden || (joint.ball().layered && joint.socket().layered),
+          "rom: counting hidden vertices needs layered maps (JointOptions::layers > 0)");
+  CompactScanner scan(joint, base, bounds, o.threshold_mm, o.vertices);
   auto gap_at = [&](double t, bool exact = false) {
     ++out.evaluations;
     return scan(rotation(t), exact);
@@ -386,8 +393,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
              : Eigen::Vector3d(joint.socket().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose());
   out.contact_mm = hip.to_working(p_joint);
   const double rim = hip.acetabulum() ? hip.acetabulum()->rim_radius_mm : hip.head_radius_mm() + 5;
-  out.limited_by =
-      !l.hidden && p_joint.norm() <= rim + o.intra_articular_margin_mm ? "intra_articular" : "extra_articular";
+  out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? "intra_articular" : "extra_articular";
   out.limited_by_hidden_vertex = l.hidden;
   if (hip.socket_clock()) {
     // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.

@@ -118,6 +118,24 @@ def test_sparse_maps_give_the_same_gaps(generated):
         impinge.Joint(ball, socket, neutral="scan", resolution=2.0, sparse=-1.0)
 
 
+def test_layered_maps_test_hidden_vertices_and_leave_the_others(generated):
+    d = generated
+    ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
+    single = impinge.Joint(ball, socket, neutral="scan", resolution=1.0)
+    layered = impinge.Joint(ball, socket, neutral="scan", resolution=1.0, layers=4)
+    a, b = single.detect_pose(20, 5, 10), layered.detect_pose(20, 5, 10)
+    for key in ("ball_gap_mm", "socket_gap_mm"):
+        tested = ~np.isnan(a[key])
+        np.testing.assert_array_equal(a[key][tested], b[key][tested])  # first-surface gaps unchanged
+    # The cup's outer wall is hidden behind its inner surface: tested by the femur's layered map now,
+    # and outside the femur (the head lies inside the cup's hollow).
+    s = b["summary"]["socket"]
+    assert s["vertices_tested_layered"] > 0 and s["min_gap_layered_mm"] > 0
+    assert a["summary"]["socket"]["vertices_tested_layered"] == 0
+    with pytest.raises(impinge.Error, match="layers"):
+        impinge.Joint(ball, socket, neutral="scan", resolution=2.0, layers=99)
+
+
 def test_bad_arrays_raise_clear_errors(generated):
     d = generated
     V, F = impinge.load_mesh(d + "/s/femur_r.ply")

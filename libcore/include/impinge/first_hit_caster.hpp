@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "impinge/mesh.hpp"
@@ -21,6 +22,12 @@ struct RayCrossing {
   double distance_mm = 0;
   bool entering = false;
 };
+
+/// Crossings from raw ray hits: `hits` (distance mm, cosine of the triangle's winding normal with the
+/// ray; any order) merged as FirstHitCaster::crossings does (hits within 1e-4 mm: one crossing by the
+/// majority of their facings, none when they cancel), facings multiplied by `orientation` (+1 or -1).
+/// For exact references built on ExactReference::all_hits.
+std::vector<RayCrossing> crossings_from_hits(std::vector<std::pair<double, double>> hits, int orientation);
 
 /// Rays from a fixed origin (the COR) against one mesh. Queries are const and thread-safe.
 class FirstHitCaster {

@@ -17,6 +17,13 @@
 
 namespace impinge {
 
+/// Which vertices a ROM search counts.
+enum class RomVertices {
+  all,            ///< every tested vertex (the ROM limit)
+  first_surface,  ///< the single-layer scans only (intra-articular; the thesis' maps)
+  hidden,         ///< the hidden vertices against the layered maps only (the first extra-articular contact)
+};
+
 /// Options of a ROM search.
 struct RomOptions {
   double threshold_mm = 0;       ///< contact when the minimum gap <= this (0: bone contact; a cartilage offset > 0)
@@ -25,6 +32,7 @@ struct RomOptions {
   double tolerance_deg = 0.1;    ///< bisection until the bracket is this narrow, deg
   bool use_bounds = true;        ///< skip vertex clusters whose bound cannot reach the threshold (same results,
                                  ///< fewer look-ups; equiangular maps)
+  RomVertices vertices = RomVertices::all;  ///< which vertices are counted (hidden ones need JointOptions::layers)
   double intra_articular_margin_mm = 10;  ///< contacts within the acetabular rim radius plus this of the COR are
                                           ///< intra-articular, farther ones extra-articular
 };
@@ -53,8 +61,9 @@ struct RomLimit {
   bool limited_by_hidden_vertex = false;  ///< that vertex is hidden behind its own body's nearer surface and was
                                           ///< tested by the other body's layered map (JointOptions::layers)
   std::string limited_by;          ///< "intra_articular" or "extra_articular" ("" without a limit): extra when
-                                   ///< the contact is a hidden vertex or lies beyond the rim radius plus
-                                   ///< RomOptions::intra_articular_margin_mm from the COR
+                                   ///< the contact lies farther than the rim radius plus
+                                   ///< RomOptions::intra_articular_margin_mm from the COR (a hidden vertex
+                                   ///< near the joint, such as the far side of the rim, is intra-articular)
   Eigen::Vector3d contact_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
                                    ///< the contact vertex at the limit, working frame (pelvis fixed), mm
   double socket_clock_h = std::numeric_limits<double>::quiet_NaN();  ///< contact on the acetabular clock
