@@ -8,6 +8,7 @@
 #include "impinge/detection.hpp"
 #include "impinge/equiangular_grid.hpp"
 #include "impinge/error.hpp"
+#include "impinge/fast_angles.hpp"
 
 namespace impinge {
 
@@ -39,16 +40,24 @@ void check(const RomOptions& o) {
 // (boundaries shared, columns periodic); +inf (-inf) when none is finite. A fine bilinear value
 // whose four nodes are finite is >= (<=) the bound of any block range covering those nodes; a
 // stencil with an infinite node gives NaN, no gap, so infinite nodes can be ignored.
-template <typename V>
+// Combining node values over blocks: the least or the greatest distance, or the union of shells.
+struct MinOrMax {
+  bool lower = true;
+  float operator()(float a, float b) const { return lower ? std::min(a, b) : std::max(a, b); }
+};
+struct BitOr {
+  std::uint64_t operator()(std::uint64_t a, std::uint64_t b) const { return a | b; }
+};
+
+template <typename V, typename Combine>
 class BlockPyramid {
  public:
   static constexpr int kFirstLevel = 2;
   // value(i): node i's value; none: the identity of `combine` (the value of an empty block).
-  template <typename Value, typename Combine>
-  BlockPyramid(const SamplingScheme& scheme, Value value, V none, Combine combine) : none_(none) {
+  template <typename Value>
+  BlockPyramid(const SamplingScheme& scheme, Value value, V none, Combine combine) : none_(none), combine_(combine) {
     const auto* g = dynamic_cast<const EquiangularGrid*>(&scheme);
     if (g == nullptr) return;  // bounds for equiangular maps only; other schemes scan every vertex
-    combine_ = combine;
     rows_ = g->rows(), cols_ = g->columns(), step_ = g->step();
     for (int L = kFirstLevel;; ++L) {
       const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b;
@@ -76,15 +85,18 @@ class BlockPyramid {
     }
   }
   bool valid() const { return !levels_.empty(); }
-  // Combined value over every stencil node of the directions within angle rho of unit u.
-  V cap(const Eigen::Vector3d& u, double rho) const {
-    const double phi = std::acos(std::clamp(u.z(), -1.0, 1.0));
+  // Combined value over every stencil node of the directions within angle rho of unit u (sin_rho =
+  // sin(rho)). Angles by fast_angles.hpp (within 1e-13 rad; the row and column ranges are padded by a
+  // node on each side).
+  V cap(const Eigen::Vector3d& u, double rho, double sin_rho) const {
+    double phi, theta;
+    fast_spherical_angles(u.x(), u.y(), u.z(), phi, theta);
     double r_lo = (phi - rho) / step_, r_hi = (phi + rho) / step_ + 1;
     int c_lo = 0, c_hi = cols_;  // whole rows when the cap holds a pole or is wide
     if (phi - rho > 0 && phi + rho < M_PI) {
-      const double half = std::asin(std::min(1.0, std::sin(rho) / std::sin(phi)));
-      double theta = std::atan2(u.y(), u.x());
-      if (theta < 0) theta += 2 * M_PI;
+      const double sin_phi = std::sqrt(std::max(0.0, u.x() * u.x() + u.y() * u.y()));
+      const double v = std::min(1.0, sin_rho / sin_phi);
+      const double half = fast_azimuth(v, std::sqrt(std::max(0.0, 1 - v * v)));  // asin(v)
       if (half < M_PI / 2) {
         c_lo = static_cast<int>(std::floor((theta - half) / step_)) - 1;
         c_hi = static_cast<int>(std::floor((theta + half) / step_)) + 2;
@@ -110,7 +122,7 @@ class BlockPyramid {
 
  private:
   V none_;
-  std::function<V(V, V)> combine_;
+  Combine combine_;
   int rows_ = 0, cols_ = 0;
   double step_ = 0;
   std::vector<std::vector<V>> levels_;
@@ -121,24 +133,25 @@ class BlockPyramid {
 // (boundaries shared, columns periodic); +inf (-inf) when none is finite. A fine bilinear value
 // whose four nodes are finite is >= (<=) the bound of any block range covering those nodes; a
 // stencil with an infinite node gives NaN, no gap, so infinite nodes can be ignored.
-BlockPyramid<float> bound_pyramid(const RadialDistanceMap& map, bool lower) {
+using BoundPyramid = BlockPyramid<float, MinOrMax>;
+using OccupancyPyramid = BlockPyramid<std::uint64_t, BitOr>;
+BoundPyramid bound_pyramid(const RadialDistanceMap& map, bool lower) {
   const float none = lower ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
-  return BlockPyramid<float>(
+  return BoundPyramid(
       map.scheme(),
       [&map, none](std::int64_t i) {
         const float d = map.at(i);
         return std::isfinite(d) ? d : none;
       },
-      none, [lower](float a, float b) { return lower ? std::min(a, b) : std::max(a, b); });
+      none, MinOrMax{lower});
 }
 
 // The radial shells a layered map's solid meets (LayeredMap::occupancy), OR-ed over blocks: a cluster
 // none of whose radii lies within the threshold of a set shell over its cone is apart from the bone.
 constexpr double kOccupancyBinMm = 2.5;
-BlockPyramid<std::uint64_t> occupancy_pyramid(const LayeredMap& map) {
-  return BlockPyramid<std::uint64_t>(
-      map.scheme(), [&map](std::int64_t i) { return map.occupancy(i, kOccupancyBinMm); }, std::uint64_t(0),
-      [](std::uint64_t a, std::uint64_t b) { return a | b; });
+OccupancyPyramid occupancy_pyramid(const LayeredMap& map) {
+  return OccupancyPyramid(
+      map.scheme(), [&map](std::int64_t i) { return map.occupancy(i, kOccupancyBinMm); }, std::uint64_t(0), BitOr{});
 }
 // The shells [lo, hi] (mm) meets.
 std::uint64_t shells(double lo, double hi) {
@@ -151,15 +164,16 @@ std::uint64_t shells(double lo, double hi) {
   return m;
 }
 
-// Clusters of a scan set: 32 consecutive vertices (Z order: neighbours on the sphere), their
-// directions' cone (unit axis, half-angle) and radius range, in the body's frame.
+// Clusters of a scan set: `size` consecutive vertices (Z order: neighbours on the sphere), their
+// directions' cone (unit axis, half-angle) and radius range, in the body's frame. Two levels: leaves
+// of kLeaf vertices, looked up together, in groups of kGroup vertices, whose bound is tried first.
+constexpr std::int64_t kLeaf = 16, kGroup = 256;
 struct Cluster {
   std::int64_t first = 0, count = 0;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
-  double rho = 0, r_min = 0, r_max = 0;
+  double rho = 0, sin_rho = 0, r_min = 0, r_max = 0;
 };
-std::vector<Cluster> clusters_of(const ScanSet& s) {
-  constexpr std::int64_t kSize = 32;
+std::vector<Cluster> clusters_of(const ScanSet& s, std::int64_t kSize) {
   std::vector<Cluster> out;
   for (std::int64_t f = 0; f < s.size(); f += kSize) {
     Cluster c;
@@ -178,6 +192,7 @@ std::vector<Cluster> clusters_of(const ScanSet& s) {
       c.rho = std::max(c.rho, std::acos(std::clamp(Eigen::Vector3d(s.x[k], s.y[k], s.z[k]).normalized().dot(c.axis),
                                                    -1.0, 1.0)));
     c.rho += 1e-9;  // rounding of the angles
+    c.sin_rho = std::sin(std::min(c.rho, M_PI / 2));  // a wider cone takes whole rows (cap)
     out.push_back(c);
   }
   return out;
@@ -196,21 +211,25 @@ struct RomBounds {
   RomBounds(const Joint& j)
       : socket_min(bound_pyramid(j.socket().map, true)),
         ball_max(bound_pyramid(j.ball().map, false)),
-        ball_clusters(clusters_of(j.ball().scan_set)),
-        socket_clusters(clusters_of(j.socket().scan_set)) {
+        ball_clusters(clusters_of(j.ball().scan_set, kLeaf)),
+        socket_clusters(clusters_of(j.socket().scan_set, kLeaf)),
+        ball_groups(clusters_of(j.ball().scan_set, kGroup)),
+        socket_groups(clusters_of(j.socket().scan_set, kGroup)) {
     if (j.socket().layered) {
       socket_occupancy.emplace(occupancy_pyramid(*j.socket().layered));
-      ball_hidden_clusters = clusters_of(j.ball().hidden_set);
+      ball_hidden_clusters = clusters_of(j.ball().hidden_set, kLeaf);
+      ball_hidden_groups = clusters_of(j.ball().hidden_set, kGroup);
     }
     if (j.ball().layered) {
       ball_occupancy.emplace(occupancy_pyramid(*j.ball().layered));
-      socket_hidden_clusters = clusters_of(j.socket().hidden_set);
+      socket_hidden_clusters = clusters_of(j.socket().hidden_set, kLeaf);
+      socket_hidden_groups = clusters_of(j.socket().hidden_set, kGroup);
     }
   }
-  BlockPyramid<float> socket_min, ball_max;
-  std::vector<Cluster> ball_clusters, socket_clusters;
-  std::optional<BlockPyramid<std::uint64_t>> socket_occupancy, ball_occupancy;
-  std::vector<Cluster> ball_hidden_clusters, socket_hidden_clusters;
+  BoundPyramid socket_min, ball_max;
+  std::vector<Cluster> ball_clusters, socket_clusters, ball_groups, socket_groups;
+  std::optional<OccupancyPyramid> socket_occupancy, ball_occupancy;
+  std::vector<Cluster> ball_hidden_clusters, socket_hidden_clusters, ball_hidden_groups, socket_hidden_groups;
 };
 class CompactScanner {
  public:
@@ -230,17 +249,28 @@ class CompactScanner {
   }
   // The least counted gap at rotation R. exact: the true minimum; otherwise the true minimum when it
   // is <= the threshold, and some value > the threshold when it is not (clusters above it are skipped).
+  // Without `exact`, the scan stops at the first counted gap <= the threshold (the caller asks only
+  // whether the bones meet), starting with the cluster that met last time.
   Least operator()(const Eigen::Matrix3d& R, bool exact) {
     Least l;
     const double cut = exact ? std::numeric_limits<double>::infinity() : threshold_;
+    exact_ = exact;
+    if (!exact && last_ != nullptr) {
+      recheck(R, l);
+      if (l.gap <= threshold_) return l;
+    }
+    last_ = nullptr;
     if (counted_ != RomVertices::hidden) {
       scan(R, joint_.ball().scan_set, joint_.socket().map, ScanSide::inside, skip_ball_, true, cut, l);
+      if (done(l)) return l;
       scan(R.transpose(), joint_.socket().scan_set, joint_.ball().map, ScanSide::outside, skip_socket_, false, cut, l);
+      if (done(l)) return l;
     }
     if (counted_ == RomVertices::first_surface) return l;
     if (joint_.socket().layered)
       scan_hidden(R, joint_.ball().hidden_set, *joint_.socket().layered, joint_.socket().caster.get(), skip_ball_hidden_,
                   true, cut, l);
+    if (done(l)) return l;
     if (joint_.ball().layered)
       scan_hidden(R.transpose(), joint_.socket().hidden_set, *joint_.ball().layered, joint_.ball().caster.get(),
                   skip_socket_hidden_, false, cut, l);
@@ -251,7 +281,7 @@ class CompactScanner {
  private:
   void scan(const Eigen::Matrix3d& R, const ScanSet& set, const RadialDistanceMap& map, ScanSide side,
             const std::vector<std::uint8_t>& skip, bool ball, double cut, Least& l) {
-    const BlockPyramid<float>* pyr = bounds_ == nullptr ? nullptr : ball ? &bounds_->socket_min : &bounds_->ball_max;
+    const BoundPyramid* pyr = bounds_ == nullptr ? nullptr : ball ? &bounds_->socket_min : &bounds_->ball_max;
     if (pyr == nullptr || !pyr->valid()) {
       scan_gaps_compact(set, R, Eigen::Vector3d::Zero(), map, side, buf_.data());
       take(set, skip, 0, set.size(), ball, l);
@@ -259,33 +289,63 @@ class CompactScanner {
       return;
     }
     const std::vector<Cluster>& cl = ball ? bounds_->ball_clusters : bounds_->socket_clusters;
-    for (const Cluster& c : cl) {
-      const float bound = pyr->cap(R * c.axis, c.rho);
-      // Lower bound of every gap in the cluster: inside, d - r >= min d - r_max; outside, r - d >= r_min - max d.
+    const std::vector<Cluster>& groups = ball ? bounds_->ball_groups : bounds_->socket_groups;
+    // Lower bound of every gap in a cluster: inside, d - r >= min d - r_max; outside, r - d >= r_min - max d.
+    auto skipped = [&](const Cluster& c) {
+      const float bound = pyr->cap(R * c.axis, c.rho, c.sin_rho);
       const double lb = ball ? double(bound) - c.r_max : c.r_min - double(bound);
-      if (lb > cut || lb > l.gap) {
-        vertices_skipped += c.count;
+      return lb > cut || lb > l.gap;
+    };
+    for (const Cluster& g : groups) {
+      if (done(l)) return;
+      if (skipped(g)) {
+        vertices_skipped += g.count;
         continue;
       }
-      double x[32], y[32], z[32], d[32];
-      for (std::int64_t k = 0; k < c.count; ++k) {
-        const Eigen::Vector3d q = R * Eigen::Vector3d(set.x[c.first + k], set.y[c.first + k], set.z[c.first + k]);
-        x[k] = q.x(), y[k] = q.y(), z[k] = q.z();
+      for (std::int64_t i = g.first / kLeaf; i < (g.first + g.count + kLeaf - 1) / kLeaf; ++i) {
+        const Cluster& c = cl[static_cast<std::size_t>(i)];
+        if (done(l)) return;
+        if (skipped(c)) {
+          vertices_skipped += c.count;
+          continue;
+        }
+        look_up(R, set, map, side, c);
+        take(set, skip, c.first, c.first + c.count, ball, l);
+        vertices_looked_up += c.count;
+        if (l.gap <= threshold_) last_ = &c, last_ball_ = ball;
       }
-      map.sample_many_soa(x, y, z, c.count, d);
-      for (std::int64_t k = 0; k < c.count; ++k) {
-        const double r = std::sqrt(x[k] * x[k] + y[k] * y[k] + z[k] * z[k]);
-        buf_[static_cast<std::size_t>(c.first + k)] = static_cast<float>(static_cast<double>(side) * (d[k] - r));
-      }
-      take(set, skip, c.first, c.first + c.count, ball, l);
-      vertices_looked_up += c.count;
     }
   }
+  void look_up(const Eigen::Matrix3d& R, const ScanSet& set, const RadialDistanceMap& map, ScanSide side,
+               const Cluster& c) {
+    double x[kLeaf], y[kLeaf], z[kLeaf], d[kLeaf];
+    for (std::int64_t k = 0; k < c.count; ++k) {
+      const Eigen::Vector3d q = R * Eigen::Vector3d(set.x[c.first + k], set.y[c.first + k], set.z[c.first + k]);
+      x[k] = q.x(), y[k] = q.y(), z[k] = q.z();
+    }
+    map.sample_many_soa(x, y, z, c.count, d);
+    for (std::int64_t k = 0; k < c.count; ++k) {
+      const double r = std::sqrt(x[k] * x[k] + y[k] * y[k] + z[k] * z[k]);
+      buf_[static_cast<std::size_t>(c.first + k)] = static_cast<float>(static_cast<double>(side) * (d[k] - r));
+    }
+  }
+  // The first-surface cluster that met at the previous evaluation, looked up first.
+  void recheck(const Eigen::Matrix3d& R, Least& l) {
+    const bool ball = last_ball_;
+    const ScanSet& set = ball ? joint_.ball().scan_set : joint_.socket().scan_set;
+    if (ball)
+      look_up(R, set, joint_.socket().map, ScanSide::inside, *last_);
+    else
+      look_up(R.transpose(), set, joint_.ball().map, ScanSide::outside, *last_);
+    take(set, ball ? skip_ball_ : skip_socket_, last_->first, last_->first + last_->count, ball, l);
+    vertices_looked_up += last_->count;
+  }
+  bool done(const Least& l) const { return !exact_ && l.gap <= threshold_; }
   // Hidden vertices of one body against the other's layered map: a cluster is skipped when no radial
   // shell of the other bone over its cone lies within min(cut, least gap so far) of its radii.
   void scan_hidden(const Eigen::Matrix3d& R, const ScanSet& set, const LayeredMap& map, const FirstHitCaster* exact,
                    const std::vector<std::uint8_t>& skip, bool ball, double cut, Least& l) {
-    const BlockPyramid<std::uint64_t>* pyr =
+    const OccupancyPyramid* pyr =
         bounds_ == nullptr ? nullptr : ball ? &*bounds_->socket_occupancy : &*bounds_->ball_occupancy;
     const std::vector<Cluster>* cl =
         bounds_ == nullptr ? nullptr : ball ? &bounds_->ball_hidden_clusters : &bounds_->socket_hidden_clusters;
@@ -295,20 +355,33 @@ class CompactScanner {
       vertices_looked_up += set.size();
       return;
     }
-    for (const Cluster& c : *cl) {
+    const std::vector<Cluster>* groups = ball ? &bounds_->ball_hidden_groups : &bounds_->socket_hidden_groups;
+    auto skipped = [&](const Cluster& c) {
       const double reach = std::max(0.0, std::min(cut, l.gap));
-      if (std::isfinite(reach) && (pyr->cap(R * c.axis, c.rho) & shells(c.r_min - reach, c.r_max + reach)) == 0) {
-        vertices_skipped += c.count;
+      return std::isfinite(reach) && (pyr->cap(R * c.axis, c.rho, c.sin_rho) & shells(c.r_min - reach, c.r_max + reach)) == 0;
+    };
+    for (const Cluster& g : *groups) {
+      if (done(l)) return;
+      if (skipped(g)) {
+        vertices_skipped += g.count;
         continue;
       }
-      ScanSet& part = part_;
-      part.index.assign(set.index.begin() + c.first, set.index.begin() + c.first + c.count);
-      part.x.assign(set.x.begin() + c.first, set.x.begin() + c.first + c.count);
-      part.y.assign(set.y.begin() + c.first, set.y.begin() + c.first + c.count);
-      part.z.assign(set.z.begin() + c.first, set.z.begin() + c.first + c.count);
-      scan_layered(part, R, Eigen::Vector3d::Zero(), map, buf_.data() + c.first, exact);
-      take(set, skip, c.first, c.first + c.count, ball, l, true);
-      vertices_looked_up += c.count;
+      for (std::int64_t i = g.first / kLeaf; i < (g.first + g.count + kLeaf - 1) / kLeaf; ++i) {
+        const Cluster& c = (*cl)[static_cast<std::size_t>(i)];
+        if (done(l)) return;
+        if (skipped(c)) {
+          vertices_skipped += c.count;
+          continue;
+        }
+        ScanSet& part = part_;
+        part.index.assign(set.index.begin() + c.first, set.index.begin() + c.first + c.count);
+        part.x.assign(set.x.begin() + c.first, set.x.begin() + c.first + c.count);
+        part.y.assign(set.y.begin() + c.first, set.y.begin() + c.first + c.count);
+        part.z.assign(set.z.begin() + c.first, set.z.begin() + c.first + c.count);
+        scan_layered(part, R, Eigen::Vector3d::Zero(), map, buf_.data() + c.first, exact);
+        take(set, skip, c.first, c.first + c.count, ball, l, true);
+        vertices_looked_up += c.count;
+      }
     }
   }
   void take(const ScanSet& set, const std::vector<std::uint8_t>& skip, std::int64_t from, std::int64_t to, bool ball,
@@ -322,6 +395,9 @@ class CompactScanner {
   const RomBounds* bounds_;
   double threshold_;
   RomVertices counted_;
+  bool exact_ = true;
+  const Cluster* last_ = nullptr;  ///< first-surface cluster that met at the last evaluation (null: none)
+  bool last_ball_ = false;
   std::vector<std::uint8_t> skip_ball_, skip_socket_, skip_ball_hidden_, skip_socket_hidden_;
   std::vector<float> buf_;
   ScanSet part_;  ///< one cluster of a hidden set (scratch)
@@ -378,7 +454,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
     const double mid = 0.5 * (lo + hi);
     (gap_at(mid).gap <= o.threshold_mm ? hi : lo) = mid;
   }
-  const Least l = gap_at(hi);
+  const Least l = gap_at(hi, true);  // the least gap and where, not only whether they meet
   // A transient touch: the bones part again one step farther.
   if (hi + o.step_deg <= o.max_deg) out.monotone = gap_at(hi + o.step_deg).gap <= o.threshold_mm;
   out.vertices_looked_up = scan.vertices_looked_up;
