@@ -53,6 +53,7 @@ template <typename V, typename Combine>
 class BlockPyramid {
  public:
   static constexpr int kFirstLevel = 2;
+  static constexpr int kBlocksPerSpan = 4;  // blocks across a cap: finer is tighter, coarser is fewer reads
   // value(i): node i's value; none: the identity of `combine` (the value of an empty block).
   template <typename Value>
   BlockPyramid(const SamplingScheme& scheme, Value value, V none, Combine combine) : none_(none), combine_(combine) {
@@ -106,7 +107,7 @@ class BlockPyramid {
     const int r1 = std::min(rows_ - 1, static_cast<int>(std::floor(r_hi)) + 1);
     const int span = std::max(r1 - r0, c_hi - c_lo);
     int L = kFirstLevel;
-    while ((1 << L) < span && L - kFirstLevel + 1 < static_cast<int>(levels_.size())) ++L;
+    while ((1 << L) * kBlocksPerSpan < span && L - kFirstLevel + 1 < static_cast<int>(levels_.size())) ++L;
     const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b;
     const std::vector<V>& v = levels_[static_cast<std::size_t>(L - kFirstLevel)];
     V m = none_;
@@ -167,7 +168,7 @@ std::uint64_t shells(double lo, double hi) {
 // Clusters of a scan set: `size` consecutive vertices (Z order: neighbours on the sphere), their
 // directions' cone (unit axis, half-angle) and radius range, in the body's frame. Two levels: leaves
 // of kLeaf vertices, looked up together, in groups of kGroup vertices, whose bound is tried first.
-constexpr std::int64_t kLeaf = 16, kGroup = 256;
+constexpr std::int64_t kLeaf = 32, kGroup = 128;
 struct Cluster {
   std::int64_t first = 0, count = 0;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();

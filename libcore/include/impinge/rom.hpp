@@ -91,7 +91,7 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
 /// Search one motion of `hip`: evaluate both scans at theta = 0, step_deg, 2 step_deg, ... up to
 /// max_deg until the minimum gap over the counted vertices (those not in `baseline`) is <=
 /// threshold, then bisect the last step to tolerance_deg. Only the minimum is computed: the
-/// first-surface vertices are taken in clusters of 32 (Z order) with a cone of directions and a
+/// first-surface vertices are taken in clusters (32 vertices in Z order, in groups of 128) with a cone of directions and a
 /// radius range, and a cluster is skipped when a bound of the other map over its cone (a pyramid
 /// of minima or maxima over the equiangular map) shows that none of its gaps can reach the
 /// threshold; the others are looked up exactly, so the result is the full scan's. Throws
