@@ -646,6 +646,8 @@ int run_motion(const InputOptions& in, const MapOptions& mo, const FrameOptions&
 struct RomCliOptions {
   double threshold_mm = 0, step_deg = 2, max_deg = 150;
   bool no_map = false;
+  bool envelope = false;
+  int envelope_coarse = 4;
 };
 
 int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo, const RomCliOptions& ro,
@@ -709,9 +711,51 @@ int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo
     for (const RomMapCell& c : cells)
       map << c.flexion_deg << ',' << c.adduction_deg << ',' << c.max_internal_rotation_deg << ',' << c.status << '\n';
   }
+  double envelope_ms = 0;
+  nlohmann::json envelope_json;
+  if (ro.envelope) {
+    t0 = Clock::now();
+    RomEnvelopeOptions eo;
+    eo.coarse_steps = ro.envelope_coarse;
+    const RomEnvelope env = rom_envelope(hip, eo, o, base);
+    envelope_ms = ms_since(t0);
+    // Valid runs of internal rotation per (flexion, adduction): the envelope in a few thousand rows.
+    std::ofstream ef(fs::path(out_dir) / "rom_envelope.csv");
+    require(ef.good(), out_dir + "/rom_envelope.csv: cannot open for writing");
+    ef << "flexion_deg,adduction_deg,internal_rotation_from_deg,internal_rotation_to_deg\n" << std::setprecision(9);
+    std::int64_t valid = 0;
+    for (std::size_t i = 0; i < env.flexion_deg.size(); ++i)
+      for (std::size_t jj = 0; jj < env.adduction_deg.size(); ++jj) {
+        const std::size_t nr = env.internal_rotation_deg.size();
+        for (std::size_t k = 0; k < nr;) {
+          if (!env.at(i, jj, k)) {
+            ++k;
+            continue;
+          }
+          std::size_t e = k;
+          while (e + 1 < nr && env.at(i, jj, e + 1)) ++e;
+          valid += static_cast<std::int64_t>(e - k + 1);
+          ef << env.flexion_deg[i] << ',' << env.adduction_deg[jj] << ',' << env.internal_rotation_deg[k] << ','
+             << env.internal_rotation_deg[e] << '\n';
+          k = e + 1;
+        }
+      }
+    looked_up += env.vertices_looked_up, skipped += env.vertices_skipped;
+    envelope_json = {{"poses", env.poses},
+                     {"poses_valid", valid},
+                     {"poses_scanned", env.poses_evaluated},
+                     {"grid", {{"flexion_deg", {eo.flexion_min_deg, eo.flexion_max_deg}},
+                               {"adduction_deg", {eo.adduction_min_deg, eo.adduction_max_deg}},
+                               {"internal_rotation_deg", {eo.internal_rotation_min_deg, eo.internal_rotation_max_deg}},
+                               {"step_deg", eo.step_deg},
+                               {"coarse_steps", eo.coarse_steps}}},
+                     {"ms", envelope_ms},
+                     {"poses_per_second", double(env.poses) / (envelope_ms / 1000)}};
+  }
   nlohmann::json j = setup_json(s);
   j["threshold_mm"] = o.threshold_mm;
   j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
+  if (ro.envelope) j["envelope"] = envelope_json;
   j["neutral_min_gap_mm"] = num_or_null(base.min_gap_mm);
   j["excluded_vertices"] = base.excluded_vertices;
   j["limits"] = limits;
@@ -720,6 +764,7 @@ int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo
                      {"socket_sampling", s.joint().socket().sampling_ms},
                      {"limits", limits_ms},
                      {"rom_map", map_ms},
+                     {"envelope", envelope_ms},
                      {"total", ms_since(t_start)}};
   j["rom_map_cells"] = map_cells;
   j["limit_evaluations"] = evaluations;
@@ -728,7 +773,9 @@ int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo
   j["share_skipped"] = looked_up + skipped > 0 ? double(skipped) / double(looked_up + skipped) : 0.0;
   write_json((fs::path(out_dir) / "summary.json").string(), j);
   std::cout << "rom: " << standard_motions().size() << " limits in " << std::fixed << std::setprecision(0)
-            << limits_ms << " ms, ROM map (" << map_cells << " cells) in " << map_ms << " ms, total "
+            << limits_ms << " ms, ROM map (" << map_cells << " cells) in " << map_ms << " ms"
+            << (ro.envelope ? ", envelope in " + std::to_string(std::lround(envelope_ms)) + " ms" : std::string())
+            << ", total "
             << ms_since(t_start) << " ms; written to " << out_dir << "\n";
   return 0;
 }
@@ -811,6 +858,14 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   rom->add_option("--max", rom_opts.max_deg, "Search no farther than this from the start, deg")->capture_default_str();
   rom->add_flag("--no-map", rom_opts.no_map, "Limits only, no ROM map");
+  rom->add_flag("--envelope", rom_opts.envelope,
+                "Also the ROM envelope: every pose of flexion -30..130 x adduction -50..40 x internal rotation -60..60 "
+                "deg (1 deg steps) valid or in contact, by adaptive refinement (rom_envelope.csv: the valid runs of "
+                "internal rotation)");
+  rom->add_option("--envelope-coarse", rom_opts.envelope_coarse,
+                  "Steps between the envelope's first poses (1: scan every pose; larger is faster and can miss a "
+                  "region of contact smaller than a cell)")
+      ->capture_default_str();
   rom->add_option("--out", rom_out, "Output folder")->required();
 
   auto* gen = app.add_subcommand("generate", "Write a generated hip model (femur_r.ply, pelvis.ply, subject.json)");

@@ -21,6 +21,9 @@
 //                     all-intersection rays for the hidden vertices, first hits for the others)
 //   layered.csv       subject x body: layered map nodes, bytes and sampling time beside the single-layer
 //                     map's; hidden vertices; the nine limits' search time with and without layers
+//   envelope.csv      subject: the ROM envelope (every pose of flexion -30..130 x adduction -50..40 x internal
+//                     rotation -60..60, 1 deg; quick: 2 deg) by adaptive refinement, timed, beside the brute
+//                     force that scans every pose, and the poses on which they differ
 //   clock_faces.csv   the acetabular clock face of each real subject in its pelvic frame
 //   thesis_table11.csv, published.csv   copies of the inputs the analysis compares with
 //   meta.json
@@ -183,6 +186,10 @@ int main(int argc, char** argv) {
                     {"subject", "body", "layers", "nodes", "layered_bytes", "single_bytes", "layered_sampling_ms",
                      "single_sampling_ms", "nodes_covered", "nodes_truncated", "nodes_not_alternating",
                      "max_crossings", "hidden_vertices", "limits_ms_single", "limits_ms_layered"});
+  CsvWriter env(dir + "/envelope.csv",
+                {"subject", "resolution_deg", "step_deg", "coarse_steps", "threads", "poses", "poses_scanned",
+                 "poses_valid", "envelope_ms", "poses_per_second", "poses_per_core_second", "brute_force_ms",
+                 "brute_force_poses_valid", "poses_differ"});
   CsvWriter sens(dir + "/sensitivity.csv", {"subject", "variant", "motion", "limit_deg", "delta_deg"});
   CsvWriter tim(dir + "/timing.csv",
                 {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "evaluations",
@@ -314,6 +321,32 @@ int main(int argc, char** argv) {
                     limits_ms, limits_layered_ms);
     }
 
+    // The ROM envelope by refinement, timed (median of 3), beside the brute force over every pose.
+    {
+      RomEnvelopeOptions eo;
+      eo.step_deg = args.quick ? 2 : 1;
+      eo.coarse_steps = 4;
+      std::vector<double> ts;
+      RomEnvelope fast;
+      for (int rep = 0; rep < 3; ++rep) {
+        const auto t1 = Clock::now();
+        fast = rom_envelope(hip, eo, ro, base);
+        ts.push_back(ms_since(t1));
+      }
+      std::sort(ts.begin(), ts.end());
+      RomEnvelopeOptions bo = eo;
+      bo.coarse_steps = 1;
+      const auto t1 = Clock::now();
+      const RomEnvelope all = rom_envelope(hip, bo, ro, base);
+      const double brute_ms = ms_since(t1);
+      std::int64_t valid = 0, all_valid = 0, differ = 0;
+      for (std::size_t p = 0; p < all.valid.size(); ++p)
+        valid += fast.valid[p], all_valid += all.valid[p], differ += fast.valid[p] != all.valid[p];
+      const double ms = ts[1];
+      env.row(s.name, resolution, eo.step_deg, eo.coarse_steps, threads, fast.poses, fast.poses_evaluated, valid, ms,
+              double(fast.poses) / (ms / 1000), double(fast.poses) / (ms / 1000) / threads, brute_ms, all_valid, differ);
+    }
+
     // FCL collide on a subset of the map's poses (flexion 45, adduction 10, internal rotation 0..58 step 2).
     double fcl_ms = std::nan("");
     int fcl_poses = 0;
@@ -372,6 +405,8 @@ int main(int argc, char** argv) {
               {"exact_check", "CGAL ray casts from the COR for every counted first-surface vertex, 0.5 deg "
                               "before and after each limit; hidden vertices are not checked"},
               {"layers", 4},
+              {"envelope", "flexion -30..130 x adduction -50..40 x internal rotation -60..60 deg, 1 deg (quick: 2), "
+                           "refined from every 4th step; time: median of 3"},
               {"extra_articular_check", "CGAL all-intersection rays from the COR for every counted hidden vertex "
                                         "(signed radial distance), plus the first-hit check when all vertices count"},
               {"subjects", subj}});

@@ -8,6 +8,8 @@
 // - extra-articular oracle: a trochanter block hidden behind the head meets an iliac plate hidden
 //   behind the cup at the closed-form angle (within 0.2 deg) with layered maps, and is invisible
 //   without them; with layers, the occupancy bounds give the full scan's limits;
+// - the ROM envelope by adaptive refinement agrees with every pose scanned (to 0.1 %), and with the
+//   ROM limit along internal rotation;
 // - a right hip and its mirrored left copy give the same limits within 0.2 deg;
 // - pre-existing overlap at the baseline is excluded and reported, not taken for a limit;
 // - bad options are errors.
@@ -16,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <iostream>
 #include <memory>
 
 #include "impinge/error.hpp"
@@ -260,4 +263,56 @@ TEST(Rom, LayeredClusterBoundsGiveTheFullScansResults) {
     extra += a[k].limited_by_hidden_vertex;
   }
   EXPECT_GT(extra, 0);
+}
+
+TEST(Rom, EnvelopeByRefinementAgreesWithEveryPoseScanned) {
+  // The adaptive envelope (coarse lattice, cells split where their corners disagree) against the
+  // brute force that scans every pose of the same grid, on a generated hip with a cam; and against
+  // the ROM limit of internal rotation from neutral (the first pose in contact along that line).
+  HipModelOptions mo;
+  mo.target_triangles = 12000;
+  mo.cam_height_mm = 2;
+  const HipModel h = make_hip_model(mo);
+  SphereFitResult head;
+  head.centre = h.cor;
+  head.radius = mo.head_radius_mm;
+  const HipJoint hip(h.ball, h.socket, Side::right, head, Landmarks{}, scan_options(0.5));
+  RomOptions ro;
+  const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), ro);
+  RomEnvelopeOptions eo;
+  eo.step_deg = 4;
+  eo.flexion_min_deg = -32, eo.flexion_max_deg = 128;
+  eo.adduction_min_deg = -52, eo.adduction_max_deg = 40;
+  eo.internal_rotation_min_deg = -60, eo.internal_rotation_max_deg = 60;
+  eo.coarse_steps = 4;
+  const RomEnvelope fast = rom_envelope(hip, eo, ro, base);
+  eo.coarse_steps = 1;
+  const RomEnvelope all = rom_envelope(hip, eo, ro, base);
+  ASSERT_EQ(fast.valid.size(), all.valid.size());
+  EXPECT_EQ(all.poses_evaluated, all.poses);
+  EXPECT_LT(fast.poses_evaluated, fast.poses / 2);
+  std::int64_t differ = 0, valid = 0;
+  for (std::size_t p = 0; p < all.valid.size(); ++p) differ += fast.valid[p] != all.valid[p], valid += all.valid[p];
+  EXPECT_GT(valid, all.poses / 10);
+  EXPECT_LT(valid, all.poses);  // both kinds occur
+  EXPECT_LE(differ, all.poses / 1000) << differ << " of " << all.poses;
+  std::cout << "envelope: " << fast.poses_evaluated << " of " << fast.poses << " scanned, " << differ << " differ, " << valid << " valid\n";
+  // Internal rotation at flexion 0, adduction 0 (index 8 and 13): valid up to the limit, not beyond.
+  const RomLimit l = find_rom_limit(hip, std::function<PoseAngles(double)>([](double t) { return PoseAngles{0, 0, t}; }),
+                                    ro, base);
+  ASSERT_TRUE(l.limit_deg > 0 && l.limit_deg < 60) << l.limit_deg;
+  ASSERT_DOUBLE_EQ(all.flexion_deg[8], 0);
+  ASSERT_DOUBLE_EQ(all.adduction_deg[13], 0);
+  for (std::size_t k = 0; k < all.internal_rotation_deg.size(); ++k) {
+    const double t = all.internal_rotation_deg[k];
+    if (t < 0) continue;
+    if (t < l.limit_deg - 0.2) {
+      EXPECT_TRUE(all.at(8, 13, k)) << t;
+    }
+    if (t > l.limit_deg + 0.2 && l.monotone) {
+      EXPECT_FALSE(all.at(8, 13, k)) << t;
+    }
+  }
+  eo.step_deg = 3;  // 92 deg of adduction is not a whole number of 3-deg steps
+  EXPECT_THROW(rom_envelope(hip, eo, ro, base), Error);
 }

@@ -124,4 +124,38 @@ std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& 
                                 const std::vector<double>& adduction_deg, const RomOptions& options,
                                 const RomBaseline& baseline);
 
+/// The grid of a ROM envelope (degrees, ISB clinical angles) and how it is refined.
+struct RomEnvelopeOptions {
+  double flexion_min_deg = -30, flexion_max_deg = 130;
+  double adduction_min_deg = -50, adduction_max_deg = 40;
+  double internal_rotation_min_deg = -60, internal_rotation_max_deg = 60;
+  double step_deg = 1;    ///< grid step on every axis, deg (each range a whole number of steps)
+  int coarse_steps = 4;   ///< the first lattice every this many steps (1: every pose evaluated)
+};
+
+/// Every pose of a grid as valid (the bones apart: the least counted gap > the threshold) or not.
+struct RomEnvelope {
+  std::vector<double> flexion_deg, adduction_deg, internal_rotation_deg;  ///< the grid's axes
+  std::vector<std::uint8_t> valid;   ///< 1 valid, 0 in contact; index (i * na + j) * nr + k for flexion i,
+                                     ///< adduction j, internal rotation k (na, nr: axis sizes)
+  std::int64_t poses = 0;            ///< grid poses
+  std::int64_t poses_evaluated = 0;  ///< poses scanned (the rest filled from the corners of their cell)
+  std::int64_t vertices_looked_up = 0, vertices_skipped = 0;
+  bool at(std::size_t i, std::size_t j, std::size_t k) const {
+    return valid[(i * adduction_deg.size() + j) * internal_rotation_deg.size() + k] != 0;
+  }
+};
+
+/// The ROM envelope (issue 14): every pose of the flexion x adduction x internal rotation grid as valid
+/// or in contact, by adaptive refinement: the poses of a coarse lattice (every coarse_steps steps) are
+/// scanned; a cell whose eight corners agree is filled with their answer; a cell whose corners disagree
+/// is split in two along each axis and the new corners scanned, down to single steps. Only poses near
+/// the envelope's boundary are scanned. Assumption (the price of the refinement): a region of contact
+/// (or of freedom) smaller than a cell and touching none of its corners is missed; coarse_steps = 1
+/// scans every pose. Each scan stops at the first contact (RomOptions, `baseline` as for
+/// find_rom_limit). All cores (OpenMP). Throws impinge::Error on an empty or uneven grid. Source:
+/// issue 14; the refinement of Kawasaki et al. 2007 in spirit.
+RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& envelope, const RomOptions& options,
+                         const RomBaseline& baseline);
+
 }  // namespace impinge
