@@ -81,10 +81,10 @@ inline void fast_spherical_angles(double x, double y, double z, double& phi, dou
   const Reduced p = reduce(rho, az), t = reduce(ay, ax);
   const double inv = 1.0 / (p.den * t.den);
   const double a = finish(rho, az, p.big, p.num * t.den * inv);
-  phi = z < 0 ? kPi - a : a;
+  phi = z < 0 ? fast_angles_detail::kPi - a : a;
   double b = finish(ay, ax, t.big, t.num * p.den * inv);
-  b = x < 0 ? kPi - b : b;
-  theta = y < 0 ? 2 * kPi - b : b;
+  b = x < 0 ? fast_angles_detail::kPi - b : b;
+  theta = y < 0 ? 2 * fast_angles_detail::kPi - b : b;
 }
 
 /// Azimuth theta = atan2(y, x) mapped to [0, 2 pi] radians (thesis Eq. 6; 2 pi only when y is a
