@@ -112,11 +112,11 @@ void BM_Rasterize(benchmark::State& st) {
   const Scene& s = scene();
   const TriangleMesh& m = st.range(0) == 0 ? s.femur : s.pelvis;
   const DistanceMode mode = st.range(2) == 1 ? DistanceMode::linear : DistanceMode::exact;
-  const FaceCulling fc = analyse_face_culling(m, s.cor);
-  const FaceCulling* cull = st.range(2) == 2 ? &fc : nullptr;
+  const RasterPlan fc = plan_rasterization(m, s.cor);
+  const RasterPlan* cull = st.range(2) == 2 ? &fc : nullptr;
   RadialDistanceMap map{EquiangularGrid(kPrecisions[st.range(1)])};
   for (auto _ : st) {
-    benchmark::DoNotOptimize(rasterize(m, s.cor, mode, map, cull, true, MapStart::reset));
+    benchmark::DoNotOptimize(rasterize(m, s.cor, mode, map, RasterizeOptions{cull, true, MapStart::reset}));
   }
   st.SetLabel(s.name + (st.range(0) == 0 ? " femur " : " pelvis ") + to_string(mode) +
               (cull ? (fc.enabled ? " culled" : " (culling disabled: " + fc.reason + ")") : ""));
@@ -126,12 +126,12 @@ void BM_Rasterize(benchmark::State& st) {
 BENCHMARK(BM_Rasterize)->ArgsProduct({{0, 1}, {0, 1, 2, 3}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The once-per-mesh face-culling analysis (args: body).
-void BM_FaceCullingAnalysis(benchmark::State& st) {
+void BM_RasterPlanAnalysis(benchmark::State& st) {
   const Scene& s = scene();
   const TriangleMesh& m = st.range(0) == 0 ? s.femur : s.pelvis;
-  for (auto _ : st) benchmark::DoNotOptimize(analyse_face_culling(m, s.cor));
+  for (auto _ : st) benchmark::DoNotOptimize(plan_rasterization(m, s.cor));
 }
-BENCHMARK(BM_FaceCullingAnalysis)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RasterPlanAnalysis)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The floor: std::fill of a map of the same size (args: precision index).
 void BM_FillMap(benchmark::State& st) {

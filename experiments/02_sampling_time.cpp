@@ -6,7 +6,7 @@
 //   sampling_time.csv  one row per subject x body x precision x method:
 //     method: fill (std::fill of the map: the floor), rsid_linear (thesis Algorithm 1),
 //             rsid_exact (exact mode, every triangle), rsid_exact_culled (exact mode with the
-//             face-culling plan made once, face_culling.hpp: its cones and row spans),
+//             face-culling plan made once, raster_plan.hpp: its cones and row spans),
 //             usid_accelerated (helix at the
 //             matched turns k = round(720 / (pi p)): rasterise the matched equiangular map with
 //             culling, resample, release; thesis sec. 4.2.2), embree_node_cast (Embree 3 casts
@@ -27,7 +27,7 @@
 
 #include "experiment_support.hpp"
 #include "impinge/embree_ray_caster.hpp"
-#include "impinge/face_culling.hpp"
+#include "impinge/raster_plan.hpp"
 #include "impinge/helix_scheme.hpp"
 #include "impinge/naive_sampling.hpp"
 #include "impinge/rasterize.hpp"
@@ -72,8 +72,8 @@ int main(int argc, char** argv) {
       const TriangleMesh& mesh = body == 0 ? s.femur : s.pelvis;
       const std::string bname = body == 0 ? "femur" : "pelvis";
       const auto tri = static_cast<std::int64_t>(mesh.F.rows());
-      FaceCulling plan;
-      const double t_plan = median_ms([&] { plan = analyse_face_culling(mesh, cor); }, reps);
+      RasterPlan plan;
+      const double t_plan = median_ms([&] { plan = plan_rasterization(mesh, cor); }, reps);
       csv.row(s.name, int(s.generated), bname, tri, 0.0, "none", 0.0, "culling_analysis", 0, 0, t_plan, 0, 0,
               std::nan(""), int(plan.enabled), static_cast<std::int64_t>(plan.triangle_order.size()), 0);
       std::unique_ptr<EmbreeRayCaster> embree;
@@ -94,14 +94,14 @@ int main(int argc, char** argv) {
         put("fill", median_ms(reset, reps), 0, 0, nodes, 0);
         SamplingStats st;
         const auto fresh = MapStart::reset;
-        double t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::linear, map, nullptr, true, fresh); }, reps);
+        double t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::linear, map, RasterizeOptions{nullptr, true, fresh}); }, reps);
         put("rsid_linear", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
             st.node_tests);
-        t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::exact, map, nullptr, true, fresh); }, reps);
+        t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::exact, map, RasterizeOptions{nullptr, true, fresh}); }, reps);
         put("rsid_exact", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
             st.node_tests);
         const RadialDistanceMap full = map;
-        t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::exact, map, &plan, true, fresh); }, reps);
+        t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::exact, map, RasterizeOptions{&plan, true, fresh}); }, reps);
         put("rsid_exact_culled", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
             st.node_tests);
         std::int64_t differing = 0;
@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
           const int k = static_cast<int>(matched_helix_turns(p));
           RadialDistanceMap helix(make_scheme("helix", k));
           SamplingOptions o;
-          o.culling = &plan;
+          o.plan = &plan;
           SamplingReport rep;
           t = median_ms([&] { rep = sample_surface(mesh, cor, o, helix); }, reps);
           put("usid_accelerated", t, rep.nodes_covered, 0, helix.num_nodes(), rep.raster.triangles, "helix", k);

@@ -27,7 +27,7 @@
 #include "impinge/detection.hpp"
 #include "impinge/embree_ray_caster.hpp"
 #include "impinge/exact_reference.hpp"
-#include "impinge/face_culling.hpp"
+#include "impinge/raster_plan.hpp"
 #include "impinge/fcl_collision.hpp"
 #include "impinge/helix_scheme.hpp"
 #include "impinge/pairwise.hpp"

@@ -15,7 +15,7 @@
 #include <random>
 
 #include "impinge/equiangular_grid.hpp"
-#include "impinge/face_culling.hpp"
+#include "impinge/raster_plan.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/rasterize.hpp"
 #include "test_support.hpp"
@@ -42,10 +42,10 @@ struct KernelScope {
 };
 
 template <typename M>
-M rasterized(const TriangleMesh& m, const Eigen::Vector3d& cor, double p, const FaceCulling* plan, KernelSet set) {
+M rasterized(const TriangleMesh& m, const Eigen::Vector3d& cor, double p, const RasterPlan* plan, KernelSet set) {
   set_kernel_set(set);
   M map{EquiangularGrid(p)};
-  rasterize(m, cor, DistanceMode::exact, map, plan);
+  rasterize(m, cor, DistanceMode::exact, map, RasterizeOptions{plan});
   return map;
 }
 
@@ -65,9 +65,9 @@ TEST(Kernels, RasteriserHalvesGiveIdenticalMaps) {
   KernelScope scope;
   const Bones b = bones();
   for (const TriangleMesh& m : b.meshes) {
-    const FaceCulling plan = analyse_face_culling(m, b.cor);
+    const RasterPlan plan = plan_rasterization(m, b.cor);
     for (double p : {0.5, 0.1}) {
-      for (const FaceCulling* pl : {static_cast<const FaceCulling*>(nullptr), &plan}) {
+      for (const RasterPlan* pl : {static_cast<const RasterPlan*>(nullptr), &plan}) {
         const auto native = rasterized<RadialDistanceMap>(m, b.cor, p, pl, KernelSet::native);
         const auto generic = rasterized<RadialDistanceMap>(m, b.cor, p, pl, KernelSet::generic);
         std::int64_t differ = 0, covered = 0;

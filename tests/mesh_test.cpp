@@ -9,7 +9,7 @@
 #include "impinge/embree_ray_caster.hpp"
 #include "impinge/error.hpp"
 #include "impinge/exact_reference.hpp"
-#include "impinge/face_culling.hpp"
+#include "impinge/raster_plan.hpp"
 #include "impinge/fcl_collision.hpp"
 #include "impinge/femur_frame.hpp"
 #include "impinge/generated_models.hpp"
@@ -79,7 +79,7 @@ TEST(Mesh, EveryEntryPointThatIndexesFacesRefusesABadIndex) {
     sample_naive(bad, h.cor, map);
   });
   expect_error("cast_ray_naive", [&] { cast_ray_naive(bad, h.cor, Eigen::Vector3d::UnitX()); });
-  expect_error("analyse_face_culling", [&] { analyse_face_culling(bad, h.cor); });
+  expect_error("plan_rasterization", [&] { plan_rasterization(bad, h.cor); });
   expect_error("Joint", [&] { Joint(bad, h.socket, h.cor, JointOptions{}); });
   expect_error("locate_femoral_head", [&] { locate_femoral_head(bad); });
   if (have_exact_reference()) expect_error("ExactReference", [&] { ExactReference r(bad); });

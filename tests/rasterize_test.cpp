@@ -17,7 +17,7 @@
 #include <random>
 
 #include "impinge/error.hpp"
-#include "impinge/face_culling.hpp"
+#include "impinge/raster_plan.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/naive_sampling.hpp"
 #include "impinge/spherical_frame.hpp"
@@ -290,12 +290,12 @@ TEST(Rasterize, RowSpansGiveTheSameMapAsWholeBoxes) {
   for (double p : {2.0, 0.5, 0.1, 0.75, 0.3}) {
     const TriangleMesh m = span_stress_mesh(p, rng);
     const Eigen::Vector3d cor = Eigen::Vector3d::Zero();
-    const FaceCulling plan = analyse_face_culling(m, cor);  // open mesh: disabled, all cones
+    const RasterPlan plan = plan_rasterization(m, cor);  // open mesh: disabled, all cones
     ASSERT_FALSE(plan.enabled);
     RadialDistanceMap box{EquiangularGrid(p)}, span{EquiangularGrid(p)}, planned{EquiangularGrid(p)};
-    const SamplingStats sb = rasterize(m, cor, DistanceMode::exact, box, nullptr, /*row_spans=*/false);
+    const SamplingStats sb = rasterize(m, cor, DistanceMode::exact, box, RasterizeOptions{nullptr, false});
     const SamplingStats ss = rasterize(m, cor, DistanceMode::exact, span);
-    const SamplingStats sp = rasterize(m, cor, DistanceMode::exact, planned, &plan);
+    const SamplingStats sp = rasterize(m, cor, DistanceMode::exact, planned, RasterizeOptions{&plan});
     EXPECT_EQ(nodes_not_identical(box, span), 0) << "p=" << p;
     EXPECT_EQ(nodes_not_identical(box, planned), 0) << "p=" << p;
     EXPECT_EQ(sb.nodes_covered, ss.nodes_covered);
@@ -305,7 +305,7 @@ TEST(Rasterize, RowSpansGiveTheSameMapAsWholeBoxes) {
     EXPECT_GT(ss.pole_triangles, 0);
     EXPECT_GT(ss.seam_triangles, 0);
     RadialDistanceMapDouble box_d{EquiangularGrid(p)}, span_d{EquiangularGrid(p)};
-    rasterize(m, cor, DistanceMode::exact, box_d, nullptr, false);
+    rasterize(m, cor, DistanceMode::exact, box_d, RasterizeOptions{nullptr, false});
     rasterize(m, cor, DistanceMode::exact, span_d);
     EXPECT_EQ(nodes_not_identical(box_d, span_d), 0) << "p=" << p;
   }
@@ -319,31 +319,31 @@ TEST(Rasterize, MapStartResetEqualsAFreshMapAndKeepKeepsNearerValues) {
   const TriangleMesh stress = span_stress_mesh(0.1, rng);  // pole cones reach over many bands
   for (const TriangleMesh* m : {&stress, &h.socket}) {
     const Eigen::Vector3d cor = m == &stress ? Eigen::Vector3d::Zero() : h.cor;
-    const FaceCulling plan = analyse_face_culling(*m, cor);
+    const RasterPlan plan = plan_rasterization(*m, cor);
     for (double p : {0.1, 0.75}) {  // 51 bands of rows and one (float maps)
       RadialDistanceMap fresh{EquiangularGrid(p)};
-      const SamplingStats sf = rasterize(*m, cor, DistanceMode::exact, fresh, &plan);
+      const SamplingStats sf = rasterize(*m, cor, DistanceMode::exact, fresh, RasterizeOptions{&plan});
       ASSERT_GT(sf.nodes_covered, 1000) << m->source;
       RadialDistanceMap dirty{EquiangularGrid(p)}, dirty_unplanned{EquiangularGrid(p)};
       std::fill(dirty.data(), dirty.data() + dirty.num_nodes(), 0.5f);  // nearer than any surface
       std::fill(dirty_unplanned.data(), dirty_unplanned.data() + dirty_unplanned.num_nodes(), 0.5f);
-      const SamplingStats sr = rasterize(*m, cor, DistanceMode::exact, dirty, &plan, true, MapStart::reset);
+      const SamplingStats sr = rasterize(*m, cor, DistanceMode::exact, dirty, RasterizeOptions{&plan, true, MapStart::reset});
       EXPECT_EQ(nodes_not_identical(fresh, dirty), 0) << m->source << " p=" << p;
       EXPECT_EQ(sr.nodes_covered, sf.nodes_covered);
       EXPECT_EQ(sr.node_tests, sf.node_tests);
-      rasterize(*m, cor, DistanceMode::exact, dirty_unplanned, nullptr, true, MapStart::reset);
+      rasterize(*m, cor, DistanceMode::exact, dirty_unplanned, RasterizeOptions{nullptr, true, MapStart::reset});
       RadialDistanceMap fresh_unplanned{EquiangularGrid(p)};
       rasterize(*m, cor, DistanceMode::exact, fresh_unplanned);
       EXPECT_EQ(nodes_not_identical(fresh_unplanned, dirty_unplanned), 0) << m->source << " p=" << p;
       RadialDistanceMapDouble fresh_d{EquiangularGrid(p)}, dirty_d{EquiangularGrid(p)};
-      rasterize(*m, cor, DistanceMode::exact, fresh_d, &plan);
+      rasterize(*m, cor, DistanceMode::exact, fresh_d, RasterizeOptions{&plan});
       std::fill(dirty_d.data(), dirty_d.data() + dirty_d.num_nodes(), 0.5);
-      rasterize(*m, cor, DistanceMode::exact, dirty_d, &plan, true, MapStart::reset);
+      rasterize(*m, cor, DistanceMode::exact, dirty_d, RasterizeOptions{&plan, true, MapStart::reset});
       EXPECT_EQ(nodes_not_identical(fresh_d, dirty_d), 0) << m->source << " p=" << p;
       // keep: the 0.5 mm values are nearer than every hit, so nothing changes.
       RadialDistanceMap kept{EquiangularGrid(p)};
       std::fill(kept.data(), kept.data() + kept.num_nodes(), 0.5f);
-      const SamplingStats sk = rasterize(*m, cor, DistanceMode::exact, kept, &plan, true, MapStart::keep);
+      const SamplingStats sk = rasterize(*m, cor, DistanceMode::exact, kept, RasterizeOptions{&plan, true, MapStart::keep});
       EXPECT_EQ(sk.nodes_covered, 0);
       EXPECT_EQ(std::count(kept.data(), kept.data() + kept.num_nodes(), 0.5f), kept.num_nodes());
     }
@@ -354,10 +354,10 @@ TEST(Rasterize, RowSpansOnRealBonesGiveTheSameMap) {
   const auto real = test::load_real_joint("lhdl-ct");
   if (!real) GTEST_SKIP() << "no shared data (" << IMPINGE_SHARED_DATA << ")";
   for (const TriangleMesh* m : {&real->femur, &real->pelvis}) {
-    const FaceCulling plan = analyse_face_culling(*m, real->cor);
+    const RasterPlan plan = plan_rasterization(*m, real->cor);
     RadialDistanceMap box{EquiangularGrid(0.1)}, span{EquiangularGrid(0.1)};
-    rasterize(*m, real->cor, DistanceMode::exact, box, &plan, false);
-    const SamplingStats st = rasterize(*m, real->cor, DistanceMode::exact, span, &plan);
+    rasterize(*m, real->cor, DistanceMode::exact, box, RasterizeOptions{&plan, false});
+    const SamplingStats st = rasterize(*m, real->cor, DistanceMode::exact, span, RasterizeOptions{&plan});
     EXPECT_EQ(nodes_not_identical(box, span), 0) << m->source;
     EXPECT_GT(st.nodes_covered, box.num_nodes() / 10) << m->source;
   }
@@ -365,17 +365,17 @@ TEST(Rasterize, RowSpansOnRealBonesGiveTheSameMap) {
 
 TEST(Rasterize, PlanOfAnotherMeshOrCorIsRefused) {
   const HipModel h = make_hip_model(HipModelOptions{});
-  const FaceCulling plan = analyse_face_culling(h.socket, h.cor);
+  const RasterPlan plan = plan_rasterization(h.socket, h.cor);
   RadialDistanceMap map{EquiangularGrid(2.0)};
-  EXPECT_NO_THROW(rasterize(h.socket, h.cor, DistanceMode::exact, map, &plan));
-  EXPECT_THROW(rasterize(h.ball, h.cor, DistanceMode::exact, map, &plan), Error);
-  EXPECT_THROW(rasterize(h.socket, Eigen::Vector3d(h.cor + Eigen::Vector3d(0, 0, 1e-9)), DistanceMode::exact, map, &plan),
+  EXPECT_NO_THROW(rasterize(h.socket, h.cor, DistanceMode::exact, map, RasterizeOptions{&plan}));
+  EXPECT_THROW(rasterize(h.ball, h.cor, DistanceMode::exact, map, RasterizeOptions{&plan}), Error);
+  EXPECT_THROW(rasterize(h.socket, Eigen::Vector3d(h.cor + Eigen::Vector3d(0, 0, 1e-9)), DistanceMode::exact, map, RasterizeOptions{&plan}),
                Error);
   TriangleMesh moved = h.socket;
   moved.V(7, 1) += 1e-12;  // one coordinate, one ulp-scale edit
-  EXPECT_THROW(rasterize(moved, h.cor, DistanceMode::exact, map, &plan), Error);
+  EXPECT_THROW(rasterize(moved, h.cor, DistanceMode::exact, map, RasterizeOptions{&plan}), Error);
   // Linear mode does not use the plan's cones (the thesis' algorithm on every triangle).
-  EXPECT_NO_THROW(rasterize(h.ball, h.cor, DistanceMode::linear, map, &plan));
+  EXPECT_NO_THROW(rasterize(h.ball, h.cor, DistanceMode::linear, map, RasterizeOptions{&plan}));
 }
 
 TEST(Rasterize, NodesThroughSharedVerticesAreCovered) {
@@ -386,14 +386,14 @@ TEST(Rasterize, NodesThroughSharedVerticesAreCovered) {
   // both modes, float and double, with and without a culling plan, in any orientation of the axis.
   for (const Eigen::Vector3d axis : {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()}) {
     const TriangleMesh m = make_uv_sphere(22, Eigen::Vector3d::Zero(), 72, 36, axis);
-    const FaceCulling plan = analyse_face_culling(m, Eigen::Vector3d::Zero());
+    const RasterPlan plan = plan_rasterization(m, Eigen::Vector3d::Zero());
     for (double p : {1.0, 0.5, 0.25})
       for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear})
-        for (const FaceCulling* pl : {static_cast<const FaceCulling*>(nullptr), &plan}) {
+        for (const RasterPlan* pl : {static_cast<const RasterPlan*>(nullptr), &plan}) {
           RadialDistanceMap f{EquiangularGrid(p)};
           RadialDistanceMapDouble d{EquiangularGrid(p)};
-          rasterize(m, Eigen::Vector3d::Zero(), mode, f, pl);
-          rasterize(m, Eigen::Vector3d::Zero(), mode, d, pl);
+          rasterize(m, Eigen::Vector3d::Zero(), mode, f, RasterizeOptions{pl});
+          rasterize(m, Eigen::Vector3d::Zero(), mode, d, RasterizeOptions{pl});
           EXPECT_EQ(f.nodes_covered(), f.num_nodes()) << "p=" << p << " " << to_string(mode) << " axis " << axis.x();
           EXPECT_EQ(d.nodes_covered(), d.num_nodes()) << "p=" << p << " " << to_string(mode) << " axis " << axis.x();
         }

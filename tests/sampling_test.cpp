@@ -83,6 +83,6 @@ TEST(Sampling, RasterizingIntoAUsedMapGivesAFreshMap) {
   }
   RadialDistanceMap hx{HelixScheme(20)};
   std::fill(hx.data(), hx.data() + hx.num_nodes(), 0.25f);
-  EXPECT_THROW(rasterize(h.socket, h.cor, DistanceMode::exact, hx, nullptr, true, MapStart::reset), Error);
+  EXPECT_THROW(rasterize(h.socket, h.cor, DistanceMode::exact, hx, RasterizeOptions{nullptr, true, MapStart::reset}), Error);
   EXPECT_EQ(std::count(hx.data(), hx.data() + hx.num_nodes(), 0.25f), hx.num_nodes());
 }

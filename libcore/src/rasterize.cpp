@@ -62,7 +62,7 @@ class Rasterizer {
       ++stats_.triangles_edge_on;
       return;
     }
-    if (keep_sign_ != 0 && (det > 0 ? 1 : -1) != keep_sign_) {  // never the nearest hit (face_culling.hpp)
+    if (keep_sign_ != 0 && (det > 0 ? 1 : -1) != keep_sign_) {  // never the nearest hit (raster_plan.hpp)
       ++stats_.triangles_culled;
       return;
     }
@@ -263,14 +263,17 @@ class Rasterizer {
 
 template <typename Scalar>
 SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, DistanceMode mode,
-                        RadialDistanceMapT<Scalar>& map, const FaceCulling* culling, bool row_spans, MapStart start) {
+                        RadialDistanceMapT<Scalar>& map, const RasterizeOptions& options) {
+  const RasterPlan* culling = options.plan;
+  const bool row_spans = options.row_spans;
+  const MapStart start = options.start;
   require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
   validate_mesh(mesh);  // a bad index is an error before anything is read or changed
   (void)equiangular_grid_of(map.scheme());  // throws for a map that is not equiangular, before anything is changed
   const bool planned = culling != nullptr && mode == DistanceMode::exact;
   // The plan's cones: the kept triangles (all when culling is disabled), set up once.
   if (planned && (culling->cor != cor || culling->mesh_fingerprint != mesh_fingerprint(mesh)))
-    throw Error(mesh.source + ": face culling plan was made for another mesh or centre of rotation");
+    throw Error(mesh.source + ": rasterisation plan was made for another mesh or centre of rotation");
   const bool banded = planned && start == MapStart::reset;  // the reset fused with the drawing
   if (start == MapStart::reset && !banded)
     std::fill(map.data(), map.data() + map.num_nodes(), RadialDistanceMapT<Scalar>::no_surface());
@@ -298,9 +301,9 @@ SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, Di
 }
 
 template SamplingStats rasterize<float>(const TriangleMesh&, const Eigen::Vector3d&, DistanceMode,
-                                        RadialDistanceMapT<float>&, const FaceCulling*, bool, MapStart);
+                                        RadialDistanceMapT<float>&, const RasterizeOptions&);
 template SamplingStats rasterize<double>(const TriangleMesh&, const Eigen::Vector3d&, DistanceMode,
-                                         RadialDistanceMapT<double>&, const FaceCulling*, bool, MapStart);
+                                         RadialDistanceMapT<double>&, const RasterizeOptions&);
 
 RadialDistanceMap rasterize_map(const TriangleMesh& mesh, const Eigen::Vector3d& cor, double precision_deg,
                                 DistanceMode mode, SamplingStats* stats) {

@@ -82,20 +82,20 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
     rep.method = equiangular ? SamplingMethod::rasterize : SamplingMethod::resample;
   auto t0 = std::chrono::steady_clock::now();
   // Face culling (exact mode): the caller's plan, or one made here when asked to.
-  FaceCulling own;
-  const FaceCulling* cull = o.culling;
+  RasterPlan own;
+  const RasterPlan* cull = o.plan;
   if (cull == nullptr && o.cull_faces && o.mode == DistanceMode::exact &&
       (rep.method == SamplingMethod::rasterize || rep.method == SamplingMethod::resample)) {
-    own = analyse_face_culling(mesh, cor);
+    own = plan_rasterization(mesh, cor);
     cull = &own;
-    rep.culling_ms = ms_since(t0);
+    rep.planning_ms = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
   }
   rep.faces_culled = cull != nullptr && cull->enabled && o.mode == DistanceMode::exact;
   switch (rep.method) {
     case SamplingMethod::rasterize:
       // A fresh map, as documented (with a plan the reset is fused with the drawing).
-      rep.raster = rasterize(mesh, cor, o.mode, map, cull, true, MapStart::reset);  // throws via equiangular_grid_of
+      rep.raster = rasterize(mesh, cor, o.mode, map, RasterizeOptions{cull, true, MapStart::reset});  // throws via equiangular_grid_of
                                                                                       // when not equiangular
       rep.rasterize_ms = ms_since(t0);
       break;
@@ -109,7 +109,7 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
       rep.resample_precision_deg = p;
       {
         RadialDistanceMap tmp{EquiangularGrid(p)};
-        rep.raster = rasterize(mesh, cor, o.mode, tmp, cull);
+        rep.raster = rasterize(mesh, cor, o.mode, tmp, RasterizeOptions{cull});
         rep.rasterize_ms = ms_since(t0);
         t0 = std::chrono::steady_clock::now();
         resample(tmp, map);

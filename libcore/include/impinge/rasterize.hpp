@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "impinge/face_culling.hpp"
+#include "impinge/raster_plan.hpp"
 #include "impinge/mesh.hpp"
 #include "impinge/equiangular_grid.hpp"
 #include "impinge/radial_distance_map.hpp"
@@ -32,7 +32,7 @@ const char* to_string(DistanceMode mode);
 struct SamplingStats {
   std::int64_t triangles = 0;          ///< triangles in the mesh
   std::int64_t triangles_edge_on = 0;  ///< skipped: plane through the COR (covers no direction)
-  std::int64_t triangles_culled = 0;   ///< skipped: can never be the nearest hit (face_culling.hpp)
+  std::int64_t triangles_culled = 0;   ///< skipped: can never be the nearest hit (raster_plan.hpp)
   std::int64_t pole_triangles = 0;     ///< triangles touching or containing a pole (cases 1-3)
   std::int64_t seam_triangles = 0;     ///< triangles crossing theta = 0/360
   std::int64_t node_tests = 0;         ///< node-in-triangle tests performed
@@ -51,6 +51,20 @@ enum class MapStart {
   reset,
 };
 
+/// How rasterize draws (issue 12: one options struct instead of a positional tail).
+struct RasterizeOptions {
+  /// Exact mode only (ignored in linear mode): plan_rasterization's plan for this mesh and COR. Its
+  /// cones are rasterised (set up once; the kept triangles when culling is enabled, about half of a
+  /// closed mesh, else all), in its cache-friendly order. Null: every triangle, set up here.
+  const RasterPlan* plan = nullptr;
+  /// Exact mode: test only the columns of each row that the cone can cover (triangle_cone.hpp)
+  /// instead of the whole box; the map is the same node for node (tested), so false is only the
+  /// reference for that test.
+  bool row_spans = true;
+  /// Keep the map's values where they are nearer (the default) or reset the map first (MapStart).
+  MapStart start = MapStart::keep;
+};
+
 /// Fill `map` with the nearest hit of every node's ray on `mesh` by rasterisation: each
 /// triangle is projected into the (phi, theta) grid (its bounding rows and columns, with the
 /// theta = 0/360 seam and the poles handled: the whole row range is taken when the triangle's
@@ -60,22 +74,15 @@ enum class MapStart {
 /// (the pelvis is not star-shaped from the COR). Nodes no triangle covers keep "no surface".
 ///
 /// `mesh`: vertices in mm in the map's frame; `cor` (mm): origin of the spherical frame.
-/// Cost O(triangles + nodes in the triangles' bounding boxes). `start`: keep the map's values
-/// where they are nearer (the default) or reset the map first (MapStart).
-/// `culling` (exact mode only; ignored in linear mode): the plan of analyse_face_culling for
-/// this mesh and COR. Its cones are rasterised (set up once; the kept triangles when culling is
-/// enabled, about half of a closed mesh, else all). Throws impinge::Error naming the mesh when
-/// the plan was made for another mesh or COR (mesh_fingerprint), or the mesh is invalid
-/// (validate_mesh, checked before the map is touched).
-/// `row_spans` (exact mode): test only the columns of each row that the cone can cover
-/// (triangle_cone.hpp) instead of the whole box; the map is the same node for node (tested), so
-/// false is only the reference for that test. The row kernels run in vectorised clones
-/// (AVX-512 / AVX2 chosen at run time).
+/// Cost O(triangles + nodes in the triangles' bounding boxes). `options`: RasterizeOptions (a plan,
+/// row spans, whether the map starts fresh). Throws impinge::Error naming the mesh when the plan was
+/// made for another mesh or COR (mesh_fingerprint), or the mesh is invalid (validate_mesh, checked
+/// before the map is touched). The row kernels run in vectorised clones (AVX-512 / AVX2 chosen at run
+/// time).
 /// Source: thesis sec. 3.2, Algorithm 1, Fig. 33-34; culling, cones and spans: issue 4.
 template <typename Scalar>
 SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, DistanceMode mode,
-                        RadialDistanceMapT<Scalar>& map, const FaceCulling* culling = nullptr, bool row_spans = true,
-                        MapStart start = MapStart::keep);
+                        RadialDistanceMapT<Scalar>& map, const RasterizeOptions& options = {});
 
 /// One-shot convenience: a new float map of precision `precision_deg` sampled from `mesh`.
 RadialDistanceMap rasterize_map(const TriangleMesh& mesh, const Eigen::Vector3d& cor, double precision_deg,

@@ -37,11 +37,11 @@ struct SamplingOptions {
   /// error adds to the scheme's own, so comparisons of schemes at equal error use 2 (a quarter of
   /// that error, at four times the rasterisation). Source: issue 12.
   int resample_oversampling = 1;
-  /// Exact mode: skip the triangles that can never be the nearest hit (face_culling.hpp).
-  /// With `culling` null, the analysis is made here (O(m), counted in culling_ms); culling
-  /// turns itself off, and says why, on meshes where it would not be exact.
+  /// Exact mode: skip the triangles that can never be the nearest hit (raster_plan.hpp).
+  /// With `plan` null, the plan is made here (O(m), counted in planning_ms); culling turns itself
+  /// off, and says why, on meshes where it would not be exact.
   bool cull_faces = true;
-  const FaceCulling* culling = nullptr;  ///< a plan made once by analyse_face_culling, or null
+  const RasterPlan* plan = nullptr;  ///< a plan made once by plan_rasterization for this mesh and COR, or null
 };
 
 /// What a sampling run did.
@@ -51,7 +51,7 @@ struct SamplingReport {
   double resample_precision_deg = 0;                          ///< temporary map precision (resample), else 0
   std::int64_t nodes_covered = 0;                             ///< nodes with a surface in the filled map
   double rasterize_ms = 0, resample_ms = 0, ray_cast_ms = 0;  ///< wall times of the stages
-  double culling_ms = 0;                                      ///< face-culling analysis made here
+  double planning_ms = 0;                                     ///< rasterisation plan (face culling) made here
   bool faces_culled = false;                                  ///< rasterised with culling
 };
 

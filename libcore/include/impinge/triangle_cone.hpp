@@ -2,7 +2,7 @@
 /// @file triangle_cone.hpp
 /// The part of a triangle's exact-mode rasterisation set-up that does not depend on the map's
 /// precision (issue 4's faster rasteriser; not in the thesis). A face-culling plan
-/// (face_culling.hpp) holds one per kept triangle, made once per mesh and COR, so that a
+/// (raster_plan.hpp) holds one per kept triangle, made once per mesh and COR, so that a
 /// rasterisation only turns these angles into rows, columns and row spans.
 
 #include <Eigen/Core>

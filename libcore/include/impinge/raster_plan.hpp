@@ -1,7 +1,10 @@
 #pragma once
-/// @file face_culling.hpp
-/// Which triangles of a mesh can be the nearest hit of a ray from the COR (issue 4's faster
-/// rasteriser; not in the thesis). Along any ray from a point off a closed, consistently
+/// @file raster_plan.hpp
+/// A rasterisation plan: what can be prepared once per mesh and COR before rasterising it at any
+/// precision (issue 4's faster rasteriser; not in the thesis): which triangles can be the nearest hit
+/// of a ray from the COR (face culling), in what order to draw them, and their cones set up.
+///
+/// Face culling: which triangles of a mesh can be the nearest hit of a ray from the COR. Along any ray from a point off a closed, consistently
 /// oriented surface, hits alternate between entering and leaving the solid, so the first hit
 /// always has the same orientation relative to the ray: entering when the COR is outside (the
 /// pelvis seen from the hip centre), leaving when it is inside (the femoral head). The other
@@ -22,8 +25,9 @@
 
 namespace impinge {
 
-/// Result of the analysis, with the evidence.
-struct FaceCulling {
+/// The plan for rasterising one mesh about one COR (plan_rasterization), with the evidence for its
+/// culling. Formerly FaceCulling (issue 12 asked for a name that says what it is).
+struct RasterPlan {
   bool enabled = false;             ///< true when culling is exact for this mesh and COR
   int keep_sign = 0;                ///< +1 or -1: keep triangles with sign(det) == keep_sign
   std::int64_t boundary_edges = 0;  ///< directed edges without exactly one reverse edge
@@ -56,6 +60,6 @@ std::uint64_t mesh_fingerprint(const TriangleMesh& mesh);
 /// Cost O(m) for the edges and cones plus O(rays x m); a once-per-mesh precomputation like
 /// building a BVH. Throws impinge::Error for an invalid
 /// mesh or a non-finite COR.
-FaceCulling analyse_face_culling(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays = 8);
+RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays = 8);
 
 }  // namespace impinge

@@ -1,4 +1,4 @@
-#include "impinge/face_culling.hpp"
+#include "impinge/raster_plan.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +13,7 @@ namespace impinge {
 
 namespace {
 /// Kept triangles (all when culling is disabled) in Z-curve order of their centroid direction.
-void order_triangles(const TriangleMesh& mesh, const Eigen::Vector3d& cor, FaceCulling& fc) {
+void order_triangles(const TriangleMesh& mesh, const Eigen::Vector3d& cor, RasterPlan& fc) {
   std::vector<std::pair<std::uint64_t, std::int32_t>> key;
   key.reserve(static_cast<std::size_t>(mesh.F.rows()));
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
@@ -57,11 +57,11 @@ std::uint64_t mesh_fingerprint(const TriangleMesh& mesh) {
   return h ^ static_cast<std::uint64_t>(mesh.V.rows()) * 31 ^ static_cast<std::uint64_t>(mesh.F.rows());
 }
 
-FaceCulling analyse_face_culling(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays) {
+RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays) {
   validate_mesh(mesh);
   require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
   require(rays >= 1, "face culling: at least one ray is needed");
-  FaceCulling fc;
+  RasterPlan fc;
   // Closed and consistently oriented: every directed edge (i, j) has exactly one (j, i).
   // Outgoing edges per vertex in compressed rows.
   const auto n = static_cast<std::size_t>(mesh.V.rows());

@@ -1,4 +1,4 @@
-// face_culling.hpp and its use by the rasteriser. Invariants checked:
+// raster_plan.hpp and its use by the rasteriser. Invariants checked:
 //  - on closed, consistently oriented meshes the culled exact-mode map equals the full one node
 //    for node (generated head with the COR inside; two nested-layer spheres with the COR inside
 //    one and outside both; the same meshes with every face flipped; a real pelvis and femur
@@ -7,7 +7,7 @@
 //    with the orientation;
 //  - an open mesh disables culling and says why; the triangle order lists each kept triangle
 //    once.
-#include "impinge/face_culling.hpp"
+#include "impinge/raster_plan.hpp"
 
 #include <gtest/gtest.h>
 
@@ -29,10 +29,10 @@ TriangleMesh flipped(TriangleMesh m) {
 }
 
 /// Culled and full exact-mode maps at precision p: number of nodes that differ.
-std::int64_t differing_nodes(const TriangleMesh& m, const Eigen::Vector3d& cor, double p, const FaceCulling& fc) {
+std::int64_t differing_nodes(const TriangleMesh& m, const Eigen::Vector3d& cor, double p, const RasterPlan& fc) {
   RadialDistanceMap a{EquiangularGrid(p)}, b{EquiangularGrid(p)};
   const SamplingStats sa = rasterize(m, cor, DistanceMode::exact, a);
-  const SamplingStats sb = rasterize(m, cor, DistanceMode::exact, b, &fc);
+  const SamplingStats sb = rasterize(m, cor, DistanceMode::exact, b, RasterizeOptions{&fc});
   EXPECT_EQ(sa.nodes_covered, sb.nodes_covered);
   EXPECT_EQ(sb.triangles, sa.triangles);
   std::int64_t diff = 0;
@@ -41,20 +41,20 @@ std::int64_t differing_nodes(const TriangleMesh& m, const Eigen::Vector3d& cor, 
 }
 }  // namespace
 
-TEST(FaceCulling, HeadWithTheCorInsideKeepsLeavingFaces) {
+TEST(RasterPlan, HeadWithTheCorInsideKeepsLeavingFaces) {
   HipModelOptions o;
   o.target_triangles = 3000;
   o.cam_height_mm = 3;
   const HipModel h = make_hip_model(o);
   for (const TriangleMesh& m : {h.ball, flipped(h.ball)}) {
-    const FaceCulling fc = analyse_face_culling(m, h.cor);
+    const RasterPlan fc = plan_rasterization(m, h.cor);
     ASSERT_TRUE(fc.enabled) << fc.reason;
     EXPECT_EQ(fc.boundary_edges, 0);
     EXPECT_EQ(fc.rays_agreeing, fc.rays_checked);
     EXPECT_EQ(std::int64_t(fc.triangle_order.size()), m.F.rows());  // star-shaped: every face leaves
     for (double p : {2.0, 0.5}) EXPECT_EQ(differing_nodes(m, h.cor, p, fc), 0) << "p " << p;
   }
-  EXPECT_EQ(analyse_face_culling(h.ball, h.cor).keep_sign, -analyse_face_culling(flipped(h.ball), h.cor).keep_sign);
+  EXPECT_EQ(plan_rasterization(h.ball, h.cor).keep_sign, -plan_rasterization(flipped(h.ball), h.cor).keep_sign);
 }
 
 namespace {
@@ -74,27 +74,27 @@ TriangleMesh two_spheres() {
 }
 }  // namespace
 
-TEST(FaceCulling, NestedLayersCullHalfTheFarShellAndKeepTheMap) {
+TEST(RasterPlan, NestedLayersCullHalfTheFarShellAndKeepTheMap) {
   const TriangleMesh m = two_spheres();
   for (const Eigen::Vector3d& cor : {Eigen::Vector3d(1, 2, -1), Eigen::Vector3d(-25, 3, 1)}) {
     for (const TriangleMesh& mm : {m, flipped(m)}) {
-      const FaceCulling fc = analyse_face_culling(mm, cor);
+      const RasterPlan fc = plan_rasterization(mm, cor);
       ASSERT_TRUE(fc.enabled) << fc.reason;
       EXPECT_LT(std::int64_t(fc.triangle_order.size()), mm.F.rows());
       for (double p : {2.0, 0.5}) EXPECT_EQ(differing_nodes(mm, cor, p, fc), 0) << "p " << p;
     }
   }
   // Inside the first sphere the kept faces leave the solid; outside both they enter it.
-  EXPECT_EQ(analyse_face_culling(m, Eigen::Vector3d(1, 2, -1)).keep_sign,
-            -analyse_face_culling(m, Eigen::Vector3d(-25, 3, 1)).keep_sign);
+  EXPECT_EQ(plan_rasterization(m, Eigen::Vector3d(1, 2, -1)).keep_sign,
+            -plan_rasterization(m, Eigen::Vector3d(-25, 3, 1)).keep_sign);
 }
 
-TEST(FaceCulling, OpenMeshDisablesCullingAndSaysWhy) {
+TEST(RasterPlan, OpenMeshDisablesCullingAndSaysWhy) {
   HipModelOptions o;
   o.target_triangles = 1000;
   TriangleMesh m = make_hip_model(o).ball;
   m.F.conservativeResize(m.F.rows() - 1, 3);
-  const FaceCulling fc = analyse_face_culling(m, make_hip_model(o).cor);
+  const RasterPlan fc = plan_rasterization(m, make_hip_model(o).cor);
   EXPECT_FALSE(fc.enabled);
   EXPECT_EQ(fc.boundary_edges, 3);
   EXPECT_NE(fc.reason.find("directed edges"), std::string::npos);
@@ -106,20 +106,20 @@ TEST(FaceCulling, OpenMeshDisablesCullingAndSaysWhy) {
   EXPECT_EQ(differing_nodes(m, make_hip_model(o).cor, 2.0, fc), 0);
 }
 
-TEST(FaceCulling, RealBonesCulledMapsEqualFullMaps) {
+TEST(RasterPlan, RealBonesCulledMapsEqualFullMaps) {
   const auto real = test::load_real_joint("lhdl-ct");
   if (!real) GTEST_SKIP() << "no shared data (" << IMPINGE_SHARED_DATA << ")";
   for (const TriangleMesh* m : {&real->femur, &real->pelvis}) {
-    const FaceCulling fc = analyse_face_culling(*m, real->cor);
+    const RasterPlan fc = plan_rasterization(*m, real->cor);
     ASSERT_TRUE(fc.enabled) << m->source << ": " << fc.reason;
     EXPECT_EQ(differing_nodes(*m, real->cor, 0.25, fc), 0) << m->source;
   }
 }
 
-TEST(FaceCulling, BadInputThrows) {
+TEST(RasterPlan, BadInputThrows) {
   HipModelOptions o;
   o.target_triangles = 300;
   const HipModel h = make_hip_model(o);
-  EXPECT_THROW(analyse_face_culling(h.ball, Eigen::Vector3d(NAN, 0, 0)), std::exception);
-  EXPECT_THROW(analyse_face_culling(h.ball, h.cor, 0), std::exception);
+  EXPECT_THROW(plan_rasterization(h.ball, Eigen::Vector3d(NAN, 0, 0)), std::exception);
+  EXPECT_THROW(plan_rasterization(h.ball, h.cor, 0), std::exception);
 }
