@@ -2,7 +2,7 @@
 
 Reads RESULTS/03_detection_time/detection.csv and throughput.csv; writes table4_9.tex (generated
 models at the thesis' triangle levels), table_real.tex (every real subject, pushed pose),
-table_throughput.tex, detection_time.pdf/png, macros.tex."""
+table_throughput.tex, table_schemes.tex (every registered scheme), detection_time.pdf/png, macros.tex."""
 import numpy as np
 import matplotlib.pyplot as plt
 
@@ -63,12 +63,33 @@ write_table(d, "table_real", ["subject", "pose", "vertices", "RSID 0.5", "RSID 0
             align="llrrrrrrrrrrrr")
 
 rows = []
-for (s, m, r), g in thr.groupby(["subject", "method", "resolution"], sort=False):
+for (s, m, r), g in thr[thr.method.isin(["rsid", "usid"])].groupby(["subject", "method", "resolution"], sort=False):
     one = g[g.threads == 1].poses_per_s.iloc[0]
     two = g[g.threads == 2].poses_per_s.iloc[0]
-    rows.append([s, labels[m], f"{r:g}", f"{one:,.0f}", f"{two:,.0f}", f"{two / one:.2f}"])
+    rows.append([s, labels.get(m, m), f"{r:g}", f"{one:,.0f}", f"{two:,.0f}", f"{two / one:.2f}"])
 write_table(d, "table_throughput", ["subject", "method", "resolution", "poses/s, 1 thread", "poses/s, 2 threads",
                                     "speed-up"], rows, align="llrrrr")
+
+# Every registered scheme on the real subjects (pushed pose, matched to 0.1 deg): one pose's detection
+# and the throughput over random poses, one thread (issue 12: a new scheme appears here unasked).
+peer_methods = set(labels) - {"rsid", "usid"}
+schemes = [m for m in dict.fromkeys(t.method) if m not in peer_methods]
+rows = []
+real = t[~t.generated.astype(bool) & (t.pose == "pushed_3mm")]
+for s_, g in real.groupby("subject", sort=False):
+    base = get(g, "rsid", 0.1)
+    for m in schemes:
+        r = g[(g.method == m) & np.isclose(g.spacing_deg, 0.1)]
+        if len(r) == 0:
+            continue
+        r = r.iloc[0]
+        tp = thr[(thr.subject == s_) & (thr.method == m) & np.isclose(thr.spacing_deg, 0.1) & (thr.threads == 1)]
+        res = f"{int(r.resolution):,}" if float(r.resolution).is_integer() else f"{r.resolution:.4g}"
+        rows.append([s_, labels.get(m, m), res, fmt(r.time_ms), f"{r.ns_per_vertex:.1f}",
+                     f"{r.time_ms / base:.2f}" if np.isfinite(base) and base > 0 else "--",
+                     f"{tp.poses_per_s.iloc[0]:,.0f}" if len(tp) else "--"])
+write_table(d, "table_schemes", ["subject", "scheme", "resolution", "ms per pose", "ns/vertex", "/ RSID",
+                                 "poses/s (random)"], rows, align="llrrrrr")
 
 # Figure: ms per pose (both scans) against triangles per model, pushed pose, log-log.
 fig, ax = plt.subplots(figsize=(6.5, 3.8))

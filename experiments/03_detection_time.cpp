@@ -7,6 +7,7 @@
 //     pose: rest (the scan pose) or pushed_3mm (the femur translated 3 mm from the COR towards
 //           the centroid of the pelvis vertices within 45 mm: into the acetabulum)
 //     method: rsid (equiangular map, exact mode, fast scan), usid (helix at the matched turns),
+//             every other registered scheme by its name (at resolution_for_spacing of each precision),
 //             embree_radial (rtcIntersect1 per vertex), embree_radial_packet8 (rtcIntersect8),
 //             cgal_radial (CGAL AABB tree first intersection per vertex: the exact reference),
 //             fcl_collide (FCL OBBRSS trees, every contact), fcl_distance (FCL minimum distance),
@@ -14,8 +15,9 @@
 //     vertices: the scanned vertices of both bodies (first surface, within 45 mm of the COR);
 //     time_ms: both scans (or the whole query) of one pose; ball_ms, socket_ms: per scan;
 //     ns_per_vertex = time / vertices; result: min gap (mm) for the radial methods, contacts,
-//     distance (mm) or intersecting pairs for the others; thesis_ms: Table 4 / 9
-//   throughput.csv  poses per second for RSID and USID over 256 random poses (rotations up to
+//     distance (mm) or intersecting pairs for the others; thesis_ms: Table 4 / 9; spacing_deg: the
+//     equiangular precision a scheme's resolution is matched to (empty for the peers)
+//   throughput.csv  poses per second for every scheme's maps over 256 random poses (rotations up to
 //                   20 deg about the COR), with 1 and 2 threads (each thread its own poses)
 //   meta.json
 // Command: build/experiments/exp_03_detection_time --out results --data ../shared/data/hips [--quick]
@@ -26,6 +28,7 @@
 #include "experiment_support.hpp"
 #include "impinge/detection.hpp"
 #include "impinge/embree_ray_caster.hpp"
+#include "impinge/error.hpp"
 #include "impinge/exact_reference.hpp"
 #include "impinge/raster_plan.hpp"
 #include "impinge/fcl_collision.hpp"
@@ -91,9 +94,10 @@ int main(int argc, char** argv) {
 
   CsvWriter csv(dir + "/detection.csv",
                 {"subject", "generated", "femur_triangles", "pelvis_triangles", "pose", "method", "resolution",
-                 "vertices", "time_ms", "ball_ms", "socket_ms", "ns_per_vertex", "result", "result_kind", "thesis_ms"});
+                 "vertices", "time_ms", "ball_ms", "socket_ms", "ns_per_vertex", "result", "result_kind", "thesis_ms",
+                 "spacing_deg"});
   CsvWriter thr(dir + "/throughput.csv",
-                {"subject", "method", "resolution", "threads", "poses", "time_ms", "poses_per_s"});
+                {"subject", "method", "resolution", "threads", "poses", "time_ms", "poses_per_s", "spacing_deg"});
   int done = 0;
   const int total = static_cast<int>(subjects.size());
   for (const Subject& s : subjects) {
@@ -102,20 +106,37 @@ int main(int argc, char** argv) {
     const Eigen::Vector3d push = 3.0 * push_direction(s.pelvis, cor, kRegionMm);
     const auto ft = static_cast<std::int64_t>(s.femur.F.rows()), pt = static_cast<std::int64_t>(s.pelvis.F.rows());
     auto row = [&](const std::string& pose, const std::string& method, double res, std::int64_t vertices, double ms,
-                   double ball_ms, double socket_ms, double result, const std::string& kind) {
+                   double ball_ms, double socket_ms, double result, const std::string& kind,
+                   double spacing = std::nan("")) {
       csv.row(s.name, int(s.generated), ft, pt, pose, method, res, vertices, ms, ball_ms, socket_ms,
-              vertices > 0 ? ms * 1e6 / double(vertices) : std::nan(""), result, kind, thesis_ms(s.name, method));
+              vertices > 0 ? ms * 1e6 / double(vertices) : std::nan(""), result, kind, thesis_ms(s.name, method),
+              spacing);
     };
     // Maps: equiangular at each precision, helix at the matched turns.
     struct Scheme {
       std::string method;
       double res;
       std::shared_ptr<const SamplingScheme> scheme;
+      double spacing;  ///< the equiangular precision (deg) it is matched to
     };
     std::vector<Scheme> schemes;
     for (double p : precisions) {
-      schemes.push_back({"rsid", p, make_scheme("equiangular", p)});
-      schemes.push_back({"usid", matched_helix_turns(p), make_scheme("helix", matched_helix_turns(p))});
+      schemes.push_back({"rsid", p, make_scheme("equiangular", p), p});
+      schemes.push_back({"usid", matched_helix_turns(p), make_scheme("helix", matched_helix_turns(p)), p});
+    }
+    // Every other registered scheme at the coarsest resolution whose node spacing is at most p
+    // (issue 12: a new scheme is timed here without touching this driver); method = its name.
+    for (const auto& [name, unit] : scheme_names()) {
+      (void)unit;
+      if (name == "equiangular" || name == "helix") continue;  // above, as the thesis' RSID and USID
+      for (double p : precisions) {
+        try {
+          const double r = resolution_for_spacing(name, p);
+          schemes.push_back({name, r, make_scheme(name, r), p});
+        } catch (const Error&) {
+          // a resolution this scheme does not take at this spacing (e.g. conchoid needs 90/p integral)
+        }
+      }
     }
     std::vector<std::pair<Body, Body>> built;
     for (const Scheme& sc : schemes)
@@ -147,7 +168,7 @@ int main(int argc, char** argv) {
         const double ts = median_ms(
             [&] { scan_gaps_compact(pb.set, I, Eigen::Vector3d(-t), fb.map, ScanSide::outside, g2.data()); }, reps);
         row(pname, schemes[k].method, schemes[k].res, fb.set.size() + pb.set.size(), tb + ts, tb, ts, min_of(g1, g2),
-            "min_gap_mm");
+            "min_gap_mm", schemes[k].spacing);
       }
       std::vector<float> g1(std::size_t(fset.size())), g2(std::size_t(pset.size()));
       if (emb_f) {
@@ -217,7 +238,7 @@ int main(int argc, char** argv) {
             },
             reps);
         thr.row(s.name, schemes[k].method, schemes[k].res, threads, static_cast<int>(poses.size()), ms,
-                1000.0 * double(poses.size()) / ms);
+                1000.0 * double(poses.size()) / ms, schemes[k].spacing);
       }
     }
   }
