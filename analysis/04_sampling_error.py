@@ -12,6 +12,10 @@ d = experiment_dir("04_sampling_error")
 t5 = read_csv(d, "table5.csv")
 cov = read_csv(d, "covering.csv")
 rad = read_csv(d, "radial_error.csv")
+# The thesis' schemes in the tables and figures below; every registered scheme in table_schemes.
+THESIS = ["equiangular", "helix"]
+rad_all, cov_all = rad, cov
+rad, cov = rad[rad.scheme.isin(THESIS)], cov[cov.scheme.isin(THESIS)]
 
 write_table(d, "table5", ["$p$ (deg)", "$N$", "Eq. 7 (mm)", "thesis (mm)", "Eq. 8 (\\%)", "thesis (\\%)"],
             [[f"{r.precision_deg:g}", f"{int(r.equator_nodes)}", f"{r.eq7_mm:.4f}", f"{r.thesis_eq7_mm:.3f}",
@@ -36,6 +40,20 @@ for r in rad.itertuples():
                  f"{r.median_mm:.2e}", f"{r.eq7_mm:.3f}", bound, within])
 write_table(d, "table_radial", ["shape", "scheme", "mode", "res.", "max (mm)", "p95 (mm)", "median (mm)",
                                 "Eq. 7 (mm)", "bound (mm)", "within bound (\\%)"], rows, align="llllrrrrrr")
+
+# Every registered scheme (exact mode) at the finest precision every run has: radial error and the
+# covering radius's ratio to Eq. 7 (issue 12: a new scheme appears here unasked).
+p_cmp = 0.1
+rows = []
+for (shape, scheme), g in rad_all[np.isclose(rad_all.precision_deg, p_cmp) & (rad_all["mode"] == "exact")].groupby(
+        ["shape", "scheme"], sort=False):
+    r = g.iloc[0]
+    c = cov_all[(cov_all["shape"] == shape) & (cov_all.scheme == scheme) & np.isclose(cov_all.resolution, r.resolution)]
+    ratio = f"{(c.max_nearest_mm / c.eq7_mm).max():.2f}" if len(c) else "--"
+    res = f"{int(r.resolution):,}" if float(r.resolution).is_integer() else f"{r.resolution:.4g}"
+    rows.append([shape.replace("_", " "), scheme, res, f"{r.max_mm:.2e}", f"{r.p95_mm:.2e}", ratio])
+write_table(d, "table_schemes", ["shape", "scheme", "resolution", "max (mm)", "p95 (mm)", "covering / Eq. 7"], rows,
+            align="llrrrr")
 
 shapes = list(dict.fromkeys(list(rad["shape"]) + list(cov["shape"])))
 # One colour per shape, one line style per scheme and mode, and a legend for each: the colours
