@@ -35,6 +35,17 @@ HipJointOptions scan_options(double precision_deg) {
   o.joint.scheme = make_scheme("equiangular", precision_deg);
   return o;
 }
+// The generated 12k-triangle hip with a 2 mm cam, its true head as the COR, scan neutral.
+std::unique_ptr<HipJoint> cam_hip(double precision_deg) {
+  HipModelOptions mo;
+  mo.target_triangles = 12000;
+  mo.cam_height_mm = 2;
+  const HipModel h = make_hip_model(mo);
+  SphereFitResult head;
+  head.centre = h.cor;
+  head.radius = mo.head_radius_mm;
+  return std::make_unique<HipJoint>(h.ball, h.socket, Side::right, head, Landmarks{}, scan_options(precision_deg));
+}
 }  // namespace
 
 TEST(Rom, NeckMeetsTheRimWhereTheClosedFormSays) {
@@ -139,15 +150,8 @@ TEST(Rom, PreExistingOverlapIsExcludedAndBadOptionsAreErrors) {
 TEST(Rom, ClusterBoundsGiveTheFullScansResults) {
   // The bounds only skip clusters that cannot reach the threshold: limits and ROM map equal the
   // search that looks up every first-surface vertex (generated hip with a cam, and lhdl-ct when present).
-  HipModelOptions mo;
-  mo.target_triangles = 12000;
-  mo.cam_height_mm = 2;
-  const HipModel h = make_hip_model(mo);
-  SphereFitResult head;
-  head.centre = h.cor;
-  head.radius = mo.head_radius_mm;
   std::vector<std::unique_ptr<HipJoint>> hips;
-  hips.push_back(std::make_unique<HipJoint>(h.ball, h.socket, Side::right, head, Landmarks{}, scan_options(0.25)));
+  hips.push_back(cam_hip(0.25));
   if (auto j = test::load_real_joint("lhdl-ct")) {
     HipJointOptions o;
     o.joint.scheme = make_scheme("equiangular", 0.25);
@@ -269,14 +273,8 @@ TEST(Rom, EnvelopeByRefinementAgreesWithEveryPoseScanned) {
   // The adaptive envelope (coarse lattice, cells split where their corners disagree) against the
   // brute force that scans every pose of the same grid, on a generated hip with a cam; and against
   // the ROM limit of internal rotation from neutral (the first pose in contact along that line).
-  HipModelOptions mo;
-  mo.target_triangles = 12000;
-  mo.cam_height_mm = 2;
-  const HipModel h = make_hip_model(mo);
-  SphereFitResult head;
-  head.centre = h.cor;
-  head.radius = mo.head_radius_mm;
-  const HipJoint hip(h.ball, h.socket, Side::right, head, Landmarks{}, scan_options(0.5));
+  const std::unique_ptr<HipJoint> cam = cam_hip(0.5);
+  const HipJoint& hip = *cam;
   RomOptions ro;
   const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), ro);
   RomEnvelopeOptions eo;
