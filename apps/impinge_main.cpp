@@ -696,6 +696,7 @@ int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo
   const double limits_ms = ms_since(t0);
   double map_ms = 0;
   std::size_t map_cells = 0;
+  std::int64_t map_evaluations = 0;
   if (!ro.no_map) {
     t0 = Clock::now();
     std::vector<double> flex, add;
@@ -704,7 +705,8 @@ int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo
     const std::vector<RomMapCell> cells = rom_map(hip, flex, add, o, base);
     map_ms = ms_since(t0);
     map_cells = cells.size();
-    for (const RomMapCell& c : cells) looked_up += c.vertices_looked_up, skipped += c.vertices_skipped;
+    for (const RomMapCell& c : cells)
+      looked_up += c.vertices_looked_up, skipped += c.vertices_skipped, map_evaluations += c.evaluations;
     std::ofstream map(fs::path(out_dir) / "rom_map.csv");
     require(map.good(), out_dir + "/rom_map.csv: cannot open for writing");
     map << "flexion_deg,adduction_deg,max_internal_rotation_deg,status\n" << std::setprecision(9);
@@ -767,6 +769,7 @@ int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo
                      {"envelope", envelope_ms},
                      {"total", ms_since(t_start)}};
   j["rom_map_cells"] = map_cells;
+  j["rom_map_evaluations"] = map_evaluations;
   j["limit_evaluations"] = evaluations;
   j["vertices_looked_up"] = looked_up;
   j["vertices_skipped_by_bounds"] = skipped;

@@ -252,11 +252,8 @@ int main(int argc, char** argv) {
       map.row(s.name, c.flexion_deg, c.adduction_deg, c.max_internal_rotation_deg, c.status);
       looked += c.vertices_looked_up, skipped += c.vertices_skipped;
     }
-    // Evaluations of the map: estimated from the look-ups per evaluation of the limits (both count
-    // every first-surface vertex once per evaluation, looked up or skipped).
-    const double per_eval = double(joint.ball().scan_set.size() + joint.socket().scan_set.size());
-    const auto map_evals = static_cast<std::int64_t>(std::llround(
-        double(looked + skipped) / per_eval)) - evaluations;
+    std::int64_t map_evals = 0;
+    for (const RomMapCell& c : cells) map_evals += c.evaluations;
     const std::int64_t all_evals = evaluations + map_evals;
 
     // Exact check 0.5 deg either side of each limit (CGAL ray casts).

@@ -537,6 +537,7 @@ std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& 
                                 o, base, bounds.get());
       c.vertices_looked_up = l.vertices_looked_up;
       c.vertices_skipped = l.vertices_skipped;
+      c.evaluations = l.evaluations;
       c.max_internal_rotation_deg = l.contact_at_start ? std::numeric_limits<double>::quiet_NaN() : l.limit_deg;
       c.status = l.contact_at_start ? "contact_at_zero" : std::isnan(l.limit_deg) ? "free" : "limited";
     } catch (const std::exception& e) {

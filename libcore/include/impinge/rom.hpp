@@ -115,6 +115,7 @@ struct RomMapCell {
   std::string status;  ///< "limited", "free" (no contact up to max_deg), "contact_at_zero" (in contact
                        ///< already without rotation)
   std::int64_t vertices_looked_up = 0, vertices_skipped = 0;  ///< over its search
+  int evaluations = 0;                                        ///< poses evaluated by its search
 };
 
 /// The ROM map: for every flexion x adduction of the grids (degrees), the largest internal
