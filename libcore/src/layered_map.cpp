@@ -126,16 +126,18 @@ void LayeredMap::signed_distance_many_soa(const double* x, const double* y, cons
   }
 }
 
-std::uint64_t LayeredMap::occupancy(std::int64_t i, double bin_mm) const {
+std::uint64_t radial_shell_bits(double lo, double hi, double bin_mm) {
   auto bin = [&](double r) {
     const double b = r / bin_mm;
     return b >= 63 ? 63 : b > 0 ? static_cast<int>(b) : 0;
   };
-  auto span = [&](double a, double b) {
-    std::uint64_t m = 0;
-    for (int k = bin(a); k <= bin(b); ++k) m |= std::uint64_t(1) << k;
-    return m;
-  };
+  std::uint64_t m = 0;
+  for (int k = bin(lo); k <= bin(hi); ++k) m |= std::uint64_t(1) << k;
+  return m;
+}
+
+std::uint64_t LayeredMap::occupancy(std::int64_t i, double bin_mm) const {
+  auto span = [&](double a, double b) { return radial_shell_bits(a, b, bin_mm); };
   const int n = count(i);
   if (n == 0) return truncated(i) ? ~std::uint64_t(0) : 0;
   std::uint64_t m = 0;

@@ -156,15 +156,7 @@ OccupancyPyramid occupancy_pyramid(const LayeredMap& map) {
       map.scheme(), [&map](std::int64_t i) { return map.occupancy(i, kOccupancyBinMm); }, std::uint64_t(0), BitOr{});
 }
 // The shells [lo, hi] (mm) meets.
-std::uint64_t shells(double lo, double hi) {
-  auto bin = [](double r) {
-    const double b = r / kOccupancyBinMm;
-    return b >= 63 ? 63 : b > 0 ? static_cast<int>(b) : 0;
-  };
-  std::uint64_t m = 0;
-  for (int k = bin(lo); k <= bin(hi); ++k) m |= std::uint64_t(1) << k;
-  return m;
-}
+std::uint64_t shells(double lo, double hi) { return radial_shell_bits(lo, hi, kOccupancyBinMm); }
 
 // Clusters of a scan set: `size` consecutive vertices (Z order: neighbours on the sphere), their
 // directions' cone (unit axis, half-angle) and radius range, in the body's frame. Two levels: leaves

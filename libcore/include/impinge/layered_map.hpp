@@ -29,6 +29,10 @@ namespace impinge {
 /// inside after the first entering crossing and outside after the first leaving one.
 double signed_radial_distance(const RayCrossing* crossings, int count, bool complete, double r_mm);
 
+/// The radial shells [b w, (b + 1) w) (w = bin_mm; shell 63 also holds every radius beyond) that the
+/// radii [lo_mm, hi_mm] meet, as bits of a 64-bit mask: the unit of LayeredMap::occupancy.
+std::uint64_t radial_shell_bits(double lo_mm, double hi_mm, double bin_mm);
+
 /// Counts of a layered sampling, so nothing is dropped silently.
 struct LayeredSamplingReport {
   std::int64_t nodes = 0;                ///< nodes of the scheme
