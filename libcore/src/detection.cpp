@@ -1,6 +1,7 @@
 #include "impinge/detection.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "impinge/error.hpp"
@@ -35,6 +36,10 @@ ScanSet make_scan_set(PointsRef P, const std::vector<std::uint8_t>& mask) {
 }
 
 namespace {
+/// R (3 x 3) row by row, then t: the 12 numbers of pose_block.
+std::array<double, 12> pose_rows(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  return {R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2), t.x(), t.y(), t.z()};
+}
 /// q = R p + t and |q| for a block of vertices (vectorised clones).
 IMPINGE_SIMD_CLONES
 void pose_block(const double* __restrict X, const double* __restrict Y, const double* __restrict Z, int m,
@@ -60,14 +65,13 @@ template <typename Scalar>
 void scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                        const RadialDistanceMapT<Scalar>& map, ScanSide side, float* gap_mm) {
   const double s = static_cast<double>(static_cast<int>(side));
-  const double Rt[12] = {R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2),
-                         R(2, 0), R(2, 1), R(2, 2), t.x(),   t.y(),   t.z()};
+  const std::array<double, 12> Rt = pose_rows(R, t);
   constexpr std::int64_t kBlock = 256;
   double qx[kBlock], qy[kBlock], qz[kBlock], radius[kBlock], d[kBlock];
   const std::int64_t n = set.size();
   for (std::int64_t b = 0; b < n; b += kBlock) {
     const int m = static_cast<int>(std::min(kBlock, n - b));
-    pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt, qx, qy, qz, radius);
+    pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt.data(), qx, qy, qz, radius);
     map.sample_many_soa(qx, qy, qz, m, d);
     gap_block(d, radius, s, m, gap_mm + b);
   }
@@ -82,8 +86,7 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
     return 0;
   }
   const double s = static_cast<double>(static_cast<int>(side));
-  const double Rt[12] = {R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2),
-                         R(2, 0), R(2, 1), R(2, 2), t.x(),   t.y(),   t.z()};
+  const std::array<double, 12> Rt = pose_rows(R, t);
   constexpr std::int64_t kBlock = 256;
   double qx[kBlock], qy[kBlock], qz[kBlock], radius[kBlock], d[kBlock];
   const std::int64_t n = set.size();
@@ -97,7 +100,7 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
   pending.clear();
   for (std::int64_t b = 0; b < n; b += kBlock) {
     const int m = static_cast<int>(std::min(kBlock, n - b));
-    pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt, qx, qy, qz, radius);
+    pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt.data(), qx, qy, qz, radius);
     map.sample_many_soa_marked(qx, qy, qz, m, d);
     float* g = gap_mm + b;
     gap_block(d, radius, s, m, g);
@@ -117,16 +120,21 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
 
 std::int64_t scan_layered(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const LayeredMap& map,
                           float* gap_mm, const FirstHitCaster* exact) {
-  const double Rt[12] = {R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2),
-                         R(2, 0), R(2, 1), R(2, 2), t.x(),   t.y(),   t.z()};
+  return scan_layered(set, 0, set.size(), R, t, map, gap_mm, exact);
+}
+
+std::int64_t scan_layered(const ScanSet& set, std::int64_t first, std::int64_t count, const Eigen::Matrix3d& R,
+                          const Eigen::Vector3d& t, const LayeredMap& map, float* gap_mm, const FirstHitCaster* exact) {
+  require(first >= 0 && count >= 0 && first + count <= set.size(), "layered scan: vertex range outside the set");
+  const std::array<double, 12> Rt = pose_rows(R, t);
   constexpr std::int64_t kBlock = 256;
   double qx[kBlock], qy[kBlock], qz[kBlock], radius[kBlock], d[kBlock];
   std::uint8_t flag[kBlock];
-  const std::int64_t n = set.size();
+  const std::int64_t n = first + count;
   std::int64_t refined = 0;
-  for (std::int64_t b = 0; b < n; b += kBlock) {
+  for (std::int64_t b = first; b < n; b += kBlock) {
     const int m = static_cast<int>(std::min(kBlock, n - b));
-    pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt, qx, qy, qz, radius);
+    pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt.data(), qx, qy, qz, radius);
     map.signed_distance_many_soa(qx, qy, qz, m, d, exact != nullptr ? flag : nullptr);
     for (int j = 0; j < m; ++j) {
       double g = d[j];

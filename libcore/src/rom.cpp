@@ -367,12 +367,7 @@ class CompactScanner {
           vertices_skipped += c.count;
           continue;
         }
-        ScanSet& part = part_;
-        part.index.assign(set.index.begin() + c.first, set.index.begin() + c.first + c.count);
-        part.x.assign(set.x.begin() + c.first, set.x.begin() + c.first + c.count);
-        part.y.assign(set.y.begin() + c.first, set.y.begin() + c.first + c.count);
-        part.z.assign(set.z.begin() + c.first, set.z.begin() + c.first + c.count);
-        scan_layered(part, R, Eigen::Vector3d::Zero(), map, buf_.data() + c.first, exact);
+        scan_layered(set, c.first, c.count, R, Eigen::Vector3d::Zero(), map, buf_.data(), exact);
         take(set, skip, c.first, c.first + c.count, ball, l, true);
         vertices_looked_up += c.count;
       }
@@ -394,7 +389,6 @@ class CompactScanner {
   bool last_ball_ = false;
   std::vector<std::uint8_t> skip_ball_, skip_socket_, skip_ball_hidden_, skip_socket_hidden_;
   std::vector<float> buf_;
-  ScanSet part_;  ///< one cluster of a hidden set (scratch)
 };
 
 }  // namespace

@@ -108,6 +108,11 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
 std::int64_t scan_layered(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const LayeredMap& map,
                           float* gap_mm, const FirstHitCaster* exact);
 
+/// scan_layered over the vertices [first, first + count) of `set` only: gap_mm[j] for j in that range
+/// (gap_mm still indexed like the whole set). Throws impinge::Error for a range outside the set.
+std::int64_t scan_layered(const ScanSet& set, std::int64_t first, std::int64_t count, const Eigen::Matrix3d& R,
+                          const Eigen::Vector3d& t, const LayeredMap& map, float* gap_mm, const FirstHitCaster* exact);
+
 /// Write a layered scan's gaps into `out` (already expanded by expand_scan for the same body): vertex
 /// set.index[j] gets gap_mm[j] with status tested_layered, or no_surface when NaN.
 void expand_layered_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out);
