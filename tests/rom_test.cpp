@@ -148,8 +148,9 @@ TEST(Rom, PreExistingOverlapIsExcludedAndBadOptionsAreErrors) {
 }
 
 TEST(Rom, ClusterBoundsGiveTheFullScansResults) {
-  // The bounds only skip clusters that cannot reach the threshold: limits and ROM map equal the
-  // search that looks up every first-surface vertex (generated hip with a cam, and lhdl-ct when present).
+  // The bounds only skip clusters and vertices that cannot reach the threshold, at this pose or
+  // (reused over widened caps) at nearby ones: limits, exact least gaps and ROM map equal the search
+  // that looks up every first-surface vertex (generated hip with a cam, and lhdl-ct when present).
   std::vector<std::unique_ptr<HipJoint>> hips;
   hips.push_back(cam_hip(0.25));
   if (auto j = test::load_real_joint("lhdl-ct")) {
@@ -158,31 +159,36 @@ TEST(Rom, ClusterBoundsGiveTheFullScansResults) {
     hips.push_back(std::make_unique<HipJoint>(j->femur, j->pelvis, Side::right, locate_femoral_head(j->femur),
                                               Landmarks{}, o));
   }
-  for (const auto& hip : hips) {
-    RomOptions with, without;
-    without.use_bounds = false;
-    const RomBaseline base = rom_baseline(*hip, hip->femur_rotation({}), with);
-    const auto a = find_rom_limits(*hip, standard_motions(), with, base);
-    const auto b = find_rom_limits(*hip, standard_motions(), without, base);
-    std::int64_t skipped = 0;
-    for (std::size_t k = 0; k < a.size(); ++k) {
-      EXPECT_EQ(std::isnan(a[k].limit_deg), std::isnan(b[k].limit_deg)) << k;
-      if (!std::isnan(a[k].limit_deg)) {
-        EXPECT_EQ(a[k].limit_deg, b[k].limit_deg) << k;
+  for (const auto& hip : hips)
+    for (double threshold : {0.0, 1.5}) {  // bone contact, and a cartilage offset
+      SCOPED_TRACE(threshold);
+      RomOptions with, without;
+      with.threshold_mm = without.threshold_mm = threshold;
+      without.use_bounds = false;
+      const RomBaseline base = rom_baseline(*hip, hip->femur_rotation({}), with);
+      const auto a = find_rom_limits(*hip, standard_motions(), with, base);
+      const auto b = find_rom_limits(*hip, standard_motions(), without, base);
+      std::int64_t skipped = 0;
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        EXPECT_EQ(std::isnan(a[k].limit_deg), std::isnan(b[k].limit_deg)) << k;
+        if (!std::isnan(a[k].limit_deg)) {
+          EXPECT_EQ(a[k].limit_deg, b[k].limit_deg) << k;
+          EXPECT_EQ(a[k].min_gap_at_limit_mm, b[k].min_gap_at_limit_mm) << k;  // the exact least gap
+        }
+        EXPECT_EQ(a[k].min_gap_at_start_mm, b[k].min_gap_at_start_mm) << k;
+        EXPECT_EQ(b[k].vertices_skipped, 0);
+        skipped += a[k].vertices_skipped;
       }
-      EXPECT_EQ(b[k].vertices_skipped, 0);
-      skipped += a[k].vertices_skipped;
-    }
-    EXPECT_GT(skipped, 0);
-    const std::vector<double> flex{0, 45, 90}, add{-10, 10};
-    const auto ma = rom_map(*hip, flex, add, with, base), mb = rom_map(*hip, flex, add, without, base);
-    for (std::size_t k = 0; k < ma.size(); ++k) {
-      EXPECT_EQ(ma[k].status, mb[k].status);
-      if (ma[k].status == "limited") {
-        EXPECT_EQ(ma[k].max_internal_rotation_deg, mb[k].max_internal_rotation_deg);
+      EXPECT_GT(skipped, 0);
+      const std::vector<double> flex{0, 45, 90}, add{-10, 10};
+      const auto ma = rom_map(*hip, flex, add, with, base), mb = rom_map(*hip, flex, add, without, base);
+      for (std::size_t k = 0; k < ma.size(); ++k) {
+        EXPECT_EQ(ma[k].status, mb[k].status);
+        if (ma[k].status == "limited") {
+          EXPECT_EQ(ma[k].max_internal_rotation_deg, mb[k].max_internal_rotation_deg);
+        }
       }
     }
-  }
 }
 
 TEST(Rom, TrochanterMeetsTheIliacPlateWhereTheClosedFormSays) {

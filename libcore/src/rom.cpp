@@ -54,34 +54,59 @@ template <typename V, typename Combine>
 class BlockPyramid {
  public:
   static constexpr int kFirstLevel = 2;
-  static constexpr int kBlocksPerSpan = 4;  // blocks across a cap: finer is tighter, coarser is fewer reads
-  // value(i): node i's value; none: the identity of `combine` (the value of an empty block).
+  // Blocks across a cap, at most: finer is tighter, coarser is fewer reads.
+  static constexpr int kMaxBlocksPerSpan = 16;
+  // Each stored row repeats its first kPad blocks after its last, so a cap's column range (at most
+  // blocks_per_span + 3 blocks, or the whole row) is read without wrapping.
+  static constexpr int kPad = kMaxBlocksPerSpan + 4;
+  // value(i): node i's value (called from several threads); none: the identity of `combine` (the
+  // value of an empty block).
   template <typename Value>
   BlockPyramid(const SamplingScheme& scheme, Value value, V none, Combine combine) : none_(none), combine_(combine) {
     const auto* g = dynamic_cast<const EquiangularGrid*>(&scheme);
     if (g == nullptr) return;  // bounds for equiangular maps only; other schemes scan every vertex
     rows_ = g->rows(), cols_ = g->columns(), step_ = g->step();
     for (int L = kFirstLevel;; ++L) {
-      const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b;
-      std::vector<V> v(static_cast<std::size_t>(br) * bc, none);
-      for (int i = 0; i < br; ++i)
-        for (int j = 0; j < bc; ++j) {
-          V m = none;
-          if (L == kFirstLevel) {
-            for (int r = i * b; r <= std::min((i + 1) * b, rows_ - 1); ++r)
-              for (int c = j * b; c <= (j + 1) * b; ++c) m = combine(m, value(std::int64_t(r) * cols_ + (c % cols_)));
-          } else {
-            const std::vector<V>& p = levels_.back();
-            const int pbr = (rows_ - 1 + b / 2 - 1) / (b / 2), pbc = (cols_ + b / 2 - 1) / (b / 2);
+      const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b, stride = bc + kPad;
+      // Stored padded: row i holds blocks 0 .. bc + kPad - 1, block j at (j mod bc).
+      std::vector<V> v(static_cast<std::size_t>(br) * stride, none);
+      if (L == kFirstLevel) {
+#pragma omp parallel
+        {
+          std::vector<V> row(static_cast<std::size_t>(bc) * b + 1);  // one node row, wrapped
+#pragma omp for schedule(static)
+          for (int i = 0; i < br; ++i) {
+            V* out = v.data() + static_cast<std::size_t>(i) * stride;
+            for (int r = i * b; r <= std::min((i + 1) * b, rows_ - 1); ++r) {
+              const std::int64_t first = std::int64_t(r) * cols_;
+              for (int c = 0; c < cols_; ++c) row[static_cast<std::size_t>(c)] = value(first + c);
+              for (int c = cols_; c <= bc * b; ++c) row[static_cast<std::size_t>(c)] = row[static_cast<std::size_t>(c - cols_)];
+              for (int j = 0; j < bc; ++j) {
+                V m = out[j];
+                for (int c = j * b; c <= (j + 1) * b; ++c) m = combine(m, row[static_cast<std::size_t>(c)]);
+                out[j] = m;
+              }
+            }
+          }
+        }
+      } else {
+        const std::vector<V>& p = levels_.back();
+        const int pbr = (rows_ - 1 + b / 2 - 1) / (b / 2), pbc = (cols_ + b / 2 - 1) / (b / 2), pstride = pbc + kPad;
+        for (int i = 0; i < br; ++i)
+          for (int j = 0; j < bc; ++j) {
+            V m = none;
             for (int di = 0; di < 2; ++di)
               for (int dj = 0; dj < 2; ++dj) {
                 const int pi = 2 * i + di, pj = 2 * j + dj;
                 if (pi >= pbr) continue;
-                m = combine(m, p[static_cast<std::size_t>(pi) * pbc + (pj % pbc)]);
+                m = combine(m, p[static_cast<std::size_t>(pi) * pstride + (pj % pbc)]);
               }
+            v[static_cast<std::size_t>(i) * stride + j] = m;
           }
-          v[static_cast<std::size_t>(i) * bc + j] = m;
-        }
+      }
+      for (int i = 0; i < br; ++i)
+        for (int j = bc; j < stride; ++j)
+          v[static_cast<std::size_t>(i) * stride + j] = v[static_cast<std::size_t>(i) * stride + (j % bc)];
       levels_.push_back(std::move(v));
       if (br <= 2 && bc <= 2) break;
     }
@@ -90,7 +115,7 @@ class BlockPyramid {
   // Combined value over every stencil node of the directions within angle rho of unit u (sin_rho =
   // sin(rho)). Angles by fast_angles.hpp (within 1e-13 rad; the row and column ranges are padded by a
   // node on each side).
-  V cap(const Eigen::Vector3d& u, double rho, double sin_rho) const {
+  V cap(const Eigen::Vector3d& u, double rho, double sin_rho, int blocks_per_span) const {
     double phi, theta;
     fast_spherical_angles(u.x(), u.y(), u.z(), phi, theta);
     double r_lo = (phi - rho) / step_, r_hi = (phi + rho) / step_ + 1;
@@ -108,17 +133,27 @@ class BlockPyramid {
     const int r1 = std::min(rows_ - 1, static_cast<int>(std::floor(r_hi)) + 1);
     const int span = std::max(r1 - r0, c_hi - c_lo);
     int L = kFirstLevel;
-    while ((1 << L) * kBlocksPerSpan < span && L - kFirstLevel + 1 < static_cast<int>(levels_.size())) ++L;
-    const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b;
-    const std::vector<V>& v = levels_[static_cast<std::size_t>(L - kFirstLevel)];
-    V m = none_;
+    while ((1 << L) * blocks_per_span < span && L - kFirstLevel + 1 < static_cast<int>(levels_.size())) ++L;
+    const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b, stride = bc + kPad;
+    const V* v = levels_[static_cast<std::size_t>(L - kFirstLevel)].data();
     const int i0 = r0 / b, i1 = std::min(br - 1, r1 / b);
-    const bool all_cols = c_hi - c_lo >= cols_;
-    const int j0 = all_cols ? 0 : static_cast<int>(std::floor(double(c_lo) / b));
-    const int j1 = all_cols ? bc - 1 : static_cast<int>(std::floor(double(c_hi) / b));
-    for (int i = i0; i <= i1; ++i)
-      for (int j = j0; j <= j1; ++j)
-        m = combine_(m, v[static_cast<std::size_t>(i) * bc + static_cast<std::size_t>(((j % bc) + bc) % bc)]);
+    int j0 = 0, j1 = bc - 1;  // inclusive
+    if (c_hi - c_lo < cols_) {
+      j0 = static_cast<int>(std::floor(double(c_lo) / b));
+      j1 = static_cast<int>(std::floor(double(c_hi) / b));
+      if (j1 - j0 >= bc) {
+        j0 = 0, j1 = bc - 1;
+      } else {
+        const int shift = j0 >= 0 ? -(j0 / bc) * bc : ((-j0 + bc - 1) / bc) * bc;  // j0 into [0, bc)
+        j0 += shift, j1 += shift;
+        if (j1 >= bc + kPad) j0 = 0, j1 = bc - 1;  // cannot happen for a cap of the chosen level
+      }
+    }
+    V m = none_;
+    for (int i = i0; i <= i1; ++i) {
+      const V* row = v + static_cast<std::size_t>(i) * stride;
+      for (int j = j0; j <= j1; ++j) m = combine_(m, row[j]);
+    }
     return m;
   }
 
@@ -162,6 +197,8 @@ std::uint64_t shells(double lo, double hi) { return radial_shell_bits(lo, hi, kO
 // directions' cone (unit axis, half-angle) and radius range, in the body's frame. Two levels: leaves
 // of kLeaf vertices, looked up together, in groups of kGroup vertices, whose bound is tried first.
 constexpr std::int64_t kLeaf = 32, kGroup = 128;
+// Blocks across the bounding cap of a group, a leaf and a hidden cluster (measured on lhdl-ct).
+constexpr int kGroupBlocks = 8, kLeafBlocks = 8, kHiddenBlocks = 4;
 struct Cluster {
   std::int64_t first = 0, count = 0;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
@@ -201,63 +238,99 @@ struct Least {
   bool hidden = false;  ///< a hidden vertex, tested by the other body's layered map
   std::size_t vertex = 0;
 };
+// The ball's first-surface vertices that can meet the socket at some rotation: a vertex at radius r
+// has gap >= (least finite node of the socket map) - r at every rotation (a bilinear value is at
+// least its least node), so a vertex with r < that least node - threshold never counts. Their
+// clusters serve the searches that ask only whether the bones meet; the exact least gap scans all.
+ScanSet reachable_subset(const ScanSet& s, double least_node, double threshold) {
+  ScanSet out;
+  out.vertices = s.vertices;
+  for (std::int64_t k = 0; k < s.size(); ++k)
+    if (!(std::sqrt(s.x[k] * s.x[k] + s.y[k] * s.y[k] + s.z[k] * s.z[k]) < least_node - threshold)) {
+      out.index.push_back(s.index[k]);
+      out.x.push_back(s.x[k]), out.y.push_back(s.y[k]), out.z.push_back(s.z[k]);
+    }
+  return out;
+}
+double least_node(const RadialDistanceMap& map) {
+  float m = std::numeric_limits<float>::infinity();
+  const std::int64_t n = map.num_nodes();
+#pragma omp parallel for reduction(min : m) schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const float d = map.at(i);
+    if (std::isfinite(d)) m = std::min(m, d);
+  }
+  return m;
+}
+// A scan set with its two levels of clusters.
+struct Clustered {
+  Clustered() = default;
+  explicit Clustered(const ScanSet& s) : leaves(clusters_of(s, kLeaf)), groups(clusters_of(s, kGroup)) {}
+  std::vector<Cluster> leaves, groups;
+};
 struct RomBounds {
-  RomBounds(const Joint& j)
+  RomBounds(const Joint& j, double threshold)
       : socket_min(bound_pyramid(j.socket().map, true)),
         ball_max(bound_pyramid(j.ball().map, false)),
-        ball_clusters(clusters_of(j.ball().scan_set, kLeaf)),
-        socket_clusters(clusters_of(j.socket().scan_set, kLeaf)),
-        ball_groups(clusters_of(j.ball().scan_set, kGroup)),
-        socket_groups(clusters_of(j.socket().scan_set, kGroup)) {
+        ball_reachable(reachable_subset(j.ball().scan_set, least_node(j.socket().map), threshold)),
+        ball(j.ball().scan_set),
+        socket(j.socket().scan_set),
+        ball_reachable_clusters(ball_reachable) {
     if (j.socket().layered) {
       socket_occupancy.emplace(occupancy_pyramid(*j.socket().layered));
-      ball_hidden_clusters = clusters_of(j.ball().hidden_set, kLeaf);
-      ball_hidden_groups = clusters_of(j.ball().hidden_set, kGroup);
+      ball_hidden = Clustered(j.ball().hidden_set);
     }
     if (j.ball().layered) {
       ball_occupancy.emplace(occupancy_pyramid(*j.ball().layered));
-      socket_hidden_clusters = clusters_of(j.socket().hidden_set, kLeaf);
-      socket_hidden_groups = clusters_of(j.socket().hidden_set, kGroup);
+      socket_hidden = Clustered(j.socket().hidden_set);
     }
   }
   BoundPyramid socket_min, ball_max;
-  std::vector<Cluster> ball_clusters, socket_clusters, ball_groups, socket_groups;
+  ScanSet ball_reachable;
+  Clustered ball, socket, ball_reachable_clusters;
   std::optional<OccupancyPyramid> socket_occupancy, ball_occupancy;
-  std::vector<Cluster> ball_hidden_clusters, socket_hidden_clusters, ball_hidden_groups, socket_hidden_groups;
+  Clustered ball_hidden, socket_hidden;
 };
 class CompactScanner {
  public:
   CompactScanner(const Joint& joint, const RomBaseline& base, const RomBounds* bounds, double threshold,
                  RomVertices counted)
       : joint_(joint), bounds_(bounds), threshold_(threshold), counted_(counted) {
-    const ScanSet& b = joint.ball().scan_set;
-    const ScanSet& s = joint.socket().scan_set;
-    for (std::int32_t i : b.index) skip_ball_.push_back(base.skip_ball[static_cast<std::size_t>(i)]);
-    for (std::int32_t i : s.index) skip_socket_.push_back(base.skip_socket[static_cast<std::size_t>(i)]);
-    for (std::int32_t i : joint.ball().hidden_set.index)
-      skip_ball_hidden_.push_back(base.skip_ball[static_cast<std::size_t>(i)]);
-    for (std::int32_t i : joint.socket().hidden_set.index)
-      skip_socket_hidden_.push_back(base.skip_socket[static_cast<std::size_t>(i)]);
-    buf_.resize(static_cast<std::size_t>(std::max({b.size(), s.size(), joint.ball().hidden_set.size(),
-                                                   joint.socket().hidden_set.size()})));
+    auto skips = [](const ScanSet& set, const std::vector<std::uint8_t>& by_vertex) {
+      std::vector<std::uint8_t> out;
+      for (std::int32_t i : set.index) out.push_back(by_vertex[static_cast<std::size_t>(i)]);
+      return out;
+    };
+    skip_ball_ = skips(joint.ball().scan_set, base.skip_ball);
+    skip_socket_ = skips(joint.socket().scan_set, base.skip_socket);
+    skip_ball_hidden_ = skips(joint.ball().hidden_set, base.skip_ball);
+    skip_socket_hidden_ = skips(joint.socket().hidden_set, base.skip_socket);
+    if (bounds_ != nullptr) skip_ball_reachable_ = skips(bounds_->ball_reachable, base.skip_ball);
+    buf_.resize(static_cast<std::size_t>(std::max({joint.ball().scan_set.size(), joint.socket().scan_set.size(),
+                                                   joint.ball().hidden_set.size(), joint.socket().hidden_set.size()})));
   }
   // The least counted gap at rotation R. exact: the true minimum; otherwise the true minimum when it
-  // is <= the threshold, and some value > the threshold when it is not (clusters above it are skipped).
-  // Without `exact`, the scan stops at the first counted gap <= the threshold (the caller asks only
-  // whether the bones meet), starting with the cluster that met last time.
+  // is <= the threshold, and some value > the threshold when it is not (clusters above it and the
+  // ball vertices that no rotation brings within it are skipped). Without `exact`, the scan stops at
+  // the first counted gap <= the threshold (the caller asks only whether the bones meet), starting
+  // with the cluster that met last time.
   Least operator()(const Eigen::Matrix3d& R, bool exact) {
     Least l;
     const double cut = exact ? std::numeric_limits<double>::infinity() : threshold_;
     exact_ = exact;
-    if (!exact && last_ != nullptr) {
+    if (!exact && last_.cluster != nullptr) {
       recheck(R, l);
       if (l.gap <= threshold_) return l;
     }
-    last_ = nullptr;
+    last_ = {};
     if (counted_ != RomVertices::hidden) {
-      scan(R, joint_.ball().scan_set, joint_.socket().map, ScanSide::inside, skip_ball_, true, cut, l);
+      const Part ball = bounds_ == nullptr ? Part{&joint_.ball().scan_set, &skip_ball_, nullptr, true}
+                        : exact ? Part{&joint_.ball().scan_set, &skip_ball_, &bounds_->ball, true}
+                                : Part{&bounds_->ball_reachable, &skip_ball_reachable_, &bounds_->ball_reachable_clusters, true};
+      const Part socket{&joint_.socket().scan_set, &skip_socket_, bounds_ == nullptr ? nullptr : &bounds_->socket, false};
+      scan(R, ball, joint_.socket().map, cut, l);
       if (done(l)) return l;
-      scan(R.transpose(), joint_.socket().scan_set, joint_.ball().map, ScanSide::outside, skip_socket_, false, cut, l);
+      scan(R.transpose(), socket, joint_.ball().map, cut, l);
       if (done(l)) return l;
     }
     if (counted_ == RomVertices::first_surface) return l;
@@ -273,40 +346,78 @@ class CompactScanner {
   std::int64_t vertices_looked_up = 0, vertices_skipped = 0;
 
  private:
-  void scan(const Eigen::Matrix3d& R, const ScanSet& set, const RadialDistanceMap& map, ScanSide side,
-            const std::vector<std::uint8_t>& skip, bool ball, double cut, Least& l) {
+  // First-surface vertices of one body, their skip flags (pre-existing overlap) and clusters (null:
+  // no bounds); ball: the femur's, looked up in the socket map (inside), else the pelvis' (outside).
+  struct Part {
+    const ScanSet* set = nullptr;
+    const std::vector<std::uint8_t>* skip = nullptr;
+    const Clustered* clusters = nullptr;
+    bool ball = true;
+  };
+  void scan(const Eigen::Matrix3d& R, const Part& part, const RadialDistanceMap& map, double cut, Least& l) {
+    const ScanSet& set = *part.set;
+    const bool ball = part.ball;
+    const ScanSide side = ball ? ScanSide::inside : ScanSide::outside;
     const BoundPyramid* pyr = bounds_ == nullptr ? nullptr : ball ? &bounds_->socket_min : &bounds_->ball_max;
-    if (pyr == nullptr || !pyr->valid()) {
+    if (pyr == nullptr || !pyr->valid() || part.clusters == nullptr) {
       scan_gaps_compact(set, R, Eigen::Vector3d::Zero(), map, side, buf_.data());
-      take(set, skip, 0, set.size(), ball, l);
+      take(set, *part.skip, 0, set.size(), ball, l);
       vertices_looked_up += set.size();
       return;
     }
-    const std::vector<Cluster>& cl = ball ? bounds_->ball_clusters : bounds_->socket_clusters;
-    const std::vector<Cluster>& groups = ball ? bounds_->ball_groups : bounds_->socket_groups;
-    // Lower bound of every gap in a cluster: inside, d - r >= min d - r_max; outside, r - d >= r_min - max d.
+    const std::vector<Cluster>& cl = part.clusters->leaves;
+    // Lower bound of every gap in a cluster whose directions lie within `widen` of where R takes
+    // them: inside, d - r >= min d - r_max; outside, r - d >= r_min - max d.
+    auto lower_bound = [&](const Cluster& c, double widen) {
+      const double rho = c.rho + widen;
+      const float bound = pyr->cap(R * c.axis, rho, widen == 0 ? c.sin_rho : std::sin(std::min(rho, M_PI / 2)),
+                                   c.count > kLeaf ? kGroupBlocks : kLeafBlocks);
+      return ball ? double(bound) - c.r_max : c.r_min - double(bound);
+    };
     auto skipped = [&](const Cluster& c) {
-      const float bound = pyr->cap(R * c.axis, c.rho, c.sin_rho);
-      const double lb = ball ? double(bound) - c.r_max : c.r_min - double(bound);
+      const double lb = lower_bound(c, 0);
       return lb > cut || lb > l.gap;
     };
-    for (const Cluster& g : groups) {
+    // A search's poses follow each other closely: a cluster whose bound over a cap widened by
+    // kReuseRad stays above the cut is skipped at every later pose within that angle of this one
+    // (the directions of its vertices move by at most the angle of the relative rotation).
+    const bool reusable = !exact_;
+    std::vector<Reuse>& reuse_g = ball ? reuse_ball_groups_ : reuse_socket_groups_;
+    std::vector<Reuse>& reuse_l = ball ? reuse_ball_leaves_ : reuse_socket_leaves_;
+    if (reusable && reuse_g.size() != part.clusters->groups.size()) {
+      reuse_g.assign(part.clusters->groups.size(), Reuse{});
+      reuse_l.assign(cl.size(), Reuse{});
+    }
+    auto skip_reusing = [&](const Cluster& c, Reuse& u) {
+      if (u.valid && (u.R.array() * R.array()).sum() >= kReuseMinTrace) return true;
+      bool skip;
+      if (!u.failed) {
+        u.valid = lower_bound(c, kReuseRad) > cut, u.R = R;
+        skip = u.valid || lower_bound(c, 0) > cut;
+      } else {
+        skip = lower_bound(c, 0) > cut, u.valid = false;
+      }
+      u.failed = !skip;
+      return skip;
+    };
+    for (std::size_t gi = 0; gi < part.clusters->groups.size(); ++gi) {
+      const Cluster& g = part.clusters->groups[gi];
       if (done(l)) return;
-      if (skipped(g)) {
+      if (reusable ? skip_reusing(g, reuse_g[gi]) : skipped(g)) {
         vertices_skipped += g.count;
         continue;
       }
       for (std::int64_t i = g.first / kLeaf; i < (g.first + g.count + kLeaf - 1) / kLeaf; ++i) {
         const Cluster& c = cl[static_cast<std::size_t>(i)];
         if (done(l)) return;
-        if (skipped(c)) {
+        if (reusable ? skip_reusing(c, reuse_l[static_cast<std::size_t>(i)]) : skipped(c)) {
           vertices_skipped += c.count;
           continue;
         }
         look_up(R, set, map, side, c);
-        take(set, skip, c.first, c.first + c.count, ball, l);
+        take(set, *part.skip, c.first, c.first + c.count, ball, l);
         vertices_looked_up += c.count;
-        if (l.gap <= threshold_) last_ = &c, last_ball_ = ball;
+        if (l.gap <= threshold_) last_ = {part, &c};
       }
     }
   }
@@ -325,14 +436,13 @@ class CompactScanner {
   }
   // The first-surface cluster that met at the previous evaluation, looked up first.
   void recheck(const Eigen::Matrix3d& R, Least& l) {
-    const bool ball = last_ball_;
-    const ScanSet& set = ball ? joint_.ball().scan_set : joint_.socket().scan_set;
-    if (ball)
-      look_up(R, set, joint_.socket().map, ScanSide::inside, *last_);
+    const Part& p = last_.part;
+    if (p.ball)
+      look_up(R, *p.set, joint_.socket().map, ScanSide::inside, *last_.cluster);
     else
-      look_up(R.transpose(), set, joint_.ball().map, ScanSide::outside, *last_);
-    take(set, ball ? skip_ball_ : skip_socket_, last_->first, last_->first + last_->count, ball, l);
-    vertices_looked_up += last_->count;
+      look_up(R.transpose(), *p.set, joint_.ball().map, ScanSide::outside, *last_.cluster);
+    take(*p.set, *p.skip, last_.cluster->first, last_.cluster->first + last_.cluster->count, p.ball, l);
+    vertices_looked_up += last_.cluster->count;
   }
   bool done(const Least& l) const { return !exact_ && l.gap <= threshold_; }
   // Hidden vertices of one body against the other's layered map: a cluster is skipped when no radial
@@ -342,17 +452,17 @@ class CompactScanner {
     const OccupancyPyramid* pyr =
         bounds_ == nullptr ? nullptr : ball ? &*bounds_->socket_occupancy : &*bounds_->ball_occupancy;
     const std::vector<Cluster>* cl =
-        bounds_ == nullptr ? nullptr : ball ? &bounds_->ball_hidden_clusters : &bounds_->socket_hidden_clusters;
+        bounds_ == nullptr ? nullptr : ball ? &bounds_->ball_hidden.leaves : &bounds_->socket_hidden.leaves;
     if (pyr == nullptr || !pyr->valid()) {
       scan_layered(set, R, Eigen::Vector3d::Zero(), map, buf_.data(), exact);
       take(set, skip, 0, set.size(), ball, l, true);
       vertices_looked_up += set.size();
       return;
     }
-    const std::vector<Cluster>* groups = ball ? &bounds_->ball_hidden_groups : &bounds_->socket_hidden_groups;
+    const std::vector<Cluster>* groups = ball ? &bounds_->ball_hidden.groups : &bounds_->socket_hidden.groups;
     auto skipped = [&](const Cluster& c) {
       const double reach = std::max(0.0, std::min(cut, l.gap));
-      return std::isfinite(reach) && (pyr->cap(R * c.axis, c.rho, c.sin_rho) & shells(c.r_min - reach, c.r_max + reach)) == 0;
+      return std::isfinite(reach) && (pyr->cap(R * c.axis, c.rho, c.sin_rho, kHiddenBlocks) & shells(c.r_min - reach, c.r_max + reach)) == 0;
     };
     for (const Cluster& g : *groups) {
       if (done(l)) return;
@@ -385,9 +495,20 @@ class CompactScanner {
   double threshold_;
   RomVertices counted_;
   bool exact_ = true;
-  const Cluster* last_ = nullptr;  ///< first-surface cluster that met at the last evaluation (null: none)
-  bool last_ball_ = false;
-  std::vector<std::uint8_t> skip_ball_, skip_socket_, skip_ball_hidden_, skip_socket_hidden_;
+  // A group's bound at an earlier pose over a widened cap (valid: it was above the cut), or that
+  // its bound failed at the last pose (failed: try the plain cap first next time).
+  struct Reuse {
+    Eigen::Matrix3d R = Eigen::Matrix3d::Zero();
+    bool valid = false, failed = false;
+  };
+  static constexpr double kReuseRad = 2.05 * M_PI / 180;
+  static inline const double kReuseMinTrace = 1 + 2 * std::cos(kReuseRad);  // trace of a rotation by kReuseRad
+  std::vector<Reuse> reuse_ball_groups_, reuse_socket_groups_, reuse_ball_leaves_, reuse_socket_leaves_;
+  struct Met {
+    Part part;
+    const Cluster* cluster = nullptr;
+  } last_;  ///< the first-surface cluster that met at the last evaluation (cluster null: none)
+  std::vector<std::uint8_t> skip_ball_reachable_, skip_ball_, skip_socket_, skip_ball_hidden_, skip_socket_hidden_;
   std::vector<float> buf_;
 };
 
@@ -472,7 +593,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
 RomLimit find_rom_limit(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation,
                         const RomOptions& o, const RomBaseline& base) {
   check(o);
-  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint()) : nullptr;
+  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint(), o.threshold_mm) : nullptr;
   return search(hip, rotation, o, base, bounds.get());
 }
 
@@ -485,7 +606,7 @@ RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(doub
 std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
                                       const RomOptions& o, const RomBaseline& base) {
   check(o);
-  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint()) : nullptr;
+  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint(), o.threshold_mm) : nullptr;
   std::vector<RomLimit> out(motions.size());
   std::vector<std::string> errors(motions.size());
   const auto n = static_cast<std::int64_t>(motions.size());
@@ -507,7 +628,7 @@ std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<Sta
 std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& flexion,
                                 const std::vector<double>& adduction, const RomOptions& o, const RomBaseline& base) {
   check(o);
-  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint()) : nullptr;
+  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint(), o.threshold_mm) : nullptr;
   std::vector<RomMapCell> cells;
   for (double f : flexion)
     for (double a : adduction) cells.push_back({f, a, std::numeric_limits<double>::quiet_NaN(), ""});
@@ -565,7 +686,7 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
   auto index = [&](int i, int j, int k) { return (std::size_t(i) * n[1] + j) * n[2] + k; };
   std::vector<std::int8_t> state(static_cast<std::size_t>(out.poses), -1);  // -1 unknown, 0 contact, 1 valid
   const Joint& joint = hip.joint();
-  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(joint) : nullptr;
+  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(joint, o.threshold_mm) : nullptr;
 
   // Scan the listed poses on all cores; each thread keeps its scanner.
   std::int64_t looked = 0, skipped = 0;
