@@ -661,13 +661,14 @@ int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo
   const double setup_ms = ms_since(t_start);
   const HipJoint& hip = *s.hip;
   const Eigen::Matrix3d to_input = s.to_working.transpose();
-  // Pre-existing overlap at neutral (a segmentation's) is excluded, not taken for a limit.
+  // Pre-existing overlap at neutral (a segmentation's) is excluded, not taken for a limit. The
+  // baseline's scan and the search bounds it builds count with the limits' time.
+  auto t0 = Clock::now();
   const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), o);
   if (base.excluded_vertices > 0)
     std::cerr << "impinge: warning: " << base.excluded_vertices << " vertices are within " << o.threshold_mm
               << " mm at neutral (overlap before any motion); they are not counted in the limits\n";
   fs::create_directories(out_dir);
-  auto t0 = Clock::now();
   std::ofstream lim(fs::path(out_dir) / "rom_limits.csv");
   require(lim.good(), out_dir + "/rom_limits.csv: cannot open for writing");
   lim << "motion,limit_deg,limited_by,socket_clock_h,femur_clock_h,min_gap_at_limit_mm,monotone,"

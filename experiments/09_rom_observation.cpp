@@ -234,9 +234,10 @@ int main(int argc, char** argv) {
       wrote_renders = true;
     }
 
-    // ROM limits and map, timed (the search after the maps exist; sampling reported beside).
-    const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), ro);
+    // ROM limits and map, timed (the search after the maps exist; sampling reported beside). The
+    // baseline (a full scan at neutral) and the search bounds it builds count with the limits.
     auto t0 = Clock::now();
+    const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), ro);
     const std::vector<StandardMotion> motions = standard_motions();
     const std::vector<RomLimit> limits = find_rom_limits(hip, motions, ro, base);
     const double limits_ms = ms_since(t0);

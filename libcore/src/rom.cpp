@@ -112,6 +112,12 @@ class BlockPyramid {
     }
   }
   bool valid() const { return !levels_.empty(); }
+  // Combined value over every node (none when the pyramid is not valid).
+  V all() const {
+    V m = none_;
+    for (const V& x : levels_.empty() ? std::vector<V>{} : levels_.back()) m = combine_(m, x);
+    return m;
+  }
   // Combined value over every stencil node of the directions within angle rho of unit u (sin_rho =
   // sin(rho)). Angles by fast_angles.hpp (within 1e-13 rad; the row and column ranges are padded by a
   // node on each side).
@@ -197,12 +203,16 @@ std::uint64_t shells(double lo, double hi) { return radial_shell_bits(lo, hi, kO
 // directions' cone (unit axis, half-angle) and radius range, in the body's frame. Two levels: leaves
 // of kLeaf vertices, looked up together, in groups of kGroup vertices, whose bound is tried first.
 constexpr std::int64_t kLeaf = 32, kGroup = 128;
+// A cluster's bound over its cap widened by this angle serves every later pose of a search within
+// the angle (CompactScanner): two steps of the default search.
+constexpr double kReuseRad = 4.1 * M_PI / 180;
 // Blocks across the bounding cap of a group, a leaf and a hidden cluster (measured on lhdl-ct).
 constexpr int kGroupBlocks = 8, kLeafBlocks = 8, kHiddenBlocks = 4;
 struct Cluster {
   std::int64_t first = 0, count = 0;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
   double rho = 0, sin_rho = 0, r_min = 0, r_max = 0;
+  double sin_rho_widened = 0;  ///< sin(rho + kReuseRad), for the bounds reused at nearby poses
 };
 std::vector<Cluster> clusters_of(const ScanSet& s, std::int64_t kSize) {
   std::vector<Cluster> out;
@@ -224,6 +234,7 @@ std::vector<Cluster> clusters_of(const ScanSet& s, std::int64_t kSize) {
                                                    -1.0, 1.0)));
     c.rho += 1e-9;  // rounding of the angles
     c.sin_rho = std::sin(std::min(c.rho, M_PI / 2));  // a wider cone takes whole rows (cap)
+    c.sin_rho_widened = std::sin(std::min(c.rho + kReuseRad, M_PI / 2));
     out.push_back(c);
   }
   return out;
@@ -252,27 +263,23 @@ ScanSet reachable_subset(const ScanSet& s, double least_node, double threshold) 
     }
   return out;
 }
-double least_node(const RadialDistanceMap& map) {
-  float m = std::numeric_limits<float>::infinity();
-  const std::int64_t n = map.num_nodes();
-#pragma omp parallel for reduction(min : m) schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const float d = map.at(i);
-    if (std::isfinite(d)) m = std::min(m, d);
-  }
-  return m;
-}
 // A scan set with its two levels of clusters.
 struct Clustered {
   Clustered() = default;
   explicit Clustered(const ScanSet& s) : leaves(clusters_of(s, kLeaf)), groups(clusters_of(s, kGroup)) {}
   std::vector<Cluster> leaves, groups;
 };
-struct RomBounds {
-  RomBounds(const Joint& j, double threshold)
-      : socket_min(bound_pyramid(j.socket().map, true)),
+}  // namespace
+
+// Bounds for the searches of one joint at one threshold: the map pyramids and the clusters
+// (shared by every search that holds the baseline they were made with; read-only).
+struct RomSearchBounds {
+  RomSearchBounds(const Joint& j, double threshold)
+      : joint(&j),
+        threshold_mm(threshold),
+        socket_min(bound_pyramid(j.socket().map, true)),
         ball_max(bound_pyramid(j.ball().map, false)),
-        ball_reachable(reachable_subset(j.ball().scan_set, least_node(j.socket().map), threshold)),
+        ball_reachable(reachable_subset(j.ball().scan_set, socket_min.all(), threshold)),
         ball(j.ball().scan_set),
         socket(j.socket().scan_set),
         ball_reachable_clusters(ball_reachable) {
@@ -285,12 +292,17 @@ struct RomBounds {
       socket_hidden = Clustered(j.socket().hidden_set);
     }
   }
+  const Joint* joint;
+  double threshold_mm;
   BoundPyramid socket_min, ball_max;
   ScanSet ball_reachable;
   Clustered ball, socket, ball_reachable_clusters;
   std::optional<OccupancyPyramid> socket_occupancy, ball_occupancy;
   Clustered ball_hidden, socket_hidden;
 };
+
+namespace {
+using RomBounds = RomSearchBounds;
 class CompactScanner {
  public:
   CompactScanner(const Joint& joint, const RomBaseline& base, const RomBounds* bounds, double threshold,
@@ -368,9 +380,9 @@ class CompactScanner {
     const std::vector<Cluster>& cl = part.clusters->leaves;
     // Lower bound of every gap in a cluster whose directions lie within `widen` of where R takes
     // them: inside, d - r >= min d - r_max; outside, r - d >= r_min - max d.
-    auto lower_bound = [&](const Cluster& c, double widen) {
+    auto lower_bound = [&](const Cluster& c, double widen) {  // widen: 0 or kReuseRad
       const double rho = c.rho + widen;
-      const float bound = pyr->cap(R * c.axis, rho, widen == 0 ? c.sin_rho : std::sin(std::min(rho, M_PI / 2)),
+      const float bound = pyr->cap(R * c.axis, rho, widen == 0 ? c.sin_rho : c.sin_rho_widened,
                                    c.count > kLeaf ? kGroupBlocks : kLeafBlocks);
       return ball ? double(bound) - c.r_max : c.r_min - double(bound);
     };
@@ -501,7 +513,6 @@ class CompactScanner {
     Eigen::Matrix3d R = Eigen::Matrix3d::Zero();
     bool valid = false, failed = false;
   };
-  static constexpr double kReuseRad = 2.05 * M_PI / 180;
   static inline const double kReuseMinTrace = 1 + 2 * std::cos(kReuseRad);  // trace of a rotation by kReuseRad
   std::vector<Reuse> reuse_ball_groups_, reuse_socket_groups_, reuse_ball_leaves_, reuse_socket_leaves_;
   struct Met {
@@ -526,10 +537,18 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
   for (auto s : b.skip_ball) b.excluded_vertices += s;
   for (auto s : b.skip_socket) b.excluded_vertices += s;
   b.min_gap_mm = std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);
+  if (o.use_bounds) b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), o.threshold_mm);
   return b;
 }
 
 namespace {
+// The baseline's bounds when they were made for this joint and threshold, else new ones (null
+// without bounds).
+std::shared_ptr<const RomSearchBounds> bounds_for(const Joint& joint, const RomOptions& o, const RomBaseline& base) {
+  if (!o.use_bounds) return nullptr;
+  if (base.bounds && base.bounds->joint == &joint && base.bounds->threshold_mm == o.threshold_mm) return base.bounds;
+  return std::make_shared<const RomSearchBounds>(joint, o.threshold_mm);
+}
 RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation, const RomOptions& o,
                 const RomBaseline& base, const RomBounds* bounds) {
   const Joint& joint = hip.joint();
@@ -593,7 +612,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
 RomLimit find_rom_limit(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation,
                         const RomOptions& o, const RomBaseline& base) {
   check(o);
-  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint(), o.threshold_mm) : nullptr;
+  const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(hip.joint(), o, base);
   return search(hip, rotation, o, base, bounds.get());
 }
 
@@ -606,7 +625,7 @@ RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(doub
 std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
                                       const RomOptions& o, const RomBaseline& base) {
   check(o);
-  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint(), o.threshold_mm) : nullptr;
+  const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(hip.joint(), o, base);
   std::vector<RomLimit> out(motions.size());
   std::vector<std::string> errors(motions.size());
   const auto n = static_cast<std::int64_t>(motions.size());
@@ -628,7 +647,7 @@ std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<Sta
 std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& flexion,
                                 const std::vector<double>& adduction, const RomOptions& o, const RomBaseline& base) {
   check(o);
-  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(hip.joint(), o.threshold_mm) : nullptr;
+  const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(hip.joint(), o, base);
   std::vector<RomMapCell> cells;
   for (double f : flexion)
     for (double a : adduction) cells.push_back({f, a, std::numeric_limits<double>::quiet_NaN(), ""});
@@ -686,7 +705,7 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
   auto index = [&](int i, int j, int k) { return (std::size_t(i) * n[1] + j) * n[2] + k; };
   std::vector<std::int8_t> state(static_cast<std::size_t>(out.poses), -1);  // -1 unknown, 0 contact, 1 valid
   const Joint& joint = hip.joint();
-  const std::unique_ptr<RomBounds> bounds = o.use_bounds ? std::make_unique<RomBounds>(joint, o.threshold_mm) : nullptr;
+  const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(joint, o, base);
 
   // Scan the listed poses on all cores; each thread keeps its scanner.
   std::int64_t looked = 0, skipped = 0;

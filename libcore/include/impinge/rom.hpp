@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,8 @@ struct RomLimit {
   std::int64_t vertices_skipped = 0;    ///< first-surface vertices skipped by the cluster bounds
 };
 
+struct RomSearchBounds;  ///< opaque: a joint's bound pyramids and vertex clusters for ROM searches
+
 /// The vertices not counted in ROM searches: those within the threshold at a baseline pose
 /// (anatomical neutral for clinical motions), so that a segmentation's overlap is reported and not
 /// taken for a limit.
@@ -83,9 +86,14 @@ struct RomBaseline {
   std::vector<std::uint8_t> skip_ball, skip_socket;  ///< 1 = not counted (per vertex of each body)
   std::int64_t excluded_vertices = 0;
   double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< least gap of all vertices at the baseline
+  /// The bounds of the cluster search (RomOptions::use_bounds), built once by rom_baseline (about
+  /// 10 ms for 0.1 deg maps) and shared by every search given this baseline with the same joint and
+  /// threshold; a search with another threshold builds its own.
+  std::shared_ptr<const RomSearchBounds> bounds;
 };
 
-/// The baseline at the femur rotation R (joint frame), e.g. hip.femur_rotation({}) for neutral.
+/// The baseline at the femur rotation R (joint frame), e.g. hip.femur_rotation({}) for neutral,
+/// with the search bounds for options.threshold_mm when options.use_bounds.
 RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const RomOptions& options = {});
 
 /// Search one motion of `hip`: evaluate both scans at theta = 0, step_deg, 2 step_deg, ... up to
