@@ -549,8 +549,10 @@ std::shared_ptr<const RomSearchBounds> bounds_for(const Joint& joint, const RomO
   if (base.bounds && base.bounds->joint == &joint && base.bounds->threshold_mm == o.threshold_mm) return base.bounds;
   return std::make_shared<const RomSearchBounds>(joint, o.threshold_mm);
 }
+// limit_only: only limit_deg, contact_at_start and the counts are wanted (a ROM map's cell), so
+// neither end is scanned for the exact least gap and the monotony is not checked.
 RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation, const RomOptions& o,
-                const RomBaseline& base, const RomBounds* bounds) {
+                const RomBaseline& base, const RomBounds* bounds, bool limit_only = false) {
   const Joint& joint = hip.joint();
   require(base.skip_ball.size() == static_cast<std::size_t>(joint.ball().relative.rows()) &&
               base.skip_socket.size() == static_cast<std::size_t>(joint.socket().relative.rows()),
@@ -565,8 +567,9 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
     return scan(rotation(t), exact);
   };
   double lo = 0, hi = 0;
-  out.min_gap_at_start_mm = gap_at(0, true).gap;
-  bool found = out.min_gap_at_start_mm <= o.threshold_mm;
+  const double start_gap = gap_at(0, !limit_only).gap;
+  if (!limit_only) out.min_gap_at_start_mm = start_gap;
+  bool found = start_gap <= o.threshold_mm;
   out.contact_at_start = found;
   for (int k = 1; !found; ++k) {
     const double t = std::min(o.max_deg, k * o.step_deg);
@@ -581,6 +584,12 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
   while (hi - lo > o.tolerance_deg) {
     const double mid = 0.5 * (lo + hi);
     (gap_at(mid).gap <= o.threshold_mm ? hi : lo) = mid;
+  }
+  if (limit_only) {
+    out.vertices_looked_up = scan.vertices_looked_up;
+    out.vertices_skipped = scan.vertices_skipped;
+    out.limit_deg = hi;
+    return out;
   }
   const Least l = gap_at(hi, true);  // the least gap and where, not only whether they meet
   // A transient touch: the bones part again one step farther.
@@ -660,7 +669,7 @@ std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& 
       const RomLimit l = search(hip, std::function<Eigen::Matrix3d(double)>([&](double t) {
                                   return hip.femur_rotation(PoseAngles{c.flexion_deg, c.adduction_deg, t});
                                 }),
-                                o, base, bounds.get());
+                                o, base, bounds.get(), true);
       c.vertices_looked_up = l.vertices_looked_up;
       c.vertices_skipped = l.vertices_skipped;
       c.evaluations = l.evaluations;
