@@ -99,10 +99,13 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
 /// Search one motion of `hip`: evaluate both scans at theta = 0, step_deg, 2 step_deg, ... up to
 /// max_deg until the minimum gap over the counted vertices (those not in `baseline`) is <=
 /// threshold, then bisect the last step to tolerance_deg. Only the minimum is computed: the
-/// first-surface vertices are taken in clusters (32 vertices in Z order, in groups of 128) with a cone of directions and a
-/// radius range, and a cluster is skipped when a bound of the other map over its cone (a pyramid
-/// of minima or maxima over the equiangular map) shows that none of its gaps can reach the
-/// threshold; the others are looked up exactly, so the result is the full scan's. Throws
+/// first-surface vertices are taken in clusters (32 vertices in Z order, in groups of 128) with a
+/// cone of directions and a radius range, and a cluster is skipped when a bound of the other map
+/// over its cone (a pyramid of minima or maxima over the equiangular map) shows that none of its
+/// gaps can reach the threshold. A bound over the cone widened by 4.1 deg is reused at later poses
+/// whose rotation relative to it is within that angle; femur vertices nearer the COR than the
+/// socket map's least node less the threshold are left out of the scans that ask only whether the
+/// bones meet. The others are looked up exactly, so the result is the full scan's. Throws
 /// impinge::Error on invalid options.
 RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(double)>& motion,
                         const RomOptions& options, const RomBaseline& baseline);
