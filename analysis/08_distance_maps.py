@@ -3,7 +3,7 @@
 
 Reads RESULTS/08_distance_maps/gap_statistics.csv, vertex_gaps.csv, clock_faces.csv and the
 render_<subject>_<body>.ply meshes the driver wrote; writes table_finest.tex, table_convergence.tex,
-table_acetabulum.tex, min_gap.pdf, levels.pdf, maps_<subject>.pdf (map images with colour bars), render_<subject>.pdf (shaded, with the clock face), macros.tex."""
+table_acetabulum.tex, table_usid.tex, table_schemes.tex, min_gap.pdf, levels.pdf, maps_<subject>.pdf (map images with colour bars), render_<subject>.pdf (shaded, with the clock face), macros.tex."""
 import json
 import os
 
@@ -199,10 +199,35 @@ ax.grid(True, which="both", alpha=0.3)
 ax.legend(fontsize=7)
 save(fig, d, "usid_vs_rsid")
 
+# Table: every other registered scheme beside the equiangular grid at the same node spacing, exact
+# mode, at the finest spacing it was run at (issue 12: the driver loops over the registry).
+ot = allst[~allst.scheme.isin(["equiangular", "helix"])]
+rows = []
+other_p = ot.precision_deg.min() if len(ot) else np.nan
+for s_ in subjects:
+    e = st[(st.subject == s_) & (st.precision_deg == other_p) & (st["mode"] == "exact")]
+    if e.empty:
+        continue
+    eb, es = e[e.scan == "ball"].iloc[0], e[e.scan == "socket"].iloc[0]
+    for name, g in ot[(ot.subject == s_) & (ot.precision_deg == other_p)].groupby("scheme", sort=False):
+        b, so = g[g.scan == "ball"].iloc[0], g[g.scan == "socket"].iloc[0]
+        rows.append([s_, name, f"{b.resolution:g}", f"{b.min_gap_mm:.3f}", f"{eb.min_gap_mm:.3f}",
+                     f"{b.vs_equiangular_p95_abs_mm:.4f}", f"{b.vs_equiangular_max_abs_mm:.2f}",
+                     f"{(b.sampling_ms + so.sampling_ms):.0f}", f"{(eb.sampling_ms + es.sampling_ms):.0f}",
+                     f"{b.detection_ns_per_lookup:.0f}", f"{eb.detection_ns_per_lookup:.0f}",
+                     f"{(b.map_bytes + so.map_bytes) / (eb.map_bytes + es.map_bytes):.2f}"])
+write_table(d, "table_schemes", ["subject", "scheme", "resolution", "min gap", "equiang. min", "p95 $|\\Delta|$",
+                                 "max $|\\Delta|$", "ms", "equiang. ms", "ns", "equiang. ns", "bytes ratio"], rows,
+            align="llrrrrrrrrrr")
+others = ot[(ot.precision_deg == other_p) & (ot.scan == "ball")]
+
 pen = st[(st.precision_deg == finest) & (st["mode"] == "exact") & (st.scan == "ball")]
 write_macros(d, "macros", {
     "DMfinest": f"{finest:g}",
     "DMsubjects": str(len(subjects)),
+    "DMotherSpacing": f"{other_p:g}",
+    "DMotherSchemes": str(others.scheme.nunique()),
+    "DMotherPninetyFiveMax": f"{others.vs_equiangular_p95_abs_mm.max():.4f}",
     "DMpenetratingSubjects": str(int((pen.vertices_penetrating > 0).sum())),
     "DMinclinationRange": (f"{anat.inclination_deg.min():.0f}--{anat.inclination_deg.max():.0f}" if len(anat) else "n/a"),
     "DMrimRmsRange": (f"{anat.rim_plane_rms_mm.min():.1f}--{anat.rim_plane_rms_mm.max():.1f}" if len(anat) else "n/a"),

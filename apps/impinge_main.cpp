@@ -98,7 +98,8 @@ void add_map_options(CLI::App* app, MapOptions& o) {
   app->add_option("--spacing", o.spacing,
                   "Largest node spacing wanted, degrees, for any scheme: the coarsest resolution that reaches it "
                   "(instead of --resolution)");
-  app->add_option("--sampling", o.sampling, "auto, rasterize, resample or ray-cast (naive, small meshes only)")
+  app->add_option("--sampling", o.sampling,
+                  "auto, rasterize, resample, ray-cast (naive, small meshes only) or ray-cast-bvh (exact node values for any scheme)")
       ->capture_default_str();
   app->add_option("--mode", o.mode, "Distance mode: 'linear' (thesis Alg. 1) or 'exact' (ray-plane)")
       ->capture_default_str();

@@ -224,9 +224,9 @@ int main(int argc, char** argv) {
         // helix maps are resampled from an equiangular map of matched spacing: two interpolations.
         // The bilinear bound holds for the schemes that interpolate bilinearly in (phi, theta) or along
         // the helix (equiangular, helix, helix-eq10); for the others no bound is claimed (NaN).
-        const std::string& sn = v.scheme->name();
-        const double passes = sn == "equiangular" ? 1 : 2;
-        const bool bilinear = sn == "equiangular" || sn == "helix" || sn == "helix-eq10";
+        const std::string& scheme_name = v.scheme->name();
+        const double passes = scheme_name == "equiangular" ? 1 : 2;
+        const bool bilinear = scheme_name == "equiangular" || scheme_name == "helix" || scheme_name == "helix-eq10";
         // mesh faceting at 0.25-deg facets: sagitta over a cell diagonal
         const double facet = s.radius * (1 - std::cos(std::sqrt(2.0) * 0.25 * kDegToRad / 2)) * 2;
         if (analytic && bilinear) {

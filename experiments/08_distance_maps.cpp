@@ -7,7 +7,8 @@
 //                       vertices are tested against the other body's map, while map_* and
 //                       sampling_ms describe the scanned body's own map; COR in the RAS frame
 //   vertex_gaps.csv     per-vertex gaps within 45 mm of the COR at the finest precision, exact mode
-//   map_<subject>_<body>.png  the maps at 0.5 deg (theta across, phi down); *_helix.png at k = 458
+//   map_<subject>_<body>.png  the maps at 0.5 deg (theta across, phi down); *_helix.png at k = 458,
+//                       *_<scheme>.png for the other registered schemes (drawn in their own way)
 //   map_images.csv    each map image's grey scale (grey 40 = nearest_mm, 255 = farthest_mm), for colour bars
 //   render_<subject>_<body>.ply  both bones within 60 mm of the COR at the scan pose, in the pelvic
 //                       frame (ISB; generated models: the scan's anatomical axes), with gaps, levels
@@ -20,14 +21,19 @@
 //   meta.json
 // Command: build/experiments/exp_08_distance_maps --out results --data ../shared/data/hips [--quick]
 // Precisions 1, 0.5, 0.1 and (outside quick mode) 0.05 deg, each with the helix of matched turns
-// k = round(720 / (pi p)) (thesis Table 6); modes linear and exact; scan pose (identity). Sampling
+// k = round(720 / (pi p)) (thesis Table 6); modes linear and exact; scan pose (identity). Every
+// other registered scheme (scheme_names) at the coarsest resolution whose node spacing is at most p,
+// for p >= 0.1 deg, exact mode, with its gaps' difference from the equiangular ones (the vs_*
+// columns) and its map images (map_<subject>_<body>_<scheme>.png). Sampling
 // and detection times are medians over the repetitions. Helix rows also give the difference of
 // their gaps from the equiangular ones at the same precision and mode (thesis Fig. 50).
+#include <algorithm>
 #include <filesystem>
 #include <map>
 
 #include "experiment_support.hpp"
 #include "impinge/clock_face.hpp"
+#include "impinge/error.hpp"
 #include "impinge/helix_scheme.hpp"
 #include "impinge/hip_joint.hpp"
 #include "impinge/mesh_io.hpp"
@@ -87,7 +93,9 @@ int main(int argc, char** argv) {
                        {"subject", "body", "scheme", "resolution", "file", "nearest_mm", "farthest_mm"});
   CsvWriter vertices(dir + "/vertex_gaps.csv", {"subject", "scan", "vertex", "x_mm", "y_mm", "z_mm", "gap_mm"});
 
-  const int total = static_cast<int>(subjects.size() * precisions.size() * 4);
+  const auto others = static_cast<int>(scheme_names().size()) - 2;  // registered beyond the thesis' two
+  const auto coarse = std::count_if(precisions.begin(), precisions.end(), [](double p) { return p >= 0.1; });
+  const int total = static_cast<int>(subjects.size()) * (static_cast<int>(precisions.size()) * 4 + static_cast<int>(coarse) * others);
   auto abs_diff = [](const std::vector<float>& a, const std::vector<float>& b) {
     std::vector<double> d;
     for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
@@ -105,10 +113,25 @@ int main(int argc, char** argv) {
     for (double p : precisions) {
       std::map<DistanceMode, std::vector<float>> rsid_ball;  // equiangular ball gaps per mode
       const double k = matched_helix_turns(p);
-      for (const auto& scheme : {make_scheme("equiangular", p), make_scheme("helix", k)}) {
-        const bool helix = scheme->name() != "equiangular";
+      std::vector<std::shared_ptr<const SamplingScheme>> schemes{make_scheme("equiangular", p), make_scheme("helix", k)};
+      // Every other registered scheme (issue 12: without touching this driver), exact mode, at the
+      // coarsest resolution whose node spacing is at most p, for p >= 0.1 deg.
+      if (p >= 0.1)
+        for (const auto& [name, unit] : scheme_names()) {
+          (void)unit;
+          if (name == "equiangular" || name == "helix") continue;
+          try {
+            schemes.push_back(make_scheme(name, resolution_for_spacing(name, p)));
+          } catch (const Error&) {
+            // a resolution this scheme does not take at this spacing (e.g. conchoid needs 90/p integral)
+          }
+        }
+      for (const auto& scheme : schemes) {
+        const bool helix = scheme->name() != "equiangular";  // compared with the equiangular gaps below
+        const bool thesis_scheme = scheme->name() == "equiangular" || scheme->name() == "helix";
         std::vector<float> exact_ball;  // exact-mode gaps, for the linear-vs-exact difference
         for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
+          if (!thesis_scheme && mode == DistanceMode::linear) continue;
           progress("08_distance_maps", ++done, total,
                    s.name + " " + scheme->name() + " " + std::to_string(scheme->resolution()) + " " + to_string(mode));
           JointOptions o;
@@ -175,7 +198,7 @@ int main(int argc, char** argv) {
                       b == 0 ? vs_p95 : std::nan(""), b == 0 ? vs_max : std::nan(""), b == 0 ? vs_n : std::int64_t(0));
           }
           if (p == 0.5 && mode == DistanceMode::exact) {
-            const std::string suffix = helix ? "_helix.png" : ".png";
+            const std::string suffix = helix ? "_" + scheme->name() + ".png" : ".png";
             for (int b = 0; b < 2; ++b) {
               const std::string body = b == 0 ? "ball" : "socket";
               const std::string file = "map_" + s.name + "_" + body + suffix;

@@ -116,7 +116,9 @@ TEST(DepthDiscontinuity, GapsAtARimMatchTheExactRadialGapForEveryScheme) {
       // Rotated 30 deg about an axis across the cup, so that ball vertices look past the rim.
       const Eigen::Matrix3d R = Eigen::AngleAxisd(0.5, axis.unitOrthogonal()).toRotationMatrix();
       const PoseResult r = j.detect(R);
-      if (refine) EXPECT_GT(r.ball.vertices_refined, 0) << name;
+      if (refine) {
+        EXPECT_GT(r.ball.vertices_refined, 0) << name;
+      }
       for (Eigen::Index i = 0; i < ball.V.rows(); ++i) {
         if (r.ball_gaps.status[std::size_t(i)] != ScanGaps::tested) continue;
         const Eigen::Vector3d q = R * j.ball().relative.row(i).transpose();

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "impinge/error.hpp"
+#include "impinge/first_hit_caster.hpp"
 #include "impinge/naive_sampling.hpp"
 #include "impinge/spherical_frame.hpp"
 
@@ -15,7 +16,8 @@ SamplingMethod parse_sampling_method(const std::string& name) {
   if (name == "rasterize") return SamplingMethod::rasterize;
   if (name == "resample") return SamplingMethod::resample;
   if (name == "ray-cast") return SamplingMethod::ray_cast;
-  throw Error("sampling method '" + name + "': expected auto, rasterize, resample or ray-cast");
+  if (name == "ray-cast-bvh") return SamplingMethod::ray_cast_bvh;
+  throw Error("sampling method '" + name + "': expected auto, rasterize, resample, ray-cast or ray-cast-bvh");
 }
 
 const char* to_string(SamplingMethod method) {
@@ -28,6 +30,8 @@ const char* to_string(SamplingMethod method) {
       return "resample";
     case SamplingMethod::ray_cast:
       return "ray-cast";
+    case SamplingMethod::ray_cast_bvh:
+      return "ray-cast-bvh";
   }
   return "?";
 }
@@ -121,6 +125,17 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
       sample_naive(mesh, cor, map);
       rep.ray_cast_ms = ms_since(t0);
       break;
+    case SamplingMethod::ray_cast_bvh: {
+      require(FirstHitCaster::available(), mesh.source + ": ray-cast-bvh sampling needs Embree or CGAL in this build");
+      const FirstHitCaster caster(mesh, cor);
+      const SamplingScheme& scheme = map.scheme();
+      Scalar* out = map.data();
+      const std::int64_t n = map.num_nodes();
+#pragma omp parallel for schedule(dynamic, 4096)
+      for (std::int64_t i = 0; i < n; ++i) out[i] = static_cast<Scalar>(caster.first_hit(scheme.node_direction(i)));
+      rep.ray_cast_ms = ms_since(t0);
+      break;
+    }
     case SamplingMethod::automatic:
       break;
   }

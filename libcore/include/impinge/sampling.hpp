@@ -19,9 +19,13 @@ enum class SamplingMethod {
   rasterize,  ///< equiangular maps only (thesis Algorithm 1)
   resample,   ///< rasterise a temporary equiangular map, interpolate it at every node, release it
   ray_cast,   ///< every node's ray against every triangle (naive, O(nodes x triangles))
+  /// Every node's ray through a BVH (FirstHitCaster: Embree, else CGAL), on all cores: the exact
+  /// first hit at every node of any scheme, without the bilinear error that `resample` adds.
+  /// O(nodes log triangles). Throws impinge::Error when the build has no ray caster. Source: issue 12.
+  ray_cast_bvh,
 };
 
-/// Parse "auto", "rasterize", "resample", "ray-cast"; throws impinge::Error otherwise.
+/// Parse "auto", "rasterize", "resample", "ray-cast", "ray-cast-bvh"; throws impinge::Error otherwise.
 SamplingMethod parse_sampling_method(const std::string& name);
 const char* to_string(SamplingMethod method);
 
