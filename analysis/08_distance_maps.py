@@ -173,19 +173,29 @@ if os.path.exists(os.path.join(d, "poses.csv")) and len(read_csv(d, "poses.csv")
 
 # RSID beside USID (thesis Fig. 50): same precision (helix at the matched k), same mode.
 rows = []
+def versus(eb, es, ob, os_):
+    """Columns comparing another scheme's ball and socket rows (ob, os_) with the equiangular grid's
+    (eb, es): both min gaps, the ball gaps' p95 and max difference, sampling ms of both bones, ns per
+    look-up, and the bytes ratio of both maps."""
+    return [f"{eb.min_gap_mm:.3f}", f"{ob.min_gap_mm:.3f}", f"{ob.vs_equiangular_p95_abs_mm:.4f}",
+            f"{ob.vs_equiangular_max_abs_mm:.2f}", f"{(eb.sampling_ms + es.sampling_ms):.0f}",
+            f"{(ob.sampling_ms + os_.sampling_ms):.0f}", f"{eb.detection_ns_per_lookup:.0f}",
+            f"{ob.detection_ns_per_lookup:.0f}", f"{(ob.map_bytes + os_.map_bytes) / (eb.map_bytes + es.map_bytes):.3f}"]
+
+
+def row_of(t, s_, scan, p, mode):
+    return t[(t.subject == s_) & (t.scan == scan) & (t.precision_deg == p) & (t["mode"] == mode)].iloc[0]
+
+
+rows = []
 for s_ in subjects:
     for (p, mode), g in hx[(hx.subject == s_) & (hx.scan == "ball")].groupby(["precision_deg", "mode"], sort=False):
         h = g.iloc[0]
-        e = st[(st.subject == s_) & (st.scan == "ball") & (st.precision_deg == p) & (st["mode"] == mode)].iloc[0]
-        hs = hx[(hx.subject == s_) & (hx.scan == "socket") & (hx.precision_deg == p) & (hx["mode"] == mode)].iloc[0]
-        es = st[(st.subject == s_) & (st.scan == "socket") & (st.precision_deg == p) & (st["mode"] == mode)].iloc[0]
-        rows.append([s_, f"{p:g} / {int(h.resolution)}", mode, f"{e.min_gap_mm:.3f}", f"{h.min_gap_mm:.3f}",
-                     f"{h.vs_equiangular_p95_abs_mm:.4f}", f"{h.vs_equiangular_max_abs_mm:.2f}",
-                     f"{(e.sampling_ms + es.sampling_ms):.0f}", f"{(h.sampling_ms + hs.sampling_ms):.0f}",
-                     f"{e.detection_ns_per_lookup:.0f}", f"{h.detection_ns_per_lookup:.0f}",
-                     f"{h.map_bytes / e.map_bytes:.3f}"])
-write_table(d, "table_usid", ["subject", "$p$ / $k$", "mode", "RSID min", "USID min", "p95 $|\Delta|$",
-                              "max $|\Delta|$", "RSID ms", "USID ms", "RSID ns", "USID ns", "bytes ratio"], rows,
+        rows.append([s_, f"{p:g} / {int(h.resolution)}", mode] +
+                    versus(row_of(st, s_, "ball", p, mode), row_of(st, s_, "socket", p, mode), h,
+                           row_of(hx, s_, "socket", p, mode)))
+write_table(d, "table_usid", ["subject", "$p$ / $k$", "mode", "RSID min", "USID min", "p95 $|\\Delta|$",
+                              "max $|\\Delta|$", "RSID ms", "USID ms", "RSID ns", "USID ns", "bytes ratio"], rows,
             align="llrrrrrrrrrr")
 
 fig, ax = plt.subplots(figsize=(5.5, 3.2))
@@ -205,19 +215,14 @@ ot = allst[~allst.scheme.isin(["equiangular", "helix"])]
 rows = []
 other_p = ot.precision_deg.min() if len(ot) else np.nan
 for s_ in subjects:
-    e = st[(st.subject == s_) & (st.precision_deg == other_p) & (st["mode"] == "exact")]
-    if e.empty:
+    if st[(st.subject == s_) & (st.precision_deg == other_p) & (st["mode"] == "exact")].empty:
         continue
-    eb, es = e[e.scan == "ball"].iloc[0], e[e.scan == "socket"].iloc[0]
     for name, g in ot[(ot.subject == s_) & (ot.precision_deg == other_p)].groupby("scheme", sort=False):
-        b, so = g[g.scan == "ball"].iloc[0], g[g.scan == "socket"].iloc[0]
-        rows.append([s_, name, f"{b.resolution:g}", f"{b.min_gap_mm:.3f}", f"{eb.min_gap_mm:.3f}",
-                     f"{b.vs_equiangular_p95_abs_mm:.4f}", f"{b.vs_equiangular_max_abs_mm:.2f}",
-                     f"{(b.sampling_ms + so.sampling_ms):.0f}", f"{(eb.sampling_ms + es.sampling_ms):.0f}",
-                     f"{b.detection_ns_per_lookup:.0f}", f"{eb.detection_ns_per_lookup:.0f}",
-                     f"{(b.map_bytes + so.map_bytes) / (eb.map_bytes + es.map_bytes):.2f}"])
-write_table(d, "table_schemes", ["subject", "scheme", "resolution", "min gap", "equiang. min", "p95 $|\\Delta|$",
-                                 "max $|\\Delta|$", "ms", "equiang. ms", "ns", "equiang. ns", "bytes ratio"], rows,
+        rows.append([s_, name, f"{g.resolution.iloc[0]:g}"] +
+                    versus(row_of(st, s_, "ball", other_p, "exact"), row_of(st, s_, "socket", other_p, "exact"),
+                           row_of(g, s_, "ball", other_p, "exact"), row_of(g, s_, "socket", other_p, "exact")))
+write_table(d, "table_schemes", ["subject", "scheme", "resolution", "equiang. min", "min gap", "p95 $|\\Delta|$",
+                                 "max $|\\Delta|$", "equiang. ms", "ms", "equiang. ns", "ns", "bytes ratio"], rows,
             align="llrrrrrrrrrr")
 others = ot[(ot.precision_deg == other_p) & (ot.scan == "ball")]
 
