@@ -11,7 +11,7 @@
 /// 2 pi (frac((F_k + 1) Phi) - (Phi - 1)) and z by -2 F_k / n. The direction's lattice coordinates
 /// give the parallelogram cell that holds it; the cell is split by its diagonal that is shorter on
 /// the sphere (the local Delaunay triangulation), and the look-up is barycentric in that triangle
-/// (three nodes; the fourth weight is 0). Across the boundary between two bases (a change of k)
+/// (three nodes; the fourth slot repeats one of them with weight 0). Across the boundary between two bases (a change of k)
 /// the triangulations differ, so the look-up jumps there by at most the interpolation error. Near the
 /// poles a lattice corner can fall outside [0, n): it is replaced by the nearest valid node (node 0
 /// or n - 1), which is first order within about one node spacing of the pole.
@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "impinge/sampling_scheme.hpp"
 
@@ -44,8 +45,25 @@ class FibonacciScheme : public SchemeImpl<FibonacciScheme> {
   double max_node_spacing() const override { return max_spacing_; }
   /// Barycentric stencil in the local Delaunay triangle (see the file comment).
   void stencil_at(double x, double y, double z, std::int64_t nodes[4], double w[4]) const;
+  /// Block stencils (SamplingScheme::stencils_soa): the same computation as stencil_at, branch-free
+  /// over the block so that it vectorises (AVX-512, AVX2 or plain, chosen at run time).
+  void stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
+                    double* w) const override;
+
+  /// Zones the look-up can choose, at most: k = 2 .. 33 covers n < Phi^68 / (pi sqrt 5), far
+  /// beyond the 2^31 nodes a map holds.
+  static constexpr int kMaxZones = 32;
+  /// The lattice bases of the zones k = 2 .. k_max a look-up can choose, by zone (index k - 2),
+  /// as arrays for the block look-up: Fibonacci numbers f0 = F_k, f1 = F_k+1; the inverse m of the
+  /// basis matrix ((a0, a1), (z0, z1)) (lattice coordinates = m (azimuth, z - z_0)); a0 a1 and
+  /// z0 z1 (which diagonal of a cell is shorter); and each zone's least n pi sqrt(5) (1 - z^2),
+  /// Phi^(2k), padded to kMaxZones with +inf.
+  struct Zones {
+    std::vector<double> f0, f1, m00, m01, m10, m11, a0a1, z0z1, start;
+  };
 
  private:
+  Zones zones_;
   /// Lattice cell of direction (x, y, z): corner indices i[4] of (c, c + e0, c + e1, c + e0 + e1)
   /// (unclamped), fractional coordinates (s, t), and whether the cell's diagonal c -- c + e0 + e1
   /// is the shorter one.
