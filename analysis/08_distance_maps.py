@@ -218,7 +218,8 @@ for s_ in subjects:
     if st[(st.subject == s_) & (st.precision_deg == other_p) & (st["mode"] == "exact")].empty:
         continue
     for name, g in ot[(ot.subject == s_) & (ot.precision_deg == other_p)].groupby("scheme", sort=False):
-        rows.append([s_, name, f"{g.resolution.iloc[0]:g}"] +
+        res = g.resolution.iloc[0]
+        rows.append([s_, name, f"{int(res)}" if res == int(res) else f"{res:.4g}"] +
                     versus(row_of(st, s_, "ball", other_p, "exact"), row_of(st, s_, "socket", other_p, "exact"),
                            row_of(g, s_, "ball", other_p, "exact"), row_of(g, s_, "socket", other_p, "exact")))
 write_table(d, "table_schemes", ["subject", "scheme", "resolution", "equiang. min", "min gap", "p95 $|\\Delta|$",
