@@ -302,10 +302,9 @@ struct RomSearchBounds {
 };
 
 namespace {
-using RomBounds = RomSearchBounds;
 class CompactScanner {
  public:
-  CompactScanner(const Joint& joint, const RomBaseline& base, const RomBounds* bounds, double threshold,
+  CompactScanner(const Joint& joint, const RomBaseline& base, const RomSearchBounds* bounds, double threshold,
                  RomVertices counted)
       : joint_(joint), bounds_(bounds), threshold_(threshold), counted_(counted) {
     auto skips = [](const ScanSet& set, const std::vector<std::uint8_t>& by_vertex) {
@@ -503,7 +502,7 @@ class CompactScanner {
         l.vertex = static_cast<std::size_t>(set.index[j]);
   }
   const Joint& joint_;
-  const RomBounds* bounds_;
+  const RomSearchBounds* bounds_;
   double threshold_;
   RomVertices counted_;
   bool exact_ = true;
@@ -552,7 +551,7 @@ std::shared_ptr<const RomSearchBounds> bounds_for(const Joint& joint, const RomO
 // limit_only: only limit_deg, contact_at_start and the counts are wanted (a ROM map's cell), so
 // neither end is scanned for the exact least gap and the monotony is not checked.
 RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation, const RomOptions& o,
-                const RomBaseline& base, const RomBounds* bounds, bool limit_only = false) {
+                const RomBaseline& base, const RomSearchBounds* bounds, bool limit_only = false) {
   const Joint& joint = hip.joint();
   require(base.skip_ball.size() == static_cast<std::size_t>(joint.ball().relative.rows()) &&
               base.skip_socket.size() == static_cast<std::size_t>(joint.socket().relative.rows()),
