@@ -1,7 +1,6 @@
 #include "impinge/fibonacci_scheme.hpp"
 
 #include <algorithm>
-#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -107,6 +106,17 @@ void FibonacciScheme::node_angles(std::int64_t first, std::int64_t count, double
 }
 
 namespace {
+/// The zone index (k - 2) of v = n pi sqrt(5) (1 - z^2): the last of the kMaxZones starts v
+/// reaches (0 when none), by a branch-free binary search, so that the block look-up vectorises.
+inline int zone_index(double v, const double* start) {
+  int zi = v >= start[16] ? 16 : 0;
+  zi += v >= start[zi + 8] ? 8 : 0;
+  zi += v >= start[zi + 4] ? 4 : 0;
+  zi += v >= start[zi + 2] ? 2 : 0;
+  return zi + (v >= start[zi + 1] ? 1 : 0);
+}
+static_assert(FibonacciScheme::kMaxZones == 32, "zone_index searches 32 starts");
+
 /// The block look-up (issue 12), branch-free so that it vectorises; cloned for AVX-512 and AVX2 and
 /// chosen at run time. For each direction: its zone (the last zone start Phi^(2k) that
 /// n pi sqrt(5) (1 - z^2) reaches: the table holds kMaxZones starts, +inf past the last zone), its
@@ -127,12 +137,7 @@ void fibonacci_stencils_kernel(const double* __restrict x, const double* __restr
     const double len = std::sqrt(x[j] * x[j] + y[j] * y[j] + z[j] * z[j]);
     const double cz = z[j] / len, a = fast_azimuth(y[j], x[j]);  // [0, 2 pi): the lattice repeats every 2 pi
     const double s2 = std::max(0.0, (1 - cz) * (1 + cz)), v = nc * s2;
-    // The last zone start v reaches (zone 0 when none): a branch-free binary search of the 32.
-    int zi = v >= start[16] ? 16 : 0;
-    zi += v >= start[zi + 8] ? 8 : 0;
-    zi += v >= start[zi + 4] ? 4 : 0;
-    zi += v >= start[zi + 2] ? 2 : 0;
-    zi += v >= start[zi + 1] ? 1 : 0;
+    const int zi = zone_index(v, start);
     const double rz = cz - z_first;
     const double f0 = m00[zi] * a + m01[zi] * rz, f1 = m10[zi] * a + m11[zi] * rz;
     const double c0 = std::floor(f0), c1 = std::floor(f1);
@@ -170,21 +175,16 @@ void FibonacciScheme::stencils_soa(const double* x, const double* y, const doubl
   fibonacci_stencils(x, y, z, n, zones_, double(n_), nodes, w);
 }
 
-void FibonacciScheme::cell(double x, double y, double z, std::int64_t i[4], double& s, double& t,
-                           bool& main_diagonal) const {
-  // Lattice cell by Keinert et al.'s formulas (the zone from its logarithm), for node().
+void FibonacciScheme::cell(double x, double y, double z, std::int64_t i[4]) const {
   const double len = std::sqrt(x * x + y * y + z * z);
   const double cz = z / len, a = fast_azimuth(y, x);
-  const std::size_t zi = static_cast<std::size_t>(zone_at(cz, double(n_)) - 2);
+  const auto zi = static_cast<std::size_t>(
+      zone_index(double(n_) * kPi * 2.2360679774997896964 * std::max(0.0, (1 - cz) * (1 + cz)), zones_.start.data()));
   const double rz = cz - (1 - inv_n_);
   const double f0 = zones_.m00[zi] * a + zones_.m01[zi] * rz, f1 = zones_.m10[zi] * a + zones_.m11[zi] * rz;
-  const double c0 = std::floor(f0), c1 = std::floor(f1);
-  s = f0 - c0, t = f1 - c1;
-  const double F0 = zones_.f0[zi], F1 = zones_.f1[zi], base = F0 * c0 + F1 * c1;
+  const double F0 = zones_.f0[zi], F1 = zones_.f1[zi], base = F0 * std::floor(f0) + F1 * std::floor(f1);
   i[0] = std::llround(base), i[1] = std::llround(base + F0), i[2] = std::llround(base + F1),
   i[3] = std::llround(base + F0 + F1);
-  const double s2 = std::max(0.0, (1 - cz) * (1 + cz));
-  main_diagonal = s2 * s2 * zones_.a0a1[zi] + zones_.z0z1[zi] <= 0;
 }
 
 void FibonacciScheme::stencil_at(double x, double y, double z, std::int64_t nodes[4], double w[4]) const {
@@ -195,9 +195,7 @@ void FibonacciScheme::stencil_at(double x, double y, double z, std::int64_t node
 
 std::int64_t FibonacciScheme::node(const Eigen::Vector3d& u) const {
   std::int64_t i[4];
-  double s, t;
-  bool main;
-  cell(u.x(), u.y(), u.z(), i, s, t, main);
+  cell(u.x(), u.y(), u.z(), i);
   const Eigen::Vector3d d = u.normalized();
   std::int64_t best = std::clamp<std::int64_t>(i[0], 0, n_ - 1);
   double best_d = (node_direction(best) - d).squaredNorm();

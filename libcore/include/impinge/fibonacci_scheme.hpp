@@ -64,10 +64,9 @@ class FibonacciScheme : public SchemeImpl<FibonacciScheme> {
 
  private:
   Zones zones_;
-  /// Lattice cell of direction (x, y, z): corner indices i[4] of (c, c + e0, c + e1, c + e0 + e1)
-  /// (unclamped), fractional coordinates (s, t), and whether the cell's diagonal c -- c + e0 + e1
-  /// is the shorter one.
-  void cell(double x, double y, double z, std::int64_t i[4], double& s, double& t, bool& main_diagonal) const;
+  /// Lattice cell of direction (x, y, z), in the block look-up's zone: corner indices i[4] of
+  /// (c, c + e0, c + e1, c + e0 + e1), unclamped.
+  void cell(double x, double y, double z, std::int64_t i[4]) const;
   /// Azimuth of node i in [0, 2 pi).
   double azimuth(std::int64_t i) const;
   std::int64_t n_;
