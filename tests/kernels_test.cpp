@@ -1,7 +1,8 @@
 // Both halves of every CPU-dispatched kernel pair (kernels.hpp) give the same results: the
 // rasteriser's AVX-512 span pass and row kernel against the generic C++ ones (maps node for node,
 // bit for bit), and the equiangular grid's AVX2 look-ups against the generic ones (every gap), on
-// real bones (or the generated hip without shared data), with and without a culling plan.
+// real bones (or the generated hip without shared data), with and without a culling plan; and the
+// Fibonacci lattice's AVX-512 block stencils against its generic ones (every stencil).
 // On a CPU without AVX-512 or AVX2 both sides are the generic kernels and the test still checks
 // that forcing them works. ctest also runs the rasteriser, sampling, detection and
 // depth-discontinuity suites whole with IMPINGE_KERNELS=generic (tests/CMakeLists.txt).
@@ -15,6 +16,7 @@
 #include <random>
 
 #include "impinge/equiangular_grid.hpp"
+#include "impinge/fibonacci_scheme.hpp"
 #include "impinge/raster_plan.hpp"
 #include "impinge/generated_models.hpp"
 #include "impinge/rasterize.hpp"
@@ -118,5 +120,59 @@ TEST(Kernels, LookUpHalvesGiveIdenticalGaps) {
     }
     EXPECT_EQ(differ, 0) << m.source << ": largest relative difference " << worst;
     EXPECT_GT(finite, n / 4) << m.source;
+  }
+}
+
+// The Fibonacci lattice's AVX-512 block look-up (zone parameters from registers, for blocks whose
+// directions span fewer than kZoneWindow zones) against the generic kernel: the same corners and
+// the same weights up to rounding, for blocks of nearby directions at many latitudes (the register
+// path, including blocks across zone boundaries and at the poles) and for blocks of random
+// directions (which span more zones: the fallback).
+TEST(Kernels, FibonacciStencilHalvesAgree) {
+  KernelScope scope;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0, 1);
+  std::uniform_real_distribution<double> uni(-1, 1);
+  for (double nodes : {1000.0, 82483.0, 8250517.0}) {
+    const FibonacciScheme s(nodes);
+    for (int block = 0; block < 400; ++block) {
+      const int m = 1 + int(rng() % kStencilBlock);
+      // Half the blocks: a cone of 0.5 to 20 deg around a random axis (nearby directions, as in a
+      // scan set); the other half: random directions.
+      const double spread = block % 2 ? 0.0 : 0.009 * (1 + block % 40);
+      const Eigen::Vector3d axis = block % 20 == 0 ? Eigen::Vector3d(0, 0, block % 40 ? 1 : -1)
+                                                   : Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+      std::vector<double> x(m), y(m), z(m);
+      for (int j = 0; j < m; ++j) {
+        const Eigen::Vector3d u =
+            spread > 0 ? (axis + spread * Eigen::Vector3d(uni(rng), uni(rng), uni(rng))).normalized()
+                       : Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+        x[j] = 30 * u.x(), y[j] = 30 * u.y(), z[j] = 30 * u.z();
+      }
+      std::vector<std::int32_t> na(4 * m), nb(4 * m);
+      std::vector<double> wa(4 * m), wb(4 * m);
+      set_kernel_set(KernelSet::native);
+      s.stencils_soa(x.data(), y.data(), z.data(), m, na.data(), wa.data());
+      set_kernel_set(KernelSet::generic);
+      s.stencils_soa(x.data(), y.data(), z.data(), m, nb.data(), wb.data());
+      for (int j = 0; j < m; ++j) {
+        // Compare as stencils: the interpolated direction (sum of weights times node directions)
+        // and, away from a cell's or triangle's edge, the nodes themselves; weights differ by the
+        // rounding of the lattice coordinates (fused multiply-adds or not: 1e-12 at 8 M nodes).
+        Eigen::Vector3d pa = Eigen::Vector3d::Zero(), pb = Eigen::Vector3d::Zero();
+        double least = 1;
+        for (int k = 0; k < 4; ++k) {
+          pa += wa[k * m + j] * s.node_direction(na[k * m + j]);
+          pb += wb[k * m + j] * s.node_direction(nb[k * m + j]);
+          least = std::min(least, std::abs(wa[k * m + j]) > 0 ? wa[k * m + j] : 1.0);
+        }
+        ASSERT_LT((pa - pb).norm(), 1e-9) << "n " << nodes << " block " << block << " direction " << j;
+        if (least > 1e-9)
+          for (int k = 0; k < 4; ++k) {
+            EXPECT_EQ(na[k * m + j], nb[k * m + j]) << "n " << nodes << " block " << block << " direction " << j;
+            EXPECT_NEAR(wa[k * m + j], wb[k * m + j], 1e-9) << "n " << nodes << " block " << block;
+          }
+      }
+    }
   }
 }

@@ -6,7 +6,12 @@
 
 #include "impinge/error.hpp"
 #include "impinge/fast_angles.hpp"
+#include "cpu_dispatch.hpp"
 #include "simd_clones.hpp"
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 namespace impinge {
 
@@ -74,7 +79,11 @@ FibonacciScheme::FibonacciScheme(double nodes) {
     t.start.push_back(std::pow(kPhi, 2 * k));
   }
   require(zones_.start.size() <= std::size_t(kMaxZones), os.str());
-  zones_.start.resize(kMaxZones, std::numeric_limits<double>::infinity());
+  // Padded for the block look-up: it reads kZoneWindow zones from any zone a direction can have.
+  for (auto* v : {&zones_.f0, &zones_.f1, &zones_.m00, &zones_.m01, &zones_.m10, &zones_.m11, &zones_.a0a1,
+                  &zones_.z0z1})
+    v->resize(kMaxZones + kZoneWindow, 0.0);
+  zones_.start.resize(kMaxZones + kZoneWindow, std::numeric_limits<double>::infinity());
   // Longest triangle edge: both basis steps and the shorter diagonal, at 4,096 latitudes between the
   // outermost nodes.
   max_spacing_ = 0;
@@ -162,8 +171,129 @@ void fibonacci_stencils_kernel(const double* __restrict x, const double* __restr
     w3[j] = main ? (upper ? s : t) : (upper ? s + t - 1 : 0);
   }
 }
+/// Cosine of the polar angle cz, sin^2 of it s2 and azimuth az of a block of directions: the first
+/// pass of the AVX-512 block look-up (vectorised clones).
+IMPINGE_SIMD_CLONES
+void fibonacci_angles(const double* __restrict x, const double* __restrict y, const double* __restrict z, int n,
+                      double* __restrict cz, double* __restrict s2, double* __restrict az) {
+  for (int j = 0; j < n; ++j) {
+    const double len = std::sqrt(x[j] * x[j] + y[j] * y[j] + z[j] * z[j]);
+    const double c = z[j] / len;
+    cz[j] = c, s2[j] = std::max(0.0, (1 - c) * (1 + c));
+    az[j] = fast_azimuth(y[j], x[j]);  // [0, 2 pi): the lattice repeats every 2 pi
+  }
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+// GCC 12's AVX-512 intrinsics pass _mm512_undefined_pd() as the unused source, which it then
+// reports as uninitialised (GCC bug 105593, fixed in GCC 13).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+/// The block look-up with AVX-512 when the block's directions lie in fewer than kZoneWindow
+/// consecutive zones (nearly always: a block is a run of a scan set, whose vertices are in Z order
+/// of direction): each direction's zone parameters are picked from registers holding the window's
+/// zones by one permute each, where fibonacci_stencils_kernel gathers them from memory, and the
+/// zone is counted with kZoneWindow - 1 compares instead of a binary search of gathers. The same
+/// computation otherwise (the same corners and weights, up to the rounding of fused multiply-adds).
+/// Returns false, having written nothing, when the zones span kZoneWindow or more.
+/// min(max(c, 0), last) by lane; max with 0 gives 0 for a NaN c.
+__attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline __m512d clamp_pd(__m512d c, __m512d last) {
+  return _mm512_min_pd(_mm512_max_pd(c, _mm512_setzero_pd()), last);
+}
+
+/// Lane i of the result: lane d_i of window.
+__attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline __m512d pick(__m512i d, __m512d window) {
+  return _mm512_permutexvar_pd(d, window);
+}
+
+__attribute__((target("avx512f,avx512vl,avx512dq"))) bool fibonacci_stencils_avx512(
+    const double* x, const double* y, const double* z, int n, const FibonacciScheme::Zones& t, double n_nodes,
+    std::int32_t* nodes, double* w) {
+  constexpr int kW = FibonacciScheme::kZoneWindow;
+  static_assert(kW == 8, "one 8-lane register per zone parameter");
+  alignas(64) double cz[kStencilBlock], s2v[kStencilBlock], az[kStencilBlock];
+  fibonacci_angles(x, y, z, n, cz, s2v, az);
+  const double nc = n_nodes * kPi * 2.2360679774997896964, z_first = 1 - 1 / n_nodes, last = n_nodes - 1;
+  // The least and largest n pi sqrt(5) (1 - z^2) of the block (NaN ignored), and their zones.
+  __m512d lo = _mm512_set1_pd(std::numeric_limits<double>::infinity()), hi = _mm512_set1_pd(-1.0);
+  for (int j = 0; j < n; j += 8) {
+    const __mmask8 k = n - j >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - j)) - 1);
+    const __m512d s2 = _mm512_maskz_loadu_pd(k, s2v + j);
+    lo = _mm512_mask_min_pd(lo, k, s2, lo), hi = _mm512_mask_max_pd(hi, k, s2, hi);
+  }
+  const double* start = t.start.data();
+  alignas(64) double lo8[8], hi8[8];
+  _mm512_store_pd(lo8, lo), _mm512_store_pd(hi8, hi);
+  const int zlo = zone_index(nc * *std::min_element(lo8, lo8 + 8), start);
+  const int zhi = zone_index(nc * *std::max_element(hi8, hi8 + 8), start);
+  if (zhi - zlo >= kW) return false;
+  const __m512d F0w = _mm512_loadu_pd(t.f0.data() + zlo), F1w = _mm512_loadu_pd(t.f1.data() + zlo);
+  const __m512d m00w = _mm512_loadu_pd(t.m00.data() + zlo), m01w = _mm512_loadu_pd(t.m01.data() + zlo);
+  const __m512d m10w = _mm512_loadu_pd(t.m10.data() + zlo), m11w = _mm512_loadu_pd(t.m11.data() + zlo);
+  const __m512d a0a1w = _mm512_loadu_pd(t.a0a1.data() + zlo), z0z1w = _mm512_loadu_pd(t.z0z1.data() + zlo);
+  const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1.0), vlast = _mm512_set1_pd(last);
+  const __m512d vnc = _mm512_set1_pd(nc), vz_first = _mm512_set1_pd(z_first);
+  const __m512i one_i = _mm512_set1_epi64(1);
+  for (int j = 0; j < n; j += 8) {
+    const __mmask8 k = n - j >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - j)) - 1);
+    const __m512d a = _mm512_maskz_loadu_pd(k, az + j), s2 = _mm512_maskz_loadu_pd(k, s2v + j);
+    const __m512d rz = _mm512_sub_pd(_mm512_maskz_loadu_pd(k, cz + j), vz_first);
+    // The zone within the window: how many of the window's later zone starts v reaches.
+    const __m512d v = _mm512_mul_pd(vnc, s2);
+    __m512i d = _mm512_setzero_si512();
+    for (int q = 1; q <= zhi - zlo; ++q)
+      d = _mm512_mask_add_epi64(d, _mm512_cmp_pd_mask(v, _mm512_set1_pd(start[zlo + q]), _CMP_GE_OQ), d, one_i);
+    const __m512d F0 = pick(d, F0w), F1 = pick(d, F1w);
+    const __m512d f0 = _mm512_add_pd(_mm512_mul_pd(pick(d, m00w), a),
+                                     _mm512_mul_pd(pick(d, m01w), rz));
+    const __m512d f1 = _mm512_add_pd(_mm512_mul_pd(pick(d, m10w), a),
+                                     _mm512_mul_pd(pick(d, m11w), rz));
+    const __m512d c0 = _mm512_roundscale_pd(f0, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    const __m512d c1 = _mm512_roundscale_pd(f1, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    const __m512d s = _mm512_sub_pd(f0, c0), tt = _mm512_sub_pd(f1, c1);
+    const __m512d base = _mm512_add_pd(_mm512_mul_pd(F0, c0), _mm512_mul_pd(F1, c1));
+    // Clamped corners; max(x, 0) gives 0 for a NaN x, so a degenerate direction reads node 0.
+    const __m512d c00 = clamp_pd(base, vlast), c10 = clamp_pd(_mm512_add_pd(base, F0), vlast);
+    const __m512d c01 = clamp_pd(_mm512_add_pd(base, F1), vlast);
+    const __m512d c11 = clamp_pd(_mm512_add_pd(_mm512_add_pd(base, F0), F1), vlast);
+    // The shorter diagonal on the sphere: 0 -- 3 when s2^2 a0 a1 + z0 z1 <= 0.
+    const __m512d diag = _mm512_add_pd(_mm512_mul_pd(_mm512_mul_pd(s2, s2), pick(d, a0a1w)),
+                                       pick(d, z0z1w));
+    const __mmask8 main = _mm512_cmp_pd_mask(diag, zero, _CMP_LE_OQ);
+    const __mmask8 upper = (main & _mm512_cmp_pd_mask(s, tt, _CMP_LT_OQ)) |
+                           (~main & _mm512_cmp_pd_mask(_mm512_add_pd(s, tt), one, _CMP_GT_OQ));
+    const __mmask8 mu = main & upper, ml = main & ~upper, au = ~main & upper, al = ~main & ~upper;
+    // Corners as in fibonacci_stencils_kernel: the one outside the triangle repeats one inside it.
+    const __m512d i0 = _mm512_mask_blend_pd(au, c00, c11), i1 = _mm512_mask_blend_pd(mu, c10, c00);
+    const __m512d i2 = _mm512_mask_blend_pd(ml, c01, c00), i3 = _mm512_mask_blend_pd(al, c11, c00);
+    const __m512d one_s = _mm512_sub_pd(one, s), one_t = _mm512_sub_pd(one, tt);
+    // w0 = main ? (upper ? 1 - t : 1 - s) : (upper ? 0 : 1 - s - t), and so on.
+    __m512d w0 = _mm512_mask_blend_pd(al, _mm512_mask_blend_pd(mu, one_s, one_t), _mm512_sub_pd(one_s, tt));
+    w0 = _mm512_mask_blend_pd(au, w0, zero);
+    __m512d w1 = _mm512_mask_blend_pd(ml, _mm512_mask_blend_pd(au, s, one_t), _mm512_sub_pd(s, tt));
+    w1 = _mm512_mask_blend_pd(mu, w1, zero);
+    __m512d w2 = _mm512_mask_blend_pd(mu, _mm512_mask_blend_pd(au, tt, one_s), _mm512_sub_pd(tt, s));
+    w2 = _mm512_mask_blend_pd(ml, w2, zero);
+    __m512d w3 = _mm512_mask_blend_pd(au, _mm512_mask_blend_pd(mu, tt, s), _mm512_sub_pd(_mm512_add_pd(s, tt), one));
+    w3 = _mm512_mask_blend_pd(al, w3, zero);
+    _mm256_mask_storeu_epi32(nodes + j, k, _mm512_cvttpd_epi32(i0));
+    _mm256_mask_storeu_epi32(nodes + n + j, k, _mm512_cvttpd_epi32(i1));
+    _mm256_mask_storeu_epi32(nodes + 2 * n + j, k, _mm512_cvttpd_epi32(i2));
+    _mm256_mask_storeu_epi32(nodes + 3 * n + j, k, _mm512_cvttpd_epi32(i3));
+    _mm512_mask_storeu_pd(w + j, k, w0), _mm512_mask_storeu_pd(w + n + j, k, w1);
+    _mm512_mask_storeu_pd(w + 2 * n + j, k, w2), _mm512_mask_storeu_pd(w + 3 * n + j, k, w3);
+  }
+  return true;
+}
+#pragma GCC diagnostic pop
+#endif
+
 void fibonacci_stencils(const double* x, const double* y, const double* z, int n, const FibonacciScheme::Zones& t,
                         double n_nodes, std::int32_t* nodes, double* w) {
+#if defined(__GNUC__) && defined(__x86_64__)
+  if (n <= kStencilBlock && detail::use_avx512() && fibonacci_stencils_avx512(x, y, z, n, t, n_nodes, nodes, w)) return;
+#endif
   fibonacci_stencils_kernel(x, y, z, n, t.f0.data(), t.f1.data(), t.m00.data(), t.m01.data(), t.m10.data(),
                             t.m11.data(), t.a0a1.data(), t.z0z1.data(), t.start.data(), n_nodes, nodes, nodes + n,
                             nodes + 2 * n, nodes + 3 * n, w, w + n, w + 2 * n, w + 3 * n);

@@ -53,11 +53,14 @@ class FibonacciScheme : public SchemeImpl<FibonacciScheme> {
   /// Zones the look-up can choose, at most: k = 2 .. 33 covers n < Phi^68 / (pi sqrt 5), far
   /// beyond the 2^31 nodes a map holds.
   static constexpr int kMaxZones = 32;
+  /// Zones the AVX-512 block look-up holds in registers: a block whose directions span fewer
+  /// zones takes its zone parameters from registers (the tables are padded by this many).
+  static constexpr int kZoneWindow = 8;
   /// The lattice bases of the zones k = 2 .. k_max a look-up can choose, by zone (index k - 2),
   /// as arrays for the block look-up: Fibonacci numbers f0 = F_k, f1 = F_k+1; the inverse m of the
   /// basis matrix ((a0, a1), (z0, z1)) (lattice coordinates = m (azimuth, z - z_0)); a0 a1 and
   /// z0 z1 (which diagonal of a cell is shorter); and each zone's least n pi sqrt(5) (1 - z^2),
-  /// Phi^(2k), padded to kMaxZones with +inf.
+  /// Phi^(2k); each table padded to kMaxZones + kZoneWindow entries (starts with +inf).
   struct Zones {
     std::vector<double> f0, f1, m00, m01, m10, m11, a0a1, z0z1, start;
   };

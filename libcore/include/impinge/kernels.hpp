@@ -1,8 +1,8 @@
 #pragma once
 /// @file kernels.hpp
 /// Which implementation the CPU-dispatched hot loops run: the rasteriser's span pass and exact row
-/// kernel (AVX-512 F/VL/DQ or generic C++), and the equiangular grid's bilinear look-ups (AVX2+FMA or
-/// generic C++). Both halves of every pair compute the same formulas; the generic one runs on any
+/// kernel (AVX-512 F/VL/DQ or generic C++), the equiangular grid's bilinear look-ups (AVX2+FMA or
+/// generic C++) and the Fibonacci lattice's block stencils (AVX-512 F/VL/DQ or generic). Both halves of every pair compute the same formulas; the generic one runs on any
 /// x86-64 (and any other) CPU. Forcing `generic` on an AVX-512 machine tests the half that other
 /// machines run, and A/B-measures the vector kernels.
 /// Not covered: functions that GCC compiles per ISA level from one source (`target_clones`); they are
