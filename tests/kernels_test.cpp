@@ -57,7 +57,7 @@ TEST(Kernels, ForcingGenericIsReported) {
   KernelScope scope;
   set_kernel_set(KernelSet::generic);
   EXPECT_EQ(kernel_set(), KernelSet::generic);
-  EXPECT_EQ(kernel_description(), "rasteriser generic, look-ups generic");
+  EXPECT_EQ(kernel_description(), "rasteriser generic, look-ups generic, fibonacci stencils generic");
   set_kernel_set(KernelSet::native);
   EXPECT_EQ(kernel_set(), KernelSet::native);
   EXPECT_NE(kernel_description().find("rasteriser "), std::string::npos);

@@ -54,7 +54,8 @@ void set_kernel_set(KernelSet set) { g_set.store(static_cast<int>(set), std::mem
 
 std::string kernel_description() {
   return std::string("rasteriser ") + (detail::use_avx512() ? "avx512" : "generic") + ", look-ups " +
-         (detail::use_avx2_fma() ? "avx2" : "generic");
+         (detail::use_avx2_fma() ? "avx2" : "generic") + ", fibonacci stencils " +
+         (detail::use_avx512() ? "avx512" : "generic");
 }
 
 namespace detail {

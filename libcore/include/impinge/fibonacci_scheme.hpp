@@ -46,7 +46,10 @@ class FibonacciScheme : public SchemeImpl<FibonacciScheme> {
   /// Barycentric stencil in the local Delaunay triangle (see the file comment).
   void stencil_at(double x, double y, double z, std::int64_t nodes[4], double w[4]) const;
   /// Block stencils (SamplingScheme::stencils_soa): the same computation as stencil_at, branch-free
-  /// over the block so that it vectorises (AVX-512, AVX2 or plain, chosen at run time).
+  /// over the block so that it vectorises (AVX-512, AVX2 or plain, chosen at run time). With the
+  /// native kernels (kernels.hpp) on an AVX-512 CPU, a block whose directions lie in fewer than
+  /// kZoneWindow zones reads its zone parameters from registers instead of gathering them; the
+  /// result differs from the generic kernel's by the rounding of fused multiply-adds (tested).
   void stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
                     double* w) const override;
 

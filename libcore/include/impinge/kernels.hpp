@@ -28,8 +28,8 @@ KernelSet kernel_set();
 /// beyond rounding (tested: the same maps node for node, the same gaps).
 void set_kernel_set(KernelSet set);
 
-/// What runs now, for meta data and logs: e.g. "rasteriser avx512, look-ups avx2" or
-/// "rasteriser generic, look-ups generic".
+/// What runs now, for meta data and logs: e.g. "rasteriser avx512, look-ups avx2, fibonacci
+/// stencils avx512" or "rasteriser generic, look-ups generic, fibonacci stencils generic".
 std::string kernel_description();
 
 }  // namespace impinge
