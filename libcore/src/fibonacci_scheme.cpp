@@ -190,13 +190,6 @@ void fibonacci_angles(const double* __restrict x, const double* __restrict y, co
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-/// The block look-up with AVX-512 when the block's directions lie in fewer than kZoneWindow
-/// consecutive zones (nearly always: a block is a run of a scan set, whose vertices are in Z order
-/// of direction): each direction's zone parameters are picked from registers holding the window's
-/// zones by one permute each, where fibonacci_stencils_kernel gathers them from memory, and the
-/// zone is counted with kZoneWindow - 1 compares instead of a binary search of gathers. The same
-/// computation otherwise (the same corners and weights, up to the rounding of fused multiply-adds).
-/// Returns false, having written nothing, when the zones span kZoneWindow or more.
 /// min(max(c, 0), last) by lane; max with 0 gives 0 for a NaN c.
 __attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline __m512d clamp_pd(__m512d c, __m512d last) {
   return _mm512_min_pd(_mm512_max_pd(c, _mm512_setzero_pd()), last);
@@ -207,6 +200,13 @@ __attribute__((target("avx512f,avx512vl,avx512dq"), always_inline)) inline __m51
   return _mm512_permutexvar_pd(d, window);
 }
 
+/// The block look-up with AVX-512 when the block's directions lie in fewer than kZoneWindow
+/// consecutive zones (usually: a block is a run of a scan set, whose vertices are in Z order of
+/// direction): each direction's zone parameters are picked from registers holding the window's
+/// zones by one permute each, where fibonacci_stencils_kernel gathers them from memory, and the
+/// zone is counted with at most kZoneWindow - 1 compares, not a binary search of gathers. The same
+/// computation otherwise (the same corners and weights, up to the rounding of fused multiply-adds).
+/// Returns false, having written nothing, when the zones span kZoneWindow or more.
 __attribute__((target("avx512f,avx512vl,avx512dq"))) bool fibonacci_stencils_avx512(
     const double* x, const double* y, const double* z, int n, const FibonacciScheme::Zones& t, double n_nodes,
     std::int32_t* nodes, double* w) {
