@@ -54,7 +54,9 @@ TEST(HipJoint, SameMinimumGapsForAnyScanPlacement) {
       return out;
     };
     const auto ref = gaps(j->femur, j->pelvis);
-    for (int k = 0; k < 20; ++k) {
+    // Six random placements per subject (each a rotation and a shift of up to 400 mm per axis): a
+    // placement that the set-up does not undo shows in every pose's gaps.
+    for (int k = 0; k < 6; ++k) {
       const Eigen::Matrix3d Q = test::random_rotation(rng);
       const Eigen::Vector3d t(shift(rng), shift(rng), shift(rng));
       const auto moved = gaps(test::transformed(j->femur, Q, t), test::transformed(j->pelvis, Q, t));

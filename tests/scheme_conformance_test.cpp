@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <random>
 
 #include "impinge/error.hpp"
@@ -30,15 +31,6 @@
 using namespace impinge;
 
 namespace {
-
-// Resolutions with node spacings of at most 2 and 1 deg (resolution_for_spacing) and the scheme's
-// default, in the scheme's own unit.
-std::vector<double> resolutions(const std::string& name) {
-  std::vector<double> out;
-  for (double p : {2.0, 1.0}) out.push_back(resolution_for_spacing(name, p));
-  out.push_back(default_resolution(name));
-  return out;
-}
 
 // Resolutions in degrees ("precision_deg") are finer when smaller; every other resolution is a
 // whole count (turns, cells, nside) that is finer when larger.
@@ -58,17 +50,31 @@ std::vector<Eigen::Vector3d> directions(std::mt19937_64& rng, int n) {
   return out;
 }
 
+// One case: a registered scheme at the coarsest resolution with node spacings of at most 2 or 1 deg
+// (resolution_for_spacing), or at its default (spacing_deg 0). The resolution is found when a test
+// asks for it, not when the cases are listed: ctest runs each test in its own process, and finding
+// every case's resolution up front cost each of them 1.6 s.
 struct Case {
   std::string name;
-  double resolution;
+  double spacing_deg;  // 2, 1, or 0 for default_resolution(name)
+  double resolution() const {
+    static std::map<std::pair<std::string, double>, double> found;
+    const auto key = std::make_pair(name, spacing_deg);
+    auto it = found.find(key);
+    if (it == found.end())
+      it = found.emplace(key, spacing_deg > 0 ? resolution_for_spacing(name, spacing_deg) : default_resolution(name)).first;
+    return it->second;
+  }
 };
 // Readable names in test output (gtest prints unknown types as bytes).
-void PrintTo(const Case& c, std::ostream* os) { *os << c.name << " at " << c.resolution; }
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.name << (c.spacing_deg > 0 ? " at node spacing <= " + std::to_string(c.spacing_deg) + " deg" : " at its default");
+}
 
 std::vector<Case> cases() {
   std::vector<Case> out;
   for (const auto& [name, unit] : scheme_names())
-    for (double r : resolutions(name)) out.push_back({name, r});
+    for (double p : {2.0, 1.0, 0.0}) out.push_back({name, p});
   return out;
 }
 
@@ -77,7 +83,7 @@ std::vector<Case> cases() {
 class SchemeConformance : public ::testing::TestWithParam<Case> {};
 
 TEST_P(SchemeConformance, NodeOfItsOwnDirectionIsItself) {
-  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
   const std::int64_t n = s->num_nodes();
   std::mt19937_64 rng(3);
   std::uniform_int_distribution<std::int64_t> pick(0, n - 1);
@@ -98,7 +104,7 @@ TEST_P(SchemeConformance, NodeOfItsOwnDirectionIsItself) {
 TEST_P(SchemeConformance, NodeAnglesAreThoseOfNodeDirections) {
   // node_angles (the resampling fast path, overridden by most schemes) against the angles of
   // node_direction, on every node at coarse resolutions and a run of nodes at fine ones.
-  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
   const std::int64_t n = std::min<std::int64_t>(s->num_nodes(), 300000);
   std::vector<double> phi(static_cast<std::size_t>(n)), theta(phi.size());
   s->node_angles(0, n, phi.data(), theta.data());
@@ -116,7 +122,7 @@ TEST_P(SchemeConformance, NodeAnglesAreThoseOfNodeDirections) {
 }
 
 TEST_P(SchemeConformance, StencilsAreConvexCombinationsOfValidNodes) {
-  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
   std::mt19937_64 rng(5);
   for (const Eigen::Vector3d& u : directions(rng, 20000)) {
     const Stencil st = s->interpolate(u);
@@ -132,7 +138,7 @@ TEST_P(SchemeConformance, StencilsAreConvexCombinationsOfValidNodes) {
 }
 
 TEST_P(SchemeConformance, SingleBatchAndSoaLookUpsAgree) {
-  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> val(20, 30);
   RadialDistanceMap mf(s);
@@ -178,7 +184,7 @@ TEST_P(SchemeConformance, SingleBatchAndSoaLookUpsAgree) {
 }
 
 TEST_P(SchemeConformance, BlockStencilsAreConvexCombinationsOfValidNodes) {
-  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
   std::mt19937_64 rng(13);
   const std::vector<Eigen::Vector3d> dirs = directions(rng, 3000);
   std::vector<double> x, y, z;
@@ -206,7 +212,7 @@ TEST_P(SchemeConformance, SparseMapsGiveTheDenseMapsBits) {
   // with the whole map as region every look-up has the same bits, plain and marked, float and
   // double; with a region of 25 mm, the same bits wherever every weighted node is within it, and
   // NaN (no surface within the region) wherever a weighted node lies in an absent tile.
-  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
   std::mt19937_64 rng(15);
   std::uniform_real_distribution<double> val(20, 30), unit(0, 1);
   RadialDistanceMap mf(s);
@@ -288,7 +294,7 @@ TEST_P(SchemeConformance, SparseMapsGiveTheDenseMapsBits) {
 
 TEST_P(SchemeConformance, MaxNodeSpacingAgainstBruteForce) {
   if (!have_exact_reference()) GTEST_SKIP() << "no CGAL in this build";
-  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
   if (s->num_nodes() > 300000) GTEST_SKIP() << "brute force at the coarse resolutions only";
   std::vector<Eigen::Vector3d> nodes;
   for (std::int64_t i = 0; i < s->num_nodes(); ++i) nodes.push_back(s->node_direction(i));
@@ -309,7 +315,7 @@ TEST_P(SchemeConformance, MaxNodeSpacingAgainstBruteForce) {
 TEST_P(SchemeConformance, ResolutionForSpacingIsTheCoarsestThatReachesIt) {
   // resolution_for_spacing(name, s): max_node_spacing <= s, and the next coarser resolution does not
   // reach s (minimal), for spacings around this case's own.
-  const auto here = make_scheme(GetParam().name, GetParam().resolution);
+  const auto here = make_scheme(GetParam().name, GetParam().resolution());
   const double s_deg = here->max_node_spacing() * 180 / M_PI * 1.05;
   const double r = resolution_for_spacing(GetParam().name, s_deg);
   const auto s = make_scheme(GetParam().name, r);
@@ -343,7 +349,7 @@ TEST_P(SchemeConformance, SampledSphereAgreesWithTheExactReference) {
   // (h = max_node_spacing) of a radius function whose second derivative is below 7 mm, plus twice
   // the facet sagitta; resampling adds the same bound at the temporary grid's spacing.
   if (!have_exact_reference()) GTEST_SKIP() << "no CGAL in this build";
-  const auto s = make_scheme(GetParam().name, GetParam().resolution);
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
   if (s->num_nodes() > 30000) GTEST_SKIP() << "exact node values at the coarse resolutions only";
   const TriangleMesh mesh = make_uv_sphere(22, Eigen::Vector3d(1.5, -2.0, 1.6), 180, 90, Eigen::Vector3d(0.2, 0.1, 0.97));
   const ExactReference exact(mesh);
@@ -389,7 +395,7 @@ TEST_P(SchemeConformance, BadResolutionsAreRefusedByName) {
 
 INSTANTIATE_TEST_SUITE_P(Registered, SchemeConformance, ::testing::ValuesIn(cases()),
                          [](const ::testing::TestParamInfo<Case>& i) {
-                           std::string n = i.param.name + "_" + std::to_string(int(std::lround(i.param.resolution * 100)));
+                           std::string n = i.param.name + (i.param.spacing_deg > 0 ? "_" + std::to_string(int(i.param.spacing_deg)) + "deg" : "_default");
                            for (char& c : n)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return n;
