@@ -14,18 +14,18 @@
 #include <map>
 #include <memory>
 
-#include "impinge/detection.hpp"
-#include "impinge/embree_ray_caster.hpp"
-#include "impinge/exact_reference.hpp"
-#include "impinge/fcl_collision.hpp"
-#include "impinge/generated_models.hpp"
-#include "impinge/mesh_io.hpp"
-#include "impinge/naive_sampling.hpp"
-#include "impinge/pairwise.hpp"
-#include "impinge/rasterize.hpp"
-#include "impinge/sampling.hpp"
-#include "impinge/sphere_fit.hpp"
-#include "impinge/subject.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/casters/embree_ray_caster.hpp"
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/casters/fcl_collision.hpp"
+#include "impinge/casters/pairwise.hpp"
+#include "impinge/detection/detection.hpp"
+#include "impinge/io/generated_models.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/io/subject.hpp"
+#include "impinge/sampling/naive_sampling.hpp"
+#include "impinge/sampling/rasterize.hpp"
+#include "impinge/sampling/sampling.hpp"
 
 using namespace impinge;
 
@@ -240,9 +240,8 @@ void BM_EmbreeQuery(benchmark::State& st) {
   const ScanSet& set = st.range(2) ? (ball ? b.femur_hip : b.pelvis_hip) : (ball ? b.femur_set : b.pelvis_set);
   std::vector<float> out(static_cast<std::size_t>(set.size()));
   for (auto _ : st) {
-    (ball ? pelvis : femur)
-        .scan_gaps(set, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(),
-                   ball ? ScanSide::inside : ScanSide::outside, out.data(), st.range(1) == 1);
+    scan_gaps_embree(ball ? pelvis : femur, set, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(),
+                     ball ? ScanSide::inside : ScanSide::outside, out.data(), st.range(1) == 1);
     benchmark::DoNotOptimize(out.data());
   }
   st.counters["ns_per_lookup"] = benchmark::Counter(double(set.size()) * double(st.iterations()),

@@ -20,11 +20,11 @@
 #include <fstream>
 
 #include "experiment_support.hpp"
-#include "impinge/equiangular_grid.hpp"
-#include "impinge/helix_scheme.hpp"
-#include "impinge/radial_distance_map.hpp"
-#include "impinge/sampling.hpp"
-#include "impinge/spherical_frame.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/maps/radial_distance_map.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/equiangular_grid.hpp"
+#include "impinge/schemes/helix_scheme.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

@@ -26,12 +26,12 @@
 #include <random>
 
 #include "experiment_support.hpp"
-#include "impinge/embree_ray_caster.hpp"
-#include "impinge/raster_plan.hpp"
-#include "impinge/helix_scheme.hpp"
-#include "impinge/naive_sampling.hpp"
-#include "impinge/rasterize.hpp"
-#include "impinge/sampling.hpp"
+#include "impinge/casters/embree_ray_caster.hpp"
+#include "impinge/sampling/naive_sampling.hpp"
+#include "impinge/sampling/raster_plan.hpp"
+#include "impinge/sampling/rasterize.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/helix_scheme.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

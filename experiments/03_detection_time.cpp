@@ -26,15 +26,15 @@
 #include <thread>
 
 #include "experiment_support.hpp"
-#include "impinge/detection.hpp"
-#include "impinge/embree_ray_caster.hpp"
-#include "impinge/error.hpp"
-#include "impinge/exact_reference.hpp"
-#include "impinge/raster_plan.hpp"
-#include "impinge/fcl_collision.hpp"
-#include "impinge/helix_scheme.hpp"
-#include "impinge/pairwise.hpp"
-#include "impinge/sampling.hpp"
+#include "impinge/casters/embree_ray_caster.hpp"
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/casters/fcl_collision.hpp"
+#include "impinge/casters/pairwise.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/detection/detection.hpp"
+#include "impinge/sampling/raster_plan.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/helix_scheme.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;
@@ -173,9 +173,9 @@ int main(int argc, char** argv) {
       std::vector<float> g1(std::size_t(fset.size())), g2(std::size_t(pset.size()));
       if (emb_f) {
         for (int packet = 0; packet < 2; ++packet) {
-          const double tb = median_ms([&] { emb_p->scan_gaps(fset, I, t, ScanSide::inside, g1.data(), packet); }, reps);
+          const double tb = median_ms([&] { scan_gaps_embree(*emb_p, fset, I, t, ScanSide::inside, g1.data(), packet); }, reps);
           const double ts = median_ms(
-              [&] { emb_f->scan_gaps(pset, I, Eigen::Vector3d(-t), ScanSide::outside, g2.data(), packet); }, reps);
+              [&] { scan_gaps_embree(*emb_f, pset, I, Eigen::Vector3d(-t), ScanSide::outside, g2.data(), packet); }, reps);
           row(pname, packet ? "embree_radial_packet8" : "embree_radial", 0, nv, tb + ts, tb, ts, min_of(g1, g2),
               "min_gap_mm");
         }

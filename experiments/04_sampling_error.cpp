@@ -18,15 +18,15 @@
 #include <random>
 
 #include "experiment_support.hpp"
-#include "impinge/conchoid.hpp"
-#include "impinge/error.hpp"
-#include "impinge/exact_reference.hpp"
-#include "impinge/generated_models.hpp"
-#include "impinge/helix_scheme.hpp"
-#include "impinge/sampling.hpp"
-#include "impinge/sampling_error.hpp"
-#include "impinge/sphere_fit.hpp"
-#include "impinge/spherical_frame.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/io/generated_models.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/sampling/sampling_error.hpp"
+#include "impinge/schemes/conchoid.hpp"
+#include "impinge/schemes/helix_scheme.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

@@ -14,11 +14,11 @@
 #include <random>
 
 #include "experiment_support.hpp"
-#include "impinge/generated_models.hpp"
-#include "impinge/joint.hpp"
-#include "impinge/naive_sampling.hpp"
-#include "impinge/sampling_error.hpp"
-#include "impinge/spherical_frame.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/detection/joint.hpp"
+#include "impinge/io/generated_models.hpp"
+#include "impinge/sampling/naive_sampling.hpp"
+#include "impinge/sampling/sampling_error.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

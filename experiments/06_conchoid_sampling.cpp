@@ -14,10 +14,10 @@
 #include <random>
 
 #include "experiment_support.hpp"
-#include "impinge/conchoid.hpp"
-#include "impinge/radial_distance_map.hpp"
-#include "impinge/sampling_scheme.hpp"
-#include "impinge/spherical_frame.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/maps/radial_distance_map.hpp"
+#include "impinge/schemes/conchoid.hpp"
+#include "impinge/schemes/sampling_scheme.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

@@ -12,8 +12,8 @@
 #include <random>
 
 #include "experiment_support.hpp"
-#include "impinge/helix_scheme.hpp"
-#include "impinge/spherical_frame.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/schemes/helix_scheme.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

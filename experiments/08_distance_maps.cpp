@@ -32,16 +32,16 @@
 #include <map>
 
 #include "experiment_support.hpp"
-#include "impinge/clock_face.hpp"
-#include "impinge/error.hpp"
-#include "impinge/helix_scheme.hpp"
-#include "impinge/hip_joint.hpp"
-#include "impinge/mesh_io.hpp"
-#include "impinge/joint.hpp"
-#include "impinge/map_image.hpp"
-#include "impinge/sampling.hpp"
-#include "impinge/sphere_fit.hpp"
-#include "impinge/spherical_frame.hpp"
+#include "impinge/anatomy/clock_face.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/clinical/hip_joint.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/detection/joint.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/maps/map_image.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/helix_scheme.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

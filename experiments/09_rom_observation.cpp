@@ -36,16 +36,16 @@
 #include <sstream>
 
 #include "experiment_support.hpp"
-#include "impinge/clock_face.hpp"
-#include "impinge/error.hpp"
-#include "impinge/exact_reference.hpp"
-#include "impinge/fcl_collision.hpp"
-#include "impinge/first_hit_caster.hpp"
-#include "impinge/hip_joint.hpp"
-#include "impinge/layered_map.hpp"
-#include "impinge/mesh_io.hpp"
-#include "impinge/rom.hpp"
-#include "impinge/sphere_fit.hpp"
+#include "impinge/anatomy/clock_face.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/casters/fcl_collision.hpp"
+#include "impinge/casters/first_hit_caster.hpp"
+#include "impinge/clinical/hip_joint.hpp"
+#include "impinge/clinical/rom.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/maps/layered_map.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

@@ -35,15 +35,15 @@
 #include <optional>
 
 #include "experiment_support.hpp"
-#include "impinge/depth_discontinuity.hpp"
-#include "impinge/detection.hpp"
-#include "impinge/embree_ray_caster.hpp"
-#include "impinge/error.hpp"
-#include "impinge/exact_reference.hpp"
-#include "impinge/first_hit_caster.hpp"
-#include "impinge/helix_scheme.hpp"
-#include "impinge/sampling.hpp"
-#include "impinge/spherical_frame.hpp"
+#include "impinge/casters/embree_ray_caster.hpp"
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/casters/first_hit_caster.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/detection/detection.hpp"
+#include "impinge/maps/depth_discontinuity.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/helix_scheme.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;
@@ -303,8 +303,8 @@ int main(int argc, char** argv) {
         for (int packet = 0; packet < 2; ++packet) {
           const double tq = median_ms(
               [&] {
-                ep.scan_gaps(fset, I, t, ScanSide::inside, g[0].data(), packet);
-                ef.scan_gaps(pset, I, Eigen::Vector3d(-t), ScanSide::outside, g[1].data(), packet);
+                scan_gaps_embree(ep, fset, I, t, ScanSide::inside, g[0].data(), packet);
+                scan_gaps_embree(ef, pset, I, Eigen::Vector3d(-t), ScanSide::outside, g[1].data(), packet);
               },
               reps);
           put(pname, packet ? "embree_radial_packet8" : "embree_radial", "exact", 0, 0,

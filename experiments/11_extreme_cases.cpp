@@ -17,11 +17,11 @@
 
 #include "11_extreme_cases_catalogue.hpp"
 #include "experiment_support.hpp"
-#include "impinge/exact_reference.hpp"
-#include "impinge/femur_frame.hpp"
-#include "impinge/first_hit_caster.hpp"
-#include "impinge/helix_scheme.hpp"
-#include "impinge/hip_joint.hpp"
+#include "impinge/anatomy/femur_frame.hpp"
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/casters/first_hit_caster.hpp"
+#include "impinge/clinical/hip_joint.hpp"
+#include "impinge/schemes/helix_scheme.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

@@ -29,14 +29,14 @@
 #include <random>
 #include <sstream>
 
-#include "impinge/conchoid.hpp"
-#include "impinge/exact_reference.hpp"
-#include "impinge/generated_models.hpp"
-#include "impinge/helix_arc_length.hpp"
-#include "impinge/helix_scheme.hpp"
-#include "impinge/joint.hpp"
-#include "impinge/sampling.hpp"
-#include "impinge/sphere_fit.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/detection/joint.hpp"
+#include "impinge/io/generated_models.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/conchoid.hpp"
+#include "impinge/schemes/helix_arc_length.hpp"
+#include "impinge/schemes/helix_scheme.hpp"
 
 namespace impinge::experiment {
 

@@ -15,10 +15,10 @@
 #include <random>
 
 #include "experiment_support.hpp"
-#include "impinge/error.hpp"
-#include "impinge/generated_models.hpp"
-#include "impinge/sphere_fit.hpp"
-#include "impinge/spherical_frame.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/io/generated_models.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;

@@ -7,10 +7,10 @@
 #include <filesystem>
 #include <iostream>
 
-#include "impinge/kernels.hpp"
-#include "impinge/error.hpp"
-#include "impinge/mesh_io.hpp"
-#include "impinge/subject.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/kernels.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/io/subject.hpp"
 
 namespace impinge::experiment {
 

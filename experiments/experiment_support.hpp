@@ -10,11 +10,11 @@
 #include <type_traits>
 #include <vector>
 
-#include "impinge/generated_models.hpp"
-#include "impinge/joint.hpp"
-#include "impinge/mesh.hpp"
-#include "impinge/pose.hpp"
-#include "impinge/sphere_fit.hpp"
+#include "impinge/anatomy/pose.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/core/mesh.hpp"
+#include "impinge/detection/joint.hpp"
+#include "impinge/io/generated_models.hpp"
 
 namespace impinge::experiment {
 

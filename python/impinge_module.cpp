@@ -17,17 +17,17 @@
 #include <string>
 #include <vector>
 
-#include "impinge/error.hpp"
-#include "impinge/generated_models.hpp"
-#include "impinge/hip_joint.hpp"
-#include "impinge/map_io.hpp"
-#include "impinge/mesh.hpp"
-#include "impinge/mesh_io.hpp"
-#include "impinge/rom.hpp"
-#include "impinge/sampling.hpp"
-#include "impinge/sampling_scheme.hpp"
-#include "impinge/sphere_fit.hpp"
-#include "impinge/subject.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/clinical/hip_joint.hpp"
+#include "impinge/clinical/rom.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/mesh.hpp"
+#include "impinge/io/generated_models.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/io/subject.hpp"
+#include "impinge/maps/map_io.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/sampling_scheme.hpp"
 
 namespace py = pybind11;
 using namespace impinge;

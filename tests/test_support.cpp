@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "impinge/mesh_io.hpp"
-#include "impinge/sphere_fit.hpp"
-#include "impinge/subject.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/io/subject.hpp"
 
 namespace impinge::test {
 

@@ -5,7 +5,7 @@
 #include <random>
 #include <string>
 
-#include "impinge/mesh.hpp"
+#include "impinge/core/mesh.hpp"
 
 namespace impinge::test {
 

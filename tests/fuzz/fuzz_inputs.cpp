@@ -7,10 +7,10 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "impinge/error.hpp"
-#include "impinge/mesh_io.hpp"
-#include "impinge/motion.hpp"
-#include "impinge/subject.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/io/motion.hpp"
+#include "impinge/io/subject.hpp"
 
 namespace impinge::fuzz {
 

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <iostream>
 
-#include "impinge/generated_models.hpp"
-#include "impinge/joint.hpp"
+#include "impinge/detection/joint.hpp"
+#include "impinge/io/generated_models.hpp"
 
 int main() {
   impinge::HipModelOptions o;

@@ -11,6 +11,6 @@ cmake -S "$src/tests/package_consumer" -B "$work/build" -G Ninja -DCMAKE_BUILD_T
 cmake --build "$work/build" >/dev/null
 "$work/build/consumer"
 # The installed tree holds the headers, the library and the package files, nothing else.
-test -f "$work/prefix/include/impinge/joint.hpp"
+test -f "$work/prefix/include/impinge/detection/joint.hpp"
 test -f "$work/prefix/lib/cmake/impinge/impingeConfig.cmake"
 echo "package consumer ok"

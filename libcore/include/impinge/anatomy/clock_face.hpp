@@ -1,0 +1,74 @@
+#pragma once
+/// @file clock_face.hpp
+/// Clock faces of the hip: the acetabular clock (rim plane, 6 o'clock at the acetabular notch /
+/// transverse acetabular ligament, 12 superior, 3 anterior on both sides; Blankenbaker et al.
+/// 2007, Skeletal Radiol 36:391; Philippon et al. 2007, thesis Fig. 43) found on the pelvis, and
+/// the femoral head-neck clock (viewed along the neck axis: 12 superior, 3 anterior on both sides,
+/// as cam lesions are located, e.g. Noetzli et al. 2002).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "impinge/anatomy/anatomical_frame.hpp"
+#include "impinge/anatomy/pose.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/core/mesh.hpp"
+
+namespace impinge {
+
+/// A clock face: a plane through `centre` with normal `axis`, 12 o'clock along `twelve` and 3
+/// o'clock along `three` (unit, in the plane, orthogonal). Frame of the bone it belongs to, mm.
+struct ClockFace {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();    ///< out of the acetabulum / along the neck towards the head
+  Eigen::Vector3d twelve = Eigen::Vector3d::UnitY();  ///< 12 o'clock
+  Eigen::Vector3d three = Eigen::Vector3d::UnitX();   ///< 3 o'clock (anterior)
+
+  /// Clock position of point p (mm, same frame) in hours, (0, 12]: 12 at `twelve`, 3 at `three`,
+  /// continuous (1.5 = half past one). NaN when p projects onto the centre.
+  double hour(const Eigen::Vector3d& p) const;
+  /// The sector (0..11) of an hour: sector k covers hours (k, k + 1], sector 11 is (11, 12].
+  static int sector(double hour);
+  /// The same clock face in another frame: points x -> R x + t (R: 3 x 3 rotation, t: mm).
+  ClockFace transformed(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const;
+};
+
+/// The acetabulum of a pelvis: its sphere, rim and clock face.
+struct Acetabulum {
+  SphereFitResult sphere;                 ///< geometric sphere fit of the cup surface (lunate surface and fossa), mm
+  Eigen::Vector3d rim_centre;             ///< centroid of the rim points, mm
+  Eigen::Vector3d opening;                ///< unit normal of the rim plane, out of the acetabulum
+  double rim_radius_mm = 0;               ///< mean distance of the rim points from the rim centre
+  double rim_plane_rms_mm = 0;            ///< rms distance of the rim points from their plane
+  std::vector<Eigen::Vector3d> rim;       ///< rim points, one per azimuth bin with cup vertices
+  double notch_coverage_deg = 0;          ///< the cup's extent from its pole at the notch
+  double median_coverage_deg = 0;         ///< and its median over the rim
+  std::int64_t cup_vertices = 0;          ///< pelvis vertices taken as the cup
+  ClockFace clock;                        ///< 12 superior, 3 anterior, 6 at the notch
+};
+
+/// Find the acetabulum of `pelvis` (working frame, mm) around the femoral head (centre
+/// `head_centre`, radius `head_radius_mm`) of a hip on `side`, with the pelvic frame `pelvis_frame`
+/// (for superior and anterior):
+/// 1. cup: pelvis vertices within head radius + `cup_margin_mm` of the head centre;
+/// 2. sphere: geometric fit of the lunate zone (cup vertices within 4 mm of the head sphere): the
+///    acetabular centre onto which Puls et al. 2010's equidistant method seats the head;
+/// 3. rim: in each 5-degree azimuth bin about the cup's axis, the cup vertex farthest from the
+///    cup's pole (the edge where the bone leaves the head); the rim plane by least squares;
+/// 4. notch: the azimuth, in the inferior half, where the cup's extent (smoothed over 45 deg) is least:
+///    6 o'clock; 12 opposite; 3 anterior.
+/// Throws impinge::Error naming the mesh when fewer than 50 cup vertices or 36 rim points are
+/// found (is the head in the acetabulum?).
+Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& head_centre, double head_radius_mm,
+                           const AnatomicalFrame& pelvis_frame, double cup_margin_mm = 8.0);
+
+/// The femoral head-neck clock face (femur frame, working coordinates, mm): centre at the head
+/// centre, axis from the neck (the centroid of the femur's vertices 4 to 12 mm outside the head
+/// sphere) to the head centre, 12 o'clock towards the femoral frame's +y (superior) and 3 towards
+/// +x (anterior), both projected onto the plane normal to the axis. Throws impinge::Error
+/// naming the mesh when no neck vertices are found.
+ClockFace femoral_clock_face(const TriangleMesh& femur, const Eigen::Vector3d& head_centre, double head_radius_mm,
+                             const AnatomicalFrame& femur_frame);
+
+}  // namespace impinge

@@ -1,0 +1,71 @@
+#pragma once
+/// @file femur_frame.hpp
+/// Femoral landmarks found on a whole femur mesh (head centre, epicondyles, posterior condyles)
+/// and the femoral ISB frame (Wu et al. 2002) built from them.
+
+#include <Eigen/Core>
+#include <string>
+
+#include "impinge/anatomy/anatomical_frame.hpp"
+#include "impinge/anatomy/pose.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/core/mesh.hpp"
+
+namespace impinge {
+
+/// Which line sets the femur's medio-lateral direction (z); y always runs from the epicondyles'
+/// midpoint to the head centre.
+enum class FemurFrameKind {
+  epicondyles,         ///< ISB: z in the plane of the head centre and both epicondyles
+  posterior_condyles,  ///< z parallel to the posterior condylar axis (the tangent to both posterior condyles)
+};
+
+/// Femoral landmarks, mm, working frame.
+struct FemurLandmarks {
+  Eigen::Vector3d head_centre;                                        ///< centre of the fitted head sphere
+  Eigen::Vector3d epicondyle_lateral, epicondyle_medial;              ///< most prominent points of the distal femur
+  Eigen::Vector3d posterior_condyle_lateral, posterior_condyle_medial;///< the posterior condylar axis' contact points
+  Landmarks as_map() const;                                           ///< the five under their snake_case names
+  std::map<std::string, std::string> source;                          ///< per name: "found" or "given"
+};
+
+/// Names accepted in subject.json's "landmarks" for the femur (besides "hip_centre", which
+/// replaces the head fit).
+inline const char* const kFemurLandmarkNames[] = {"epicondyle_lateral", "epicondyle_medial", "posterior_condyle_lateral",
+                                                  "posterior_condyle_medial"};
+
+/// Long axis of a femur: the principal axis of largest variance of its vertices (n x 3, mm),
+/// unit, pointing towards `proximal_hint` (mm; for example the head centre) when it is finite.
+Eigen::Vector3d femur_long_axis(PointsRef V, const Eigen::Vector3d& proximal_hint);
+
+/// Femoral head sphere on a whole femur in any orientation: the long axis (principal axis), then
+/// fit_femoral_head with each end in turn taken as proximal; the end whose sphere has more
+/// inliers is the head. Independent of how the femur lay in the scanner. Throws impinge::Error
+/// naming the mesh when neither end gives a plausible sphere.
+SphereFitResult locate_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options = {});
+
+/// Find the distal landmarks of a whole femur (working frame, mm) whose head centre is
+/// `head_centre` (mm): the long axis (principal axis, towards the head); the distal slab (the
+/// last `distal_fraction` of the femur's length along it); the medial direction from the head's
+/// offset; epicondyles as the pair of slab vertices extreme along the medio-lateral direction,
+/// refined until that direction is the line through them (projected off the long axis); the
+/// posterior condyles as the most posterior slab vertex of each half, refined until the
+/// posterior direction is normal to the line through them (their bitangent). `side`: which
+/// femur (the lateral epicondyle is on the right of a right femur). Landmarks in `given`
+/// replace found ones. Throws impinge::Error naming the mesh on a femur too short or a slab
+/// too small.
+FemurLandmarks find_femur_landmarks(const TriangleMesh& femur, const Eigen::Vector3d& head_centre, Side side,
+                                    const Landmarks& given = {}, double distal_fraction = 0.15);
+
+/// The femoral frame (ISB: origin at the head centre; y from the epicondyles' midpoint to the
+/// head centre; z perpendicular to y towards the right, in the plane of the head centre and
+/// both epicondyles, or parallel to the posterior condylar axis; x = y x z anterior).
+/// quality_mm is left 0 (the caller sets the head fit residual). Throws impinge::Error when
+/// the landmarks are collinear.
+AnatomicalFrame femur_frame(const FemurLandmarks& landmarks, Side side,
+                            FemurFrameKind kind = FemurFrameKind::epicondyles);
+
+/// Parse "epicondyles" / "posterior-condyles"; throws impinge::Error naming `context` otherwise.
+FemurFrameKind parse_femur_frame_kind(const std::string& text, const std::string& context);
+
+}  // namespace impinge

@@ -1,0 +1,28 @@
+#pragma once
+/// @file clock_summary.hpp
+/// Where a scan's contacts lie on a clock face (anatomy/clock_face.hpp): the hour of the closest
+/// vertex and the contact area per hour sector and impingement level (thesis sec. 5.2, Tables 11-13).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "impinge/anatomy/clock_face.hpp"
+#include "impinge/core/mesh.hpp"
+#include "impinge/detection/detection.hpp"
+#include "impinge/detection/impingement_levels.hpp"
+
+namespace impinge {
+
+/// Where a scan's contact lies on a clock face.
+struct ClockSummary {
+  double closest_hour = 0;                    ///< clock position of the tested vertex with the least gap, hours; NaN if none
+  std::vector<double> sector_level_area_mm2;  ///< 12 x levels: vertex area (mm^2) of the tested vertices in hour
+                                              ///< sector k (hours (k, k+1]) at level l, at [k * levels + l]
+};
+
+/// Clock summary of one scan: `gaps` (n vertices), their positions V (n x 3, mm, the frame of
+/// `clock`, unposed: the clock moves with its bone), vertex areas (n, mm^2). Into `out`.
+void clock_summary(const ScanGaps& gaps, PointsRef V, const Eigen::VectorXd& area, const ClockFace& clock,
+                   const ImpingementLevels& levels, ClockSummary& out);
+
+}  // namespace impinge

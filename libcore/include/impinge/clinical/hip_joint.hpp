@@ -1,0 +1,116 @@
+#pragma once
+/// @file hip_joint.hpp
+/// A hip ready for clinical poses: the anatomical frames found from the bones, and the Joint
+/// (both radial distance maps) built in the pelvic frame, so that a pose is three clinical angles
+/// and the results do not depend on how the subject lay in the scanner.
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "impinge/anatomy/clock_face.hpp"
+#include "impinge/anatomy/hip_frames.hpp"
+#include "impinge/anatomy/pose.hpp"
+#include "impinge/clinical/clock_summary.hpp"
+#include "impinge/detection/joint.hpp"
+
+namespace impinge {
+
+/// Options of a HipJoint.
+struct HipJointOptions {
+  JointOptions joint;                     ///< maps, mode, levels
+  Neutral neutral = Neutral::anatomical;  ///< what zero angles mean
+  HipFrameOptions frames;                 ///< which pelvic and femoral frames (anatomical neutral only)
+  /// Re-seat the head (anatomical neutral only): translate the femur so that its head centre lies on
+  /// the acetabular sphere centre (the lunate zone's sphere; Puls et al. 2010, Comput Aided Surg
+  /// 15:75, equidistant method), for segmentations whose bones overlap at the scan pose.
+  bool reseat = false;
+  /// Map files (save_map) to use instead of sampling: {ball, socket}; empty = sample. They must
+  /// have been saved from a HipJoint of the same meshes and options (save_maps): their stored COR
+  /// (working frame) must equal this joint's within 1e-6 mm and their scheme joint.scheme's.
+  std::string ball_map_file, socket_map_file;
+  /// Accept a centre of rotation outside the femur (ball) mesh, for research; otherwise that is an
+  /// error (the gaps would be measured along rays that leave the head: silently wrong numbers).
+  bool allow_cor_outside_ball = false;
+};
+
+/// Femur (ball) and pelvis (socket) of one hip about the centre of rotation, posed by clinical
+/// angles. The joint frame, in which the maps are built and detect() works, has its origin at the
+/// COR and axes:
+/// - anatomical neutral: the pelvic frame's, arranged as the thesis' scan frame (x = pelvic Z
+///   right, y = pelvic X anterior, z = pelvic Y superior; the maps' pole superior), so the maps
+///   and gaps are the same for any placement of the subject in the scanner;
+/// - scan neutral: the working frame's (the maps as the thesis built them).
+class HipJoint {
+ public:
+  /// Build the frames (anatomical neutral: find_hip_frames with "hip_centre" = head.centre; the
+  /// acetabulum and both clock faces) and both maps. `femur`, `pelvis`: whole bones in the
+  /// working frame (RAS, mm); `head`: the femoral head sphere (mm, working frame; its centre is
+  /// the COR; a NaN radius is estimated as the median distance of the femur's vertices within
+  /// 35 mm of the centre); `given`: landmarks that replace found ones (mm, working frame).
+  /// With options.reseat the femur is first translated by reseat_translation() and the COR is the
+  /// acetabular centre. Throws impinge::Error naming the mesh and step that failed (for example
+  /// no whole pelvis with anatomical neutral: use scan neutral or give the landmarks), and naming
+  /// the COR when it lies outside the femur mesh (its map leaves more than 1e-4 of the directions
+  /// without surface) unless options.allow_cor_outside_ball. A head radius outside 5-60 mm (metres
+  /// instead of mm?) adds a warning (warnings()).
+  HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const SphereFitResult& head, const Landmarks& given,
+           const HipJointOptions& options);
+
+  /// Rotation (3 x 3, joint frame) of the femur about the COR at `angles` (degrees, ISB signs).
+  Eigen::Matrix3d femur_rotation(const PoseAngles& angles) const;
+
+  /// Both scans at `angles` (Joint::detect with femur_rotation(angles)); into `out`, reusing
+  /// its storage.
+  void detect(const PoseAngles& angles, PoseResult& out) const;
+  PoseResult detect(const PoseAngles& angles) const;
+
+  /// Working-frame position (mm) of a joint-frame point p (mm): cor + A^T p.
+  Eigen::Vector3d to_working(const Eigen::Vector3d& p) const { return cor_ + joint_to_working_ * p; }
+  /// Rotation from joint-frame to working-frame directions (3 x 3, orthonormal).
+  const Eigen::Matrix3d& joint_to_working() const { return joint_to_working_; }
+  /// Vertices (n x 3, mm, working frame) of the femur posed by R (joint frame) or of the pelvis.
+  Vertices posed_femur(const Eigen::Matrix3d& R) const;
+  Vertices pelvis_vertices() const;
+
+  const Joint& joint() const { return *joint_; }
+  /// The anatomical frames in the working frame (empty with scan neutral).
+  const std::optional<HipFrames>& frames() const { return frames_; }
+  /// The acetabulum (working frame, before any re-seating; empty with scan neutral).
+  const std::optional<Acetabulum>& acetabulum() const { return acetabulum_; }
+  /// Clock faces in the joint frame (socket: acetabular; ball: femoral head-neck, on the unposed
+  /// femur); empty with scan neutral.
+  const std::optional<ClockFace>& socket_clock() const { return socket_clock_; }
+  const std::optional<ClockFace>& ball_clock() const { return ball_clock_; }
+  /// Where each scan of `res` lies on its clock face (anatomical neutral only; else untouched).
+  void clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& socket) const;
+  /// The femur's translation by re-seating (mm, working frame; zero without it).
+  const Eigen::Vector3d& reseat_translation() const { return reseat_; }
+  /// Save both maps (map_io.hpp) with the working-frame COR, for options.ball_map_file and
+  /// socket_map_file of a later HipJoint. Throws impinge::Error on I/O errors.
+  void save_maps(const std::string& ball_path, const std::string& socket_path) const;
+  /// Warnings about the input (e.g. an implausible head radius: wrong units?), one line each.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  /// Head radius used for the acetabulum and clocks (mm).
+  double head_radius_mm() const { return head_radius_; }
+  const Eigen::Vector3d& cor() const { return cor_; }
+  Side side() const { return side_; }
+  Neutral neutral() const { return neutral_; }
+  double frames_ms() const { return frames_ms_; }
+
+ private:
+  Side side_;
+  Neutral neutral_;
+  Eigen::Vector3d cor_;
+  Eigen::Matrix3d joint_to_working_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d femur_axes_joint_ = Eigen::Matrix3d::Identity();  // femoral frame axes in the joint frame
+  std::optional<HipFrames> frames_;
+  std::optional<Acetabulum> acetabulum_;
+  std::optional<ClockFace> socket_clock_, ball_clock_;
+  Eigen::Vector3d reseat_ = Eigen::Vector3d::Zero();
+  double head_radius_ = 0;
+  std::vector<std::string> warnings_;
+  std::optional<Joint> joint_;
+  double frames_ms_ = 0;
+};
+
+}  // namespace impinge

@@ -1,0 +1,173 @@
+#pragma once
+/// @file rom.hpp
+/// Range-of-motion limits (thesis sec. 5.2; issue 14): from neutral along a motion, the first
+/// angle at which the bones meet (minimum gap <= threshold), found by steps and bisection, with
+/// where they meet; and the ROM map of clinical planning tools (Tannast et al. 2007,
+/// Kubiak-Langer et al. 2007): the largest internal rotation over flexion x adduction.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "impinge/anatomy/pose.hpp"
+#include "impinge/clinical/hip_joint.hpp"
+
+namespace impinge {
+
+/// Which vertices a ROM search counts.
+enum class RomVertices {
+  all,            ///< every tested vertex (the ROM limit)
+  first_surface,  ///< the single-layer scans only (intra-articular; the thesis' maps)
+  hidden,         ///< the hidden vertices against the layered maps only (the first extra-articular contact)
+};
+
+/// Options of a ROM search.
+struct RomOptions {
+  double threshold_mm = 0;       ///< contact when the minimum gap <= this (0: bone contact; a cartilage offset > 0)
+  double step_deg = 2;           ///< coarse step along the motion, deg
+  double max_deg = 150;          ///< search no farther than this from neutral, deg
+  double tolerance_deg = 0.1;    ///< bisection until the bracket is this narrow, deg
+  bool use_bounds = true;        ///< skip vertex clusters whose bound cannot reach the threshold (same results,
+                                 ///< fewer look-ups; equiangular maps)
+  RomVertices vertices = RomVertices::all;  ///< which vertices are counted (hidden ones need JointOptions::layers)
+  double intra_articular_margin_mm = 10;  ///< contacts within the acetabular rim radius plus this of the COR are
+                                          ///< intra-articular, farther ones extra-articular
+};
+
+/// A standard motion: angles(theta) for theta >= 0 from its start (degrees).
+struct StandardMotion {
+  std::string name;
+  std::function<PoseAngles(double)> angles;
+};
+
+/// The standard motions of clinical ROM tests: flexion, extension, abduction, adduction,
+/// internal_rotation, external_rotation (from neutral), internal_rotation_90_flexion,
+/// external_rotation_90_flexion (from 90 deg flexion) and fadir (internal rotation at 90 deg
+/// flexion and 10 deg adduction).
+std::vector<StandardMotion> standard_motions();
+
+/// Where and how a motion is limited.
+struct RomLimit {
+  double limit_deg = std::numeric_limits<double>::quiet_NaN();  ///< first contact angle (upper end of the final
+                                                                 ///< bracket), NaN when none within max_deg
+  double min_gap_at_limit_mm = std::numeric_limits<double>::quiet_NaN();
+  double min_gap_at_start_mm = std::numeric_limits<double>::quiet_NaN();  ///< over the counted vertices
+  bool monotone = true;            ///< the bones are still in contact one step beyond the limit (false: a transient
+                                   ///< touch; the gap curve crosses the threshold again)
+  bool limited_by_ball = false;    ///< the least gap was a femur vertex (else a pelvis vertex)
+  bool limited_by_hidden_vertex = false;  ///< that vertex is hidden behind its own body's nearer surface and was
+                                          ///< tested by the other body's layered map (JointOptions::layers)
+  std::string limited_by;          ///< "intra_articular" or "extra_articular" ("" without a limit): extra when
+                                   ///< the contact lies farther than the rim radius plus
+                                   ///< RomOptions::intra_articular_margin_mm from the COR (a hidden vertex
+                                   ///< near the joint, such as the far side of the rim, is intra-articular)
+  Eigen::Vector3d contact_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+                                   ///< the contact vertex at the limit, working frame (pelvis fixed), mm
+  double socket_clock_h = std::numeric_limits<double>::quiet_NaN();  ///< contact on the acetabular clock
+  double femur_clock_h = std::numeric_limits<double>::quiet_NaN();   ///< contact on the femoral head-neck clock
+  std::int64_t excluded_vertices = 0;  ///< vertices within the threshold at the baseline pose (pre-existing
+                                       ///< overlap, e.g. of the segmentation): not counted
+  bool contact_at_start = false;       ///< the counted gap is already within the threshold at theta = 0 (limit 0)
+  int evaluations = 0;                 ///< poses evaluated
+  std::int64_t vertices_looked_up = 0;  ///< map look-ups made over the search
+  std::int64_t vertices_skipped = 0;    ///< first-surface vertices skipped by the cluster bounds
+};
+
+struct RomSearchBounds;  ///< opaque: a joint's bound pyramids and vertex clusters for ROM searches
+
+/// The vertices not counted in ROM searches: those within the threshold at a baseline pose
+/// (anatomical neutral for clinical motions), so that a segmentation's overlap is reported and not
+/// taken for a limit.
+struct RomBaseline {
+  std::vector<std::uint8_t> skip_ball, skip_socket;  ///< 1 = not counted (per vertex of each body)
+  std::int64_t excluded_vertices = 0;
+  double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< least gap of all vertices at the baseline
+  /// The bounds of the cluster search (RomOptions::use_bounds), built once by rom_baseline (about
+  /// 10 ms for 0.1 deg maps) and shared by every search given this baseline with the same joint and
+  /// threshold; a search with another threshold builds its own.
+  std::shared_ptr<const RomSearchBounds> bounds;
+};
+
+/// The baseline at the femur rotation R (joint frame), e.g. hip.femur_rotation({}) for neutral,
+/// with the search bounds for options.threshold_mm when options.use_bounds.
+RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const RomOptions& options = {});
+
+/// Search one motion of `hip`: evaluate both scans at theta = 0, step_deg, 2 step_deg, ... up to
+/// max_deg until the minimum gap over the counted vertices (those not in `baseline`) is <=
+/// threshold, then bisect the last step to tolerance_deg. Only the minimum is computed: the
+/// first-surface vertices are taken in clusters (32 vertices in Z order, in groups of 128) with a
+/// cone of directions and a radius range, and a cluster is skipped when a bound of the other map
+/// over its cone (a pyramid of minima or maxima over the equiangular map) shows that none of its
+/// gaps can reach the threshold. A bound over the cone widened by 4.1 deg is reused at later poses
+/// whose rotation relative to it is within that angle; femur vertices nearer the COR than the
+/// socket map's least node less the threshold are left out of the scans that ask only whether the
+/// bones meet. The others are looked up exactly, so the result is the full scan's. Throws
+/// impinge::Error on invalid options.
+RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(double)>& motion,
+                        const RomOptions& options, const RomBaseline& baseline);
+
+/// The same for any path of femur rotations (joint frame) `rotation(theta)`, e.g. a rotation
+/// about a fixed axis for analytic tests.
+RomLimit find_rom_limit(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation,
+                        const RomOptions& options, const RomBaseline& baseline);
+
+/// Every motion of `motions`, on all cores (OpenMP), sharing one set of bounds.
+std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
+                                      const RomOptions& options, const RomBaseline& baseline);
+
+/// One cell of a ROM map: the largest internal rotation at (flexion, adduction).
+struct RomMapCell {
+  double flexion_deg = 0, adduction_deg = 0;
+  double max_internal_rotation_deg = std::numeric_limits<double>::quiet_NaN();  ///< NaN: see status
+  std::string status;  ///< "limited", "free" (no contact up to max_deg), "contact_at_zero" (in contact
+                       ///< already without rotation)
+  std::int64_t vertices_looked_up = 0, vertices_skipped = 0;  ///< over its search
+  int evaluations = 0;                                        ///< poses evaluated by its search
+};
+
+/// The ROM map: for every flexion x adduction of the grids (degrees), the largest internal
+/// rotation before contact (find_rom_limit along internal rotation from zero, `baseline` as for
+/// the standard motions). Cells are independent and run on all cores (OpenMP).
+std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& flexion_deg,
+                                const std::vector<double>& adduction_deg, const RomOptions& options,
+                                const RomBaseline& baseline);
+
+/// The grid of a ROM envelope (degrees, ISB clinical angles) and how it is refined.
+struct RomEnvelopeOptions {
+  double flexion_min_deg = -30, flexion_max_deg = 130;
+  double adduction_min_deg = -50, adduction_max_deg = 40;
+  double internal_rotation_min_deg = -60, internal_rotation_max_deg = 60;
+  double step_deg = 1;    ///< grid step on every axis, deg (each range a whole number of steps)
+  int coarse_steps = 4;   ///< the first lattice every this many steps (1: every pose evaluated)
+};
+
+/// Every pose of a grid as valid (the bones apart: the least counted gap > the threshold) or not.
+struct RomEnvelope {
+  std::vector<double> flexion_deg, adduction_deg, internal_rotation_deg;  ///< the grid's axes
+  std::vector<std::uint8_t> valid;   ///< 1 valid, 0 in contact; index (i * na + j) * nr + k for flexion i,
+                                     ///< adduction j, internal rotation k (na, nr: axis sizes)
+  std::int64_t poses = 0;            ///< grid poses
+  std::int64_t poses_evaluated = 0;  ///< poses scanned (the rest filled from the corners of their cell)
+  std::int64_t vertices_looked_up = 0, vertices_skipped = 0;
+  bool at(std::size_t i, std::size_t j, std::size_t k) const {
+    return valid[(i * adduction_deg.size() + j) * internal_rotation_deg.size() + k] != 0;
+  }
+};
+
+/// The ROM envelope (issue 14): every pose of the flexion x adduction x internal rotation grid as valid
+/// or in contact, by adaptive refinement: the poses of a coarse lattice (every coarse_steps steps) are
+/// scanned; a cell whose eight corners agree is filled with their answer; a cell whose corners disagree
+/// is split in two along each axis and the new corners scanned, down to single steps. Only poses near
+/// the envelope's boundary are scanned. Assumption (the price of the refinement): a region of contact
+/// (or of freedom) smaller than a cell and touching none of its corners is missed; coarse_steps = 1
+/// scans every pose. Each scan stops at the first contact (RomOptions, `baseline` as for
+/// find_rom_limit). All cores (OpenMP). Throws impinge::Error on an empty or uneven grid. Source:
+/// issue 14; the refinement of Kawasaki et al. 2007 in spirit.
+RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& envelope, const RomOptions& options,
+                         const RomBaseline& baseline);
+
+}  // namespace impinge

@@ -1,0 +1,127 @@
+#pragma once
+/// @file joint.hpp
+/// A ball-and-socket joint ready for detection: both maps built once, then any number of
+/// poses queried (thesis Fig. 27: preprocessing, then simulation).
+
+#include <Eigen/Core>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "impinge/casters/first_hit_caster.hpp"
+#include "impinge/core/mesh.hpp"
+#include "impinge/detection/detection.hpp"
+#include "impinge/detection/impingement_levels.hpp"
+#include "impinge/maps/layered_map.hpp"
+#include "impinge/maps/radial_distance_map.hpp"
+#include "impinge/sampling/rasterize.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/sampling_scheme.hpp"
+
+namespace impinge {
+
+/// Options of a Joint.
+struct JointOptions {
+  /// Sampling scheme of both maps (make_scheme); default equiangular at p = 0.5 deg.
+  std::shared_ptr<const SamplingScheme> scheme = make_scheme("equiangular", 0.5);
+  DistanceMode mode = DistanceMode::exact;                         ///< rasterisation distance mode
+  SamplingMethod sampling = SamplingMethod::automatic;             ///< how maps are filled
+  double occlusion_tolerance_mm = 1.0;                             ///< a vertex farther than its own map's surface
+                                                                   ///< plus this is hidden (not on the first surface)
+  double max_radius_mm = std::numeric_limits<double>::infinity();  ///< region of interest about
+                                                                   ///< the COR, mm
+  ImpingementLevels levels;                                        ///< gap classes
+  /// Exact look-ups at depth discontinuities (issue 15): mark each map's nodes where its
+  /// interpolation may be off by more than discontinuity_tolerance_mm (mark_depth_discontinuities)
+  /// and resolve every look-up whose stencil holds one by a ray cast of the other mesh
+  /// (FirstHitCaster), and every first-surface decision of such a vertex by a ray cast of its own.
+  /// Off, or in a build without Embree or CGAL, the maps answer alone (the thesis' algorithm).
+  bool exact_at_discontinuities = true;
+  double discontinuity_tolerance_mm = 0.05;  ///< see exact_at_discontinuities, mm (> 0)
+  /// Store both maps sparse (RadialDistanceMapT::make_sparse) once they are filled and marked: only
+  /// the tiles with a surface within sparse_region_mm of the COR (default: any surface, which gives
+  /// every gap bit for bit as the dense maps; a finite region answers "no surface" beyond it).
+  /// Source: issue 12.
+  bool sparse_maps = false;
+  double sparse_region_mm = std::numeric_limits<double>::infinity();  ///< see sparse_maps, mm (> 0)
+  /// Layered maps (issue 14): with layers = N > 0, each body also gets a LayeredMap of the same scheme
+  /// with N crossings per node (filled by ray casts, all cores), and the vertices hidden behind their
+  /// own body's nearer surface (not in the first-surface mask) within extra_articular_radius_mm of the
+  /// COR are tested against the other body's layered map: the trochanters, the shaft and the neck
+  /// against the ilium, ischium and AIIS (extra-articular impingement). First-surface vertices keep the
+  /// single-layer look-up (intra-articular results are unchanged, bit for bit). 0: off (the thesis).
+  /// Needs a ray caster (Embree or CGAL). Memory per map: nodes * (4 N + 1) bytes.
+  int layers = 0;
+  double extra_articular_radius_mm = 150;  ///< hidden vertices farther from the COR are not tested, mm (> 0)
+};
+
+/// One body of the joint after preprocessing.
+struct JointBody {
+  TriangleMesh mesh;               ///< anatomical frame, mm
+  Vertices relative;               ///< n x 3, vertices minus the COR, mm
+  RadialDistanceMap map;           ///< its radial distance map about the COR
+  std::vector<std::uint8_t> mask;  ///< 1 for vertices on the first surface within the region
+  ScanSet scan_set;                ///< the masked vertices, prepared for the fast scan
+  Eigen::VectorXd vertex_area;     ///< n, mm^2
+  SamplingReport sampling;         ///< how the map was filled, with counts
+  double sampling_ms = 0;          ///< wall time of filling the map, ms
+  /// Ray caster of the mesh about the COR when exact_at_discontinuities is on (else null).
+  std::shared_ptr<const FirstHitCaster> exact;
+  std::int64_t nodes_marked = 0;   ///< map nodes with the depth-discontinuity mark
+  double marking_ms = 0;           ///< wall time of marking them and building the ray caster, ms
+  /// With JointOptions::layers > 0 (else null / empty): the layered map about the COR, the ray caster
+  /// that filled it (also resolves layered look-ups across edges of the bone), and the hidden vertices
+  /// tested against the other body's layered map.
+  std::shared_ptr<const LayeredMap> layered;
+  std::shared_ptr<const FirstHitCaster> caster;
+  ScanSet hidden_set;
+  LayeredSamplingReport layered_sampling;
+};
+
+/// Result of both scans at one pose.
+struct PoseResult {
+  ScanGaps ball_gaps, socket_gaps;
+  ScanSummary ball, socket;
+  double ball_detection_ms = 0, socket_detection_ms = 0;  ///< both include the layered scans when on
+  std::vector<float> compact_gaps;  ///< scratch of detect (the compact scans), kept to reuse its storage
+};
+
+/// Ball (femur) and socket (pelvis) about a fixed COR.
+class Joint {
+ public:
+  /// Rasterise both meshes (anatomical frame, mm) about `cor` (mm) and compute the first-
+  /// surface masks. Throws impinge::Error on invalid options or a non-finite COR.
+  Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options);
+
+  /// The same with both maps given (for example loaded with load_map) instead of sampled: no
+  /// rasterisation. The maps must be about `cor` in the meshes' frame and of options.scheme's
+  /// scheme and resolution. Throws impinge::Error when a map's scheme, resolution or node count
+  /// differs from options.scheme.
+  Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options,
+        RadialDistanceMap ball_map, RadialDistanceMap socket_map);
+
+  /// Both scans (ball vertices against the socket map, socket vertices against the ball map)
+  /// with the ball rotated by R (3 x 3) about the COR and then translated by t (mm, socket
+  /// frame; zero for a pure ball-and-socket motion, nonzero to push the head into the cup).
+  /// Thesis Algorithm 2 applied twice, through scan_gaps_compact; with layers, the hidden vertices of
+  /// each body against the other's layered map too (scan_layered; status tested_layered).
+  PoseResult detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) const;
+
+  /// The same into `out`, reusing its vectors: after the first pose, no allocation per pose
+  /// (for motions and ROM searches over many poses).
+  void detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& out) const;
+
+  const JointBody& ball() const { return ball_; }
+  const JointBody& socket() const { return socket_; }
+  const Eigen::Vector3d& cor() const { return cor_; }
+  const JointOptions& options() const { return options_; }
+
+ private:
+  JointBody build(TriangleMesh mesh, std::optional<RadialDistanceMap> map = std::nullopt) const;
+  Eigen::Vector3d cor_;
+  JointOptions options_;
+  JointBody ball_, socket_;
+};
+
+}  // namespace impinge

@@ -1,0 +1,51 @@
+#pragma once
+/// @file subject.hpp
+/// A subject: femur and pelvis meshes, side and frame convention, from subject.json.
+
+#include <Eigen/Core>
+#include <string>
+
+#include "impinge/anatomy/anatomical_frame.hpp"
+#include "impinge/anatomy/pose.hpp"
+#include "impinge/core/mesh.hpp"
+
+namespace impinge {
+
+/// Frame convention of a scan. LPS: +x left, +y posterior, +z superior (DICOM);
+/// RAS: +x right, +y anterior, +z superior. impinge's anatomical frame is RAS.
+enum class FrameConvention { LPS, RAS };
+
+/// Parsed subject.json: {"side": "right"|"left", "frame": "LPS"|"RAS", "units": "mm",
+/// "femur": file, "pelvis": file, "landmarks": {name: [x, y, z], ...}} (file names relative to
+/// the json's folder; landmarks optional, mm, in the files' frame). Landmark names: asis_right,
+/// asis_left, psis_right, psis_left, pubic_tubercle_right, pubic_tubercle_left, hip_centre,
+/// epicondyle_lateral, epicondyle_medial, posterior_condyle_lateral, posterior_condyle_medial.
+/// Optional "neutral": "anatomical" or "scan" (see Neutral).
+struct SubjectInfo {
+  std::string name;  ///< folder name
+  Side side = Side::right;
+  FrameConvention frame = FrameConvention::RAS;
+  std::string femur_path;  ///< absolute or relative-to-cwd path
+  std::string pelvis_path;
+  Landmarks landmarks;  ///< given landmarks, mm, in the files' frame (`frame`)
+  std::string neutral;  ///< optional "neutral": "anatomical" | "scan": the zero pose when the user gives none
+                        ///< (generated models, which have no whole bones, say "scan"); empty when absent
+};
+
+/// Read `json_path`. Throws impinge::Error naming the file and the key on a missing or bad
+/// key, unknown side/frame, units other than mm, an unknown landmark name or a landmark that is
+/// not three finite numbers, or unreadable JSON.
+SubjectInfo load_subject(const std::string& json_path);
+
+/// Linear map (3 x 3) from `frame` coordinates to the anatomical frame (RAS). Orthogonal and
+/// its own inverse for LPS (diag(-1, -1, 1)).
+Eigen::Matrix3d to_anatomical(FrameConvention frame);
+
+/// Apply a 3 x 3 linear map to every vertex in place (V <- V * M^T).
+void transform_vertices(Vertices& V, const Eigen::Matrix3d& M);
+
+/// Parse "LPS" / "RAS"; "right" / "left". Throw impinge::Error naming `context` otherwise.
+FrameConvention parse_frame(const std::string& s, const std::string& context);
+Side parse_side(const std::string& s, const std::string& context);
+
+}  // namespace impinge

@@ -1,0 +1,145 @@
+#include "impinge/anatomy/clock_face.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "impinge/core/error.hpp"
+
+namespace impinge {
+
+double ClockFace::hour(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d d = p - centre;
+  const double a = d.dot(twelve), b = d.dot(three);
+  if (a == 0 && b == 0) return std::nan("");
+  double h = std::atan2(b, a) * 6.0 / M_PI;  // (-6, 6], 0 at twelve, +3 at three
+  if (h <= 0) h += 12;
+  return h;
+}
+
+ClockFace ClockFace::transformed(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const {
+  return ClockFace{R * centre + t, R * axis, R * twelve, R * three};
+}
+
+int ClockFace::sector(double hour) {
+  const int k = static_cast<int>(std::ceil(hour)) - 1;
+  return std::clamp(k, 0, 11);
+}
+
+namespace {
+// In-plane unit vector: v without its component along unit n.
+Eigen::Vector3d in_plane(const Eigen::Vector3d& v, const Eigen::Vector3d& n) { return (v - v.dot(n) * n).normalized(); }
+}  // namespace
+
+Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c, double r, const AnatomicalFrame& P,
+                           double margin) {
+  const std::string ctx = pelvis.source + ": acetabulum";
+  require(c.allFinite() && std::isfinite(r) && r > 0, ctx + ": head centre and radius must be finite");
+  const Vertices& V = pelvis.V;
+  Acetabulum A;
+  std::vector<Eigen::Index> cup;
+  Eigen::Vector3d mean_dir = Eigen::Vector3d::Zero();
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const Eigen::Vector3d d = V.row(i).transpose() - c;
+    const double n = d.norm();
+    if (n > 0 && n < r + margin) cup.push_back(i), mean_dir += d / n;
+  }
+  A.cup_vertices = static_cast<std::int64_t>(cup.size());
+  require(cup.size() >= 50, ctx + ": only " + std::to_string(cup.size()) + " pelvis vertices within " +
+                                std::to_string(r + margin) + " mm of the head centre (is the head in the acetabulum?)");
+  // The sphere of the lunate zone: cup vertices within 4 mm of the head sphere (the rim's flare and
+  // the deep fossa would inflate it).
+  std::vector<Eigen::Index> lunate;
+  for (Eigen::Index i : cup)
+    if ((V.row(i).transpose() - c).norm() < r + 4) lunate.push_back(i);
+  require(lunate.size() >= 20, ctx + ": fewer than 20 pelvis vertices within 4 mm of the head sphere");
+  Eigen::Matrix<double, Eigen::Dynamic, 3> pts(static_cast<Eigen::Index>(lunate.size()), 3);
+  for (std::size_t k = 0; k < lunate.size(); ++k) pts.row(static_cast<Eigen::Index>(k)) = V.row(lunate[k]);
+  A.sphere = fit_sphere_geometric(pts);
+  // The cup's pole (its deepest direction) and axis out of the cup.
+  const Eigen::Vector3d pole = mean_dir.normalized();
+  const Eigen::Vector3d axis = -pole;
+  const Eigen::Vector3d e1 = in_plane(P.axes.col(1), axis);  // superior, in the plane across the axis
+  const Eigen::Vector3d e2 = axis.cross(e1);
+  // Rim: per 5-degree azimuth bin, the cup vertex with the largest angle from the pole.
+  constexpr int kBins = 72;
+  std::vector<double> cover(kBins, -1);
+  std::vector<Eigen::Vector3d> rim(kBins);
+  for (Eigen::Index i : cup) {
+    const Eigen::Vector3d d = V.row(i).transpose() - c;
+    const double theta = std::acos(std::clamp(d.normalized().dot(pole), -1.0, 1.0));
+    double psi = std::atan2(d.dot(e2), d.dot(e1));
+    if (psi < 0) psi += 2 * M_PI;
+    const int b = std::min(kBins - 1, static_cast<int>(psi / (2 * M_PI) * kBins));
+    if (theta > cover[static_cast<std::size_t>(b)]) cover[static_cast<std::size_t>(b)] = theta, rim[static_cast<std::size_t>(b)] = V.row(i).transpose();
+  }
+  for (int b = 0; b < kBins; ++b)
+    if (cover[static_cast<std::size_t>(b)] >= 0) A.rim.push_back(rim[static_cast<std::size_t>(b)]);
+  require(A.rim.size() >= 36, ctx + ": the cup has vertices in only " + std::to_string(A.rim.size()) +
+                                  " of 72 azimuths around its axis: no rim");
+  // Rim plane.
+  Eigen::Vector3d m = Eigen::Vector3d::Zero();
+  for (const auto& p : A.rim) m += p;
+  m /= static_cast<double>(A.rim.size());
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  for (const auto& p : A.rim) C += (p - m) * (p - m).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+  Eigen::Vector3d n = es.eigenvectors().col(0);
+  if (n.dot(axis) < 0) n = -n;
+  A.rim_centre = m;
+  A.opening = n;
+  double rr = 0, rms = 0;
+  for (const auto& p : A.rim) rr += (p - m).norm(), rms += std::pow((p - m).dot(n), 2);
+  A.rim_radius_mm = rr / static_cast<double>(A.rim.size());
+  A.rim_plane_rms_mm = std::sqrt(rms / static_cast<double>(A.rim.size()));
+  // Notch: least extent (smoothed over +-22.5 deg; empty bins count as no extent) in the inferior half.
+  std::vector<double> cov(kBins);
+  for (int b = 0; b < kBins; ++b) cov[static_cast<std::size_t>(b)] = std::max(0.0, cover[static_cast<std::size_t>(b)]);
+  int best = -1;
+  double best_v = 1e300;
+  std::vector<double> sorted;
+  for (int b = 0; b < kBins; ++b) {
+    double s = 0;
+    for (int k = -4; k <= 4; ++k) s += cov[static_cast<std::size_t>((b + k + kBins) % kBins)];
+    s /= 9;
+    const double psi = (b + 0.5) * 2 * M_PI / kBins;
+    const Eigen::Vector3d dir = std::cos(psi) * e1 + std::sin(psi) * e2;
+    if (dir.dot(P.axes.col(1)) < 0 && s < best_v) best_v = s, best = b;
+    sorted.push_back(cov[static_cast<std::size_t>(b)]);
+  }
+  std::nth_element(sorted.begin(), sorted.begin() + kBins / 2, sorted.end());
+  A.median_coverage_deg = sorted[kBins / 2] * 180 / M_PI;
+  A.notch_coverage_deg = best_v * 180 / M_PI;
+  const double psi = (best + 0.5) * 2 * M_PI / kBins;
+  const Eigen::Vector3d six = in_plane(std::cos(psi) * e1 + std::sin(psi) * e2, n);
+  A.clock.centre = m;
+  A.clock.axis = n;
+  A.clock.twelve = -six;
+  A.clock.three = n.cross(A.clock.twelve);
+  if (A.clock.three.dot(P.axes.col(0)) < 0) A.clock.three = -A.clock.three;  // 3 o'clock anterior on both sides
+  return A;
+}
+
+ClockFace femoral_clock_face(const TriangleMesh& femur, const Eigen::Vector3d& c, double r,
+                             const AnatomicalFrame& F) {
+  require(c.allFinite() && std::isfinite(r) && r > 0, femur.source + ": femoral clock: head centre and radius must be finite");
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (Eigen::Index i = 0; i < femur.V.rows(); ++i) {
+    const double d = (femur.V.row(i).transpose() - c).norm();
+    if (d > r + 4 && d < r + 12) s += femur.V.row(i).transpose(), ++n;
+  }
+  require(n >= 10, femur.source + ": femoral clock: no neck vertices 4 to 12 mm outside the head sphere");
+  ClockFace k;
+  k.centre = c;
+  k.axis = (c - s / n).normalized();
+  k.twelve = in_plane(F.axes.col(1), k.axis);
+  k.three = k.axis.cross(k.twelve);
+  if (k.three.dot(F.axes.col(0)) < 0) k.three = -k.three;
+  return k;
+}
+
+}  // namespace impinge

@@ -1,0 +1,191 @@
+#include "impinge/anatomy/femur_frame.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "impinge/core/error.hpp"
+
+namespace impinge {
+
+Landmarks FemurLandmarks::as_map() const {
+  return {{"head_centre", head_centre},
+          {"epicondyle_lateral", epicondyle_lateral},
+          {"epicondyle_medial", epicondyle_medial},
+          {"posterior_condyle_lateral", posterior_condyle_lateral},
+          {"posterior_condyle_medial", posterior_condyle_medial}};
+}
+
+Eigen::Vector3d femur_long_axis(PointsRef V, const Eigen::Vector3d& proximal_hint) {
+  require(V.rows() >= 4, "femur long axis: too few vertices");
+  const Eigen::RowVector3d c = V.colwise().mean();
+  const Eigen::MatrixXd D = V.rowwise() - c;
+  const Eigen::Matrix3d C = D.transpose() * D / static_cast<double>(V.rows());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+  Eigen::Vector3d L = es.eigenvectors().col(2);  // largest eigenvalue
+  if (proximal_hint.allFinite() && L.dot(proximal_hint - c.transpose()) < 0) L = -L;
+  return L;
+}
+
+SphereFitResult locate_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options) {
+  validate_mesh(femur);
+  const Eigen::Vector3d L = femur_long_axis(femur.V, Eigen::Vector3d::Constant(std::nan("")));
+  SphereFitResult best;
+  bool have = false;
+  std::string errors;
+  for (const double s : {1.0, -1.0}) {
+    // Rotate so that s L becomes +z, fit there, rotate the centre back.
+    const Eigen::Matrix3d Q = Eigen::Quaterniond::FromTwoVectors(s * L, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    TriangleMesh m;
+    m.V = femur.V * Q.transpose();
+    m.F = femur.F;
+    m.source = femur.source;
+    try {
+      SphereFitResult r = fit_femoral_head(m, options);
+      r.centre = Q.transpose() * r.centre;
+      if (!have || r.points_used > best.points_used) best = r, have = true;
+    } catch (const Error& e) {
+      errors += std::string(errors.empty() ? "" : "; ") + e.what();
+    }
+  }
+  require(have, femur.source + ": no femoral head found at either end of the long axis (" + errors + ")");
+  return best;
+}
+
+namespace {
+
+// Vertices of the distal slab: projection on L within `fraction` of the femur's length from its distal end.
+std::vector<Eigen::Index> distal_slab(const Vertices& V, const Eigen::Vector3d& L, double fraction, double& length) {
+  const Eigen::VectorXd t = V * L;
+  const double tmin = t.minCoeff(), tmax = t.maxCoeff();
+  length = tmax - tmin;
+  std::vector<Eigen::Index> slab;
+  for (Eigen::Index i = 0; i < V.rows(); ++i)
+    if (t[i] <= tmin + fraction * length) slab.push_back(i);
+  return slab;
+}
+
+}  // namespace
+
+FemurLandmarks find_femur_landmarks(const TriangleMesh& femur, const Eigen::Vector3d& head_centre, Side side,
+                                    const Landmarks& given, double distal_fraction) {
+  const std::string ctx = femur.source + ": automatic femoral landmarks";
+  require(head_centre.allFinite(), ctx + ": head centre is not finite");
+  require(distal_fraction > 0 && distal_fraction < 0.5, ctx + ": distal fraction must be in (0, 0.5)");
+  FemurLandmarks out;
+  out.head_centre = head_centre;
+  Landmarks found;
+  bool need = false;
+  for (const char* name : kFemurLandmarkNames) need = need || !given.count(name);
+  if (need) {
+    validate_mesh(femur);
+    const Vertices& V = femur.V;
+    const Eigen::Vector3d L = femur_long_axis(V, head_centre);
+    double length = 0;
+    const std::vector<Eigen::Index> slab = distal_slab(V, L, distal_fraction, length);
+    require(slab.size() >= 50,
+            ctx + ": the femur is too short or too coarse along its long axis for a distal slab (a whole femur "
+                  "is needed; give the landmarks in subject.json)");
+    auto perp = [&](Eigen::Vector3d v) { return Eigen::Vector3d(v - v.dot(L) * L); };
+    Eigen::Vector3d slab_centre = Eigen::Vector3d::Zero();
+    for (Eigen::Index i : slab) slab_centre += V.row(i).transpose();
+    slab_centre /= static_cast<double>(slab.size());
+    // Medial: towards the head's offset from the shaft's line through the slab centre.
+    Eigen::Vector3d medial = perp(head_centre - slab_centre);
+    require(medial.norm() > 1e-6, ctx + ": the head centre lies on the long axis; cannot tell medial from lateral");
+    medial.normalize();
+    // Start from the slab's widest direction across the long axis (2-D principal axis), medial sign.
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    for (Eigen::Index i : slab) {
+      const Eigen::Vector3d d = perp(V.row(i).transpose() - slab_centre);
+      C += d * d.transpose();
+    }
+    Eigen::Vector3d e = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(C).eigenvectors().col(2);
+    if (e.dot(medial) < 0) e = -e;
+    auto extreme = [&](const Eigen::Vector3d& dir, const std::vector<Eigen::Index>& set, Eigen::Vector3d& p) {
+      double best = -std::numeric_limits<double>::infinity();
+      for (Eigen::Index i : set) {
+        const double s = V.row(i).dot(dir);
+        if (s > best) best = s, p = V.row(i).transpose();
+      }
+    };
+    Eigen::Vector3d med = Eigen::Vector3d::Zero(), lat = Eigen::Vector3d::Zero();
+    for (int it = 0; it < 20; ++it) {
+      extreme(e, slab, med);
+      extreme(-e, slab, lat);
+      Eigen::Vector3d e2 = perp(med - lat);
+      require(e2.norm() > 1e-6, ctx + ": the epicondyles coincide");
+      e2.normalize();
+      if ((e2 - e).norm() < 1e-12) break;
+      e = e2;
+    }
+    require(length >= 3 * (med - lat).norm(),
+            ctx + ": the mesh is " + std::to_string(length) + " mm long but " + std::to_string((med - lat).norm()) +
+                " mm wide at its distal end: not a whole femur (give the landmarks in subject.json)");
+    found["epicondyle_medial"] = med;
+    found["epicondyle_lateral"] = lat;
+    // Posterior condyles: split the slab at the midpoint of the epicondyles; posterior = -(anterior),
+    // anterior = L x (lateral direction) for a right femur (x = y x z with z = lateral), mirrored for the left.
+    const Eigen::Vector3d lateral_dir = -e;
+    const Eigen::Vector3d right_dir = side == Side::right ? lateral_dir : Eigen::Vector3d(-lateral_dir);
+    Eigen::Vector3d post = -L.cross(right_dir).normalized();
+    const double split = 0.5 * (med + lat).dot(e);
+    std::vector<Eigen::Index> med_half, lat_half;
+    for (Eigen::Index i : slab) (V.row(i).dot(e) > split ? med_half : lat_half).push_back(i);
+    require(!med_half.empty() && !lat_half.empty(), ctx + ": a condyle is missing from the distal slab");
+    Eigen::Vector3d pm = Eigen::Vector3d::Zero(), pl = Eigen::Vector3d::Zero();
+    for (int it = 0; it < 20; ++it) {
+      extreme(post, med_half, pm);
+      extreme(post, lat_half, pl);
+      Eigen::Vector3d axis = perp(pm - pl);
+      require(axis.norm() > 1e-6, ctx + ": the posterior condyles coincide");
+      Eigen::Vector3d post2 = L.cross(axis).normalized();
+      if (post2.dot(post) < 0) post2 = -post2;
+      if ((post2 - post).norm() < 1e-12) break;
+      post = post2;
+    }
+    found["posterior_condyle_medial"] = pm;
+    found["posterior_condyle_lateral"] = pl;
+  }
+  auto pick = [&](const char* name, Eigen::Vector3d& p) {
+    const auto g = given.find(name);
+    require(g == given.end() || g->second.allFinite(), femur.source + ": given landmark " + name + " is not finite");
+    p = g != given.end() ? g->second : found.at(name);
+    out.source[name] = g != given.end() ? "given" : "found";
+  };
+  pick("epicondyle_lateral", out.epicondyle_lateral);
+  pick("epicondyle_medial", out.epicondyle_medial);
+  pick("posterior_condyle_lateral", out.posterior_condyle_lateral);
+  pick("posterior_condyle_medial", out.posterior_condyle_medial);
+  return out;
+}
+
+AnatomicalFrame femur_frame(const FemurLandmarks& L, Side side, FemurFrameKind kind) {
+  AnatomicalFrame F;
+  F.origin = L.head_centre;
+  const Eigen::Vector3d y = L.head_centre - 0.5 * (L.epicondyle_lateral + L.epicondyle_medial);
+  const double m = side == Side::right ? 1.0 : -1.0;  // lateral is right on a right femur
+  if (kind == FemurFrameKind::epicondyles) {
+    F.axes = orthonormal_axes(y, 1, m * (L.epicondyle_lateral - L.epicondyle_medial), 2, "ISB femoral frame");
+    F.definition = "ISB femur (Wu et al. 2002): y from the epicondyles' midpoint to the head centre, z in the plane "
+                   "of the head centre and both epicondyles (right), x = y x z (anterior); origin at the head centre";
+  } else {
+    F.axes = orthonormal_axes(y, 1, m * (L.posterior_condyle_lateral - L.posterior_condyle_medial), 2,
+                              "femoral frame (posterior condylar axis)");
+    F.definition = "femur: y from the epicondyles' midpoint to the head centre, z parallel to the posterior "
+                   "condylar axis (right), x = y x z (anterior); origin at the head centre";
+  }
+  F.landmarks = L.as_map();
+  F.landmark_source = L.source;
+  return F;
+}
+
+FemurFrameKind parse_femur_frame_kind(const std::string& text, const std::string& context) {
+  if (text == "epicondyles") return FemurFrameKind::epicondyles;
+  if (text == "posterior-condyles") return FemurFrameKind::posterior_condyles;
+  throw Error(context + ": femoral frame '" + text + "' is neither 'epicondyles' nor 'posterior-condyles'");
+}
+
+}  // namespace impinge

@@ -1,0 +1,209 @@
+#include "impinge/anatomy/sphere_fit.hpp"
+
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_multifit_nlinear.h>
+#include <gsl/gsl_vector.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "impinge/core/error.hpp"
+
+namespace impinge {
+
+using PointMatrix = Vertices;
+
+namespace {
+double rms_of(PointsRef P, const Eigen::Vector3d& c, double r) {
+  double s = 0;
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const double e = (P.row(i).transpose() - c).norm() - r;
+    s += e * e;
+  }
+  return std::sqrt(s / static_cast<double>(P.rows()));
+}
+
+int residual_f(const gsl_vector* x, void* data, gsl_vector* f) {
+  const auto& P = *static_cast<const PointsRef*>(data);
+  const Eigen::Vector3d c(gsl_vector_get(x, 0), gsl_vector_get(x, 1), gsl_vector_get(x, 2));
+  const double r = gsl_vector_get(x, 3);
+  for (Eigen::Index i = 0; i < P.rows(); ++i)
+    gsl_vector_set(f, static_cast<std::size_t>(i), (P.row(i).transpose() - c).norm() - r);
+  return GSL_SUCCESS;
+}
+
+int residual_df(const gsl_vector* x, void* data, gsl_matrix* J) {
+  const auto& P = *static_cast<const PointsRef*>(data);
+  const Eigen::Vector3d c(gsl_vector_get(x, 0), gsl_vector_get(x, 1), gsl_vector_get(x, 2));
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const Eigen::Vector3d d = P.row(i).transpose() - c;
+    const double L = d.norm();
+    const auto row = static_cast<std::size_t>(i);
+    for (int k = 0; k < 3; ++k) gsl_matrix_set(J, row, static_cast<std::size_t>(k), L > 0 ? -d[k] / L : 0.0);
+    gsl_matrix_set(J, row, 3, -1.0);
+  }
+  return GSL_SUCCESS;
+}
+}  // namespace
+
+SphereFitResult fit_sphere_algebraic(PointsRef P) {
+  require(P.rows() >= 4, "sphere fit: needs at least 4 points, got " + std::to_string(P.rows()));
+  // Centre the data for conditioning.
+  const Eigen::RowVector3d mean = P.colwise().mean();
+  const PointMatrix Q = P.rowwise() - mean;
+  Eigen::MatrixXd A(Q.rows(), 4);
+  Eigen::VectorXd b(Q.rows());
+  for (Eigen::Index i = 0; i < Q.rows(); ++i) {
+    A(i, 0) = 2 * Q(i, 0);
+    A(i, 1) = 2 * Q(i, 1);
+    A(i, 2) = 2 * Q(i, 2);
+    A(i, 3) = 1;
+    b[i] = Q.row(i).squaredNorm();
+  }
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+  require(qr.rank() == 4, "sphere fit: points are coplanar or degenerate (rank " + std::to_string(qr.rank()) + ")");
+  const Eigen::Vector4d x = qr.solve(b);
+  SphereFitResult res;
+  const Eigen::Vector3d c = x.head<3>();
+  const double r2 = x[3] + c.squaredNorm();
+  require(r2 > 0, "sphere fit: no real sphere fits the points");
+  res.centre = c + mean.transpose();
+  res.radius = std::sqrt(r2);
+  res.rms_residual = rms_of(P, res.centre, res.radius);
+  res.points_used = P.rows();
+  res.converged = true;
+  return res;
+}
+
+SphereFitResult fit_sphere_geometric(PointsRef P) {
+  SphereFitResult start = fit_sphere_algebraic(P);
+  const gsl_multifit_nlinear_type* T = gsl_multifit_nlinear_trust;
+  gsl_multifit_nlinear_parameters params = gsl_multifit_nlinear_default_parameters();
+  const std::size_t n = static_cast<std::size_t>(P.rows()), p = 4;
+  gsl_multifit_nlinear_workspace* w = gsl_multifit_nlinear_alloc(T, &params, n, p);
+  gsl_multifit_nlinear_fdf fdf;
+  fdf.f = residual_f;
+  fdf.df = residual_df;
+  fdf.fvv = nullptr;
+  fdf.n = n;
+  fdf.p = p;
+  fdf.params = const_cast<PointsRef*>(&P);
+  gsl_vector* x0 = gsl_vector_alloc(p);
+  for (int k = 0; k < 3; ++k) gsl_vector_set(x0, static_cast<std::size_t>(k), start.centre[k]);
+  gsl_vector_set(x0, 3, start.radius);
+  gsl_multifit_nlinear_init(x0, &fdf, w);
+  int info = 0;
+  const int status = gsl_multifit_nlinear_driver(200, 1e-12, 1e-12, 1e-12, nullptr, nullptr, &info, w);
+  const gsl_vector* x = gsl_multifit_nlinear_position(w);
+  SphereFitResult res;
+  res.centre = Eigen::Vector3d(gsl_vector_get(x, 0), gsl_vector_get(x, 1), gsl_vector_get(x, 2));
+  res.radius = std::abs(gsl_vector_get(x, 3));
+  res.iterations = static_cast<int>(gsl_multifit_nlinear_niter(w));
+  res.converged = (status == GSL_SUCCESS);
+  gsl_vector_free(x0);
+  gsl_multifit_nlinear_free(w);
+  require(res.centre.allFinite() && std::isfinite(res.radius), "sphere fit: solver diverged");
+  res.rms_residual = rms_of(P, res.centre, res.radius);
+  res.points_used = P.rows();
+  return res;
+}
+
+namespace {
+PointMatrix gather(const Vertices& V, const std::vector<Eigen::Index>& idx) {
+  PointMatrix P(static_cast<Eigen::Index>(idx.size()), 3);
+  for (std::size_t i = 0; i < idx.size(); ++i) P.row(static_cast<Eigen::Index>(i)) = V.row(idx[i]);
+  return P;
+}
+
+/// Sphere through four points, or false if they are (nearly) coplanar.
+bool sphere_through(const Eigen::Vector3d p[4], Eigen::Vector3d& c, double& r) {
+  Eigen::Matrix3d A;
+  Eigen::Vector3d b;
+  for (int k = 0; k < 3; ++k) {
+    A.row(k) = 2 * (p[k + 1] - p[0]).transpose();
+    b[k] = p[k + 1].squaredNorm() - p[0].squaredNorm();
+  }
+  const double det = A.determinant();
+  const double scale = A.row(0).norm() * A.row(1).norm() * A.row(2).norm();
+  if (!(std::abs(det) > 1e-9 * scale)) return false;
+  c = A.partialPivLu().solve(b);
+  r = (p[0] - c).norm();
+  return std::isfinite(r);
+}
+}  // namespace
+
+SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& o) {
+  const Vertices& V = femur.V;
+  require(V.rows() >= 4, femur.source + ": too few vertices for a head fit");
+  const double zmax = V.col(2).maxCoeff();
+  std::vector<Eigen::Index> cand;
+  for (Eigen::Index i = 0; i < V.rows(); ++i)
+    if (V(i, 2) >= zmax - o.proximal_extent_mm) cand.push_back(i);
+  require(cand.size() >= 4, femur.source + ": too few proximal vertices for a head fit");
+
+  std::mt19937_64 rng(o.seed);
+  std::uniform_int_distribution<std::size_t> pick(0, cand.size() - 1);
+  std::size_t best_count = 0;
+  Eigen::Vector3d best_c = Eigen::Vector3d::Zero();
+  double best_r = 0;
+  for (int it = 0; it < o.ransac_iterations; ++it) {
+    Eigen::Vector3d p[4];
+    for (auto& q : p) q = V.row(cand[pick(rng)]).transpose();
+    Eigen::Vector3d c;
+    double r;
+    if (!sphere_through(p, c, r) || r < o.min_radius_mm || r > o.max_radius_mm) continue;
+    std::size_t count = 0;
+    for (Eigen::Index i : cand)
+      if (std::abs((V.row(i).transpose() - c).norm() - r) < o.inlier_threshold_mm) ++count;
+    if (count > best_count) {
+      best_count = count;
+      best_c = c;
+      best_r = r;
+    }
+  }
+  std::ostringstream msg;
+  msg << femur.source << ": no sphere of radius " << o.min_radius_mm << "-" << o.max_radius_mm
+      << " mm found on the proximal femur (is +z superior?)";
+  require(best_count >= 20, msg.str());
+
+  SphereFitResult res;
+  Eigen::Vector3d c = best_c;
+  double r = best_r;
+  double threshold = o.inlier_threshold_mm;
+  for (int round = 0; round < o.refinement_rounds; ++round) {
+    std::vector<Eigen::Index> in;
+    std::vector<double> abs_res;
+    for (Eigen::Index i : cand) {
+      const double e = std::abs((V.row(i).transpose() - c).norm() - r);
+      if (e < threshold) {
+        in.push_back(i);
+        abs_res.push_back(e);
+      }
+    }
+    require(in.size() >= 4, msg.str());
+    res = fit_sphere_geometric(gather(V, in));
+    c = res.centre;
+    r = res.radius;
+    // Tighten the band to 3 robust sigmas (1.4826 MAD) of the inliers, within
+    // [0.2, 1] x the user's threshold: drops the neck and cam points that the first band let in.
+    std::nth_element(abs_res.begin(), abs_res.begin() + abs_res.size() / 2, abs_res.end());
+    const double sigma = 1.4826 * abs_res[abs_res.size() / 2];
+    threshold = std::clamp(3 * sigma, 0.2 * o.inlier_threshold_mm, o.inlier_threshold_mm);
+  }
+  res.iterations = o.refinement_rounds;
+  return res;
+}
+
+SphereFitResult fit_sphere_in_region(const TriangleMesh& femur, const Eigen::Vector3d& region_centre,
+                                     double region_radius_mm) {
+  std::vector<Eigen::Index> in;
+  for (Eigen::Index i = 0; i < femur.V.rows(); ++i)
+    if ((femur.V.row(i).transpose() - region_centre).norm() <= region_radius_mm) in.push_back(i);
+  require(in.size() >= 4, femur.source + ": fewer than 4 vertices in the head selection region");
+  return fit_sphere_geometric(gather(femur.V, in));
+}
+
+}  // namespace impinge

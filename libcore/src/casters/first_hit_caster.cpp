@@ -1,0 +1,247 @@
+#include "impinge/casters/first_hit_caster.hpp"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <limits>
+#include <optional>
+
+#include "impinge/casters/embree_ray_caster.hpp"
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/core/error.hpp"
+
+namespace impinge {
+
+struct FirstHitCaster::Impl {
+  std::string backend;
+  Eigen::Vector3d origin;
+  std::vector<Eigen::Matrix3d> edge_on;  ///< columns: the corners relative to the origin
+  std::optional<EmbreeRayCaster> embree;
+  std::optional<ExactReference> cgal;
+  std::vector<Eigen::Vector3f> normals;  ///< unit normal of each triangle given to Embree (crossings)
+};
+
+bool FirstHitCaster::available() { return have_embree() || have_exact_reference(); }
+
+FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin)
+    : impl_(std::make_unique<Impl>()) {
+  require(available(), "first-hit ray caster: this build has neither Embree nor CGAL (" + mesh.source + ")");
+  require(origin.allFinite(), "first-hit ray caster: origin is not finite (" + mesh.source + ")");
+  impl_->origin = origin;
+  // Triangles edge-on to the origin (their plane through it, to float precision) are met by a ray
+  // from the origin only inside their plane, where Embree's float intersection returns distances
+  // of no meaning (radial rims of generated cups: hits at 2 mm on a cup of radius 24.5). Every
+  // such ray meets the neighbouring triangles at the same points, so they are left out, as are
+  // zero-area triangles.
+  TriangleMesh clean = mesh;
+  // Vertices that coincide to 1e-6 mm but are distinct (the seam of a generated surface, a crack
+  // of a segmentation) are welded: Embree's watertightness holds for identical corners only, and a
+  // ray along such a seam would otherwise slip through it.
+  {
+    std::map<std::array<std::int64_t, 3>, int> cell;
+    std::vector<int> to(static_cast<std::size_t>(clean.V.rows()));
+    for (Eigen::Index i = 0; i < clean.V.rows(); ++i) {
+      const std::array<std::int64_t, 3> key{std::llround(clean.V(i, 0) * 1e6), std::llround(clean.V(i, 1) * 1e6),
+                                            std::llround(clean.V(i, 2) * 1e6)};
+      to[static_cast<std::size_t>(i)] = cell.emplace(key, static_cast<int>(i)).first->second;
+    }
+    for (Eigen::Index f = 0; f < clean.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) clean.F(f, k) = to[static_cast<std::size_t>(clean.F(f, k))];
+  }
+  remove_degenerate_faces(clean);
+  {
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index f = 0; f < clean.F.rows(); ++f) {
+      const Eigen::Vector3d a = clean.V.row(clean.F(f, 0)).transpose() - origin,
+                            b = clean.V.row(clean.F(f, 1)).transpose() - origin,
+                            c = clean.V.row(clean.F(f, 2)).transpose() - origin;
+      const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+      const double scale = std::max({a.norm(), b.norm(), c.norm()});
+      if (std::abs(n.dot(a)) > 1e-6 * scale)
+        keep.push_back(f);
+      else {
+        Eigen::Matrix3d T;
+        T << a, b, c;
+        impl_->edge_on.push_back(T);
+      }
+    }
+    edge_on_ = clean.F.rows() - static_cast<Eigen::Index>(keep.size());
+    Faces F(static_cast<Eigen::Index>(keep.size()), 3);
+    for (std::size_t k = 0; k < keep.size(); ++k) F.row(static_cast<Eigen::Index>(k)) = clean.F.row(keep[k]);
+    clean.F = std::move(F);
+  }
+  {
+    // Orientation by the signed volume of the triangles kept (a closed mesh's edge-on triangles
+    // add no volume about the origin, which lies in their plane).
+    double volume = 0;
+    impl_->normals.reserve(static_cast<std::size_t>(clean.F.rows()));
+    for (Eigen::Index f = 0; f < clean.F.rows(); ++f) {
+      const Eigen::Vector3d a = clean.V.row(clean.F(f, 0)).transpose() - origin,
+                            b = clean.V.row(clean.F(f, 1)).transpose() - origin,
+                            c = clean.V.row(clean.F(f, 2)).transpose() - origin;
+      volume += a.dot(b.cross(c)) / 6;
+      impl_->normals.push_back((b - a).cross(c - a).normalized().cast<float>());
+    }
+    orientation_ = volume >= 0 ? 1 : -1;
+  }
+  if (have_embree()) {
+    impl_->embree.emplace(clean, origin, /*robust=*/true);
+    impl_->backend = "embree";
+  } else {
+    impl_->cgal.emplace(clean);
+    impl_->backend = "cgal";
+  }
+  // Whether the origin lies inside the solid: the majority over 13 rays of whether the first crossing
+  // leaves it (a ray that misses says outside).
+  {
+    int inside = 0;
+    std::vector<RayCrossing> c;
+    for (int k = 0; k < 13; ++k) {
+      const double z = 1 - (2 * k + 1) / 13.0, rho = std::sqrt(1 - z * z), az = 2.399963229728653 * k + 0.1;
+      raw_crossings(Eigen::Vector3d(rho * std::cos(az), rho * std::sin(az), z), c);
+      inside += !c.empty() && !c.front().entering;
+    }
+    origin_inside_ = 2 * inside > 13;
+  }
+}
+
+FirstHitCaster::~FirstHitCaster() = default;
+FirstHitCaster::FirstHitCaster(FirstHitCaster&&) noexcept = default;
+FirstHitCaster& FirstHitCaster::operator=(FirstHitCaster&&) noexcept = default;
+
+namespace {
+/// Nearest t >= 0 at which the ray t u (|u| = 1) meets triangle T (corners as columns, relative
+/// to the ray's origin) in double: Moller-Trumbore, and for a ray in the triangle's plane (an
+/// edge-on triangle seen along itself) the first crossing of its edges. +inf when it misses.
+double edge_on_hit(const Eigen::Matrix3d& T, const Eigen::Vector3d& u) {
+  const Eigen::Vector3d a = T.col(0), e1 = T.col(1) - a, e2 = T.col(2) - a;
+  const Eigen::Vector3d pv = u.cross(e2);
+  const double det = e1.dot(pv);
+  const double inf = std::numeric_limits<double>::infinity();
+  if (std::abs(det) > 1e-12 * e1.norm() * e2.norm()) {
+    const Eigen::Vector3d tv = -a;
+    const double bu = tv.dot(pv) / det;
+    const Eigen::Vector3d qv = tv.cross(e1);
+    const double bv = u.dot(qv) / det, t = e2.dot(qv) / det;
+    return (bu >= 0 && bv >= 0 && bu + bv <= 1 && t >= 0) ? t : inf;
+  }
+  const Eigen::Vector3d n = e1.cross(e2).normalized();
+  if (std::abs(n.dot(u)) > 1e-9) return inf;  // not in the plane: meets it only at the origin
+  double best = inf;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d p = T.col(k), d = T.col((k + 1) % 3) - p;
+    // t u = p + s d in the plane: least squares of the 3 x 2 system [u, -d] (t, s) = p.
+    Eigen::Matrix<double, 3, 2> A;
+    A << u, -d;
+    const Eigen::Matrix2d N = A.transpose() * A;
+    if (std::abs(N.determinant()) < 1e-18 * N.norm() * N.norm()) continue;  // parallel edge
+    const Eigen::Vector2d ts = N.ldlt().solve(A.transpose() * p);
+    if (ts[0] >= 0 && ts[1] >= -1e-12 && ts[1] <= 1 + 1e-12) best = std::min(best, ts[0]);
+  }
+  return best;
+}
+}  // namespace
+
+double FirstHitCaster::first_hit(const Eigen::Vector3d& direction) const {
+  double h;
+  if (impl_->embree) {
+    // Embree intersects in float and is not watertight at a shared vertex: a ray exactly through
+    // one (a vertex of the other bone collinear with one of this mesh from the COR, as on meshes
+    // built on the same angular grid) can slip between its triangles. The least hit of the ray
+    // and two rays 1e-6 rad beside it (2.5e-5 mm at 25 mm) closes such slits.
+    const Eigen::Vector3d u = direction.normalized();
+    const Eigen::Vector3d a = u.unitOrthogonal(), b = u.cross(a);
+    const Eigen::Vector3d d1 = u + 1e-6 * a, d2 = u + 1e-6 * (b * 0.866 - a * 0.5);
+    const float dirs[9] = {float(u.x()),  float(u.y()),  float(u.z()),  float(d1.x()), float(d1.y()),
+                           float(d1.z()), float(d2.x()), float(d2.y()), float(d2.z())};
+    h = impl_->embree->least_hit(dirs, 3);
+  } else {
+    const std::optional<double> c = impl_->cgal->first_hit(impl_->origin, direction.normalized());
+    h = c ? *c : std::numeric_limits<double>::infinity();
+  }
+  if (!impl_->edge_on.empty()) {
+    const Eigen::Vector3d u = direction.normalized();
+    for (const Eigen::Matrix3d& T : impl_->edge_on) h = std::min(h, edge_on_hit(T, u));
+  }
+  return h;
+}
+
+namespace {
+void merge_hits(std::vector<std::pair<double, double>>& raw, int orientation, std::vector<RayCrossing>& out);
+/// A closed surface seen from a fixed origin: crossings alternate, end leaving the solid, and start
+/// entering it exactly when the origin lies outside.
+bool consistent(const std::vector<RayCrossing>& c, bool origin_inside) {
+  if (c.empty()) return !origin_inside;
+  if (c.front().entering == origin_inside || c.back().entering) return false;
+  for (std::size_t k = 1; k < c.size(); ++k)
+    if (c[k].entering == c[k - 1].entering) return false;
+  return true;
+}
+}  // namespace
+
+void FirstHitCaster::crossings(const Eigen::Vector3d& direction, std::vector<RayCrossing>& out) const {
+  const Eigen::Vector3d u = direction.normalized();
+  raw_crossings(u, out);
+  if (consistent(out, origin_inside_)) return;
+  // Embree's float intersection is not watertight at a shared vertex: a ray exactly through one can
+  // slip between its triangles and lose a crossing (a closed mesh then reads inconsistently). Two rays
+  // 1e-6 rad beside it (2.5e-5 mm at 25 mm) decide; when neither is consistent either (a mesh that is
+  // not closed), the ray's own crossings stand.
+  const Eigen::Vector3d a = u.unitOrthogonal(), b = u.cross(a);
+  thread_local std::vector<RayCrossing> other;
+  for (const Eigen::Vector3d& d : {Eigen::Vector3d(u + 1e-6 * a), Eigen::Vector3d(u + 1e-6 * (0.866 * b - 0.5 * a))}) {
+    raw_crossings(d.normalized(), other);
+    if (consistent(other, origin_inside_)) {
+      out.swap(other);
+      return;
+    }
+  }
+}
+
+void FirstHitCaster::raw_crossings(const Eigen::Vector3d& u, std::vector<RayCrossing>& out) const {
+  out.clear();
+  // (distance, facing cosine with the winding's normal), any order.
+  thread_local std::vector<std::pair<double, double>> raw;
+  raw.clear();
+  if (impl_->embree) {
+    thread_local std::vector<std::pair<float, unsigned>> hits;
+    hits.clear();
+    impl_->embree->all_hits(float(u.x()), float(u.y()), float(u.z()), hits);
+    for (const auto& [t, f] : hits) raw.emplace_back(double(t), double(impl_->normals[f].cast<double>().dot(u)));
+  } else {
+    for (const auto& h : impl_->cgal->all_hits(impl_->origin, u)) raw.push_back(h);
+  }
+  merge_hits(raw, orientation_, out);
+}
+
+std::vector<RayCrossing> crossings_from_hits(std::vector<std::pair<double, double>> hits, int orientation) {
+  std::vector<RayCrossing> out;
+  merge_hits(hits, orientation, out);
+  return out;
+}
+
+namespace {
+void merge_hits(std::vector<std::pair<double, double>>& raw, int orientation, std::vector<RayCrossing>& out) {
+  out.clear();
+  std::sort(raw.begin(), raw.end());
+  for (std::size_t i = 0; i < raw.size();) {
+    // A group of hits within 1e-4 mm of its first: one crossing by the majority of the facings.
+    std::size_t j = i;
+    int facing = 0;
+    for (; j < raw.size() && raw[j].first - raw[i].first <= 1e-4; ++j)
+      facing += raw[j].second < 0 ? -1 : raw[j].second > 0 ? 1 : 0;
+    facing *= orientation;
+    if (facing != 0) out.push_back({raw[i].first, facing < 0});
+    i = j;
+  }
+}
+}  // namespace
+
+const std::string& FirstHitCaster::backend() const { return impl_->backend; }
+
+}  // namespace impinge

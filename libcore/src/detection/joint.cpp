@@ -1,0 +1,134 @@
+#include "impinge/detection/joint.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "impinge/core/error.hpp"
+#include "impinge/maps/depth_discontinuity.hpp"
+#include "impinge/sampling/layered_sampling.hpp"
+
+namespace impinge {
+
+namespace {
+const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
+  require(o.scheme != nullptr, "joint: no sampling scheme given");
+  require(cor.allFinite(), "joint: centre of rotation is not finite");
+  require(o.occlusion_tolerance_mm >= 0, "joint: occlusion tolerance must be >= 0 mm");
+  require(o.max_radius_mm > 0, "joint: region radius must be > 0 mm");
+  require(o.sparse_region_mm > 0, "joint: sparse region must be > 0 mm");
+  require(!o.exact_at_discontinuities || (std::isfinite(o.discontinuity_tolerance_mm) && o.discontinuity_tolerance_mm > 0),
+          "joint: the depth-discontinuity tolerance must be > 0 mm and finite");
+  require(o.layers >= 0 && o.layers <= LayeredMap::kMaxLayers,
+          "joint: layers must be 0 (off) to " + std::to_string(LayeredMap::kMaxLayers) + ", not " +
+              std::to_string(o.layers));
+  require(o.layers == 0 || FirstHitCaster::available(),
+          "joint: layered maps need a ray caster (Embree or CGAL), and this build has neither");
+  require(o.extra_articular_radius_mm > 0, "joint: the extra-articular radius must be > 0 mm");
+  o.levels.validate();
+  return o;
+}
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options)
+    : cor_(cor), options_(checked(options, cor)), ball_(build(std::move(ball))), socket_(build(std::move(socket))) {}
+
+Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options,
+             RadialDistanceMap ball_map, RadialDistanceMap socket_map)
+    : cor_(cor),
+      options_(checked(options, cor)),
+      ball_(build(std::move(ball), std::move(ball_map))),
+      socket_(build(std::move(socket), std::move(socket_map))) {}
+
+JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given) const {
+  validate_mesh(mesh);
+  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0, nullptr, nullptr, {}, {}};
+  b.relative = b.mesh.V.rowwise() - cor_.transpose();
+  if (given) {
+    const SamplingScheme& want = *options_.scheme;
+    const SamplingScheme& have = given->scheme();
+    require(have.name() == want.name() && have.resolution() == want.resolution() &&
+                given->num_nodes() == want.num_nodes(),
+            b.mesh.source + ": the given map is " + have.name() + " at " + std::to_string(have.resolution()) +
+                ", the joint's scheme is " + want.name() + " at " + std::to_string(want.resolution()));
+    b.map = std::move(*given);
+    b.sampling.nodes_covered = b.map.nodes_covered();
+  } else {
+    SamplingOptions so;
+    so.mode = options_.mode;
+    so.method = options_.sampling;
+    const auto t0 = std::chrono::steady_clock::now();
+    b.sampling = sample_surface(b.mesh, cor_, so, b.map);
+    b.sampling_ms = ms_since(t0);
+  }
+  if (options_.exact_at_discontinuities && FirstHitCaster::available()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    b.nodes_marked = mark_depth_discontinuities(b.map, options_.discontinuity_tolerance_mm);
+    b.exact = std::make_shared<const FirstHitCaster>(b.mesh, cor_);
+    b.marking_ms = ms_since(t0);
+    b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm, *b.exact);
+  } else {
+    clear_depth_discontinuities(b.map);  // a given map may carry marks
+    b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);
+  }
+  if (options_.sparse_maps) b.map.make_sparse(options_.sparse_region_mm);
+  b.scan_set = make_scan_set(b.relative, b.mask);
+  b.vertex_area = vertex_areas(b.mesh);
+  if (options_.layers > 0) {
+    b.caster = b.exact != nullptr ? b.exact : std::make_shared<const FirstHitCaster>(b.mesh, cor_);
+    auto layered = std::make_shared<LayeredMap>(options_.scheme, options_.layers);
+    b.layered_sampling = sample_layered_map(*layered, *b.caster);
+    b.layered = std::move(layered);
+    std::vector<std::uint8_t> hidden(b.mask.size(), 0);
+    for (std::size_t i = 0; i < hidden.size(); ++i) {
+      const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
+      hidden[i] = !b.mask[i] && r > 0 && r <= options_.extra_articular_radius_mm;
+    }
+    b.hidden_set = make_scan_set(b.relative, hidden);
+  }
+  return b;
+}
+
+PoseResult Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const {
+  PoseResult res;
+  detect(R, t, res);
+  return res;
+}
+
+void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& res) const {
+  std::vector<float>& gaps = res.compact_gaps;
+  gaps.resize(static_cast<std::size_t>(std::max(ball_.scan_set.size(), socket_.scan_set.size())));
+  auto t0 = std::chrono::steady_clock::now();
+  const std::int64_t ball_refined =
+      scan_gaps_compact(ball_.scan_set, R, t, socket_.map, ScanSide::inside, gaps.data(), socket_.exact.get());
+  res.ball_detection_ms = ms_since(t0);
+  expand_scan(ball_.scan_set, gaps.data(), res.ball_gaps);
+  res.ball_gaps.refined = ball_refined;
+  if (socket_.layered) {
+    gaps.resize(std::max(gaps.size(), static_cast<std::size_t>(ball_.hidden_set.size())));
+    res.ball_gaps.refined += scan_layered(ball_.hidden_set, R, t, *socket_.layered, gaps.data(), socket_.caster.get());
+    expand_layered_scan(ball_.hidden_set, gaps.data(), res.ball_gaps);
+    res.ball_detection_ms = ms_since(t0);
+  }
+  // Socket vertices in the ball's frame: R^T (p - t).
+  t0 = std::chrono::steady_clock::now();
+  const std::int64_t socket_refined =
+      scan_gaps_compact(socket_.scan_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), ball_.map,
+                        ScanSide::outside, gaps.data(), ball_.exact.get());
+  res.socket_detection_ms = ms_since(t0);
+  expand_scan(socket_.scan_set, gaps.data(), res.socket_gaps);
+  res.socket_gaps.refined = socket_refined;
+  if (ball_.layered) {
+    gaps.resize(std::max(gaps.size(), static_cast<std::size_t>(socket_.hidden_set.size())));
+    res.socket_gaps.refined += scan_layered(socket_.hidden_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)),
+                                            *ball_.layered, gaps.data(), ball_.caster.get());
+    expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
+    res.socket_detection_ms = ms_since(t0);
+  }
+  summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels, res.ball);
+  summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels, res.socket);
+}
+
+}  // namespace impinge

@@ -1,0 +1,160 @@
+#include "impinge/io/mesh_io.hpp"
+
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cctype>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "impinge/core/error.hpp"
+#include "io/mesh_readers.hpp"
+
+namespace impinge {
+
+namespace {
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+// load_mesh's checks on a mesh read by any reader: valid, degenerate faces removed, some left.
+TriangleMesh checked(TriangleMesh mesh, const std::string& path) {
+  mesh.source = path;
+  require(mesh.V.rows() > 0, path + ": mesh has no vertices");
+  require(mesh.F.rows() > 0, path + ": mesh has no triangles");
+  validate_mesh(mesh);
+  remove_degenerate_faces(mesh);
+  require(mesh.F.rows() > 0, path + ": every triangle is degenerate (zero area)");
+  return mesh;
+}
+}  // namespace
+
+TriangleMesh load_mesh(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  require(fs::exists(path, ec), path + ": file does not exist");
+  require(fs::is_regular_file(path, ec), path + ": not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  require(in.good(), path + ": cannot open file for reading");
+  const std::string ext = lower_extension(path);
+  if (ext == ".ply" || ext == ".off") {
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return checked(ext == ".ply" ? detail::read_ply(path, bytes.str()) : detail::read_off(path, bytes.str()), path);
+  }
+  in.close();  // assimp opens the file itself
+  unsigned flags = 0;
+  Assimp::Importer importer;
+  if (ext == ".stl" || ext == ".obj") {
+    // Weld corners by position only: drop the per-face normals and texture coordinates that
+    // would otherwise keep identical positions apart.
+    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TEXCOORDS |
+                                                            aiComponent_COLORS | aiComponent_TANGENTS_AND_BITANGENTS);
+    flags |= aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices;
+  }
+  const aiScene* scene = importer.ReadFile(path, flags);
+  if (scene == nullptr) throw Error(path + ": cannot parse mesh: " + importer.GetErrorString());
+  require(scene->mNumMeshes > 0, path + ": file holds no mesh");
+
+  std::size_t nv = 0, nf = 0;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    nv += scene->mMeshes[m]->mNumVertices;
+    nf += scene->mMeshes[m]->mNumFaces;
+  }
+  require(nv > 0, path + ": mesh has no vertices");
+  require(nf > 0, path + ": mesh has no triangles");
+
+  TriangleMesh mesh;
+  mesh.V.resize(static_cast<Eigen::Index>(nv), 3);
+  mesh.F.resize(static_cast<Eigen::Index>(nf), 3);
+  Eigen::Index vo = 0, fo = 0;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    for (unsigned i = 0; i < am->mNumVertices; ++i) {
+      mesh.V(vo + i, 0) = am->mVertices[i].x;
+      mesh.V(vo + i, 1) = am->mVertices[i].y;
+      mesh.V(vo + i, 2) = am->mVertices[i].z;
+    }
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) {
+        std::ostringstream os;
+        os << path << ": face " << (fo + f) << " has " << face.mNumIndices << " vertices; only triangles are supported";
+        throw Error(os.str());
+      }
+      for (int k = 0; k < 3; ++k) {
+        const unsigned idx = face.mIndices[k];
+        if (idx >= am->mNumVertices) {
+          std::ostringstream os;
+          os << path << ": face " << (fo + f) << " has vertex index " << idx << " outside [0, " << am->mNumVertices
+             << ")";
+          throw Error(os.str());
+        }
+        mesh.F(fo + f, k) = static_cast<int>(vo + idx);
+      }
+    }
+    vo += am->mNumVertices;
+    fo += am->mNumFaces;
+  }
+  return checked(std::move(mesh), path);
+}
+
+namespace {
+template <typename T>
+void put(std::ofstream& os, T value) {
+  os.write(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+void write_faces(std::ofstream& os, const Faces& F) {
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    put<std::uint8_t>(os, 3);
+    for (int k = 0; k < 3; ++k) put<std::int32_t>(os, F(f, k));
+  }
+}
+}  // namespace
+
+void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const Eigen::VectorXf& gap_mm,
+                   const Eigen::Matrix<unsigned char, Eigen::Dynamic, 1>& level,
+                   const Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor>& rgb) {
+  require(gap_mm.size() == V.rows() && level.size() == V.rows() && rgb.rows() == V.rows(),
+          path + ": per-vertex arrays do not match the vertex count");
+  std::ofstream os(path, std::ios::binary);
+  require(os.good(), path + ": cannot open for writing");
+  os << "ply\nformat binary_little_endian 1.0\ncomment impinge per-vertex gap (mm)\n"
+     << "element vertex " << V.rows() << "\n"
+     << "property float x\nproperty float y\nproperty float z\n"
+     << "property float gap_mm\nproperty float quality\nproperty uchar level\n"
+     << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+     << "element face " << F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    for (int k = 0; k < 3; ++k) put<float>(os, static_cast<float>(V(i, k)));
+    put<float>(os, gap_mm[i]);
+    put<float>(os, gap_mm[i]);
+    put<std::uint8_t>(os, level[i]);
+    for (int k = 0; k < 3; ++k) put<std::uint8_t>(os, rgb(i, k));
+  }
+  write_faces(os, F);
+  require(os.good(), path + ": write failed");
+}
+
+void write_ply(const std::string& path, const TriangleMesh& mesh) {
+  validate_mesh(mesh);
+  std::ofstream os(path, std::ios::binary);
+  require(os.good(), path + ": cannot open for writing");
+  os << "ply\nformat binary_little_endian 1.0\nelement vertex " << mesh.V.rows() << "\n"
+     << "property float x\nproperty float y\nproperty float z\n"
+     << "element face " << mesh.F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
+    for (int k = 0; k < 3; ++k) put<float>(os, static_cast<float>(mesh.V(i, k)));
+  write_faces(os, mesh.F);
+  require(os.good(), path + ": write failed");
+}
+
+}  // namespace impinge

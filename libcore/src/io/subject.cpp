@@ -1,0 +1,84 @@
+#include "impinge/io/subject.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "impinge/anatomy/femur_frame.hpp"
+#include "impinge/anatomy/pelvis_frame.hpp"
+#include "impinge/core/error.hpp"
+
+namespace impinge {
+
+FrameConvention parse_frame(const std::string& s, const std::string& context) {
+  if (s == "LPS") return FrameConvention::LPS;
+  if (s == "RAS") return FrameConvention::RAS;
+  throw Error(context + ": frame '" + s + "' is neither LPS nor RAS");
+}
+
+Side parse_side(const std::string& s, const std::string& context) {
+  if (s == "right") return Side::right;
+  if (s == "left") return Side::left;
+  throw Error(context + ": side '" + s + "' is neither right nor left");
+}
+
+SubjectInfo load_subject(const std::string& json_path) {
+  namespace fs = std::filesystem;
+  std::ifstream in(json_path);
+  require(in.good(), json_path + ": cannot open subject file");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const std::exception& e) {
+    throw Error(json_path + ": not valid JSON: " + e.what());
+  }
+  auto str = [&](const char* key) -> std::string {
+    require(j.contains(key), json_path + ": missing key '" + key + "'");
+    require(j[key].is_string(), json_path + ": key '" + key + "' must be a string");
+    return j[key].get<std::string>();
+  };
+  SubjectInfo s;
+  const fs::path dir = fs::path(json_path).parent_path();
+  s.name = fs::absolute(dir).filename().string();
+  s.side = parse_side(str("side"), json_path);
+  s.frame = parse_frame(str("frame"), json_path);
+  if (j.contains("units")) require(str("units") == "mm", json_path + ": units must be 'mm'");
+  s.femur_path = (dir / str("femur")).string();
+  s.pelvis_path = (dir / str("pelvis")).string();
+  if (j.contains("neutral")) {
+    s.neutral = str("neutral");
+    parse_neutral(s.neutral, json_path + ": key 'neutral'");
+  }
+  if (j.contains("landmarks")) {
+    const auto& lm = j["landmarks"];
+    require(lm.is_object(), json_path + ": key 'landmarks' must be an object {name: [x, y, z]}");
+    for (const auto& [name, value] : lm.items()) {
+      bool known = name == "hip_centre";
+      for (const char* n : kPelvisLandmarkNames) known = known || name == n;
+      for (const char* n : kFemurLandmarkNames) known = known || name == n;
+      require(known, json_path + ": landmarks: unknown name '" + name + "'");
+      bool ok = value.is_array() && value.size() == 3;
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      for (std::size_t k = 0; ok && k < 3; ++k) {
+        ok = value[k].is_number();
+        if (ok) p[static_cast<Eigen::Index>(k)] = value[k].get<double>();
+      }
+      require(ok && p.allFinite(), json_path + ": landmarks: '" + name + "' must be three finite numbers [x, y, z] (mm)");
+      s.landmarks[name] = p;
+    }
+  }
+  return s;
+}
+
+Eigen::Matrix3d to_anatomical(FrameConvention frame) {
+  Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
+  if (frame == FrameConvention::LPS) {
+    M(0, 0) = -1;
+    M(1, 1) = -1;
+  }
+  return M;
+}
+
+void transform_vertices(Vertices& V, const Eigen::Matrix3d& M) { V = (V * M.transpose()).eval(); }
+
+}  // namespace impinge

@@ -1,0 +1,153 @@
+#include "impinge/sampling/sampling.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "impinge/casters/first_hit_caster.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/sampling/naive_sampling.hpp"
+
+namespace impinge {
+
+SamplingMethod parse_sampling_method(const std::string& name) {
+  if (name == "auto") return SamplingMethod::automatic;
+  if (name == "rasterize") return SamplingMethod::rasterize;
+  if (name == "resample") return SamplingMethod::resample;
+  if (name == "ray-cast") return SamplingMethod::ray_cast;
+  if (name == "ray-cast-bvh") return SamplingMethod::ray_cast_bvh;
+  throw Error("sampling method '" + name + "': expected auto, rasterize, resample, ray-cast or ray-cast-bvh");
+}
+
+const char* to_string(SamplingMethod method) {
+  switch (method) {
+    case SamplingMethod::automatic:
+      return "auto";
+    case SamplingMethod::rasterize:
+      return "rasterize";
+    case SamplingMethod::resample:
+      return "resample";
+    case SamplingMethod::ray_cast:
+      return "ray-cast";
+    case SamplingMethod::ray_cast_bvh:
+      return "ray-cast-bvh";
+  }
+  return "?";
+}
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+template <typename Scalar>
+void resample(const RadialDistanceMap& source, RadialDistanceMapT<Scalar>& target) {
+  const EquiangularGrid& g = equiangular_grid_of(source.scheme());
+  const SamplingScheme& scheme = target.scheme();
+  const float* src = source.data();
+  Scalar* dst = target.data();
+  constexpr std::int64_t kBlock = 4096;
+  std::vector<double> phi(kBlock), theta(kBlock);
+  const std::int64_t n = target.num_nodes();
+  for (std::int64_t first = 0; first < n; first += kBlock) {
+    const std::int64_t count = std::min(kBlock, n - first);
+    scheme.node_angles(first, count, phi.data(), theta.data());
+    for (std::int64_t j = 0; j < count; ++j) {
+      std::int64_t nd[4];
+      double w[4];
+      g.stencil_angles(phi[j], theta[j], nd, w);
+      double v = w[0] * src[nd[0]] + w[1] * src[nd[1]] + w[2] * src[nd[2]] + w[3] * src[nd[3]];
+      if (!std::isfinite(v)) {  // a neighbour without surface: keep only if its weight is 0
+        v = 0;
+        for (int k = 0; k < 4; ++k) {
+          if (w[k] == 0) continue;
+          if (!std::isfinite(src[nd[k]])) {
+            v = std::numeric_limits<double>::infinity();
+            break;
+          }
+          v += w[k] * src[nd[k]];
+        }
+      }
+      dst[first + j] = static_cast<Scalar>(v);
+    }
+  }
+}
+
+template <typename Scalar>
+SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& cor, const SamplingOptions& o,
+                              RadialDistanceMapT<Scalar>& map) {
+  require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
+  SamplingReport rep;
+  const bool equiangular = dynamic_cast<const EquiangularGrid*>(&map.scheme()) != nullptr;
+  rep.method = o.method;
+  if (rep.method == SamplingMethod::automatic)
+    rep.method = equiangular ? SamplingMethod::rasterize : SamplingMethod::resample;
+  auto t0 = std::chrono::steady_clock::now();
+  // Face culling (exact mode): the caller's plan, or one made here when asked to.
+  RasterPlan own;
+  const RasterPlan* cull = o.plan;
+  if (cull == nullptr && o.cull_faces && o.mode == DistanceMode::exact &&
+      (rep.method == SamplingMethod::rasterize || rep.method == SamplingMethod::resample)) {
+    own = plan_rasterization(mesh, cor);
+    cull = &own;
+    rep.planning_ms = ms_since(t0);
+    t0 = std::chrono::steady_clock::now();
+  }
+  rep.faces_culled = cull != nullptr && cull->enabled && o.mode == DistanceMode::exact;
+  switch (rep.method) {
+    case SamplingMethod::rasterize:
+      // A fresh map, as documented (with a plan the reset is fused with the drawing).
+      rep.raster = rasterize(mesh, cor, o.mode, map, RasterizeOptions{cull, true, MapStart::reset});  // throws via equiangular_grid_of
+                                                                                      // when not equiangular
+      rep.rasterize_ms = ms_since(t0);
+      break;
+    case SamplingMethod::resample: {
+      double p = o.resample_precision_deg;
+      if (p <= 0) {
+        require(o.resample_oversampling >= 1, mesh.source + ": resample oversampling " +
+                                                   std::to_string(o.resample_oversampling) + " must be >= 1");
+        p = matched_equiangular_precision(map.scheme().max_node_spacing() / o.resample_oversampling);
+      }
+      rep.resample_precision_deg = p;
+      {
+        RadialDistanceMap tmp{EquiangularGrid(p)};
+        rep.raster = rasterize(mesh, cor, o.mode, tmp, RasterizeOptions{cull});
+        rep.rasterize_ms = ms_since(t0);
+        t0 = std::chrono::steady_clock::now();
+        resample(tmp, map);
+        rep.resample_ms = ms_since(t0);
+      }  // the temporary map is released here (thesis sec. 4.2.2)
+      break;
+    }
+    case SamplingMethod::ray_cast:
+      sample_naive(mesh, cor, map);
+      rep.ray_cast_ms = ms_since(t0);
+      break;
+    case SamplingMethod::ray_cast_bvh: {
+      require(FirstHitCaster::available(), mesh.source + ": ray-cast-bvh sampling needs Embree or CGAL in this build");
+      const FirstHitCaster caster(mesh, cor);
+      const SamplingScheme& scheme = map.scheme();
+      Scalar* out = map.data();
+      const std::int64_t n = map.num_nodes();
+#pragma omp parallel for schedule(dynamic, 4096)
+      for (std::int64_t i = 0; i < n; ++i) out[i] = static_cast<Scalar>(caster.first_hit(scheme.node_direction(i)));
+      rep.ray_cast_ms = ms_since(t0);
+      break;
+    }
+    case SamplingMethod::automatic:
+      break;
+  }
+  rep.nodes_covered = map.nodes_covered();
+  return rep;
+}
+
+template void resample<float>(const RadialDistanceMap&, RadialDistanceMapT<float>&);
+template void resample<double>(const RadialDistanceMap&, RadialDistanceMapT<double>&);
+template SamplingReport sample_surface<float>(const TriangleMesh&, const Eigen::Vector3d&, const SamplingOptions&,
+                                              RadialDistanceMapT<float>&);
+template SamplingReport sample_surface<double>(const TriangleMesh&, const Eigen::Vector3d&, const SamplingOptions&,
+                                               RadialDistanceMapT<double>&);
+
+}  // namespace impinge

@@ -1,0 +1,114 @@
+// Clock faces (acetabular and femoral head-neck). Invariants:
+// - hour() is the angle from 12 towards 3 in hours: 12, 3, 6, 9 on the axes, 1.5 half-way;
+//   sectors cover (k, k+1];
+// - on every shared subject and a mirrored left copy: the acetabular sphere lies within a few mm
+//   of the head centre, the opening faces lateral, inferior and anterior with inclination and
+//   anteversion in the anatomical range (Murray 1993 radiographic definitions), 12 o'clock is
+//   superior, 3 o'clock anterior on both sides, the notch (6 o'clock) is where the cup's extent
+//   is least; mirrored points get the same hours on the mirrored hip;
+// - the femoral clock's axis runs along the neck (neck-shaft angle 115-145 deg);
+// - clock_summary keeps every tested vertex's area and finds the closest vertex's hour.
+#include "impinge/anatomy/clock_face.hpp"
+#include "impinge/clinical/clock_summary.hpp"
+
+#include <gtest/gtest.h>
+
+#include "impinge/anatomy/hip_frames.hpp"
+#include "test_support.hpp"
+
+using namespace impinge;
+
+TEST(ClockFace, HoursAndSectors) {
+  ClockFace c;
+  c.centre = Eigen::Vector3d(1, 2, 3);
+  c.twelve = Eigen::Vector3d(0, 1, 0);
+  c.three = Eigen::Vector3d(1, 0, 0);
+  c.axis = Eigen::Vector3d(0, 0, -1);
+  auto h = [&](double x, double y) { return c.hour(c.centre + Eigen::Vector3d(x, y, 7)); };
+  EXPECT_NEAR(h(0, 1), 12, 1e-12);
+  EXPECT_NEAR(h(1, 0), 3, 1e-12);
+  EXPECT_NEAR(h(0, -1), 6, 1e-12);
+  EXPECT_NEAR(h(-1, 0), 9, 1e-12);
+  EXPECT_NEAR(h(1, 1), 1.5, 1e-12);
+  EXPECT_TRUE(std::isnan(h(0, 0)));
+  EXPECT_EQ(ClockFace::sector(0.5), 0);
+  EXPECT_EQ(ClockFace::sector(1.0), 0);
+  EXPECT_EQ(ClockFace::sector(1.0001), 1);
+  EXPECT_EQ(ClockFace::sector(12), 11);
+  std::mt19937_64 rng(3);
+  const Eigen::Matrix3d R = test::random_rotation(rng);
+  const ClockFace m = c.transformed(R, Eigen::Vector3d(5, 6, 7));
+  EXPECT_NEAR(m.hour(R * (c.centre + Eigen::Vector3d(1, 1, 0)) + Eigen::Vector3d(5, 6, 7)), 1.5, 1e-12);
+}
+
+TEST(ClockFace, AcetabulumAndFemoralClockOnRealHipsBothSides) {
+  bool any = false;
+  for (const char* name : {"lhdl-ct", "mc22", "tlem2-mri"}) {
+    auto j = test::load_real_joint(name);
+    if (!j) continue;
+    any = true;
+    const HipFrames h = find_hip_frames(j->femur, j->pelvis, Side::right);
+    const Acetabulum A = find_acetabulum(j->pelvis, h.head.centre, h.head.radius, h.pelvis);
+    // Mirrored left copy.
+    TriangleMesh fl = j->femur, pl = j->pelvis;
+    for (TriangleMesh* m : {&fl, &pl}) {
+      m->V.col(0) *= -1;
+      m->F.col(1).swap(m->F.col(2));
+    }
+    const HipFrames hl = find_hip_frames(fl, pl, Side::left);
+    const Acetabulum Al = find_acetabulum(pl, hl.head.centre, hl.head.radius, hl.pelvis);
+    for (const auto& [side, hh, AA] : {std::tuple{Side::right, &h, &A}, std::tuple{Side::left, &hl, &Al}}) {
+      SCOPED_TRACE(std::string(name) + (side == Side::right ? " right" : " left"));
+      const double m = side == Side::right ? 1 : -1;
+      const AnatomicalFrame& P = hh->pelvis;
+      EXPECT_LT((AA->sphere.centre - hh->head.centre).norm(), 5);
+      EXPECT_GT(AA->sphere.radius, hh->head.radius - 2);
+      EXPECT_LT(AA->sphere.radius, hh->head.radius + 5);
+      const Eigen::Vector3d n = P.axes.transpose() * AA->opening;  // X anterior, Y superior, Z right
+      const double inclination = std::atan2(m * n.z(), -n.y()) * 180 / M_PI;
+      const double anteversion = std::asin(n.x()) * 180 / M_PI;
+      EXPECT_GT(inclination, 30);
+      EXPECT_LT(inclination, 60);
+      EXPECT_GT(anteversion, 5);
+      EXPECT_LT(anteversion, 35);
+      EXPECT_GT((P.axes.transpose() * AA->clock.twelve).y(), 0.5);  // 12 superior
+      EXPECT_GT((P.axes.transpose() * AA->clock.three).x(), 0.7);   // 3 anterior, both sides
+      EXPECT_LT(AA->notch_coverage_deg, AA->median_coverage_deg - 4);
+      EXPECT_GT(AA->rim_radius_mm, 20);
+      EXPECT_LT(AA->rim_radius_mm, 35);
+      const ClockFace K = femoral_clock_face(side == Side::right ? j->femur : fl, hh->head.centre, hh->head.radius,
+                                             hh->femur);
+      const double neck_shaft = 180 - std::acos(K.axis.dot(hh->femur.axes.col(1))) * 180 / M_PI;
+      EXPECT_GT(neck_shaft, 115);
+      EXPECT_LT(neck_shaft, 145);
+      EXPECT_LT(m * K.axis.dot(hh->femur.axes.col(2)), -0.5);  // towards the head: medial
+    }
+    // Mirror symmetry: the mirror image of a pelvis vertex has the same hour on the left hip.
+    for (Eigen::Index i = 0; i < j->pelvis.V.rows(); i += 2003) {
+      const double hr = A.clock.hour(j->pelvis.V.row(i).transpose()), hl2 = Al.clock.hour(pl.V.row(i).transpose());
+      const double d = std::abs(hr - hl2);
+      EXPECT_LT(std::min(d, 12 - d), 1e-6) << name << " vertex " << i;
+    }
+  }
+  if (!any) GTEST_SKIP() << "shared data absent";
+}
+
+TEST(ClockFace, SummaryKeepsEveryAreaAndFindsTheClosestHour) {
+  ClockFace c;  // twelve +y, three +x, centre 0
+  Vertices V(4, 3);
+  V << 0, 1, 0, 1, 0, 0, 0, -1, 0, -1, 0.2, 0;
+  ScanGaps g;
+  g.gap_mm = {5.0f, 0.5f, std::nanf(""), -1.0f};
+  g.status = {ScanGaps::tested, ScanGaps::tested, ScanGaps::beyond_reach, ScanGaps::tested};
+  Eigen::VectorXd area(4);
+  area << 1, 2, 4, 8;
+  ImpingementLevels levels;
+  ClockSummary s;
+  clock_summary(g, V, area, c, levels, s);
+  ASSERT_EQ(s.sector_level_area_mm2.size(), static_cast<std::size_t>(12 * levels.count()));
+  double total = 0;
+  for (double a : s.sector_level_area_mm2) total += a;
+  EXPECT_DOUBLE_EQ(total, 11);  // 1 + 2 + 8: the untested vertex counts nowhere
+  EXPECT_NEAR(s.closest_hour, c.hour(V.row(3).transpose()), 1e-12);
+  EXPECT_DOUBLE_EQ(s.sector_level_area_mm2[static_cast<std::size_t>(2 * levels.count() + levels.level(0.5f))], 2);
+}

@@ -1,0 +1,326 @@
+// End to end: the CLI on a generated subject writes summary.json with the documented keys, PLYs
+// with the input's vertex count, and map PNGs; bad input exits non-zero with one line. On the
+// shared real subjects (skipped when ../shared/data/hips is absent): at p = 0.1 in exact mode
+// the gaps agree with an exact ray cast (naive, double precision, every triangle) within 0.05 mm
+// for at least 95 % of the tested vertices, in both scans.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/detection/joint.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/io/subject.hpp"
+#include "impinge/sampling/naive_sampling.hpp"
+#include "test_support.hpp"
+
+using namespace impinge;
+namespace fs = std::filesystem;
+
+namespace {
+int run(const std::string& args, std::string* output = nullptr) {
+  const std::string cmd = std::string(IMPINGE_CLI) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[512];
+  while (fgets(buf, sizeof buf, p) != nullptr) out += buf;
+  const int rc = pclose(p);
+  if (output != nullptr) *output = out;
+  return WEXITSTATUS(rc);
+}
+
+long ply_vertex_count(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("element vertex ", 0) == 0) return std::stol(line.substr(15));
+  return -1;
+}
+}  // namespace
+
+TEST(EndToEnd, CliOnGeneratedSubject) {
+  const std::string d = test::temp_dir("e2e");
+  ASSERT_EQ(run("generate --triangles 3000 --cam 2 --out " + d + "/subject"), 0);
+  std::string out;
+  ASSERT_EQ(run("distance --subject " + d + "/subject/subject.json --precision 1 --mode linear --pose 30,10,5 --out " +
+                    d + "/out",
+                &out),
+            0)
+      << out;
+  std::ifstream js(d + "/out/summary.json");
+  const nlohmann::json j = nlohmann::json::parse(js);
+  for (const char* key : {"cor_mm", "head_radius_mm", "sphere_fit_rms_mm", "precision_deg", "mode", "pose_deg"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  for (const char* body : {"ball", "socket"})
+    for (const char* key : {"vertices_tested", "vertices_no_surface", "min_gap_mm", "vertices_penetrating", "map_nodes",
+                            "map_nodes_covered", "map_bytes", "sampling_ms", "detection_ms"})
+      EXPECT_TRUE(j[body].contains(key)) << body << "." << key;
+  EXPECT_EQ(j["mode"], "linear");
+  EXPECT_NEAR(j["head_radius_mm"].get<double>(), 22, 0.05);
+  EXPECT_EQ(j["ball"]["map_nodes"], 65160);
+  const TriangleMesh femur = load_mesh(d + "/subject/femur_r.ply");
+  EXPECT_EQ(ply_vertex_count(d + "/out/ball_gaps.ply"), femur.V.rows());
+  // the written PLY is readable again, same vertex count and order of faces
+  EXPECT_EQ(load_mesh(d + "/out/ball_gaps.ply").F, femur.F);
+  EXPECT_TRUE(fs::file_size(d + "/out/ball_map.png") > 100);
+  EXPECT_TRUE(fs::file_size(d + "/out/socket_map.png") > 100);
+  // Shaded renders.
+  ASSERT_EQ(run("distance --subject " + d + "/subject/subject.json --precision 2 --render --out " + d + "/r", &out), 0)
+      << out;
+  for (const char* f : {"render.png", "render_anterior.png", "render_lateral.png", "render_socket_medial.png"})
+    EXPECT_GT(fs::file_size(d + "/r/" + f), 10000u) << f;
+}
+
+TEST(EndToEnd, CliErrorsAreOneLine) {
+  const std::string d = test::temp_dir("e2e_err");
+  std::string out;
+  EXPECT_NE(run("distance --ball " + d + "/nope.ply --socket " + d + "/nope.ply --out " + d, &out), 0);
+  EXPECT_NE(out.find("nope.ply"), std::string::npos);
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  ASSERT_EQ(run("generate --triangles 300 --out " + d + "/s"), 0);
+  EXPECT_NE(run("distance --subject " + d + "/s/subject.json --precision 0.7 --out " + d + "/o", &out), 0);
+  EXPECT_NE(out.find("precision 0.7"), std::string::npos) << out;
+  EXPECT_NE(run("distance --subject " + d + "/s/subject.json --pose 1,2 --out " + d + "/o", &out), 0);
+  EXPECT_NE(run("distance --subject " + d + "/s/subject.json --mode cubic --out " + d + "/o", &out), 0);
+  EXPECT_NE(out.find("cubic"), std::string::npos) << out;
+  // A given COR far from the femoral head is an error naming it and the head centre (the generated
+  // subject's head is at true_cor_mm); --allow-any-cor accepts it.
+  std::ifstream sj(d + "/s/subject.json");
+  const nlohmann::json subject = nlohmann::json::parse(sj);
+  const auto c = subject["true_cor_mm"];
+  const std::string far = std::to_string(c[0].get<double>() - 40) + "," + std::to_string(c[1].get<double>()) + "," +
+                          std::to_string(c[2].get<double>());
+  EXPECT_NE(run("distance --subject " + d + "/s/subject.json --precision 2 --cor=" + far + " --out " + d + "/o", &out), 0);
+  EXPECT_NE(out.find("from the fitted femoral head centre"), std::string::npos) << out;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  EXPECT_EQ(run("distance --subject " + d + "/s/subject.json --precision 2 --cor=" + far + " --allow-any-cor --out " + d +
+                    "/o",
+                &out),
+            0)
+      << out;
+}
+
+class RealSubject : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(RealSubject, ExactModeAgreesWithExactRayCastAtTenthDegree) {
+  const std::string json = std::string(IMPINGE_SHARED_DATA) + "/" + GetParam() + "/subject.json";
+  if (!fs::exists(json)) GTEST_SKIP() << "shared data absent: " << json;
+  const SubjectInfo s = load_subject(json);
+  TriangleMesh femur = load_mesh(s.femur_path), pelvis = load_mesh(s.pelvis_path);
+  transform_vertices(femur.V, to_anatomical(s.frame));
+  transform_vertices(pelvis.V, to_anatomical(s.frame));
+  const SphereFitResult fit = fit_femoral_head(femur);
+  EXPECT_GT(fit.radius, 18);
+  EXPECT_LT(fit.radius, 30);
+  EXPECT_LT(fit.rms_residual, 1.0);
+  JointOptions o;
+  o.scheme = make_scheme("equiangular", 0.1);
+  o.mode = DistanceMode::exact;
+  const Joint j(femur, pelvis, fit.centre, o);
+  const PoseResult r = j.detect(Eigen::Matrix3d::Identity());
+  auto check = [&](const ScanGaps& g, const JointBody& body, const TriangleMesh& other, double side) {
+    std::int64_t tested = 0, within = 0;
+    for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
+      if (g.status[i] != ScanGaps::tested) continue;
+      const Eigen::Vector3d p = body.relative.row(static_cast<Eigen::Index>(i)).transpose();
+      const auto hit = cast_ray_naive(other, fit.centre, p.normalized());
+      ++tested;
+      if (!hit) continue;  // the oracle sees no surface: counts as disagreement
+      const double exact = side * (hit->first - p.norm());
+      if (std::abs(exact - g.gap_mm[i]) <= 0.05) ++within;
+    }
+    EXPECT_GT(tested, 500);
+    std::cout << GetParam() << ": " << within << " of " << tested << " tested vertices ("
+              << 100.0 * double(within) / double(tested) << " %) within 0.05 mm of the exact ray cast\n";
+    EXPECT_GE(double(within), 0.95 * double(tested)) << GetParam() << ": " << within << " of " << tested;
+  };
+  check(r.ball_gaps, j.ball(), pelvis, 1.0);
+  check(r.socket_gaps, j.socket(), femur, -1.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Shared, RealSubject, ::testing::Values("lhdl-ct", "mc22", "tlem2-mri"));
+
+namespace {
+/// gap_mm per vertex from a PLY written by write_gap_ply (x y z gap_mm quality level r g b).
+std::vector<float> read_gap_ply(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  long n = -1;
+  while (std::getline(in, line) && line != "end_header")
+    if (line.rfind("element vertex ", 0) == 0) n = std::stol(line.substr(15));
+  std::vector<float> gaps;
+  for (long i = 0; i < n; ++i) {
+    float rec[5];
+    unsigned char extra[4];
+    in.read(reinterpret_cast<char*>(rec), sizeof rec);
+    in.read(reinterpret_cast<char*>(extra), sizeof extra);
+    gaps.push_back(rec[3]);
+  }
+  return gaps;
+}
+}  // namespace
+
+class SchemesAgree : public ::testing::TestWithParam<std::string> {};
+
+// The CLI with the helix (k = 458) and the equiangular grid (p = 0.5 deg, matched equator):
+// on the vertices both test, the 95th percentile of |gap difference| is within 0.05 mm (twice the
+// slope-times-spacing error of a 45-deg surface 25 mm away over 0.5 deg is 0.44 mm; the smooth
+// majority agrees far better), and the generated model agrees everywhere within 0.02 mm.
+TEST_P(SchemesAgree, HelixAndEquiangularGapsAgree) {
+  std::string json = std::string(IMPINGE_SHARED_DATA) + "/" + GetParam() + "/subject.json";
+  const std::string d = test::temp_dir("schemes_" + GetParam());
+  if (GetParam() == "generated") {
+    ASSERT_EQ(run("generate --triangles 12000 --cam 2 --out " + d + "/subject"), 0);
+    json = d + "/subject/subject.json";
+  }
+  if (!fs::exists(json)) GTEST_SKIP() << "shared data absent: " << json;
+  std::string out;
+  ASSERT_EQ(run("distance --subject " + json + " --scheme helix --turns 458 --out " + d + "/helix", &out), 0) << out;
+  ASSERT_EQ(run("distance --subject " + json + " --scheme equiangular --precision 0.5 --out " + d + "/eq", &out), 0)
+      << out;
+  for (const char* body : {"ball", "socket"}) {
+    const std::vector<float> h = read_gap_ply(d + "/helix/" + body + "_gaps.ply"),
+                             e = read_gap_ply(d + "/eq/" + body + "_gaps.ply");
+    ASSERT_EQ(h.size(), e.size());
+    std::vector<double> diff;
+    for (std::size_t i = 0; i < h.size(); ++i)
+      if (std::isfinite(h[i]) && std::isfinite(e[i])) diff.push_back(std::abs(double(h[i]) - e[i]));
+    ASSERT_GT(diff.size(), 500u);
+    std::sort(diff.begin(), diff.end());
+    const double p95 = diff[diff.size() * 95 / 100];
+    std::cout << GetParam() << " " << body << ": " << diff.size() << " vertices, p95 |helix - equiangular| = " << p95
+              << " mm, max " << diff.back() << " mm\n";
+    EXPECT_LE(p95, 0.05) << body;
+    if (GetParam() == "generated") {
+      EXPECT_LE(diff.back(), 0.02) << body;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Shared, SchemesAgree, ::testing::Values("lhdl-ct", "mc22", "tlem2-mri", "generated"));
+
+// ---- impinge motion -----------------------------------------------------------------------
+
+namespace {
+struct FrameRow {
+  double ball_min, socket_min;
+};
+std::vector<FrameRow> read_frames_csv(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.rfind("frame,time_s,flexion_deg,adduction_deg,internal_rotation_deg,ball_min_gap_mm,"
+                       "socket_min_gap_mm,penetrating_area_mm2",
+                       0),
+            0u)
+      << line;
+  std::vector<FrameRow> rows;
+  while (std::getline(in, line)) {
+    std::vector<std::string> c;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) c.push_back(cell);
+    rows.push_back({std::stod(c[5]), std::stod(c[6])});
+  }
+  return rows;
+}
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+// Per-frame min gaps of `motion` equal `impinge distance --pose` at the same angles.
+void expect_motion_equals_distance(const std::string& subject_args, const std::string& motion_file,
+                                   const std::vector<std::string>& poses, const std::string& d) {
+  std::string out;
+  ASSERT_EQ(run("motion " + subject_args + " --motion " + motion_file + " --quiet --out " + d + "/motion", &out), 0)
+      << out;
+  const auto rows = read_frames_csv(d + "/motion/frames.csv");
+  ASSERT_EQ(rows.size(), poses.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const std::string od = d + "/pose" + std::to_string(k);
+    ASSERT_EQ(run("distance " + subject_args + " --pose=" + poses[k] + " --out " + od, &out), 0) << out;
+    const nlohmann::json j = read_json(od + "/summary.json");
+    EXPECT_NEAR(rows[k].ball_min, j["ball"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
+    EXPECT_NEAR(rows[k].socket_min, j["socket"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
+  }
+}
+}  // namespace
+
+TEST(EndToEnd, MotionCsvOnAGeneratedSubjectEqualsDistanceAtEachPose) {
+  const std::string d = test::temp_dir("e2e_motion");
+  ASSERT_EQ(run("generate --triangles 3000 --cam 2 --out " + d + "/subject"), 0);
+  test::write_text(d + "/m.csv",
+                   "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,0,0,0\n0.1,20,5,-5\n0.2,40,-10,10\n");
+  expect_motion_equals_distance("--subject " + d + "/subject/subject.json --precision 1", d + "/m.csv",
+                                {"0,0,0", "20,5,-5", "40,-10,10"}, d);
+  const nlohmann::json j = read_json(d + "/motion/summary.json");
+  EXPECT_EQ(j["neutral"], "scan");  // the generated subject says so
+  EXPECT_EQ(j["motion_frames"], 3);
+  for (const char* key : {"ball_sampling", "socket_sampling", "detection_total", "total"})
+    EXPECT_TRUE(j["timings_ms"].contains(key)) << key;
+  EXPECT_TRUE(fs::exists(d + "/motion/gaps.pvd"));
+  EXPECT_TRUE(fs::exists(d + "/motion/gaps/frame_000002.vtp"));
+}
+
+TEST(EndToEnd, BadMotionFilesWriteNothing) {
+  const std::string d = test::temp_dir("e2e_motion_bad");
+  ASSERT_EQ(run("generate --triangles 300 --out " + d + "/s"), 0);
+  const std::string subject = " --subject " + d + "/s/subject.json --precision 2 ";
+  auto check = [&](const std::string& name, const std::string& text, const std::string& expect) {
+    test::write_text(d + "/" + name, text);
+    std::string out;
+    const std::string od = d + "/out_" + name;
+    EXPECT_NE(run("motion" + subject + "--motion " + d + "/" + name + " --out " + od, &out), 0);
+    EXPECT_NE(out.find(expect), std::string::npos) << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+    EXPECT_FALSE(fs::exists(od)) << "output written for a bad motion file";
+  };
+  check("nan.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,1,2,3\n1,nan,2,3\n",
+        "nan.csv:3: column 'flexion_deg'");
+  check("unit.mot", "x\ninDegrees=perhaps\nendheader\ntime\thip_flexion_r\n", "unit.mot:2: unknown unit");
+  check("col.mot", "x\ninDegrees=yes\nendheader\ntime\thip_flexion_r\thip_adduction_r\n0\t1\t2\n",
+        "col.mot:4: missing column 'hip_rotation_r'");
+  check("empty.csv", "", "empty motion file");
+}
+
+TEST(EndToEnd, MotionOnARealSubjectEqualsDistanceAndLoadsInVtk) {
+  const std::string json = std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/subject.json";
+  if (!fs::exists(json)) GTEST_SKIP() << "shared data absent";
+  const std::string d = test::temp_dir("e2e_motion_real");
+  test::write_text(d + "/rom.mot",
+                   "rom\nversion=1\nnRows=4\nnColumns=4\ninDegrees=no\nendheader\n"
+                   "time\thip_flexion_r\thip_adduction_r\thip_rotation_r\thip_flexion_l\n"
+                   "0\t0\t0\t0\t9\n0.5\t1.5707963267948966\t0\t0\t9\n1\t1.5707963267948966\t0.17453292519943295\t"
+                   "0.3490658503988659\t9\n1.5\t0\t-0.5235987755982988\t0\t9\n");
+  expect_motion_equals_distance("--subject " + json + " --precision 0.5", d + "/rom.mot",
+                                {"0,0,0", "90,0,0", "90,10,20", "0,-30,0"}, d);
+  const nlohmann::json j = read_json(d + "/motion/summary.json");
+  EXPECT_EQ(j["neutral"], "anatomical");
+  for (const char* lm : {"asis_right", "asis_left", "psis_right", "psis_left", "pubic_tubercle_right"})
+    EXPECT_EQ(j["frames"]["pelvis"]["landmarks"][lm]["source"], "found") << lm;
+  for (const char* lm : {"head_centre", "epicondyle_lateral", "epicondyle_medial"})
+    EXPECT_TRUE(j["frames"]["femur"]["landmarks"].contains(lm)) << lm;
+  // ParaView's reader: every file of the collection loads with VTK (Debian's python3-vtk9), has both
+  // bones' vertices and a gap_mm array whose minimum is the frame's min gap.
+  const TriangleMesh femur = load_mesh(std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/femur_r.ply");
+  const TriangleMesh pelvis = load_mesh(std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/pelvis.ply");
+  const auto rows = read_frames_csv(d + "/motion/frames.csv");
+  std::string expect_min;
+  for (const auto& r : rows) expect_min += std::to_string(std::min(r.ball_min, r.socket_min)) + ",";
+  const std::string cmd = "/usr/bin/python3 " + std::string(IMPINGE_SOURCE_DIR) + "/tests/check_pvd.py " + d +
+                          "/motion/gaps.pvd " + std::to_string(femur.V.rows() + pelvis.V.rows()) + " " +
+                          std::to_string(femur.F.rows() + pelvis.F.rows()) + " " + expect_min + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[512];
+  while (fgets(buf, sizeof buf, p) != nullptr) out += buf;
+  EXPECT_EQ(WEXITSTATUS(pclose(p)), 0) << out;
+  EXPECT_NE(out.find("4 frames ok"), std::string::npos) << out;
+}

@@ -1,0 +1,91 @@
+// Motion files (CSV and OpenSim .mot/.sto). Invariants: values read back as written (degrees;
+// radians converted), columns found by name in any order, the side picks _r or _l, and every
+// malformed file is a one-line error naming the file, the line and the column.
+#include "impinge/io/motion.hpp"
+
+#include <gtest/gtest.h>
+
+#include "impinge/core/error.hpp"
+#include "test_support.hpp"
+
+using namespace impinge;
+using impinge::test::temp_dir;
+using impinge::test::write_text;
+
+namespace {
+std::string error_of(const std::string& path, Side side = Side::right) {
+  try {
+    load_motion(path, side);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+const char* kMotHeader = "walk\nversion=1\nnRows=3\nnColumns=5\ninDegrees=yes\nendheader\n";
+}  // namespace
+
+TEST(Motion, CsvColumnsByNameInAnyOrder) {
+  const std::string d = temp_dir("motion_csv");
+  write_text(d + "/m.csv",
+             "adduction_deg,time_s,internal_rotation_deg,flexion_deg,note\n1.5,0,-3,10,x\n2,0.01,4,20.25,y\n");
+  const Motion m = load_motion(d + "/m.csv", Side::right);
+  ASSERT_EQ(m.frames(), 2u);
+  EXPECT_EQ(m.format, "csv");
+  EXPECT_EQ(m.time_s[1], 0.01);
+  EXPECT_EQ(m.angles[1].flexion_deg, 20.25);
+  EXPECT_EQ(m.angles[0].adduction_deg, 1.5);
+  EXPECT_EQ(m.angles[0].internal_rotation_deg, -3);
+}
+
+TEST(Motion, OpenSimDegreesRadiansSidesAndPathLabels) {
+  const std::string d = temp_dir("motion_mot");
+  write_text(d + "/a.mot", std::string(kMotHeader) +
+                               "time\tpelvis_tilt\thip_flexion_r\thip_adduction_r\thip_rotation_r\thip_flexion_l\t"
+                               "hip_adduction_l\thip_rotation_l\n"
+                               "0.0\t1\t30\t-5\t7\t-10\t2\t3\n0.5\t1\t31\t-6\t8\t-11\t3\t4\n");
+  const Motion r = load_motion(d + "/a.mot", Side::right);
+  ASSERT_EQ(r.frames(), 2u);
+  EXPECT_EQ(r.format, "opensim");
+  EXPECT_EQ(r.angles[1].flexion_deg, 31);
+  EXPECT_EQ(r.angles[1].adduction_deg, -6);
+  EXPECT_EQ(r.angles[1].internal_rotation_deg, 8);
+  const Motion l = load_motion(d + "/a.mot", Side::left);
+  EXPECT_EQ(l.angles[0].flexion_deg, -10);
+  EXPECT_EQ(l.angles[0].internal_rotation_deg, 3);
+  // OpenSim 4 storage in radians with path labels.
+  write_text(d + "/b.sto",
+             "states\ninDegrees=no\nendheader\ntime /jointset/hip_r/hip_flexion_r/value "
+             "/jointset/hip_r/hip_adduction_r/value /jointset/hip_r/hip_rotation_r/value\n0 1.5707963267948966 0 "
+             "-0.5\n");
+  const Motion b = load_motion(d + "/b.sto", Side::right);
+  EXPECT_NEAR(b.angles[0].flexion_deg, 90, 1e-12);
+  EXPECT_NEAR(b.angles[0].internal_rotation_deg, -0.5 * 180 / M_PI, 1e-12);
+}
+
+TEST(Motion, BadFilesAreOneLineErrorsNamingFileLineAndColumn) {
+  const std::string d = temp_dir("motion_bad");
+  auto check = [&](const std::string& name, const std::string& text, const std::string& expect) {
+    write_text(d + "/" + name, text);
+    const std::string e = error_of(d + "/" + name);
+    EXPECT_NE(e.find(d + "/" + name), std::string::npos) << e;
+    EXPECT_NE(e.find(expect), std::string::npos) << "expected '" << expect << "' in: " << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  };
+  check("missing.csv", "time_s,flexion_deg,adduction_deg\n0,1,2\n", ":1: missing column 'internal_rotation_deg'");
+  check("text.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,1,2,3\n0.1,1,abc,3\n",
+        ":3: column 'adduction_deg': 'abc' is not a number");
+  check("nan.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,nan,2,3\n",
+        ":2: column 'flexion_deg': 'nan' is not finite");
+  check("short.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,1,2\n",
+        ":2: column 'internal_rotation_deg': the row has only 3 cells");
+  check("back.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n1,1,2,3\n0.5,1,2,3\n",
+        ":3: column 'time_s': time decreases");
+  check("empty.csv", "", "empty motion file");
+  check("noframes.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n", "no frames");
+  check("unit.mot", "x\ninDegrees=maybe\nendheader\n", ":2: unknown unit 'inDegrees=maybe'");
+  check("nounit.mot", "x\nendheader\ntime hip_flexion_r\n", "unit is unknown");
+  check("noend.mot", "x\ninDegrees=yes\n", "no 'endheader'");
+  check("nocol.mot", std::string(kMotHeader) + "time\thip_flexion_r\thip_adduction_r\n0\t1\t2\n",
+        ":7: missing column 'hip_rotation_r'");
+  EXPECT_NE(error_of(d + "/absent.mot").find("cannot open"), std::string::npos);
+}

@@ -1,0 +1,58 @@
+// Conchoid (thesis sec. 5.1): GSL arc length against closed forms (b = 0: a circle, a * phi;
+// a -> b: the cardioid, 4 a sin(phi / 2)); Table 10 and the closed form 3.03 b to the printed
+// digits; equal-length angles cut the curve into equal lengths; the weighted grid keeps the
+// scheme invariants.
+#include "impinge/schemes/conchoid.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/maps/radial_distance_map.hpp"
+#include "impinge/schemes/conchoid_grid.hpp"
+
+using namespace impinge;
+
+TEST(Conchoid, ArcLengthClosedForms) {
+  const Conchoid circle(20, 0);
+  for (double phi : {0.1, 1.0, kPi / 2, kPi}) EXPECT_NEAR(circle.arc_length(phi), 20 * phi, 1e-10);
+  const Conchoid cardioid(10 + 1e-9, 10);
+  for (double phi : {0.3, 1.2, kPi / 2, 2.5}) EXPECT_NEAR(cardioid.arc_length(phi), 40 * std::sin(phi / 2), 1e-6);
+  EXPECT_THROW(Conchoid(1, 2), Error);
+}
+
+TEST(Conchoid, ThesisNumbersToPrintedDigits) {
+  EXPECT_NEAR(conchoid_length_thesis(1.0), 3.03, 0.005);    // "3.03 b"
+  EXPECT_NEAR(kMenschikA / kMenschikB, 1.15, 0.005);        // "a = 1.15 b"
+  const std::vector<double> t10 = conchoid_angles_eq16(4);  // Table 10: 0, 27, 56, 90 deg
+  const double printed[] = {0, 27, 56, 90};
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(t10[i] * kRadToDeg, printed[i], 0.5) << i;
+  // Eq. 16 at 1 deg: phi_i = 2 asin(0.00785 i)
+  EXPECT_NEAR(conchoid_angles_eq16(91)[10], 2 * std::asin(0.0785), 2e-4);
+}
+
+TEST(Conchoid, EqualLengthAnglesCutEqualLengths) {
+  const Conchoid c(kMenschikA, kMenschikB);
+  const std::vector<double> a = c.equal_length_angles(31, kPi / 2);
+  const double seg = c.arc_length(kPi / 2) / 30;
+  for (int i = 1; i < 31; ++i) EXPECT_NEAR(c.arc_length(a[i]) - c.arc_length(a[i - 1]), seg, 1e-9);
+  // the rays near the pole (long curve, r large) are closer together than equal angles
+  EXPECT_LT(a[1], kPi / 2 / 30);
+}
+
+TEST(ConchoidGrid, SchemeInvariants) {
+  const ConchoidGrid g(2);
+  EXPECT_EQ(g.num_nodes(), (180 / 2 + 1) * (360 / 2));  // equal node count to the equiangular grid
+  for (std::int64_t i = g.columns(); i < g.num_nodes() - g.columns(); ++i) ASSERT_EQ(g.node(g.node_direction(i)), i);
+  RadialDistanceMap map{g};
+  std::fill(map.data(), map.data() + map.num_nodes(), 9.5f);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> U(0, 1);
+  for (int j = 0; j < 2000; ++j) {
+    const Eigen::Vector3d u = direction(std::acos(2 * U(rng) - 1), 2 * kPi * U(rng));
+    EXPECT_NEAR(map.sample(u), 9.5, 1e-5);
+  }
+  EXPECT_THROW(ConchoidGrid(0.7), Error);
+}
