@@ -29,6 +29,7 @@
 #include "impinge/core/error.hpp"
 #include "impinge/core/parse.hpp"
 #include "impinge/core/spherical_frame.hpp"
+#include "impinge/core/timing.hpp"
 #include "impinge/detection/joint.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
@@ -40,11 +41,9 @@
 
 using namespace impinge;
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 // ---- options -------------------------------------------------------------------------------
 
@@ -688,11 +687,11 @@ int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo
     looked_up += l.vertices_looked_up;
     skipped += l.vertices_skipped;
     const Eigen::Vector3d c = to_input * l.contact_mm;
-    lim << m.name << ',' << l.limit_deg << ',' << l.limited_by << ',' << l.socket_clock_h << ',' << l.femur_clock_h
+    lim << m.name << ',' << l.limit_deg << ',' << to_string(l.limited_by) << ',' << l.socket_clock_h << ',' << l.femur_clock_h
         << ',' << l.min_gap_at_limit_mm << ',' << (l.monotone ? 1 : 0) << ','
         << (l.contact_at_start ? 1 : 0) << ','
         << c.x() << ',' << c.y() << ',' << c.z() << ',' << l.evaluations << '\n';
-    limits.push_back({{"motion", m.name}, {"limit_deg", num_or_null(l.limit_deg)}, {"limited_by", l.limited_by},
+    limits.push_back({{"motion", m.name}, {"limit_deg", num_or_null(l.limit_deg)}, {"limited_by", to_string(l.limited_by)},
                       {"monotone", l.monotone}});
   }
   const double limits_ms = ms_since(t0);
@@ -713,7 +712,7 @@ int run_rom(const InputOptions& in, const MapOptions& mo, const FrameOptions& fo
     require(map.good(), out_dir + "/rom_map.csv: cannot open for writing");
     map << "flexion_deg,adduction_deg,max_internal_rotation_deg,status\n" << std::setprecision(9);
     for (const RomMapCell& c : cells)
-      map << c.flexion_deg << ',' << c.adduction_deg << ',' << c.max_internal_rotation_deg << ',' << c.status << '\n';
+      map << c.flexion_deg << ',' << c.adduction_deg << ',' << c.max_internal_rotation_deg << ',' << to_string(c.status) << '\n';
   }
   double envelope_ms = 0;
   nlohmann::json envelope_json;

@@ -213,7 +213,7 @@ int main(int argc, char** argv) {
         err.reserve(dirs.size());
         std::vector<double> value(dirs.size());
         for (std::size_t j = 0; j < dirs.size(); ++j) {
-          value[j] = map.sample(dirs[j]);
+          value[j] = map.lookup(dirs[j]);
           if (std::isfinite(value[j]) && std::isfinite(exact[j])) err.push_back(std::abs(value[j] - exact[j]));
         }
         const std::vector<double> se = sorted(err);

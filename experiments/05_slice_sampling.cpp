@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
     const Joint joint(stairs, cup, cor, o);
     double s2 = 0, smax = 0, t2 = 0, tmax = 0;
     for (std::size_t j = 0; j < dirs.size(); ++j) {
-      const double v = joint.ball().map.sample(dirs[j]);
+      const double v = joint.ball().map.lookup(dirs[j]);
       s2 += (v - R) * (v - R), smax = std::max(smax, std::abs(v - R));
       t2 += (v - stair_exact[j]) * (v - stair_exact[j]), tmax = std::max(tmax, std::abs(v - stair_exact[j]));
     }

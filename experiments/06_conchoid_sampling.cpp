@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
       std::vector<double> err;
       double s2 = 0;
       for (const auto& u : dirs) {
-        const double e = std::abs(map.sample(u) - exact.radius(std::acos(std::clamp(u.z(), -1.0, 1.0))));
+        const double e = std::abs(map.lookup(u) - exact.radius(std::acos(std::clamp(u.z(), -1.0, 1.0))));
         err.push_back(e);
         s2 += e * e;
       }

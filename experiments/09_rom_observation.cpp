@@ -44,16 +44,15 @@
 #include "impinge/clinical/hip_joint.hpp"
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/timing.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/maps/layered_map.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 namespace {
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 struct Table11Row {
   std::string patient, hip, motion;
@@ -250,7 +249,7 @@ int main(int argc, char** argv) {
     std::int64_t evaluations = 0, looked = 0, skipped = 0;
     for (const RomLimit& l : limits) evaluations += l.evaluations, looked += l.vertices_looked_up, skipped += l.vertices_skipped;
     for (const RomMapCell& c : cells) {
-      map.row(s.name, c.flexion_deg, c.adduction_deg, c.max_internal_rotation_deg, c.status);
+      map.row(s.name, c.flexion_deg, c.adduction_deg, c.max_internal_rotation_deg, to_string(c.status));
       looked += c.vertices_looked_up, skipped += c.vertices_skipped;
     }
     std::int64_t map_evals = 0;
@@ -269,7 +268,7 @@ int main(int argc, char** argv) {
         after = exact_least_gap(joint, ex_pelvis, ex_femur, base, hip.femur_rotation(motions[k].angles(l.limit_deg + 0.5)));
         validated = before > ro.threshold_mm && after <= ro.threshold_mm ? "yes" : "no";
       }
-      lim.row(s.name, motions[k].name, l.limit_deg, l.limited_by, l.socket_clock_h, l.femur_clock_h,
+      lim.row(s.name, motions[k].name, l.limit_deg, to_string(l.limited_by), l.socket_clock_h, l.femur_clock_h,
               l.min_gap_at_limit_mm, l.monotone ? 1 : 0, l.contact_at_start ? 1 : 0, before, after, validated);
     }
 
@@ -304,7 +303,7 @@ int main(int argc, char** argv) {
             after = exact(l.limit_deg + 0.5);
             validated = before > ro.threshold_mm && after <= ro.threshold_mm ? "yes" : "no";
           }
-          extra.row(s.name, xm[k].name, counted == RomVertices::all ? "all" : "hidden", l.limit_deg, l.limited_by,
+          extra.row(s.name, xm[k].name, counted == RomVertices::all ? "all" : "hidden", l.limit_deg, to_string(l.limited_by),
                     l.limited_by_hidden_vertex ? 1 : 0, l.limited_by_ball ? 1 : 0, l.socket_clock_h,
                     l.contact_mm.allFinite() ? (l.contact_mm - lhip.to_working(Eigen::Vector3d::Zero())).norm()
                                              : std::nan(""),

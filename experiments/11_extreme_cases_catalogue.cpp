@@ -178,7 +178,7 @@ void sample_lookups(const TriangleMesh& mesh, const Eigen::Vector3d& cor, const 
   so.mode = mode;
   sample_surface(mesh, cor, so, map);
   out.assign(pts.size() / 3, 0);
-  map.sample_many(pts.data(), std::int64_t(out.size()), out.data());
+  map.lookup_many(pts.data(), std::int64_t(out.size()), out.data());
 }
 
 struct SphereCase {

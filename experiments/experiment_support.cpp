@@ -9,6 +9,7 @@
 
 #include "impinge/core/error.hpp"
 #include "impinge/core/kernels.hpp"
+#include "impinge/core/timing.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/subject.hpp"
 
@@ -92,7 +93,7 @@ double median_ms(const std::function<void()>& fn, int reps) {
   for (int i = 0; i < std::max(1, reps); ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     fn();
-    t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    t.push_back(ms_since(t0));
   }
   std::sort(t.begin(), t.end());
   return t.size() % 2 ? t[t.size() / 2] : 0.5 * (t[t.size() / 2 - 1] + t[t.size() / 2]);

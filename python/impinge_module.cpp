@@ -470,7 +470,7 @@ PYBIND11_MODULE(impinge, m) {
               const RomLimit& l = limits[k];
               py::dict e;
               e["limit_deg"] = l.limit_deg;
-              e["limited_by"] = l.limited_by;
+              e["limited_by"] = to_string(l.limited_by);
               e["socket_clock_h"] = l.socket_clock_h;
               e["femur_clock_h"] = l.femur_clock_h;
               e["min_gap_at_limit_mm"] = l.min_gap_at_limit_mm;

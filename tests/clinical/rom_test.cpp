@@ -78,7 +78,7 @@ TEST(Rom, NeckMeetsTheRimWhereTheClosedFormSays) {
     EXPECT_NEAR(l.limit_deg, psi_contact - psi0, 0.2) << "psi0 " << psi0;
     EXPECT_LE(l.min_gap_at_limit_mm, 0);
     EXPECT_TRUE(l.monotone);
-    EXPECT_EQ(l.limited_by, "intra_articular");
+    EXPECT_EQ(l.limited_by, ImpingementSite::intra_articular);
     // The contact lies on the rim's inner edge: R from the COR, at the rim's polar angle.
     EXPECT_NEAR((l.contact_mm - h.cor).norm(), inner, 0.3);
     // Turning the other way about the same axis the neck first crosses the opening axis, then meets the
@@ -184,7 +184,7 @@ TEST(Rom, ClusterBoundsGiveTheFullScansResults) {
       const auto ma = rom_map(*hip, flex, add, with, base), mb = rom_map(*hip, flex, add, without, base);
       for (std::size_t k = 0; k < ma.size(); ++k) {
         EXPECT_EQ(ma[k].status, mb[k].status);
-        if (ma[k].status == "limited") {
+        if (ma[k].status == RomMapStatus::limited) {
           EXPECT_EQ(ma[k].max_internal_rotation_deg, mb[k].max_internal_rotation_deg);
         }
       }
@@ -237,7 +237,7 @@ TEST(Rom, TrochanterMeetsTheIliacPlateWhereTheClosedFormSays) {
         continue;
       }
       EXPECT_NEAR(l.limit_deg, want, 0.2) << "closed form " << want;
-      EXPECT_EQ(l.limited_by, "extra_articular");
+      EXPECT_EQ(l.limited_by, ImpingementSite::extra_articular);
       EXPECT_TRUE(l.limited_by_hidden_vertex);
       EXPECT_TRUE(l.limited_by_ball);
       if (bounds) {

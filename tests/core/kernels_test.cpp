@@ -98,11 +98,11 @@ TEST(Kernels, LookUpHalvesGiveIdenticalGaps) {
       x[i] = g(rng), y[i] = g(rng), z[i] = g(rng);
     }
     set_kernel_set(KernelSet::native);
-    map.sample_many_soa(x.data(), y.data(), z.data(), n, a.data());
-    map.sample_many_soa_marked(x.data(), y.data(), z.data(), n, d.data());
+    map.lookup_many_soa(x.data(), y.data(), z.data(), n, a.data());
+    map.lookup_many_soa_marked(x.data(), y.data(), z.data(), n, d.data());
     set_kernel_set(KernelSet::generic);
-    map.sample_many_soa(x.data(), y.data(), z.data(), n, c.data());
-    map.sample_many_soa_marked(x.data(), y.data(), z.data(), n, e.data());
+    map.lookup_many_soa(x.data(), y.data(), z.data(), n, c.data());
+    map.lookup_many_soa_marked(x.data(), y.data(), z.data(), n, e.data());
     // The same value up to the rounding of one fused multiply-add per weight (a few ulp of the
     // distance), and the same class: NaN (no surface), -inf (marked) or finite.
     std::int64_t differ = 0, finite = 0;

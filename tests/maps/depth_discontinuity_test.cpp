@@ -87,8 +87,8 @@ TEST(DepthDiscontinuity, AJumpMarksTheNodesBesideItAndOnlyThose) {
       }
     }
     std::vector<double> out(x.size()), plain(x.size());
-    map.sample_many_soa_marked(x.data(), y.data(), z.data(), std::int64_t(x.size()), out.data());
-    map.sample_many_soa(x.data(), y.data(), z.data(), std::int64_t(x.size()), plain.data());
+    map.lookup_many_soa_marked(x.data(), y.data(), z.data(), std::int64_t(x.size()), out.data());
+    map.lookup_many_soa(x.data(), y.data(), z.data(), std::int64_t(x.size()), plain.data());
     for (std::size_t j = 0; j < x.size(); ++j) {
       if (j % 4 < 2) {
         EXPECT_EQ(out[j], -std::numeric_limits<double>::infinity()) << name << " point " << j;

@@ -207,7 +207,7 @@ TEST(Rasterize, ConvergesToAnalyticSphereOffTheCor) {
     const RadialDistanceMap map = rasterize_map(s, Eigen::Vector3d::Zero(), p, DistanceMode::exact);
     double worst = 0;
     for (const auto& u : dirs)
-      worst = std::max(worst, std::abs(map.sample(u) - test::ray_sphere_far(Eigen::Vector3d::Zero(), u, centre, 22)));
+      worst = std::max(worst, std::abs(map.lookup(u) - test::ray_sphere_far(Eigen::Vector3d::Zero(), u, centre, 22)));
     // faceting of a 0.5 deg mesh: sagitta <= 22 (1 - cos 0.5 deg) ~ 0.84 um; interpolation
     // error of a smooth radius function: O(h^2), here below (h^2 / 8) * max|r''| with |r''|<~8 mm
     const double h = p * kDegToRad;

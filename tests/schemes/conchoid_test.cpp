@@ -52,7 +52,7 @@ TEST(ConchoidGrid, SchemeInvariants) {
   std::uniform_real_distribution<double> U(0, 1);
   for (int j = 0; j < 2000; ++j) {
     const Eigen::Vector3d u = direction(std::acos(2 * U(rng) - 1), 2 * kPi * U(rng));
-    EXPECT_NEAR(map.sample(u), 9.5, 1e-5);
+    EXPECT_NEAR(map.lookup(u), 9.5, 1e-5);
   }
   EXPECT_THROW(ConchoidGrid(0.7), Error);
 }

@@ -129,7 +129,7 @@ TEST(HelixScheme, ConstantMapInterpolatesToConstant) {
         sum += st.weights[j];
       }
       EXPECT_NEAR(sum, 1, 1e-12);
-      EXPECT_NEAR(map.sample(3.0 * u), 17.25, 1e-5);
+      EXPECT_NEAR(map.lookup(3.0 * u), 17.25, 1e-5);
     }
   }
 }
@@ -176,7 +176,7 @@ TEST(HelixScheme, VectorisedLookUpEqualsTheScalarStencil) {
     const auto n = static_cast<std::int64_t>(x.size());
     std::vector<double> pts, soa(static_cast<std::size_t>(n)), aos(static_cast<std::size_t>(n));
     for (std::int64_t i = 0; i < n; ++i) pts.insert(pts.end(), {x[i], y[i], z[i]});
-    map.sample_many_soa(x.data(), y.data(), z.data(), n, soa.data());
+    map.lookup_many_soa(x.data(), y.data(), z.data(), n, soa.data());
     for (std::int64_t i = 0; i < n; ++i) {
       const Stencil st = h.interpolate(Eigen::Vector3d(x[i], y[i], z[i]));
       double v = 0;

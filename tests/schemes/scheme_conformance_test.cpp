@@ -4,8 +4,8 @@
 //    pole rows repeat the pole), for every node at coarse resolutions and a sample at fine ones;
 //  - stencils: node indices in range, weights >= 0 summing to 1, at random directions and at
 //    directions at and near both poles and across the seam;
-//  - the single look-up (interpolate and the weighted sum), the map's row-major batch (sample_many)
-//    and its structure-of-arrays batch (sample_many_soa) give the same values within the rounding of
+//  - the single look-up (interpolate and the weighted sum), the map's row-major batch (lookup_many)
+//    and its structure-of-arrays batch (lookup_many_soa) give the same values within the rounding of
 //    their angle computations, float and double maps;
 //  - max_node_spacing() against brute force (CGAL kd-tree over the node directions): no direction
 //    is farther than it from its nearest node, and it is not overstated (the largest such distance
@@ -13,9 +13,15 @@
 //  - resolution_for_spacing gives the coarsest resolution that reaches a node spacing;
 //  - node_angles matches node_direction; block stencils (stencils_soa) are convex combinations;
 //  - sparse maps give the dense maps' bits (plain and marked look-ups, float and double);
-//  - a sampled sphere agrees with CGAL's exact first hit within the interpolation bound.
+//  - a sampled sphere agrees with CGAL's exact first hit within the interpolation bound;
+//  - capabilities (HEALPix's neighbors, query_disc, conformable): neighbour stencils are valid,
+//    within four node spacings of their node and the same in blocks as one at a time; neighbours()
+//    is sorted, unique and without the node; nodes_in_cap equals a brute-force scan over every node
+//    (also at the poles, the seam, radius 0 and pi); a scheme is conformable with itself and with
+//    the same scheme made again, not with another resolution or another scheme.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -24,6 +30,7 @@
 
 #include "impinge/casters/exact_reference.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "impinge/sampling/sampling.hpp"
 #include "impinge/schemes/sampling_scheme.hpp"
@@ -157,13 +164,13 @@ TEST_P(SchemeConformance, SingleBatchAndSoaLookUpsAgree) {
     std::vector<double> batch(static_cast<std::size_t>(n)), soa(static_cast<std::size_t>(n)),
         far(static_cast<std::size_t>(n));
     if (storage == 0) {
-      mf.sample_many(unit.data(), n, batch.data());
-      mf.sample_many(scaled.data(), n, far.data());
-      mf.sample_many_soa(x.data(), y.data(), z.data(), n, soa.data());
+      mf.lookup_many(unit.data(), n, batch.data());
+      mf.lookup_many(scaled.data(), n, far.data());
+      mf.lookup_many_soa(x.data(), y.data(), z.data(), n, soa.data());
     } else {
-      md.sample_many(unit.data(), n, batch.data());
-      md.sample_many(scaled.data(), n, far.data());
-      md.sample_many_soa(x.data(), y.data(), z.data(), n, soa.data());
+      md.lookup_many(unit.data(), n, batch.data());
+      md.lookup_many(scaled.data(), n, far.data());
+      md.lookup_many_soa(x.data(), y.data(), z.data(), n, soa.data());
     }
     for (std::int64_t j = 0; j < n; ++j) {
       const Stencil st = s->interpolate(dirs[std::size_t(j)]);
@@ -246,10 +253,10 @@ TEST_P(SchemeConformance, SparseMapsGiveTheDenseMapsBits) {
     EXPECT_LT(sparse.bytes(), dense_bytes * 3 / 4) << s->name() << ": nine tenths of the sphere have no surface";
     EXPECT_EQ(sparse.nodes_covered(), dense.nodes_covered());
     EXPECT_THROW((void)sparse.data(), Error);
-    dense.sample_many_soa(x.data(), y.data(), z.data(), n, a.data());
-    sparse.sample_many_soa(x.data(), y.data(), z.data(), n, b.data());
-    dense.sample_many_soa_marked(x.data(), y.data(), z.data(), n, am.data());
-    sparse.sample_many_soa_marked(x.data(), y.data(), z.data(), n, bm.data());
+    dense.lookup_many_soa(x.data(), y.data(), z.data(), n, a.data());
+    sparse.lookup_many_soa(x.data(), y.data(), z.data(), n, b.data());
+    dense.lookup_many_soa_marked(x.data(), y.data(), z.data(), n, am.data());
+    sparse.lookup_many_soa_marked(x.data(), y.data(), z.data(), n, bm.data());
     int nan = 0, marked = 0;
     for (std::int64_t j = 0; j < n; ++j) {
       ASSERT_TRUE(bits_equal(a[j], b[j])) << s->name() << " point " << j << ": " << a[j] << " vs " << b[j];
@@ -262,7 +269,7 @@ TEST_P(SchemeConformance, SparseMapsGiveTheDenseMapsBits) {
     // A copy of a sparse map is a sparse map with its own tiles.
     const auto copy = sparse;
     std::vector<double> c(un);
-    copy.sample_many_soa(x.data(), y.data(), z.data(), n, c.data());
+    copy.lookup_many_soa(x.data(), y.data(), z.data(), n, c.data());
     for (std::int64_t j = 0; j < n; ++j) ASSERT_TRUE(bits_equal(a[j], c[j]));
   };
   check(mf, mf);
@@ -271,8 +278,8 @@ TEST_P(SchemeConformance, SparseMapsGiveTheDenseMapsBits) {
   RadialDistanceMap near = mf;
   near.make_sparse(25.0);
   std::vector<double> a(static_cast<std::size_t>(n)), b(static_cast<std::size_t>(n));
-  mf.sample_many_soa(x.data(), y.data(), z.data(), n, a.data());
-  near.sample_many_soa(x.data(), y.data(), z.data(), n, b.data());
+  mf.lookup_many_soa(x.data(), y.data(), z.data(), n, a.data());
+  near.lookup_many_soa(x.data(), y.data(), z.data(), n, b.data());
   int same = 0;
   for (std::int64_t j = 0; j < n; ++j) {
     const Stencil st = s->interpolate(dirs[std::size_t(j)]);
@@ -371,8 +378,8 @@ TEST_P(SchemeConformance, SampledSphereAgreesWithTheExactReference) {
   for (const Eigen::Vector3d& u : directions(rng, 2000)) {
     const auto r = exact.first_hit(Eigen::Vector3d::Zero(), u);
     ASSERT_TRUE(r.has_value());
-    worst_cast = std::max(worst_cast, std::abs(cast.sample(u) - *r));
-    worst_fast = std::max(worst_fast, std::abs(fast.sample(u) - *r));
+    worst_cast = std::max(worst_cast, std::abs(cast.lookup(u) - *r));
+    worst_fast = std::max(worst_fast, std::abs(fast.lookup(u) - *r));
   }
   EXPECT_LT(worst_cast, cast_bound) << s->name() << " " << s->resolution();
   EXPECT_LT(worst_fast, fast_bound) << s->name() << " " << s->resolution() << " (" << to_string(rep.method) << ")";
@@ -389,6 +396,115 @@ TEST_P(SchemeConformance, BadResolutionsAreRefusedByName) {
       ADD_FAILURE() << name << " accepted resolution " << r << " (" << s->num_nodes() << " nodes)";
     } catch (const Error& e) {
       EXPECT_NE(std::string(e.what()).find(name.substr(0, 5)), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Great-circle distance between two unit vectors, radians.
+double arc(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+
+TEST_P(SchemeConformance, NeighbourStencilsAreNearValidAndBlockIndependent) {
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
+  const std::int64_t n = s->num_nodes();
+  const double h = s->max_node_spacing();
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<std::int64_t> pick(0, n - 1);
+  // A block that straddles the first nodes (a pole), one at the end, and random nodes.
+  std::vector<std::int64_t> firsts{0, std::max<std::int64_t>(0, n - 300)};
+  for (int k = 0; k < 20; ++k) firsts.push_back(std::min(pick(rng), n - 100));
+  std::vector<Stencil> block(4 * 300), one(4);
+  std::vector<std::int64_t> nb;
+  for (const std::int64_t first : firsts) {
+    const std::int64_t count = std::min<std::int64_t>(first == 0 || first + 300 >= n ? 300 : 100, n - first);
+    s->neighbour_stencils(first, count, block.data());
+    for (std::int64_t k = 0; k < count; ++k) {
+      const std::int64_t i = first + k;
+      s->neighbour_stencils(i, 1, one.data());
+      const Eigen::Vector3d u = s->node_direction(i);
+      for (int q = 0; q < 4; ++q) {
+        const Stencil& st = block[static_cast<std::size_t>(4 * k + q)];
+        double sum = 0;
+        for (int j = 0; j < 4; ++j) {
+          ASSERT_GE(st.nodes[j], 0) << i;
+          ASSERT_LT(st.nodes[j], n) << i;
+          ASSERT_GE(st.weights[j], -1e-12) << i;  // HEALPix rounds to -2e-16
+          sum += st.weights[j];
+          if (st.weights[j] > 0) {
+            EXPECT_LE(arc(u, s->node_direction(st.nodes[j])), 4 * h) << "node " << i;
+          }
+        }
+        EXPECT_NEAR(sum, 1, 1e-9) << "node " << i;
+        // The same stencil from a block and from a single call, to the rounding of a vectorised
+        // stencil: the same weighted direction.
+        Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
+        for (int j = 0; j < 4; ++j) {
+          a += st.weights[j] * s->node_direction(st.nodes[j]);
+          b += one[q].weights[j] * s->node_direction(one[q].nodes[j]);
+        }
+        EXPECT_LT((a - b).norm(), 1e-9) << "node " << i << ", neighbour " << q << ": block and single calls differ";
+      }
+      s->neighbours(i, nb);
+      EXPECT_FALSE(nb.empty()) << "node " << i;
+      EXPECT_TRUE(std::is_sorted(nb.begin(), nb.end()));
+      EXPECT_EQ(std::adjacent_find(nb.begin(), nb.end()), nb.end()) << "node " << i << ": repeated neighbour";
+      EXPECT_EQ(std::find(nb.begin(), nb.end(), i), nb.end()) << "node " << i << " is its own neighbour";
+    }
+  }
+  EXPECT_THROW(s->neighbours(n, nb), Error);
+  EXPECT_THROW(s->neighbours(-1, nb), Error);
+}
+
+TEST_P(SchemeConformance, NodesInCapEqualABruteForceScan) {
+  const auto s = make_scheme(GetParam().name, GetParam().resolution());
+  const std::int64_t n = s->num_nodes();
+  std::vector<Eigen::Vector3d> node(static_cast<std::size_t>(n));
+  for (std::int64_t i = 0; i < n; ++i) node[static_cast<std::size_t>(i)] = s->node_direction(i);
+  std::mt19937_64 rng(12);
+  std::vector<Eigen::Vector3d> dirs = directions(rng, 12);
+  if (n > 100000) dirs.resize(5);                         // the poles and the seam only
+  dirs.push_back(node[static_cast<std::size_t>(n / 3)]);  // exactly on a node
+  const double h = s->max_node_spacing();
+  std::vector<std::int64_t> got;
+  for (const Eigen::Vector3d& d : dirs)
+    for (double r : {0.0, 0.5 * h, 3 * h, 0.3, 2.0, kPi}) {
+      // Nodes within 1e-12 of the boundary may fall either way (the rounding of the normalisation).
+      const Eigen::Vector3d u = d.normalized();
+      const double c = std::cos(r);
+      s->nodes_in_cap(3.0 * d, r, got);
+      ASSERT_TRUE(std::is_sorted(got.begin(), got.end()));
+      ASSERT_EQ(std::adjacent_find(got.begin(), got.end()), got.end());
+      std::size_t k = 0;
+      std::int64_t missing = 0, extra = 0;
+      for (std::int64_t i = 0; i < n; ++i) {
+        const double dot = node[static_cast<std::size_t>(i)].dot(u);
+        const bool in = k < got.size() && got[k] == i;
+        k += in;
+        missing += !in && dot >= c + 1e-12;
+        extra += in && dot < c - 1e-12;
+      }
+      EXPECT_EQ(k, got.size()) << "node indices out of range";
+      ASSERT_EQ(missing + extra, 0) << "direction (" << u.transpose() << "), radius " << r << " rad: " << missing
+                                    << " nodes of the cap missing, " << extra << " outside it returned";
+    }
+  EXPECT_THROW(s->nodes_in_cap(Eigen::Vector3d::Zero(), 0.1, got), Error);
+  EXPECT_THROW(s->nodes_in_cap(Eigen::Vector3d::UnitZ(), -0.1, got), Error);
+  EXPECT_THROW(s->nodes_in_cap(Eigen::Vector3d(std::nan(""), 0, 1), 0.1, got), Error);
+}
+
+TEST_P(SchemeConformance, ConformableWithItselfOnly) {
+  const std::string& name = GetParam().name;
+  const double r = GetParam().resolution();
+  const auto s = make_scheme(name, r);
+  EXPECT_TRUE(s->conformable(*s));
+  EXPECT_TRUE(s->conformable(*make_scheme(name, r)));
+  // Another resolution of the same scheme, and every other registered scheme at a resolution of its own.
+  const double other = resolution_for_spacing(name, GetParam().spacing_deg == 2.0 ? 1.0 : 2.0);
+  if (other != r) {
+    EXPECT_FALSE(s->conformable(*make_scheme(name, other)));
+  }
+  for (const auto& [n2, unit] : scheme_names()) {
+    if (n2 != name) {
+      EXPECT_FALSE(s->conformable(*make_scheme(n2, resolution_for_spacing(n2, 2.0)))) << n2;
     }
   }
 }

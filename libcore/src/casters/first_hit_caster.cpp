@@ -18,7 +18,6 @@
 namespace impinge {
 
 struct FirstHitCaster::Impl {
-  std::string backend;
   Eigen::Vector3d origin;
   std::vector<Eigen::Matrix3d> edge_on;  ///< columns: the corners relative to the origin
   std::optional<EmbreeRayCaster> embree;
@@ -91,10 +90,8 @@ FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& 
   }
   if (have_embree()) {
     impl_->embree.emplace(clean, origin, /*robust=*/true);
-    impl_->backend = "embree";
   } else {
     impl_->cgal.emplace(clean);
-    impl_->backend = "cgal";
   }
   // Whether the origin lies inside the solid: the majority over 13 rays of whether the first crossing
   // leaves it (a ray that misses says outside).
@@ -242,6 +239,5 @@ void merge_hits(std::vector<std::pair<double, double>>& raw, int orientation, st
 }
 }  // namespace
 
-const std::string& FirstHitCaster::backend() const { return impl_->backend; }
 
 }  // namespace impinge

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "impinge/core/error.hpp"
+#include "impinge/core/timing.hpp"
 #include "impinge/maps/map_io.hpp"
 
 namespace impinge {
@@ -63,7 +64,7 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
       frames_->femur = femur_frame(fl, side, options.frames.femur);
       frames_->femur.quality_mm = quality;
     }
-    frames_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    frames_ms_ = ms_since(t0);
     // Joint frame: pelvic axes arranged as the scan frame, p_joint = S P^T (p - cor).
     joint_to_working_ = frames_->pelvis.axes * S.transpose();
     femur_axes_joint_ = joint_to_working_.transpose() * frames_->femur.axes;

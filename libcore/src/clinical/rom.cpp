@@ -13,6 +13,24 @@
 
 namespace impinge {
 
+const char* to_string(ImpingementSite site) {
+  switch (site) {
+    case ImpingementSite::intra_articular: return "intra_articular";
+    case ImpingementSite::extra_articular: return "extra_articular";
+    case ImpingementSite::none: break;
+  }
+  return "";
+}
+
+const char* to_string(RomMapStatus status) {
+  switch (status) {
+    case RomMapStatus::limited: return "limited";
+    case RomMapStatus::contact_at_zero: return "contact_at_zero";
+    case RomMapStatus::free: break;
+  }
+  return "free";
+}
+
 std::vector<StandardMotion> standard_motions() {
   return {
       {"flexion", [](double t) { return PoseAngles{t, 0, 0}; }},
@@ -63,8 +81,9 @@ class BlockPyramid {
   // value of an empty block).
   template <typename Value>
   BlockPyramid(const SamplingScheme& scheme, Value value, V none, Combine combine) : none_(none), combine_(combine) {
-    const auto* g = dynamic_cast<const EquiangularGrid*>(&scheme);
-    if (g == nullptr) return;  // bounds for equiangular maps only; other schemes scan every vertex
+    // Bounds over the rows and columns of an equiangular grid; maps of other schemes scan every vertex.
+    const auto g = conformable_equiangular_grid(scheme);
+    if (!g) return;
     rows_ = g->rows(), cols_ = g->columns(), step_ = g->step();
     for (int L = kFirstLevel;; ++L) {
       const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b, stride = bc + kPad;
@@ -439,7 +458,7 @@ class CompactScanner {
       const Eigen::Vector3d q = R * Eigen::Vector3d(set.x[c.first + k], set.y[c.first + k], set.z[c.first + k]);
       x[k] = q.x(), y[k] = q.y(), z[k] = q.z();
     }
-    map.sample_many_soa(x, y, z, c.count, d);
+    map.lookup_many_soa(x, y, z, c.count, d);
     for (std::int64_t k = 0; k < c.count; ++k) {
       const double r = std::sqrt(x[k] * x[k] + y[k] * y[k] + z[k] * z[k]);
       buf_[static_cast<std::size_t>(c.first + k)] = static_cast<float>(static_cast<double>(side) * (d[k] - r));
@@ -605,7 +624,8 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
              : Eigen::Vector3d(joint.socket().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose());
   out.contact_mm = hip.to_working(p_joint);
   const double rim = hip.acetabulum() ? hip.acetabulum()->rim_radius_mm : hip.head_radius_mm() + 5;
-  out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? "intra_articular" : "extra_articular";
+  out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? ImpingementSite::intra_articular
+                                                                      : ImpingementSite::extra_articular;
   out.limited_by_hidden_vertex = l.hidden;
   if (hip.socket_clock()) {
     // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.
@@ -658,7 +678,7 @@ std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& 
   const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(hip.joint(), o, base);
   std::vector<RomMapCell> cells;
   for (double f : flexion)
-    for (double a : adduction) cells.push_back({f, a, std::numeric_limits<double>::quiet_NaN(), ""});
+    for (double a : adduction) cells.push_back({f, a, std::numeric_limits<double>::quiet_NaN(), RomMapStatus::free});
   const auto n = static_cast<std::int64_t>(cells.size());
   std::vector<std::string> errors(cells.size());
 #pragma omp parallel for schedule(dynamic, 1)
@@ -673,7 +693,9 @@ std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& 
       c.vertices_skipped = l.vertices_skipped;
       c.evaluations = l.evaluations;
       c.max_internal_rotation_deg = l.contact_at_start ? std::numeric_limits<double>::quiet_NaN() : l.limit_deg;
-      c.status = l.contact_at_start ? "contact_at_zero" : std::isnan(l.limit_deg) ? "free" : "limited";
+      c.status = l.contact_at_start          ? RomMapStatus::contact_at_zero
+                 : std::isnan(l.limit_deg) ? RomMapStatus::free
+                                           : RomMapStatus::limited;
     } catch (const std::exception& e) {
       errors[static_cast<std::size_t>(k)] = e.what();
     }

@@ -73,7 +73,7 @@ void scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen
   for (std::int64_t b = 0; b < n; b += kBlock) {
     const int m = static_cast<int>(std::min(kBlock, n - b));
     pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt.data(), qx, qy, qz, radius);
-    map.sample_many_soa(qx, qy, qz, m, d);
+    map.lookup_many_soa(qx, qy, qz, m, d);
     gap_block(d, radius, s, m, gap_mm + b);
   }
 }
@@ -102,7 +102,7 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
   for (std::int64_t b = 0; b < n; b += kBlock) {
     const int m = static_cast<int>(std::min(kBlock, n - b));
     pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt.data(), qx, qy, qz, radius);
-    map.sample_many_soa_marked(qx, qy, qz, m, d);
+    map.lookup_many_soa_marked(qx, qy, qz, m, d);
     float* g = gap_mm + b;
     gap_block(d, radius, s, m, g);
     // Marked stencils came back as -inf, so their gaps are +-inf: noted here, resolved by the ray
@@ -188,7 +188,7 @@ std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMa
     const Eigen::Vector3d p = P.row(i).transpose();
     const double r = p.norm();
     if (!(r > 0) || r > max_radius_mm) continue;
-    double d = own_map.sample(p);
+    double d = own_map.lookup(p);
     if (std::isnan(d)) {
       // At the edge of the map's coverage: compare with the nearest surface among the stencil
       // nodes that have one (a rim vertex of an outer shell is still hidden by the inner one).

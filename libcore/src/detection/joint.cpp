@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "impinge/core/error.hpp"
+#include "impinge/core/timing.hpp"
 #include "impinge/maps/depth_discontinuity.hpp"
 #include "impinge/sampling/layered_sampling.hpp"
 
@@ -27,9 +28,6 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
   o.levels.validate();
   return o;
 }
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 }  // namespace
 
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options)
@@ -49,8 +47,7 @@ JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given
   if (given) {
     const SamplingScheme& want = *options_.scheme;
     const SamplingScheme& have = given->scheme();
-    require(have.name() == want.name() && have.resolution() == want.resolution() &&
-                given->num_nodes() == want.num_nodes(),
+    require(want.conformable(have),
             b.mesh.source + ": the given map is " + have.name() + " at " + std::to_string(have.resolution()) +
                 ", the joint's scheme is " + want.name() + " at " + std::to_string(want.resolution()));
     b.map = std::move(*given);

@@ -38,11 +38,11 @@ void write_grey_png(const std::string& path, const unsigned char* pixels, int w,
 }  // namespace
 
 MapImageScale write_map_png(const std::string& path, const RadialDistanceMap& map) {
-  // Pixel values: the node values of an equiangular map, else the map interpolated at the
+  // Pixel values: the node values of a map conformable with an equiangular grid, else the map interpolated at the
   // nodes of an equiangular image grid matched to the scheme's spacing (at most 3600 x 1801).
   std::vector<double> value;
   int w, h;
-  if (const auto* g = dynamic_cast<const EquiangularGrid*>(&map.scheme())) {
+  if (const auto g = conformable_equiangular_grid(map.scheme())) {
     w = g->columns(), h = g->rows();
     value.resize(static_cast<std::size_t>(map.num_nodes()));
     for (std::int64_t i = 0; i < map.num_nodes(); ++i) value[static_cast<std::size_t>(i)] = map.at(i);  // dense or sparse
@@ -52,7 +52,7 @@ MapImageScale write_map_png(const std::string& path, const RadialDistanceMap& ma
     w = img.columns(), h = img.rows();
     value.resize(static_cast<std::size_t>(img.num_nodes()));
     for (std::int64_t i = 0; i < img.num_nodes(); ++i) {
-      const double v = map.sample(img.node_direction(i));
+      const double v = map.lookup(img.node_direction(i));
       value[static_cast<std::size_t>(i)] = std::isnan(v) ? std::numeric_limits<double>::infinity() : v;
     }
   }

@@ -216,18 +216,18 @@ std::size_t RadialDistanceMapT<Scalar>::make_sparse(double region_mm) {
 }
 
 template <typename Scalar>
-void RadialDistanceMapT<Scalar>::sample_many(const double* pts, std::int64_t n, double* out) const {
+void RadialDistanceMapT<Scalar>::lookup_many(const double* pts, std::int64_t n, double* out) const {
   double x[kStencilBlock], y[kStencilBlock], z[kStencilBlock];
   for (std::int64_t b = 0; b < n; b += kStencilBlock) {
     const int m = static_cast<int>(std::min<std::int64_t>(kStencilBlock, n - b));
     for (int j = 0; j < m; ++j) x[j] = pts[3 * (b + j)], y[j] = pts[3 * (b + j) + 1], z[j] = pts[3 * (b + j) + 2];
-    lookup<false>(x, y, z, m, out + b);
+    lookup_soa<false>(x, y, z, m, out + b);
   }
 }
 
 template <typename Scalar>
 template <bool kMarked>
-void RadialDistanceMapT<Scalar>::lookup(const double* x, const double* y, const double* z, std::int64_t n,
+void RadialDistanceMapT<Scalar>::lookup_soa(const double* x, const double* y, const double* z, std::int64_t n,
                                         double* out) const {
   alignas(64) std::int32_t nd[4 * kStencilBlock];
   alignas(64) double w[4 * kStencilBlock];
@@ -242,12 +242,12 @@ void RadialDistanceMapT<Scalar>::lookup(const double* x, const double* y, const 
 
 template class RadialDistanceMapT<float>;
 template class RadialDistanceMapT<double>;
-template void RadialDistanceMapT<float>::lookup<false>(const double*, const double*, const double*, std::int64_t,
+template void RadialDistanceMapT<float>::lookup_soa<false>(const double*, const double*, const double*, std::int64_t,
                                                        double*) const;
-template void RadialDistanceMapT<float>::lookup<true>(const double*, const double*, const double*, std::int64_t,
+template void RadialDistanceMapT<float>::lookup_soa<true>(const double*, const double*, const double*, std::int64_t,
                                                       double*) const;
-template void RadialDistanceMapT<double>::lookup<false>(const double*, const double*, const double*, std::int64_t,
+template void RadialDistanceMapT<double>::lookup_soa<false>(const double*, const double*, const double*, std::int64_t,
                                                         double*) const;
-template void RadialDistanceMapT<double>::lookup<true>(const double*, const double*, const double*, std::int64_t,
+template void RadialDistanceMapT<double>::lookup_soa<true>(const double*, const double*, const double*, std::int64_t,
                                                        double*) const;
 }  // namespace impinge

@@ -6,6 +6,8 @@
 #include <limits>
 #include <vector>
 
+#include "impinge/core/timing.hpp"
+
 namespace impinge {
 
 LayeredSamplingReport sample_layered_map(LayeredMap& map, const FirstHitCaster& caster) {
@@ -37,7 +39,7 @@ LayeredSamplingReport sample_layered_map(LayeredMap& map, const FirstHitCaster& 
   rep.nodes_truncated = truncated;
   rep.nodes_not_alternating = not_alternating;
   rep.max_crossings = most;
-  rep.sampling_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  rep.sampling_ms = ms_since(t0);
   return rep;
 }
 

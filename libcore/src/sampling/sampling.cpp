@@ -7,6 +7,7 @@
 #include "impinge/casters/first_hit_caster.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
+#include "impinge/core/timing.hpp"
 #include "impinge/sampling/naive_sampling.hpp"
 
 namespace impinge {
@@ -35,12 +36,6 @@ const char* to_string(SamplingMethod method) {
   }
   return "?";
 }
-
-namespace {
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-}  // namespace
 
 template <typename Scalar>
 void resample(const RadialDistanceMap& source, RadialDistanceMapT<Scalar>& target) {
@@ -80,10 +75,11 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
                               RadialDistanceMapT<Scalar>& map) {
   require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
   SamplingReport rep;
-  const bool equiangular = dynamic_cast<const EquiangularGrid*>(&map.scheme()) != nullptr;
   rep.method = o.method;
+  // The rasteriser fills an equiangular grid: a map conformable with one is rasterised directly,
+  // any other is resampled from one (thesis sec. 4.2.2).
   if (rep.method == SamplingMethod::automatic)
-    rep.method = equiangular ? SamplingMethod::rasterize : SamplingMethod::resample;
+    rep.method = conformable_equiangular_grid(map.scheme()) ? SamplingMethod::rasterize : SamplingMethod::resample;
   auto t0 = std::chrono::steady_clock::now();
   // Face culling (exact mode): the caller's plan, or one made here when asked to.
   RasterPlan own;

@@ -61,6 +61,72 @@ void EquiangularGrid::node_angles(std::int64_t first, std::int64_t count, double
   }
 }
 
+std::optional<EquiangularGrid> conformable_equiangular_grid(const SamplingScheme& scheme) {
+  try {
+    EquiangularGrid grid(matched_equiangular_precision(scheme.max_node_spacing()));
+    if (scheme.conformable(grid)) return grid;
+  } catch (const Error&) {  // no equiangular grid at that spacing (too fine for 32-bit node indices)
+  }
+  return std::nullopt;
+}
+
+void EquiangularGrid::neighbour_stencils(std::int64_t first, std::int64_t count, Stencil* out) const {
+  auto one = [](Stencil& s, std::int64_t node) {
+    s.nodes = {node, node, node, node};
+    s.weights = {1, 0, 0, 0};
+  };
+  for (std::int64_t k = 0; k < count; ++k) {
+    const std::int64_t i = first + k;
+    const int r = static_cast<int>(i / cols_), c = static_cast<int>(i % cols_);
+    const int cl = c == 0 ? cols_ - 1 : c - 1, cr = c + 1 == cols_ ? 0 : c + 1, co = (c + cols_ / 2) % cols_;
+    auto at = [&](int rr, int cc) { return std::int64_t(rr) * cols_ + cc; };
+    Stencil* s = out + 4 * k;
+    one(s[0], r == 0 ? at(1, co) : at(r - 1, c));
+    one(s[1], r == rows_ - 1 ? at(rows_ - 2, co) : at(r + 1, c));
+    one(s[2], at(r, cl));
+    one(s[3], at(r, cr));
+  }
+}
+
+void EquiangularGrid::nodes_in_cap(const Eigen::Vector3d& direction, double radius_rad,
+                                   std::vector<std::int64_t>& out) const {
+  require(direction.allFinite() && direction.norm() > 0, "sampling scheme 'equiangular': nodes_in_cap needs a nonzero, finite direction");
+  require(radius_rad >= 0, "sampling scheme 'equiangular': nodes_in_cap radius " + std::to_string(radius_rad) + " rad must be >= 0");
+  const Eigen::Vector3d u = direction.normalized();
+  const double r = std::min(radius_rad, kPi), cr = std::cos(r);
+  const SphericalCoordinates s = to_spherical(u);
+  out.clear();
+  // Rows whose polar angle lies within r (and a rounding margin) of the cap centre's.
+  constexpr double kMargin = 1e-9;
+  const int r0 = std::max(0, static_cast<int>(std::floor((s.phi - r) * inv_step_ - kMargin)));
+  const int r1 = std::min(rows_ - 1, static_cast<int>(std::ceil((s.phi + r) * inv_step_ + kMargin)));
+  const double sp0 = std::sin(s.phi), cp0 = std::cos(s.phi);
+  for (int row = r0; row <= r1; ++row) {
+    const double phi = row * step_, sp = std::sin(phi), cp = std::cos(phi);
+    const std::int64_t base = std::int64_t(row) * cols_;
+    auto take = [&](int c) {
+      if (node_direction(base + c).dot(u) >= cr) out.push_back(base + c);
+    };
+    // cos(d theta) at the cap's boundary on this row; whole rows at a pole or inside the cap.
+    const double denom = sp0 * sp;
+    const double cdt = denom > 1e-12 ? (cr - cp0 * cp) / denom : -2.0;
+    if (cdt <= -1 + 1e-9) {
+      for (int c = 0; c < cols_; ++c) take(c);
+      continue;
+    }
+    if (cdt > 1 + 1e-9) continue;  // the row passes outside the cap
+    const double half = std::acos(std::min(1.0, cdt)) + kMargin;
+    const int c0 = static_cast<int>(std::floor((s.theta - half) * inv_step_)), c1 = static_cast<int>(std::ceil((s.theta + half) * inv_step_));
+    if (c1 - c0 + 1 >= cols_) {
+      for (int c = 0; c < cols_; ++c) take(c);
+      continue;
+    }
+    const std::size_t before = out.size();
+    for (int c = c0; c <= c1; ++c) take(((c % cols_) + cols_) % cols_);
+    std::sort(out.begin() + static_cast<std::ptrdiff_t>(before), out.end());  // columns wrapped at the seam
+  }
+}
+
 namespace {
 /// Pass 1 of the look-up: cell (base node index, column step to the next column) and the
 /// fractional position (t along phi, s along theta) of n directions. Branch-free so it

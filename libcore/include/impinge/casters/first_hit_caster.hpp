@@ -53,8 +53,6 @@ class FirstHitCaster {
   int orientation() const { return orientation_; }
   /// Whether the origin lies inside the solid (the majority of 13 rays' first crossings).
   bool origin_inside() const { return origin_inside_; }
-  /// "embree" or "cgal".
-  const std::string& backend() const;
   /// Triangles whose plane passes through the origin (to 1e-6 of their distance): a ray from the
   /// origin meets them only inside their plane, where Embree's float intersection gives distances
   /// of no meaning (2 mm hits on the radial rim of a 24.5 mm cup). They are kept out of the BVH

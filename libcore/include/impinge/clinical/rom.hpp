@@ -50,6 +50,12 @@ struct StandardMotion {
 /// flexion and 10 deg adduction).
 std::vector<StandardMotion> standard_motions();
 
+/// Where a ROM limit's contact lies: intra-articular (within the rim radius plus
+/// RomOptions::intra_articular_margin_mm of the COR) or extra-articular (farther); none without a limit.
+enum class ImpingementSite { none, intra_articular, extra_articular };
+/// "", "intra_articular", "extra_articular" (the CSV and JSON spelling).
+const char* to_string(ImpingementSite site);
+
 /// Where and how a motion is limited.
 struct RomLimit {
   double limit_deg = std::numeric_limits<double>::quiet_NaN();  ///< first contact angle (upper end of the final
@@ -61,7 +67,7 @@ struct RomLimit {
   bool limited_by_ball = false;    ///< the least gap was a femur vertex (else a pelvis vertex)
   bool limited_by_hidden_vertex = false;  ///< that vertex is hidden behind its own body's nearer surface and was
                                           ///< tested by the other body's layered map (JointOptions::layers)
-  std::string limited_by;          ///< "intra_articular" or "extra_articular" ("" without a limit): extra when
+  ImpingementSite limited_by = ImpingementSite::none;  ///< intra- or extra-articular (none without a limit): extra when
                                    ///< the contact lies farther than the rim radius plus
                                    ///< RomOptions::intra_articular_margin_mm from the COR (a hidden vertex
                                    ///< near the joint, such as the far side of the rim, is intra-articular)
@@ -120,11 +126,19 @@ std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<Sta
                                       const RomOptions& options, const RomBaseline& baseline);
 
 /// One cell of a ROM map: the largest internal rotation at (flexion, adduction).
+/// The outcome of one ROM map cell's search.
+enum class RomMapStatus {
+  limited,          ///< contact at max_internal_rotation_deg
+  free,             ///< no contact up to max_deg
+  contact_at_zero,  ///< in contact already without rotation
+};
+/// "limited", "free", "contact_at_zero" (the CSV spelling).
+const char* to_string(RomMapStatus status);
+
 struct RomMapCell {
   double flexion_deg = 0, adduction_deg = 0;
   double max_internal_rotation_deg = std::numeric_limits<double>::quiet_NaN();  ///< NaN: see status
-  std::string status;  ///< "limited", "free" (no contact up to max_deg), "contact_at_zero" (in contact
-                       ///< already without rotation)
+  RomMapStatus status = RomMapStatus::free;
   std::int64_t vertices_looked_up = 0, vertices_skipped = 0;  ///< over its search
   int evaluations = 0;                                        ///< poses evaluated by its search
 };

@@ -56,7 +56,7 @@ struct ScanSummary {
 
 /// One scan of Algorithm 2: for every vertex i with mask[i] != 0, q = R * P.row(i) (P: n x 3,
 /// mm, relative to the COR in the vertex body's frame; R: 3 x 3 rotation into the map's frame),
-/// gap = side * (map.sample(q) - |q|). A one-shot convenience: it builds the ScanSet of the mask
+/// gap = side * (map.lookup(q) - |q|). A one-shot convenience: it builds the ScanSet of the mask
 /// and runs scan_gaps_compact; for many poses build the set once (make_scan_set, as Joint does)
 /// and call scan_gaps_compact. `out` is resized to n. Vertices at the COR itself are reported
 /// as no surface.
@@ -82,7 +82,7 @@ ScanSet make_scan_set(PointsRef P, const std::vector<std::uint8_t>& mask);
 
 /// The fast scan (issue 4): for every vertex j of `set`, q = R * p_j + t in the map's frame
 /// (R: 3 x 3 rotation, t: translation, mm; the identity and 0 when the bodies share the COR),
-/// gap_mm[j] = side * (map.sample(q) - |q|), NaN where the map has no surface in q's direction
+/// gap_mm[j] = side * (map.lookup(q) - |q|), NaN where the map has no surface in q's direction
 /// or q is the COR. `gap_mm` must hold set.size() floats. Allocation-free, single thread; blocks
 /// of 256 vertices: transform, then the scheme's two-pass look-up (stencils, then loads).
 template <typename Scalar>
@@ -132,7 +132,7 @@ void expand_layered_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out)
 void expand_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out);
 
 /// Vertices of a body that lie on its own first surface seen from the COR:
-/// mask[i] = 1 when |p_i| <= own_map.sample(p_i) + tolerance_mm and |p_i| <= max_radius_mm; at
+/// mask[i] = 1 when |p_i| <= own_map.lookup(p_i) + tolerance_mm and |p_i| <= max_radius_mm; at
 /// the edge of the own map's coverage the nearest covered stencil node is used, and a vertex
 /// none of whose stencil nodes is covered is skipped (the map cannot place its first surface).
 /// Pose-invariant (the COR is fixed in both bodies), so computed once per body. Vertices hidden

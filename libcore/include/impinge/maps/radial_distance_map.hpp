@@ -83,27 +83,27 @@ class RadialDistanceMapT {
   /// Interpolated radial distance (mm) of the surface in the direction of `p` (any nonzero
   /// vector relative to the COR), by the scheme's stencil (thesis Algorithms 2 and 3). NaN when
   /// a node with nonzero weight has no surface. For many points use the batch forms.
-  double sample(const Eigen::Vector3d& p) const {
+  double lookup(const Eigen::Vector3d& p) const {
     double out;
-    sample_many_soa(&p.x(), &p.y(), &p.z(), 1, &out);
+    lookup_many_soa(&p.x(), &p.y(), &p.z(), 1, &out);
     return out;
   }
-  /// sample() at n points (pts: n x 3 row-major).
-  void sample_many(const double* pts, std::int64_t n, double* out) const;
-  /// sample_many with the points in structure-of-arrays form (x, y, z: n values each, mm).
-  void sample_many_soa(const double* x, const double* y, const double* z, std::int64_t n, double* out) const {
-    lookup<false>(x, y, z, n, out);
+  /// lookup() at n points (pts: n x 3 row-major).
+  void lookup_many(const double* pts, std::int64_t n, double* out) const;
+  /// lookup_many with the points in structure-of-arrays form (x, y, z: n values each, mm).
+  void lookup_many_soa(const double* x, const double* y, const double* z, std::int64_t n, double* out) const {
+    lookup_soa<false>(x, y, z, n, out);
   }
-  /// sample_many_soa, except that a point whose stencil holds a node with the depth-discontinuity
+  /// lookup_many_soa, except that a point whose stencil holds a node with the depth-discontinuity
   /// mark (mark_depth_discontinuities), with any weight, gets -infinity: the caller resolves it
   /// exactly.
-  void sample_many_soa_marked(const double* x, const double* y, const double* z, std::int64_t n, double* out) const {
-    lookup<true>(x, y, z, n, out);
+  void lookup_many_soa_marked(const double* x, const double* y, const double* z, std::int64_t n, double* out) const {
+    lookup_soa<true>(x, y, z, n, out);
   }
 
  private:
   template <bool kMarked>
-  void lookup(const double* x, const double* y, const double* z, std::int64_t n, double* out) const;
+  void lookup_soa(const double* x, const double* y, const double* z, std::int64_t n, double* out) const;
 
   std::shared_ptr<const SamplingScheme> scheme_;
   std::int64_t num_nodes_ = 0;

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "impinge/core/fast_angles.hpp"
 #include "impinge/schemes/sampling_scheme.hpp"
@@ -83,6 +85,14 @@ class EquiangularGrid : public SchemeImpl<EquiangularGrid> {
   /// The same stencils as stencil_at up to the rounding of the angles (one division for both).
   void stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
                     double* w) const override;
+  /// The row neighbours (r -+ 1, same column; across a pole, row 1 half a turn round) and column
+  /// neighbours (c -+ 1, wrapping at the seam) of each node, one node of weight 1 each: the nodes
+  /// that the bilinear stencils join (SamplingScheme::neighbour_stencils).
+  void neighbour_stencils(std::int64_t first, std::int64_t count, Stencil* out) const override;
+  /// The rows within the cap's polar range, and in each the columns within the azimuth half-width
+  /// where the cap's boundary crosses the row (whole rows around a pole), each node confirmed by the
+  /// same distance test as the default (SamplingScheme::nodes_in_cap): O(nodes in the cap + rows).
+  void nodes_in_cap(const Eigen::Vector3d& direction, double radius_rad, std::vector<std::int64_t>& out) const override;
 
  private:
   double precision_deg_;
@@ -91,6 +101,12 @@ class EquiangularGrid : public SchemeImpl<EquiangularGrid> {
   int rows_;
   int cols_;
 };
+
+/// The equiangular grid whose node indexing a map of `scheme` shares (SamplingScheme::conformable
+/// with the grid of the scheme's node spacing), or nothing. For the operations that run over an
+/// equiangular grid's rows and columns (rasterising straight into a map, ROM bound pyramids, map
+/// images); any other scheme takes their general path. Never throws.
+std::optional<EquiangularGrid> conformable_equiangular_grid(const SamplingScheme& scheme);
 
 /// `scheme` as an equiangular grid, for the operations that need one (rasterisation, the
 /// resampling source). Throws impinge::Error naming the scheme when it is another.

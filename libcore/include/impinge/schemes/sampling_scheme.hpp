@@ -60,6 +60,36 @@ class SamplingScheme {
   /// fast_angles.hpp). Source: thesis Algorithms 2 and 3 (the look-ups), split for the plug-in.
   virtual void stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
                             double* w) const = 0;
+
+  // ---- Capabilities (after HEALPix's neighbors, query_disc and conformable, Gorski et al. 2005) ----
+  // Defaults that work for any scheme from the members above; a scheme with a cheaper exact form
+  // overrides them (the equiangular grid does). tests/schemes/scheme_conformance_test.cpp checks
+  // every registered scheme against brute force.
+
+  /// Neighbours of the nodes [first, first + count) as two opposite pairs, for second differences
+  /// (maps/depth_discontinuity.hpp): out[4 k] and out[4 k + 1] are the stencils one step away from
+  /// node first + k along -phi and +phi, out[4 k + 2] and out[4 k + 3] along -theta and +theta;
+  /// `out` holds 4 count stencils. Default: the interpolation stencils (stencils_soa) of the points
+  /// at great-circle distance max_node_spacing() along the unit tangents e_phi and e_theta of the
+  /// node's (phi, theta) (node_angles). The equiangular grid gives its row and column neighbours
+  /// (one node of weight 1 each; across a pole, the next row half a turn round).
+  virtual void neighbour_stencils(std::int64_t first, std::int64_t count, Stencil* out) const;
+
+  /// The nodes adjacent to node i (HEALPix's neighbors): the distinct nodes of nonzero weight in
+  /// neighbour_stencils(i), without i, ascending. `out` is cleared first. Throws impinge::Error for
+  /// i outside [0, num_nodes()).
+  void neighbours(std::int64_t i, std::vector<std::int64_t>& out) const;
+
+  /// Every node whose direction lies within great-circle distance `radius_rad` of `direction` (any
+  /// nonzero vector), ascending (HEALPix's query_disc, inclusive). `out` is cleared first. Default:
+  /// every node tested, O(num_nodes()); the equiangular grid visits only the rows and columns the
+  /// cap spans. Throws impinge::Error for a zero or non-finite direction or a negative or NaN radius.
+  virtual void nodes_in_cap(const Eigen::Vector3d& direction, double radius_rad, std::vector<std::int64_t>& out) const;
+
+  /// True when a map of `other` holds the same directions at the same node indices, so that its
+  /// values can be read with this scheme's indices (HEALPix's conformable): the same registry name,
+  /// resolution and node count.
+  virtual bool conformable(const SamplingScheme& other) const;
 };
 
 /// Largest block of stencils_soa (directions per call).
