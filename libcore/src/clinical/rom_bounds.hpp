@@ -1,0 +1,308 @@
+#pragma once
+// Private to libcore/src/clinical: the bounds of the ROM searches (rom.hpp): pyramids of minima,
+// maxima and shell occupancies over an equiangular map, clusters of scan-set vertices, and the
+// RomSearchBounds a baseline shares. Included by rom.cpp and rom_envelope.cpp only.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "impinge/clinical/rom.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/fast_angles.hpp"
+#include "impinge/detection/detection.hpp"
+#include "impinge/schemes/equiangular_grid.hpp"
+
+namespace impinge {
+namespace rom_detail {
+
+inline void check(const RomOptions& o) {
+  require(std::isfinite(o.threshold_mm), "rom: threshold must be finite");
+  require(o.step_deg > 0 && o.max_deg > 0 && o.tolerance_deg > 0 && o.tolerance_deg <= o.step_deg,
+          "rom: need step > 0, max > 0 and 0 < tolerance <= step (degrees)");
+}
+
+// ---- bounds ----------------------------------------------------------------------------------
+// A pyramid of minima (or maxima) over an equiangular map: at level L, block (i, j) holds the min
+// (max) of the finite node values in fine rows [i 2^L, (i+1) 2^L] and columns [j 2^L, (j+1) 2^L]
+// (boundaries shared, columns periodic); +inf (-inf) when none is finite. A fine bilinear value
+// whose four nodes are finite is >= (<=) the bound of any block range covering those nodes; a
+// stencil with an infinite node gives NaN, no gap, so infinite nodes can be ignored.
+// Combining node values over blocks: the least or the greatest distance, or the union of shells.
+struct MinOrMax {
+  bool lower = true;
+  float operator()(float a, float b) const { return lower ? std::min(a, b) : std::max(a, b); }
+};
+struct BitOr {
+  std::uint64_t operator()(std::uint64_t a, std::uint64_t b) const { return a | b; }
+};
+
+template <typename V, typename Combine>
+class BlockPyramid {
+ public:
+  static constexpr int kFirstLevel = 2;
+  // Blocks across a cap, at most: finer is tighter, coarser is fewer reads.
+  static constexpr int kMaxBlocksPerSpan = 16;
+  // Each stored row repeats its first kPad blocks after its last, so a cap's column range (at most
+  // blocks_per_span + 3 blocks, or the whole row) is read without wrapping.
+  static constexpr int kPad = kMaxBlocksPerSpan + 4;
+  // value(i): node i's value (called from several threads); none: the identity of `combine` (the
+  // value of an empty block).
+  template <typename Value>
+  BlockPyramid(const SamplingScheme& scheme, Value value, V none, Combine combine) : none_(none), combine_(combine) {
+    // Bounds over the rows and columns of an equiangular grid; maps of other schemes scan every vertex.
+    const auto g = conformable_equiangular_grid(scheme);
+    if (!g) return;
+    rows_ = g->rows(), cols_ = g->columns(), step_ = g->step();
+    for (int L = kFirstLevel;; ++L) {
+      const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b, stride = bc + kPad;
+      // Stored padded: row i holds blocks 0 .. bc + kPad - 1, block j at (j mod bc).
+      std::vector<V> v(static_cast<std::size_t>(br) * stride, none);
+      if (L == kFirstLevel) {
+#pragma omp parallel
+        {
+          std::vector<V> row(static_cast<std::size_t>(bc) * b + 1);  // one node row, wrapped
+#pragma omp for schedule(static)
+          for (int i = 0; i < br; ++i) {
+            V* out = v.data() + static_cast<std::size_t>(i) * stride;
+            for (int r = i * b; r <= std::min((i + 1) * b, rows_ - 1); ++r) {
+              const std::int64_t first = std::int64_t(r) * cols_;
+              for (int c = 0; c < cols_; ++c) row[static_cast<std::size_t>(c)] = value(first + c);
+              for (int c = cols_; c <= bc * b; ++c) row[static_cast<std::size_t>(c)] = row[static_cast<std::size_t>(c - cols_)];
+              for (int j = 0; j < bc; ++j) {
+                V m = out[j];
+                for (int c = j * b; c <= (j + 1) * b; ++c) m = combine(m, row[static_cast<std::size_t>(c)]);
+                out[j] = m;
+              }
+            }
+          }
+        }
+      } else {
+        const std::vector<V>& p = levels_.back();
+        const int pbr = (rows_ - 1 + b / 2 - 1) / (b / 2), pbc = (cols_ + b / 2 - 1) / (b / 2), pstride = pbc + kPad;
+        for (int i = 0; i < br; ++i)
+          for (int j = 0; j < bc; ++j) {
+            V m = none;
+            for (int di = 0; di < 2; ++di)
+              for (int dj = 0; dj < 2; ++dj) {
+                const int pi = 2 * i + di, pj = 2 * j + dj;
+                if (pi >= pbr) continue;
+                m = combine(m, p[static_cast<std::size_t>(pi) * pstride + (pj % pbc)]);
+              }
+            v[static_cast<std::size_t>(i) * stride + j] = m;
+          }
+      }
+      for (int i = 0; i < br; ++i)
+        for (int j = bc; j < stride; ++j)
+          v[static_cast<std::size_t>(i) * stride + j] = v[static_cast<std::size_t>(i) * stride + (j % bc)];
+      levels_.push_back(std::move(v));
+      if (br <= 2 && bc <= 2) break;
+    }
+  }
+  bool valid() const { return !levels_.empty(); }
+  // Combined value over every node (none when the pyramid is not valid).
+  V all() const {
+    V m = none_;
+    for (const V& x : levels_.empty() ? std::vector<V>{} : levels_.back()) m = combine_(m, x);
+    return m;
+  }
+  // Combined value over every stencil node of the directions within angle rho of unit u (sin_rho =
+  // sin(rho)). Angles by fast_angles.hpp (within 1e-13 rad; the row and column ranges are padded by a
+  // node on each side).
+  V cap(const Eigen::Vector3d& u, double rho, double sin_rho, int blocks_per_span) const {
+    double phi, theta;
+    fast_spherical_angles(u.x(), u.y(), u.z(), phi, theta);
+    double r_lo = (phi - rho) / step_, r_hi = (phi + rho) / step_ + 1;
+    int c_lo = 0, c_hi = cols_;  // whole rows when the cap holds a pole or is wide
+    if (phi - rho > 0 && phi + rho < M_PI) {
+      const double sin_phi = std::sqrt(std::max(0.0, u.x() * u.x() + u.y() * u.y()));
+      const double v = std::min(1.0, sin_rho / sin_phi);
+      const double half = fast_azimuth(v, std::sqrt(std::max(0.0, 1 - v * v)));  // asin(v)
+      if (half < M_PI / 2) {
+        c_lo = static_cast<int>(std::floor((theta - half) / step_)) - 1;
+        c_hi = static_cast<int>(std::floor((theta + half) / step_)) + 2;
+      }
+    }
+    const int r0 = std::max(0, static_cast<int>(std::floor(r_lo)) - 1);
+    const int r1 = std::min(rows_ - 1, static_cast<int>(std::floor(r_hi)) + 1);
+    const int span = std::max(r1 - r0, c_hi - c_lo);
+    int L = kFirstLevel;
+    while ((1 << L) * blocks_per_span < span && L - kFirstLevel + 1 < static_cast<int>(levels_.size())) ++L;
+    const int b = 1 << L, br = (rows_ - 1 + b - 1) / b, bc = (cols_ + b - 1) / b, stride = bc + kPad;
+    const V* v = levels_[static_cast<std::size_t>(L - kFirstLevel)].data();
+    const int i0 = r0 / b, i1 = std::min(br - 1, r1 / b);
+    int j0 = 0, j1 = bc - 1;  // inclusive
+    if (c_hi - c_lo < cols_) {
+      j0 = static_cast<int>(std::floor(double(c_lo) / b));
+      j1 = static_cast<int>(std::floor(double(c_hi) / b));
+      if (j1 - j0 >= bc) {
+        j0 = 0, j1 = bc - 1;
+      } else {
+        const int shift = j0 >= 0 ? -(j0 / bc) * bc : ((-j0 + bc - 1) / bc) * bc;  // j0 into [0, bc)
+        j0 += shift, j1 += shift;
+        if (j1 >= bc + kPad) j0 = 0, j1 = bc - 1;  // cannot happen for a cap of the chosen level
+      }
+    }
+    V m = none_;
+    for (int i = i0; i <= i1; ++i) {
+      const V* row = v + static_cast<std::size_t>(i) * stride;
+      for (int j = j0; j <= j1; ++j) m = combine_(m, row[j]);
+    }
+    return m;
+  }
+
+ private:
+  V none_;
+  Combine combine_;
+  int rows_ = 0, cols_ = 0;
+  double step_ = 0;
+  std::vector<std::vector<V>> levels_;
+};
+
+// A pyramid of minima (or maxima) over an equiangular map: at level L, block (i, j) holds the min
+// (max) of the finite node values in fine rows [i 2^L, (i+1) 2^L] and columns [j 2^L, (j+1) 2^L]
+// (boundaries shared, columns periodic); +inf (-inf) when none is finite. A fine bilinear value
+// whose four nodes are finite is >= (<=) the bound of any block range covering those nodes; a
+// stencil with an infinite node gives NaN, no gap, so infinite nodes can be ignored.
+using BoundPyramid = BlockPyramid<float, MinOrMax>;
+using OccupancyPyramid = BlockPyramid<std::uint64_t, BitOr>;
+inline BoundPyramid bound_pyramid(const RadialDistanceMap& map, bool lower) {
+  const float none = lower ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+  return BoundPyramid(
+      map.scheme(),
+      [&map, none](std::int64_t i) {
+        const float d = map.at(i);
+        return std::isfinite(d) ? d : none;
+      },
+      none, MinOrMax{lower});
+}
+
+// The radial shells a layered map's solid meets (LayeredMap::occupancy), OR-ed over blocks: a cluster
+// none of whose radii lies within the threshold of a set shell over its cone is apart from the bone.
+constexpr double kOccupancyBinMm = 2.5;
+inline OccupancyPyramid occupancy_pyramid(const LayeredMap& map) {
+  return OccupancyPyramid(
+      map.scheme(), [&map](std::int64_t i) { return map.occupancy(i, kOccupancyBinMm); }, std::uint64_t(0), BitOr{});
+}
+// The shells [lo, hi] (mm) meets.
+inline std::uint64_t shells(double lo, double hi) { return radial_shell_bits(lo, hi, kOccupancyBinMm); }
+
+// Clusters of a scan set: `size` consecutive vertices (Z order: neighbours on the sphere), their
+// directions' cone (unit axis, half-angle) and radius range, in the body's frame. Two levels: leaves
+// of kLeaf vertices, looked up together, in groups of kGroup vertices, whose bound is tried first.
+constexpr std::int64_t kLeaf = 32, kGroup = 128;
+// A cluster's bound over its cap widened by this angle serves every later pose of a search within
+// the angle (CompactScanner): two steps of the default search.
+constexpr double kReuseRad = 4.1 * M_PI / 180;
+// Blocks across the bounding cap of a group, a leaf and a hidden cluster (measured on lhdl-ct).
+constexpr int kGroupBlocks = 8, kLeafBlocks = 8, kHiddenBlocks = 4;
+struct Cluster {
+  std::int64_t first = 0, count = 0;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double rho = 0, sin_rho = 0, r_min = 0, r_max = 0;
+  double sin_rho_widened = 0;  ///< sin(rho + kReuseRad), for the bounds reused at nearby poses
+};
+inline std::vector<Cluster> clusters_of(const ScanSet& s, std::int64_t kSize) {
+  std::vector<Cluster> out;
+  for (std::int64_t f = 0; f < s.size(); f += kSize) {
+    Cluster c;
+    c.first = f;
+    c.count = std::min(kSize, s.size() - f);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    c.r_min = std::numeric_limits<double>::infinity();
+    for (std::int64_t k = f; k < f + c.count; ++k) {
+      const Eigen::Vector3d p(s.x[k], s.y[k], s.z[k]);
+      sum += p.normalized();
+      c.r_min = std::min(c.r_min, p.norm());
+      c.r_max = std::max(c.r_max, p.norm());
+    }
+    c.axis = sum.norm() > 1e-9 ? Eigen::Vector3d(sum.normalized()) : Eigen::Vector3d::UnitZ();
+    for (std::int64_t k = f; k < f + c.count; ++k)
+      c.rho = std::max(c.rho, std::acos(std::clamp(Eigen::Vector3d(s.x[k], s.y[k], s.z[k]).normalized().dot(c.axis),
+                                                   -1.0, 1.0)));
+    c.rho += 1e-9;  // rounding of the angles
+    c.sin_rho = std::sin(std::min(c.rho, M_PI / 2));  // a wider cone takes whole rows (cap)
+    c.sin_rho_widened = std::sin(std::min(c.rho + kReuseRad, M_PI / 2));
+    out.push_back(c);
+  }
+  return out;
+}
+
+// The least gap over the counted vertices of both scans at a femur rotation. Clusters whose bound
+// cannot reach the threshold are skipped; the others are looked up exactly (a search needs only the
+// minimum: no per-vertex expansion or summary). Shared, read-only, by every search of a joint.
+struct Least {
+  double gap = std::numeric_limits<double>::infinity();
+  bool ball = false;
+  bool hidden = false;  ///< a hidden vertex, tested by the other body's layered map
+  std::size_t vertex = 0;
+};
+// The ball's first-surface vertices that can meet the socket at some rotation: a vertex at radius r
+// has gap >= (least finite node of the socket map) - r at every rotation (a bilinear value is at
+// least its least node), so a vertex with r < that least node - threshold never counts. Their
+// clusters serve the searches that ask only whether the bones meet; the exact least gap scans all.
+inline ScanSet reachable_subset(const ScanSet& s, double least_node, double threshold) {
+  ScanSet out;
+  out.vertices = s.vertices;
+  for (std::int64_t k = 0; k < s.size(); ++k)
+    if (!(std::sqrt(s.x[k] * s.x[k] + s.y[k] * s.y[k] + s.z[k] * s.z[k]) < least_node - threshold)) {
+      out.index.push_back(s.index[k]);
+      out.x.push_back(s.x[k]), out.y.push_back(s.y[k]), out.z.push_back(s.z[k]);
+    }
+  return out;
+}
+// A scan set with its two levels of clusters.
+struct Clustered {
+  Clustered() = default;
+  explicit Clustered(const ScanSet& s) : leaves(clusters_of(s, kLeaf)), groups(clusters_of(s, kGroup)) {}
+  std::vector<Cluster> leaves, groups;
+};
+
+}  // namespace rom_detail
+
+// Bounds for the searches of one joint at one threshold: the map pyramids and the clusters
+// (shared by every search that holds the baseline they were made with; read-only).
+struct RomSearchBounds {
+  RomSearchBounds(const Joint& j, double threshold)
+      : joint(&j),
+        threshold_mm(threshold),
+        socket_min(rom_detail::bound_pyramid(j.socket().map, true)),
+        ball_max(rom_detail::bound_pyramid(j.ball().map, false)),
+        ball_reachable(rom_detail::reachable_subset(j.ball().scan_set, socket_min.all(), threshold)),
+        ball(j.ball().scan_set),
+        socket(j.socket().scan_set),
+        ball_reachable_clusters(ball_reachable) {
+    if (j.socket().layered) {
+      socket_occupancy.emplace(rom_detail::occupancy_pyramid(*j.socket().layered));
+      ball_hidden = rom_detail::Clustered(j.ball().hidden_set);
+    }
+    if (j.ball().layered) {
+      ball_occupancy.emplace(rom_detail::occupancy_pyramid(*j.ball().layered));
+      socket_hidden = rom_detail::Clustered(j.socket().hidden_set);
+    }
+  }
+  const Joint* joint;
+  double threshold_mm;
+  rom_detail::BoundPyramid socket_min, ball_max;
+  ScanSet ball_reachable;
+  rom_detail::Clustered ball, socket, ball_reachable_clusters;
+  std::optional<rom_detail::OccupancyPyramid> socket_occupancy, ball_occupancy;
+  rom_detail::Clustered ball_hidden, socket_hidden;
+};
+
+namespace rom_detail {
+// The baseline's bounds when they were made for this joint and threshold, else new ones (null
+// without bounds).
+inline std::shared_ptr<const RomSearchBounds> bounds_for(const Joint& joint, const RomOptions& o, const RomBaseline& base) {
+  if (!o.use_bounds) return nullptr;
+  if (base.bounds && base.bounds->joint == &joint && base.bounds->threshold_mm == o.threshold_mm) return base.bounds;
+  return std::make_shared<const RomSearchBounds>(joint, o.threshold_mm);
+}
+}  // namespace rom_detail
+}  // namespace impinge
