@@ -50,7 +50,9 @@ TEST_P(FuzzInputs, FoundInputsAreRefusedOrAcceptedNeverBugs) {
     const Outcome o = impinge::fuzz::run_input(GetParam(), bytes.data(), bytes.size());
     EXPECT_NE(o.kind, Outcome::bug) << p << ": " << o.message;
     // A refusal names the file the loader was given.
-    if (o.kind == Outcome::refused) EXPECT_NE(o.message.find("impinge-fuzz-"), std::string::npos) << p << ": " << o.message;
+    if (o.kind == Outcome::refused) {
+      EXPECT_NE(o.message.find("impinge-fuzz-"), std::string::npos) << p << ": " << o.message;
+    }
   }
 }
 
