@@ -9,6 +9,7 @@
 #include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
 #include "core/simd_clones.hpp"
+#include "schemes/cap_query.hpp"
 
 namespace impinge {
 
@@ -90,9 +91,7 @@ void EquiangularGrid::neighbour_stencils(std::int64_t first, std::int64_t count,
 
 void EquiangularGrid::nodes_in_cap(const Eigen::Vector3d& direction, double radius_rad,
                                    std::vector<std::int64_t>& out) const {
-  require(direction.allFinite() && direction.norm() > 0, "sampling scheme 'equiangular': nodes_in_cap needs a nonzero, finite direction");
-  require(radius_rad >= 0, "sampling scheme 'equiangular': nodes_in_cap radius " + std::to_string(radius_rad) + " rad must be >= 0");
-  const Eigen::Vector3d u = direction.normalized();
+  const Eigen::Vector3d u = checked_cap_axis(name(), direction, radius_rad);
   const double r = std::min(radius_rad, kPi), cr = std::cos(r);
   const SphericalCoordinates s = to_spherical(u);
   out.clear();

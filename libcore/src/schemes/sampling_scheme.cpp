@@ -6,6 +6,7 @@
 
 #include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
+#include "schemes/cap_query.hpp"
 
 namespace impinge {
 
@@ -55,11 +56,7 @@ void SamplingScheme::neighbours(std::int64_t i, std::vector<std::int64_t>& out) 
 
 void SamplingScheme::nodes_in_cap(const Eigen::Vector3d& direction, double radius_rad,
                                   std::vector<std::int64_t>& out) const {
-  require(direction.allFinite() && direction.norm() > 0,
-          "sampling scheme '" + name() + "': nodes_in_cap needs a nonzero, finite direction");
-  require(radius_rad >= 0, "sampling scheme '" + name() + "': nodes_in_cap radius " + std::to_string(radius_rad) +
-                               " rad must be >= 0");
-  const Eigen::Vector3d u = direction.normalized();
+  const Eigen::Vector3d u = checked_cap_axis(name(), direction, radius_rad);
   const double c = std::cos(std::min(radius_rad, kPi));
   out.clear();
   const std::int64_t n = num_nodes();
