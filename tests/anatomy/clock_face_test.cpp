@@ -57,6 +57,11 @@ TEST(ClockFace, AcetabulumAndFemoralClockOnRealHipsBothSides) {
     }
     const HipFrames hl = find_hip_frames(fl, pl, Side::left);
     const Acetabulum Al = find_acetabulum(pl, hl.head.centre, hl.head.radius, hl.pelvis);
+    // The mirrored (left) hip reads the same angles as the right one it mirrors.
+    const AcetabularOrientation oR = radiographic_orientation(A, h.pelvis, Side::right);
+    const AcetabularOrientation oL = radiographic_orientation(Al, hl.pelvis, Side::left);
+    EXPECT_NEAR(oR.inclination_deg, oL.inclination_deg, 1.0);
+    EXPECT_NEAR(oR.anteversion_deg, oL.anteversion_deg, 1.0);
     for (const auto& [side, hh, AA] : {std::tuple{Side::right, &h, &A}, std::tuple{Side::left, &hl, &Al}}) {
       SCOPED_TRACE(std::string(name) + (side == Side::right ? " right" : " left"));
       const double m = side == Side::right ? 1 : -1;
@@ -71,6 +76,9 @@ TEST(ClockFace, AcetabulumAndFemoralClockOnRealHipsBothSides) {
       EXPECT_LT(inclination, 60);
       EXPECT_GT(anteversion, 5);
       EXPECT_LT(anteversion, 35);
+      const AcetabularOrientation o = radiographic_orientation(*AA, P, side);
+      EXPECT_NEAR(o.inclination_deg, inclination, 1e-9);
+      EXPECT_NEAR(o.anteversion_deg, anteversion, 1e-9);
       EXPECT_GT((P.axes.transpose() * AA->clock.twelve).y(), 0.5);  // 12 superior
       EXPECT_GT((P.axes.transpose() * AA->clock.three).x(), 0.7);   // 3 anterior, both sides
       EXPECT_LT(AA->notch_coverage_deg, AA->median_coverage_deg - 4);

@@ -142,4 +142,12 @@ ClockFace femoral_clock_face(const TriangleMesh& femur, const Eigen::Vector3d& c
   return k;
 }
 
+AcetabularOrientation radiographic_orientation(const Acetabulum& acetabulum, const AnatomicalFrame& pelvis_frame,
+                                               Side side) {
+  const Eigen::Vector3d n = pelvis_frame.axes.transpose() * acetabulum.opening;
+  const double m = side == Side::right ? 1.0 : -1.0;
+  constexpr double deg = 180.0 / 3.14159265358979323846;
+  return {std::atan2(m * n.z(), -n.y()) * deg, std::asin(std::clamp(n.x(), -1.0, 1.0)) * deg};
+}
+
 }  // namespace impinge

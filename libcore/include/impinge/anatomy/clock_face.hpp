@@ -63,6 +63,20 @@ struct Acetabulum {
 Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& head_centre, double head_radius_mm,
                            const AnatomicalFrame& pelvis_frame, double cup_margin_mm = 8.0);
 
+/// Radiographic orientation of the acetabulum (Murray 1993, J Bone Joint Surg Br 75:228): the
+/// angles of its opening (the rim plane's normal, out of the acetabulum), degrees.
+struct AcetabularOrientation {
+  double inclination_deg = 0;  ///< between the longitudinal axis and the opening, in the coronal plane (normal ~40-50)
+  double anteversion_deg = 0;  ///< between the opening and the coronal plane (normal ~10-25)
+};
+
+/// The radiographic inclination and anteversion of `acetabulum` (working frame) in the pelvic frame
+/// `pelvis_frame` (ISB: X anterior, Y superior, Z right), mirrored for a left `side` so that both
+/// sides read the same: with n the opening in pelvic axes and m = +1 right, -1 left,
+/// inclination = atan2(m n_Z, -n_Y), anteversion = asin(n_X). Never throws.
+AcetabularOrientation radiographic_orientation(const Acetabulum& acetabulum, const AnatomicalFrame& pelvis_frame,
+                                               Side side);
+
 /// The femoral head-neck clock face (femur frame, working coordinates, mm): centre at the head
 /// centre, axis from the neck (the centroid of the femur's vertices 4 to 12 mm outside the head
 /// sphere) to the head centre, 12 o'clock towards the femoral frame's +y (superior) and 3 towards

@@ -1,0 +1,33 @@
+#pragma once
+/// @file outputs.hpp
+/// Posed bones with their gaps as mesh files, in the input frame: PLY per bone (the CLI's
+/// ball_gaps.ply and socket_gaps.ply) and one VTK PolyData per motion frame (ParaView).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "impinge/detection/joint.hpp"
+#include "impinge/session/session.hpp"
+
+namespace impinge {
+
+/// The impingement level of every vertex of `gaps` under `levels` (ImpingementLevels::level),
+/// 255 where the vertex was not tested (NaN gap). Length: the body's vertex count.
+std::vector<std::uint8_t> vertex_levels(const ScanGaps& gaps, const ImpingementLevels& levels);
+
+/// Both bones at one pose as binary PLY (write_gap_ply: x y z gap_mm; level and its colour): the
+/// femur posed by R (3 x 3, joint frame) into `ball_path`, the pelvis into `socket_path`; vertices
+/// in the input frame, mm, in the meshes' vertex order. Throws impinge::Error naming a file on I/O
+/// errors.
+void write_pose_plys(const std::string& ball_path, const std::string& socket_path, const Session& session,
+                     const PoseResult& result, const Eigen::Matrix3d& R);
+
+/// Both bones in one VTK PolyData (.vtp): the femur posed by R (joint frame), then the pelvis,
+/// with point arrays gap_mm (float32, NaN untested), level (uint8, 255 untested) and body (0
+/// femur, 1 pelvis); input frame, mm. Throws impinge::Error naming the file on I/O errors.
+void write_pose_vtp(const std::string& path, const Session& session, const PoseResult& result,
+                    const Eigen::Matrix3d& R);
+
+}  // namespace impinge

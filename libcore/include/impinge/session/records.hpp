@@ -1,0 +1,66 @@
+#pragma once
+/// @file records.hpp
+/// What a run reports, built once for every front end: JSON records (the CLI's summary.json, the
+/// Python module's dicts, the experiments' rows) and CSV tables. Positions and axes are in the
+/// input frame (mm), angles in degrees; a quantity that does not exist (no surface, no limit) is
+/// JSON null, never a made-up number.
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "impinge/anatomy/clock_face.hpp"
+#include "impinge/clinical/clock_summary.hpp"
+#include "impinge/detection/joint.hpp"
+#include "impinge/session/session.hpp"
+
+namespace impinge {
+
+/// A table of records: column names and rows (JSON arrays of the same length; numbers, strings,
+/// booleans, or null for NaN).
+struct Table {
+  std::vector<std::string> columns;
+  std::vector<nlohmann::json> rows;
+  /// Append a row. Throws impinge::Error when its length differs from the columns'.
+  void add(nlohmann::json row);
+  /// Column `name` of every row. Throws impinge::Error naming an unknown column.
+  std::vector<nlohmann::json> column(const std::string& name) const;
+};
+
+/// A finite number as JSON, NaN and infinities as null.
+nlohmann::json number_or_null(double x);
+
+/// Write `table` as CSV (RFC 4180: header, then one line per row; numbers to 9 significant
+/// digits, null as "nan", booleans as 1/0, text quoted when it holds a comma, quote or line break).
+/// Throws impinge::Error naming the file on an I/O error.
+void write_csv(const std::string& path, const Table& table);
+/// Write `j` as indented JSON. Throws impinge::Error naming the file on an I/O error.
+void write_json(const std::string& path, const nlohmann::json& j);
+
+/// One scan's summary (ScanSummary: counts, least gaps, penetration, areas per level) with its
+/// body's map and sampling figures, its detection time (ms) and, when `clock` is given, where on
+/// its clock face it lies (closest hour and the area per clock sector and level, mm^2).
+nlohmann::json scan_record(const JointBody& body, const ScanSummary& summary, double detection_ms,
+                           const ImpingementLevels& levels, const ClockSummary* clock);
+
+/// An anatomical frame: definition, origin, axes (ISB: x anterior, y superior, z right), landmarks
+/// with their source, and its quality (mm) under `quality_name`; in the input frame by `to_input`
+/// (3 x 3, working -> input).
+nlohmann::json frame_record(const AnatomicalFrame& frame, const Eigen::Matrix3d& to_input, const char* quality_name);
+
+/// The acetabulum: sphere, rim, opening, radiographic inclination and anteversion
+/// (radiographic_orientation), clock axes and coverage; in the input frame by `to_input`.
+nlohmann::json acetabulum_record(const Acetabulum& acetabulum, const AnatomicalFrame& pelvis, Side side,
+                                 const Eigen::Matrix3d& to_input);
+
+/// What every command reports about its set-up (summary.json's common part): inputs, side and
+/// input frame, COR and how it was found, scheme and resolution, map settings, neutral, warnings,
+/// the scan-pose overlap, and with anatomical neutral the frames, the scan pose and the acetabulum.
+nlohmann::json setup_record(const Session& session);
+
+/// Both scans at one pose: pose_deg, and ball / socket scan_record()s with clocks (anatomical
+/// neutral).
+nlohmann::json pose_record(const Session& session, const PoseAngles& pose, const PoseResult& result);
+
+}  // namespace impinge

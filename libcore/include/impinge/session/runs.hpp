@@ -1,0 +1,84 @@
+#pragma once
+/// @file runs.hpp
+/// The loops every front end runs on a Session: both scans at every frame of a motion, and the ROM
+/// search (limits, ROM map, envelope), with their records as tables (the CLI's frames.csv,
+/// rom_limits.csv, rom_map.csv and rom_envelope.csv; the Python module's dicts).
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "impinge/clinical/rom.hpp"
+#include "impinge/session/records.hpp"
+#include "impinge/session/session.hpp"
+
+namespace impinge {
+
+/// One frame of a motion run, as the loop hands it to its caller.
+struct MotionFrame {
+  std::size_t index = 0;
+  double time_s = 0;
+  PoseAngles angles;                         ///< degrees, ISB
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  ///< the femur's rotation, joint frame
+  const PoseResult* result = nullptr;        ///< both scans (valid during the callback)
+  ClockSummary ball_clock, socket_clock;     ///< closest hours (NaN with scan neutral)
+  /// The socket vertex with the least gap, as Session::report_point gives it (pelvic frame with
+  /// anatomical neutral, else the input frame), mm; NaN when no socket vertex was tested.
+  Eigen::Vector3d socket_closest = Eigen::Vector3d::Constant(std::nan(""));
+  double detection_ms = 0;                   ///< both scans of this frame
+};
+
+/// The columns of a motion table for `levels` (frames.csv): frame, time_s, the three angles, both
+/// least gaps (mm), penetrating areas (mm^2), the socket's area per level, both closest clock hours,
+/// the socket's closest point (x, y, z mm) and detection_ms.
+std::vector<std::string> motion_columns(const ImpingementLevels& levels);
+/// One frame's row of that table.
+nlohmann::json motion_row(const MotionFrame& frame);
+
+/// Both scans at every pose of `angles` (k poses, degrees; `time_s`: k times or empty for the
+/// index), calling `on_frame` after each. Returns the total detection time, ms. Throws what
+/// `on_frame` throws; times of another length than the angles are an error.
+double run_motion(const Session& session, const std::vector<PoseAngles>& angles, const std::vector<double>& time_s,
+                  const std::function<void(const MotionFrame&)>& on_frame);
+
+/// What a ROM run computes (RomOptions: threshold, search step and range).
+struct RomRequest {
+  RomOptions search;
+  bool map = true;                        ///< the ROM map: the largest internal rotation per flexion x adduction
+  std::vector<double> map_flexion_deg;    ///< empty: 0..120 step 5
+  std::vector<double> map_adduction_deg;  ///< empty: -20..40 step 5
+  bool envelope = false;                  ///< the ROM envelope (rom_envelope)
+  RomEnvelopeOptions envelope_options;
+};
+
+/// The results of a ROM run and their cost.
+struct RomRun {
+  RomOptions search;
+  RomBaseline baseline;                  ///< the neutral scan (vertices in contact there are excluded)
+  std::vector<StandardMotion> motions;   ///< standard_motions()
+  std::vector<RomLimit> limits;          ///< one per motion
+  std::vector<double> map_flexion_deg, map_adduction_deg;
+  std::vector<RomMapCell> map;           ///< flexion-major; empty without a map
+  std::optional<RomEnvelope> envelope;
+  RomEnvelopeOptions envelope_options;
+  double limits_ms = 0, map_ms = 0, envelope_ms = 0;  ///< wall time, ms (the baseline counts with the limits)
+  std::int64_t limit_evaluations = 0, map_evaluations = 0;
+  std::int64_t vertices_looked_up = 0, vertices_skipped = 0;  ///< over limits, map and envelope
+};
+
+/// The ROM limits of the standard motions from neutral (find_rom_limits), then the map and the
+/// envelope as requested. Throws impinge::Error on bad options (RomOptions, RomEnvelopeOptions).
+RomRun run_rom(const Session& session, const RomRequest& request);
+
+/// rom_limits.csv: motion, limit_deg, limited_by, socket_clock_h, femur_clock_h,
+/// min_gap_at_limit_mm, monotone, contact_at_start, contact_x/y/z_mm (input frame), evaluations.
+Table rom_limits_table(const Session& session, const RomRun& run);
+/// rom_map.csv: flexion_deg, adduction_deg, max_internal_rotation_deg, status.
+Table rom_map_table(const RomRun& run);
+/// rom_envelope.csv: the valid runs of internal rotation per flexion and adduction (from, to).
+Table rom_envelope_table(const RomRun& run);
+/// The ROM part of summary.json: threshold, search, limits, envelope figures, counts, timings.
+nlohmann::json rom_record(const RomRun& run);
+
+}  // namespace impinge

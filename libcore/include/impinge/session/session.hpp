@@ -1,0 +1,199 @@
+#pragma once
+/// @file session.hpp
+/// One set-up for every front end. The CLI, the Python module, the experiments and the benchmarks
+/// hand the same inputs and options to a Session and get the same HipJoint: the meshes read and
+/// brought from their input frame (LPS or RAS) into the working frame (RAS), the centre of rotation
+/// found by one policy and checked, the scheme and resolution chosen, the frames and both maps built.
+/// What a run reports (records.hpp) and the loops over poses (runs.hpp) build on it.
+///
+/// Frames: the *input frame* is the meshes' own (LPS or RAS, subject.json's "frame"); the *working
+/// frame* is RAS, mm; the *joint frame* is HipJoint's (origin at the COR). Everything a user gives
+/// (COR, head region, landmarks, rotations) and everything reported is in the input frame.
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "impinge/anatomy/anatomical_frame.hpp"
+#include "impinge/anatomy/pose.hpp"
+#include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/clinical/hip_joint.hpp"
+#include "impinge/core/mesh.hpp"
+#include "impinge/io/subject.hpp"
+
+namespace impinge {
+
+/// Where the bones come from: a subject.json, mesh files, or meshes in memory (any mix: meshes
+/// and files given here replace the subject's).
+struct SessionInput {
+  std::string subject;                                 ///< subject.json: meshes, side, frame, landmarks, neutral
+  std::string ball, socket;                            ///< femur and pelvis mesh files (PLY, STL, OBJ, OFF; mm)
+  std::optional<TriangleMesh> ball_mesh, socket_mesh;  ///< femur and pelvis in memory (input frame, mm)
+  std::string side;   ///< "right" | "left"; empty: the subject's, else right. Contradicting the subject: an error
+  std::string frame;  ///< "LPS" | "RAS"; empty: the subject's, else RAS. Contradicting the subject: an error
+  Landmarks landmarks;  ///< given landmarks (input frame, mm; names as subject.json's), over the subject's
+};
+
+/// How the centre of rotation (COR) is found. In order: `head_region` (a sphere fit to the femur's
+/// vertices there), `given`, the subject's "hip_centre" landmark, else automatic: the femoral head
+/// found on the whole femur in any orientation and fitted (locate_femoral_head: long axis, RANSAC
+/// and geometric sphere fit; thesis sec. 3.4).
+struct CorOptions {
+  std::optional<Eigen::Vector3d> given;        ///< X, Y, Z: mm, input frame
+  std::optional<Eigen::Vector4d> head_region;  ///< X, Y, Z, R: fit the head to femur vertices within R mm of X, Y, Z
+  /// Accept a given COR outside the femoral head (research). Otherwise a given COR farther from the
+  /// fitted head centre than the head radius is an error naming both, and HipJoint refuses a COR
+  /// outside the femur mesh.
+  bool allow_any = false;
+};
+
+/// Parse the CLI's COR text: "auto" (empty optional) or "X,Y,Z" (mm). Throws impinge::Error
+/// naming `context` on anything else.
+std::optional<Eigen::Vector3d> parse_cor(const std::string& text, const std::string& context);
+/// Parse "X,Y,Z,R" (mm) for CorOptions::head_region. Throws impinge::Error naming `context`.
+Eigen::Vector4d parse_head_region(const std::string& text, const std::string& context);
+
+/// The maps: scheme and resolution, how they are filled, and what detection does with them
+/// (JointOptions). At most one of resolution, precision, turns and spacing; none: the scheme's
+/// default (0.5 deg node spacing equivalent).
+struct MapSettings {
+  std::string scheme = "equiangular";  ///< a registered scheme (scheme_names())
+  double resolution = 0;               ///< the scheme's own unit; 0: not given
+  double precision = 0;                ///< alias for equiangular grids: p, degrees
+  double turns = 0;                    ///< alias for the helix: k turns
+  double spacing = 0;                  ///< largest node spacing wanted, degrees: the coarsest resolution reaching it
+  std::string sampling = "auto";       ///< auto, rasterize, resample, ray-cast, ray-cast-bvh
+  std::string mode = "exact";          ///< exact | linear (thesis Alg. 1)
+  std::vector<double> levels;          ///< impingement thresholds, mm, decreasing; empty: the thesis' (6, 2 mm)
+  double occlusion_tolerance_mm = 1.0;
+  double max_radius_mm = 0;             ///< test only vertices within this of the COR; 0: all
+  double sparse_mm = 0;                 ///< sparse maps keeping tiles with a surface within this (inf: any); 0: dense
+  double discontinuity_tolerance_mm = 0.05;
+  bool maps_only = false;               ///< no exact look-ups at depth discontinuities (the thesis' algorithm)
+  int layers = 0;                       ///< layered maps of this many crossings per node (0: off)
+  double extra_articular_radius_mm = 150;
+  std::string ball_map_file, socket_map_file;  ///< saved maps to load instead of sampling (both or neither)
+};
+
+/// Frames and neutral (HipJointOptions).
+struct FrameSettings {
+  std::string neutral;  ///< "anatomical" | "scan"; empty: the subject's "neutral", else anatomical
+  bool reseat = false;  ///< Puls et al. 2010's equidistant seating at the scan pose
+  std::string pelvis_frame = "isb";         ///< isb | app
+  std::string femur_frame = "epicondyles";  ///< epicondyles | posterior-condyles
+};
+
+/// Everything a Session needs.
+struct SessionOptions {
+  SessionInput input;
+  CorOptions cor;
+  MapSettings maps;
+  FrameSettings frames;
+};
+
+/// The meshes of a SessionInput in the working frame (RAS, mm), with what the input said.
+struct LoadedInput {
+  TriangleMesh femur, pelvis;  ///< working frame
+  std::string femur_source, pelvis_source;  ///< file paths, or "ball (in memory)" / "socket (in memory)"
+  Side side = Side::right;
+  FrameConvention frame = FrameConvention::RAS;
+  Eigen::Matrix3d to_working = Eigen::Matrix3d::Identity();  ///< input frame -> working frame (3 x 3)
+  Landmarks landmarks;     ///< working frame, mm
+  std::string neutral;     ///< the subject's "neutral" (empty when none)
+  std::string name;        ///< the subject's folder name (empty without a subject)
+};
+
+/// The side of `input` without reading its meshes (subject.json's, or `side`, else right), to
+/// read a motion file for it before the joint is built. Throws impinge::Error as load_input.
+Side input_side(const SessionInput& input);
+
+/// Read and convert the input (no COR, no maps). Throws impinge::Error naming the file or option:
+/// a missing mesh, an unreadable file, a side or frame that contradicts subject.json.
+LoadedInput load_input(const SessionInput& input);
+
+/// The COR and how it was found.
+struct CorResult {
+  SphereFitResult head;  ///< centre: the COR (working frame, mm); radius and rms NaN when given
+  std::string method;    ///< e.g. "automatic sphere fit (long axis, RANSAC + geometric)"
+};
+
+/// The COR of `in` by the policy of CorOptions (see there). Throws impinge::Error naming the
+/// option: a given COR outside the head without allow_any, both a given COR and a head region, a
+/// head region with too few vertices, or no femoral head found.
+CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor);
+
+/// The scheme that MapSettings asks for. Throws impinge::Error on two resolutions or a bad one.
+std::shared_ptr<const SamplingScheme> scheme_of(const MapSettings& maps);
+
+/// HipJointOptions from the settings (validated: mode, sampling, levels, sparse, layers, frames).
+/// `subject_neutral`: the subject's "neutral" when FrameSettings::neutral is empty. Throws
+/// impinge::Error naming the option.
+HipJointOptions hip_joint_options(const MapSettings& maps, const FrameSettings& frames,
+                                  const std::string& subject_neutral = "");
+
+/// A hip set up from inputs and options: the same for the CLI, Python, experiments and benchmarks.
+/// Immutable once built; detect() and the runs are const and may be called from several threads.
+class Session {
+ public:
+  /// Load, find the COR, build the frames and maps (HipJoint), and scan the scan pose once (a
+  /// segmentation overlap there becomes a warning). Throws impinge::Error naming the file, option
+  /// or step that failed; with anatomical neutral a failure says how to use scan neutral instead.
+  explicit Session(const SessionOptions& options);
+
+  const HipJoint& hip() const { return *hip_; }
+  /// The HipJoint, shared (Python keeps map views alive with it).
+  const std::shared_ptr<const HipJoint>& shared_hip() const { return hip_; }
+  const Joint& joint() const { return hip_->joint(); }
+  const SessionOptions& options() const { return options_; }
+  const HipJointOptions& hip_options() const { return hip_options_; }
+  const JointOptions& joint_options() const { return hip_options_.joint; }
+
+  Side side() const { return side_; }
+  FrameConvention input_frame() const { return frame_; }
+  /// Input frame -> working frame (3 x 3, orthonormal); to_input() is its transpose.
+  const Eigen::Matrix3d& to_working() const { return to_working_; }
+  Eigen::Matrix3d to_input() const { return to_working_.transpose(); }
+  const std::string& ball_source() const { return ball_source_; }
+  const std::string& socket_source() const { return socket_source_; }
+  const std::string& subject_name() const { return subject_name_; }
+  /// The head sphere the COR came from (working frame; radius NaN when the COR was given).
+  const SphereFitResult& head() const { return cor_.head; }
+  const std::string& cor_method() const { return cor_.method; }
+  /// Least gap of both scans at the scan pose (after any re-seating), mm; < 0: the bones overlap.
+  double scan_pose_min_gap_mm() const { return scan_pose_min_gap_mm_; }
+  /// HipJoint's warnings and the session's (overlap at the scan pose), one line each.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+  /// A working-frame point or direction (mm) in the input frame.
+  Eigen::Vector3d to_input(const Eigen::Vector3d& working) const { return to_working_.transpose() * working; }
+  /// The COR in the input frame, mm.
+  Eigen::Vector3d cor_input() const { return to_input(hip_->cor()); }
+  /// Vertices (n x 3, mm, input frame) of the femur posed by R (3 x 3, joint frame), of the pelvis.
+  Vertices femur_input(const Eigen::Matrix3d& R) const;
+  Vertices pelvis_input() const;
+  /// A femur motion given in the input frame (rotation R_in 3 x 3 about the COR, then translation
+  /// t_in, mm) in the joint frame, for Joint::detect. Rotations checked by the caller.
+  std::pair<Eigen::Matrix3d, Eigen::Vector3d> joint_motion(const Eigen::Matrix3d& R_in,
+                                                           const Eigen::Vector3d& t_in) const;
+  /// A joint-frame rotation of the femur (femur_rotation) in the input frame (3 x 3).
+  Eigen::Matrix3d input_rotation(const Eigen::Matrix3d& R_joint) const;
+  /// A joint-frame point (mm) as reports give it: in the pelvic frame (AnatomicalFrame::to_local:
+  /// its origin and ISB axes) with anatomical neutral, else in the input frame.
+  Eigen::Vector3d report_point(const Eigen::Vector3d& joint_point) const;
+
+ private:
+  SessionOptions options_;
+  HipJointOptions hip_options_;
+  Side side_ = Side::right;
+  FrameConvention frame_ = FrameConvention::RAS;
+  Eigen::Matrix3d to_working_ = Eigen::Matrix3d::Identity();
+  std::string ball_source_, socket_source_, subject_name_;
+  CorResult cor_;
+  std::shared_ptr<const HipJoint> hip_;
+  double scan_pose_min_gap_mm_ = 0;
+  std::vector<std::string> warnings_;
+};
+
+}  // namespace impinge

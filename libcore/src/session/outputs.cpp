@@ -1,0 +1,65 @@
+#include "impinge/session/outputs.hpp"
+
+#include <cmath>
+
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/io/vtk_output.hpp"
+
+namespace impinge {
+
+std::vector<std::uint8_t> vertex_levels(const ScanGaps& g, const ImpingementLevels& levels) {
+  std::vector<std::uint8_t> out(g.gap_mm.size());
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = std::isnan(g.gap_mm[i]) ? 255 : static_cast<std::uint8_t>(levels.level(g.gap_mm[i]));
+  return out;
+}
+
+namespace {
+// One bone's gaps as a PLY: vertices V (input frame), gap_mm, level and its colour.
+void write_body_ply(const std::string& path, const ImpingementLevels& levels, const JointBody& body,
+                    const ScanGaps& gaps, const Vertices& V, bool is_ball) {
+  const Eigen::Index n = body.mesh.V.rows();
+  const std::vector<std::uint8_t> lv = vertex_levels(gaps, levels);
+  Eigen::VectorXf gap(n);
+  Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
+  Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    gap[i] = gaps.gap_mm[k];
+    level[i] = lv[k];
+    const auto c = level_colour(level[i], levels.count(), is_ball);
+    rgb.row(i) << c[0], c[1], c[2];
+  }
+  write_gap_ply(path, V, body.mesh.F, gap, level, rgb);
+}
+}  // namespace
+
+void write_pose_plys(const std::string& ball_path, const std::string& socket_path, const Session& s,
+                     const PoseResult& res, const Eigen::Matrix3d& R) {
+  const ImpingementLevels& levels = s.joint_options().levels;
+  write_body_ply(ball_path, levels, s.joint().ball(), res.ball_gaps, s.femur_input(R), true);
+  write_body_ply(socket_path, levels, s.joint().socket(), res.socket_gaps, s.pelvis_input(), false);
+}
+
+void write_pose_vtp(const std::string& path, const Session& s, const PoseResult& res, const Eigen::Matrix3d& R) {
+  const JointBody& b = s.joint().ball();
+  const JointBody& p = s.joint().socket();
+  const Eigen::Index nb = b.mesh.V.rows(), np = p.mesh.V.rows();
+  Vertices V(nb + np, 3);
+  V.topRows(nb) = s.femur_input(R);
+  V.bottomRows(np) = s.pelvis_input();
+  Faces F(b.mesh.F.rows() + p.mesh.F.rows(), 3);
+  F.topRows(b.mesh.F.rows()) = b.mesh.F;
+  F.bottomRows(p.mesh.F.rows()) = p.mesh.F.array() + static_cast<int>(nb);
+  PointArray gap{"gap_mm", {}, {}}, level{"level", {}, {}}, body{"body", {}, {}};
+  gap.f32 = res.ball_gaps.gap_mm;
+  gap.f32.insert(gap.f32.end(), res.socket_gaps.gap_mm.begin(), res.socket_gaps.gap_mm.end());
+  level.u8 = vertex_levels(res.ball_gaps, s.joint_options().levels);
+  const auto ls = vertex_levels(res.socket_gaps, s.joint_options().levels);
+  level.u8.insert(level.u8.end(), ls.begin(), ls.end());
+  body.u8.assign(static_cast<std::size_t>(nb), 0);
+  body.u8.resize(static_cast<std::size_t>(nb + np), 1);
+  write_vtp(path, V, F, {gap, level, body});
+}
+
+}  // namespace impinge

@@ -1,0 +1,237 @@
+#include "impinge/session/records.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/sampling_scheme.hpp"
+
+namespace impinge {
+
+void Table::add(nlohmann::json row) {
+  require(row.is_array() && row.size() == columns.size(),
+          "table row of " + std::to_string(row.size()) + " cells for " + std::to_string(columns.size()) + " columns");
+  rows.push_back(std::move(row));
+}
+
+std::vector<nlohmann::json> Table::column(const std::string& name) const {
+  std::size_t c = 0;
+  while (c < columns.size() && columns[c] != name) ++c;
+  require(c < columns.size(), "table: no column '" + name + "'");
+  std::vector<nlohmann::json> out;
+  out.reserve(rows.size());
+  for (const auto& r : rows) out.push_back(r[c]);
+  return out;
+}
+
+nlohmann::json number_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+namespace {
+
+nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+std::string csv_cell(const nlohmann::json& c) {
+  if (c.is_null()) return "nan";
+  if (c.is_boolean()) return c.get<bool>() ? "1" : "0";
+  if (c.is_number_integer() || c.is_number_unsigned()) return c.dump();
+  if (c.is_number_float()) {
+    std::ostringstream o;
+    o.precision(9);
+    o << c.get<double>();
+    return o.str();
+  }
+  const std::string s = c.is_string() ? c.get<std::string>() : c.dump();
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return q + "\"";
+}
+
+}  // namespace
+
+void write_csv(const std::string& path, const Table& t) {
+  std::ofstream os(path);
+  require(os.good(), path + ": cannot open for writing");
+  for (std::size_t k = 0; k < t.columns.size(); ++k) os << (k ? "," : "") << t.columns[k];
+  os << '\n';
+  for (const auto& r : t.rows) {
+    for (std::size_t k = 0; k < r.size(); ++k) os << (k ? "," : "") << csv_cell(r[k]);
+    os << '\n';
+  }
+  require(os.good(), path + ": write failed");
+}
+
+void write_json(const std::string& path, const nlohmann::json& j) {
+  std::ofstream os(path);
+  require(os.good(), path + ": cannot open for writing");
+  os << j.dump(2) << "\n";
+  require(os.good(), path + ": write failed");
+}
+
+nlohmann::json scan_record(const JointBody& body, const ScanSummary& s, double detection_ms,
+                           const ImpingementLevels& levels, const ClockSummary* clock) {
+  nlohmann::json j;
+  if (clock != nullptr) {
+    j["closest_clock_h"] = number_or_null(clock->closest_hour);
+    nlohmann::json sectors = nlohmann::json::array();
+    for (int k = 0; k < 12; ++k) {
+      nlohmann::json row = nlohmann::json::array();
+      for (int l = 0; l < levels.count(); ++l)
+        row.push_back(clock->sector_level_area_mm2[static_cast<std::size_t>(k * levels.count() + l)]);
+      sectors.push_back(row);
+    }
+    j["clock_sector_level_area_mm2"] = sectors;
+    j["clock_sector_note"] = "row k: hours (k, k+1]; column l: impingement level l; vertex area in mm^2";
+  }
+  j["vertices"] = s.vertices;
+  j["vertices_tested"] = s.vertices_tested;
+  j["vertices_no_surface"] = s.vertices_no_surface;
+  j["vertices_beyond_reach"] = s.vertices_beyond_reach;
+  j["vertices_refined"] = s.vertices_refined;
+  j["vertices_tested_layered"] = s.vertices_tested_layered;
+  j["min_gap_layered_mm"] = number_or_null(s.min_gap_layered_mm);
+  j["min_gap_mm"] = number_or_null(s.min_gap_mm);
+  j["vertices_penetrating"] = s.vertices_penetrating;
+  j["area_penetrating_mm2"] = s.area_penetrating_mm2;
+  nlohmann::json lv = nlohmann::json::array();
+  for (int k = 0; k < levels.count(); ++k)
+    lv.push_back({{"level", k},
+                  {"name", levels.name(k)},
+                  {"vertices", s.level_vertices[static_cast<std::size_t>(k)]},
+                  {"area_mm2", s.level_area_mm2[static_cast<std::size_t>(k)]}});
+  j["levels"] = lv;
+  j["map_nodes"] = body.map.num_nodes();
+  j["map_nodes_covered"] = body.sampling.nodes_covered;
+  j["sampling_method"] = to_string(body.sampling.method);
+  if (body.sampling.resample_precision_deg > 0) j["resample_precision_deg"] = body.sampling.resample_precision_deg;
+  j["map_bytes"] = body.map.bytes();
+  j["map_sparse"] = body.map.sparse();
+  j["map_tiles_stored"] = body.map.tiles_stored();
+  j["map_tiles_total"] = body.map.tiles_total();
+  if (body.layered) {
+    j["layers"] = body.layered->layers();
+    j["layered_map_bytes"] = body.layered->bytes();
+    j["layered_nodes_covered"] = body.layered_sampling.nodes_covered;
+    j["layered_nodes_truncated"] = body.layered_sampling.nodes_truncated;
+    j["layered_nodes_not_alternating"] = body.layered_sampling.nodes_not_alternating;
+    j["layered_max_crossings"] = body.layered_sampling.max_crossings;
+    j["layered_sampling_ms"] = body.layered_sampling.sampling_ms;
+    j["hidden_vertices"] = body.hidden_set.size();
+  }
+  j["triangles"] = body.mesh.F.rows();
+  j["degenerate_triangles_skipped"] = body.mesh.degenerate_faces_skipped;
+  j["triangles_edge_on"] = body.sampling.raster.triangles_edge_on;
+  j["pole_triangles"] = body.sampling.raster.pole_triangles;
+  j["seam_triangles"] = body.sampling.raster.seam_triangles;
+  j["sampling_ms"] = body.sampling_ms;
+  j["detection_ms"] = detection_ms;
+  return j;
+}
+
+nlohmann::json frame_record(const AnatomicalFrame& f, const Eigen::Matrix3d& to_input, const char* quality_name) {
+  nlohmann::json j;
+  j["definition"] = f.definition;
+  j["origin_mm"] = vec(to_input * f.origin);
+  j["x_axis"] = vec(to_input * f.axes.col(0));
+  j["y_axis"] = vec(to_input * f.axes.col(1));
+  j["z_axis"] = vec(to_input * f.axes.col(2));
+  nlohmann::json lm = nlohmann::json::object();
+  for (const auto& [name, p] : f.landmarks)
+    lm[name] = {{"position_mm", vec(to_input * p)},
+                {"source", f.landmark_source.count(name) ? f.landmark_source.at(name) : "found"}};
+  j["landmarks"] = lm;
+  j[quality_name] = number_or_null(f.quality_mm);
+  return j;
+}
+
+nlohmann::json acetabulum_record(const Acetabulum& A, const AnatomicalFrame& pelvis, Side side,
+                                 const Eigen::Matrix3d& to_input) {
+  const AcetabularOrientation o = radiographic_orientation(A, pelvis, side);
+  return {{"sphere_centre_mm", vec(to_input * A.sphere.centre)},
+          {"sphere_radius_mm", A.sphere.radius},
+          {"sphere_fit_rms_mm", A.sphere.rms_residual},
+          {"rim_centre_mm", vec(to_input * A.rim_centre)},
+          {"rim_radius_mm", A.rim_radius_mm},
+          {"rim_plane_rms_mm", A.rim_plane_rms_mm},
+          {"opening", vec(to_input * A.opening)},
+          {"radiographic_inclination_deg", o.inclination_deg},
+          {"radiographic_anteversion_deg", o.anteversion_deg},
+          {"clock_twelve", vec(to_input * A.clock.twelve)},
+          {"clock_three", vec(to_input * A.clock.three)},
+          {"notch_coverage_deg", A.notch_coverage_deg},
+          {"median_coverage_deg", A.median_coverage_deg},
+          {"convention", "12 superior, 3 anterior on both sides, 6 at the acetabular notch (Blankenbaker et al. 2007); "
+                         "inclination and anteversion radiographic (Murray 1993) in the pelvic frame"}};
+}
+
+nlohmann::json setup_record(const Session& s) {
+  const Eigen::Matrix3d to_input = s.to_input();
+  const JointOptions& opt = s.joint_options();
+  const HipJoint& hip = s.hip();
+  nlohmann::json j;
+  j["impinge_version"] = IMPINGE_VERSION;
+  j["ball_file"] = s.ball_source();
+  j["socket_file"] = s.socket_source();
+  j["side"] = s.side() == Side::right ? "right" : "left";
+  j["input_frame"] = s.input_frame() == FrameConvention::LPS ? "LPS" : "RAS";
+  j["cor_mm"] = vec(s.cor_input());
+  j["cor_method"] = s.cor_method();
+  j["head_radius_mm"] = number_or_null(s.head().radius);
+  j["sphere_fit_rms_mm"] = number_or_null(s.head().rms_residual);
+  j["sphere_fit_points"] = s.head().points_used;
+  j["scheme"] = opt.scheme->name();
+  j[opt.scheme->resolution_name()] = opt.scheme->resolution();
+  j["max_node_spacing_deg"] = opt.scheme->max_node_spacing() * kRadToDeg;
+  j["sampling_method"] = to_string(s.joint().ball().sampling.method);
+  j["mode"] = to_string(opt.mode);
+  j["levels_thresholds_mm"] = opt.levels.thresholds_mm;
+  j["occlusion_tolerance_mm"] = opt.occlusion_tolerance_mm;
+  j["exact_at_discontinuities"] = opt.exact_at_discontinuities && s.joint().ball().exact != nullptr;
+  j["discontinuity_tolerance_mm"] = opt.discontinuity_tolerance_mm;
+  j["layers"] = opt.layers;
+  j["nodes_marked"] = {{"ball", s.joint().ball().nodes_marked}, {"socket", s.joint().socket().nodes_marked}};
+  j["neutral"] = hip.neutral() == Neutral::anatomical ? "anatomical" : "scan";
+  j["warnings"] = s.warnings();
+  j["scan_pose_min_gap_mm"] = number_or_null(s.scan_pose_min_gap_mm());
+  j["overlap_at_scan_pose"] = s.scan_pose_min_gap_mm() < 0;
+  j["pose_convention"] =
+      "ISB joint coordinate system (Wu et al. 2002): flexion about the pelvic Z axis, adduction about the floating "
+      "axis, internal rotation about the femoral y axis; flexion, adduction and internal rotation positive; left "
+      "hips mirrored";
+  if (const auto& frames = hip.frames()) {
+    nlohmann::json f;
+    AnatomicalFrame femur = frames->femur;
+    femur.quality_mm = s.head().rms_residual;
+    f["pelvis"] = frame_record(frames->pelvis, to_input, "app_out_of_plane_mm");
+    f["femur"] = frame_record(femur, to_input, "head_fit_rms_mm");
+    f["scan_pose_deg"] = {{"flexion", frames->scan_pose.flexion_deg},
+                          {"adduction", frames->scan_pose.adduction_deg},
+                          {"internal_rotation", frames->scan_pose.internal_rotation_deg}};
+    f["frames_ms"] = hip.frames_ms();
+    f["acetabulum"] = acetabulum_record(*hip.acetabulum(), frames->pelvis, s.side(), to_input);
+    f["reseat_translation_mm"] = vec(to_input * hip.reseat_translation());
+    f["reseat_distance_mm"] = hip.reseat_translation().norm();
+    f["axes_note"] = "axes and positions in the input files' frame; x anterior, y superior, z right (ISB)";
+    j["frames"] = f;
+  }
+  return j;
+}
+
+nlohmann::json pose_record(const Session& s, const PoseAngles& pose, const PoseResult& res) {
+  nlohmann::json j;
+  j["pose_deg"] = {pose.flexion_deg, pose.adduction_deg, pose.internal_rotation_deg};
+  j["pose_names"] = {"flexion", "adduction", "internal_rotation"};
+  ClockSummary ball_clock, socket_clock;
+  s.hip().clocks(res, ball_clock, socket_clock);
+  const bool clocks = s.hip().socket_clock().has_value();
+  const ImpingementLevels& levels = s.joint_options().levels;
+  j["ball"] = scan_record(s.joint().ball(), res.ball, res.ball_detection_ms, levels, clocks ? &ball_clock : nullptr);
+  j["socket"] =
+      scan_record(s.joint().socket(), res.socket, res.socket_detection_ms, levels, clocks ? &socket_clock : nullptr);
+  return j;
+}
+
+}  // namespace impinge

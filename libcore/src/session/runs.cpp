@@ -1,0 +1,205 @@
+#include "impinge/session/runs.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "impinge/core/error.hpp"
+#include "impinge/core/timing.hpp"
+
+namespace impinge {
+
+std::vector<std::string> motion_columns(const ImpingementLevels& levels) {
+  std::vector<std::string> c = {"frame",           "time_s",          "flexion_deg",          "adduction_deg",
+                                "internal_rotation_deg", "ball_min_gap_mm", "socket_min_gap_mm",
+                                "penetrating_area_mm2",  "ball_penetrating_area_mm2"};
+  for (int k = 0; k < levels.count(); ++k) c.push_back("socket_level" + std::to_string(k) + "_area_mm2");
+  for (const char* name : {"socket_closest_clock_h", "femur_closest_clock_h", "socket_closest_x_mm",
+                           "socket_closest_y_mm", "socket_closest_z_mm", "detection_ms"})
+    c.emplace_back(name);
+  return c;
+}
+
+nlohmann::json motion_row(const MotionFrame& f) {
+  const PoseResult& r = *f.result;
+  nlohmann::json row = {f.index,
+                        f.time_s,
+                        f.angles.flexion_deg,
+                        f.angles.adduction_deg,
+                        f.angles.internal_rotation_deg,
+                        number_or_null(r.ball.min_gap_mm),
+                        number_or_null(r.socket.min_gap_mm),
+                        r.socket.area_penetrating_mm2,
+                        r.ball.area_penetrating_mm2};
+  for (double area : r.socket.level_area_mm2) row.push_back(area);
+  row.push_back(number_or_null(f.socket_clock.closest_hour));
+  row.push_back(number_or_null(f.ball_clock.closest_hour));
+  for (int c = 0; c < 3; ++c) row.push_back(number_or_null(f.socket_closest[c]));
+  row.push_back(f.detection_ms);
+  return row;
+}
+
+double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const std::vector<double>& time_s,
+                  const std::function<void(const MotionFrame&)>& on_frame) {
+  require(time_s.empty() || time_s.size() == angles.size(),
+          "motion: " + std::to_string(time_s.size()) + " times for " + std::to_string(angles.size()) + " poses");
+  const JointBody& socket = s.joint().socket();
+  PoseResult res;
+  MotionFrame f;
+  f.result = &res;
+  double detect_ms = 0;
+  for (std::size_t k = 0; k < angles.size(); ++k) {
+    f.index = k;
+    f.time_s = time_s.empty() ? static_cast<double>(k) : time_s[k];
+    f.angles = angles[k];
+    f.R = s.hip().femur_rotation(angles[k]);
+    const auto t0 = Clock::now();
+    s.joint().detect(f.R, Eigen::Vector3d::Zero(), res);
+    f.detection_ms = ms_since(t0);
+    detect_ms += f.detection_ms;
+    // The socket vertex with the least gap.
+    float best = std::numeric_limits<float>::infinity();
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < res.socket_gaps.gap_mm.size(); ++i)
+      if (res.socket_gaps.gap_mm[i] < best) best = res.socket_gaps.gap_mm[i], at = i;
+    f.socket_closest = std::isfinite(best)
+                           ? s.report_point(socket.relative.row(static_cast<Eigen::Index>(at)).transpose())
+                           : Eigen::Vector3d::Constant(std::nan(""));
+    f.ball_clock.closest_hour = f.socket_clock.closest_hour = std::nan("");
+    s.hip().clocks(res, f.ball_clock, f.socket_clock);
+    on_frame(f);
+  }
+  return detect_ms;
+}
+
+RomRun run_rom(const Session& s, const RomRequest& q) {
+  RomRun run;
+  run.search = q.search;
+  const HipJoint& hip = s.hip();
+  // Pre-existing overlap at neutral (a segmentation's) is excluded, not taken for a limit. The
+  // baseline's scan and the search bounds it builds count with the limits' time.
+  auto t0 = Clock::now();
+  run.baseline = rom_baseline(hip, hip.femur_rotation({}), q.search);
+  run.motions = standard_motions();
+  run.limits = find_rom_limits(hip, run.motions, q.search, run.baseline);
+  run.limits_ms = ms_since(t0);
+  for (const RomLimit& l : run.limits) {
+    run.limit_evaluations += l.evaluations;
+    run.vertices_looked_up += l.vertices_looked_up;
+    run.vertices_skipped += l.vertices_skipped;
+  }
+  if (q.map) {
+    run.map_flexion_deg = q.map_flexion_deg;
+    run.map_adduction_deg = q.map_adduction_deg;
+    if (run.map_flexion_deg.empty())
+      for (int f = 0; f <= 120; f += 5) run.map_flexion_deg.push_back(f);
+    if (run.map_adduction_deg.empty())
+      for (int a = -20; a <= 40; a += 5) run.map_adduction_deg.push_back(a);
+    t0 = Clock::now();
+    run.map = rom_map(hip, run.map_flexion_deg, run.map_adduction_deg, q.search, run.baseline);
+    run.map_ms = ms_since(t0);
+    for (const RomMapCell& c : run.map) {
+      run.vertices_looked_up += c.vertices_looked_up;
+      run.vertices_skipped += c.vertices_skipped;
+      run.map_evaluations += c.evaluations;
+    }
+  }
+  if (q.envelope) {
+    run.envelope_options = q.envelope_options;
+    t0 = Clock::now();
+    run.envelope = rom_envelope(hip, q.envelope_options, q.search, run.baseline);
+    run.envelope_ms = ms_since(t0);
+    run.vertices_looked_up += run.envelope->vertices_looked_up;
+    run.vertices_skipped += run.envelope->vertices_skipped;
+  }
+  return run;
+}
+
+Table rom_limits_table(const Session& s, const RomRun& run) {
+  Table t;
+  t.columns = {"motion",      "limit_deg",        "limited_by",   "socket_clock_h", "femur_clock_h",
+               "min_gap_at_limit_mm", "monotone", "contact_at_start", "contact_x_mm", "contact_y_mm",
+               "contact_z_mm", "evaluations"};
+  for (std::size_t k = 0; k < run.motions.size(); ++k) {
+    const RomLimit& l = run.limits[k];
+    const Eigen::Vector3d c = s.to_input(l.contact_mm);
+    t.add({run.motions[k].name, number_or_null(l.limit_deg), to_string(l.limited_by), number_or_null(l.socket_clock_h),
+           number_or_null(l.femur_clock_h), number_or_null(l.min_gap_at_limit_mm), l.monotone, l.contact_at_start,
+           number_or_null(c.x()), number_or_null(c.y()), number_or_null(c.z()), l.evaluations});
+  }
+  return t;
+}
+
+Table rom_map_table(const RomRun& run) {
+  Table t;
+  t.columns = {"flexion_deg", "adduction_deg", "max_internal_rotation_deg", "status"};
+  for (const RomMapCell& c : run.map)
+    t.add({c.flexion_deg, c.adduction_deg, number_or_null(c.max_internal_rotation_deg), to_string(c.status)});
+  return t;
+}
+
+Table rom_envelope_table(const RomRun& run) {
+  Table t;
+  t.columns = {"flexion_deg", "adduction_deg", "internal_rotation_from_deg", "internal_rotation_to_deg"};
+  if (!run.envelope) return t;
+  const RomEnvelope& env = *run.envelope;
+  const std::size_t nr = env.internal_rotation_deg.size();
+  for (std::size_t i = 0; i < env.flexion_deg.size(); ++i)
+    for (std::size_t j = 0; j < env.adduction_deg.size(); ++j)
+      for (std::size_t k = 0; k < nr;) {
+        if (!env.at(i, j, k)) {
+          ++k;
+          continue;
+        }
+        std::size_t e = k;
+        while (e + 1 < nr && env.at(i, j, e + 1)) ++e;
+        t.add({env.flexion_deg[i], env.adduction_deg[j], env.internal_rotation_deg[k], env.internal_rotation_deg[e]});
+        k = e + 1;
+      }
+  return t;
+}
+
+nlohmann::json rom_record(const RomRun& run) {
+  nlohmann::json j;
+  const RomOptions& o = run.search;
+  j["threshold_mm"] = o.threshold_mm;
+  j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
+  j["neutral_min_gap_mm"] = number_or_null(run.baseline.min_gap_mm);
+  j["excluded_vertices"] = run.baseline.excluded_vertices;
+  nlohmann::json limits = nlohmann::json::array();
+  for (std::size_t k = 0; k < run.motions.size(); ++k) {
+    const RomLimit& l = run.limits[k];
+    limits.push_back({{"motion", run.motions[k].name},
+                      {"limit_deg", number_or_null(l.limit_deg)},
+                      {"limited_by", to_string(l.limited_by)},
+                      {"monotone", l.monotone}});
+  }
+  j["limits"] = limits;
+  if (run.envelope) {
+    const RomEnvelope& env = *run.envelope;
+    const RomEnvelopeOptions& eo = run.envelope_options;
+    std::int64_t valid = 0;
+    for (std::uint8_t v : env.valid) valid += v != 0;
+    j["envelope"] = {
+        {"poses", env.poses},
+        {"poses_valid", valid},
+        {"poses_scanned", env.poses_evaluated},
+        {"grid",
+         {{"flexion_deg", {eo.flexion_min_deg, eo.flexion_max_deg}},
+          {"adduction_deg", {eo.adduction_min_deg, eo.adduction_max_deg}},
+          {"internal_rotation_deg", {eo.internal_rotation_min_deg, eo.internal_rotation_max_deg}},
+          {"step_deg", eo.step_deg},
+          {"coarse_steps", eo.coarse_steps}}},
+        {"ms", run.envelope_ms},
+        {"poses_per_second", run.envelope_ms > 0 ? double(env.poses) / (run.envelope_ms / 1000) : 0.0}};
+  }
+  j["rom_map_cells"] = run.map.size();
+  j["rom_map_evaluations"] = run.map_evaluations;
+  j["limit_evaluations"] = run.limit_evaluations;
+  j["vertices_looked_up"] = run.vertices_looked_up;
+  j["vertices_skipped_by_bounds"] = run.vertices_skipped;
+  const std::int64_t all = run.vertices_looked_up + run.vertices_skipped;
+  j["share_skipped"] = all > 0 ? double(run.vertices_skipped) / double(all) : 0.0;
+  return j;
+}
+
+}  // namespace impinge

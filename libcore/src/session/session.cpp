@@ -1,0 +1,265 @@
+#include "impinge/session/session.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "impinge/anatomy/femur_frame.hpp"
+#include "impinge/anatomy/pelvis_frame.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/parse.hpp"
+#include "impinge/detection/impingement_levels.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/maps/layered_map.hpp"
+#include "impinge/sampling/rasterize.hpp"
+#include "impinge/sampling/sampling.hpp"
+#include "impinge/schemes/sampling_scheme.hpp"
+
+namespace impinge {
+
+namespace {
+std::string num(double x) {
+  std::ostringstream o;
+  o << x;
+  return o.str();
+}
+std::string point_text(const Eigen::Vector3d& p) {
+  return "(" + num(p.x()) + ", " + num(p.y()) + ", " + num(p.z()) + ")";
+}
+}  // namespace
+
+std::optional<Eigen::Vector3d> parse_cor(const std::string& text, const std::string& context) {
+  if (text.empty() || text == "auto") return std::nullopt;
+  const auto v = parse_number_list(text, context, 3);
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+Eigen::Vector4d parse_head_region(const std::string& text, const std::string& context) {
+  const auto v = parse_number_list(text, context, 4);
+  require(v[3] > 0, context + " '" + text + "': the radius R must be > 0 mm");
+  return Eigen::Vector4d(v[0], v[1], v[2], v[3]);
+}
+
+namespace {
+// The side: the subject's, or the given one; both must agree.
+Side checked_side(const SessionInput& input, const std::optional<Side>& subject_side) {
+  if (input.side.empty()) return subject_side.value_or(Side::right);
+  const Side s = parse_side(input.side, "side");
+  require(!subject_side || *subject_side == s,
+          "side '" + input.side + "' contradicts " + input.subject + " (its \"side\" is " +
+              (*subject_side == Side::right ? "right" : "left") + ")");
+  return s;
+}
+}  // namespace
+
+Side input_side(const SessionInput& input) {
+  std::optional<Side> subject_side;
+  if (!input.subject.empty()) subject_side = load_subject(input.subject).side;
+  return checked_side(input, subject_side);
+}
+
+LoadedInput load_input(const SessionInput& input) {
+  LoadedInput in;
+  std::string ball = input.ball, socket = input.socket;
+  Landmarks landmarks;
+  std::optional<Side> subject_side;
+  std::optional<FrameConvention> subject_frame;
+  if (!input.subject.empty()) {
+    const SubjectInfo info = load_subject(input.subject);
+    subject_side = info.side;
+    subject_frame = info.frame;
+    if (ball.empty() && !input.ball_mesh) ball = info.femur_path;
+    if (socket.empty() && !input.socket_mesh) socket = info.pelvis_path;
+    landmarks = info.landmarks;
+    in.neutral = info.neutral;
+    in.name = info.name;
+  }
+  in.side = checked_side(input, subject_side);
+  in.frame = subject_frame.value_or(FrameConvention::RAS);
+  if (!input.frame.empty()) {
+    const FrameConvention f = parse_frame(input.frame, "frame");
+    require(!subject_frame || *subject_frame == f,
+            "frame '" + input.frame + "' contradicts " + input.subject + " (its \"frame\" is " +
+                (*subject_frame == FrameConvention::LPS ? "LPS" : "RAS") + ")");
+    in.frame = f;
+  }
+  require(input.ball_mesh || !ball.empty(), "no femur: give ball (a mesh file or mesh) or subject");
+  require(input.socket_mesh || !socket.empty(), "no pelvis: give socket (a mesh file or mesh) or subject");
+  require(!(input.ball_mesh && !input.ball.empty()), "give ball as a file or a mesh, not both");
+  require(!(input.socket_mesh && !input.socket.empty()), "give socket as a file or a mesh, not both");
+  if (input.ball_mesh) {
+    in.femur = *input.ball_mesh;
+    in.femur_source = in.femur.source.empty() ? "ball (in memory)" : in.femur.source;
+  } else {
+    in.femur = load_mesh(ball);
+    in.femur_source = ball;
+  }
+  if (input.socket_mesh) {
+    in.pelvis = *input.socket_mesh;
+    in.pelvis_source = in.pelvis.source.empty() ? "socket (in memory)" : in.pelvis.source;
+  } else {
+    in.pelvis = load_mesh(socket);
+    in.pelvis_source = socket;
+  }
+  for (const auto& [name, p] : input.landmarks) {
+    require(p.allFinite(), "landmark " + name + ": not three finite numbers");
+    landmarks[name] = p;
+  }
+  in.to_working = to_anatomical(in.frame);
+  transform_vertices(in.femur.V, in.to_working);
+  transform_vertices(in.pelvis.V, in.to_working);
+  for (auto& [name, p] : landmarks) in.landmarks[name] = in.to_working * p;
+  return in;
+}
+
+CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) {
+  const Eigen::Matrix3d& M = in.to_working;
+  CorResult r;
+  require(!(cor.given && cor.head_region), "give a COR or a head region, not both");
+  if (cor.head_region) {
+    const Eigen::Vector4d& v = *cor.head_region;
+    r.head = fit_sphere_in_region(in.femur, M * v.head<3>(), v[3]);
+    r.method = "sphere fit in region";
+    return r;
+  }
+  if (cor.given) {
+    r.head.centre = M * *cor.given;
+    r.head.radius = r.head.rms_residual = std::nan("");
+    r.method = "given";
+    if (!cor.allow_any) {
+      // A given COR must lie in the femoral head: compare with the head the bone itself shows.
+      const SphereFitResult head = locate_femoral_head(in.femur);
+      const double d = (r.head.centre - head.centre).norm();
+      if (d > head.radius)
+        throw Error("cor " + point_text(*cor.given) + " mm is " + num(d) + " mm from the fitted femoral head centre " +
+                    point_text(M.transpose() * head.centre) + " mm, farther than the head radius " +
+                    num(head.radius) + " mm: the COR must lie in the head (input frame, mm); allow-any-cor accepts it");
+    }
+    return r;
+  }
+  if (in.landmarks.count("hip_centre")) {
+    r.head.centre = in.landmarks.at("hip_centre");
+    r.head.radius = r.head.rms_residual = std::nan("");
+    r.method = "given (subject.json landmark hip_centre)";
+    return r;
+  }
+  r.head = locate_femoral_head(in.femur);
+  r.method = "automatic sphere fit (long axis, RANSAC + geometric)";
+  return r;
+}
+
+std::shared_ptr<const SamplingScheme> scheme_of(const MapSettings& m) {
+  const int given = (m.resolution > 0) + (m.precision > 0) + (m.turns > 0) + (m.spacing > 0);
+  require(given <= 1, "give one of resolution, precision, turns and spacing");
+  for (const auto& [name, x] : {std::pair{"resolution", m.resolution}, std::pair{"precision", m.precision},
+                                std::pair{"turns", m.turns}, std::pair{"spacing", m.spacing}})
+    require(std::isfinite(x) && x >= 0, std::string(name) + " " + num(x) + ": must be a finite number > 0 (0: not given)");
+  double res = default_resolution(m.scheme);
+  if (m.spacing > 0) res = resolution_for_spacing(m.scheme, m.spacing);
+  if (m.resolution > 0) res = m.resolution;
+  if (m.precision > 0) res = m.precision;
+  if (m.turns > 0) res = m.turns;
+  return make_scheme(m.scheme, res);
+}
+
+HipJointOptions hip_joint_options(const MapSettings& m, const FrameSettings& f, const std::string& subject_neutral) {
+  HipJointOptions o;
+  if (!f.neutral.empty())
+    o.neutral = parse_neutral(f.neutral, "neutral");
+  else if (!subject_neutral.empty())
+    o.neutral = parse_neutral(subject_neutral, "subject.json \"neutral\"");
+  o.reseat = f.reseat;
+  o.frames.pelvis = parse_pelvis_frame_kind(f.pelvis_frame, "pelvis-frame");
+  o.frames.femur = parse_femur_frame_kind(f.femur_frame, "femur-frame");
+  JointOptions& jo = o.joint;
+  jo.scheme = scheme_of(m);
+  jo.mode = parse_distance_mode(m.mode);
+  jo.sampling = parse_sampling_method(m.sampling);
+  require(std::isfinite(m.occlusion_tolerance_mm) && m.occlusion_tolerance_mm >= 0,
+          "occlusion-tolerance " + num(m.occlusion_tolerance_mm) + ": must be >= 0 mm");
+  jo.occlusion_tolerance_mm = m.occlusion_tolerance_mm;
+  require(!std::isnan(m.max_radius_mm) && m.max_radius_mm >= 0,
+          "max-radius " + num(m.max_radius_mm) + ": must be >= 0 mm (0: all vertices)");
+  jo.max_radius_mm = m.max_radius_mm > 0 ? m.max_radius_mm : std::numeric_limits<double>::infinity();
+  require(std::isfinite(m.discontinuity_tolerance_mm) && m.discontinuity_tolerance_mm > 0,
+          "discontinuity-tolerance " + num(m.discontinuity_tolerance_mm) + ": must be > 0 mm");
+  jo.exact_at_discontinuities = !m.maps_only;
+  jo.discontinuity_tolerance_mm = m.discontinuity_tolerance_mm;
+  require(!std::isnan(m.sparse_mm) && m.sparse_mm >= 0,
+          "sparse " + num(m.sparse_mm) + ": must be a distance in mm >= 0, or inf");
+  jo.sparse_maps = m.sparse_mm > 0;
+  if (jo.sparse_maps) jo.sparse_region_mm = m.sparse_mm;
+  if (!m.levels.empty()) {
+    jo.levels.thresholds_mm = m.levels;
+    jo.levels.validate();
+  }
+  require(m.layers >= 0 && m.layers <= LayeredMap::kMaxLayers,
+          "layers " + std::to_string(m.layers) + ": must be 0 (off) to " + std::to_string(LayeredMap::kMaxLayers));
+  require(std::isfinite(m.extra_articular_radius_mm) && m.extra_articular_radius_mm > 0,
+          "extra-articular-radius must be > 0 mm");
+  jo.layers = m.layers;
+  jo.extra_articular_radius_mm = m.extra_articular_radius_mm;
+  require(m.ball_map_file.empty() == m.socket_map_file.empty(), "maps: give both map files (ball and socket) or none");
+  o.ball_map_file = m.ball_map_file;
+  o.socket_map_file = m.socket_map_file;
+  return o;
+}
+
+Session::Session(const SessionOptions& options) : options_(options) {
+  // The cheap options are checked before anything is read or built.
+  hip_options_ = hip_joint_options(options.maps, options.frames);
+  LoadedInput in = load_input(options.input);
+  if (options.frames.neutral.empty() && !in.neutral.empty())
+    hip_options_.neutral = parse_neutral(in.neutral, options.input.subject + ": \"neutral\"");
+  side_ = in.side;
+  frame_ = in.frame;
+  to_working_ = in.to_working;
+  ball_source_ = in.femur_source;
+  socket_source_ = in.pelvis_source;
+  subject_name_ = in.name;
+  cor_ = find_centre_of_rotation(in, options.cor);
+  hip_options_.allow_cor_outside_ball = options.cor.allow_any;
+  try {
+    hip_ = std::make_shared<const HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
+                                            hip_options_);
+  } catch (const Error& e) {
+    if (hip_options_.neutral != Neutral::anatomical || hip_options_.reseat) throw;
+    throw Error(std::string(e.what()) +
+                " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan "
+                "uses the scan pose instead]");
+  }
+  warnings_ = hip_->warnings();
+  // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).
+  const PoseResult scan = joint().detect(Eigen::Matrix3d::Identity());
+  scan_pose_min_gap_mm_ = std::fmin(scan.ball.min_gap_mm, scan.socket.min_gap_mm);
+  if (scan_pose_min_gap_mm_ < 0)
+    warnings_.push_back("the bones overlap by " + num(-scan_pose_min_gap_mm_) +
+                        " mm at the scan pose (a segmentation overlap, not an impingement)" +
+                        (hip_options_.reseat ? "" : "; reseat seats the head on the acetabular centre"));
+}
+
+Vertices Session::femur_input(const Eigen::Matrix3d& R) const {
+  return (hip_->posed_femur(R) * to_working_).eval();  // rows: v^T M = (M^T v)^T, M^T = input <- working
+}
+
+Vertices Session::pelvis_input() const { return (hip_->pelvis_vertices() * to_working_).eval(); }
+
+std::pair<Eigen::Matrix3d, Eigen::Vector3d> Session::joint_motion(const Eigen::Matrix3d& R_in,
+                                                                  const Eigen::Vector3d& t_in) const {
+  // joint <- working <- input: A = joint_to_working^T, M = to_working.
+  const Eigen::Matrix3d B = hip_->joint_to_working().transpose() * to_working_;
+  return {B * R_in * B.transpose(), B * t_in};
+}
+
+Eigen::Matrix3d Session::input_rotation(const Eigen::Matrix3d& R_joint) const {
+  const Eigen::Matrix3d B = hip_->joint_to_working().transpose() * to_working_;
+  return B.transpose() * R_joint * B;
+}
+
+Eigen::Vector3d Session::report_point(const Eigen::Vector3d& joint_point) const {
+  const Eigen::Vector3d w = hip_->to_working(joint_point);
+  if (hip_->frames()) return hip_->frames()->pelvis.to_local(w);
+  return to_input(w);
+}
+
+}  // namespace impinge
