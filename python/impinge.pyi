@@ -1,7 +1,7 @@
 """Type stubs of the impinge module (pybind11): impingement detection in ball-and-socket joints.
 
 Units: mm and degrees. Vertices: float (n, 3); faces: integer (m, 3), 0-based."""
-from typing import Any, Dict, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -41,14 +41,35 @@ class Map:
     def node_directions(self) -> npt.NDArray[np.float64]: ...
 
 class Joint:
-    """Femur (ball) and pelvis (socket) with both maps built once."""
-    def __init__(self, ball: Tuple[npt.ArrayLike, npt.ArrayLike], socket: Tuple[npt.ArrayLike, npt.ArrayLike],
-                 cor: Optional[Sequence[float]] = None, side: str = "right", neutral: str = "anatomical",
-                 scheme: str = "equiangular", resolution: float = 0.0, mode: str = "exact", sampling: str = "auto",
-                 occlusion_tolerance_mm: float = 1.0, max_radius_mm: float = 0.0,
-                 levels: Optional[Sequence[float]] = None, reseat: bool = False, pelvis_frame: str = "isb",
-                 femur_frame: str = "epicondyles", maps: Optional[Tuple[str, str]] = None,
-                 sparse: float = 0.0) -> None: ...
+    """A hip set up as `impinge distance` sets it up (the session layer): both maps built once, then
+    any number of poses. Every option of `impinge distance` is a keyword, named as the CLI's with
+    underscores (lengths with _mm); None means the default. Positions, rotations and frames given
+    or returned are in the input frame (`frame`)."""
+    def __init__(self, ball: Optional[Union[str, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
+                 socket: Optional[Union[str, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None, *,
+                 subject: Optional[str] = None, side: Optional[str] = None, frame: Optional[str] = None,
+                 cor: Optional[Union[str, Sequence[float]]] = None, allow_any_cor: bool = False,
+                 head_region: Optional[Sequence[float]] = None,
+                 landmarks: Optional[Dict[str, Sequence[float]]] = None,
+                 scheme: str = "equiangular", resolution: float = 0.0, precision: float = 0.0, turns: float = 0.0,
+                 spacing: float = 0.0, sampling: str = "auto", mode: str = "exact",
+                 levels: Optional[Sequence[float]] = None, occlusion_tolerance_mm: float = 1.0,
+                 max_radius_mm: float = 0.0, sparse: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
+                 layers: int = 0, extra_articular_radius_mm: float = 150.0, maps_only: bool = False,
+                 maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
+                 pelvis_frame: str = "isb", reseat: bool = False, femur_frame: str = "epicondyles") -> None:
+        """ball, socket: mesh files or (V (n, 3) float mm, F (m, 3) int); or subject: a subject.json
+        (meshes, side, frame, landmarks, neutral). side: 'right'/'left'; frame: 'LPS'/'RAS' (the
+        meshes' frame; default the subject's, else RAS). cor: 'auto' (the femoral head fitted) or
+        (x, y, z) mm; head_region: (x, y, z, r) mm, fit the head there; allow_any_cor: accept a COR
+        outside the head. scheme and one of resolution/precision/turns/spacing (0: the scheme's
+        0.5 deg default); sampling; mode 'exact'/'linear'; levels: thresholds mm, decreasing;
+        sparse: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for
+        hidden vertices (extra-articular), within extra_articular_radius_mm; maps_only: no exact
+        look-ups at depth discontinuities; maps: (ball_path, socket_path) from save_maps().
+        neutral: 'anatomical' (ISB frames) or 'scan' (default: the subject's, else anatomical);
+        pelvis_frame 'isb'/'app'; femur_frame 'epicondyles'/'posterior-condyles'; reseat: seat
+        the head on the acetabular centre. Raises Error naming the option, array or file."""
     def save_maps(self, ball_path: str, socket_path: str) -> None:
         """Save both maps for Joint(..., maps=(ball_path, socket_path))."""
     def detect(self, R: Optional[npt.ArrayLike] = None, t: Optional[Sequence[float]] = None) -> Dict[str, Any]:
@@ -58,7 +79,7 @@ class Joint:
                     internal_rotation: float = 0.0) -> Dict[str, Any]:
         """Both scans at clinical angles (degrees, ISB)."""
     def motion(self, angles: npt.ArrayLike) -> Dict[str, npt.NDArray[np.float64]]:
-        """Both scans at every row of angles (k, 3) -> per-frame min gaps and penetrating areas."""
+        """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each."""
     def rom_limits(self, threshold_mm: float = 0.0, step_deg: float = 2.0,
                    max_deg: float = 150.0) -> Dict[str, Any]:
         """ROM limits from neutral for the standard motions -> dict motion -> dict(limit_deg, limited_by, ...)."""
@@ -71,3 +92,6 @@ class Joint:
     ball_map: Map
     socket_map: Map
     frames: Optional[Dict[str, Any]]
+    setup: Dict[str, Any]
+    """The set-up as the CLI's summary.json reports it."""
+    warnings: List[str]

@@ -28,6 +28,10 @@
 #include "impinge/maps/map_io.hpp"
 #include "impinge/sampling/sampling.hpp"
 #include "impinge/schemes/sampling_scheme.hpp"
+#include "impinge/session/records.hpp"
+#include "impinge/session/runs.hpp"
+#include "impinge/session/session.hpp"
+#include <functional>
 
 namespace py = pybind11;
 using namespace impinge;
@@ -145,50 +149,174 @@ struct MapView {
   const RadialDistanceMap* map;
 };
 
-// The Python Joint: a HipJoint plus its options.
+// The Python Joint: a Session (impinge/session/session.hpp), as the CLI builds it.
 struct PyJoint {
-  std::shared_ptr<const HipJoint> hip;
-  Side side = Side::right;
+  std::shared_ptr<const Session> session;
+  const HipJoint& hip() const { return session->hip(); }
 };
 
-PyJoint make_joint(const py::handle& ball, const py::handle& socket, const py::handle& cor, const std::string& side,
-                   const std::string& neutral, const std::string& scheme, double resolution, const std::string& mode,
-                   const std::string& sampling, double occlusion_tolerance_mm, double max_radius_mm,
-                   const std::optional<std::vector<double>>& levels, bool reseat, const std::string& pelvis_frame,
-                   const std::string& femur_frame, const std::optional<std::pair<std::string, std::string>>& maps,
-                   double sparse, int layers) {
-  TriangleMesh b = to_mesh(ball, "ball"), s = to_mesh(socket, "socket");
-  HipJointOptions o;
-  o.joint.scheme = make_scheme(scheme, resolution > 0 ? resolution : default_resolution(scheme));
-  o.joint.mode = parse_distance_mode(mode);
-  o.joint.sampling = parse_sampling_method(sampling);
-  o.joint.occlusion_tolerance_mm = occlusion_tolerance_mm;
-  o.joint.max_radius_mm = max_radius_mm > 0 ? max_radius_mm : std::numeric_limits<double>::infinity();
-  require(!std::isnan(sparse) && sparse >= 0, "Joint: sparse " + std::to_string(sparse) + " must be >= 0 mm or inf");
-  o.joint.sparse_maps = sparse > 0;
-  if (sparse > 0) o.joint.sparse_region_mm = sparse;
-  o.joint.layers = layers;  // checked by Joint
-  if (levels) {
-    o.joint.levels.thresholds_mm = *levels;
-    o.joint.levels.validate();
+// ---- Joint's options: one table, the same names as the CLI's (dashes as underscores, "_mm" where a
+// length), so that Joint(...) takes every option `impinge distance` takes.
+
+std::string as_string(const py::handle& v, const std::string& name) {
+  if (!py::isinstance<py::str>(v)) throw Error(name + ": expected a string, got " + std::string(py::str(v.get_type())));
+  return v.cast<std::string>();
+}
+double as_double(const py::handle& v, const std::string& name) {
+  try {
+    return py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>();
+  } catch (const py::error_already_set&) {
+    throw Error(name + ": expected a number, got " + std::string(py::str(v.get_type())));
   }
-  o.neutral = parse_neutral(neutral, "neutral");
-  o.reseat = reseat;
-  o.frames.pelvis = parse_pelvis_frame_kind(pelvis_frame, "pelvis_frame");
-  o.frames.femur = parse_femur_frame_kind(femur_frame, "femur_frame");
-  if (maps) o.ball_map_file = maps->first, o.socket_map_file = maps->second;
+}
+int as_int(const py::handle& v, const std::string& name) {
+  const double x = as_double(v, name);
+  if (x != std::floor(x) || std::fabs(x) > 1e9) throw Error(name + ": expected a whole number, got " + std::to_string(x));
+  return static_cast<int>(x);
+}
+bool as_bool(const py::handle& v, const std::string& name) {
+  if (!py::isinstance<py::bool_>(v)) throw Error(name + ": expected True or False");
+  return v.cast<bool>();
+}
+std::vector<double> as_numbers(const py::handle& v, const std::string& name, std::size_t count) {
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(v);
+  if (!a || a.ndim() != 1 || (count > 0 && static_cast<std::size_t>(a.size()) != count))
+    throw Error(name + ": expected " + (count ? std::to_string(count) + " numbers" : std::string("a list of numbers")));
+  std::vector<double> out(a.data(), a.data() + a.size());
+  for (double x : out)
+    if (!std::isfinite(x)) throw Error(name + ": not finite");
+  return out;
+}
+
+// A mesh option: a file path or a pair (V, F) of arrays.
+void set_mesh(const py::handle& v, const std::string& name, std::string& path, std::optional<TriangleMesh>& mesh) {
+  if (py::isinstance<py::str>(v) || py::hasattr(v, "__fspath__"))
+    path = py::str(py::module_::import("os").attr("fspath")(v)).cast<std::string>();
+  else
+    mesh = to_mesh(v, name);
+}
+
+using OptionSetter = std::function<void(SessionOptions&, const py::handle&, const std::string&)>;
+
+// Every option of Joint(...) by name (sorted as the CLI's help lists them).
+const std::vector<std::pair<std::string, OptionSetter>>& joint_options() {
+  static const std::vector<std::pair<std::string, OptionSetter>> t = {
+      {"subject", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         o.input.subject = py::str(py::module_::import("os").attr("fspath")(v)).cast<std::string>();
+         (void)n;
+       }},
+      {"ball", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         set_mesh(v, n, o.input.ball, o.input.ball_mesh);
+       }},
+      {"socket", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         set_mesh(v, n, o.input.socket, o.input.socket_mesh);
+       }},
+      {"side", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.input.side = as_string(v, n); }},
+      {"frame", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.input.frame = as_string(v, n); }},
+      {"cor", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         if (py::isinstance<py::str>(v)) {
+           o.cor.given = parse_cor(v.cast<std::string>(), n);
+         } else {
+           const auto x = as_numbers(v, n, 3);
+           o.cor.given = Eigen::Vector3d(x[0], x[1], x[2]);
+         }
+       }},
+      {"allow_any_cor", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.cor.allow_any = as_bool(v, n); }},
+      {"head_region", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         const auto x = as_numbers(v, n, 4);
+         if (!(x[3] > 0)) throw Error(n + ": the radius R must be > 0 mm");
+         o.cor.head_region = Eigen::Vector4d(x[0], x[1], x[2], x[3]);
+       }},
+      {"landmarks", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         if (!py::isinstance<py::dict>(v)) throw Error(n + ": expected a dict name -> (x, y, z) mm");
+         for (const auto& [k, p] : py::reinterpret_borrow<py::dict>(v)) {
+           const auto x = as_numbers(p, n + "['" + py::str(k).cast<std::string>() + "']", 3);
+           o.input.landmarks[py::str(k).cast<std::string>()] = Eigen::Vector3d(x[0], x[1], x[2]);
+         }
+       }},
+      {"scheme", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.scheme = as_string(v, n); }},
+      {"resolution", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.resolution = as_double(v, n); }},
+      {"precision", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.precision = as_double(v, n); }},
+      {"turns", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.turns = as_double(v, n); }},
+      {"spacing", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.spacing = as_double(v, n); }},
+      {"sampling", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.sampling = as_string(v, n); }},
+      {"mode", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.mode = as_string(v, n); }},
+      {"levels", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.levels = as_numbers(v, n, 0); }},
+      {"occlusion_tolerance_mm", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         o.maps.occlusion_tolerance_mm = as_double(v, n);
+       }},
+      {"max_radius_mm", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.max_radius_mm = as_double(v, n); }},
+      {"sparse", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.sparse_mm = as_double(v, n); }},
+      {"discontinuity_tolerance_mm", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         o.maps.discontinuity_tolerance_mm = as_double(v, n);
+       }},
+      {"layers", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.layers = as_int(v, n); }},
+      {"extra_articular_radius_mm", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         o.maps.extra_articular_radius_mm = as_double(v, n);
+       }},
+      {"maps_only", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.maps_only = as_bool(v, n); }},
+      {"maps", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         const auto p = py::cast<std::pair<std::string, std::string>>(v);
+         (void)n;
+         o.maps.ball_map_file = p.first, o.maps.socket_map_file = p.second;
+       }},
+      {"neutral", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.frames.neutral = as_string(v, n); }},
+      {"pelvis_frame", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.frames.pelvis_frame = as_string(v, n); }},
+      {"reseat", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.frames.reseat = as_bool(v, n); }},
+      {"femur_frame", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.frames.femur_frame = as_string(v, n); }},
+  };
+  return t;
+}
+
+PyJoint make_joint(const py::object& ball, const py::object& socket, const py::kwargs& kw) {
+  SessionOptions o;
+  const auto& table = joint_options();
+  auto set = [&](const std::string& name, const py::handle& v) {
+    if (v.is_none()) return;  // None: the default
+    for (const auto& [n, setter] : table)
+      if (n == name) {
+        setter(o, v, name);
+        return;
+      }
+    std::string known;
+    for (const auto& [n, setter] : table) known += (known.empty() ? "" : ", ") + n;
+    throw Error("Joint: unknown option '" + name + "' (options: " + known + ")");
+  };
+  set("ball", ball);
+  set("socket", socket);
+  for (const auto& [k, v] : kw) set(py::str(k).cast<std::string>(), v);
   PyJoint j;
-  j.side = parse_side(side, "side");
-  SphereFitResult head;
-  if (cor.is_none()) {
-    head = locate_femoral_head(b);
-  } else {
-    head.centre = to_point(cor, "cor");
-    head.radius = std::nan("");
+  {
+    py::gil_scoped_release release;
+    j.session = std::make_shared<const Session>(o);
   }
-  py::gil_scoped_release release;
-  j.hip = std::make_shared<const HipJoint>(std::move(b), std::move(s), j.side, head, Landmarks{}, o);
+  for (const std::string& w : j.session->warnings())
+    if (PyErr_WarnEx(PyExc_UserWarning, ("impinge: " + w).c_str(), 1) != 0) throw py::error_already_set();
   return j;
+}
+
+// A JSON record (records.hpp) as Python objects (dicts, lists, floats; null as None).
+py::object from_json(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+// A table's columns as a dict of arrays: float64 for numbers (None as NaN), lists for text.
+py::dict table_columns(const Table& t) {
+  py::dict d;
+  for (std::size_t c = 0; c < t.columns.size(); ++c) {
+    const bool text = !t.rows.empty() && t.rows[0][c].is_string();
+    if (text) {
+      py::list l;
+      for (const auto& r : t.rows) l.append(r[c].get<std::string>());
+      d[py::str(t.columns[c])] = l;
+      continue;
+    }
+    std::vector<double> v(t.rows.size());
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      const auto& x = t.rows[k][c];
+      v[k] = x.is_null() ? std::nan("") : x.is_boolean() ? double(x.get<bool>()) : x.get<double>();
+    }
+    d[py::str(t.columns[c])] = own(std::move(v), {py::ssize_t(t.rows.size())});
+  }
+  return d;
 }
 
 py::dict result_dict(PoseResult&& r) {
@@ -208,13 +336,6 @@ py::dict result_dict(PoseResult&& r) {
   return d;
 }
 
-// Joint-frame rotation of a working-frame rotation R and translation t about the COR.
-std::pair<Eigen::Matrix3d, Eigen::Vector3d> to_joint_frame(const HipJoint& h, const Eigen::Matrix3d& R,
-                                                           const Eigen::Vector3d& t) {
-  const Eigen::Matrix3d A = h.joint_to_working().transpose();
-  return {A * R * A.transpose(), A * t};
-}
-
 // Checked clinical angles (k x 3, degrees) from a numpy array.
 std::vector<PoseAngles> to_angles(const py::handle& angles_obj) {
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(angles_obj);
@@ -230,58 +351,22 @@ std::vector<PoseAngles> to_angles(const py::handle& angles_obj) {
   return poses;
 }
 
-struct MotionColumns {
-  std::vector<double> ball_min, socket_min, ball_pen, socket_pen;
-};
-
-// Both scans at every pose (C++ only; the caller releases the GIL).
-MotionColumns run_motion(const HipJoint& h, const std::vector<PoseAngles>& poses) {
-  MotionColumns m;
-  for (auto* v : {&m.ball_min, &m.socket_min, &m.ball_pen, &m.socket_pen}) v->resize(poses.size());
-  PoseResult r;
-  for (std::size_t f = 0; f < poses.size(); ++f) {
-    h.detect(poses[f], r);
-    m.ball_min[f] = r.ball.min_gap_mm;
-    m.socket_min[f] = r.socket.min_gap_mm;
-    m.ball_pen[f] = r.ball.area_penetrating_mm2;
-    m.socket_pen[f] = r.socket.area_penetrating_mm2;
-  }
-  return m;
-}
-
+// Both scans at every pose: the motion table's columns (frames.csv's), one C++ loop without the GIL.
 py::dict motion(const PyJoint& j, const py::handle& angles_obj) {
   const std::vector<PoseAngles> poses = to_angles(angles_obj);
-  const auto k = static_cast<py::ssize_t>(poses.size());
-  MotionColumns m;
+  Table t;
+  t.columns = motion_columns(j.session->joint_options().levels);
+  t.rows.reserve(poses.size());
   {
     py::gil_scoped_release release;
-    m = run_motion(*j.hip, poses);
+    run_motion(*j.session, poses, {}, [&](const MotionFrame& f) { t.rows.push_back(motion_row(f)); });
   }
-  py::dict d;
-  d["ball_min_gap_mm"] = own(std::move(m.ball_min), {k});
-  d["socket_min_gap_mm"] = own(std::move(m.socket_min), {k});
-  d["ball_penetrating_area_mm2"] = own(std::move(m.ball_pen), {k});
-  d["socket_penetrating_area_mm2"] = own(std::move(m.socket_pen), {k});
+  py::dict d = table_columns(t);
+  d["socket_penetrating_area_mm2"] = d["penetrating_area_mm2"];
   return d;
 }
 
-}  // namespace
-
-PYBIND11_MODULE(impinge, m) {
-  m.doc() =
-      "impinge: impingement detection in ball-and-socket joints (the hip) by spherical radial distance maps.\n"
-      "Units: mm and degrees. Vertices: float (n, 3); faces: integer (m, 3), 0-based. Gaps: positive apart,\n"
-      "negative penetrating, NaN where a vertex was not tested.";
-  m.attr("__version__") = IMPINGE_VERSION;
-  static py::exception<Error> error(m, "Error", PyExc_ValueError);
-  py::register_exception_translator([](std::exception_ptr p) {
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const Error& e) {
-      error(e.what());
-    }
-  });
-
+void bind_functions(py::module_& m) {
   m.def(
       "load_mesh",
       [](const std::string& path) {
@@ -347,6 +432,9 @@ PYBIND11_MODULE(impinge, m) {
       "A generated hip (sphere head with neck, optional cam bump, cup with rim; scan frame RAS, mm) -> "
       "dict(ball=(V, F), socket=(V, F), cor, head_radius_mm). Use it with neutral='scan'.");
 
+}
+
+void bind_types(py::module_& m) {
   py::class_<SphereFitResult>(m, "SphereFit", "A fitted sphere: centre (mm), radius (mm), rms_residual (mm).")
       .def_property_readonly("centre", [](const SphereFitResult& s) { return s.centre; })
       .def_readonly("radius", &SphereFitResult::radius)
@@ -390,50 +478,72 @@ PYBIND11_MODULE(impinge, m) {
       .def_property_readonly("bytes", [](const MapView& v) { return v.map->bytes(); })
       .def_property_readonly("sparse", [](const MapView& v) { return v.map->sparse(); });
 
-  py::class_<PyJoint>(m, "Joint",
-                      "A hip: femur (ball) and pelvis (socket) in one frame (mm), both radial distance maps built "
-                      "once, then any number of poses.")
-      .def(py::init(&make_joint), py::arg("ball"), py::arg("socket"), py::arg("cor") = py::none(),
-           py::arg("side") = "right", py::arg("neutral") = "anatomical", py::arg("scheme") = "equiangular",
-           py::arg("resolution") = 0.0, py::arg("mode") = "exact", py::arg("sampling") = "auto",
-           py::arg("occlusion_tolerance_mm") = 1.0, py::arg("max_radius_mm") = 0.0,
-           py::arg("levels") = py::none(), py::arg("reseat") = false, py::arg("pelvis_frame") = "isb",
-           py::arg("femur_frame") = "epicondyles", py::arg("maps") = py::none(), py::arg("sparse") = 0.0,
-           py::arg("layers") = 0,
-           "ball, socket: (V (n, 3) float, F (m, 3) int) in one frame, mm (RAS-like: x right, y anterior, z "
-           "superior for neutral='scan'). cor: centre of rotation (3,), mm; None fits the femoral head. "
-           "neutral: 'anatomical' (ISB frames found on whole bones) or 'scan'. scheme/resolution: sampling "
-           "scheme and its resolution (0: the scheme's default, 0.5 deg equivalent). mode: 'exact' or 'linear'. "
-           "levels: impingement thresholds (mm, decreasing). maps: (ball_path, socket_path) saved by save_maps() "
-           "to load instead of sampling. sparse: store the maps sparse, keeping the tiles with a surface within this "
-           "many mm of the COR (inf: any surface, the same gaps bit for bit; 0: dense). layers: N > 0 also tests "
-           "the vertices hidden behind their own bone against the other bone's layered map of N crossings per node "
-           "(extra-articular impingement; their gaps appear with the others). Builds both maps (the GIL is released). Raises impinge.Error on bad "
-           "arrays, options or map files.")
-      .def(
-          "detect",
-          [](const PyJoint& j, const py::handle& R, const py::handle& t) {
-            const Eigen::Matrix3d Rw = to_rotation(R);
-            const Eigen::Vector3d tw = t.is_none() ? Eigen::Vector3d::Zero() : to_point(t, "t");
-            const auto [Rj, tj] = to_joint_frame(*j.hip, Rw, tw);
-            PoseResult r;
-            {
-              py::gil_scoped_release release;
-              j.hip->joint().detect(Rj, tj, r);
-            }
-            return result_dict(std::move(r));
-          },
-          py::arg("R") = py::none(), py::arg("t") = py::none(),
-          "Both scans with the femur rotated by R (3, 3; input frame) about the COR, then translated by t (3,) "
-          "mm -> dict(ball_gap_mm, socket_gap_mm: float32 (n,) in the input's vertex order, NaN where not "
-          "tested; ball_status, socket_status: uint8 (0 tested, 1 no surface, 2 beyond reach); summary).")
+}
+
+std::string joint_doc() {
+  std::string names;
+  for (const auto& [n, setter] : joint_options()) names += (names.empty() ? "" : ", ") + n;
+  return "Joint(ball=None, socket=None, **options): a hip set up as `impinge distance` sets it up (the session "
+         "layer): femur (ball) and pelvis (socket) from a subject.json, mesh files or (V, F) arrays, in their input "
+         "frame (frame='LPS' or 'RAS', mm); both maps built once (the GIL is released), then any number of poses. "
+         "Options, named as the CLI's with underscores (None or absent: the default): " + names +
+         ". cor: 'auto', or (x, y, z) mm in the input frame; head_region: (x, y, z, r) mm; landmarks: dict name -> "
+         "(x, y, z) mm; levels: thresholds in mm, decreasing; maps: (ball_path, socket_path) saved by save_maps(). "
+         "Positions, rotations and frames given or returned are in the input frame. Raises impinge.Error naming "
+         "the option, array or file on bad input; warnings (e.g. an overlap at the scan pose) as UserWarning.";
+}
+
+py::dict rom_limits(const PyJoint& j, double threshold_mm, double step_deg, double max_deg) {
+  RomRequest q;
+  q.search.threshold_mm = threshold_mm;
+  q.search.step_deg = step_deg;
+  q.search.max_deg = max_deg;
+  q.map = false;
+  RomRun run;
+  {
+    py::gil_scoped_release release;
+    run = run_rom(*j.session, q);
+  }
+  const Table t = rom_limits_table(*j.session, run);
+  py::dict d;
+  for (std::size_t k = 0; k < t.rows.size(); ++k) {
+    py::dict e;
+    for (std::size_t c = 1; c < t.columns.size(); ++c) {
+      const nlohmann::json& x = t.rows[k][c];
+      e[py::str(t.columns[c])] = x.is_null() ? py::object(py::float_(std::nan(""))) : from_json(x);
+    }
+    e["contact_mm"] = Eigen::Vector3d(j.session->to_input(run.limits[k].contact_mm));
+    d[py::str(run.motions[k].name)] = e;
+  }
+  d["excluded_vertices"] = run.baseline.excluded_vertices;
+  return d;
+}
+
+void add_joint_queries(py::class_<PyJoint>& c) {
+  c.def(
+       "detect",
+       [](const PyJoint& j, const py::handle& R, const py::handle& t) {
+         const Eigen::Matrix3d Rin = to_rotation(R);
+         const Eigen::Vector3d tin = t.is_none() ? Eigen::Vector3d::Zero() : to_point(t, "t");
+         const auto [Rj, tj] = j.session->joint_motion(Rin, tin);
+         PoseResult r;
+         {
+           py::gil_scoped_release release;
+           j.session->joint().detect(Rj, tj, r);
+         }
+         return result_dict(std::move(r));
+       },
+       py::arg("R") = py::none(), py::arg("t") = py::none(),
+       "Both scans with the femur rotated by R (3, 3; input frame) about the COR, then translated by t (3,) "
+       "mm -> dict(ball_gap_mm, socket_gap_mm: float32 (n,) in the input's vertex order, NaN where not "
+       "tested; ball_status, socket_status: uint8 (0 tested, 1 no surface, 2 beyond reach); summary).")
       .def(
           "detect_pose",
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
             PoseResult r;
             {
               py::gil_scoped_release release;
-              j.hip->detect(PoseAngles{flexion, adduction, internal_rotation}, r);
+              j.hip().detect(PoseAngles{flexion, adduction, internal_rotation}, r);
             }
             return result_dict(std::move(r));
           },
@@ -441,52 +551,17 @@ PYBIND11_MODULE(impinge, m) {
           "Both scans at clinical angles (degrees, ISB joint coordinate system: flexion, adduction and internal "
           "rotation positive; zero per `neutral`) -> the same dict as detect().")
       .def("motion", &motion, py::arg("angles"),
-           "Both scans at every row of angles (k, 3): flexion, adduction, internal rotation in degrees -> "
-           "dict of float64 (k,) arrays: ball_min_gap_mm, socket_min_gap_mm, ball_penetrating_area_mm2, "
-           "socket_penetrating_area_mm2. One call; the GIL is released.")
-      .def(
-          "save_maps", [](const PyJoint& j, const std::string& ball, const std::string& socket) {
-            j.hip->save_maps(ball, socket);
-          },
-          py::arg("ball_path"), py::arg("socket_path"),
-          "Save both maps (impinge map files with scheme, resolution, COR and checksum) for Joint(..., maps=...).")
-      .def(
-          "rom_limits",
-          [](const PyJoint& j, double threshold_mm, double step_deg, double max_deg) {
-            RomOptions o;
-            o.threshold_mm = threshold_mm;
-            o.step_deg = step_deg;
-            o.max_deg = max_deg;
-            const std::vector<StandardMotion> motions = standard_motions();
-            std::vector<RomLimit> limits;
-            RomBaseline base;
-            {
-              py::gil_scoped_release release;
-              base = rom_baseline(*j.hip, j.hip->femur_rotation({}), o);
-              limits = find_rom_limits(*j.hip, motions, o, base);
-            }
-            py::dict d;
-            for (std::size_t k = 0; k < motions.size(); ++k) {
-              const RomLimit& l = limits[k];
-              py::dict e;
-              e["limit_deg"] = l.limit_deg;
-              e["limited_by"] = to_string(l.limited_by);
-              e["socket_clock_h"] = l.socket_clock_h;
-              e["femur_clock_h"] = l.femur_clock_h;
-              e["min_gap_at_limit_mm"] = l.min_gap_at_limit_mm;
-              e["contact_mm"] = l.contact_mm;
-              e["monotone"] = l.monotone;
-              e["contact_at_start"] = l.contact_at_start;
-              d[py::str(motions[k].name)] = e;
-            }
-            d["excluded_vertices"] = base.excluded_vertices;
-            return d;
-          },
-          py::arg("threshold_mm") = 0.0, py::arg("step_deg") = 2.0, py::arg("max_deg") = 150.0,
-          "ROM limits from neutral for the standard motions (flexion, extension, abduction, adduction, internal and "
-          "external rotation, both rotations at 90 deg flexion, FADIR) -> dict motion -> dict(limit_deg (NaN: none "
-          "within max_deg), limited_by, socket_clock_h, femur_clock_h, min_gap_at_limit_mm, contact_mm (input "
-          "frame), monotone, contact_at_start); and excluded_vertices (in contact at neutral, not counted).")
+           "Both scans at every row of angles (k, 3): flexion, adduction, internal rotation in degrees -> dict of "
+           "(k,) arrays, the columns of the CLI's frames.csv (ball_min_gap_mm, socket_min_gap_mm, "
+           "penetrating_area_mm2 = socket_penetrating_area_mm2, ball_penetrating_area_mm2, socket_levelN_area_mm2, "
+           "closest clock hours and point, detection_ms). One C++ loop; the GIL is released.")
+      .def("rom_limits", &rom_limits, py::arg("threshold_mm") = 0.0, py::arg("step_deg") = 2.0,
+           py::arg("max_deg") = 150.0,
+           "ROM limits from neutral for the standard motions (flexion, extension, abduction, adduction, internal and "
+           "external rotation, both rotations at 90 deg flexion, FADIR) -> dict motion -> the CLI's rom_limits.csv "
+           "row (limit_deg (NaN: none within max_deg), limited_by, socket_clock_h, femur_clock_h, "
+           "min_gap_at_limit_mm, monotone, contact_at_start, evaluations) and contact_mm (input frame); and "
+           "excluded_vertices (in contact at neutral, not counted).")
       .def(
           "rom_map",
           [](const PyJoint& j, const std::vector<double>& flexion, const std::vector<double>& adduction,
@@ -496,8 +571,8 @@ PYBIND11_MODULE(impinge, m) {
             std::vector<RomMapCell> cells;
             {
               py::gil_scoped_release release;
-              const RomBaseline base = rom_baseline(*j.hip, j.hip->femur_rotation({}), o);
-              cells = rom_map(*j.hip, flexion, adduction, o, base);
+              const RomBaseline base = rom_baseline(j.hip(), j.hip().femur_rotation({}), o);
+              cells = rom_map(j.hip(), flexion, adduction, o, base);
             }
             std::vector<double> ir(cells.size());
             for (std::size_t k = 0; k < cells.size(); ++k) ir[k] = cells[k].max_internal_rotation_deg;
@@ -510,64 +585,113 @@ PYBIND11_MODULE(impinge, m) {
       .def(
           "femur_rotation",
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
-            const HipJoint& h = *j.hip;
-            const Eigen::Matrix3d A = h.joint_to_working();
-            return Eigen::Matrix3d(A * h.femur_rotation({flexion, adduction, internal_rotation}) * A.transpose());
+            return j.session->input_rotation(j.hip().femur_rotation({flexion, adduction, internal_rotation}));
           },
           py::arg("flexion") = 0.0, py::arg("adduction") = 0.0, py::arg("internal_rotation") = 0.0,
           "Rotation (3, 3; input frame) of the femur about the COR at the clinical angles.")
-      .def_property_readonly("cor", [](const PyJoint& j) { return j.hip->cor(); },
-                             "Centre of rotation (3,), mm, input frame.")
-      .def_property_readonly("ball_map", [](const PyJoint& j) { return MapView{j.hip, &j.hip->joint().ball().map}; })
-      .def_property_readonly("socket_map",
-                             [](const PyJoint& j) { return MapView{j.hip, &j.hip->joint().socket().map}; })
-      .def_property_readonly(
-          "frames",
-          [](const PyJoint& j) -> py::object {
-            if (!j.hip->frames()) return py::none();
-            const HipFrames& f = *j.hip->frames();
-            py::dict d;
-            for (const auto& [name, frame] : {std::pair{"pelvis", &f.pelvis}, std::pair{"femur", &f.femur}}) {
-              py::dict fr;
-              fr["origin"] = frame->origin;
-              fr["axes"] = frame->axes;
-              py::dict lm;
-              for (const auto& [k, p] : frame->landmarks) lm[py::str(k)] = p;
-              fr["landmarks"] = lm;
-              d[name] = fr;
-            }
-            d["scan_pose"] = std::vector<double>{f.scan_pose.flexion_deg, f.scan_pose.adduction_deg,
-                                                 f.scan_pose.internal_rotation_deg};
-            return d;
-          },
-          "Anatomical frames (anatomical neutral; None with scan neutral): origin (3,), axes (3, 3; columns X "
-          "anterior, Y superior, Z right), landmarks; scan_pose in degrees.")
       .def(
-          "_bench_detect_ns",
-          [](const PyJoint& j, const py::handle& R, int repetitions) {
-            // Median ns of Joint::detect (C++ loop, reused buffers): the reference for the binding's overhead.
-            const auto [Rj, tj] = to_joint_frame(*j.hip, to_rotation(R), Eigen::Vector3d::Zero());
-            std::vector<double> ns;
-            PoseResult r;
-            py::gil_scoped_release release;
-            for (int k = 0; k < repetitions; ++k) {
-              const auto t0 = std::chrono::steady_clock::now();
-              j.hip->joint().detect(Rj, tj, r);
-              ns.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count());
-            }
-            std::nth_element(ns.begin(), ns.begin() + static_cast<std::ptrdiff_t>(ns.size() / 2), ns.end());
-            return ns[ns.size() / 2];
+          "save_maps", [](const PyJoint& j, const std::string& ball, const std::string& socket) {
+            j.hip().save_maps(ball, socket);
           },
-          py::arg("R") = py::none(), py::arg("repetitions") = 50)
+          py::arg("ball_path"), py::arg("socket_path"),
+          "Save both maps (impinge map files with scheme, resolution, COR and checksum) for Joint(..., maps=...).");
+}
+
+py::object frames_dict(const PyJoint& j) {
+  if (!j.hip().frames()) return py::none();
+  const HipFrames& f = *j.hip().frames();
+  const Session& s = *j.session;
+  py::dict d;
+  for (const auto& [name, frame] : {std::pair{"pelvis", &f.pelvis}, std::pair{"femur", &f.femur}}) {
+    py::dict fr;
+    fr["origin"] = Eigen::Vector3d(s.to_input(frame->origin));
+    fr["axes"] = Eigen::Matrix3d(s.to_input() * frame->axes);
+    py::dict lm;
+    for (const auto& [k, p] : frame->landmarks) lm[py::str(k)] = Eigen::Vector3d(s.to_input(p));
+    fr["landmarks"] = lm;
+    d[name] = fr;
+  }
+  d["scan_pose"] = std::vector<double>{f.scan_pose.flexion_deg, f.scan_pose.adduction_deg,
+                                       f.scan_pose.internal_rotation_deg};
+  return d;
+}
+
+void add_joint_properties(py::class_<PyJoint>& c) {
+  c.def_property_readonly("cor", [](const PyJoint& j) { return j.session->cor_input(); },
+                          "Centre of rotation (3,), mm, input frame.")
+      .def_property_readonly("ball_map",
+                             [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().ball().map}; })
+      .def_property_readonly(
+          "socket_map", [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().socket().map}; })
+      .def_property_readonly("frames", &frames_dict,
+                             "Anatomical frames (anatomical neutral; None with scan neutral), input frame: origin (3,), "
+                             "axes (3, 3; columns X anterior, Y superior, Z right), landmarks; scan_pose in degrees.")
+      .def_property_readonly(
+          "setup", [](const PyJoint& j) { return from_json(setup_record(*j.session)); },
+          "The set-up as the CLI's summary.json reports it (inputs, input frame, COR and its method, scheme, maps, "
+          "frames and acetabulum in the input frame, warnings) -> dict.")
+      .def_property_readonly("warnings", [](const PyJoint& j) { return j.session->warnings(); },
+                             "Warnings about the input, one line each (also raised as UserWarning).");
+}
+
+void add_joint_benchmarks(py::class_<PyJoint>& c) {
+  c.def(
+       "_bench_detect_ns",
+       [](const PyJoint& j, const py::handle& R, int repetitions) {
+         // Median ns of Joint::detect (C++ loop, reused buffers): the reference for the binding's overhead.
+         const auto [Rj, tj] = j.session->joint_motion(to_rotation(R), Eigen::Vector3d::Zero());
+         std::vector<double> ns;
+         PoseResult r;
+         py::gil_scoped_release release;
+         for (int k = 0; k < repetitions; ++k) {
+           const auto t0 = std::chrono::steady_clock::now();
+           j.hip().joint().detect(Rj, tj, r);
+           ns.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count());
+         }
+         std::nth_element(ns.begin(), ns.begin() + static_cast<std::ptrdiff_t>(ns.size() / 2), ns.end());
+         return ns[ns.size() / 2];
+       },
+       py::arg("R") = py::none(), py::arg("repetitions") = 50)
       .def(
           "_bench_motion_ns",
           [](const PyJoint& j, const py::handle& angles) {
             // ns of the C++ loop motion() runs, timed inside C++: the reference for motion()'s overhead.
             const std::vector<PoseAngles> poses = to_angles(angles);
+            std::vector<nlohmann::json> rows;
+            rows.reserve(poses.size());
             py::gil_scoped_release release;
             const auto t0 = std::chrono::steady_clock::now();
-            const MotionColumns m = run_motion(*j.hip, poses);
+            run_motion(*j.session, poses, {}, [&](const MotionFrame& f) { rows.push_back(motion_row(f)); });
             return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
           },
           py::arg("angles"));
+}
+
+void bind_joint(py::module_& m) {
+  py::class_<PyJoint> c(m, "Joint", "A hip set up as the CLI sets it up (the session layer); see __init__.");
+  static const std::string doc = joint_doc();  // pybind11 keeps the pointer
+  c.def(py::init(&make_joint), py::arg("ball") = py::none(), py::arg("socket") = py::none(), doc.c_str());
+  add_joint_queries(c);
+  add_joint_properties(c);
+  add_joint_benchmarks(c);
+}
+
+}  // namespace
+PYBIND11_MODULE(impinge, m) {
+  m.doc() =
+      "impinge: impingement detection in ball-and-socket joints (the hip) by spherical radial distance maps.\n"
+      "Units: mm and degrees. Vertices: float (n, 3); faces: integer (m, 3), 0-based. Gaps: positive apart,\n"
+      "negative penetrating, NaN where a vertex was not tested.";
+  m.attr("__version__") = IMPINGE_VERSION;
+  static py::exception<Error> error(m, "Error", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const Error& e) {
+      error(e.what());
+    }
+  });
+  bind_functions(m);
+  bind_types(m);
+  bind_joint(m);
 }

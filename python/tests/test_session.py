@@ -1,0 +1,164 @@
+"""Python's Joint against the CLI through the one set-up they share (the session layer).
+
+Invariants: Joint takes every option `impinge distance` takes, at run time and in the stub file;
+a subject given in LPS gives the CLI's gaps bit for bit, whether Python reads subject.json or gets
+the LPS arrays with frame='LPS'; results given in the input frame (COR, frames, rotations) are the
+CLI's; bad options raise impinge.Error naming the option."""
+import ast
+import json
+import os
+import re
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+import impinge
+from test_impinge import CLI, DATA, read_gaps
+
+STUB = os.path.join(os.path.dirname(__file__), "..", "impinge.pyi")
+# CLI options of `impinge distance` that are not Joint options: where to write and what to do at one pose.
+NOT_JOINT_OPTIONS = {"help", "out", "pose", "render"}
+
+
+def cli_options(command):
+    """The long options of `impinge COMMAND --help`, as Python names (dashes to underscores)."""
+    text = subprocess.run([CLI, command, "--help"], check=True, capture_output=True, text=True).stdout
+    return sorted({m.replace("-", "_") for m in re.findall(r"^\s+(?:-\w, )?--([a-z][a-z-]*)", text, re.M)}
+                  - NOT_JOINT_OPTIONS)
+
+
+def stub_joint_parameters():
+    tree = ast.parse(open(STUB).read())
+    joint = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Joint")
+    init = next(n for n in joint.body if isinstance(n, ast.FunctionDef) and n.name == "__init__")
+    a = init.args
+    return {x.arg for x in a.args + a.kwonlyargs} - {"self"}
+
+
+def runtime_joint_options():
+    """The options the module's Joint accepts, from its docstring's list (the C++ option table)."""
+    doc = impinge.Joint.__init__.__doc__
+    listed = re.search(r"Options, named as the CLI's with underscores \(None or absent: the default\): ([a-z_, ]+)\.",
+                       doc)
+    assert listed, doc
+    return {x.strip() for x in listed.group(1).split(",")}
+
+
+def python_name(option, names):
+    """The Joint keyword for a CLI option: the same name, or with _mm for a length."""
+    for n in (option, option + "_mm"):
+        if n in names:
+            return n
+    return None
+
+
+def test_joint_and_its_stub_take_every_distance_option():
+    options = cli_options("distance")
+    assert len(options) > 25, options  # the parse found the options
+    stub, runtime = stub_joint_parameters(), runtime_joint_options()
+    missing_stub = [o for o in options if python_name(o, stub) is None]
+    missing_runtime = [o for o in options if python_name(o, runtime) is None]
+    assert not missing_stub, f"impinge.pyi's Joint lacks {missing_stub}"
+    assert not missing_runtime, f"Joint lacks {missing_runtime}"
+    # The stub lists what the module takes, no more, no less.
+    assert stub == runtime, (stub - runtime, runtime - stub)
+
+
+def test_an_unknown_or_bad_option_names_itself():
+    with pytest.raises(impinge.Error, match="unknown option 'layer'.*layers"):
+        impinge.Joint(subject="x.json", layer=2)
+    with pytest.raises(impinge.Error, match="head_region: expected 4 numbers"):
+        impinge.Joint(subject="x.json", head_region=[1, 2, 3])
+    with pytest.raises(impinge.Error, match="maps_only: expected True or False"):
+        impinge.Joint(subject="x.json", maps_only="yes")
+
+
+def lps_subject(folder):
+    """A subject of the shared data given in LPS, or a generated hip converted to LPS."""
+    src = os.path.join(DATA, "lhdl-ct", "subject.json")
+    if os.path.exists(src):
+        with open(src) as f:
+            assert json.load(f)["frame"] == "LPS"
+        return src, {}
+    subprocess.run([CLI, "generate", "--triangles", "3000", "--cam", "2", "--out", folder + "/g"], check=True,
+                   capture_output=True)
+    lps = np.diag([-1.0, -1.0, 1.0])
+    for name in ("femur_r", "pelvis"):
+        V, F = impinge.load_mesh(f"{folder}/g/{name}.ply")
+        write_ply(f"{folder}/g/{name}_lps.ply", V @ lps, F)
+    with open(folder + "/g/subject.json") as f:
+        s = json.load(f)
+    cor = (np.array(s["true_cor_mm"]) @ lps).tolist()
+    s.update(frame="LPS", femur="femur_r_lps.ply", pelvis="pelvis_lps.ply")
+    with open(folder + "/g/lps.json", "w") as f:
+        json.dump(s, f)
+    return folder + "/g/lps.json", {"cor": cor}
+
+
+def write_ply(path, V, F):
+    with open(path, "w") as f:
+        f.write(f"ply\nformat ascii 1.0\nelement vertex {len(V)}\nproperty double x\nproperty double y\n"
+                f"property double z\nelement face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n")
+        for v in V:
+            f.write(f"{v[0]!r} {v[1]!r} {v[2]!r}\n")
+        for t in F:
+            f.write(f"3 {t[0]} {t[1]} {t[2]}\n")
+
+
+def test_a_subject_in_lps_gives_the_cli_gaps():
+    d = tempfile.mkdtemp(prefix="impinge_session_")
+    subject, extra = lps_subject(d)
+    cli_extra = [f"--cor={','.join(map(repr, extra['cor']))}"] if "cor" in extra else []
+    subprocess.run([CLI, "distance", "--subject", subject, "--precision", "1", "--pose=30,5,10", "--out", d + "/cli"]
+                   + cli_extra, check=True, capture_output=True)
+    cli_ball, cli_socket = read_gaps(d + "/cli/ball_gaps.ply"), read_gaps(d + "/cli/socket_gaps.ply")
+    with open(d + "/cli/summary.json") as f:
+        summary = json.load(f)
+    assert summary["input_frame"] == "LPS"
+
+    # Python reading the same subject.json.
+    j = impinge.Joint(subject=subject, precision=1, **extra)
+    r = j.detect_pose(30, 5, 10)
+    np.testing.assert_array_equal(r["ball_gap_mm"], cli_ball)
+    np.testing.assert_array_equal(r["socket_gap_mm"], cli_socket)
+    np.testing.assert_allclose(j.cor, summary["cor_mm"], rtol=0, atol=1e-9)
+    assert j.setup["input_frame"] == "LPS" and j.setup["cor_mm"] == pytest.approx(summary["cor_mm"], abs=1e-9)
+
+    # Python given the LPS arrays and frame='LPS': the same joint, the same gaps.
+    with open(subject) as f:
+        s = json.load(f)
+    base = os.path.dirname(subject)
+    ball, socket = (impinge.load_mesh(os.path.join(base, s[k])) for k in ("femur", "pelvis"))
+    j2 = impinge.Joint(ball, socket, frame="LPS", side=s["side"], neutral=s.get("neutral"), precision=1, **extra)
+    np.testing.assert_array_equal(j2.detect_pose(30, 5, 10)["ball_gap_mm"], cli_ball)
+    np.testing.assert_array_equal(j2.detect_pose(30, 5, 10)["socket_gap_mm"], cli_socket)
+
+    # Rotations are in the input frame: the pose's rotation about the COR, applied to the LPS
+    # vertices, gives the same gaps, and moves the femur as the CLI's posed PLY shows it.
+    R = j.femur_rotation(30, 5, 10)
+    np.testing.assert_array_equal(j.detect(R)["ball_gap_mm"], cli_ball)
+    posed = (ball[0] - j.cor) @ R.T + j.cor
+    with open(d + "/cli/ball_gaps.ply", "rb") as f:
+        while f.readline().strip() != b"end_header":
+            pass
+        xyz = np.frombuffer(f.read(len(ball[0]) * 24), dtype=np.dtype([("f", "<f4", 5), ("b", "u1", 4)]))["f"][:, :3]
+    np.testing.assert_allclose(posed, xyz, atol=1e-3)
+
+    # Frames, when anatomical, are the CLI's (input frame).
+    if summary.get("frames"):
+        np.testing.assert_allclose(j.frames["pelvis"]["origin"], summary["frames"]["pelvis"]["origin_mm"], atol=1e-9)
+        np.testing.assert_allclose(j.frames["pelvis"]["axes"][:, 0], summary["frames"]["pelvis"]["x_axis"], atol=1e-12)
+
+
+def test_side_or_frame_contradicting_the_subject_is_an_error():
+    d = tempfile.mkdtemp(prefix="impinge_session_")
+    subprocess.run([CLI, "generate", "--triangles", "1000", "--out", d + "/g"], check=True, capture_output=True)
+    with pytest.raises(impinge.Error, match="side 'left' contradicts"):
+        impinge.Joint(subject=d + "/g/subject.json", side="left")
+    with pytest.raises(impinge.Error, match="frame 'LPS' contradicts"):
+        impinge.Joint(subject=d + "/g/subject.json", frame="LPS")
+    out = subprocess.run([CLI, "distance", "--subject", d + "/g/subject.json", "--frame", "LPS", "--out", d + "/o"],
+                         capture_output=True, text=True)
+    assert out.returncode == 2 and "frame 'LPS' contradicts" in out.stderr
