@@ -26,6 +26,7 @@
 #include "impinge/sampling/naive_sampling.hpp"
 #include "impinge/sampling/rasterize.hpp"
 #include "impinge/sampling/sampling.hpp"
+#include "impinge/session/session.hpp"
 
 using namespace impinge;
 
@@ -49,13 +50,14 @@ const Scene& scene() {
     const char* env = std::getenv("IMPINGE_BENCH_SUBJECT");
     const std::string dir = env ? env : std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct";
     if (std::filesystem::exists(dir + "/subject.json")) {
-      const SubjectInfo info = load_subject(dir + "/subject.json");
-      sc->name = info.name;
-      sc->femur = load_mesh(info.femur_path);
-      sc->pelvis = load_mesh(info.pelvis_path);
-      transform_vertices(sc->femur.V, to_anatomical(info.frame));
-      transform_vertices(sc->pelvis.V, to_anatomical(info.frame));
-      sc->cor = fit_femoral_head(sc->femur).centre;
+      // Read and centred as every front end does it (the session layer).
+      SessionInput in;
+      in.subject = dir + "/subject.json";
+      LoadedInput li = load_input(in);
+      sc->name = li.name;
+      sc->cor = find_centre_of_rotation(li, {}).head.centre;
+      sc->femur = std::move(li.femur);
+      sc->pelvis = std::move(li.pelvis);
     } else {
       HipModelOptions o;
       o.target_triangles = 12000;

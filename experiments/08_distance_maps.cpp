@@ -232,13 +232,12 @@ int main(int argc, char** argv) {
       {"neutral", {0, 0, 0}}, {"flexion90", {90, 0, 0}}, {"adduction30", {0, 30, 0}}, {"internal30", {0, 0, 30}}};
   bool wrote_poses = false;
   for (const Subject& s : subjects) {
-    HipJointOptions ho;
-    ho.joint.scheme = make_scheme("equiangular", render_precision);
-    ho.joint.mode = DistanceMode::exact;
-    ho.neutral = s.generated ? Neutral::scan : Neutral::anatomical;
-    SphereFitResult head = s.generated ? SphereFitResult{} : locate_femoral_head(s.femur);
-    if (s.generated) head.centre = s.true_cor, head.radius = std::nan("");
-    const HipJoint hip(s.femur, s.pelvis, s.side, head, {}, ho);
+    MapSettings maps;
+    maps.precision = render_precision;
+    maps.mode = "exact";
+    const Session session(session_options(s, maps));  // as the CLI sets a subject up
+    const HipJoint& hip = session.hip();
+    const HipJointOptions& ho = session.hip_options();
     const PoseResult res = hip.joint().detect(Eigen::Matrix3d::Identity());
     // Joint frame -> pelvic frame: p_pelvic = S^T p_joint (S = scan_axes()).
     const Eigen::Matrix3d to_pelvic = scan_axes().transpose();
@@ -260,13 +259,12 @@ int main(int argc, char** argv) {
     if (hip.socket_clock()) {
       const ClockFace c = hip.socket_clock()->transformed(to_pelvic, Eigen::Vector3d::Zero());
       const Acetabulum& A = *hip.acetabulum();
-      const Eigen::Vector3d n = hip.frames()->pelvis.axes.transpose() * A.opening;
-      const double m = s.side == Side::right ? 1.0 : -1.0;
+      const AcetabularOrientation orientation = radiographic_orientation(A, hip.frames()->pelvis, s.side);
       const PoseAngles& sp = hip.frames()->scan_pose;
       clocks.row(s.name, s.side == Side::right ? "right" : "left", "anatomical", c.centre.x(), c.centre.y(),
                  c.centre.z(), c.twelve.x(), c.twelve.y(), c.twelve.z(), c.three.x(), c.three.y(), c.three.z(),
-                 A.rim_radius_mm, A.rim_plane_rms_mm, std::atan2(m * n.z(), -n.y()) * kRadToDeg,
-                 std::asin(std::clamp(n.x(), -1.0, 1.0)) * kRadToDeg, hip.head_radius_mm(), A.sphere.radius,
+                 A.rim_radius_mm, A.rim_plane_rms_mm, orientation.inclination_deg,
+                 orientation.anteversion_deg, hip.head_radius_mm(), A.sphere.radius,
                  sp.flexion_deg, sp.adduction_deg, sp.internal_rotation_deg);
     } else {
       const double nan = std::nan("");

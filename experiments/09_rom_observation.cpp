@@ -47,6 +47,7 @@
 #include "impinge/core/timing.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/maps/layered_map.hpp"
+#include "impinge/session/runs.hpp"
 
 using namespace impinge;
 using namespace impinge::experiment;
@@ -171,10 +172,9 @@ int main(int argc, char** argv) {
                 {"subject", "patient", "motion", "angle_deg", "flexion_deg", "adduction_deg", "internal_rotation_deg",
                  "ball_min_gap_mm", "socket_min_gap_mm", "socket_closest_clock_h", "socket_area_over6_mm2",
                  "socket_area_4to6_mm2", "socket_area_2to4_mm2", "socket_area_0to2_mm2", "socket_area_penetrating_mm2"});
-  CsvWriter lim(dir + "/rom_limits.csv",
-                {"subject", "motion", "limit_deg", "limited_by", "socket_clock_h", "femur_clock_h", "min_gap_at_limit_mm",
-                 "monotone", "contact_at_start", "exact_gap_before_mm", "exact_gap_after_mm", "validated"});
-  CsvWriter map(dir + "/rom_map.csv", {"subject", "flexion_deg", "adduction_deg", "max_internal_rotation_deg", "status"});
+  // rom_limits.csv and rom_map.csv: the CLI's tables (session layer) with the subject first; the limits
+  // also with their exact check.
+  Table lim, map;
   CsvWriter clocks(dir + "/clock_faces.csv", {"subject", "side", "centre_x_mm", "centre_y_mm", "centre_z_mm", "twelve_x",
                                               "twelve_y", "twelve_z", "three_x", "three_y", "three_z", "rim_radius_mm"});
   CsvWriter extra(dir + "/extra_articular.csv",
@@ -200,13 +200,13 @@ int main(int argc, char** argv) {
   bool wrote_renders = false;
   for (const Subject& s : subjects) {
     progress("09_rom_observation", ++done, total, s.name);
-    HipJointOptions ho;
-    ho.joint.scheme = make_scheme("equiangular", resolution);
-    ho.joint.levels = observation_levels;
-    ho.neutral = s.generated ? Neutral::scan : Neutral::anatomical;
-    SphereFitResult head = s.generated ? SphereFitResult{} : locate_femoral_head(s.femur);
-    if (s.generated) head.centre = s.true_cor, head.radius = std::nan("");
-    const HipJoint hip(s.femur, s.pelvis, s.side, head, {}, ho);
+    MapSettings maps;
+    maps.precision = resolution;
+    maps.levels = observation_levels.thresholds_mm;
+    const SessionOptions so = session_options(s, maps);
+    const Session session(so);
+    const HipJoint& hip = session.hip();
+    const SphereFitResult head = session.head();
     const Joint& joint = hip.joint();
 
     // Table 11's extremities (real subjects: clinical angles from anatomical neutral).
@@ -235,26 +235,28 @@ int main(int argc, char** argv) {
 
     // ROM limits and map, timed (the search after the maps exist; sampling reported beside). The
     // baseline (a full scan at neutral) and the search bounds it builds count with the limits.
-    auto t0 = Clock::now();
-    const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), ro);
-    const std::vector<StandardMotion> motions = standard_motions();
-    const std::vector<RomLimit> limits = find_rom_limits(hip, motions, ro, base);
-    const double limits_ms = ms_since(t0);
-    std::vector<double> flex, add;
-    for (int f = 0; f <= 120; f += 5) flex.push_back(f);
-    for (int a = -20; a <= 40; a += 5) add.push_back(a);
-    t0 = Clock::now();
-    const std::vector<RomMapCell> cells = rom_map(hip, flex, add, ro, base);
-    const double map_ms = ms_since(t0);
-    std::int64_t evaluations = 0, looked = 0, skipped = 0;
-    for (const RomLimit& l : limits) evaluations += l.evaluations, looked += l.vertices_looked_up, skipped += l.vertices_skipped;
-    for (const RomMapCell& c : cells) {
-      map.row(s.name, c.flexion_deg, c.adduction_deg, c.max_internal_rotation_deg, to_string(c.status));
-      looked += c.vertices_looked_up, skipped += c.vertices_skipped;
+    RomRequest rq;
+    rq.search = ro;
+    const RomRun run = run_rom(session, rq);  // as `impinge rom` runs it: limits, then the map
+    const RomBaseline& base = run.baseline;
+    const std::vector<StandardMotion>& motions = run.motions;
+    const std::vector<RomLimit>& limits = run.limits;
+    const double limits_ms = run.limits_ms, map_ms = run.map_ms;
+    const std::int64_t looked = run.vertices_looked_up, skipped = run.vertices_skipped;
+    const std::int64_t all_evals = run.limit_evaluations + run.map_evaluations;
+    const Table limits_table = rom_limits_table(session, run), map_table = rom_map_table(run);
+    if (map.columns.empty()) {
+      map.columns = {"subject"};
+      map.columns.insert(map.columns.end(), map_table.columns.begin(), map_table.columns.end());
+      lim.columns = {"subject"};
+      lim.columns.insert(lim.columns.end(), limits_table.columns.begin(), limits_table.columns.end());
+      for (const char* c : {"exact_gap_before_mm", "exact_gap_after_mm", "validated"}) lim.columns.emplace_back(c);
     }
-    std::int64_t map_evals = 0;
-    for (const RomMapCell& c : cells) map_evals += c.evaluations;
-    const std::int64_t all_evals = evaluations + map_evals;
+    for (const nlohmann::json& r : map_table.rows) {
+      nlohmann::json row = {s.name};
+      row.insert(row.end(), r.begin(), r.end());
+      map.add(row);
+    }
 
     // Exact check 0.5 deg either side of each limit (CGAL ray casts).
     const ExactReference ex_pelvis(joint.socket().mesh), ex_femur(joint.ball().mesh);
@@ -268,17 +270,21 @@ int main(int argc, char** argv) {
         after = exact_least_gap(joint, ex_pelvis, ex_femur, base, hip.femur_rotation(motions[k].angles(l.limit_deg + 0.5)));
         validated = before > ro.threshold_mm && after <= ro.threshold_mm ? "yes" : "no";
       }
-      lim.row(s.name, motions[k].name, l.limit_deg, to_string(l.limited_by), l.socket_clock_h, l.femur_clock_h,
-              l.min_gap_at_limit_mm, l.monotone ? 1 : 0, l.contact_at_start ? 1 : 0, before, after, validated);
+      nlohmann::json row = {s.name};
+      row.insert(row.end(), limits_table.rows[k].begin(), limits_table.rows[k].end());
+      for (const nlohmann::json& x : {number_or_null(before), number_or_null(after), nlohmann::json(validated)})
+        row.push_back(x);
+      lim.add(row);
     }
 
     // Extra-articular impingement (issue 14): layered maps of 4 crossings per node; the standard motions
     // and two with external rotation, counting every vertex (the limit) and the hidden ones only (the
     // first extra-articular contact), each checked exactly 0.5 deg either side.
     {
-      HipJointOptions lo = ho;
-      lo.joint.layers = 4;
-      const HipJoint lhip(s.femur, s.pelvis, s.side, head, {}, lo);
+      SessionOptions lo = so;
+      lo.maps.layers = 4;
+      const Session lsession(lo);
+      const HipJoint& lhip = lsession.hip();
       const Joint& lj = lhip.joint();
       const RomBaseline lbase = rom_baseline(lhip, lhip.femur_rotation({}), ro);
       const std::vector<StandardMotion> xm = extra_articular_motions();
@@ -311,7 +317,7 @@ int main(int argc, char** argv) {
         }
       }
       for (const JointBody* b : {&lj.ball(), &lj.socket()})
-        layered.row(s.name, b == &lj.ball() ? "femur" : "pelvis", lo.joint.layers, b->layered->num_nodes(),
+        layered.row(s.name, b == &lj.ball() ? "femur" : "pelvis", lo.maps.layers, b->layered->num_nodes(),
                     b->layered->bytes(), b->map.bytes(), b->layered_sampling.sampling_ms, b->sampling_ms,
                     b->layered_sampling.nodes_covered, b->layered_sampling.nodes_truncated,
                     b->layered_sampling.nodes_not_alternating, b->layered_sampling.max_crossings, b->hidden_set.size(),
@@ -368,9 +374,12 @@ int main(int argc, char** argv) {
 
     // Sensitivity: the COR moved 1 mm along each pelvic axis; other resolutions.
     auto limits_of = [&](const SphereFitResult& h, double res) {
-      HipJointOptions o2 = ho;
-      o2.joint.scheme = make_scheme("equiangular", res);
-      const HipJoint hj(s.femur, s.pelvis, s.side, h, {}, o2);
+      SessionOptions o2 = so;
+      o2.maps.precision = res;
+      o2.cor.given = h.centre;  // a perturbed centre: research, not checked against the head
+      o2.cor.allow_any = true;
+      const Session hs(o2);
+      const HipJoint& hj = hs.hip();
       return find_rom_limits(hj, motions, ro, rom_baseline(hj, hj.femur_rotation({}), ro));
     };
     auto record = [&](const std::string& variant, const std::vector<RomLimit>& v) {
@@ -388,6 +397,8 @@ int main(int argc, char** argv) {
     for (double res : sens_resolutions)
       if (res != resolution) record("resolution_" + std::to_string(res).substr(0, 4), limits_of(head, res));
   }
+  write_csv(dir + "/rom_limits.csv", lim);
+  write_csv(dir + "/rom_map.csv", map);
   nlohmann::json subj = nlohmann::json::array();
   for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
   write_meta(dir, args,

@@ -88,17 +88,17 @@ int main(int argc, char** argv) {
   int done = 0;
   const int total = static_cast<int>(subjects.size() * schemes.size());
   for (const Subject& s : subjects) {
-    SphereFitResult head = s.generated ? SphereFitResult{} : locate_femoral_head(s.femur);
-    if (s.generated) head.centre = s.true_cor, head.radius = std::nan("");
     for (const auto& [name, res] : schemes) {
       progress("11_extreme_cases", ++done, total, s.name + " " + name);
-      std::optional<HipJoint> hips[2];  // 0: maps alone, 1: exact look-ups at discontinuities
+      std::optional<Session> sessions[2];  // 0: maps alone, 1: exact look-ups at discontinuities
+      const HipJoint* hips[2];
       for (int m = 0; m < 2; ++m) {
-        HipJointOptions ho;
-        ho.joint.scheme = make_scheme(name, res);
-        ho.joint.exact_at_discontinuities = m == 1;
-        ho.neutral = s.generated ? Neutral::scan : Neutral::anatomical;
-        hips[m].emplace(s.femur, s.pelvis, s.side, head, Landmarks{}, ho);
+        MapSettings maps;
+        maps.scheme = name;
+        maps.resolution = res;
+        maps.maps_only = m == 0;
+        sessions[m].emplace(session_options(s, maps));
+        hips[m] = &sessions[m]->hip();
       }
       const Joint& j0 = hips[0]->joint();
       const ExactReference ef(without_edge_on(j0.ball().mesh, j0.cor())),
@@ -190,12 +190,11 @@ int main(int argc, char** argv) {
     const double eps = 0.05;
     for (const Subject& s : subjects) {
       progress("11_extreme_cases outputs", 0, 0, s.name);
-      SphereFitResult head = s.generated ? SphereFitResult{} : locate_femoral_head(s.femur);
-      if (s.generated) head.centre = s.true_cor, head.radius = std::nan("");
-      HipJointOptions ho;
-      ho.joint.scheme = make_scheme("equiangular", p);
-      ho.neutral = s.generated ? Neutral::scan : Neutral::anatomical;
-      const HipJoint hip(s.femur, s.pelvis, s.side, head, Landmarks{}, ho);
+      MapSettings maps;
+      maps.precision = p;
+      const Session session(session_options(s, maps));
+      const HipJoint& hip = session.hip();
+      const HipJointOptions& ho = session.hip_options();
       const Joint& jm = hip.joint();
       const ExactReference ef(without_edge_on(jm.ball().mesh, jm.cor())),
           ep(without_edge_on(jm.socket().mesh, jm.cor()));

@@ -12,6 +12,7 @@
 #include "impinge/core/timing.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/subject.hpp"
+#include "impinge/session/session.hpp"
 
 namespace impinge::experiment {
 
@@ -45,15 +46,16 @@ std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& gen
       if (fs::exists(e.path() / "subject.json")) dirs.push_back(e.path());
     std::sort(dirs.begin(), dirs.end());
     for (const auto& d : dirs) {
-      const SubjectInfo info = load_subject((d / "subject.json").string());
+      SessionInput in;
+      in.subject = (d / "subject.json").string();
+      LoadedInput li = load_input(in);  // meshes in the anatomical frame, as every front end reads them
       Subject s;
-      s.name = info.name;
-      s.source = "shared/data/hips/" + info.name;
-      s.side = info.side;
-      s.femur = load_mesh(info.femur_path);
-      s.pelvis = load_mesh(info.pelvis_path);
-      transform_vertices(s.femur.V, to_anatomical(info.frame));
-      transform_vertices(s.pelvis.V, to_anatomical(info.frame));
+      s.name = li.name;
+      s.source = "shared/data/hips/" + li.name;
+      s.side = li.side;
+      s.femur = std::move(li.femur);
+      s.pelvis = std::move(li.pelvis);
+      s.landmarks = std::move(li.landmarks);
       out.push_back(std::move(s));
     }
   }
@@ -74,7 +76,30 @@ std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& gen
   return out;
 }
 
-Eigen::Vector3d subject_cor(const Subject& s) { return s.generated ? s.true_cor : fit_femoral_head(s.femur).centre; }
+Eigen::Vector3d subject_cor(const Subject& s) {
+  if (s.generated) return s.true_cor;
+  LoadedInput in;
+  in.femur = s.femur;
+  in.side = s.side;
+  in.landmarks = s.landmarks;
+  return find_centre_of_rotation(in, {}).head.centre;
+}
+
+SessionOptions session_options(const Subject& s, const MapSettings& maps) {
+  SessionOptions o;
+  o.input.ball_mesh = s.femur;
+  o.input.socket_mesh = s.pelvis;
+  o.input.side = s.side == Side::right ? "right" : "left";
+  o.input.frame = "RAS";
+  o.input.landmarks = s.landmarks;
+  o.maps = maps;
+  o.frames.neutral = s.generated ? "scan" : "anatomical";
+  if (s.generated) {
+    o.cor.given = s.true_cor;
+    o.cor.allow_any = true;  // the true centre: no fitted head to check it against (a partial femur)
+  }
+  return o;
+}
 
 Eigen::Vector3d push_direction(const TriangleMesh& pelvis, const Eigen::Vector3d& cor, double radius_mm) {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();

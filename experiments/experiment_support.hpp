@@ -15,6 +15,7 @@
 #include "impinge/core/mesh.hpp"
 #include "impinge/detection/joint.hpp"
 #include "impinge/io/generated_models.hpp"
+#include "impinge/session/session.hpp"
 
 namespace impinge::experiment {
 
@@ -36,6 +37,7 @@ struct Subject {
   bool generated = false;
   Side side = Side::right;
   TriangleMesh femur, pelvis;
+  Landmarks landmarks;  ///< given in subject.json (anatomical frame, mm); none for generated
   Eigen::Vector3d true_cor = Eigen::Vector3d::Constant(std::nan(""));  ///< known for generated
 };
 
@@ -43,9 +45,15 @@ struct Subject {
 /// the generated hip model(s) with the given triangle counts.
 std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& generated_triangles);
 
-/// The COR of a subject: the true centre for generated models, the automatic femoral-head fit
-/// (fit_femoral_head) for real ones. mm, anatomical frame.
+/// The COR of a subject: the true centre for generated models; for real ones the session layer's
+/// automatic policy (find_centre_of_rotation: locate_femoral_head), as the CLI and Python find it.
+/// mm, anatomical frame.
 Eigen::Vector3d subject_cor(const Subject& s);
+
+/// Session options for a subject (the same set-up as the CLI's and Python's): its meshes in memory
+/// (anatomical frame, RAS), its side; anatomical neutral for real subjects, scan neutral and the
+/// true COR for generated ones; `maps` as given.
+SessionOptions session_options(const Subject& s, const MapSettings& maps = {});
 
 /// Unit direction in which the femur is pushed into the acetabulum: from the COR towards the
 /// centroid of the pelvis vertices within `radius_mm` of it (the acetabular fossa side).

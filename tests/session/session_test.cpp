@@ -1,0 +1,251 @@
+// The session layer: one set-up for every front end. Invariants:
+// - the input frame is undone exactly: a hip given in LPS (x and y negated) has the gaps of the
+//   same hip given in RAS bit for bit, its COR and posed vertices are reported back in LPS;
+// - the COR policy: a head-region fit finds the generated head's analytic centre and radius; a
+//   given COR outside the head is refused naming both centres (unless allow_any); a subject's
+//   hip_centre landmark is used; a given COR wins over the landmark;
+// - bad options are refused before any file is read, naming the option;
+// - the runs equal the library calls they wrap: run_motion's rows are Joint::detect's least gaps
+//   at each pose, run_rom's limits find_rom_limits's;
+// - tables refuse ragged rows and write RFC 4180 CSV.
+#include "impinge/session/session.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include "impinge/core/error.hpp"
+#include "impinge/io/generated_models.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/session/records.hpp"
+#include "impinge/session/runs.hpp"
+
+using namespace impinge;
+namespace fs = std::filesystem;
+
+namespace {
+
+// The generated hip (2000 triangles) with a 2 mm cam bump, or without one (a spherical head).
+const HipModel& model(bool cam = true) {
+  static const HipModel h[2] = {[] {
+                                  HipModelOptions o;
+                                  o.target_triangles = 2000;
+                                  o.cam_height_mm = 0;
+                                  return make_hip_model(o);
+                                }(),
+                                [] {
+                                  HipModelOptions o;
+                                  o.target_triangles = 2000;
+                                  o.cam_height_mm = 2;
+                                  return make_hip_model(o);
+                                }()};
+  return h[cam ? 1 : 0];
+}
+
+// Options for the generated hip given in `frame` (its meshes converted from RAS), true COR given.
+SessionOptions generated_options(const std::string& frame, bool cam = true) {
+  const HipModel& h = model(cam);
+  const Eigen::Matrix3d M = to_anatomical(frame == "LPS" ? FrameConvention::LPS : FrameConvention::RAS);
+  SessionOptions o;
+  o.input.ball_mesh = h.ball;
+  o.input.socket_mesh = h.socket;
+  transform_vertices(o.input.ball_mesh->V, M);  // RAS -> frame (M is its own inverse)
+  transform_vertices(o.input.socket_mesh->V, M);
+  o.input.frame = frame;
+  o.cor.given = M * h.cor;
+  o.frames.neutral = "scan";
+  o.maps.precision = 1;
+  return o;
+}
+
+// A real subject.json of the shared data, or "" when the folder is absent.
+std::string test_data_subject() {
+  const std::string p = std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/subject.json";
+  return fs::exists(p) ? p : std::string();
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST(Session, LpsInputGivesTheRasGapsAndReportsInLps) {
+  const Session ras(generated_options("RAS")), lps(generated_options("LPS"));
+  const Eigen::Matrix3d flip = Eigen::Vector3d(-1, -1, 1).asDiagonal();
+  EXPECT_TRUE(lps.cor_input().isApprox(flip * ras.cor_input(), 1e-12));
+  EXPECT_TRUE(ras.cor_input().isApprox(model().cor, 1e-12));
+  for (const PoseAngles& a : {PoseAngles{0, 0, 0}, PoseAngles{30, -10, 5}, PoseAngles{-20, 15, 40}}) {
+    const PoseResult r = ras.hip().detect(a), l = lps.hip().detect(a);
+    ASSERT_EQ(r.ball_gaps.gap_mm.size(), l.ball_gaps.gap_mm.size());
+    for (std::size_t i = 0; i < r.ball_gaps.gap_mm.size(); ++i)
+      EXPECT_TRUE(r.ball_gaps.gap_mm[i] == l.ball_gaps.gap_mm[i] ||
+                  (std::isnan(r.ball_gaps.gap_mm[i]) && std::isnan(l.ball_gaps.gap_mm[i])));
+    EXPECT_EQ(r.socket.min_gap_mm, l.socket.min_gap_mm);
+    // Posed vertices come back in each input frame: LPS = flip RAS.
+    const Eigen::Matrix3d R = ras.hip().femur_rotation(a);
+    const Vertices vr = ras.femur_input(R), vl = lps.femur_input(lps.hip().femur_rotation(a));
+    EXPECT_LT((vl - vr * flip).cwiseAbs().maxCoeff(), 1e-9);
+    // A rotation given in the input frame reaches the joint frame unchanged in effect.
+    const Eigen::Matrix3d Rin = lps.input_rotation(lps.hip().femur_rotation(a));
+    const auto [Rj, tj] = lps.joint_motion(Rin, Eigen::Vector3d::Zero());
+    EXPECT_TRUE(Rj.isApprox(lps.hip().femur_rotation(a), 1e-12));
+    EXPECT_EQ(tj.norm(), 0.0);
+  }
+  const nlohmann::json rec = setup_record(lps);
+  EXPECT_EQ(rec["input_frame"], "LPS");
+  EXPECT_NEAR(rec["cor_mm"][0].get<double>(), -model().cor.x(), 1e-9);
+}
+
+TEST(Session, HeadRegionFindsTheAnalyticHead) {
+  SessionOptions o = generated_options("RAS", false);  // a spherical head: vertices on the sphere
+  o.cor.given.reset();
+  const double r = HipModelOptions{}.head_radius_mm;
+  const Eigen::Vector3d c = model(false).cor;
+  o.cor.head_region = Eigen::Vector4d(c.x() + 0.2, c.y(), c.z(), r + 0.5);  // the head, not the neck
+  const Session s(o);
+  EXPECT_LT((s.cor_input() - c).norm(), 0.05);
+  EXPECT_NEAR(s.head().radius, r, 0.05);
+  EXPECT_EQ(s.cor_method(), "sphere fit in region");
+}
+
+TEST(Session, CorPolicyChecksAndOrder) {
+  const auto real = test_data_subject();
+  if (real.empty()) GTEST_SKIP() << "shared data absent";
+  SessionOptions o;
+  o.input.subject = real;
+  o.frames.neutral = "scan";
+  o.maps.precision = 2;
+  const LoadedInput in = load_input(o.input);
+  const CorResult automatic = find_centre_of_rotation(in, {});
+  EXPECT_GT(automatic.head.radius, 15);
+  EXPECT_LT(automatic.head.radius, 35);
+  // 10 mm beyond the head's surface: refused, naming the fitted centre.
+  CorOptions far;
+  far.given = in.to_working.transpose() *
+              (automatic.head.centre + Eigen::Vector3d(automatic.head.radius + 10, 0, 0));
+  EXPECT_NE(error_of([&] { find_centre_of_rotation(in, far); }).find("from the fitted femoral head centre"),
+            std::string::npos);
+  far.allow_any = true;
+  EXPECT_EQ(find_centre_of_rotation(in, far).method, "given");
+  // A landmark hip_centre is used; a given COR wins over it.
+  LoadedInput with = in;
+  with.landmarks["hip_centre"] = automatic.head.centre + Eigen::Vector3d(1, 0, 0);
+  EXPECT_TRUE(find_centre_of_rotation(with, {}).head.centre.isApprox(with.landmarks["hip_centre"]));
+  CorOptions given;
+  given.given = in.to_working.transpose() * automatic.head.centre;
+  EXPECT_TRUE(find_centre_of_rotation(with, given).head.centre.isApprox(automatic.head.centre, 1e-12));
+  given.head_region = Eigen::Vector4d(0, 0, 0, 10);
+  EXPECT_NE(error_of([&] { find_centre_of_rotation(in, given); }).find("not both"), std::string::npos);
+}
+
+TEST(Session, BadOptionsAreRefusedBeforeAnyFileIsRead) {
+  // The subject file does not exist: each error must be about the option, not the file.
+  auto refused = [](const std::function<void(SessionOptions&)>& set, const std::string& expected) {
+    SessionOptions o;
+    o.input.subject = "/nonexistent/subject.json";
+    set(o);
+    const std::string e = error_of([&] { Session s(o); });
+    EXPECT_NE(e.find(expected), std::string::npos) << e;
+    EXPECT_EQ(e.find("nonexistent"), std::string::npos) << e;
+  };
+  refused([](SessionOptions& o) { o.maps.precision = 1, o.maps.spacing = 1; }, "give one of resolution");
+  refused([](SessionOptions& o) { o.maps.layers = 99; }, "layers 99");
+  refused([](SessionOptions& o) { o.maps.sparse_mm = -1; }, "sparse -1");
+  refused([](SessionOptions& o) { o.maps.mode = "cubic"; }, "cubic");
+  refused([](SessionOptions& o) { o.maps.scheme = "hexagon"; }, "hexagon");
+  refused([](SessionOptions& o) { o.maps.ball_map_file = "a.map"; }, "both map files");
+  refused([](SessionOptions& o) { o.maps.levels = {1, 2}; }, "not below");
+  refused([](SessionOptions& o) { o.frames.neutral = "sideways"; }, "sideways");
+  refused([](SessionOptions& o) { o.frames.pelvis_frame = "xyz"; }, "xyz");
+  refused([](SessionOptions& o) { o.maps.discontinuity_tolerance_mm = 0; }, "discontinuity-tolerance");
+  EXPECT_NE(error_of([] { parse_cor("1,2", "--cor"); }).find("--cor"), std::string::npos);
+  EXPECT_NE(error_of([] { parse_head_region("1,2,3,-4", "--head-region"); }).find("radius"), std::string::npos);
+  EXPECT_FALSE(parse_cor("auto", "--cor").has_value());
+}
+
+TEST(Session, SideOrFrameContradictingTheSubjectIsAnError) {
+  const fs::path d = fs::temp_directory_path() / "impinge_session_test";
+  fs::create_directories(d);
+  write_ply((d / "femur.ply").string(), model().ball);
+  write_ply((d / "pelvis.ply").string(), model().socket);
+  std::ofstream((d / "subject.json").string())
+      << R"({"side": "right", "frame": "RAS", "units": "mm", "femur": "femur.ply", "pelvis": "pelvis.ply"})";
+  SessionInput in;
+  in.subject = (d / "subject.json").string();
+  EXPECT_EQ(input_side(in), Side::right);
+  in.side = "left";
+  EXPECT_NE(error_of([&] { load_input(in); }).find("side 'left' contradicts"), std::string::npos);
+  in.side = "right";
+  in.frame = "LPS";
+  EXPECT_NE(error_of([&] { load_input(in); }).find("frame 'LPS' contradicts"), std::string::npos);
+  in.frame.clear();
+  in.ball_mesh = model().ball;
+  in.ball = "femur.ply";
+  EXPECT_NE(error_of([&] { load_input(in); }).find("not both"), std::string::npos);
+}
+
+TEST(Session, MotionRunEqualsDetectAtEachPose) {
+  const Session s(generated_options("LPS"));
+  const std::vector<PoseAngles> poses = {{0, 0, 0}, {40, 10, -5}, {80, -15, 30}, {-15, 5, 45}};
+  Table t;
+  t.columns = motion_columns(s.joint_options().levels);
+  run_motion(s, poses, {0.0, 0.5, 1.0, 1.5}, [&](const MotionFrame& f) { t.add(motion_row(f)); });
+  ASSERT_EQ(t.rows.size(), poses.size());
+  const auto ball = t.column("ball_min_gap_mm"), socket = t.column("socket_min_gap_mm"), time = t.column("time_s");
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const PoseResult r = s.joint().detect(s.hip().femur_rotation(poses[k]));
+    EXPECT_EQ(ball[k].get<double>(), r.ball.min_gap_mm);
+    EXPECT_EQ(socket[k].get<double>(), r.socket.min_gap_mm);
+    EXPECT_EQ(time[k].get<double>(), 0.5 * double(k));
+  }
+  EXPECT_THROW(run_motion(s, poses, {0.0}, [](const MotionFrame&) {}), Error);
+}
+
+TEST(Session, RomRunEqualsTheLibraryCalls) {
+  const Session s(generated_options("RAS"));
+  RomRequest q;
+  q.map_flexion_deg = {0, 60};
+  q.map_adduction_deg = {0, 10};
+  const RomRun run = run_rom(s, q);
+  const RomBaseline base = rom_baseline(s.hip(), s.hip().femur_rotation({}), q.search);
+  const std::vector<RomLimit> direct = find_rom_limits(s.hip(), standard_motions(), q.search, base);
+  ASSERT_EQ(run.limits.size(), direct.size());
+  const Table t = rom_limits_table(s, run);
+  const auto limit = t.column("limit_deg");
+  for (std::size_t k = 0; k < direct.size(); ++k) {
+    EXPECT_TRUE(run.limits[k].limit_deg == direct[k].limit_deg ||
+                (std::isnan(run.limits[k].limit_deg) && std::isnan(direct[k].limit_deg)));
+    if (std::isnan(direct[k].limit_deg))
+      EXPECT_TRUE(limit[k].is_null());
+    else
+      EXPECT_EQ(limit[k].get<double>(), direct[k].limit_deg);
+  }
+  EXPECT_EQ(run.map.size(), 4u);
+  EXPECT_EQ(rom_map_table(run).rows.size(), 4u);
+  EXPECT_TRUE(rom_envelope_table(run).rows.empty());
+}
+
+TEST(Session, TablesRefuseRaggedRowsAndQuoteText) {
+  Table t;
+  t.columns = {"a", "b"};
+  t.add({1, "x,y"});
+  EXPECT_THROW(t.add({1}), Error);
+  t.add({number_or_null(std::nan("")), "say \"hi\""});
+  EXPECT_THROW(t.column("c"), Error);
+  const fs::path p = fs::temp_directory_path() / "impinge_table_test.csv";
+  write_csv(p.string(), t);
+  std::ifstream is(p);
+  std::stringstream ss;
+  ss << is.rdbuf();
+  EXPECT_EQ(ss.str(), "a,b\n1,\"x,y\"\nnan,\"say \"\"hi\"\"\"\n");
+}
