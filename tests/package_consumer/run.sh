@@ -12,5 +12,6 @@ cmake --build "$work/build" >/dev/null
 "$work/build/consumer"
 # The installed tree holds the headers, the library and the package files, nothing else.
 test -f "$work/prefix/include/impinge/detection/joint.hpp"
+test -f "$work/prefix/include/impinge/session/session.hpp"
 test -f "$work/prefix/lib/cmake/impinge/impingeConfig.cmake"
 echo "package consumer ok"
