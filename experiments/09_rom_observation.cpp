@@ -147,267 +147,281 @@ std::vector<StandardMotion> extra_articular_motions() {
   m.push_back({"extension_external_rotation", [](double t) { return PoseAngles{-t, 0, -t / 2}; }});
   return m;
 }
-}  // namespace
-
-int main(int argc, char** argv) {
-  const Args args = parse_args(argc, argv, "09_rom_observation: thesis sec. 5.2 ROM observation, ROM limits and maps");
-  const std::string dir = experiment_dir(args, "09_rom_observation");
-  const std::string src = IMPINGE_EXPERIMENTS_DIR;
-  fs::copy_file(src + "/09_thesis_table11.csv", dir + "/thesis_table11.csv", fs::copy_options::overwrite_existing);
-  fs::copy_file(src + "/09_published.csv", dir + "/published.csv", fs::copy_options::overwrite_existing);
-  const std::vector<Table11Row> table11 = read_table11(src + "/09_thesis_table11.csv");
-  std::vector<Subject> subjects = load_subjects(args, {});
-  bool generated = false;
-  if (subjects.empty()) {
-    subjects = load_subjects(args, {12000});
-    generated = true;
-  }
-  const double resolution = args.quick ? 0.25 : 0.1;
-  const std::vector<double> sens_resolutions = args.quick ? std::vector<double>{0.5, 0.25} : std::vector<double>{0.5, 0.25, 0.1};
+// What every step reads: the experiment's settings.
+struct Settings {
+  std::string dir;
+  bool quick = false;
+  double resolution = 0.1;                 // deg, the maps of the limits, map and envelope
+  std::vector<double> sens_resolutions;    // deg, the sensitivity's other resolutions
   RomOptions ro;
-  ImpingementLevels observation_levels;
-  observation_levels.thresholds_mm = {6, 4, 2, 0};
+  ImpingementLevels observation_levels;    // thesis sec. 5.2: blue > 6 mm, red < 2 mm
+  std::vector<Table11Row> table11;
+  int threads = 1;
+};
 
-  CsvWriter obs(dir + "/observation.csv",
-                {"subject", "patient", "motion", "angle_deg", "flexion_deg", "adduction_deg", "internal_rotation_deg",
-                 "ball_min_gap_mm", "socket_min_gap_mm", "socket_closest_clock_h", "socket_area_over6_mm2",
-                 "socket_area_4to6_mm2", "socket_area_2to4_mm2", "socket_area_0to2_mm2", "socket_area_penetrating_mm2"});
-  // rom_limits.csv and rom_map.csv: the CLI's tables (session layer) with the subject first; the limits
-  // also with their exact check.
+// The experiment's outputs, one writer or table each (see the file comment).
+struct Outputs {
+  explicit Outputs(const std::string& dir)
+      : obs(dir + "/observation.csv",
+            {"subject", "patient", "motion", "angle_deg", "flexion_deg", "adduction_deg", "internal_rotation_deg",
+             "ball_min_gap_mm", "socket_min_gap_mm", "socket_closest_clock_h", "socket_area_over6_mm2",
+             "socket_area_4to6_mm2", "socket_area_2to4_mm2", "socket_area_0to2_mm2", "socket_area_penetrating_mm2"}),
+        clocks(dir + "/clock_faces.csv", {"subject", "side", "centre_x_mm", "centre_y_mm", "centre_z_mm", "twelve_x",
+                                          "twelve_y", "twelve_z", "three_x", "three_y", "three_z", "rim_radius_mm"}),
+        extra(dir + "/extra_articular.csv",
+              {"subject", "motion", "counted", "limit_deg", "limited_by", "hidden_vertex", "ball_vertex",
+               "socket_clock_h", "contact_radius_mm", "min_gap_at_limit_mm", "contact_at_start",
+               "exact_gap_before_mm", "exact_gap_after_mm", "validated"}),
+        layered(dir + "/layered.csv",
+                {"subject", "body", "layers", "nodes", "layered_bytes", "single_bytes", "layered_sampling_ms",
+                 "single_sampling_ms", "nodes_covered", "nodes_truncated", "nodes_not_alternating", "max_crossings",
+                 "hidden_vertices", "limits_ms_single", "limits_ms_layered"}),
+        env(dir + "/envelope.csv",
+            {"subject", "resolution_deg", "step_deg", "coarse_steps", "threads", "poses", "poses_scanned",
+             "poses_valid", "envelope_ms", "poses_per_second", "poses_per_core_second", "brute_force_ms",
+             "brute_force_poses_valid", "poses_differ"}),
+        sens(dir + "/sensitivity.csv", {"subject", "variant", "motion", "limit_deg", "delta_deg"}),
+        tim(dir + "/timing.csv",
+            {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "evaluations",
+             "poses_per_second", "share_skipped", "fcl_collide_ms_per_pose", "fcl_poses_timed",
+             "fcl_search_ms_extrapolated", "fcl_over_ours", "excluded_vertices", "neutral_min_gap_mm"}) {}
+  CsvWriter obs, clocks, extra, layered, env, sens, tim;
+  // rom_limits.csv and rom_map.csv: the CLI's tables (session layer) with the subject first; the
+  // limits also with their exact check.
   Table lim, map;
-  CsvWriter clocks(dir + "/clock_faces.csv", {"subject", "side", "centre_x_mm", "centre_y_mm", "centre_z_mm", "twelve_x",
-                                              "twelve_y", "twelve_z", "three_x", "three_y", "three_z", "rim_radius_mm"});
-  CsvWriter extra(dir + "/extra_articular.csv",
-                  {"subject", "motion", "counted", "limit_deg", "limited_by", "hidden_vertex", "ball_vertex",
-                   "socket_clock_h", "contact_radius_mm", "min_gap_at_limit_mm", "contact_at_start",
-                   "exact_gap_before_mm", "exact_gap_after_mm", "validated"});
-  CsvWriter layered(dir + "/layered.csv",
-                    {"subject", "body", "layers", "nodes", "layered_bytes", "single_bytes", "layered_sampling_ms",
-                     "single_sampling_ms", "nodes_covered", "nodes_truncated", "nodes_not_alternating",
-                     "max_crossings", "hidden_vertices", "limits_ms_single", "limits_ms_layered"});
-  CsvWriter env(dir + "/envelope.csv",
-                {"subject", "resolution_deg", "step_deg", "coarse_steps", "threads", "poses", "poses_scanned",
-                 "poses_valid", "envelope_ms", "poses_per_second", "poses_per_core_second", "brute_force_ms",
-                 "brute_force_poses_valid", "poses_differ"});
-  CsvWriter sens(dir + "/sensitivity.csv", {"subject", "variant", "motion", "limit_deg", "delta_deg"});
-  CsvWriter tim(dir + "/timing.csv",
-                {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "evaluations",
-                 "poses_per_second", "share_skipped", "fcl_collide_ms_per_pose", "fcl_poses_timed",
-                 "fcl_search_ms_extrapolated", "fcl_over_ours", "excluded_vertices", "neutral_min_gap_mm"});
-  const int threads = omp_get_max_threads();
-  const int total = static_cast<int>(subjects.size());
-  int done = 0;
   bool wrote_renders = false;
-  for (const Subject& s : subjects) {
-    progress("09_rom_observation", ++done, total, s.name);
-    MapSettings maps;
-    maps.precision = resolution;
-    maps.levels = observation_levels.thresholds_mm;
-    const SessionOptions so = session_options(s, maps);
-    const Session session(so);
-    const HipJoint& hip = session.hip();
-    const SphereFitResult head = session.head();
-    const Joint& joint = hip.joint();
+};
 
-    // Table 11's extremities (real subjects: clinical angles from anatomical neutral).
-    if (!s.generated) {
-      const ClockFace c = hip.socket_clock()->transformed(scan_axes().transpose(), Eigen::Vector3d::Zero());
-      clocks.row(s.name, s.side == Side::right ? "right" : "left", c.centre.x(), c.centre.y(), c.centre.z(),
+// One subject set up as the CLI sets it up, its ROM run (`impinge rom`: limits, then the map) and
+// the exact references of both bones.
+struct SubjectRun {
+  SubjectRun(const Subject& s, const Settings& st)
+      : subject(s), options(options_of(s, st)), session(options), run(run_rom(session, request(st))),
+        ex_pelvis(session.joint().socket().mesh), ex_femur(session.joint().ball().mesh) {}
+  static SessionOptions options_of(const Subject& s, const Settings& st) {
+    MapSettings maps;
+    maps.precision = st.resolution;
+    maps.levels = st.observation_levels.thresholds_mm;
+    return session_options(s, maps);
+  }
+  static RomRequest request(const Settings& st) {
+    RomRequest q;
+    q.search = st.ro;
+    return q;
+  }
+  const Subject& subject;
+  const SessionOptions options;
+  const Session session;
+  const RomRun run;
+  const ExactReference ex_pelvis, ex_femur;
+};
+
+// Table 11's extremities as clinical poses from anatomical neutral (real subjects), and the cup
+// regions of the first subject for the medial views of Tables 12-13.
+void observe_table11(const SubjectRun& r, const Settings& st, Outputs& out) {
+  const Subject& s = r.subject;
+  const HipJoint& hip = r.session.hip();
+  const ClockFace c = hip.socket_clock()->transformed(scan_axes().transpose(), Eigen::Vector3d::Zero());
+  out.clocks.row(s.name, s.side == Side::right ? "right" : "left", c.centre.x(), c.centre.y(), c.centre.z(),
                  c.twelve.x(), c.twelve.y(), c.twelve.z(), c.three.x(), c.three.y(), c.three.z(),
                  hip.acetabulum()->rim_radius_mm);
-      for (const Table11Row& t : table11) {
-        const PoseAngles a = extremity(t.motion, t.angle);
-        const PoseResult r = hip.detect(a);
-        ClockSummary bc, sc;
-        hip.clocks(r, bc, sc);
-        const auto& L = r.socket.level_area_mm2;
-        obs.row(s.name, t.patient, t.motion, t.angle, a.flexion_deg, a.adduction_deg, a.internal_rotation_deg,
-                r.ball.min_gap_mm, r.socket.min_gap_mm, sc.closest_hour, L[0], L[1], L[2], L[3], L[4]);
-        if (!wrote_renders) {
-          // The cup region (within the rim radius + 3 mm of the COR), pelvic frame, with gaps.
-          write_region_ply(dir + "/observation_" + s.name + "_" + t.patient + "_" + t.motion + ".ply", joint.socket(),
-                           scan_axes().transpose(), hip.acetabulum()->rim_radius_mm + 3, &r.socket_gaps,
-                           observation_levels, false);
-        }
-      }
-      wrote_renders = true;
-    }
+  for (const Table11Row& t : st.table11) {
+    const PoseAngles a = extremity(t.motion, t.angle);
+    const PoseResult res = hip.detect(a);
+    ClockSummary bc, sc;
+    hip.clocks(res, bc, sc);
+    const auto& L = res.socket.level_area_mm2;
+    out.obs.row(s.name, t.patient, t.motion, t.angle, a.flexion_deg, a.adduction_deg, a.internal_rotation_deg,
+                res.ball.min_gap_mm, res.socket.min_gap_mm, sc.closest_hour, L[0], L[1], L[2], L[3], L[4]);
+    if (!out.wrote_renders)  // the cup region (within the rim radius + 3 mm of the COR), pelvic frame, with gaps
+      write_region_ply(st.dir + "/observation_" + s.name + "_" + t.patient + "_" + t.motion + ".ply",
+                       hip.joint().socket(), scan_axes().transpose(), hip.acetabulum()->rim_radius_mm + 3,
+                       &res.socket_gaps, st.observation_levels, false);
+  }
+  out.wrote_renders = true;
+}
 
-    // ROM limits and map, timed (the search after the maps exist; sampling reported beside). The
-    // baseline (a full scan at neutral) and the search bounds it builds count with the limits.
-    RomRequest rq;
-    rq.search = ro;
-    const RomRun run = run_rom(session, rq);  // as `impinge rom` runs it: limits, then the map
-    const RomBaseline& base = run.baseline;
-    const std::vector<StandardMotion>& motions = run.motions;
-    const std::vector<RomLimit>& limits = run.limits;
-    const double limits_ms = run.limits_ms, map_ms = run.map_ms;
-    const std::int64_t looked = run.vertices_looked_up, skipped = run.vertices_skipped;
-    const std::int64_t all_evals = run.limit_evaluations + run.map_evaluations;
-    const Table limits_table = rom_limits_table(session, run), map_table = rom_map_table(run);
-    if (map.columns.empty()) {
-      map.columns = {"subject"};
-      map.columns.insert(map.columns.end(), map_table.columns.begin(), map_table.columns.end());
-      lim.columns = {"subject"};
-      lim.columns.insert(lim.columns.end(), limits_table.columns.begin(), limits_table.columns.end());
-      for (const char* c : {"exact_gap_before_mm", "exact_gap_after_mm", "validated"}) lim.columns.emplace_back(c);
+// rom_limits.csv and rom_map.csv rows, each limit checked exactly 0.5 deg either side (CGAL ray casts).
+void record_limits(const SubjectRun& r, const Settings& st, Outputs& out) {
+  const Table limits_table = rom_limits_table(r.session, r.run), map_table = rom_map_table(r.run);
+  if (out.map.columns.empty()) {
+    out.map.columns = {"subject"};
+    out.map.columns.insert(out.map.columns.end(), map_table.columns.begin(), map_table.columns.end());
+    out.lim.columns = {"subject"};
+    out.lim.columns.insert(out.lim.columns.end(), limits_table.columns.begin(), limits_table.columns.end());
+    for (const char* c : {"exact_gap_before_mm", "exact_gap_after_mm", "validated"}) out.lim.columns.emplace_back(c);
+  }
+  for (const nlohmann::json& m : map_table.rows) {
+    nlohmann::json row = {r.subject.name};
+    row.insert(row.end(), m.begin(), m.end());
+    out.map.add(row);
+  }
+  const HipJoint& hip = r.session.hip();
+  for (std::size_t k = 0; k < r.run.motions.size(); ++k) {
+    const RomLimit& l = r.run.limits[k];
+    double before = std::nan(""), after = std::nan("");
+    std::string validated = "no_limit";
+    if (!std::isnan(l.limit_deg) && !l.contact_at_start) {
+      auto exact = [&](double t) {
+        return exact_least_gap(hip.joint(), r.ex_pelvis, r.ex_femur, r.run.baseline,
+                               hip.femur_rotation(r.run.motions[k].angles(t)));
+      };
+      before = exact(std::max(0.0, l.limit_deg - 0.5));
+      after = exact(l.limit_deg + 0.5);
+      validated = before > st.ro.threshold_mm && after <= st.ro.threshold_mm ? "yes" : "no";
     }
-    for (const nlohmann::json& r : map_table.rows) {
-      nlohmann::json row = {s.name};
-      row.insert(row.end(), r.begin(), r.end());
-      map.add(row);
-    }
+    nlohmann::json row = {r.subject.name};
+    row.insert(row.end(), limits_table.rows[k].begin(), limits_table.rows[k].end());
+    for (const nlohmann::json& x : {number_or_null(before), number_or_null(after), nlohmann::json(validated)})
+      row.push_back(x);
+    out.lim.add(row);
+  }
+}
 
-    // Exact check 0.5 deg either side of each limit (CGAL ray casts).
-    const ExactReference ex_pelvis(joint.socket().mesh), ex_femur(joint.ball().mesh);
-    for (std::size_t k = 0; k < motions.size(); ++k) {
-      const RomLimit& l = limits[k];
+// Extra-articular impingement (issue 14): layered maps of 4 crossings per node; the standard motions
+// and two with external rotation, counting every vertex (the limit) and the hidden ones only (the
+// first extra-articular contact), each checked exactly 0.5 deg either side.
+void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
+  SessionOptions lo = r.options;
+  lo.maps.layers = 4;
+  const Session lsession(lo);
+  const HipJoint& lhip = lsession.hip();
+  const Joint& lj = lhip.joint();
+  const RomBaseline lbase = rom_baseline(lhip, lhip.femur_rotation({}), st.ro);
+  const std::vector<StandardMotion> xm = extra_articular_motions();
+  auto t1 = Clock::now();
+  find_rom_limits(lhip, r.run.motions, st.ro, lbase);
+  const double limits_layered_ms = ms_since(t1);
+  for (const RomVertices counted : {RomVertices::all, RomVertices::hidden}) {
+    RomOptions xo = st.ro;
+    xo.vertices = counted;
+    const std::vector<RomLimit> xl = find_rom_limits(lhip, xm, xo, lbase);
+    for (std::size_t k = 0; k < xm.size(); ++k) {
+      const RomLimit& l = xl[k];
       double before = std::nan(""), after = std::nan("");
       std::string validated = "no_limit";
+      auto exact = [&](double t) {
+        const Eigen::Matrix3d R = lhip.femur_rotation(xm[k].angles(t));
+        const double h = exact_least_hidden(lj, r.ex_pelvis, r.ex_femur, lbase, R);
+        return counted == RomVertices::hidden ? h : std::min(h, exact_least_gap(lj, r.ex_pelvis, r.ex_femur, lbase, R));
+      };
       if (!std::isnan(l.limit_deg) && !l.contact_at_start) {
-        before = exact_least_gap(joint, ex_pelvis, ex_femur, base,
-                                 hip.femur_rotation(motions[k].angles(std::max(0.0, l.limit_deg - 0.5))));
-        after = exact_least_gap(joint, ex_pelvis, ex_femur, base, hip.femur_rotation(motions[k].angles(l.limit_deg + 0.5)));
-        validated = before > ro.threshold_mm && after <= ro.threshold_mm ? "yes" : "no";
+        before = exact(std::max(0.0, l.limit_deg - 0.5));
+        after = exact(l.limit_deg + 0.5);
+        validated = before > st.ro.threshold_mm && after <= st.ro.threshold_mm ? "yes" : "no";
       }
-      nlohmann::json row = {s.name};
-      row.insert(row.end(), limits_table.rows[k].begin(), limits_table.rows[k].end());
-      for (const nlohmann::json& x : {number_or_null(before), number_or_null(after), nlohmann::json(validated)})
-        row.push_back(x);
-      lim.add(row);
-    }
-
-    // Extra-articular impingement (issue 14): layered maps of 4 crossings per node; the standard motions
-    // and two with external rotation, counting every vertex (the limit) and the hidden ones only (the
-    // first extra-articular contact), each checked exactly 0.5 deg either side.
-    {
-      SessionOptions lo = so;
-      lo.maps.layers = 4;
-      const Session lsession(lo);
-      const HipJoint& lhip = lsession.hip();
-      const Joint& lj = lhip.joint();
-      const RomBaseline lbase = rom_baseline(lhip, lhip.femur_rotation({}), ro);
-      const std::vector<StandardMotion> xm = extra_articular_motions();
-      auto t1 = Clock::now();
-      find_rom_limits(lhip, motions, ro, lbase);
-      const double limits_layered_ms = ms_since(t1);
-      for (const RomVertices counted : {RomVertices::all, RomVertices::hidden}) {
-        RomOptions xo = ro;
-        xo.vertices = counted;
-        const std::vector<RomLimit> xl = find_rom_limits(lhip, xm, xo, lbase);
-        for (std::size_t k = 0; k < xm.size(); ++k) {
-          const RomLimit& l = xl[k];
-          double before = std::nan(""), after = std::nan("");
-          std::string validated = "no_limit";
-          auto exact = [&](double t) {
-            const Eigen::Matrix3d R = lhip.femur_rotation(xm[k].angles(t));
-            const double h = exact_least_hidden(lj, ex_pelvis, ex_femur, lbase, R);
-            return counted == RomVertices::hidden ? h : std::min(h, exact_least_gap(lj, ex_pelvis, ex_femur, lbase, R));
-          };
-          if (!std::isnan(l.limit_deg) && !l.contact_at_start) {
-            before = exact(std::max(0.0, l.limit_deg - 0.5));
-            after = exact(l.limit_deg + 0.5);
-            validated = before > ro.threshold_mm && after <= ro.threshold_mm ? "yes" : "no";
-          }
-          extra.row(s.name, xm[k].name, counted == RomVertices::all ? "all" : "hidden", l.limit_deg, to_string(l.limited_by),
-                    l.limited_by_hidden_vertex ? 1 : 0, l.limited_by_ball ? 1 : 0, l.socket_clock_h,
+      out.extra.row(r.subject.name, xm[k].name, counted == RomVertices::all ? "all" : "hidden", l.limit_deg,
+                    to_string(l.limited_by), l.limited_by_hidden_vertex ? 1 : 0, l.limited_by_ball ? 1 : 0,
+                    l.socket_clock_h,
                     l.contact_mm.allFinite() ? (l.contact_mm - lhip.to_working(Eigen::Vector3d::Zero())).norm()
                                              : std::nan(""),
                     l.min_gap_at_limit_mm, l.contact_at_start ? 1 : 0, before, after, validated);
-        }
-      }
-      for (const JointBody* b : {&lj.ball(), &lj.socket()})
-        layered.row(s.name, b == &lj.ball() ? "femur" : "pelvis", lo.maps.layers, b->layered->num_nodes(),
+    }
+  }
+  for (const JointBody* b : {&lj.ball(), &lj.socket()})
+    out.layered.row(r.subject.name, b == &lj.ball() ? "femur" : "pelvis", lo.maps.layers, b->layered->num_nodes(),
                     b->layered->bytes(), b->map.bytes(), b->layered_sampling.sampling_ms, b->sampling_ms,
                     b->layered_sampling.nodes_covered, b->layered_sampling.nodes_truncated,
                     b->layered_sampling.nodes_not_alternating, b->layered_sampling.max_crossings, b->hidden_set.size(),
-                    limits_ms, limits_layered_ms);
-    }
+                    r.run.limits_ms, limits_layered_ms);
+}
 
-    // The ROM envelope by refinement, timed (median of 3), beside the brute force over every pose.
-    {
-      RomEnvelopeOptions eo;
-      eo.step_deg = args.quick ? 2 : 1;
-      eo.coarse_steps = 4;
-      std::vector<double> ts;
-      RomEnvelope fast;
-      for (int rep = 0; rep < 3; ++rep) {
-        const auto t1 = Clock::now();
-        fast = rom_envelope(hip, eo, ro, base);
-        ts.push_back(ms_since(t1));
-      }
-      std::sort(ts.begin(), ts.end());
-      RomEnvelopeOptions bo = eo;
-      bo.coarse_steps = 1;
-      const auto t1 = Clock::now();
-      const RomEnvelope all = rom_envelope(hip, bo, ro, base);
-      const double brute_ms = ms_since(t1);
-      std::int64_t valid = 0, all_valid = 0, differ = 0;
-      for (std::size_t p = 0; p < all.valid.size(); ++p)
-        valid += fast.valid[p], all_valid += all.valid[p], differ += fast.valid[p] != all.valid[p];
-      const double ms = ts[1];
-      env.row(s.name, resolution, eo.step_deg, eo.coarse_steps, threads, fast.poses, fast.poses_evaluated, valid, ms,
-              double(fast.poses) / (ms / 1000), double(fast.poses) / (ms / 1000) / threads, brute_ms, all_valid, differ);
-    }
-
-    // FCL collide on a subset of the map's poses (flexion 45, adduction 10, internal rotation 0..58 step 2).
-    double fcl_ms = std::nan("");
-    int fcl_poses = 0;
-    if (have_fcl()) {
-      const FclJoint fj(joint.ball().mesh, joint.socket().mesh, Eigen::Vector3d::Zero());
-      std::vector<double> ts;
-      for (int ir = 0; ir < 60; ir += 2) {
-        const Eigen::Matrix3d R = hip.femur_rotation({45, 10, double(ir)});
-        const auto t1 = Clock::now();
-        fj.collide(R, Eigen::Vector3d::Zero(), 1);
-        ts.push_back(ms_since(t1));
-      }
-      std::sort(ts.begin(), ts.end());
-      fcl_ms = ts[ts.size() / 2];
-      fcl_poses = static_cast<int>(ts.size());
-    }
-    const double search_ms = limits_ms + map_ms;
-    const double fcl_total = fcl_ms * double(all_evals);
-    tim.row(s.name, resolution, threads, joint.ball().sampling_ms + joint.socket().sampling_ms, limits_ms, map_ms,
-            search_ms, all_evals, double(all_evals) / (search_ms / 1000), double(skipped) / double(looked + skipped),
-            fcl_ms, fcl_poses, fcl_total, fcl_total / search_ms, base.excluded_vertices, base.min_gap_mm);
-
-    // Sensitivity: the COR moved 1 mm along each pelvic axis; other resolutions.
-    auto limits_of = [&](const SphereFitResult& h, double res) {
-      SessionOptions o2 = so;
-      o2.maps.precision = res;
-      o2.cor.given = h.centre;  // a perturbed centre: research, not checked against the head
-      o2.cor.allow_any = true;
-      const Session hs(o2);
-      const HipJoint& hj = hs.hip();
-      return find_rom_limits(hj, motions, ro, rom_baseline(hj, hj.femur_rotation({}), ro));
-    };
-    auto record = [&](const std::string& variant, const std::vector<RomLimit>& v) {
-      for (std::size_t k = 0; k < motions.size(); ++k)
-        sens.row(s.name, variant, motions[k].name, v[k].limit_deg, v[k].limit_deg - limits[k].limit_deg);
-    };
-    const Eigen::Matrix3d axes = hip.frames() ? hip.frames()->pelvis.axes : scan_axes();
-    const char* axis_name[3] = {"x", "y", "z"};
-    for (int a = 0; a < 3; ++a)
-      for (const double sign : {1.0, -1.0}) {
-        SphereFitResult h = head;
-        h.centre += sign * axes.col(a);
-        record(std::string("cor_") + (sign > 0 ? "+" : "-") + axis_name[a] + "_1mm", limits_of(h, resolution));
-      }
-    for (double res : sens_resolutions)
-      if (res != resolution) record("resolution_" + std::to_string(res).substr(0, 4), limits_of(head, res));
+// The ROM envelope by refinement, timed (median of 3), beside the brute force over every pose.
+void envelope(const SubjectRun& r, const Settings& st, Outputs& out) {
+  const HipJoint& hip = r.session.hip();
+  RomEnvelopeOptions eo;
+  eo.step_deg = st.quick ? 2 : 1;
+  eo.coarse_steps = 4;
+  std::vector<double> ts;
+  RomEnvelope fast;
+  for (int rep = 0; rep < 3; ++rep) {
+    const auto t1 = Clock::now();
+    fast = rom_envelope(hip, eo, st.ro, r.run.baseline);
+    ts.push_back(ms_since(t1));
   }
-  write_csv(dir + "/rom_limits.csv", lim);
-  write_csv(dir + "/rom_map.csv", map);
+  std::sort(ts.begin(), ts.end());
+  RomEnvelopeOptions bo = eo;
+  bo.coarse_steps = 1;
+  const auto t1 = Clock::now();
+  const RomEnvelope all = rom_envelope(hip, bo, st.ro, r.run.baseline);
+  const double brute_ms = ms_since(t1);
+  std::int64_t valid = 0, all_valid = 0, differ = 0;
+  for (std::size_t p = 0; p < all.valid.size(); ++p)
+    valid += fast.valid[p], all_valid += all.valid[p], differ += fast.valid[p] != all.valid[p];
+  const double ms = ts[1];
+  out.env.row(r.subject.name, st.resolution, eo.step_deg, eo.coarse_steps, st.threads, fast.poses,
+              fast.poses_evaluated, valid, ms, double(fast.poses) / (ms / 1000),
+              double(fast.poses) / (ms / 1000) / st.threads, brute_ms, all_valid, differ);
+}
+
+// The search's cost beside FCL collide on a subset of the map's poses (flexion 45, adduction 10,
+// internal rotation 0..58 step 2), extrapolated to the search's evaluations.
+void timing(const SubjectRun& r, const Settings& st, Outputs& out) {
+  const HipJoint& hip = r.session.hip();
+  const Joint& joint = hip.joint();
+  double fcl_ms = std::nan("");
+  int fcl_poses = 0;
+  if (have_fcl()) {
+    const FclJoint fj(joint.ball().mesh, joint.socket().mesh, Eigen::Vector3d::Zero());
+    std::vector<double> ts;
+    for (int ir = 0; ir < 60; ir += 2) {
+      const Eigen::Matrix3d R = hip.femur_rotation({45, 10, double(ir)});
+      const auto t1 = Clock::now();
+      fj.collide(R, Eigen::Vector3d::Zero(), 1);
+      ts.push_back(ms_since(t1));
+    }
+    std::sort(ts.begin(), ts.end());
+    fcl_ms = ts[ts.size() / 2];
+    fcl_poses = static_cast<int>(ts.size());
+  }
+  const RomRun& run = r.run;
+  const std::int64_t all_evals = run.limit_evaluations + run.map_evaluations;
+  const double search_ms = run.limits_ms + run.map_ms;
+  const double fcl_total = fcl_ms * double(all_evals);
+  out.tim.row(r.subject.name, st.resolution, st.threads, joint.ball().sampling_ms + joint.socket().sampling_ms,
+              run.limits_ms, run.map_ms, search_ms, all_evals, double(all_evals) / (search_ms / 1000),
+              double(run.vertices_skipped) / double(run.vertices_looked_up + run.vertices_skipped), fcl_ms, fcl_poses,
+              fcl_total, fcl_total / search_ms, run.baseline.excluded_vertices, run.baseline.min_gap_mm);
+}
+
+// Sensitivity: the COR moved 1 mm along each pelvic axis; other resolutions.
+void sensitivity(const SubjectRun& r, const Settings& st, Outputs& out) {
+  const HipJoint& hip = r.session.hip();
+  const std::vector<StandardMotion>& motions = r.run.motions;
+  auto limits_of = [&](const Eigen::Vector3d& centre, double res) {
+    SessionOptions o = r.options;
+    o.maps.precision = res;
+    o.cor.given = centre;  // a perturbed centre: research, not checked against the head
+    o.cor.allow_any = true;
+    const Session hs(o);
+    const HipJoint& hj = hs.hip();
+    return find_rom_limits(hj, motions, st.ro, rom_baseline(hj, hj.femur_rotation({}), st.ro));
+  };
+  auto record = [&](const std::string& variant, const std::vector<RomLimit>& v) {
+    for (std::size_t k = 0; k < motions.size(); ++k)
+      out.sens.row(r.subject.name, variant, motions[k].name, v[k].limit_deg, v[k].limit_deg - r.run.limits[k].limit_deg);
+  };
+  const Eigen::Vector3d centre = r.session.head().centre;
+  const Eigen::Matrix3d axes = hip.frames() ? hip.frames()->pelvis.axes : scan_axes();
+  const char* axis_name[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a)
+    for (const double sign : {1.0, -1.0})
+      record(std::string("cor_") + (sign > 0 ? "+" : "-") + axis_name[a] + "_1mm",
+             limits_of(centre + sign * axes.col(a), st.resolution));
+  for (double res : st.sens_resolutions)
+    if (res != st.resolution) record("resolution_" + std::to_string(res).substr(0, 4), limits_of(centre, res));
+}
+
+void write_meta_of(const Args& args, const Settings& st, const std::vector<Subject>& subjects, bool generated) {
   nlohmann::json subj = nlohmann::json::array();
   for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
-  write_meta(dir, args,
-             {{"resolution_deg", resolution},
-              {"sensitivity_resolutions_deg", sens_resolutions},
-              {"threshold_mm", ro.threshold_mm},
-              {"step_deg", ro.step_deg},
-              {"tolerance_deg", ro.tolerance_deg},
-              {"observation_levels_mm", observation_levels.thresholds_mm},
+  write_meta(st.dir, args,
+             {{"resolution_deg", st.resolution},
+              {"sensitivity_resolutions_deg", st.sens_resolutions},
+              {"threshold_mm", st.ro.threshold_mm},
+              {"step_deg", st.ro.step_deg},
+              {"tolerance_deg", st.ro.tolerance_deg},
+              {"observation_levels_mm", st.observation_levels.thresholds_mm},
               {"neutral", generated ? "scan (generated model)" : "anatomical (ISB frames from the bones)"},
               {"rom_map", "flexion 0..120 step 5 x adduction -20..40 step 5"},
               {"exact_check", "CGAL ray casts from the COR for every counted first-surface vertex, 0.5 deg "
@@ -418,5 +432,41 @@ int main(int argc, char** argv) {
               {"extra_articular_check", "CGAL all-intersection rays from the COR for every counted hidden vertex "
                                         "(signed radial distance), plus the first-hit check when all vertices count"},
               {"subjects", subj}});
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv, "09_rom_observation: thesis sec. 5.2 ROM observation, ROM limits and maps");
+  Settings st;
+  st.dir = experiment_dir(args, "09_rom_observation");
+  st.quick = args.quick;
+  const std::string src = IMPINGE_EXPERIMENTS_DIR;
+  fs::copy_file(src + "/09_thesis_table11.csv", st.dir + "/thesis_table11.csv", fs::copy_options::overwrite_existing);
+  fs::copy_file(src + "/09_published.csv", st.dir + "/published.csv", fs::copy_options::overwrite_existing);
+  st.table11 = read_table11(src + "/09_thesis_table11.csv");
+  std::vector<Subject> subjects = load_subjects(args, {});
+  const bool generated = subjects.empty();
+  if (generated) subjects = load_subjects(args, {12000});
+  st.resolution = args.quick ? 0.25 : 0.1;
+  st.sens_resolutions = args.quick ? std::vector<double>{0.5, 0.25} : std::vector<double>{0.5, 0.25, 0.1};
+  st.observation_levels.thresholds_mm = {6, 4, 2, 0};
+  st.threads = omp_get_max_threads();
+
+  Outputs out(st.dir);
+  int done = 0;
+  for (const Subject& s : subjects) {
+    progress("09_rom_observation", ++done, static_cast<int>(subjects.size()), s.name);
+    const SubjectRun r(s, st);
+    if (!s.generated) observe_table11(r, st, out);
+    record_limits(r, st, out);
+    extra_articular(r, st, out);
+    envelope(r, st, out);
+    timing(r, st, out);
+    sensitivity(r, st, out);
+  }
+  write_csv(st.dir + "/rom_limits.csv", out.lim);
+  write_csv(st.dir + "/rom_map.csv", out.map);
+  write_meta_of(args, st, subjects, generated);
   return 0;
 }
