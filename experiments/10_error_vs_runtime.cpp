@@ -31,6 +31,7 @@
 // scheme joins with no change here.
 #include <algorithm>
 #include <cstring>
+#include <functional>
 #include <iostream>
 #include <optional>
 
@@ -79,6 +80,266 @@ struct Errors {
   std::int64_t compared = 0, mismatched = 0, large = 0, discontinuity = 0, pole = 0, seam = 0;
   double max = std::nan(""), p99 = std::nan(""), p95 = std::nan(""), median = std::nan("");
 };
+
+// The experiment's two tables.
+struct Outputs {
+  explicit Outputs(const std::string& dir)
+      : csv(dir + "/error_runtime.csv",
+            {"subject",     "generated",     "pose",         "scheme",           "mode",
+             "resolution",  "precision_deg", "vertices",     "compared",         "mismatched",
+             "max_abs_mm",  "p99_abs_mm",    "p95_abs_mm",   "median_abs_mm",    "query_ns_per_vertex",
+             "sampling_ms", "bytes",         "large_errors", "at_discontinuity", "near_pole",
+             "near_seam",   "resample_precision_deg", "storage"}),
+        vcsv(dir + "/vertex_errors.csv",
+             {"subject", "scan", "x_mm", "y_mm", "z_mm", "phi_deg", "theta_deg", "stencil_spread_mm", "error_mm"}) {}
+  CsvWriter csv, vcsv;
+};
+
+// One subject: its COR, the pushed pose, the exact references, the compared vertices of both scans
+// and the oracle's gaps at both poses.
+struct SubjectData {
+  explicit SubjectData(const Subject& subject)
+      : s(subject), cor(subject_cor(s)), push(3.0 * push_direction(s.pelvis, cor, kRegionMm)), ref_f(s.femur),
+        ref_p(s.pelvis), fset(exact_scan_set(s.femur, ref_f, cor)), pset(exact_scan_set(s.pelvis, ref_p, cor)),
+        nv(fset.size() + pset.size()) {
+    if (FirstHitCaster::available()) casters.emplace(FirstHitCaster(s.femur, cor), FirstHitCaster(s.pelvis, cor));
+    // The oracle per pose: exact radial gaps of both scans.
+    for (int pose = 0; pose < 2; ++pose)
+      for (int scan = 0; scan < 2; ++scan) {
+        const ScanSet& set = scan == 0 ? fset : pset;
+        const ExactReference& other = scan == 0 ? ref_p : ref_f;
+        const Eigen::Vector3d tt = scan == 0 ? translation(pose) : Eigen::Vector3d(-translation(pose));
+        const double side = scan == 0 ? 1 : -1;
+        for (std::int64_t j = 0; j < set.size(); ++j) {
+          const Eigen::Vector3d q = Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + tt;
+          const auto h = other.first_hit(cor, q.normalized());
+          exact[pose][scan].push_back(h ? float(side * (*h - q.norm())) : std::numeric_limits<float>::quiet_NaN());
+          dirs[pose][scan].push_back(q);
+        }
+      }
+  }
+  Eigen::Vector3d translation(int pose) const { return pose == 0 ? Eigen::Vector3d::Zero() : push; }
+  static const char* pose_name(int pose) { return pose == 0 ? "rest" : "pushed_3mm"; }
+  // Gaps of both scans (ball against the pelvis map, pelvis against the femur map) at `pose`, and the
+  // median time of `reps` scans (ms).
+  using Scan = std::function<void(const Eigen::Vector3d& t, std::vector<float> (&g)[2])>;
+  double scan(int pose, const Scan& fn, std::vector<float> (&g)[2], int reps) const {
+    g[0].assign(std::size_t(fset.size()), 0.f);
+    g[1].assign(std::size_t(pset.size()), 0.f);
+    return median_ms([&] { fn(translation(pose), g); }, reps);
+  }
+
+  const Subject& s;
+  const Eigen::Vector3d cor, push;
+  const ExactReference ref_f, ref_p;
+  std::optional<std::pair<FirstHitCaster, FirstHitCaster>> casters;
+  const ScanSet fset, pset;
+  const std::int64_t nv;
+  std::vector<float> exact[2][2];
+  std::vector<Eigen::Vector3d> dirs[2][2];  // q in the other map's frame
+};
+
+// Errors of gaps `g` (both scans) against the oracle at `pose`; the maps' stencil spreads classify
+// the large ones (nullptr for peers without maps). `dump`: each vertex's error into vertex_errors.csv.
+Errors evaluate(const SubjectData& d, int pose, const std::vector<float> (&g)[2], const RadialDistanceMap* fm,
+                const RadialDistanceMap* pm, CsvWriter* dump) {
+  Errors e;
+  std::vector<double> abs;
+  for (int scan = 0; scan < 2; ++scan) {
+    const RadialDistanceMap* other = scan == 0 ? pm : fm;
+    for (std::size_t j = 0; j < g[scan].size(); ++j) {
+      const float a = g[scan][j], b = d.exact[pose][scan][j];
+      if (std::isnan(a) != std::isnan(b)) ++e.mismatched;
+      if (std::isnan(a) || std::isnan(b)) continue;
+      const double err = std::abs(double(a) - double(b));
+      abs.push_back(err);
+      const Eigen::Vector3d& q = d.dirs[pose][scan][j];
+      double spread = std::nan("");
+      if (other != nullptr) {
+        const Stencil st = other->scheme().interpolate(q.normalized());
+        double lo = 1e300, hi = -1e300;
+        for (int k = 0; k < 4; ++k)
+          if (st.weights[k] > 0)
+            lo = std::min<double>(lo, other->at(st.nodes[k])), hi = std::max<double>(hi, other->at(st.nodes[k]));
+        spread = hi - lo;
+      }
+      const SphericalCoordinates sc = to_spherical(q);
+      if (dump != nullptr)
+        dump->row(d.s.name, scan == 0 ? "ball" : "socket", q.x(), q.y(), q.z(), sc.phi * kRadToDeg,
+                  sc.theta * kRadToDeg, spread, err);
+      if (err > 0.05) {
+        ++e.large;
+        e.discontinuity += spread > 2.0;
+        e.pole += sc.phi * kRadToDeg < 2 || sc.phi * kRadToDeg > 178;
+        const double th = sc.theta * kRadToDeg;
+        e.seam += th < 1 || th > 359;
+      }
+    }
+  }
+  e.compared = static_cast<std::int64_t>(abs.size());
+  if (!abs.empty()) {
+    e.max = *std::max_element(abs.begin(), abs.end());
+    e.p99 = quantile(abs, 0.99), e.p95 = quantile(abs, 0.95), e.median = quantile(abs, 0.5);
+  }
+  return e;
+}
+
+// One row of error_runtime.csv.
+struct Row {
+  std::string scheme, mode;
+  double resolution = 0, precision = 0, ns = 0, sampling_ms = 0, bytes = 0, resample_p = 0;
+  const char* storage = "dense";
+};
+void put(Outputs& out, const SubjectData& d, int pose, const Row& r, const Errors& e) {
+  out.csv.row(d.s.name, int(d.s.generated), SubjectData::pose_name(pose), r.scheme, r.mode, r.resolution, r.precision,
+              d.nv, e.compared, e.mismatched, e.max, e.p99, e.p95, e.median, r.ns, r.sampling_ms, r.bytes, e.large,
+              e.discontinuity, e.pole, e.seam, r.resample_p, r.storage);
+}
+
+// Both maps of one scheme, resolution and mode, filled and timed.
+struct Maps {
+  RadialDistanceMap fm, pm;
+  double sampling_ms = 0, resample_p = 0;
+};
+Maps fill_maps(const SubjectData& d, const std::shared_ptr<const SamplingScheme>& scheme, DistanceMode mode,
+               double p, int reps) {
+  Maps m{RadialDistanceMap(scheme), RadialDistanceMap(scheme), 0, 0};
+  SamplingOptions o;
+  o.mode = mode;
+  // Schemes without a rasteriser: in exact mode, the exact first hit at every node through a BVH
+  // (ray-cast-bvh), so that the comparison at equal error is of the schemes' interpolation, not of a
+  // fill; in linear mode (the thesis' rasteriser approximation) resampled from an equiangular map at
+  // half their matched precision, which adds a quarter of its error, not all of it (issue 12); the
+  // thesis' own matched precision is experiment 02's.
+  o.resample_oversampling = 2;
+  if (mode == DistanceMode::exact && scheme->name() != "equiangular" && FirstHitCaster::available())
+    o.method = SamplingMethod::ray_cast_bvh;
+  m.sampling_ms = median_ms(
+      [&] {
+        std::fill(m.fm.data(), m.fm.data() + m.fm.num_nodes(), RadialDistanceMap::no_surface());
+        std::fill(m.pm.data(), m.pm.data() + m.pm.num_nodes(), RadialDistanceMap::no_surface());
+        m.resample_p = sample_surface(d.s.femur, d.cor, o, m.fm).resample_precision_deg;
+        sample_surface(d.s.pelvis, d.cor, o, m.pm);
+      },
+      // a ray-cast fill of a fine map takes seconds: one timing is enough
+      o.method == SamplingMethod::ray_cast_bvh && p <= 0.1 ? 1 : p < 0.1 ? std::min(reps, 3) : reps);
+  return m;
+}
+
+// The maps' look-ups at both poses: dense, then (exact mode) sparse storage (issue 12; the gaps must
+// be the dense maps' bit for bit) and exact look-ups at depth discontinuities (issue 15; sampling time
+// includes the marking).
+void measure_maps(const SubjectData& d, const Maps& m, Row row, DistanceMode mode, int reps, Outputs& out) {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const double per_vertex = 1e6 / double(d.nv);
+  std::vector<float> g[2];
+  auto lookups = [&](const RadialDistanceMap& fm, const RadialDistanceMap& pm, const FirstHitCaster* cf,
+                     const FirstHitCaster* cp) {
+    return [&d, &I, f = &fm, p = &pm, cf, cp](const Eigen::Vector3d& t, std::vector<float> (&gg)[2]) {
+      scan_gaps_compact(d.fset, I, t, *p, ScanSide::inside, gg[0].data(), cp);
+      scan_gaps_compact(d.pset, I, Eigen::Vector3d(-t), *f, ScanSide::outside, gg[1].data(), cf);
+    };
+  };
+  for (int pose = 0; pose < 2; ++pose) {
+    row.ns = d.scan(pose, lookups(m.fm, m.pm, nullptr, nullptr), g, reps) * per_vertex;
+    const bool dump = pose == 0 && row.scheme == "equiangular" && mode == DistanceMode::exact && row.precision == 0.1;
+    put(out, d, pose, row, evaluate(d, pose, g, &m.fm, &m.pm, dump ? &out.vcsv : nullptr));
+  }
+  if (mode != DistanceMode::exact) return;
+  RadialDistanceMap fms = m.fm, pms = m.pm;
+  const double tsp = median_ms(
+      [&] {
+        fms = m.fm, pms = m.pm;
+        fms.make_sparse();
+        pms.make_sparse();
+      },
+      row.precision < 0.1 ? std::min(reps, 3) : reps);
+  Row sparse = row;
+  sparse.sampling_ms += tsp, sparse.bytes = double(fms.bytes() + pms.bytes()), sparse.storage = "sparse";
+  for (int pose = 0; pose < 2; ++pose) {
+    sparse.ns = d.scan(pose, lookups(fms, pms, nullptr, nullptr), g, reps) * per_vertex;
+    std::vector<float> dense[2];
+    d.scan(pose, lookups(m.fm, m.pm, nullptr, nullptr), dense, 1);
+    for (int k = 0; k < 2; ++k)
+      require(std::memcmp(g[k].data(), dense[k].data(), g[k].size() * sizeof(float)) == 0,
+              "10_error_vs_runtime: " + d.s.name + " " + row.scheme + ": sparse gaps differ from dense");
+    put(out, d, pose, sparse, evaluate(d, pose, g, &fms, &pms, nullptr));
+  }
+  if (!d.casters) return;
+  RadialDistanceMap fmr = m.fm, pmr = m.pm;
+  const double tm = median_ms(
+      [&] {
+        mark_depth_discontinuities(fmr, kDiscontinuityToleranceMm);
+        mark_depth_discontinuities(pmr, kDiscontinuityToleranceMm);
+      },
+      row.precision < 0.1 ? std::min(reps, 3) : reps);
+  Row refined = row;
+  refined.mode = "exact_refined", refined.sampling_ms += tm, refined.bytes = double(fmr.bytes() + pmr.bytes());
+  for (int pose = 0; pose < 2; ++pose) {
+    refined.ns = d.scan(pose, lookups(fmr, pmr, &d.casters->first, &d.casters->second), g, reps) * per_vertex;
+    put(out, d, pose, refined, evaluate(d, pose, g, &fmr, &pmr, nullptr));
+  }
+}
+
+// Every registered scheme at the coarsest resolution whose largest node spacing is at most p, both modes.
+void measure_schemes(const SubjectData& d, double p, int reps, Outputs& out) {
+  for (const auto& [name, resname] : scheme_names()) {
+    (void)resname;
+    const double res = resolution_for_spacing(name, p);
+    for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
+      std::shared_ptr<const SamplingScheme> scheme;
+      try {
+        scheme = make_scheme(name, res);
+      } catch (const Error&) {
+        continue;  // a resolution this scheme does not take (e.g. conchoid needs 90/p integral)
+      }
+      const Maps m = fill_maps(d, scheme, mode, p, reps);
+      Row row{name, to_string(mode), res, p, 0, m.sampling_ms, double(m.fm.bytes() + m.pm.bytes()), m.resample_p};
+      measure_maps(d, m, row, mode, reps, out);
+    }
+  }
+}
+
+// Peers on the same vertices: Embree (float ray casting, single rays and packets of 8) and CGAL itself.
+void measure_peers(const SubjectData& d, int reps, Outputs& out) {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const double per_vertex = 1e6 / double(d.nv);
+  std::vector<float> g[2];
+  const double nan = std::nan("");
+  for (int pose = 0; pose < 2; ++pose) {
+    if (have_embree()) {
+      const EmbreeRayCaster ef(d.s.femur, d.cor), ep(d.s.pelvis, d.cor);
+      for (int packet = 0; packet < 2; ++packet) {
+        const double tq = d.scan(
+            pose,
+            [&](const Eigen::Vector3d& t, std::vector<float> (&gg)[2]) {
+              scan_gaps_embree(ep, d.fset, I, t, ScanSide::inside, gg[0].data(), packet);
+              scan_gaps_embree(ef, d.pset, I, Eigen::Vector3d(-t), ScanSide::outside, gg[1].data(), packet);
+            },
+            g, reps);
+        put(out, d, pose, {packet ? "embree_radial_packet8" : "embree_radial", "exact", 0, 0, tq * per_vertex, nan, nan, 0},
+            evaluate(d, pose, g, nullptr, nullptr, nullptr));
+      }
+    }
+    const double tq = d.scan(
+        pose,
+        [&](const Eigen::Vector3d& t, std::vector<float> (&gg)[2]) {
+          for (int scan = 0; scan < 2; ++scan) {
+            const ScanSet& set = scan == 0 ? d.fset : d.pset;
+            const ExactReference& other = scan == 0 ? d.ref_p : d.ref_f;
+            const Eigen::Vector3d tt = scan == 0 ? t : Eigen::Vector3d(-t);
+            for (std::int64_t j = 0; j < set.size(); ++j) {
+              const Eigen::Vector3d q = Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + tt;
+              const auto h = other.first_hit(d.cor, q.normalized());
+              gg[scan][std::size_t(j)] = h ? float((scan == 0 ? 1 : -1) * (*h - q.norm())) : std::nanf("");
+            }
+          }
+        },
+        g, std::max(1, reps / 2));
+    put(out, d, pose, {"cgal_radial", "exact", 0, 0, tq * per_vertex, nan, nan, 0},
+        evaluate(d, pose, g, nullptr, nullptr, nullptr));
+  }
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -94,242 +355,18 @@ int main(int argc, char** argv) {
   // equal-error figures (analysis) interpolate across steps of 2x in bytes rather than 4-6x.
   // Quick runs check the pipeline at coarse resolutions only (a minute or two; the analysis writes
   // "--" for the targets these do not reach).
-  std::vector<double> precisions = args.quick ? std::vector<double>{2, 1, 0.5}
-                                              : std::vector<double>{2, 1, 0.5, 0.35, 0.25, 0.16, 0.1, 0.05};
-  const int reps = args.repetitions;
-
-  CsvWriter csv(dir + "/error_runtime.csv",
-                {"subject",     "generated",     "pose",         "scheme",           "mode",
-                 "resolution",  "precision_deg", "vertices",     "compared",         "mismatched",
-                 "max_abs_mm",  "p99_abs_mm",    "p95_abs_mm",   "median_abs_mm",    "query_ns_per_vertex",
-                 "sampling_ms", "bytes",         "large_errors", "at_discontinuity", "near_pole",
-                 "near_seam",   "resample_precision_deg", "storage"});
-  CsvWriter vcsv(dir + "/vertex_errors.csv",
-                 {"subject", "scan", "x_mm", "y_mm", "z_mm", "phi_deg", "theta_deg", "stencil_spread_mm", "error_mm"});
-  const auto schemes = scheme_names();
+  const std::vector<double> precisions = args.quick ? std::vector<double>{2, 1, 0.5}
+                                                    : std::vector<double>{2, 1, 0.5, 0.35, 0.25, 0.16, 0.1, 0.05};
+  Outputs out(dir);
   int done = 0;
   const int total = static_cast<int>(subjects.size() * precisions.size());
   for (const Subject& s : subjects) {
-    const Eigen::Vector3d cor = subject_cor(s);
-    const Eigen::Vector3d push = 3.0 * push_direction(s.pelvis, cor, kRegionMm);
-    const ExactReference ref_f(s.femur), ref_p(s.pelvis);
-    std::optional<std::pair<FirstHitCaster, FirstHitCaster>> casters;
-    if (FirstHitCaster::available()) casters.emplace(FirstHitCaster(s.femur, cor), FirstHitCaster(s.pelvis, cor));
-    const ScanSet fset = exact_scan_set(s.femur, ref_f, cor), pset = exact_scan_set(s.pelvis, ref_p, cor);
-    const std::int64_t nv = fset.size() + pset.size();
-    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-    // The oracle per pose: exact radial gaps of both scans.
-    std::vector<float> exact[2][2];
-    std::vector<Eigen::Vector3d> dirs[2][2];  // q in the other map's frame
-    for (int pose = 0; pose < 2; ++pose) {
-      const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
-      for (int scan = 0; scan < 2; ++scan) {
-        const ScanSet& set = scan == 0 ? fset : pset;
-        const ExactReference& other = scan == 0 ? ref_p : ref_f;
-        const Eigen::Vector3d tt = scan == 0 ? t : Eigen::Vector3d(-t);
-        const double side = scan == 0 ? 1 : -1;
-        for (std::int64_t j = 0; j < set.size(); ++j) {
-          const Eigen::Vector3d q = Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + tt;
-          const auto h = other.first_hit(cor, q.normalized());
-          exact[pose][scan].push_back(h ? float(side * (*h - q.norm())) : std::numeric_limits<float>::quiet_NaN());
-          dirs[pose][scan].push_back(q);
-        }
-      }
-    }
-    auto evaluate = [&](int pose, const std::vector<float>(&g)[2], const RadialDistanceMap* fm,
-                        const RadialDistanceMap* pm, bool dump) {
-      Errors e;
-      std::vector<double> abs;
-      for (int scan = 0; scan < 2; ++scan) {
-        const RadialDistanceMap* other = scan == 0 ? pm : fm;
-        for (std::size_t j = 0; j < g[scan].size(); ++j) {
-          const float a = g[scan][j], b = exact[pose][scan][j];
-          if (std::isnan(a) != std::isnan(b)) ++e.mismatched;
-          if (std::isnan(a) || std::isnan(b)) continue;
-          const double err = std::abs(double(a) - double(b));
-          abs.push_back(err);
-          const Eigen::Vector3d& q = dirs[pose][scan][j];
-          double spread = std::nan("");
-          if (other != nullptr) {
-            const Stencil st = other->scheme().interpolate(q.normalized());
-            double lo = 1e300, hi = -1e300;
-            for (int k = 0; k < 4; ++k)
-              if (st.weights[k] > 0)
-                lo = std::min<double>(lo, other->at(st.nodes[k])), hi = std::max<double>(hi, other->at(st.nodes[k]));
-            spread = hi - lo;
-          }
-          const SphericalCoordinates sc = to_spherical(q);
-          if (dump)
-            vcsv.row(s.name, scan == 0 ? "ball" : "socket", q.x(), q.y(), q.z(), sc.phi * kRadToDeg,
-                     sc.theta * kRadToDeg, spread, err);
-          if (err > 0.05) {
-            ++e.large;
-            e.discontinuity += spread > 2.0;
-            e.pole += sc.phi * kRadToDeg < 2 || sc.phi * kRadToDeg > 178;
-            const double th = sc.theta * kRadToDeg;
-            e.seam += th < 1 || th > 359;
-          }
-        }
-      }
-      e.compared = static_cast<std::int64_t>(abs.size());
-      if (!abs.empty()) {
-        e.max = *std::max_element(abs.begin(), abs.end());
-        e.p99 = quantile(abs, 0.99), e.p95 = quantile(abs, 0.95), e.median = quantile(abs, 0.5);
-      }
-      return e;
-    };
-    auto put = [&](const std::string& pose, const std::string& scheme, const std::string& mode, double res, double p,
-                   const Errors& e, double ns, double sampling_ms, double bytes, double resample_p,
-                   const char* storage = "dense") {
-      csv.row(s.name, int(s.generated), pose, scheme, mode, res, p, nv, e.compared, e.mismatched, e.max, e.p99, e.p95,
-              e.median, ns, sampling_ms, bytes, e.large, e.discontinuity, e.pole, e.seam, resample_p, storage);
-    };
-
+    const SubjectData d(s);
     for (double p : precisions) {
       progress("10_error_vs_runtime", ++done, total, s.name + " p=" + std::to_string(p));
-      for (const auto& [name, resname] : schemes) {
-        (void)resname;
-        // Every scheme at the coarsest resolution whose largest node spacing is at most p.
-        const double res = resolution_for_spacing(name, p);
-        for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
-          std::shared_ptr<const SamplingScheme> scheme;
-          try {
-            scheme = make_scheme(name, res);
-          } catch (const Error&) {
-            continue;  // a resolution this scheme does not take (e.g. conchoid needs 90/p integral)
-          }
-          RadialDistanceMap fm(scheme), pm(scheme);
-          SamplingOptions o;
-          o.mode = mode;
-          // Schemes without a rasteriser: in exact mode, the exact first hit at every node through a
-          // BVH (ray-cast-bvh), so that the comparison at equal error is of the schemes' interpolation,
-          // not of a fill; in linear mode (the thesis' rasteriser approximation) resampled from an
-          // equiangular map at half their matched precision, which adds a quarter of its error, not
-          // all of it (issue 12); the thesis' own matched precision is experiment 02's.
-          o.resample_oversampling = 2;
-          if (mode == DistanceMode::exact && name != "equiangular" && FirstHitCaster::available())
-            o.method = SamplingMethod::ray_cast_bvh;
-          double resample_p = 0;
-          const double ts = median_ms(
-              [&] {
-                std::fill(fm.data(), fm.data() + fm.num_nodes(), RadialDistanceMap::no_surface());
-                std::fill(pm.data(), pm.data() + pm.num_nodes(), RadialDistanceMap::no_surface());
-                resample_p = sample_surface(s.femur, cor, o, fm).resample_precision_deg;
-                sample_surface(s.pelvis, cor, o, pm);
-              },
-              // a ray-cast fill of a fine map takes seconds: one timing is enough
-              o.method == SamplingMethod::ray_cast_bvh && p <= 0.1 ? 1 : p < 0.1 ? std::min(reps, 3) : reps);
-          for (int pose = 0; pose < 2; ++pose) {
-            const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
-            std::vector<float> g[2] = {std::vector<float>(std::size_t(fset.size())),
-                                       std::vector<float>(std::size_t(pset.size()))};
-            const double tq = median_ms(
-                [&] {
-                  scan_gaps_compact(fset, I, t, pm, ScanSide::inside, g[0].data());
-                  scan_gaps_compact(pset, I, Eigen::Vector3d(-t), fm, ScanSide::outside, g[1].data());
-                },
-                reps);
-            const bool dump = pose == 0 && name == "equiangular" && mode == DistanceMode::exact && p == 0.1;
-            const Errors e = evaluate(pose, g, &fm, &pm, dump);
-            put(pose == 0 ? "rest" : "pushed_3mm", name, to_string(mode), res, p, e, tq * 1e6 / double(nv), ts,
-                double(fm.bytes() + pm.bytes()), resample_p);
-          }
-          // Sparse storage (issue 12): the same maps with only the tiles that hold a surface; the gaps
-          // are the dense maps' bit for bit (checked here), the bytes and the query time are not.
-          if (mode == DistanceMode::exact) {
-            RadialDistanceMap fms = fm, pms = pm;
-            const double tsp = median_ms(
-                [&] {
-                  fms = fm, pms = pm;
-                  fms.make_sparse();
-                  pms.make_sparse();
-                },
-                p < 0.1 ? std::min(reps, 3) : reps);
-            for (int pose = 0; pose < 2; ++pose) {
-              const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
-              std::vector<float> g[2] = {std::vector<float>(std::size_t(fset.size())),
-                                         std::vector<float>(std::size_t(pset.size()))};
-              std::vector<float> d[2] = {g[0], g[1]};
-              const double tq = median_ms(
-                  [&] {
-                    scan_gaps_compact(fset, I, t, pms, ScanSide::inside, g[0].data());
-                    scan_gaps_compact(pset, I, Eigen::Vector3d(-t), fms, ScanSide::outside, g[1].data());
-                  },
-                  reps);
-              scan_gaps_compact(fset, I, t, pm, ScanSide::inside, d[0].data());
-              scan_gaps_compact(pset, I, Eigen::Vector3d(-t), fm, ScanSide::outside, d[1].data());
-              for (int k = 0; k < 2; ++k)
-                require(std::memcmp(g[k].data(), d[k].data(), g[k].size() * sizeof(float)) == 0,
-                        "10_error_vs_runtime: " + s.name + " " + name + ": sparse gaps differ from dense");
-              put(pose == 0 ? "rest" : "pushed_3mm", name, to_string(mode), res, p, evaluate(pose, g, &fms, &pms, false),
-                  tq * 1e6 / double(nv), ts + tsp, double(fms.bytes() + pms.bytes()), resample_p, "sparse");
-            }
-          }
-          // Exact look-ups at depth discontinuities (issue 15): the same maps with their marks, the
-          // marked look-ups resolved by ray casts. Sampling time includes the marking.
-          if (mode == DistanceMode::exact && casters) {
-            RadialDistanceMap fmr = fm, pmr = pm;
-            const double tm = median_ms(
-                [&] {
-                  mark_depth_discontinuities(fmr, kDiscontinuityToleranceMm);
-                  mark_depth_discontinuities(pmr, kDiscontinuityToleranceMm);
-                },
-                p < 0.1 ? std::min(reps, 3) : reps);
-            for (int pose = 0; pose < 2; ++pose) {
-              const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
-              std::vector<float> g[2] = {std::vector<float>(std::size_t(fset.size())),
-                                         std::vector<float>(std::size_t(pset.size()))};
-              const double tq = median_ms(
-                  [&] {
-                    scan_gaps_compact(fset, I, t, pmr, ScanSide::inside, g[0].data(), &casters->second);
-                    scan_gaps_compact(pset, I, Eigen::Vector3d(-t), fmr, ScanSide::outside, g[1].data(),
-                                      &casters->first);
-                  },
-                  reps);
-              put(pose == 0 ? "rest" : "pushed_3mm", name, "exact_refined", res, p,
-                  evaluate(pose, g, &fmr, &pmr, false), tq * 1e6 / double(nv), ts + tm,
-                  double(fmr.bytes() + pmr.bytes()), resample_p);
-            }
-          }
-        }
-      }
+      measure_schemes(d, p, args.repetitions, out);
     }
-    // Peers on the same vertices: Embree (float ray casting) and CGAL itself.
-    for (int pose = 0; pose < 2; ++pose) {
-      const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
-      const std::string pname = pose == 0 ? "rest" : "pushed_3mm";
-      std::vector<float> g[2] = {std::vector<float>(std::size_t(fset.size())),
-                                 std::vector<float>(std::size_t(pset.size()))};
-      if (have_embree()) {
-        const EmbreeRayCaster ef(s.femur, cor), ep(s.pelvis, cor);
-        for (int packet = 0; packet < 2; ++packet) {
-          const double tq = median_ms(
-              [&] {
-                scan_gaps_embree(ep, fset, I, t, ScanSide::inside, g[0].data(), packet);
-                scan_gaps_embree(ef, pset, I, Eigen::Vector3d(-t), ScanSide::outside, g[1].data(), packet);
-              },
-              reps);
-          put(pname, packet ? "embree_radial_packet8" : "embree_radial", "exact", 0, 0,
-              evaluate(pose, g, nullptr, nullptr, false), tq * 1e6 / double(nv), std::nan(""), std::nan(""), 0);
-        }
-      }
-      const double tq = median_ms(
-          [&] {
-            for (int scan = 0; scan < 2; ++scan) {
-              const ScanSet& set = scan == 0 ? fset : pset;
-              const ExactReference& other = scan == 0 ? ref_p : ref_f;
-              const Eigen::Vector3d tt = scan == 0 ? t : Eigen::Vector3d(-t);
-              for (std::int64_t j = 0; j < set.size(); ++j) {
-                const Eigen::Vector3d q = Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + tt;
-                const auto h = other.first_hit(cor, q.normalized());
-                g[scan][std::size_t(j)] = h ? float((scan == 0 ? 1 : -1) * (*h - q.norm())) : std::nanf("");
-              }
-            }
-          },
-          std::max(1, reps / 2));
-      put(pname, "cgal_radial", "exact", 0, 0, evaluate(pose, g, nullptr, nullptr, false), tq * 1e6 / double(nv),
-          std::nan(""), std::nan(""), 0);
-    }
+    measure_peers(d, args.repetitions, out);
   }
   write_meta(dir, args,
              {{"precisions_deg", precisions},
