@@ -46,187 +46,157 @@
 using namespace impinge;
 using namespace impinge::experiment;
 
-int main(int argc, char** argv) {
-  const Args args = parse_args(argc, argv, "08_distance_maps: gap statistics and maps on real joints");
-  const std::string dir = experiment_dir(args, "08_distance_maps");
-  std::vector<Subject> subjects = load_subjects(args, {3000});
-  // Quick runs check the pipeline at 1 and 0.5 deg; full runs add 0.1 and 0.05 deg.
-  const std::vector<double> precisions = args.quick ? std::vector<double>{1, 0.5} : std::vector<double>{1, 0.5, 0.1, 0.05};
-  const double finest = precisions.back();
+namespace {
 
-  CsvWriter stats(dir + "/gap_statistics.csv", {"subject",
-                                                "generated",
-                                                "scheme",
-                                                "resolution",
-                                                "precision_deg",
-                                                "mode",
-                                                "scan",
-                                                "cor_ras_x_mm",
-                                                "cor_ras_y_mm",
-                                                "cor_ras_z_mm",
-                                                "head_radius_mm",
-                                                "sphere_fit_rms_mm",
-                                                "cor_error_mm",
-                                                "vertices",
-                                                "vertices_tested",
-                                                "vertices_no_surface",
-                                                "vertices_beyond_reach",
-                                                "min_gap_mm",
-                                                "vertices_penetrating",
-                                                "area_penetrating_mm2",
-                                                "level_none",
-                                                "level_yellow",
-                                                "level_orange",
-                                                "level_red",
-                                                "level_purple",
-                                                "map_nodes",
-                                                "map_nodes_covered",
-                                                "map_bytes",
-                                                "sampling_ms",
-                                                "detection_ms",
-                                                "detection_ns_per_lookup",
-                                                "linear_vs_exact_p95_abs_mm",
-                                                "vs_equiangular_p95_abs_mm",
-                                                "vs_equiangular_max_abs_mm",
-                                                "vs_equiangular_compared"});
-  CsvWriter map_images(dir + "/map_images.csv",
-                       {"subject", "body", "scheme", "resolution", "file", "nearest_mm", "farthest_mm"});
-  CsvWriter vertices(dir + "/vertex_gaps.csv", {"subject", "scan", "vertex", "x_mm", "y_mm", "z_mm", "gap_mm"});
+// The tables of the gap statistics.
+struct Outputs {
+  explicit Outputs(const std::string& dir)
+      : stats(dir + "/gap_statistics.csv",
+              {"subject", "generated", "scheme", "resolution", "precision_deg", "mode", "scan", "cor_ras_x_mm",
+               "cor_ras_y_mm", "cor_ras_z_mm", "head_radius_mm", "sphere_fit_rms_mm", "cor_error_mm", "vertices",
+               "vertices_tested", "vertices_no_surface", "vertices_beyond_reach", "min_gap_mm",
+               "vertices_penetrating", "area_penetrating_mm2", "level_none", "level_yellow", "level_orange",
+               "level_red", "level_purple", "map_nodes", "map_nodes_covered", "map_bytes", "sampling_ms",
+               "detection_ms", "detection_ns_per_lookup", "linear_vs_exact_p95_abs_mm", "vs_equiangular_p95_abs_mm",
+               "vs_equiangular_max_abs_mm", "vs_equiangular_compared"}),
+        map_images(dir + "/map_images.csv",
+                   {"subject", "body", "scheme", "resolution", "file", "nearest_mm", "farthest_mm"}),
+        vertices(dir + "/vertex_gaps.csv", {"subject", "scan", "vertex", "x_mm", "y_mm", "z_mm", "gap_mm"}) {}
+  CsvWriter stats, map_images, vertices;
+};
 
-  const auto others = static_cast<int>(scheme_names().size()) - 2;  // registered beyond the thesis' two
-  const auto coarse = std::count_if(precisions.begin(), precisions.end(), [](double p) { return p >= 0.1; });
-  const int total = static_cast<int>(subjects.size()) * (static_cast<int>(precisions.size()) * 4 + static_cast<int>(coarse) * others);
-  auto abs_diff = [](const std::vector<float>& a, const std::vector<float>& b) {
-    std::vector<double> d;
-    for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
-      if (std::isfinite(a[i]) && std::isfinite(b[i])) d.push_back(std::abs(double(a[i]) - b[i]));
-    std::sort(d.begin(), d.end());
-    return d;
-  };
-  auto quantile = [](const std::vector<double>& d, double q) {
-    return d.empty() ? std::nan("") : d[static_cast<std::size_t>(q * double(d.size() - 1))];
-  };
-  int done = 0;
-  for (const Subject& s : subjects) {
-    const SphereFitResult fit = fit_femoral_head(s.femur);
-    const double cor_error = s.generated ? (fit.centre - s.true_cor).norm() : std::nan("");
-    for (double p : precisions) {
-      std::map<DistanceMode, std::vector<float>> rsid_ball;  // equiangular ball gaps per mode
-      const double k = matched_helix_turns(p);
-      std::vector<std::shared_ptr<const SamplingScheme>> schemes{make_scheme("equiangular", p), make_scheme("helix", k)};
-      // Every other registered scheme (issue 12: without touching this driver), exact mode, at the
-      // coarsest resolution whose node spacing is at most p, for p >= 0.1 deg.
-      if (p >= 0.1)
-        for (const auto& [name, unit] : scheme_names()) {
-          (void)unit;
-          if (name == "equiangular" || name == "helix") continue;
-          try {
-            schemes.push_back(make_scheme(name, resolution_for_spacing(name, p)));
-          } catch (const Error&) {
-            // a resolution this scheme does not take at this spacing (e.g. conchoid needs 90/p integral)
-          }
-        }
-      for (const auto& scheme : schemes) {
-        const bool helix = scheme->name() != "equiangular";  // compared with the equiangular gaps below
-        const bool thesis_scheme = scheme->name() == "equiangular" || scheme->name() == "helix";
-        std::vector<float> exact_ball;  // exact-mode gaps, for the linear-vs-exact difference
-        for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
-          if (!thesis_scheme && mode == DistanceMode::linear) continue;
-          progress("08_distance_maps", ++done, total,
-                   s.name + " " + scheme->name() + " " + std::to_string(scheme->resolution()) + " " + to_string(mode));
-          JointOptions o;
-          o.scheme = scheme;
-          o.mode = mode;
-          const Joint joint(s.femur, s.pelvis, fit.centre, o);
-          const PoseResult res = joint.detect(Eigen::Matrix3d::Identity());
-          // Timings: rasterisation of each body and each scan, medians.
-          const int reps = p <= 0.05 ? std::max(1, args.repetitions / 2) : args.repetitions;
-          double sample_ms[2], detect_ms[2];
-          const JointBody* bodies[2] = {&joint.ball(), &joint.socket()};
-          for (int b = 0; b < 2; ++b) {
-            RadialDistanceMap scratch{scheme};
-            SamplingOptions so;
-            so.mode = mode;
-            sample_ms[b] = median_ms(
-                [&] {
-                  std::fill(scratch.data(), scratch.data() + scratch.num_nodes(), RadialDistanceMap::no_surface());
-                  sample_surface(bodies[b]->mesh, fit.centre, so, scratch);
-                },
-                reps);
-          }
-          ScanGaps scratch_gaps;
-          detect_ms[0] = median_ms(
-              [&] {
-                scan_gaps(joint.ball().relative, Eigen::Matrix3d::Identity(), joint.ball().mask, joint.socket().map,
-                          ScanSide::inside, scratch_gaps);
-              },
-              args.repetitions);
-          detect_ms[1] = median_ms(
-              [&] {
-                scan_gaps(joint.socket().relative, Eigen::Matrix3d::Identity(), joint.socket().mask, joint.ball().map,
-                          ScanSide::outside, scratch_gaps);
-              },
-              args.repetitions);
-          double p95 = std::nan(""), vs_p95 = std::nan(""), vs_max = std::nan("");
-          std::int64_t vs_n = 0;
-          if (mode == DistanceMode::exact)
-            exact_ball = res.ball_gaps.gap_mm;
-          else
-            p95 = quantile(abs_diff(exact_ball, res.ball_gaps.gap_mm), 0.95);
-          if (!helix) {
-            rsid_ball[mode] = res.ball_gaps.gap_mm;
-          } else {
-            const std::vector<double> d = abs_diff(rsid_ball[mode], res.ball_gaps.gap_mm);
-            vs_p95 = quantile(d, 0.95);
-            vs_max = d.empty() ? std::nan("") : d.back();
-            vs_n = static_cast<std::int64_t>(d.size());
-          }
-          const ScanSummary* sums[2] = {&res.ball, &res.socket};
-          for (int b = 0; b < 2; ++b) {
-            const ScanSummary& sm = *sums[b];
-            const JointBody& body = *bodies[b];
-            // per map look-up (tested + no surface); masked vertices cost one byte test each
-            const std::int64_t lookups = sm.vertices_tested + sm.vertices_no_surface;
-            const double ns = lookups > 0 ? detect_ms[b] * 1e6 / double(lookups) : std::nan("");
-            stats.row(s.name, int(s.generated), scheme->name(), scheme->resolution(), p, to_string(mode),
-                      b == 0 ? "ball" : "socket", fit.centre.x(), fit.centre.y(), fit.centre.z(), fit.radius,
-                      fit.rms_residual, cor_error, sm.vertices, sm.vertices_tested, sm.vertices_no_surface,
-                      sm.vertices_beyond_reach, sm.min_gap_mm, sm.vertices_penetrating, sm.area_penetrating_mm2,
-                      sm.level_vertices[0], sm.level_vertices[1], sm.level_vertices[2], sm.level_vertices[3],
-                      sm.level_vertices[4], body.map.num_nodes(), body.sampling.nodes_covered,
-                      std::int64_t(body.map.bytes()), sample_ms[b], detect_ms[b], ns, b == 0 ? p95 : std::nan(""),
-                      b == 0 ? vs_p95 : std::nan(""), b == 0 ? vs_max : std::nan(""), b == 0 ? vs_n : std::int64_t(0));
-          }
-          if (p == 0.5 && mode == DistanceMode::exact) {
-            const std::string suffix = helix ? "_" + scheme->name() + ".png" : ".png";
-            for (int b = 0; b < 2; ++b) {
-              const std::string body = b == 0 ? "ball" : "socket";
-              const std::string file = "map_" + s.name + "_" + body + suffix;
-              const MapImageScale sc = write_map_png(dir + "/" + file, b == 0 ? joint.ball().map : joint.socket().map);
-              map_images.row(s.name, body, scheme->name(), scheme->resolution(), file, sc.nearest_mm, sc.farthest_mm);
-            }
-          }
-          if (p == finest && mode == DistanceMode::exact && !helix) {
-            const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};
-            for (int b = 0; b < 2; ++b)
-              for (Eigen::Index i = 0; i < bodies[b]->relative.rows(); ++i) {
-                if (bodies[b]->relative.row(i).norm() > 45) continue;
-                const Eigen::Vector3d v = bodies[b]->mesh.V.row(i).transpose();
-                vertices.row(s.name, b == 0 ? "ball" : "socket", std::int64_t(i), v.x(), v.y(), v.z(),
-                             double(gaps[b]->gap_mm[static_cast<std::size_t>(i)]));
-              }
-          }
-        }
-      }
+// Sorted |a - b| over the vertices where both are finite.
+std::vector<double> abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
+  std::vector<double> d;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
+    if (std::isfinite(a[i]) && std::isfinite(b[i])) d.push_back(std::abs(double(a[i]) - b[i]));
+  std::sort(d.begin(), d.end());
+  return d;
+}
+double quantile(const std::vector<double>& d, double q) {
+  return d.empty() ? std::nan("") : d[static_cast<std::size_t>(q * double(d.size() - 1))];
+}
+
+// The schemes at precision p: the thesis' pair (equiangular p, the matched helix), and every other
+// registered scheme (issue 12: without touching this driver), exact mode, at the coarsest resolution
+// whose node spacing is at most p, for p >= 0.1 deg.
+std::vector<std::shared_ptr<const SamplingScheme>> schemes_at(double p) {
+  std::vector<std::shared_ptr<const SamplingScheme>> schemes{make_scheme("equiangular", p),
+                                                             make_scheme("helix", matched_helix_turns(p))};
+  if (p < 0.1) return schemes;
+  for (const auto& [name, unit] : scheme_names()) {
+    (void)unit;
+    if (name == "equiangular" || name == "helix") continue;
+    try {
+      schemes.push_back(make_scheme(name, resolution_for_spacing(name, p)));
+    } catch (const Error&) {
+      // a resolution this scheme does not take at this spacing (e.g. conchoid needs 90/p integral)
     }
   }
-  // Shaded-render data: the hip region of both bones at the scan pose, in the pelvic frame.
+  return schemes;
+}
+
+// One subject at one precision: what the schemes compare against.
+struct Compare {
+  std::map<DistanceMode, std::vector<float>> rsid_ball;  // equiangular ball gaps per mode
+};
+
+// Both scans at the scan pose with one scheme and mode: the statistics, the timings (fill and scan of
+// each body, medians), the differences linear - exact and scheme - equiangular, the map images
+// (0.5 deg) and the finest precision's per-vertex gaps.
+void measure(const Subject& s, const SphereFitResult& fit, double cor_error, double p, bool finest,
+             const std::shared_ptr<const SamplingScheme>& scheme, DistanceMode mode, std::vector<float>& exact_ball,
+             Compare& cmp, const Args& args, const std::string& dir, Outputs& out) {
+  const bool helix = scheme->name() != "equiangular";  // compared with the equiangular gaps below
+  JointOptions o;
+  o.scheme = scheme;
+  o.mode = mode;
+  const Joint joint(s.femur, s.pelvis, fit.centre, o);
+  const PoseResult res = joint.detect(Eigen::Matrix3d::Identity());
+  const int reps = p <= 0.05 ? std::max(1, args.repetitions / 2) : args.repetitions;
+  double sample_ms[2], detect_ms[2];
+  const JointBody* bodies[2] = {&joint.ball(), &joint.socket()};
+  for (int b = 0; b < 2; ++b) {
+    RadialDistanceMap scratch{scheme};
+    SamplingOptions so;
+    so.mode = mode;
+    sample_ms[b] = median_ms(
+        [&] {
+          std::fill(scratch.data(), scratch.data() + scratch.num_nodes(), RadialDistanceMap::no_surface());
+          sample_surface(bodies[b]->mesh, fit.centre, so, scratch);
+        },
+        reps);
+  }
+  ScanGaps scratch_gaps;
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  detect_ms[0] = median_ms(
+      [&] { scan_gaps(joint.ball().relative, I, joint.ball().mask, joint.socket().map, ScanSide::inside, scratch_gaps); },
+      args.repetitions);
+  detect_ms[1] = median_ms(
+      [&] {
+        scan_gaps(joint.socket().relative, I, joint.socket().mask, joint.ball().map, ScanSide::outside, scratch_gaps);
+      },
+      args.repetitions);
+  double p95 = std::nan(""), vs_p95 = std::nan(""), vs_max = std::nan("");
+  std::int64_t vs_n = 0;
+  if (mode == DistanceMode::exact)
+    exact_ball = res.ball_gaps.gap_mm;
+  else
+    p95 = quantile(abs_diff(exact_ball, res.ball_gaps.gap_mm), 0.95);
+  if (!helix) {
+    cmp.rsid_ball[mode] = res.ball_gaps.gap_mm;
+  } else {
+    const std::vector<double> d = abs_diff(cmp.rsid_ball[mode], res.ball_gaps.gap_mm);
+    vs_p95 = quantile(d, 0.95);
+    vs_max = d.empty() ? std::nan("") : d.back();
+    vs_n = static_cast<std::int64_t>(d.size());
+  }
+  const ScanSummary* sums[2] = {&res.ball, &res.socket};
+  for (int b = 0; b < 2; ++b) {
+    const ScanSummary& sm = *sums[b];
+    const JointBody& body = *bodies[b];
+    // per map look-up (tested + no surface); masked vertices cost one byte test each
+    const std::int64_t lookups = sm.vertices_tested + sm.vertices_no_surface;
+    const double ns = lookups > 0 ? detect_ms[b] * 1e6 / double(lookups) : std::nan("");
+    out.stats.row(s.name, int(s.generated), scheme->name(), scheme->resolution(), p, to_string(mode),
+                  b == 0 ? "ball" : "socket", fit.centre.x(), fit.centre.y(), fit.centre.z(), fit.radius,
+                  fit.rms_residual, cor_error, sm.vertices, sm.vertices_tested, sm.vertices_no_surface,
+                  sm.vertices_beyond_reach, sm.min_gap_mm, sm.vertices_penetrating, sm.area_penetrating_mm2,
+                  sm.level_vertices[0], sm.level_vertices[1], sm.level_vertices[2], sm.level_vertices[3],
+                  sm.level_vertices[4], body.map.num_nodes(), body.sampling.nodes_covered,
+                  std::int64_t(body.map.bytes()), sample_ms[b], detect_ms[b], ns, b == 0 ? p95 : std::nan(""),
+                  b == 0 ? vs_p95 : std::nan(""), b == 0 ? vs_max : std::nan(""), b == 0 ? vs_n : std::int64_t(0));
+  }
+  if (p == 0.5 && mode == DistanceMode::exact) {
+    const std::string suffix = helix ? "_" + scheme->name() + ".png" : ".png";
+    for (int b = 0; b < 2; ++b) {
+      const std::string body = b == 0 ? "ball" : "socket";
+      const std::string file = "map_" + s.name + "_" + body + suffix;
+      const MapImageScale sc = write_map_png(dir + "/" + file, b == 0 ? joint.ball().map : joint.socket().map);
+      out.map_images.row(s.name, body, scheme->name(), scheme->resolution(), file, sc.nearest_mm, sc.farthest_mm);
+    }
+  }
+  if (finest && mode == DistanceMode::exact && !helix) {
+    const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};
+    for (int b = 0; b < 2; ++b)
+      for (Eigen::Index i = 0; i < bodies[b]->relative.rows(); ++i) {
+        if (bodies[b]->relative.row(i).norm() > 45) continue;
+        const Eigen::Vector3d v = bodies[b]->mesh.V.row(i).transpose();
+        out.vertices.row(s.name, b == 0 ? "ball" : "socket", std::int64_t(i), v.x(), v.y(), v.z(),
+                         double(gaps[b]->gap_mm[static_cast<std::size_t>(i)]));
+      }
+  }
+}
+
+// Shaded-render data: the hip region of both bones at the scan pose, in the pelvic frame, set up as
+// the CLI sets a subject up; the README's figure of the clinical angles; each acetabulum's clock face.
+void write_renders(const std::vector<Subject>& subjects, const std::string& dir, double render_precision,
+                   double render_radius) {
   CsvWriter clocks(dir + "/clock_faces.csv",
                    {"subject", "side", "neutral", "centre_x_mm", "centre_y_mm", "centre_z_mm", "twelve_x", "twelve_y",
                     "twelve_z", "three_x", "three_y", "three_z", "rim_radius_mm", "rim_plane_rms_mm", "inclination_deg",
                     "anteversion_deg", "head_radius_mm", "acetabular_radius_mm", "scan_flexion_deg",
                     "scan_adduction_deg", "scan_internal_rotation_deg"});
-  const double render_precision = 0.25, render_radius = 60;
   CsvWriter poses(dir + "/poses.csv", {"pose", "flexion_deg", "adduction_deg", "internal_rotation_deg"});
   const std::vector<std::pair<std::string, PoseAngles>> figure_poses{
       {"neutral", {0, 0, 0}}, {"flexion90", {90, 0, 0}}, {"adduction30", {0, 30, 0}}, {"internal30", {0, 0, 30}}};
@@ -235,9 +205,9 @@ int main(int argc, char** argv) {
     MapSettings maps;
     maps.precision = render_precision;
     maps.mode = "exact";
-    const Session session(session_options(s, maps));  // as the CLI sets a subject up
+    const Session session(session_options(s, maps));
     const HipJoint& hip = session.hip();
-    const HipJointOptions& ho = session.hip_options();
+    const ImpingementLevels& levels = session.joint_options().levels;
     const PoseResult res = hip.joint().detect(Eigen::Matrix3d::Identity());
     // Joint frame -> pelvic frame: p_pelvic = S^T p_joint (S = scan_axes()).
     const Eigen::Matrix3d to_pelvic = scan_axes().transpose();
@@ -245,33 +215,68 @@ int main(int argc, char** argv) {
     const ScanGaps* gaps[2] = {&res.ball_gaps, &res.socket_gaps};
     for (int b = 0; b < 2; ++b)
       write_region_ply(dir + "/render_" + s.name + (b == 0 ? "_ball.ply" : "_socket.ply"), *bodies[b], to_pelvic,
-                   render_radius, gaps[b], ho.joint.levels, b == 0);
-    if (!s.generated && !wrote_poses) {  // the README's figure of the clinical angles
+                       render_radius, gaps[b], levels, b == 0);
+    if (!s.generated && !wrote_poses) {
       wrote_poses = true;
       for (const auto& [name, a] : figure_poses) {
         write_region_ply(dir + "/poses_" + s.name + "_" + name + ".ply", hip.joint().ball(),
-                     to_pelvic * hip.femur_rotation(a), 250, nullptr, ho.joint.levels, true);
+                         to_pelvic * hip.femur_rotation(a), 250, nullptr, levels, true);
         poses.row(name, a.flexion_deg, a.adduction_deg, a.internal_rotation_deg);
       }
       write_region_ply(dir + "/poses_" + s.name + "_pelvis.ply", hip.joint().socket(), to_pelvic, 150, nullptr,
-                   ho.joint.levels, false);
+                       levels, false);
     }
+    const char* side = s.side == Side::right ? "right" : "left";
     if (hip.socket_clock()) {
       const ClockFace c = hip.socket_clock()->transformed(to_pelvic, Eigen::Vector3d::Zero());
       const Acetabulum& A = *hip.acetabulum();
-      const AcetabularOrientation orientation = radiographic_orientation(A, hip.frames()->pelvis, s.side);
+      const AcetabularOrientation o = radiographic_orientation(A, hip.frames()->pelvis, s.side);
       const PoseAngles& sp = hip.frames()->scan_pose;
-      clocks.row(s.name, s.side == Side::right ? "right" : "left", "anatomical", c.centre.x(), c.centre.y(),
-                 c.centre.z(), c.twelve.x(), c.twelve.y(), c.twelve.z(), c.three.x(), c.three.y(), c.three.z(),
-                 A.rim_radius_mm, A.rim_plane_rms_mm, orientation.inclination_deg,
-                 orientation.anteversion_deg, hip.head_radius_mm(), A.sphere.radius,
-                 sp.flexion_deg, sp.adduction_deg, sp.internal_rotation_deg);
+      clocks.row(s.name, side, "anatomical", c.centre.x(), c.centre.y(), c.centre.z(), c.twelve.x(), c.twelve.y(),
+                 c.twelve.z(), c.three.x(), c.three.y(), c.three.z(), A.rim_radius_mm, A.rim_plane_rms_mm,
+                 o.inclination_deg, o.anteversion_deg, hip.head_radius_mm(), A.sphere.radius, sp.flexion_deg,
+                 sp.adduction_deg, sp.internal_rotation_deg);
     } else {
       const double nan = std::nan("");
-      clocks.row(s.name, s.side == Side::right ? "right" : "left", "scan", nan, nan, nan, nan, nan, nan, nan, nan,
-                 nan, nan, nan, nan, nan, hip.head_radius_mm(), nan, 0.0, 0.0, 0.0);
+      clocks.row(s.name, side, "scan", nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan,
+                 hip.head_radius_mm(), nan, 0.0, 0.0, 0.0);
     }
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv, "08_distance_maps: gap statistics and maps on real joints");
+  const std::string dir = experiment_dir(args, "08_distance_maps");
+  std::vector<Subject> subjects = load_subjects(args, {3000});
+  // Quick runs check the pipeline at 1 and 0.5 deg; full runs add 0.1 and 0.05 deg.
+  const std::vector<double> precisions = args.quick ? std::vector<double>{1, 0.5} : std::vector<double>{1, 0.5, 0.1, 0.05};
+  Outputs out(dir);
+  int done = 0, total = 0;
+  for (double p : precisions) total += 2 + static_cast<int>(schemes_at(p).size());  // the thesis' pair in two modes
+  total *= static_cast<int>(subjects.size());
+  for (const Subject& s : subjects) {
+    // The centre as every front end finds it (the session layer); a generated hip's is fitted, so
+    // that its error against the true centre is measured.
+    const SphereFitResult fit = s.generated ? fit_femoral_head(s.femur) : subject_head(s);
+    const double cor_error = s.generated ? (fit.centre - s.true_cor).norm() : std::nan("");
+    for (double p : precisions) {
+      Compare cmp;
+      for (const auto& scheme : schemes_at(p)) {
+        const bool thesis_scheme = scheme->name() == "equiangular" || scheme->name() == "helix";
+        std::vector<float> exact_ball;  // exact-mode gaps, for the linear-vs-exact difference
+        for (DistanceMode mode : {DistanceMode::exact, DistanceMode::linear}) {
+          if (!thesis_scheme && mode == DistanceMode::linear) continue;
+          progress("08_distance_maps", ++done, total,
+                   s.name + " " + scheme->name() + " " + std::to_string(scheme->resolution()) + " " + to_string(mode));
+          measure(s, fit, cor_error, p, p == precisions.back(), scheme, mode, exact_ball, cmp, args, dir, out);
+        }
+      }
+    }
+  }
+  const double render_precision = 0.25, render_radius = 60;
+  write_renders(subjects, dir, render_precision, render_radius);
 
   nlohmann::json subj = nlohmann::json::array();
   for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
@@ -281,7 +286,8 @@ int main(int argc, char** argv) {
               {"modes", {"exact", "linear"}},
               {"pose_deg", {0, 0, 0}},
               {"subjects", subj},
-              {"cor", "fit_femoral_head defaults (RANSAC + geometric sphere fit)"},
+              {"cor", "the session layer's automatic centre (locate_femoral_head: long axis, RANSAC + geometric "
+                      "sphere fit); generated hips: fit_femoral_head, compared with the true centre"},
               {"vertex_gaps_region_mm", 45},
               {"render", {{"precision_deg", render_precision}, {"mode", "exact"}, {"region_mm", render_radius},
                           {"frame", "pelvic (ISB, Wu et al. 2002) for real subjects; scan axes for generated"},

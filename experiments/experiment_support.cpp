@@ -76,14 +76,15 @@ std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& gen
   return out;
 }
 
-Eigen::Vector3d subject_cor(const Subject& s) {
-  if (s.generated) return s.true_cor;
+SphereFitResult subject_head(const Subject& s) {
   LoadedInput in;
   in.femur = s.femur;
   in.side = s.side;
   in.landmarks = s.landmarks;
-  return find_centre_of_rotation(in, {}).head.centre;
+  return find_centre_of_rotation(in, {}).head;
 }
+
+Eigen::Vector3d subject_cor(const Subject& s) { return s.generated ? s.true_cor : subject_head(s).centre; }
 
 SessionOptions session_options(const Subject& s, const MapSettings& maps) {
   SessionOptions o;

@@ -50,6 +50,10 @@ std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& gen
 /// mm, anatomical frame.
 Eigen::Vector3d subject_cor(const Subject& s);
 
+/// The femoral head of a real subject as the session layer's automatic policy finds it (centre,
+/// radius, rms residual; anatomical frame, mm). Throws impinge::Error when no head is found.
+SphereFitResult subject_head(const Subject& s);
+
 /// Session options for a subject (the same set-up as the CLI's and Python's): its meshes in memory
 /// (anatomical frame, RAS), its side; anatomical neutral for real subjects, scan neutral and the
 /// true COR for generated ones; `maps` as given.
