@@ -12,6 +12,7 @@
 // against the same summaries of the exact gaps.
 // Writes discontinuities.csv, outputs.csv, cases.csv and meta.json.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <iostream>
 
@@ -62,6 +63,158 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? std::nan("") : v[v.size() / 2];
 }
+// The exact first-surface masks of both bodies of `j` (the joints' 1 mm tolerance).
+std::array<std::vector<std::uint8_t>, 2> exact_masks(const Joint& j, const ExactReference& ef,
+                                                     const ExactReference& ep) {
+  std::array<std::vector<std::uint8_t>, 2> mask;
+  for (int b = 0; b < 2; ++b) {
+    const JointBody& body = b == 0 ? j.ball() : j.socket();
+    const ExactReference& own = b == 0 ? ef : ep;
+    mask[b].assign(std::size_t(body.relative.rows()), 0);
+    for (Eigen::Index i = 0; i < body.relative.rows(); ++i) {
+      const Eigen::Vector3d q = body.relative.row(i).transpose();
+      const double r = q.norm();
+      if (r > 0) mask[b][std::size_t(i)] = oracle_hit(own, j.cor(), q) >= r - kOcclusionMm;
+    }
+  }
+  return mask;
+}
+
+// Case 1 for one subject and scheme: the maps alone and with exact look-ups at depth discontinuities,
+// timed alternately over the flexions, each against the oracle on the exact first-surface vertices.
+void discontinuities(const Subject& s, const std::string& name, double res, double p,
+                     const std::vector<double>& flexions, int reps, CsvWriter& csv) {
+  std::optional<Session> sessions[2];  // 0: maps alone, 1: exact look-ups at discontinuities
+  const HipJoint* hips[2];
+  for (int m = 0; m < 2; ++m) {
+    MapSettings maps;
+    maps.scheme = name;
+    maps.resolution = res;
+    maps.maps_only = m == 0;
+    sessions[m].emplace(session_options(s, maps));
+    hips[m] = &sessions[m]->hip();
+  }
+  const Joint& j0 = hips[0]->joint();
+  const ExactReference ef(without_edge_on(j0.ball().mesh, j0.cor())), ep(without_edge_on(j0.socket().mesh, j0.cor()));
+  const auto exact_mask = exact_masks(j0, ef, ep);
+  // Interleaved timing of both joints over the poses.
+  std::vector<double> ns[2];
+  PoseResult scratch;
+  for (int rep = 0; rep < reps; ++rep)
+    for (int m = 0; m < 2; ++m) {
+      const auto t0 = std::chrono::steady_clock::now();
+      for (double f : flexions) hips[m]->detect(PoseAngles{f, 0, 0}, scratch);
+      const double dt = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
+      const Joint& jm = hips[m]->joint();
+      ns[m].push_back(dt / double(flexions.size()) / double(jm.ball().scan_set.size() + jm.socket().scan_set.size()));
+    }
+  for (int m = 0; m < 2; ++m) {
+    const HipJoint& hip = *hips[m];
+    const Joint& jm = hip.joint();
+    std::int64_t skipped = 0, added = 0, over = 0, mismatched = 0, refined = 0;
+    for (int b = 0; b < 2; ++b) {
+      const std::vector<std::uint8_t>& mk = (b == 0 ? jm.ball() : jm.socket()).mask;
+      for (std::size_t i = 0; i < mk.size(); ++i)
+        skipped += exact_mask[b][i] && !mk[i], added += !exact_mask[b][i] && mk[i];
+    }
+    std::vector<double> errors;
+    for (double f : flexions) {
+      const PoseAngles a{f, 0, 0};
+      PoseResult r;
+      hip.detect(a, r);
+      refined += r.ball.vertices_refined + r.socket.vertices_refined;
+      const Eigen::Matrix3d R = hip.femur_rotation(a);
+      for (int b = 0; b < 2; ++b) {
+        const JointBody& body = b == 0 ? jm.ball() : jm.socket();
+        const ScanGaps& g = b == 0 ? r.ball_gaps : r.socket_gaps;
+        for (Eigen::Index i = 0; i < body.relative.rows(); ++i) {
+          if (!exact_mask[b][std::size_t(i)] || g.status[std::size_t(i)] == ScanGaps::beyond_reach) continue;
+          const Eigen::Vector3d v = body.relative.row(i).transpose();
+          const Eigen::Vector3d q = b == 0 ? Eigen::Vector3d(R * v) : Eigen::Vector3d(R.transpose() * v);
+          const double h = oracle_hit(b == 0 ? ep : ef, jm.cor(), q);
+          const double gap = g.gap_mm[std::size_t(i)];
+          if (std::isinf(h) || std::isnan(gap)) {
+            mismatched += std::isinf(h) != std::isnan(gap);
+            continue;
+          }
+          const double err = std::abs(gap - (b == 0 ? h - q.norm() : q.norm() - h));
+          errors.push_back(err);
+          over += err > 0.05;
+        }
+      }
+    }
+    std::sort(errors.begin(), errors.end());
+    const double mx = errors.empty() ? std::nan("") : errors.back();
+    const double p99 = errors.empty() ? std::nan("") : errors[std::size_t(0.99 * double(errors.size() - 1))];
+    csv.row(s.name, int(s.generated), name, res, p, m == 0 ? "maps" : "refined", flexions.size(),
+            std::int64_t(errors.size()), mx, p99, over, skipped, added, mismatched,
+            double(refined) / double(flexions.size()), jm.ball().nodes_marked + jm.socket().nodes_marked,
+            jm.ball().marking_ms + jm.socket().marking_ms, median(ns[m]));
+  }
+}
+
+// Case 7 for one subject: what a user reads, not only per-vertex gaps: the minimum gap, the
+// penetrating area and the area per impingement level of both scans at ROM-extreme poses
+// (equiangular at p, exact look-ups at discontinuities, as impinge runs by default), against the same
+// summaries of the exact gaps (the oracle above) on the same vertices. Bounds from the per-vertex claim
+// eps = 0.05 mm: the minimum gap within eps; the penetrating area within the area of the vertices whose
+// exact gap is within eps of 0 (only they can change side); the level areas, summed over levels, within
+// twice the area of the vertices within eps of any threshold.
+void output_summaries(const Subject& s, double p, const std::vector<std::pair<std::string, PoseAngles>>& poses,
+                      CsvWriter& out) {
+  const double eps = 0.05;
+  MapSettings maps;
+  maps.precision = p;
+  const Session session(session_options(s, maps));
+  const HipJoint& hip = session.hip();
+  const Joint& jm = hip.joint();
+  const ExactReference ef(without_edge_on(jm.ball().mesh, jm.cor())), ep(without_edge_on(jm.socket().mesh, jm.cor()));
+  const ImpingementLevels& levels = session.joint_options().levels;
+  for (const auto& [pose_name, a] : poses) {
+    PoseResult r;
+    hip.detect(a, r);
+    const Eigen::Matrix3d R = hip.femur_rotation(a);
+    for (int b = 0; b < 2; ++b) {
+      const JointBody& body = b == 0 ? jm.ball() : jm.socket();
+      ScanGaps mapped = b == 0 ? r.ball_gaps : r.socket_gaps, exact = mapped;
+      double flip_zero = 0, flip_levels = 0;
+      for (std::size_t i = 0; i < mapped.gap_mm.size(); ++i) {
+        if (mapped.status[i] != ScanGaps::tested) continue;
+        const Eigen::Vector3d v = body.relative.row(Eigen::Index(i)).transpose();
+        const Eigen::Vector3d q = b == 0 ? Eigen::Vector3d(R * v) : Eigen::Vector3d(R.transpose() * v);
+        const double h = oracle_hit(b == 0 ? ep : ef, jm.cor(), q);
+        if (!std::isfinite(h)) {  // compare the vertices both sides test
+          mapped.status[i] = exact.status[i] = ScanGaps::beyond_reach;
+          continue;
+        }
+        const double g = b == 0 ? h - q.norm() : q.norm() - h;
+        exact.gap_mm[i] = float(g);
+        const double area = body.vertex_area[Eigen::Index(i)];
+        if (std::abs(g) <= eps) flip_zero += area;
+        for (double th : levels.thresholds_mm)
+          if (std::abs(g - th) <= eps) {
+            flip_levels += area;
+            break;
+          }
+      }
+      const ScanSummary sm = summarize_scan(mapped, body.vertex_area, levels),
+                        se = summarize_scan(exact, body.vertex_area, levels);
+      double level_error = 0;
+      for (std::size_t k = 0; k < sm.level_area_mm2.size(); ++k)
+        level_error += std::abs(sm.level_area_mm2[k] - se.level_area_mm2[k]);
+      const std::string scan = b == 0 ? "femur" : "pelvis";
+      const double dmin = std::abs(sm.min_gap_mm - se.min_gap_mm);
+      out.row(s.name, int(s.generated), pose_name, scan, "min gap", sm.min_gap_mm, se.min_gap_mm, dmin, eps, "mm",
+              int(dmin <= eps));
+      const double dpen = std::abs(sm.area_penetrating_mm2 - se.area_penetrating_mm2);
+      out.row(s.name, int(s.generated), pose_name, scan, "penetrating area", sm.area_penetrating_mm2,
+              se.area_penetrating_mm2, dpen, flip_zero, "mm2", int(dpen <= flip_zero));
+      out.row(s.name, int(s.generated), pose_name, scan, "level areas", std::nan(""), std::nan(""), level_error,
+              2 * flip_levels, "mm2", int(level_error <= 2 * flip_levels));
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -87,98 +240,11 @@ int main(int argc, char** argv) {
                  "refined_per_pose", "nodes_marked", "marking_ms", "query_ns_per_vertex"});
   int done = 0;
   const int total = static_cast<int>(subjects.size() * schemes.size());
-  for (const Subject& s : subjects) {
+  for (const Subject& s : subjects)
     for (const auto& [name, res] : schemes) {
       progress("11_extreme_cases", ++done, total, s.name + " " + name);
-      std::optional<Session> sessions[2];  // 0: maps alone, 1: exact look-ups at discontinuities
-      const HipJoint* hips[2];
-      for (int m = 0; m < 2; ++m) {
-        MapSettings maps;
-        maps.scheme = name;
-        maps.resolution = res;
-        maps.maps_only = m == 0;
-        sessions[m].emplace(session_options(s, maps));
-        hips[m] = &sessions[m]->hip();
-      }
-      const Joint& j0 = hips[0]->joint();
-      const ExactReference ef(without_edge_on(j0.ball().mesh, j0.cor())),
-          ep(without_edge_on(j0.socket().mesh, j0.cor()));
-      // The exact first-surface masks (same 1 mm tolerance as the joints').
-      std::vector<std::uint8_t> exact_mask[2];
-      for (int b = 0; b < 2; ++b) {
-        const JointBody& body = b == 0 ? j0.ball() : j0.socket();
-        const ExactReference& own = b == 0 ? ef : ep;
-        exact_mask[b].assign(std::size_t(body.relative.rows()), 0);
-        for (Eigen::Index i = 0; i < body.relative.rows(); ++i) {
-          const Eigen::Vector3d q = body.relative.row(i).transpose();
-          const double r = q.norm();
-          if (r > 0) exact_mask[b][std::size_t(i)] = oracle_hit(own, j0.cor(), q) >= r - kOcclusionMm;
-        }
-      }
-      // Interleaved timing of both joints over the poses.
-      std::vector<double> ns[2];
-      PoseResult scratch;
-      for (int rep = 0; rep < reps; ++rep)
-        for (int m = 0; m < 2; ++m) {
-          const auto t0 = std::chrono::steady_clock::now();
-          for (double f : flexions) hips[m]->detect(PoseAngles{f, 0, 0}, scratch);
-          const double dt = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
-          const Joint& jm = hips[m]->joint();
-          ns[m].push_back(dt / double(flexions.size()) / double(jm.ball().scan_set.size() + jm.socket().scan_set.size()));
-        }
-      for (int m = 0; m < 2; ++m) {
-        const HipJoint& hip = *hips[m];
-        const Joint& jm = hip.joint();
-        std::int64_t skipped = 0, added = 0, compared = 0, over = 0, mismatched = 0, refined = 0;
-        for (int b = 0; b < 2; ++b) {
-          const std::vector<std::uint8_t>& mk = (b == 0 ? jm.ball() : jm.socket()).mask;
-          for (std::size_t i = 0; i < mk.size(); ++i)
-            skipped += exact_mask[b][i] && !mk[i], added += !exact_mask[b][i] && mk[i];
-        }
-        std::vector<double> errors;
-        for (double f : flexions) {
-          const PoseAngles a{f, 0, 0};
-          PoseResult r;
-          hip.detect(a, r);
-          refined += r.ball.vertices_refined + r.socket.vertices_refined;
-          const Eigen::Matrix3d R = hip.femur_rotation(a);
-          for (int b = 0; b < 2; ++b) {
-            const JointBody& body = b == 0 ? jm.ball() : jm.socket();
-            const ScanGaps& g = b == 0 ? r.ball_gaps : r.socket_gaps;
-            for (Eigen::Index i = 0; i < body.relative.rows(); ++i) {
-              if (!exact_mask[b][std::size_t(i)] || g.status[std::size_t(i)] == ScanGaps::beyond_reach) continue;
-              const Eigen::Vector3d v = body.relative.row(i).transpose();
-              const Eigen::Vector3d q = b == 0 ? Eigen::Vector3d(R * v) : Eigen::Vector3d(R.transpose() * v);
-              const double h = oracle_hit(b == 0 ? ep : ef, jm.cor(), q);
-              const double gap = g.gap_mm[std::size_t(i)];
-              if (std::isinf(h) || std::isnan(gap)) {
-                mismatched += std::isinf(h) != std::isnan(gap);
-                continue;
-              }
-              const double err = std::abs(gap - (b == 0 ? h - q.norm() : q.norm() - h));
-              errors.push_back(err);
-              over += err > 0.05;
-            }
-          }
-        }
-        compared = std::int64_t(errors.size());
-        std::sort(errors.begin(), errors.end());
-        const double mx = errors.empty() ? std::nan("") : errors.back();
-        const double p99 = errors.empty() ? std::nan("") : errors[std::size_t(0.99 * double(errors.size() - 1))];
-        csv.row(s.name, int(s.generated), name, res, p, m == 0 ? "maps" : "refined", flexions.size(), compared, mx, p99,
-                over, skipped, added, mismatched, double(refined) / double(flexions.size()),
-                jm.ball().nodes_marked + jm.socket().nodes_marked, jm.ball().marking_ms + jm.socket().marking_ms,
-                median(ns[m]));
-      }
+      discontinuities(s, name, res, p, flexions, reps, csv);
     }
-  }
-  // Case 7: what a user reads, not only per-vertex gaps: the minimum gap, the penetrating area and the
-  // area per impingement level of both scans at ROM-extreme poses (equiangular, the finest precision,
-  // exact look-ups at discontinuities, as impinge runs by default), against the same summaries of the
-  // exact gaps (the oracle above) on the same vertices. Bounds from the per-vertex claim eps = 0.05 mm:
-  // the minimum gap within eps; the penetrating area within the area of the vertices whose exact gap
-  // is within eps of 0 (only they can change side); the level areas, summed over levels, within
-  // twice the area of the vertices within eps of any threshold.
   {
     CsvWriter out(dir + "/outputs.csv", {"subject", "generated", "pose", "scan", "quantity", "value", "exact", "error",
                                          "bound", "unit", "pass"});
@@ -187,61 +253,9 @@ int main(int argc, char** argv) {
         {"external rotation 40", {0, 0, -40}}, {"flexion 90, internal rotation 40", {90, 0, 40}},
         {"abduction 40", {0, -40, 0}}};
     if (args.quick) poses.resize(2);  // flexion 110 and internal rotation 40
-    const double eps = 0.05;
     for (const Subject& s : subjects) {
       progress("11_extreme_cases outputs", 0, 0, s.name);
-      MapSettings maps;
-      maps.precision = p;
-      const Session session(session_options(s, maps));
-      const HipJoint& hip = session.hip();
-      const HipJointOptions& ho = session.hip_options();
-      const Joint& jm = hip.joint();
-      const ExactReference ef(without_edge_on(jm.ball().mesh, jm.cor())),
-          ep(without_edge_on(jm.socket().mesh, jm.cor()));
-      const ImpingementLevels& levels = ho.joint.levels;
-      for (const auto& [pose_name, a] : poses) {
-        PoseResult r;
-        hip.detect(a, r);
-        const Eigen::Matrix3d R = hip.femur_rotation(a);
-        for (int b = 0; b < 2; ++b) {
-          const JointBody& body = b == 0 ? jm.ball() : jm.socket();
-          ScanGaps mapped = b == 0 ? r.ball_gaps : r.socket_gaps, exact = mapped;
-          double flip_zero = 0, flip_levels = 0;
-          for (std::size_t i = 0; i < mapped.gap_mm.size(); ++i) {
-            if (mapped.status[i] != ScanGaps::tested) continue;
-            const Eigen::Vector3d v = body.relative.row(Eigen::Index(i)).transpose();
-            const Eigen::Vector3d q = b == 0 ? Eigen::Vector3d(R * v) : Eigen::Vector3d(R.transpose() * v);
-            const double h = oracle_hit(b == 0 ? ep : ef, jm.cor(), q);
-            if (!std::isfinite(h)) {  // compare the vertices both sides test
-              mapped.status[i] = exact.status[i] = ScanGaps::beyond_reach;
-              continue;
-            }
-            const double g = b == 0 ? h - q.norm() : q.norm() - h;
-            exact.gap_mm[i] = float(g);
-            const double area = body.vertex_area[Eigen::Index(i)];
-            if (std::abs(g) <= eps) flip_zero += area;
-            for (double th : levels.thresholds_mm)
-              if (std::abs(g - th) <= eps) {
-                flip_levels += area;
-                break;
-              }
-          }
-          const ScanSummary sm = summarize_scan(mapped, body.vertex_area, levels),
-                            se = summarize_scan(exact, body.vertex_area, levels);
-          double level_error = 0;
-          for (std::size_t k = 0; k < sm.level_area_mm2.size(); ++k)
-            level_error += std::abs(sm.level_area_mm2[k] - se.level_area_mm2[k]);
-          const std::string scan = b == 0 ? "femur" : "pelvis";
-          const double dmin = std::abs(sm.min_gap_mm - se.min_gap_mm);
-          out.row(s.name, int(s.generated), pose_name, scan, "min gap", sm.min_gap_mm, se.min_gap_mm, dmin, eps, "mm",
-                  int(dmin <= eps));
-          const double dpen = std::abs(sm.area_penetrating_mm2 - se.area_penetrating_mm2);
-          out.row(s.name, int(s.generated), pose_name, scan, "penetrating area", sm.area_penetrating_mm2,
-                  se.area_penetrating_mm2, dpen, flip_zero, "mm2", int(dpen <= flip_zero));
-          out.row(s.name, int(s.generated), pose_name, scan, "level areas", std::nan(""), std::nan(""), level_error,
-                  2 * flip_levels, "mm2", int(level_error <= 2 * flip_levels));
-        }
-      }
+      output_summaries(s, p, poses, out);
     }
   }
   const int catalogue_steps = run_extreme_case_catalogue(args, dir);

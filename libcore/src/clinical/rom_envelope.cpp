@@ -24,6 +24,43 @@ std::vector<double> envelope_axis(double lo, double hi, double step, const char*
 struct Box {
   std::array<int, 3> lo, hi;
 };
+
+// The cells of the coarse lattice (every `coarse` steps, the last cut at the axis' end) of a grid of
+// n[a] poses per axis.
+std::vector<Box> coarse_boxes(const std::array<int, 3>& n, int coarse) {
+  std::array<std::vector<int>, 3> cuts;
+  for (int a = 0; a < 3; ++a) {
+    for (int v = 0; v < n[a] - 1; v += coarse) cuts[a].push_back(v);
+    cuts[a].push_back(n[a] - 1);
+  }
+  std::vector<Box> boxes;
+  auto at = [](const std::vector<int>& c, std::size_t k) { return c[std::min(k, c.size() - 1)]; };
+  for (std::size_t x = 0; x + 1 < std::max<std::size_t>(cuts[0].size(), 2); ++x)
+    for (std::size_t y = 0; y + 1 < std::max<std::size_t>(cuts[1].size(), 2); ++y)
+      for (std::size_t z = 0; z + 1 < std::max<std::size_t>(cuts[2].size(), 2); ++z)
+        boxes.push_back({{at(cuts[0], x), at(cuts[1], y), at(cuts[2], z)},
+                         {at(cuts[0], x + 1), at(cuts[1], y + 1), at(cuts[2], z + 1)}});
+  return boxes;
+}
+
+// Split every axis of `b` wider than one step at its middle, appending the parts to `out`; a box of
+// single steps has no parts (every corner is known).
+void split_box(const Box& b, std::vector<Box>& out) {
+  std::array<std::array<int, 3>, 3> cut;  // per axis: lo, mid, hi (mid = hi when not split)
+  std::array<int, 3> parts;
+  for (int a = 0; a < 3; ++a) {
+    const int w = b.hi[a] - b.lo[a];
+    cut[a] = {b.lo[a], w > 1 ? b.lo[a] + w / 2 : b.hi[a], b.hi[a]};
+    parts[a] = w > 1 ? 2 : 1;
+  }
+  if (parts[0] * parts[1] * parts[2] == 1) return;
+  for (int x = 0; x < parts[0]; ++x)
+    for (int y = 0; y < parts[1]; ++y)
+      for (int z = 0; z < parts[2]; ++z)
+        out.push_back({{cut[0][x], cut[1][y], cut[2][z]},
+                       {parts[0] == 1 ? cut[0][2] : cut[0][x + 1], parts[1] == 1 ? cut[1][2] : cut[1][y + 1],
+                        parts[2] == 1 ? cut[2][2] : cut[2][z + 1]}});
+}
 }  // namespace
 
 RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const RomOptions& o,
@@ -74,19 +111,7 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
     }
   };
   // The coarse lattice's cells.
-  std::vector<Box> boxes;
-  std::array<std::vector<int>, 3> cuts;
-  for (int a = 0; a < 3; ++a) {
-    for (int v = 0; v < n[a] - 1; v += e.coarse_steps) cuts[a].push_back(v);
-    cuts[a].push_back(n[a] - 1);
-  }
-  for (std::size_t x = 0; x + 1 < std::max<std::size_t>(cuts[0].size(), 2); ++x)
-    for (std::size_t y = 0; y + 1 < std::max<std::size_t>(cuts[1].size(), 2); ++y)
-      for (std::size_t z = 0; z + 1 < std::max<std::size_t>(cuts[2].size(), 2); ++z) {
-        auto at = [](const std::vector<int>& c, std::size_t k) { return c[std::min(k, c.size() - 1)]; };
-        boxes.push_back({{at(cuts[0], x), at(cuts[1], y), at(cuts[2], z)},
-                         {at(cuts[0], x + 1), at(cuts[1], y + 1), at(cuts[2], z + 1)}});
-      }
+  std::vector<Box> boxes = coarse_boxes(n, e.coarse_steps);
   std::vector<Box> uniform;  // boxes whose corners agree: filled at the end
   while (!boxes.empty()) {
     std::vector<std::size_t> list;
@@ -101,21 +126,7 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
         uniform.push_back(b);
         continue;
       }
-      // Split every axis wider than one step at its middle.
-      std::array<std::array<int, 3>, 3> cut;  // per axis: lo, mid, hi (mid = hi when not split)
-      std::array<int, 3> parts;
-      for (int a = 0; a < 3; ++a) {
-        const int w = b.hi[a] - b.lo[a];
-        cut[a] = {b.lo[a], w > 1 ? b.lo[a] + w / 2 : b.hi[a], b.hi[a]};
-        parts[a] = w > 1 ? 2 : 1;
-      }
-      if (parts[0] * parts[1] * parts[2] == 1) continue;  // single steps: every corner is known
-      for (int x = 0; x < parts[0]; ++x)
-        for (int y = 0; y < parts[1]; ++y)
-          for (int z = 0; z < parts[2]; ++z)
-            next.push_back({{cut[0][x], cut[1][y], cut[2][z]},
-                            {parts[0] == 1 ? cut[0][2] : cut[0][x + 1], parts[1] == 1 ? cut[1][2] : cut[1][y + 1],
-                             parts[2] == 1 ? cut[2][2] : cut[2][z + 1]}});
+      split_box(b, next);
     }
     boxes = std::move(next);
   }

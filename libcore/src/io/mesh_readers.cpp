@@ -187,11 +187,20 @@ class PlyBody {
 
 }  // namespace
 
-TriangleMesh read_ply(const std::string& path, const std::string& bytes) {
+namespace {
+
+// A PLY header: the format, the elements with their properties, and where the body starts.
+struct PlyHeader {
+  PlyFormat format = PlyFormat::ascii;
+  std::vector<PlyElement> elements;
+  std::size_t body_start = 0;
+};
+
+// Parse the header: lines up to `end_header`. Throws impinge::Error naming `path` and the line.
+PlyHeader parse_ply_header(const std::string& path, const std::string& bytes) {
   auto header_error = [&](std::size_t line, const std::string& message) {
     throw Error(path + ": cannot parse PLY: header line " + std::to_string(line) + ": " + message);
   };
-  // Header: lines up to `end_header`.
   std::size_t pos = 0, line_no = 0;
   PlyFormat format = PlyFormat::ascii;
   bool have_format = false;
@@ -251,9 +260,18 @@ TriangleMesh read_ply(const std::string& path, const std::string& bytes) {
   }
   if (!have_format) header_error(line_no, "no 'format' line");
   // Binary bodies written on Windows may follow "end_header\r\n"; the \n is already consumed.
+  return {format, std::move(elements), pos};
+}
 
-  // The elements we read.
+// Where the mesh is in the elements: the vertex element and its x, y, z properties, the face element
+// and its vertex-index list. Throws impinge::Error naming `path` when one is missing or out of order.
+struct PlyLayout {
   int vertex_el = -1, face_el = -1, xyz[3] = {-1, -1, -1}, face_list = -1;
+};
+PlyLayout find_ply_layout(const std::string& path, const std::vector<PlyElement>& elements) {
+  PlyLayout L;
+  int &vertex_el = L.vertex_el, &face_el = L.face_el, &face_list = L.face_list;
+  int* xyz = L.xyz;
   for (std::size_t e = 0; e < elements.size(); ++e) {
     const PlyElement& el = elements[e];
     if (el.name == "vertex" && vertex_el < 0) {
@@ -281,7 +299,19 @@ TriangleMesh read_ply(const std::string& path, const std::string& bytes) {
   if (vertex_el > face_el)
     throw Error(path + ": cannot parse PLY: the 'face' element comes before the 'vertex' element");
 
-  PlyBody body(path, bytes, pos, format);
+  return L;
+}
+
+}  // namespace
+
+TriangleMesh read_ply(const std::string& path, const std::string& bytes) {
+  const PlyHeader header = parse_ply_header(path, bytes);
+  const PlyFormat format = header.format;
+  const std::vector<PlyElement>& elements = header.elements;
+  const PlyLayout layout = find_ply_layout(path, elements);
+  const int vertex_el = layout.vertex_el, face_el = layout.face_el, face_list = layout.face_list;
+  const int* xyz = layout.xyz;
+  PlyBody body(path, bytes, header.body_start, format);
   // Refuse counts the file cannot hold before allocating for them.
   for (const PlyElement& el : elements) {
     std::size_t least = 0;  // bytes per element at least
