@@ -52,11 +52,9 @@ void measure(CsvWriter& csv, const std::shared_ptr<const SamplingScheme>& scheme
           nodes_formula, scheme->num_nodes(), int(sizeof(Scalar)), map_bytes_formula(nodes_formula, sizeof(Scalar)),
           std::int64_t(allocated), std::int64_t(rss), double(allocated) / (1024.0 * 1024.0), thesis_nodes, thesis_mb);
 }
-}  // namespace
-
-int main(int argc, char** argv) {
-  const Args args = parse_args(argc, argv, "01_lut_memory: thesis Tables 2, 6, 7; map sizes and memory");
-  const std::string dir = experiment_dir(args, "01_lut_memory");
+// Thesis Table 2 (equiangular) and Tables 6-7 (helix): nodes and memory of both storages at each
+// precision, and the helix matched to each precision.
+void thesis_tables(const std::string& dir) {
   CsvWriter csv(dir + "/lut_memory.csv", {"scheme", "resolution", "matched_precision_deg", "storage", "nodes_formula",
                                           "nodes", "bytes_per_node", "bytes_formula", "bytes_allocated",
                                           "rss_growth_bytes", "memory_mib", "thesis_nodes", "thesis_memory_mb"});
@@ -97,70 +95,84 @@ int main(int argc, char** argv) {
     measure<float>(csv, hx, w, t.helix_nodes, t.helix_mb, t.p);
     measure<double>(csv, hx, w, t.helix_nodes, t.helix_mb, t.p);
   }
-  // Every registered scheme at equal largest node spacing (issue 12): a new scheme appears here with no
-  // change to this file.
-  {
-    CsvWriter sc(dir + "/schemes.csv", {"spacing_deg", "scheme", "resolution_name", "resolution", "nodes",
-                                        "max_node_spacing_deg", "float_bytes", "nodes_over_equiangular"});
-    for (double p : {1.0, 0.5, 0.1, 0.05}) {
-      const double eq_nodes = double(make_scheme("equiangular", resolution_for_spacing("equiangular", p))->num_nodes());
+}
+
+// Every registered scheme at equal largest node spacing (issue 12): a new scheme appears here with no
+// change to this file.
+void schemes_table(const std::string& dir) {
+  CsvWriter sc(dir + "/schemes.csv", {"spacing_deg", "scheme", "resolution_name", "resolution", "nodes",
+                                      "max_node_spacing_deg", "float_bytes", "nodes_over_equiangular"});
+  for (double p : {1.0, 0.5, 0.1, 0.05}) {
+    const double eq_nodes = double(make_scheme("equiangular", resolution_for_spacing("equiangular", p))->num_nodes());
+    for (const auto& [name, unit] : scheme_names()) {
+      const auto s = make_scheme(name, resolution_for_spacing(name, p));
+      sc.row(p, name, unit, s->resolution(), s->num_nodes(), s->max_node_spacing() * kRadToDeg,
+             s->num_nodes() * std::int64_t(sizeof(float)), double(s->num_nodes()) / eq_nodes);
+    }
+  }
+}
+
+// Dense against sparse storage of real maps (issue 12).
+void sparse_table(const Args& args, const std::string& dir) {
+  CsvWriter sp(dir + "/sparse.csv", {"subject", "body", "scheme", "resolution", "spacing_deg", "nodes",
+                                     "nodes_covered", "tiles_stored", "tiles_total", "dense_bytes", "sparse_bytes"});
+  const std::vector<Subject> subjects = load_subjects(args, {3000});
+  std::vector<double> spacings{0.5, 0.1};
+  if (!args.quick) spacings.push_back(0.05);
+  int done = 0;
+  for (const Subject& sub : subjects) {
+    progress("01_lut_memory", ++done, int(subjects.size()), "sparse maps of " + sub.name);
+    const Eigen::Vector3d cor = subject_cor(sub);
+    for (double p : spacings)
       for (const auto& [name, unit] : scheme_names()) {
-        const auto s = make_scheme(name, resolution_for_spacing(name, p));
-        sc.row(p, name, unit, s->resolution(), s->num_nodes(), s->max_node_spacing() * kRadToDeg,
-               s->num_nodes() * std::int64_t(sizeof(float)), double(s->num_nodes()) / eq_nodes);
-      }
-    }
-  }
-  // Dense against sparse storage of real maps (issue 12).
-  {
-    CsvWriter sp(dir + "/sparse.csv", {"subject", "body", "scheme", "resolution", "spacing_deg", "nodes",
-                                       "nodes_covered", "tiles_stored", "tiles_total", "dense_bytes", "sparse_bytes"});
-    const std::vector<Subject> subjects = load_subjects(args, {3000});
-    std::vector<double> spacings{0.5, 0.1};
-    if (!args.quick) spacings.push_back(0.05);
-    int done = 0;
-    for (const Subject& sub : subjects) {
-      progress("01_lut_memory", ++done, int(subjects.size()), "sparse maps of " + sub.name);
-      const Eigen::Vector3d cor = subject_cor(sub);
-      for (double p : spacings)
-        for (const auto& [name, unit] : scheme_names()) {
-          const auto scheme = make_scheme(name, resolution_for_spacing(name, p));
-          for (int body = 0; body < 2; ++body) {
-            RadialDistanceMap m(scheme);
-            sample_surface(body == 0 ? sub.femur : sub.pelvis, cor, SamplingOptions{}, m);
-            const std::size_t dense = m.bytes();
-            m.make_sparse();
-            sp.row(sub.name, body == 0 ? "femur" : "pelvis", name, scheme->resolution(), p, m.num_nodes(),
-                   m.nodes_covered(), m.tiles_stored(), m.tiles_total(), std::int64_t(dense), std::int64_t(m.bytes()));
-          }
+        const auto scheme = make_scheme(name, resolution_for_spacing(name, p));
+        for (int body = 0; body < 2; ++body) {
+          RadialDistanceMap m(scheme);
+          sample_surface(body == 0 ? sub.femur : sub.pelvis, cor, SamplingOptions{}, m);
+          const std::size_t dense = m.bytes();
+          m.make_sparse();
+          sp.row(sub.name, body == 0 ? "femur" : "pelvis", name, scheme->resolution(), p, m.num_nodes(),
+                 m.nodes_covered(), m.tiles_stored(), m.tiles_total(), std::int64_t(dense), std::int64_t(m.bytes()));
         }
+      }
+  }
+}
+
+// Node density against latitude (Fig. 49 compares the two at 1 deg): nodes per steradian in
+// 1-deg bands of phi centred on whole degrees ([b - 0.5, b + 0.5), halved at the poles), so that
+// the equiangular rows, which lie on whole degrees, sit mid-band and rounding cannot move a row into
+// the next band (bands with edges on whole degrees showed empty and doubled bands).
+void density_table(const std::string& dir) {
+  CsvWriter dens(dir + "/density.csv",
+                 {"scheme", "resolution", "phi_low_deg", "phi_high_deg", "nodes", "band_sr", "nodes_per_sr"});
+  const EquiangularGrid eq(1);
+  const HelixScheme hx(229);
+  for (const SamplingScheme* s : std::initializer_list<const SamplingScheme*>{&eq, &hx}) {
+    std::vector<std::int64_t> count(181, 0);
+    std::vector<double> phi(4096), theta(4096);
+    for (std::int64_t first = 0; first < s->num_nodes(); first += 4096) {
+      const std::int64_t c = std::min<std::int64_t>(4096, s->num_nodes() - first);
+      s->node_angles(first, c, phi.data(), theta.data());
+      for (std::int64_t j = 0; j < c; ++j)
+        ++count[std::min<std::size_t>(180, static_cast<std::size_t>(std::floor(phi[j] * kRadToDeg + 0.5)))];
+    }
+    for (int b = 0; b <= 180; ++b) {
+      const double lo = std::max(0.0, b - 0.5), hi = std::min(180.0, b + 0.5);
+      const double sr = 2 * kPi * (std::cos(lo * kDegToRad) - std::cos(hi * kDegToRad));
+      dens.row(s->name(), s->resolution(), lo, hi, count[b], sr, double(count[b]) / sr);
     }
   }
-  // Node density against latitude (Fig. 49 compares the two at 1 deg): nodes per steradian in
-  // 1-deg bands of phi centred on whole degrees ([b - 0.5, b + 0.5), halved at the poles), so that
-  // the equiangular rows, which lie on whole degrees, sit mid-band and rounding cannot move a row into
-  // the next band (bands with edges on whole degrees showed empty and doubled bands).
-  {
-    CsvWriter dens(dir + "/density.csv",
-                   {"scheme", "resolution", "phi_low_deg", "phi_high_deg", "nodes", "band_sr", "nodes_per_sr"});
-    const EquiangularGrid eq(1);
-    const HelixScheme hx(229);
-    for (const SamplingScheme* s : std::initializer_list<const SamplingScheme*>{&eq, &hx}) {
-      std::vector<std::int64_t> count(181, 0);
-      std::vector<double> phi(4096), theta(4096);
-      for (std::int64_t first = 0; first < s->num_nodes(); first += 4096) {
-        const std::int64_t c = std::min<std::int64_t>(4096, s->num_nodes() - first);
-        s->node_angles(first, c, phi.data(), theta.data());
-        for (std::int64_t j = 0; j < c; ++j)
-          ++count[std::min<std::size_t>(180, static_cast<std::size_t>(std::floor(phi[j] * kRadToDeg + 0.5)))];
-      }
-      for (int b = 0; b <= 180; ++b) {
-        const double lo = std::max(0.0, b - 0.5), hi = std::min(180.0, b + 0.5);
-        const double sr = 2 * kPi * (std::cos(lo * kDegToRad) - std::cos(hi * kDegToRad));
-        dens.row(s->name(), s->resolution(), lo, hi, count[b], sr, double(count[b]) / sr);
-      }
-    }
-  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv, "01_lut_memory: thesis Tables 2, 6, 7; map sizes and memory");
+  const std::string dir = experiment_dir(args, "01_lut_memory");
+  thesis_tables(dir);
+  schemes_table(dir);
+  sparse_table(args, dir);
+  density_table(dir);
   write_meta(dir, args,
              {{"precisions_deg", {1, 0.5, 0.1, 0.05}},
               {"turns", {229, 458, 2292, 4584}},

@@ -49,6 +49,87 @@ double thesis_ms(const std::string& method, double p) {
   if (method == "usid_accelerated") return usid[i];
   return nan;
 }
+// One body of one subject, what every precision's timing needs.
+struct BodyRun {
+  const Subject& s;
+  const TriangleMesh& mesh;
+  std::string bname;
+  Eigen::Vector3d cor;
+  RasterPlan plan;
+  std::unique_ptr<EmbreeRayCaster> embree;
+};
+
+// Every method's fill of one body's map at precision p: the thesis' RSID (linear, exact, culled), the
+// matched USID, Embree's node casts and the pairwise O(m n) casts (a random subset, scaled).
+void time_precision(const BodyRun& r, double p, int reps, int pairwise_nodes, CsvWriter& csv) {
+  const Subject& s = r.s;
+  const TriangleMesh& mesh = r.mesh;
+  const Eigen::Vector3d& cor = r.cor;
+  const RasterPlan& plan = r.plan;
+  const std::string& bname = r.bname;
+  const auto tri = static_cast<std::int64_t>(mesh.F.rows());
+  RadialDistanceMap map{EquiangularGrid(p)};
+  const std::int64_t nodes = map.num_nodes();
+  auto reset = [&] { std::fill(map.data(), map.data() + nodes, RadialDistanceMap::no_surface()); };
+  auto put = [&](const std::string& method, double ms, std::int64_t covered, int extrapolated, std::int64_t timed,
+                 std::int64_t rasterised, const std::string& scheme = "equiangular", double res = -1,
+                 std::int64_t tests = 0) {
+    csv.row(s.name, int(s.generated), bname, tri, p, scheme, res < 0 ? p : res, method,
+            scheme == "equiangular" ? nodes : static_cast<std::int64_t>(res * res), covered, ms, extrapolated,
+            timed, s.name == "generated-3k" ? thesis_ms(method, p) : std::nan(""), int(plan.enabled), rasterised,
+            tests);
+  };
+  put("fill", median_ms(reset, reps), 0, 0, nodes, 0);
+  SamplingStats st;
+  const auto fresh = MapStart::reset;
+  double t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::linear, map, RasterizeOptions{nullptr, true, fresh}); }, reps);
+  put("rsid_linear", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
+      st.node_tests);
+  t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::exact, map, RasterizeOptions{nullptr, true, fresh}); }, reps);
+  put("rsid_exact", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
+      st.node_tests);
+  const RadialDistanceMap full = map;
+  t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::exact, map, RasterizeOptions{&plan, true, fresh}); }, reps);
+  put("rsid_exact_culled", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
+      st.node_tests);
+  std::int64_t differing = 0;
+  for (std::int64_t i = 0; i < nodes; ++i) differing += map.at(i) != full.at(i);
+  if (differing != 0)
+    std::cerr << "02_sampling_time: WARNING " << s.name << " " << bname << " p=" << p
+              << ": culled map differs at " << differing << " nodes\n";
+  {
+    const int k = static_cast<int>(matched_helix_turns(p));
+    RadialDistanceMap helix(make_scheme("helix", k));
+    SamplingOptions o;
+    o.plan = &plan;
+    SamplingReport rep;
+    t = median_ms([&] { rep = sample_surface(mesh, cor, o, helix); }, reps);
+    put("usid_accelerated", t, rep.nodes_covered, 0, helix.num_nodes(), rep.raster.triangles, "helix", k);
+  }
+  if (r.embree) {
+    std::int64_t covered = 0;
+    t = median_ms([&] { covered = r.embree->fill_map(map); }, p < 0.1 ? std::min(reps, 3) : reps);
+    put("embree_node_cast", t, covered, 0, nodes, tri);
+  }
+  {  // Pairwise O(m n): a random subset of nodes, scaled to the whole map.
+    std::mt19937_64 rng(11);
+    std::uniform_int_distribution<std::int64_t> pick(0, nodes - 1);
+    std::vector<std::int64_t> sample(static_cast<std::size_t>(std::min<std::int64_t>(pairwise_nodes, nodes)));
+    for (auto& i : sample) i = pick(rng);
+    volatile double sink = 0;  // keeps the casts from being optimised away
+    t = median_ms(
+        [&] {
+          for (std::int64_t i : sample) {
+            const auto h = cast_ray_naive(mesh, cor, map.scheme().node_direction(i));
+            sink = sink + (h ? h->first : 0);
+          }
+        },
+        1);
+    put("pairwise", t * double(nodes) / double(sample.size()), -1, 1, static_cast<std::int64_t>(sample.size()),
+        tri);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -69,77 +150,15 @@ int main(int argc, char** argv) {
   for (const Subject& s : subjects) {
     const Eigen::Vector3d cor = subject_cor(s);
     for (int body = 0; body < 2; ++body) {
-      const TriangleMesh& mesh = body == 0 ? s.femur : s.pelvis;
-      const std::string bname = body == 0 ? "femur" : "pelvis";
-      const auto tri = static_cast<std::int64_t>(mesh.F.rows());
-      RasterPlan plan;
-      const double t_plan = median_ms([&] { plan = plan_rasterization(mesh, cor); }, reps);
-      csv.row(s.name, int(s.generated), bname, tri, 0.0, "none", 0.0, "culling_analysis", 0, 0, t_plan, 0, 0,
-              std::nan(""), int(plan.enabled), static_cast<std::int64_t>(plan.triangle_order.size()), 0);
-      std::unique_ptr<EmbreeRayCaster> embree;
-      if (have_embree()) embree = std::make_unique<EmbreeRayCaster>(mesh, cor);
+      BodyRun r{s, body == 0 ? s.femur : s.pelvis, body == 0 ? "femur" : "pelvis", cor, {}, nullptr};
+      const auto tri = static_cast<std::int64_t>(r.mesh.F.rows());
+      const double t_plan = median_ms([&] { r.plan = plan_rasterization(r.mesh, cor); }, reps);
+      csv.row(s.name, int(s.generated), r.bname, tri, 0.0, "none", 0.0, "culling_analysis", 0, 0, t_plan, 0, 0,
+              std::nan(""), int(r.plan.enabled), static_cast<std::int64_t>(r.plan.triangle_order.size()), 0);
+      if (have_embree()) r.embree = std::make_unique<EmbreeRayCaster>(r.mesh, cor);
       for (double p : precisions) {
-        progress("02_sampling_time", ++done, total, s.name + " " + bname + " p=" + std::to_string(p));
-        RadialDistanceMap map{EquiangularGrid(p)};
-        const std::int64_t nodes = map.num_nodes();
-        auto reset = [&] { std::fill(map.data(), map.data() + nodes, RadialDistanceMap::no_surface()); };
-        auto put = [&](const std::string& method, double ms, std::int64_t covered, int extrapolated, std::int64_t timed,
-                       std::int64_t rasterised, const std::string& scheme = "equiangular", double res = -1,
-                       std::int64_t tests = 0) {
-          csv.row(s.name, int(s.generated), bname, tri, p, scheme, res < 0 ? p : res, method,
-                  scheme == "equiangular" ? nodes : static_cast<std::int64_t>(res * res), covered, ms, extrapolated,
-                  timed, s.name == "generated-3k" ? thesis_ms(method, p) : std::nan(""), int(plan.enabled), rasterised,
-                  tests);
-        };
-        put("fill", median_ms(reset, reps), 0, 0, nodes, 0);
-        SamplingStats st;
-        const auto fresh = MapStart::reset;
-        double t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::linear, map, RasterizeOptions{nullptr, true, fresh}); }, reps);
-        put("rsid_linear", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
-            st.node_tests);
-        t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::exact, map, RasterizeOptions{nullptr, true, fresh}); }, reps);
-        put("rsid_exact", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
-            st.node_tests);
-        const RadialDistanceMap full = map;
-        t = median_ms([&] { st = rasterize(mesh, cor, DistanceMode::exact, map, RasterizeOptions{&plan, true, fresh}); }, reps);
-        put("rsid_exact_culled", t, st.nodes_covered, 0, nodes, st.triangles - st.triangles_culled, "equiangular", -1,
-            st.node_tests);
-        std::int64_t differing = 0;
-        for (std::int64_t i = 0; i < nodes; ++i) differing += map.at(i) != full.at(i);
-        if (differing != 0)
-          std::cerr << "02_sampling_time: WARNING " << s.name << " " << bname << " p=" << p
-                    << ": culled map differs at " << differing << " nodes\n";
-        {
-          const int k = static_cast<int>(matched_helix_turns(p));
-          RadialDistanceMap helix(make_scheme("helix", k));
-          SamplingOptions o;
-          o.plan = &plan;
-          SamplingReport rep;
-          t = median_ms([&] { rep = sample_surface(mesh, cor, o, helix); }, reps);
-          put("usid_accelerated", t, rep.nodes_covered, 0, helix.num_nodes(), rep.raster.triangles, "helix", k);
-        }
-        if (embree) {
-          std::int64_t covered = 0;
-          t = median_ms([&] { covered = embree->fill_map(map); }, p < 0.1 ? std::min(reps, 3) : reps);
-          put("embree_node_cast", t, covered, 0, nodes, tri);
-        }
-        {  // Pairwise O(m n): a random subset of nodes, scaled to the whole map.
-          std::mt19937_64 rng(11);
-          std::uniform_int_distribution<std::int64_t> pick(0, nodes - 1);
-          std::vector<std::int64_t> sample(static_cast<std::size_t>(std::min<std::int64_t>(pairwise_nodes, nodes)));
-          for (auto& i : sample) i = pick(rng);
-          volatile double sink = 0;  // keeps the casts from being optimised away
-          t = median_ms(
-              [&] {
-                for (std::int64_t i : sample) {
-                  const auto h = cast_ray_naive(mesh, cor, map.scheme().node_direction(i));
-                  sink = sink + (h ? h->first : 0);
-                }
-              },
-              1);
-          put("pairwise", t * double(nodes) / double(sample.size()), -1, 1, static_cast<std::int64_t>(sample.size()),
-              tri);
-        }
+        progress("02_sampling_time", ++done, total, s.name + " " + r.bname + " p=" + std::to_string(p));
+        time_precision(r, p, reps, pairwise_nodes, csv);
       }
     }
   }

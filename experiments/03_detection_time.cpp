@@ -82,6 +82,172 @@ double min_of(const std::vector<float>& a, const std::vector<float>& b) {
     if (std::isfinite(g)) m = std::min<double>(m, g);
   return m;
 }
+// Maps: equiangular at each precision (RSID), the helix at the matched turns (USID), and every other
+// registered scheme at the coarsest resolution whose node spacing is at most p (issue 12: a new scheme
+// is timed here without touching this driver; method = its name).
+struct Scheme {
+  std::string method;
+  double res;
+  std::shared_ptr<const SamplingScheme> scheme;
+  double spacing;  ///< the equiangular precision (deg) it is matched to
+};
+std::vector<Scheme> schemes_at(const std::vector<double>& precisions) {
+  std::vector<Scheme> schemes;
+  for (double p : precisions) {
+    schemes.push_back({"rsid", p, make_scheme("equiangular", p), p});
+    schemes.push_back({"usid", matched_helix_turns(p), make_scheme("helix", matched_helix_turns(p)), p});
+  }
+  for (const auto& [name, unit] : scheme_names()) {
+    (void)unit;
+    if (name == "equiangular" || name == "helix") continue;  // above, as the thesis' RSID and USID
+    for (double p : precisions) {
+      try {
+        const double r = resolution_for_spacing(name, p);
+        schemes.push_back({name, r, make_scheme(name, r), p});
+      } catch (const Error&) {
+        // a resolution this scheme does not take at this spacing (e.g. conchoid needs 90/p integral)
+      }
+    }
+  }
+  return schemes;
+}
+
+// The peers available in this build, on one subject.
+struct Peers {
+  Peers(const Subject& s, const Eigen::Vector3d& cor) {
+    if (have_embree())
+      emb_f = std::make_unique<EmbreeRayCaster>(s.femur, cor), emb_p = std::make_unique<EmbreeRayCaster>(s.pelvis, cor);
+    if (have_exact_reference())
+      cg_f = std::make_unique<ExactReference>(s.femur), cg_p = std::make_unique<ExactReference>(s.pelvis);
+    if (have_fcl()) fcl = std::make_unique<FclJoint>(s.femur, s.pelvis, cor);
+    if (have_exact_reference()) pairwise = std::make_unique<PairwiseJoint>(s.femur, s.pelvis, cor, kRegionMm);
+  }
+  std::unique_ptr<EmbreeRayCaster> emb_f, emb_p;
+  std::unique_ptr<ExactReference> cg_f, cg_p;
+  std::unique_ptr<FclJoint> fcl;
+  std::unique_ptr<PairwiseJoint> pairwise;
+};
+
+// One subject: its COR, the push, its maps per scheme and the peers' vertex sets.
+struct SubjectRun {
+  SubjectRun(const Subject& subject, const std::vector<Scheme>& sc)
+      : s(subject), cor(subject_cor(s)), push(3.0 * push_direction(s.pelvis, cor, kRegionMm)), schemes(sc),
+        peers(s, cor) {
+    for (const Scheme& k : schemes) built.emplace_back(build(s.femur, cor, k.scheme), build(s.pelvis, cor, k.scheme));
+  }
+  // The peers' vertex sets: the first-surface hip-region vertices of the finest equiangular map.
+  const ScanSet& fset() const { return built[2].first.set; }
+  const ScanSet& pset() const { return built[2].second.set; }
+  const Subject& s;
+  const Eigen::Vector3d cor, push;
+  const std::vector<Scheme>& schemes;
+  std::vector<std::pair<Body, Body>> built;
+  Peers peers;
+};
+
+// One row of detection.csv.
+void row(CsvWriter& csv, const SubjectRun& r, const std::string& pose, const std::string& method, double res,
+         std::int64_t vertices, double ms, double ball_ms, double socket_ms, double result, const std::string& kind,
+         double spacing = std::nan("")) {
+  const Subject& s = r.s;
+  csv.row(s.name, int(s.generated), static_cast<std::int64_t>(s.femur.F.rows()),
+          static_cast<std::int64_t>(s.pelvis.F.rows()), pose, method, res, vertices, ms, ball_ms, socket_ms,
+          vertices > 0 ? ms * 1e6 / double(vertices) : std::nan(""), result, kind, thesis_ms(s.name, method), spacing);
+}
+
+// Both scans of every scheme's maps at one pose (ball against the pelvis map, pelvis against the femur map).
+void time_maps(const SubjectRun& r, const std::string& pname, const Eigen::Vector3d& t, int reps, CsvWriter& csv) {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  for (std::size_t k = 0; k < r.schemes.size(); ++k) {
+    const Body &fb = r.built[k].first, &pb = r.built[k].second;
+    std::vector<float> g1(std::size_t(fb.set.size())), g2(std::size_t(pb.set.size()));
+    const double tb = median_ms([&] { scan_gaps_compact(fb.set, I, t, pb.map, ScanSide::inside, g1.data()); }, reps);
+    const double ts = median_ms(
+        [&] { scan_gaps_compact(pb.set, I, Eigen::Vector3d(-t), fb.map, ScanSide::outside, g2.data()); }, reps);
+    row(csv, r, pname, r.schemes[k].method, r.schemes[k].res, fb.set.size() + pb.set.size(), tb + ts, tb, ts,
+        min_of(g1, g2), "min_gap_mm", r.schemes[k].spacing);
+  }
+}
+
+// The peers at one pose: Embree (single rays, packets of 8) and CGAL radial scans on the same vertices,
+// FCL collide and distance, pairwise triangle intersection.
+void time_peers(const SubjectRun& r, const std::string& pname, const Eigen::Vector3d& t, int reps, bool quick,
+                CsvWriter& csv) {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const ScanSet &fset = r.fset(), &pset = r.pset();
+  const std::int64_t nv = fset.size() + pset.size();
+  const Peers& P = r.peers;
+  const double nan = std::nan("");
+  std::vector<float> g1(std::size_t(fset.size())), g2(std::size_t(pset.size()));
+  if (P.emb_f)
+    for (int packet = 0; packet < 2; ++packet) {
+      const double tb = median_ms([&] { scan_gaps_embree(*P.emb_p, fset, I, t, ScanSide::inside, g1.data(), packet); }, reps);
+      const double ts = median_ms(
+          [&] { scan_gaps_embree(*P.emb_f, pset, I, Eigen::Vector3d(-t), ScanSide::outside, g2.data(), packet); }, reps);
+      row(csv, r, pname, packet ? "embree_radial_packet8" : "embree_radial", 0, nv, tb + ts, tb, ts, min_of(g1, g2),
+          "min_gap_mm");
+    }
+  if (P.cg_f) {
+    auto cgal_scan = [&](const ScanSet& set, const ExactReference& other, const Eigen::Vector3d& tt, double side,
+                         std::vector<float>& out) {
+      for (std::int64_t j = 0; j < set.size(); ++j) {
+        const Eigen::Vector3d q = Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + tt;
+        const auto h = other.first_hit(r.cor, q.normalized());
+        out[std::size_t(j)] = h ? float(side * (*h - q.norm())) : std::numeric_limits<float>::quiet_NaN();
+      }
+    };
+    const int n = std::max(1, reps / 2);
+    const double tb = median_ms([&] { cgal_scan(fset, *P.cg_p, t, 1, g1); }, n);
+    const double ts = median_ms([&] { cgal_scan(pset, *P.cg_f, Eigen::Vector3d(-t), -1, g2); }, n);
+    row(csv, r, pname, "cgal_radial", 0, nv, tb + ts, tb, ts, min_of(g1, g2), "min_gap_mm");
+  }
+  if (P.fcl) {
+    FclContacts c;
+    const double tc = median_ms([&] { c = P.fcl->collide(I, t); }, reps);
+    row(csv, r, pname, "fcl_collide", 0, 0, tc, nan, nan, double(c.contacts), "contacts");
+    double d = 0;
+    const double td = median_ms([&] { d = P.fcl->distance(I, t); }, reps);
+    row(csv, r, pname, "fcl_distance", 0, 0, td, nan, nan, d, "distance_mm");
+  }
+  if (P.pairwise &&
+      (!quick || double(P.pairwise->ball_triangles()) * double(P.pairwise->socket_triangles()) <= 2e7)) {
+    PairwiseResult pr;
+    const double tp = median_ms([&] { pr = P.pairwise->intersect(I, t); }, 1);
+    row(csv, r, pname, "pairwise", 0, 0, tp, nan, nan, double(pr.intersecting_pairs), "intersecting_pairs");
+  }
+}
+
+// Throughput: 256 random poses, one thread against two (each thread its own half).
+void throughput(const SubjectRun& r, int reps, CsvWriter& thr) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> ang(-20, 20);
+  std::vector<Eigen::Matrix3d> poses;
+  for (int i = 0; i < 256; ++i) poses.push_back(pose_rotation({ang(rng), ang(rng), ang(rng)}, r.s.side));
+  for (std::size_t k = 0; k < r.schemes.size(); ++k) {
+    const Body &fb = r.built[k].first, &pb = r.built[k].second;
+    auto run = [&](std::size_t lo, std::size_t hi) {
+      std::vector<float> a(std::size_t(fb.set.size())), b(std::size_t(pb.set.size()));
+      for (std::size_t i = lo; i < hi; ++i) {
+        scan_gaps_compact(fb.set, poses[i], Eigen::Vector3d::Zero(), pb.map, ScanSide::inside, a.data());
+        scan_gaps_compact(pb.set, Eigen::Matrix3d(poses[i].transpose()), Eigen::Vector3d::Zero(), fb.map,
+                          ScanSide::outside, b.data());
+      }
+    };
+    for (int threads : {1, 2}) {
+      const double ms = median_ms(
+          [&] {
+            if (threads == 1) return run(0, poses.size());
+            std::thread other([&] { run(poses.size() / 2, poses.size()); });
+            run(0, poses.size() / 2);
+            other.join();
+          },
+          reps);
+      thr.row(r.s.name, r.schemes[k].method, r.schemes[k].res, threads, static_cast<int>(poses.size()), ms,
+              1000.0 * double(poses.size()) / ms, r.schemes[k].spacing);
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -91,6 +257,7 @@ int main(int argc, char** argv) {
   const int reps = args.repetitions;
   const double kPrecision = 0.5;  // RSID / USID maps of the detection table (the thesis does not say)
   const std::vector<double> precisions{0.5, 0.1};
+  const std::vector<Scheme> schemes = schemes_at(precisions);
 
   CsvWriter csv(dir + "/detection.csv",
                 {"subject", "generated", "femur_triangles", "pelvis_triangles", "pose", "method", "resolution",
@@ -99,148 +266,16 @@ int main(int argc, char** argv) {
   CsvWriter thr(dir + "/throughput.csv",
                 {"subject", "method", "resolution", "threads", "poses", "time_ms", "poses_per_s", "spacing_deg"});
   int done = 0;
-  const int total = static_cast<int>(subjects.size());
   for (const Subject& s : subjects) {
-    progress("03_detection_time", ++done, total, s.name);
-    const Eigen::Vector3d cor = subject_cor(s);
-    const Eigen::Vector3d push = 3.0 * push_direction(s.pelvis, cor, kRegionMm);
-    const auto ft = static_cast<std::int64_t>(s.femur.F.rows()), pt = static_cast<std::int64_t>(s.pelvis.F.rows());
-    auto row = [&](const std::string& pose, const std::string& method, double res, std::int64_t vertices, double ms,
-                   double ball_ms, double socket_ms, double result, const std::string& kind,
-                   double spacing = std::nan("")) {
-      csv.row(s.name, int(s.generated), ft, pt, pose, method, res, vertices, ms, ball_ms, socket_ms,
-              vertices > 0 ? ms * 1e6 / double(vertices) : std::nan(""), result, kind, thesis_ms(s.name, method),
-              spacing);
-    };
-    // Maps: equiangular at each precision, helix at the matched turns.
-    struct Scheme {
-      std::string method;
-      double res;
-      std::shared_ptr<const SamplingScheme> scheme;
-      double spacing;  ///< the equiangular precision (deg) it is matched to
-    };
-    std::vector<Scheme> schemes;
-    for (double p : precisions) {
-      schemes.push_back({"rsid", p, make_scheme("equiangular", p), p});
-      schemes.push_back({"usid", matched_helix_turns(p), make_scheme("helix", matched_helix_turns(p)), p});
-    }
-    // Every other registered scheme at the coarsest resolution whose node spacing is at most p
-    // (issue 12: a new scheme is timed here without touching this driver); method = its name.
-    for (const auto& [name, unit] : scheme_names()) {
-      (void)unit;
-      if (name == "equiangular" || name == "helix") continue;  // above, as the thesis' RSID and USID
-      for (double p : precisions) {
-        try {
-          const double r = resolution_for_spacing(name, p);
-          schemes.push_back({name, r, make_scheme(name, r), p});
-        } catch (const Error&) {
-          // a resolution this scheme does not take at this spacing (e.g. conchoid needs 90/p integral)
-        }
-      }
-    }
-    std::vector<std::pair<Body, Body>> built;
-    for (const Scheme& sc : schemes)
-      built.emplace_back(build(s.femur, cor, sc.scheme), build(s.pelvis, cor, sc.scheme));
-    // The peers' vertex sets: the first-surface hip-region vertices of the finest equiangular map.
-    const ScanSet& fset = built[2].first.set;
-    const ScanSet& pset = built[2].second.set;
-    const std::int64_t nv = fset.size() + pset.size();
-    std::unique_ptr<EmbreeRayCaster> emb_f, emb_p;
-    if (have_embree())
-      emb_f = std::make_unique<EmbreeRayCaster>(s.femur, cor), emb_p = std::make_unique<EmbreeRayCaster>(s.pelvis, cor);
-    std::unique_ptr<ExactReference> cg_f, cg_p;
-    if (have_exact_reference())
-      cg_f = std::make_unique<ExactReference>(s.femur), cg_p = std::make_unique<ExactReference>(s.pelvis);
-    std::unique_ptr<FclJoint> fcl;
-    if (have_fcl()) fcl = std::make_unique<FclJoint>(s.femur, s.pelvis, cor);
-    std::unique_ptr<PairwiseJoint> pairwise;
-    if (have_exact_reference()) pairwise = std::make_unique<PairwiseJoint>(s.femur, s.pelvis, cor, kRegionMm);
-    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-
+    progress("03_detection_time", ++done, static_cast<int>(subjects.size()), s.name);
+    const SubjectRun r(s, schemes);
     for (int pose = 0; pose < 2; ++pose) {
       const std::string pname = pose == 0 ? "rest" : "pushed_3mm";
-      const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : push;
-      for (std::size_t k = 0; k < schemes.size(); ++k) {
-        const Body &fb = built[k].first, &pb = built[k].second;
-        std::vector<float> g1(std::size_t(fb.set.size())), g2(std::size_t(pb.set.size()));
-        const double tb =
-            median_ms([&] { scan_gaps_compact(fb.set, I, t, pb.map, ScanSide::inside, g1.data()); }, reps);
-        const double ts = median_ms(
-            [&] { scan_gaps_compact(pb.set, I, Eigen::Vector3d(-t), fb.map, ScanSide::outside, g2.data()); }, reps);
-        row(pname, schemes[k].method, schemes[k].res, fb.set.size() + pb.set.size(), tb + ts, tb, ts, min_of(g1, g2),
-            "min_gap_mm", schemes[k].spacing);
-      }
-      std::vector<float> g1(std::size_t(fset.size())), g2(std::size_t(pset.size()));
-      if (emb_f) {
-        for (int packet = 0; packet < 2; ++packet) {
-          const double tb = median_ms([&] { scan_gaps_embree(*emb_p, fset, I, t, ScanSide::inside, g1.data(), packet); }, reps);
-          const double ts = median_ms(
-              [&] { scan_gaps_embree(*emb_f, pset, I, Eigen::Vector3d(-t), ScanSide::outside, g2.data(), packet); }, reps);
-          row(pname, packet ? "embree_radial_packet8" : "embree_radial", 0, nv, tb + ts, tb, ts, min_of(g1, g2),
-              "min_gap_mm");
-        }
-      }
-      if (cg_f) {
-        auto cgal_scan = [&](const ScanSet& set, const ExactReference& other, const Eigen::Vector3d& tt, double side,
-                             std::vector<float>& out) {
-          for (std::int64_t j = 0; j < set.size(); ++j) {
-            const Eigen::Vector3d q = Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + tt;
-            const auto h = other.first_hit(cor, q.normalized());
-            out[std::size_t(j)] = h ? float(side * (*h - q.norm())) : std::numeric_limits<float>::quiet_NaN();
-          }
-        };
-        const int r = std::max(1, reps / 2);
-        const double tb = median_ms([&] { cgal_scan(fset, *cg_p, t, 1, g1); }, r);
-        const double ts = median_ms([&] { cgal_scan(pset, *cg_f, Eigen::Vector3d(-t), -1, g2); }, r);
-        row(pname, "cgal_radial", 0, nv, tb + ts, tb, ts, min_of(g1, g2), "min_gap_mm");
-      }
-      if (fcl) {
-        FclContacts c;
-        const double tc = median_ms([&] { c = fcl->collide(I, t); }, reps);
-        row(pname, "fcl_collide", 0, 0, tc, std::nan(""), std::nan(""), double(c.contacts), "contacts");
-        double d = 0;
-        const double td = median_ms([&] { d = fcl->distance(I, t); }, reps);
-        row(pname, "fcl_distance", 0, 0, td, std::nan(""), std::nan(""), d, "distance_mm");
-      }
-      if (pairwise) {
-        const bool affordable =
-            !args.quick || double(pairwise->ball_triangles()) * double(pairwise->socket_triangles()) <= 2e7;
-        if (affordable) {
-          PairwiseResult r;
-          const double tp = median_ms([&] { r = pairwise->intersect(I, t); }, 1);
-          row(pname, "pairwise", 0, 0, tp, std::nan(""), std::nan(""), double(r.intersecting_pairs),
-              "intersecting_pairs");
-        }
-      }
+      const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : r.push;
+      time_maps(r, pname, t, reps, csv);
+      time_peers(r, pname, t, reps, args.quick, csv);
     }
-    // Throughput: 256 random poses, one thread against two (each thread its own half).
-    std::mt19937_64 rng(5);
-    std::uniform_real_distribution<double> ang(-20, 20);
-    std::vector<Eigen::Matrix3d> poses;
-    for (int i = 0; i < 256; ++i) poses.push_back(pose_rotation({ang(rng), ang(rng), ang(rng)}, s.side));
-    for (std::size_t k = 0; k < schemes.size(); ++k) {
-      const Body &fb = built[k].first, &pb = built[k].second;
-      auto run = [&](std::size_t lo, std::size_t hi) {
-        std::vector<float> a(std::size_t(fb.set.size())), b(std::size_t(pb.set.size()));
-        for (std::size_t i = lo; i < hi; ++i) {
-          scan_gaps_compact(fb.set, poses[i], Eigen::Vector3d::Zero(), pb.map, ScanSide::inside, a.data());
-          scan_gaps_compact(pb.set, Eigen::Matrix3d(poses[i].transpose()), Eigen::Vector3d::Zero(), fb.map,
-                            ScanSide::outside, b.data());
-        }
-      };
-      for (int threads : {1, 2}) {
-        const double ms = median_ms(
-            [&] {
-              if (threads == 1) return run(0, poses.size());
-              std::thread other([&] { run(poses.size() / 2, poses.size()); });
-              run(0, poses.size() / 2);
-              other.join();
-            },
-            reps);
-        thr.row(s.name, schemes[k].method, schemes[k].res, threads, static_cast<int>(poses.size()), ms,
-                1000.0 * double(poses.size()) / ms, schemes[k].spacing);
-      }
-    }
+    throughput(r, reps, thr);
   }
   write_meta(dir, args,
              {{"region_radius_mm", kRegionMm},

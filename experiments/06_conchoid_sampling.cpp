@@ -22,45 +22,58 @@
 using namespace impinge;
 using namespace impinge::experiment;
 
+namespace {
+
+// The conchoid's arc length over the hip region: exact (GSL) against the thesis' approximations.
+void length_table(const std::string& dir, const Conchoid& exact, const Conchoid& approx_a, double b) {
+  CsvWriter len(dir + "/length.csv", {"variant", "length_mm", "length_over_b", "rel_error_vs_exact"});
+  const double L = exact.arc_length(kPi / 2);
+  // a = 1.15 b only
+  const double L115 = approx_a.arc_length(kPi / 2);
+  // a = 1.15 b and a^2 + b^2 = 2ab = 2.3 b^2: sqrt(2.3) b sqrt(2) int cos(t/2) = thesis closed form
+  const double Lth = conchoid_length_thesis(b);
+  // the thesis' printed rounding: 3.03 b
+  const double L303 = 3.03 * b;
+  for (auto [name, v] :
+       std::initializer_list<std::pair<const char*, double>>{{"exact (a, b; GSL QAGS)", L},
+                                                             {"a = 1.15 b", L115},
+                                                             {"a = 1.15 b, 2.3 b^2 (thesis closed form)", Lth},
+                                                             {"3.03 b (thesis, printed)", L303}})
+    len.row(std::string("\"") + name + "\"", v, v / b, (v - L) / L);
+}
+
+// Table 10: four equal-length angles by Eq. 16 and exactly, beside the thesis' adjusted angles.
+void table10(const std::string& dir, const Conchoid& exact) {
+  CsvWriter t10(dir + "/table10.csv", {"i", "original_deg", "eq16_deg", "exact_deg", "thesis_adjusted_deg",
+                                       "eq16_adjustment_deg", "exact_adjustment_deg"});
+  const std::vector<double> e16 = conchoid_angles_eq16(4), ex = exact.equal_length_angles(4, kPi / 2);
+  const double thesis[] = {0, 27, 56, 90};
+  for (int i = 0; i < 4; ++i)
+    t10.row(i, 30.0 * i, e16[i] * kRadToDeg, ex[i] * kRadToDeg, thesis[i], e16[i] * kRadToDeg - 30.0 * i,
+            ex[i] * kRadToDeg - 30.0 * i);
+}
+
+// The same at 0.1 deg over [0, 90] deg.
+void angles_table(const std::string& dir, const Conchoid& exact) {
+  CsvWriter an(dir + "/angles.csv",
+               {"i", "original_deg", "eq16_deg", "exact_deg", "eq16_adjustment_deg", "exact_adjustment_deg"});
+  const int n = 901;  // 0.1 deg over [0, 90]
+  const std::vector<double> e16 = conchoid_angles_eq16(n), ex = exact.equal_length_angles(n, kPi / 2);
+  for (int i = 0; i < n; ++i)
+    an.row(i, 0.1 * i, e16[i] * kRadToDeg, ex[i] * kRadToDeg, e16[i] * kRadToDeg - 0.1 * i,
+           ex[i] * kRadToDeg - 0.1 * i);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   const Args args = parse_args(argc, argv, "06_conchoid_sampling: thesis sec. 5.1 conchoid weighted sampling");
   const std::string dir = experiment_dir(args, "06_conchoid_sampling");
   const double a = kMenschikA, b = kMenschikB;
   const Conchoid exact(a, b), approx_a(1.15 * b, b);
-  {
-    CsvWriter len(dir + "/length.csv", {"variant", "length_mm", "length_over_b", "rel_error_vs_exact"});
-    const double L = exact.arc_length(kPi / 2);
-    // a = 1.15 b only
-    const double L115 = approx_a.arc_length(kPi / 2);
-    // a = 1.15 b and a^2 + b^2 = 2ab = 2.3 b^2: sqrt(2.3) b sqrt(2) int cos(t/2) = thesis closed form
-    const double Lth = conchoid_length_thesis(b);
-    // the thesis' printed rounding: 3.03 b
-    const double L303 = 3.03 * b;
-    for (auto [name, v] :
-         std::initializer_list<std::pair<const char*, double>>{{"exact (a, b; GSL QAGS)", L},
-                                                               {"a = 1.15 b", L115},
-                                                               {"a = 1.15 b, 2.3 b^2 (thesis closed form)", Lth},
-                                                               {"3.03 b (thesis, printed)", L303}})
-      len.row(std::string("\"") + name + "\"", v, v / b, (v - L) / L);
-  }
-  {
-    CsvWriter t10(dir + "/table10.csv", {"i", "original_deg", "eq16_deg", "exact_deg", "thesis_adjusted_deg",
-                                         "eq16_adjustment_deg", "exact_adjustment_deg"});
-    const std::vector<double> e16 = conchoid_angles_eq16(4), ex = exact.equal_length_angles(4, kPi / 2);
-    const double thesis[] = {0, 27, 56, 90};
-    for (int i = 0; i < 4; ++i)
-      t10.row(i, 30.0 * i, e16[i] * kRadToDeg, ex[i] * kRadToDeg, thesis[i], e16[i] * kRadToDeg - 30.0 * i,
-              ex[i] * kRadToDeg - 30.0 * i);
-  }
-  {
-    CsvWriter an(dir + "/angles.csv",
-                 {"i", "original_deg", "eq16_deg", "exact_deg", "eq16_adjustment_deg", "exact_adjustment_deg"});
-    const int n = 901;  // 0.1 deg over [0, 90]
-    const std::vector<double> e16 = conchoid_angles_eq16(n), ex = exact.equal_length_angles(n, kPi / 2);
-    for (int i = 0; i < n; ++i)
-      an.row(i, 0.1 * i, e16[i] * kRadToDeg, ex[i] * kRadToDeg, e16[i] * kRadToDeg - 0.1 * i,
-             ex[i] * kRadToDeg - 0.1 * i);
-  }
+  length_table(dir, exact, approx_a, b);
+  table10(dir, exact);
+  angles_table(dir, exact);
   // Equal node count on a conchoid joint (origin at the conchoid origin, axis z): maps filled with
   // the exact radius at every node (the sampling itself is exact here), so only the node layout
   // and its interpolation differ. Error over uniformly random directions with phi <= 90 deg.

@@ -24,62 +24,66 @@ using namespace impinge;
 using namespace impinge::experiment;
 using PointMatrix = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 
-int main(int argc, char** argv) {
-  const Args args = parse_args(argc, argv, "12_sphere_fit: thesis sec. 3.4 centre of rotation by sphere fit");
-  const std::string dir = experiment_dir(args, "12_sphere_fit");
-  const int seeds = args.quick ? 3 : 10;
-  {
-    CsvWriter syn(dir + "/synthetic.csv", {"method", "noise_mm", "coverage_deg", "cam_mm", "seed", "centre_error_mm",
-                                           "radius_error_mm", "rms_mm", "points"});
-    const double R = 22;
-    int step = 0;
-    const std::vector<double> noises{0, 0.1, 0.3, 0.5}, coverages{60, 90, 120, 150}, cams{0, 2, 4};
-    for (double noise : noises)
-      for (double cov : coverages)
-        for (double cam : cams) {
-          progress(
-              "12_sphere_fit", ++step, int(noises.size() * coverages.size() * cams.size()),
-              "noise " + std::to_string(noise) + " coverage " + std::to_string(cov) + " cam " + std::to_string(cam));
-          for (int seed = 0; seed < seeds; ++seed) {
-            // Head points: a cap of half-angle `cov` about +z (superior) with Gaussian radial noise;
-            // the cam bump: a Gaussian bump of height `cam` and width 15 deg at 60 deg from the top.
-            std::mt19937_64 rng(1000 + seed);
-            std::uniform_real_distribution<double> U(0, 1);
-            std::normal_distribution<double> N(0, 1);
-            const Eigen::Vector3d c(12, -7, 40);
-            const Eigen::Vector3d cam_dir = direction(60 * kDegToRad, 30 * kDegToRad);
-            const int n = 4000;
-            PointMatrix P(n, 3);
-            for (int i = 0; i < n; ++i) {
-              const double z = 1 - U(rng) * (1 - std::cos(cov * kDegToRad));
-              const Eigen::Vector3d u = direction(std::acos(z), 2 * kPi * U(rng));
-              const double g = std::acos(std::clamp(u.dot(cam_dir), -1.0, 1.0)) / (15 * kDegToRad);
-              P.row(i) = (c + (R + noise * N(rng) + cam * std::exp(-g * g)) * u).transpose();
-            }
-            // the automatic fit on a femur-like mesh: the generated head + neck carries the same
-            // noise-free geometry; here it runs on the point set as a vertex-only mesh
-            TriangleMesh pts;
-            pts.V = P;
-            pts.F.resize(1, 3);
-            pts.F << 0, 1, 2;
-            pts.source = "synthetic head";
-            struct Fit {
-              const char* name;
-              SphereFitResult r;
-            };
-            std::vector<Fit> fits{{"algebraic", fit_sphere_algebraic(P)}, {"geometric", fit_sphere_geometric(P)}};
-            try {
-              HeadFitOptions o;
-              o.seed = 99 + seed;
-              fits.push_back({"automatic", fit_femoral_head(pts, o)});
-            } catch (const Error&) {
-            }
-            for (const Fit& f : fits)
-              syn.row(f.name, noise, cov, cam, seed, (f.r.centre - c).norm(), f.r.radius - R, f.r.rms_residual,
-                      f.r.points_used);
+namespace {
+
+// Synthetic heads: a cap of half-angle `coverage` about +z with Gaussian radial noise and a cam bump,
+// fitted algebraically, geometrically and by the automatic fit; `seeds` draws each.
+void synthetic_table(const std::string& dir, int seeds) {
+  CsvWriter syn(dir + "/synthetic.csv", {"method", "noise_mm", "coverage_deg", "cam_mm", "seed", "centre_error_mm",
+                                         "radius_error_mm", "rms_mm", "points"});
+  const double R = 22;
+  int step = 0;
+  const std::vector<double> noises{0, 0.1, 0.3, 0.5}, coverages{60, 90, 120, 150}, cams{0, 2, 4};
+  for (double noise : noises)
+    for (double cov : coverages)
+      for (double cam : cams) {
+        progress(
+            "12_sphere_fit", ++step, int(noises.size() * coverages.size() * cams.size()),
+            "noise " + std::to_string(noise) + " coverage " + std::to_string(cov) + " cam " + std::to_string(cam));
+        for (int seed = 0; seed < seeds; ++seed) {
+          // Head points: a cap of half-angle `cov` about +z (superior) with Gaussian radial noise;
+          // the cam bump: a Gaussian bump of height `cam` and width 15 deg at 60 deg from the top.
+          std::mt19937_64 rng(1000 + seed);
+          std::uniform_real_distribution<double> U(0, 1);
+          std::normal_distribution<double> N(0, 1);
+          const Eigen::Vector3d c(12, -7, 40);
+          const Eigen::Vector3d cam_dir = direction(60 * kDegToRad, 30 * kDegToRad);
+          const int n = 4000;
+          PointMatrix P(n, 3);
+          for (int i = 0; i < n; ++i) {
+            const double z = 1 - U(rng) * (1 - std::cos(cov * kDegToRad));
+            const Eigen::Vector3d u = direction(std::acos(z), 2 * kPi * U(rng));
+            const double g = std::acos(std::clamp(u.dot(cam_dir), -1.0, 1.0)) / (15 * kDegToRad);
+            P.row(i) = (c + (R + noise * N(rng) + cam * std::exp(-g * g)) * u).transpose();
           }
+          // the automatic fit on a femur-like mesh: the generated head + neck carries the same
+          // noise-free geometry; here it runs on the point set as a vertex-only mesh
+          TriangleMesh pts;
+          pts.V = P;
+          pts.F.resize(1, 3);
+          pts.F << 0, 1, 2;
+          pts.source = "synthetic head";
+          struct Fit {
+            const char* name;
+            SphereFitResult r;
+          };
+          std::vector<Fit> fits{{"algebraic", fit_sphere_algebraic(P)}, {"geometric", fit_sphere_geometric(P)}};
+          try {
+            HeadFitOptions o;
+            o.seed = 99 + seed;
+            fits.push_back({"automatic", fit_femoral_head(pts, o)});
+          } catch (const Error&) {
+          }
+          for (const Fit& f : fits)
+            syn.row(f.name, noise, cov, cam, seed, (f.r.centre - c).norm(), f.r.radius - R, f.r.rms_residual,
+                    f.r.points_used);
         }
-  }
+      }
+}
+
+// Real femurs: the automatic fit's sensitivity to its proximal extent and inlier band, and the
+// residuals of the head vertices (Fig. 39).
+void real_tables(const Args& args, const std::string& dir) {
   CsvWriter real(dir + "/real.csv", {"subject", "proximal_extent_mm", "inlier_threshold_mm", "cx_mm", "cy_mm", "cz_mm",
                                      "radius_mm", "rms_mm", "inliers", "shift_from_default_mm"});
   CsvWriter res(dir + "/residuals.csv", {"subject", "phi_deg", "theta_deg", "residual_mm"});
@@ -108,6 +112,16 @@ int main(int argc, char** argv) {
       res.row(s.name, sc.phi * kRadToDeg, sc.theta * kRadToDeg, e);
     }
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv, "12_sphere_fit: thesis sec. 3.4 centre of rotation by sphere fit");
+  const std::string dir = experiment_dir(args, "12_sphere_fit");
+  const int seeds = args.quick ? 3 : 10;
+  synthetic_table(dir, seeds);
+  real_tables(args, dir);
   write_meta(dir, args,
              {{"seeds", seeds},
               {"points", 4000},
