@@ -79,6 +79,7 @@ std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& gen
 SphereFitResult subject_head(const Subject& s) {
   LoadedInput in;
   in.femur = s.femur;
+  in.pelvis = s.pelvis;
   in.side = s.side;
   in.landmarks = s.landmarks;
   return find_centre_of_rotation(in, {}).head;

@@ -2,8 +2,11 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <sstream>
 #include <vector>
 
 #include "impinge/core/error.hpp"
@@ -29,13 +32,17 @@ Eigen::Vector3d femur_long_axis(PointsRef V, const Eigen::Vector3d& proximal_hin
   return L;
 }
 
-SphereFitResult locate_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options) {
+namespace {
+
+// The sphere of each end of the femur's long axis (fit_femoral_head with that end up); an end
+// without a plausible sphere has an empty result and its error in `errors`.
+std::array<std::optional<SphereFitResult>, 2> head_candidates(const TriangleMesh& femur, const HeadFitOptions& options,
+                                                              std::string& errors) {
   validate_mesh(femur);
   const Eigen::Vector3d L = femur_long_axis(femur.V, Eigen::Vector3d::Constant(std::nan("")));
-  SphereFitResult best;
-  bool have = false;
-  std::string errors;
-  for (const double s : {1.0, -1.0}) {
+  std::array<std::optional<SphereFitResult>, 2> out;
+  for (int k = 0; k < 2; ++k) {
+    const double s = k == 0 ? 1.0 : -1.0;
     // Rotate so that s L becomes +z, fit there, rotate the centre back.
     const Eigen::Matrix3d Q = Eigen::Quaterniond::FromTwoVectors(s * L, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     TriangleMesh m;
@@ -45,13 +52,57 @@ SphereFitResult locate_femoral_head(const TriangleMesh& femur, const HeadFitOpti
     try {
       SphereFitResult r = fit_femoral_head(m, options);
       r.centre = Q.transpose() * r.centre;
-      if (!have || r.points_used > best.points_used) best = r, have = true;
+      out[static_cast<std::size_t>(k)] = r;
     } catch (const Error& e) {
       errors += std::string(errors.empty() ? "" : "; ") + e.what();
     }
   }
-  require(have, femur.source + ": no femoral head found at either end of the long axis (" + errors + ")");
-  return best;
+  return out;
+}
+
+// Distance (mm) from p to the nearest vertex of `mesh`.
+double nearest_vertex_distance(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
+  return std::sqrt((mesh.V.rowwise() - p.transpose()).rowwise().squaredNorm().minCoeff());
+}
+
+}  // namespace
+
+SphereFitResult locate_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options) {
+  std::string errors;
+  const auto c = head_candidates(femur, options, errors);
+  require(c[0] || c[1], femur.source + ": no femoral head found at either end of the long axis (" + errors + ")");
+  if (c[0] && c[1]) return c[0]->points_used >= c[1]->points_used ? *c[0] : *c[1];
+  return c[0] ? *c[0] : *c[1];
+}
+
+SphereFitResult locate_femoral_head(const TriangleMesh& femur, const TriangleMesh& pelvis,
+                                    const HeadFitOptions& options) {
+  validate_mesh(pelvis);
+  std::string errors;
+  auto c = head_candidates(femur, options, errors);
+  require(c[0] || c[1], femur.source + ": no femoral head found at either end of the long axis (" + errors + ")");
+  // Both ends can find the same sphere (a short proximal femur): one head, the better fit.
+  if (c[0] && c[1] && (c[0]->centre - c[1]->centre).norm() < 2.0) {
+    if (c[1]->points_used > c[0]->points_used) c[0] = c[1];
+    c[1].reset();
+  }
+  std::ostringstream seen;
+  std::optional<SphereFitResult> head;
+  int in_acetabulum = 0;
+  for (const auto& k : c) {
+    if (!k) continue;
+    const double gap = nearest_vertex_distance(pelvis, k->centre) - k->radius;
+    seen << (seen.tellp() > 0 ? "; " : "") << "sphere of radius " << k->radius << " mm at (" << k->centre.x() << ", "
+         << k->centre.y() << ", " << k->centre.z() << "): its surface " << gap << " mm from the pelvis";
+    if (std::abs(gap) <= kHeadInAcetabulumMm) ++in_acetabulum, head = k;
+  }
+  require(in_acetabulum == 1, femur.source + ": cannot tell which end of the femur is proximal: " +
+                                  (in_acetabulum == 0 ? std::string("neither") : std::string("both")) +
+                                  " end's sphere sits in the acetabulum of " + pelvis.source + " (within " +
+                                  std::to_string(int(kHeadInAcetabulumMm)) + " mm; " + seen.str() +
+                                  "). Are the femur and pelvis one hip in one frame? A given COR or head region "
+                                  "avoids the search");
+  return *head;
 }
 
 namespace {

@@ -17,7 +17,7 @@ HipFrames find_hip_frames(const TriangleMesh& femur, const TriangleMesh& pelvis,
     h.head.rms_residual = std::nan("");
     h.head_source = "given";
   } else {
-    h.head = locate_femoral_head(femur, options.head);
+    h.head = locate_femoral_head(femur, pelvis, options.head);  // the end in the acetabulum
     h.head_source = "found";
   }
   h.pelvis_landmarks = find_pelvis_landmarks(pelvis, h.head.centre, side, given);

@@ -112,6 +112,14 @@ LoadedInput load_input(const SessionInput& input) {
   return in;
 }
 
+namespace {
+// The femoral head found on the femur: the end of its long axis that sits in the acetabulum when the
+// pelvis is there, else the end with the better sphere.
+SphereFitResult located_head(const LoadedInput& in) {
+  return in.pelvis.V.rows() > 0 ? locate_femoral_head(in.femur, in.pelvis) : locate_femoral_head(in.femur);
+}
+}  // namespace
+
 CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) {
   const Eigen::Matrix3d& M = in.to_working;
   CorResult r;
@@ -128,7 +136,7 @@ CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) 
     r.method = "given";
     if (!cor.allow_any) {
       // A given COR must lie in the femoral head: compare with the head the bone itself shows.
-      const SphereFitResult head = locate_femoral_head(in.femur);
+      const SphereFitResult head = located_head(in);
       const double d = (r.head.centre - head.centre).norm();
       if (d > head.radius)
         throw Error("cor " + point_text(*cor.given) + " mm is " + num(d) + " mm from the fitted femoral head centre " +
@@ -143,8 +151,9 @@ CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) 
     r.method = "given (subject.json landmark hip_centre)";
     return r;
   }
-  r.head = locate_femoral_head(in.femur);
-  r.method = "automatic sphere fit (long axis, RANSAC + geometric)";
+  r.head = located_head(in);
+  r.method = in.pelvis.V.rows() > 0 ? "automatic sphere fit (long axis, RANSAC + geometric; the end in the acetabulum)"
+                                    : "automatic sphere fit (long axis, RANSAC + geometric)";
   return r;
 }
 

@@ -44,6 +44,22 @@ Eigen::Vector3d femur_long_axis(PointsRef V, const Eigen::Vector3d& proximal_hin
 /// naming the mesh when neither end gives a plausible sphere.
 SphereFitResult locate_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options = {});
 
+/// The femoral head of a femur (whole or proximal only, right or left, any orientation) beside its
+/// pelvis in the same frame (mm): the sphere of each end of the long axis (fit_femoral_head), and
+/// the head is the one that sits in the acetabulum (two spheres within 2 mm of each other are one),
+/// its nearest pelvis vertex within
+/// kHeadInAcetabulumMm of its surface (the joint space; the shared hips: 0.4-1.1 mm). A distal
+/// condyle or a cut shaft can out-fit the head; it cannot lie in the acetabulum. Throws
+/// impinge::Error naming both meshes when neither end's sphere, or both, sit in the acetabulum (not
+/// one hip in one frame?), or when no sphere is found.
+SphereFitResult locate_femoral_head(const TriangleMesh& femur, const TriangleMesh& pelvis,
+                                    const HeadFitOptions& options = {});
+
+/// How far (mm) the head's surface may lie from the nearest pelvis vertex and still sit in the
+/// acetabulum: the cartilage space (2-5 mm at the scan pose, shared/data/README.md) with margin for a
+/// segmentation or a subluxed head.
+inline constexpr double kHeadInAcetabulumMm = 12.0;
+
 /// Find the distal landmarks of a whole femur (working frame, mm) whose head centre is
 /// `head_centre` (mm): the long axis (principal axis, towards the head); the distal slab (the
 /// last `distal_fraction` of the femur's length along it); the medial direction from the head's

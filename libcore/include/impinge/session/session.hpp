@@ -38,8 +38,9 @@ struct SessionInput {
 
 /// How the centre of rotation (COR) is found. In order: `head_region` (a sphere fit to the femur's
 /// vertices there), `given`, the subject's "hip_centre" landmark, else automatic: the femoral head
-/// found on the whole femur in any orientation and fitted (locate_femoral_head: long axis, RANSAC
-/// and geometric sphere fit; thesis sec. 3.4).
+/// found on the femur (whole or proximal, either side, in any orientation) and fitted: a sphere at
+/// each end of the long axis (RANSAC and geometric fit; thesis sec. 3.4), the head the one that sits
+/// in the acetabulum (locate_femoral_head with the pelvis).
 struct CorOptions {
   std::optional<Eigen::Vector3d> given;        ///< X, Y, Z: mm, input frame
   std::optional<Eigen::Vector4d> head_region;  ///< X, Y, Z, R: fit the head to femur vertices within R mm of X, Y, Z
