@@ -343,6 +343,14 @@ int main(int argc, char** argv) {
   rom->add_option("--threshold", rq.search.threshold_mm,
                   "mm: the bones meet when the minimum gap is <= this (0: bone contact; a cartilage offset > 0)")
       ->capture_default_str();
+  std::string contacts = "impingement";
+  rom->add_option("--contacts", contacts,
+                  "Which contacts end a search: 'impingement' (the head-neck junction, neck or trochanters against "
+                  "the rim or the pelvis beyond it; the head's joint surface meeting the lunate surface, the joint "
+                  "space closing, is left out), 'articular' (only that: where the joint space closes) or 'all' "
+                  "(every vertex, the thesis' criterion). Anatomical neutral only (the zones need the acetabulum); "
+                  "rom_limits.csv's contact_class says which ended each limit")
+      ->capture_default_str();
   rom->add_option("--step", rq.search.step_deg, "Coarse search step, deg (then bisection to 0.1 deg)")
       ->capture_default_str();
   rom->add_option("--max", rq.search.max_deg, "Search no farther than this from the start, deg")->capture_default_str();
@@ -376,6 +384,7 @@ int main(int argc, char** argv) {
     if (*dist) return run_distance(so, text, pose, do_render, out);
     if (*mot) return run_motion(so, text, mo, out);
     rq.map = !no_map;
+    rq.search.contacts = parse_rom_contacts(contacts, "--contacts");
     if (*rom) return run_rom(so, text, rq, out);
     if (*gen) return run_generate(gen_o, out);
   } catch (const std::exception& e) {

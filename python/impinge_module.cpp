@@ -493,8 +493,9 @@ std::string joint_doc() {
          "the option, array or file on bad input; warnings (e.g. an overlap at the scan pose) as UserWarning.";
 }
 
-py::dict rom_limits(const PyJoint& j, double threshold_mm, double step_deg, double max_deg) {
+py::dict rom_limits(const PyJoint& j, double threshold_mm, double step_deg, double max_deg, const std::string& contacts) {
   RomRequest q;
+  q.search.contacts = parse_rom_contacts(contacts, "contacts");
   q.search.threshold_mm = threshold_mm;
   q.search.step_deg = step_deg;
   q.search.max_deg = max_deg;
@@ -556,12 +557,13 @@ void add_joint_queries(py::class_<PyJoint>& c) {
            "penetrating_area_mm2 = socket_penetrating_area_mm2, ball_penetrating_area_mm2, socket_levelN_area_mm2, "
            "closest clock hours and point, detection_ms). One C++ loop; the GIL is released.")
       .def("rom_limits", &rom_limits, py::arg("threshold_mm") = 0.0, py::arg("step_deg") = 2.0,
-           py::arg("max_deg") = 150.0,
+           py::arg("max_deg") = 150.0, py::arg("contacts") = "impingement",
            "ROM limits from neutral for the standard motions (flexion, extension, abduction, adduction, internal and "
            "external rotation, both rotations at 90 deg flexion, FADIR) -> dict motion -> the CLI's rom_limits.csv "
-           "row (limit_deg (NaN: none within max_deg), limited_by, socket_clock_h, femur_clock_h, "
+           "row (limit_deg (NaN: none within max_deg), limited_by, contact_class, socket_clock_h, femur_clock_h, "
            "min_gap_at_limit_mm, monotone, contact_at_start, evaluations) and contact_mm (input frame); and "
-           "excluded_vertices (in contact at neutral, not counted).")
+           "excluded_vertices (in contact at neutral, not counted). contacts: 'impingement' (the joint surfaces left out), "
+           "'articular' (only they: where the joint space closes) or 'all'.")
       .def(
           "rom_map",
           [](const PyJoint& j, const std::vector<double>& flexion, const std::vector<double>& adduction,

@@ -11,6 +11,10 @@
 // - the ROM envelope by adaptive refinement agrees with every pose scanned (to 0.1 %), and with the
 //   ROM limit along internal rotation;
 // - a right hip and its mirrored left copy give the same limits within 0.2 deg;
+// - contact classes (issue 29): counting every vertex can only end a search earlier than counting
+//   impingement alone, and where it does, on every shared subject and motion, the earlier contact is
+//   on the joint surfaces (articular); a search of the joint surfaces alone ends on articular contacts;
+//   the impingement search never does;
 // - pre-existing overlap at the baseline is excluded and reported, not taken for a limit;
 // - bad options are errors.
 #include "impinge/clinical/rom.hpp"
@@ -19,8 +23,10 @@
 
 #include <Eigen/Geometry>
 #include <iostream>
+#include <limits>
 #include <memory>
 
+#include "impinge/anatomy/femur_frame.hpp"
 #include "impinge/casters/first_hit_caster.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/io/generated_models.hpp"
@@ -122,6 +128,47 @@ TEST(Rom, MirroredLeftHipHasTheSameLimits) {
     }
   }
   EXPECT_GT(limited, 1);
+}
+
+TEST(Rom, OnlyTheJointSurfacesMeetingIsArticularAndItNeverEndsASearch) {
+  int subjects = 0, articular_earlier = 0;
+  for (const char* name : {"lhdl-ct", "mc22", "tlem2-mri", "mc22-left"}) {
+    auto j = test::load_real_joint(name);
+    if (!j) continue;
+    ++subjects;
+    SCOPED_TRACE(name);
+    HipJointOptions o;
+    o.joint.scheme = make_scheme("equiangular", 0.5);
+    const Side side = std::string(name) == "mc22-left" ? Side::left : Side::right;
+    const HipJoint hip(j->femur, j->pelvis, side, locate_femoral_head(j->femur, j->pelvis), {}, o);
+    ASSERT_TRUE(hip.articular().has_value());
+    RomOptions impingement, all, articular;
+    all.contacts = RomContacts::all;
+    articular.contacts = RomContacts::articular;
+    const RomBaseline bi = rom_baseline(hip, hip.femur_rotation({}), impingement);
+    const RomBaseline ba = rom_baseline(hip, hip.femur_rotation({}), all);
+    const RomBaseline bj = rom_baseline(hip, hip.femur_rotation({}), articular);
+    EXPECT_GT(bi.articular_vertices, 0);
+    EXPECT_EQ(ba.articular_vertices, 0);
+    const std::vector<StandardMotion> motions = standard_motions();
+    const auto li = find_rom_limits(hip, motions, impingement, bi), la = find_rom_limits(hip, motions, all, ba),
+               lj = find_rom_limits(hip, motions, articular, bj);
+    for (std::size_t k = 0; k < motions.size(); ++k) {
+      SCOPED_TRACE(motions[k].name);
+      const double inf = std::numeric_limits<double>::infinity();
+      const double a = std::isnan(la[k].limit_deg) ? inf : la[k].limit_deg;
+      const double i = std::isnan(li[k].limit_deg) ? inf : li[k].limit_deg;
+      EXPECT_LE(a, i + 0.1);
+      if (a < i - 0.2) {
+        ++articular_earlier;
+        EXPECT_EQ(la[k].contact_class, ContactClass::articular);
+      }
+      if (!std::isnan(li[k].limit_deg)) EXPECT_NE(li[k].contact_class, ContactClass::articular);
+      if (!std::isnan(lj[k].limit_deg)) EXPECT_EQ(lj[k].contact_class, ContactClass::articular);
+    }
+  }
+  if (subjects == 0) GTEST_SKIP() << "shared data absent";
+  EXPECT_GT(articular_earlier, 0);  // the MRI hips' joint spaces close before they impinge
 }
 
 TEST(Rom, PreExistingOverlapIsExcludedAndBadOptionsAreErrors) {

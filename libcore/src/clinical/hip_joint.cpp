@@ -46,6 +46,10 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     g["hip_centre"] = cor_;
     frames_ = find_hip_frames(femur, pelvis, side, g, options.frames);
     acetabulum_ = find_acetabulum(pelvis, cor_, head_radius_, frames_->pelvis);
+    SphereFitResult head_sphere = head;
+    head_sphere.centre = cor_;
+    head_sphere.radius = head_radius_;
+    articular_ = find_articular_zones(femur, head_sphere, pelvis, *acetabulum_, options.articular);
     const ClockFace femoral = femoral_clock_face(femur, cor_, head_radius_, frames_->femur);
     if (options.reseat) {
       // The femur, its frame and clock move with the head onto the acetabular centre.
@@ -103,6 +107,18 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
                 std::to_string(cor_.y()) + ", " + std::to_string(cor_.z()) + ") mm is outside the femur mesh (" +
                 std::to_string(100 * uncovered) + " % of the directions from it meet no femur surface): a COR "
                 "in the wrong frame or units? allow_cor_outside_ball (CLI: --allow-any-cor) accepts it");
+}
+
+ContactClass HipJoint::contact_class(bool ball, std::int64_t vertex, const Eigen::Vector3d& p_joint,
+                                     double intra_margin_mm) const {
+  if (articular_) {
+    const std::vector<std::uint8_t>& zone = ball ? articular_->femur : articular_->pelvis;
+    if (vertex >= 0 && static_cast<std::size_t>(vertex) < zone.size() && zone[static_cast<std::size_t>(vertex)])
+      return ContactClass::articular;
+  }
+  const double rim = acetabulum_ ? acetabulum_->rim_radius_mm : head_radius_ + 5;
+  return p_joint.norm() <= rim + intra_margin_mm ? ContactClass::intra_articular_impingement
+                                                 : ContactClass::extra_articular_impingement;
 }
 
 void HipJoint::save_maps(const std::string& ball_path, const std::string& socket_path) const {

@@ -12,6 +12,13 @@
 namespace impinge {
 using namespace rom_detail;
 
+RomContacts parse_rom_contacts(const std::string& text, const std::string& context) {
+  if (text == "impingement") return RomContacts::impingement;
+  if (text == "articular") return RomContacts::articular;
+  if (text == "all") return RomContacts::all;
+  throw Error(context + " '" + text + "': expected impingement, articular or all");
+}
+
 const char* to_string(ImpingementSite site) {
   switch (site) {
     case ImpingementSite::intra_articular: return "intra_articular";
@@ -55,6 +62,13 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
   for (std::size_t i = 0; i < b.skip_socket.size(); ++i) b.skip_socket[i] = r.socket_gaps.gap_mm[i] <= o.threshold_mm;
   for (auto s : b.skip_ball) b.excluded_vertices += s;
   for (auto s : b.skip_socket) b.excluded_vertices += s;
+  // The joint surfaces: left out of impingement searches, the only ones counted where the joint space closes.
+  if (const auto& z = hip.articular(); z && o.contacts != RomContacts::all) {
+    const bool keep_articular = o.contacts == RomContacts::articular;
+    for (auto [skip, zone] : {std::pair{&b.skip_ball, &z->femur}, std::pair{&b.skip_socket, &z->pelvis}})
+      for (std::size_t i = 0; i < skip->size(); ++i)
+        if (!(*skip)[i] && (((*zone)[i] != 0) != keep_articular)) (*skip)[i] = 1, ++b.articular_vertices;
+  }
   b.min_gap_mm = std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);
   if (o.use_bounds) b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), o.threshold_mm);
   return b;
@@ -121,6 +135,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
   out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? ImpingementSite::intra_articular
                                                                       : ImpingementSite::extra_articular;
   out.limited_by_hidden_vertex = l.hidden;
+  out.contact_class = hip.contact_class(l.ball, static_cast<std::int64_t>(l.vertex), p_joint, o.intra_articular_margin_mm);
   if (hip.socket_clock()) {
     // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.
     out.socket_clock_h = hip.socket_clock()->hour(p_joint);

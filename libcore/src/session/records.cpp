@@ -2,9 +2,11 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "impinge/core/error.hpp"
+#include "impinge/clinical/rom.hpp"
 #include "impinge/core/spherical_frame.hpp"
 #include "impinge/sampling/sampling.hpp"
 #include "impinge/schemes/sampling_scheme.hpp"
@@ -231,6 +233,22 @@ nlohmann::json pose_record(const Session& s, const PoseAngles& pose, const PoseR
   j["ball"] = scan_record(s.joint().ball(), res.ball, res.ball_detection_ms, levels, clocks ? &ball_clock : nullptr);
   j["socket"] =
       scan_record(s.joint().socket(), res.socket, res.socket_detection_ms, levels, clocks ? &socket_clock : nullptr);
+  // Where each scan comes closest, classed (articular, intra- or extra-articular impingement).
+  const Eigen::Matrix3d R = s.hip().femur_rotation(pose);
+  for (const bool ball : {true, false}) {
+    const ScanGaps& g = ball ? res.ball_gaps : res.socket_gaps;
+    const JointBody& body = ball ? s.joint().ball() : s.joint().socket();
+    float best = std::numeric_limits<float>::infinity();
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < g.gap_mm.size(); ++i)
+      if (g.gap_mm[i] < best) best = g.gap_mm[i], at = i;
+    const Eigen::Vector3d v = body.relative.row(static_cast<Eigen::Index>(at)).transpose();
+    const ContactClass c = std::isfinite(best) ? s.hip().contact_class(ball, static_cast<std::int64_t>(at),
+                                                                       ball ? Eigen::Vector3d(R * v) : v,
+                                                                       kIntraArticularMarginMm)
+                                               : ContactClass::none;
+    j[ball ? "ball" : "socket"]["closest_contact_class"] = to_string(c);
+  }
   return j;
 }
 

@@ -14,7 +14,7 @@ std::vector<std::string> motion_columns(const ImpingementLevels& levels) {
                                 "penetrating_area_mm2",  "ball_penetrating_area_mm2"};
   for (int k = 0; k < levels.count(); ++k) c.push_back("socket_level" + std::to_string(k) + "_area_mm2");
   for (const char* name : {"socket_closest_clock_h", "femur_closest_clock_h", "socket_closest_x_mm",
-                           "socket_closest_y_mm", "socket_closest_z_mm", "detection_ms"})
+                           "socket_closest_y_mm", "socket_closest_z_mm", "socket_closest_class", "detection_ms"})
     c.emplace_back(name);
   return c;
 }
@@ -34,6 +34,7 @@ nlohmann::json motion_row(const MotionFrame& f) {
   row.push_back(number_or_null(f.socket_clock.closest_hour));
   row.push_back(number_or_null(f.ball_clock.closest_hour));
   for (int c = 0; c < 3; ++c) row.push_back(number_or_null(f.socket_closest[c]));
+  row.push_back(to_string(f.socket_closest_class));
   row.push_back(f.detection_ms);
   return row;
 }
@@ -61,9 +62,11 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
     std::size_t at = 0;
     for (std::size_t i = 0; i < res.socket_gaps.gap_mm.size(); ++i)
       if (res.socket_gaps.gap_mm[i] < best) best = res.socket_gaps.gap_mm[i], at = i;
-    f.socket_closest = std::isfinite(best)
-                           ? s.report_point(socket.relative.row(static_cast<Eigen::Index>(at)).transpose())
-                           : Eigen::Vector3d::Constant(std::nan(""));
+    const Eigen::Vector3d p = socket.relative.row(static_cast<Eigen::Index>(at)).transpose();
+    f.socket_closest = std::isfinite(best) ? s.report_point(p) : Eigen::Vector3d::Constant(std::nan(""));
+    f.socket_closest_class = std::isfinite(best)
+                                 ? s.hip().contact_class(false, static_cast<std::int64_t>(at), p, kIntraArticularMarginMm)
+                                 : ContactClass::none;
     f.ball_clock.closest_hour = f.socket_clock.closest_hour = std::nan("");
     s.hip().clocks(res, f.ball_clock, f.socket_clock);
     on_frame(f);
@@ -116,13 +119,14 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
 
 Table rom_limits_table(const Session& s, const RomRun& run) {
   Table t;
-  t.columns = {"motion",      "limit_deg",        "limited_by",   "socket_clock_h", "femur_clock_h",
+  t.columns = {"motion",      "limit_deg",        "limited_by",   "contact_class", "socket_clock_h", "femur_clock_h",
                "min_gap_at_limit_mm", "monotone", "contact_at_start", "contact_x_mm", "contact_y_mm",
                "contact_z_mm", "evaluations"};
   for (std::size_t k = 0; k < run.motions.size(); ++k) {
     const RomLimit& l = run.limits[k];
     const Eigen::Vector3d c = s.to_input(l.contact_mm);
-    t.add({run.motions[k].name, number_or_null(l.limit_deg), to_string(l.limited_by), number_or_null(l.socket_clock_h),
+    t.add({run.motions[k].name, number_or_null(l.limit_deg), to_string(l.limited_by), to_string(l.contact_class),
+           number_or_null(l.socket_clock_h),
            number_or_null(l.femur_clock_h), number_or_null(l.min_gap_at_limit_mm), l.monotone, l.contact_at_start,
            number_or_null(c.x()), number_or_null(c.y()), number_or_null(c.z()), l.evaluations});
   }
@@ -165,6 +169,10 @@ nlohmann::json rom_record(const RomRun& run) {
   j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
   j["neutral_min_gap_mm"] = number_or_null(run.baseline.min_gap_mm);
   j["excluded_vertices"] = run.baseline.excluded_vertices;
+  j["contacts_counted"] = o.contacts == RomContacts::impingement ? "impingement (the joint surfaces left out)"
+                          : o.contacts == RomContacts::articular ? "articular (the joint surfaces only)"
+                                                                 : "all";
+  j["articular_vertices_left_out"] = run.baseline.articular_vertices;
   nlohmann::json limits = nlohmann::json::array();
   for (std::size_t k = 0; k < run.motions.size(); ++k) {
     const RomLimit& l = run.limits[k];

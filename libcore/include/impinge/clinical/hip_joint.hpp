@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <optional>
 
+#include "impinge/anatomy/articular_zones.hpp"
 #include "impinge/anatomy/clock_face.hpp"
 #include "impinge/anatomy/hip_frames.hpp"
 #include "impinge/anatomy/pose.hpp"
@@ -31,6 +32,8 @@ struct HipJointOptions {
   /// Accept a centre of rotation outside the femur (ball) mesh, for research; otherwise that is an
   /// error (the gaps would be measured along rays that leave the head: silently wrong numbers).
   bool allow_cor_outside_ball = false;
+  /// Tolerances of the articular zones (anatomical neutral only; articular_zones.hpp).
+  ArticularZoneOptions articular;
 };
 
 /// Femur (ball) and pelvis (socket) of one hip about the centre of rotation, posed by clinical
@@ -83,6 +86,15 @@ class HipJoint {
   const std::optional<ClockFace>& ball_clock() const { return ball_clock_; }
   /// Where each scan of `res` lies on its clock face (anatomical neutral only; else untouched).
   void clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& socket) const;
+  /// The joint surfaces per vertex (the femoral head's, the lunate's), to tell the joint space
+  /// closing from impingement (anatomical neutral only: they need the acetabulum; else empty).
+  const std::optional<ArticularZones>& articular() const { return articular_; }
+  /// The class of a contact at vertex `vertex` of the femur (`ball`) or the pelvis, at joint-frame
+  /// position `p_joint` (mm): articular when the vertex is on its joint surface, else intra-articular
+  /// impingement within the acetabular rim radius (head radius + 5 mm without an acetabulum) plus
+  /// `intra_margin_mm` of the COR, else extra-articular.
+  ContactClass contact_class(bool ball, std::int64_t vertex, const Eigen::Vector3d& p_joint,
+                             double intra_margin_mm) const;
   /// The femur's translation by re-seating (mm, working frame; zero without it).
   const Eigen::Vector3d& reseat_translation() const { return reseat_; }
   /// Save both maps (map_io.hpp) with the working-frame COR, for options.ball_map_file and
@@ -106,6 +118,7 @@ class HipJoint {
   std::optional<HipFrames> frames_;
   std::optional<Acetabulum> acetabulum_;
   std::optional<ClockFace> socket_clock_, ball_clock_;
+  std::optional<ArticularZones> articular_;
   Eigen::Vector3d reseat_ = Eigen::Vector3d::Zero();
   double head_radius_ = 0;
   std::vector<std::string> warnings_;

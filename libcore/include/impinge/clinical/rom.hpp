@@ -25,6 +25,21 @@ enum class RomVertices {
   hidden,         ///< the hidden vertices against the layered maps only (the first extra-articular contact)
 };
 
+/// Which contacts end a ROM search (the articular zones of HipJoint::articular(); with scan neutral
+/// there are none and every option counts every vertex).
+enum class RomContacts {
+  impingement,  ///< impingement only: the joint surfaces (head against lunate) are not counted (the limit)
+  articular,    ///< the joint surfaces only: where the joint space closes, reported apart
+  all,          ///< every vertex: where the bones first meet (the thesis' criterion)
+};
+
+/// Parse "impingement", "articular" or "all". Throws impinge::Error naming `context` otherwise.
+RomContacts parse_rom_contacts(const std::string& text, const std::string& context);
+
+/// Contacts within the acetabular rim radius plus this (mm) of the COR are intra-articular, farther
+/// ones extra-articular (RomOptions' default; the motion and distance summaries use it too).
+inline constexpr double kIntraArticularMarginMm = 10;
+
 /// Options of a ROM search.
 struct RomOptions {
   double threshold_mm = 0;       ///< contact when the minimum gap <= this (0: bone contact; a cartilage offset > 0)
@@ -34,8 +49,11 @@ struct RomOptions {
   bool use_bounds = true;        ///< skip vertex clusters whose bound cannot reach the threshold (same results,
                                  ///< fewer look-ups; equiangular maps)
   RomVertices vertices = RomVertices::all;  ///< which vertices are counted (hidden ones need JointOptions::layers)
-  double intra_articular_margin_mm = 10;  ///< contacts within the acetabular rim radius plus this of the COR are
-                                          ///< intra-articular, farther ones extra-articular
+  RomContacts contacts = RomContacts::impingement;  ///< which contacts end a search (issue 29); applied by
+                                                    ///< rom_baseline, through the vertices it leaves out
+  /// Contacts within the acetabular rim radius plus this (mm) of the COR are intra-articular,
+  /// farther ones extra-articular.
+  double intra_articular_margin_mm = kIntraArticularMarginMm;
 };
 
 /// A standard motion: angles(theta) for theta >= 0 from its start (degrees).
@@ -67,6 +85,8 @@ struct RomLimit {
   bool limited_by_ball = false;    ///< the least gap was a femur vertex (else a pelvis vertex)
   bool limited_by_hidden_vertex = false;  ///< that vertex is hidden behind its own body's nearer surface and was
                                           ///< tested by the other body's layered map (JointOptions::layers)
+  ContactClass contact_class = ContactClass::none;  ///< the limit's contact (HipJoint::contact_class); none
+                                                    ///< without a limit
   ImpingementSite limited_by = ImpingementSite::none;  ///< intra- or extra-articular (none without a limit): extra when
                                    ///< the contact lies farther than the rim radius plus
                                    ///< RomOptions::intra_articular_margin_mm from the COR (a hidden vertex
@@ -91,6 +111,7 @@ struct RomSearchBounds;  ///< opaque: a joint's bound pyramids and vertex cluste
 struct RomBaseline {
   std::vector<std::uint8_t> skip_ball, skip_socket;  ///< 1 = not counted (per vertex of each body)
   std::int64_t excluded_vertices = 0;
+  std::int64_t articular_vertices = 0;  ///< not counted for RomOptions::contacts (on, or off, the joint surfaces)
   double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< least gap of all vertices at the baseline
   /// The bounds of the cluster search (RomOptions::use_bounds), built once by rom_baseline (about
   /// 10 ms for 0.1 deg maps) and shared by every search given this baseline with the same joint and

@@ -60,7 +60,7 @@ nlohmann::json acetabulum_record(const Acetabulum& acetabulum, const AnatomicalF
 nlohmann::json setup_record(const Session& session);
 
 /// Both scans at one pose: pose_deg, and ball / socket scan_record()s with clocks (anatomical
-/// neutral).
+/// neutral) and the class of each scan's closest vertex (closest_contact_class).
 nlohmann::json pose_record(const Session& session, const PoseAngles& pose, const PoseResult& result);
 
 }  // namespace impinge

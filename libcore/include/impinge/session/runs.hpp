@@ -26,12 +26,15 @@ struct MotionFrame {
   /// The socket vertex with the least gap, as Session::report_point gives it (pelvic frame with
   /// anatomical neutral, else the input frame), mm; NaN when no socket vertex was tested.
   Eigen::Vector3d socket_closest = Eigen::Vector3d::Constant(std::nan(""));
+  /// Its class (HipJoint::contact_class): articular on the lunate surface, else intra- or
+  /// extra-articular; none when no socket vertex was tested.
+  ContactClass socket_closest_class = ContactClass::none;
   double detection_ms = 0;                   ///< both scans of this frame
 };
 
 /// The columns of a motion table for `levels` (frames.csv): frame, time_s, the three angles, both
 /// least gaps (mm), penetrating areas (mm^2), the socket's area per level, both closest clock hours,
-/// the socket's closest point (x, y, z mm) and detection_ms.
+/// the socket's closest point (x, y, z mm) and its contact class, and detection_ms.
 std::vector<std::string> motion_columns(const ImpingementLevels& levels);
 /// One frame's row of that table.
 nlohmann::json motion_row(const MotionFrame& frame);
@@ -71,7 +74,7 @@ struct RomRun {
 /// envelope as requested. Throws impinge::Error on bad options (RomOptions, RomEnvelopeOptions).
 RomRun run_rom(const Session& session, const RomRequest& request);
 
-/// rom_limits.csv: motion, limit_deg, limited_by, socket_clock_h, femur_clock_h,
+/// rom_limits.csv: motion, limit_deg, limited_by, contact_class, socket_clock_h, femur_clock_h,
 /// min_gap_at_limit_mm, monotone, contact_at_start, contact_x/y/z_mm (input frame), evaluations.
 Table rom_limits_table(const Session& session, const RomRun& run);
 /// rom_map.csv: flexion_deg, adduction_deg, max_internal_rotation_deg, status.
