@@ -74,7 +74,8 @@ class Joint:
         """Save both maps for Joint(..., maps=(ball_path, socket_path))."""
     def detect(self, R: Optional[npt.ArrayLike] = None, t: Optional[Sequence[float]] = None) -> Dict[str, Any]:
         """Both scans, femur rotated by R about the COR and translated by t -> dict(ball_gap_mm,
-        socket_gap_mm (float32, NaN untested), ball_status, socket_status (uint8), summary)."""
+        socket_gap_mm (float32, NaN untested), ball_status, socket_status (uint8), summary: each scan's
+        record as summary.json gives it)."""
     def detect_pose(self, flexion: float = 0.0, adduction: float = 0.0,
                     internal_rotation: float = 0.0) -> Dict[str, Any]:
         """Both scans at clinical angles (degrees, ISB)."""

@@ -126,22 +126,6 @@ py::dict sphere_dict(const SphereFitResult& s) {
   return d;
 }
 
-py::dict summary_dict(const ScanSummary& s) {
-  py::dict d;
-  d["vertices"] = s.vertices;
-  d["vertices_tested"] = s.vertices_tested;
-  d["vertices_no_surface"] = s.vertices_no_surface;
-  d["vertices_beyond_reach"] = s.vertices_beyond_reach;
-  d["vertices_refined"] = s.vertices_refined;
-  d["vertices_tested_layered"] = s.vertices_tested_layered;
-  d["min_gap_layered_mm"] = s.min_gap_layered_mm;
-  d["min_gap_mm"] = s.min_gap_mm;
-  d["vertices_penetrating"] = s.vertices_penetrating;
-  d["area_penetrating_mm2"] = s.area_penetrating_mm2;
-  d["level_area_mm2"] = s.level_area_mm2;
-  d["level_vertices"] = s.level_vertices;
-  return d;
-}
 
 // A map's view for Python: values as a read-only numpy view kept alive by the joint.
 struct MapView {
@@ -295,8 +279,28 @@ PyJoint make_joint(const py::object& ball, const py::object& socket, const py::k
   return j;
 }
 
-// A JSON record (records.hpp) as Python objects (dicts, lists, floats; null as None).
-py::object from_json(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+// A JSON record (records.hpp) as Python objects (dicts, lists, numbers, strings; null as None),
+// converted directly (no text in between: detect() returns one per call).
+py::object from_json(const nlohmann::json& j) {
+  switch (j.type()) {
+    case nlohmann::json::value_t::object: {
+      py::dict d;
+      for (const auto& [k, v] : j.items()) d[py::str(k)] = from_json(v);
+      return std::move(d);
+    }
+    case nlohmann::json::value_t::array: {
+      py::list l;
+      for (const auto& v : j) l.append(from_json(v));
+      return std::move(l);
+    }
+    case nlohmann::json::value_t::string: return py::str(j.get<std::string>());
+    case nlohmann::json::value_t::boolean: return py::bool_(j.get<bool>());
+    case nlohmann::json::value_t::number_integer: return py::int_(j.get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned: return py::int_(j.get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float: return py::float_(j.get<double>());
+    default: return py::none();
+  }
+}
 
 // A table's columns as a dict of arrays: float64 for numbers (None as NaN), lists for text.
 py::dict table_columns(const Table& t) {
@@ -319,13 +323,17 @@ py::dict table_columns(const Table& t) {
   return d;
 }
 
-py::dict result_dict(PoseResult&& r) {
+// Both scans as Python: the gaps and statuses as numpy arrays (owning the C++ buffers), and each
+// scan's summary as summary.json records it (scan_record).
+py::dict result_dict(const Session& session, PoseResult&& r) {
   py::dict d;
   const auto nb = static_cast<py::ssize_t>(r.ball_gaps.gap_mm.size());
   const auto ns = static_cast<py::ssize_t>(r.socket_gaps.gap_mm.size());
+  const ImpingementLevels& levels = session.joint_options().levels;
   py::dict summary;
-  summary["ball"] = summary_dict(r.ball);
-  summary["socket"] = summary_dict(r.socket);
+  summary["ball"] = from_json(scan_record(session.joint().ball(), r.ball, r.ball_detection_ms, levels, nullptr));
+  summary["socket"] =
+      from_json(scan_record(session.joint().socket(), r.socket, r.socket_detection_ms, levels, nullptr));
   summary["ball_detection_ms"] = r.ball_detection_ms;
   summary["socket_detection_ms"] = r.socket_detection_ms;
   d["ball_gap_mm"] = own(std::move(r.ball_gaps.gap_mm), {nb});
@@ -532,7 +540,7 @@ void add_joint_queries(py::class_<PyJoint>& c) {
            py::gil_scoped_release release;
            j.session->joint().detect(Rj, tj, r);
          }
-         return result_dict(std::move(r));
+         return result_dict(*j.session, std::move(r));
        },
        py::arg("R") = py::none(), py::arg("t") = py::none(),
        "Both scans with the femur rotated by R (3, 3; input frame) about the COR, then translated by t (3,) "
@@ -546,7 +554,7 @@ void add_joint_queries(py::class_<PyJoint>& c) {
               py::gil_scoped_release release;
               j.hip().detect(PoseAngles{flexion, adduction, internal_rotation}, r);
             }
-            return result_dict(std::move(r));
+            return result_dict(*j.session, std::move(r));
           },
           py::arg("flexion") = 0.0, py::arg("adduction") = 0.0, py::arg("internal_rotation") = 0.0,
           "Both scans at clinical angles (degrees, ISB joint coordinate system: flexion, adduction and internal "

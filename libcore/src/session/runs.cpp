@@ -85,11 +85,11 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
   run.motions = standard_motions();
   run.limits = find_rom_limits(hip, run.motions, q.search, run.baseline);
   run.limits_ms = ms_since(t0);
-  for (const RomLimit& l : run.limits) {
-    run.limit_evaluations += l.evaluations;
-    run.vertices_looked_up += l.vertices_looked_up;
-    run.vertices_skipped += l.vertices_skipped;
-  }
+  auto count = [&run](const auto& x) {  // a limit's, a cell's or the envelope's look-ups
+    run.vertices_looked_up += x.vertices_looked_up;
+    run.vertices_skipped += x.vertices_skipped;
+  };
+  for (const RomLimit& l : run.limits) count(l), run.limit_evaluations += l.evaluations;
   if (q.map) {
     run.map_flexion_deg = q.map_flexion_deg;
     run.map_adduction_deg = q.map_adduction_deg;
@@ -100,19 +100,14 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
     t0 = Clock::now();
     run.map = rom_map(hip, run.map_flexion_deg, run.map_adduction_deg, q.search, run.baseline);
     run.map_ms = ms_since(t0);
-    for (const RomMapCell& c : run.map) {
-      run.vertices_looked_up += c.vertices_looked_up;
-      run.vertices_skipped += c.vertices_skipped;
-      run.map_evaluations += c.evaluations;
-    }
+    for (const RomMapCell& c : run.map) count(c), run.map_evaluations += c.evaluations;
   }
   if (q.envelope) {
     run.envelope_options = q.envelope_options;
     t0 = Clock::now();
     run.envelope = rom_envelope(hip, q.envelope_options, q.search, run.baseline);
     run.envelope_ms = ms_since(t0);
-    run.vertices_looked_up += run.envelope->vertices_looked_up;
-    run.vertices_skipped += run.envelope->vertices_skipped;
+    count(*run.envelope);
   }
   return run;
 }
