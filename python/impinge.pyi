@@ -17,8 +17,10 @@ def load_mesh(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]
 def fit_sphere(points: npt.ArrayLike) -> Dict[str, Any]:
     """Geometric least-squares sphere -> dict(centre, radius, rms_residual, points_used)."""
 
-def locate_femoral_head(V: npt.ArrayLike, F: npt.ArrayLike) -> SphereFit:
-    """Femoral head sphere of a whole femur in any orientation."""
+def locate_femoral_head(V: npt.ArrayLike, F: npt.ArrayLike,
+                        pelvis: Optional[Tuple[npt.ArrayLike, npt.ArrayLike]] = None) -> SphereFit:
+    """Femoral head sphere of a femur in any orientation; with its pelvis (same frame), the end that
+    sits in the acetabulum, as the CLI finds it."""
 
 def generated_hip(triangles: int = 3000, cam_mm: float = 0.0, coverage_deg: float = 100.0) -> Dict[str, Any]:
     """A generated hip -> dict(ball=(V, F), socket=(V, F), cor, head_radius_mm); use neutral='scan'."""

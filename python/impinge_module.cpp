@@ -405,14 +405,21 @@ void bind_functions(py::module_& m) {
 
   m.def(
       "locate_femoral_head",
-      [](const py::handle& V, const py::handle& F) {
+      [](const py::handle& V, const py::handle& F, const py::handle& pelvis) {
         const TriangleMesh mesh = to_mesh(py::make_tuple(V, F), "femur");
+        if (pelvis.is_none()) {
+          py::gil_scoped_release release;
+          return locate_femoral_head(mesh);
+        }
+        const TriangleMesh p = to_mesh(pelvis, "pelvis");
         py::gil_scoped_release release;
-        return locate_femoral_head(mesh);
+        return locate_femoral_head(mesh, p);
       },
-      py::arg("V"), py::arg("F"),
-      "Femoral head sphere of a whole femur in any orientation (long axis, RANSAC and geometric fit) -> "
-      "SphereFit.");
+      py::arg("V"), py::arg("F"), py::arg("pelvis") = py::none(),
+      "Femoral head sphere of a femur in any orientation (long axis, RANSAC and geometric fit at each end) -> "
+      "SphereFit. pelvis: (V, F) in the same frame: the head is the end that sits in the acetabulum, as the "
+      "CLI finds it (whole or proximal femur, either side); without it, the end with the better sphere. Raises "
+      "impinge.Error when it cannot tell which end is proximal.");
 
   m.def(
       "generated_hip",

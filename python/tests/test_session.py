@@ -162,3 +162,17 @@ def test_side_or_frame_contradicting_the_subject_is_an_error():
     out = subprocess.run([CLI, "distance", "--subject", d + "/g/subject.json", "--frame", "LPS", "--out", d + "/o"],
                          capture_output=True, text=True)
     assert out.returncode == 2 and "frame 'LPS' contradicts" in out.stderr
+
+
+@pytest.mark.skipif(not os.path.exists(os.path.join(DATA, "mc22-left", "subject.json")), reason="shared data absent")
+def test_the_head_is_found_beside_its_pelvis_as_the_cli_finds_it():
+    """mc22's real left femur: with its pelvis, the head within 2 mm of its hand-checked centre (LPS,
+    tests/anatomy/femur_frame_test.cpp) and the CLI's centre; a pelvis far away is an error."""
+    V, F = impinge.load_mesh(os.path.join(DATA, "mc22-left", "femur_l.ply"))
+    P, G = impinge.load_mesh(os.path.join(DATA, "mc22-left", "pelvis.ply"))
+    head = impinge.locate_femoral_head(V, F, pelvis=(P, G))
+    assert np.linalg.norm(head.centre - np.array([88.08, -6.13, -12.91])) < 2.0
+    j = impinge.Joint(subject=os.path.join(DATA, "mc22-left", "subject.json"), precision=2)
+    np.testing.assert_allclose(j.cor, head.centre, atol=1e-9)
+    with pytest.raises(impinge.Error, match="cannot tell which end of the femur is proximal"):
+        impinge.locate_femoral_head(V, F, pelvis=(P + 300.0, G))
