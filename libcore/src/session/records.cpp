@@ -222,6 +222,19 @@ nlohmann::json setup_record(const Session& s) {
   return j;
 }
 
+ClosestPoint closest_point(const Session& s, bool ball, const ScanGaps& gaps, const Eigen::Matrix3d& R) {
+  ClosestPoint c;
+  float best = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < gaps.gap_mm.size(); ++i)
+    if (gaps.gap_mm[i] < best) best = gaps.gap_mm[i], c.vertex = static_cast<std::int64_t>(i);
+  if (c.vertex < 0) return c;
+  const JointBody& body = ball ? s.joint().ball() : s.joint().socket();
+  const Eigen::Vector3d v = body.relative.row(static_cast<Eigen::Index>(c.vertex)).transpose();
+  c.p_joint = ball ? Eigen::Vector3d(R * v) : v;
+  c.contact_class = s.hip().contact_class(ball, c.vertex, c.p_joint, kIntraArticularMarginMm);
+  return c;
+}
+
 nlohmann::json pose_record(const Session& s, const PoseAngles& pose, const PoseResult& res) {
   nlohmann::json j;
   j["pose_deg"] = {pose.flexion_deg, pose.adduction_deg, pose.internal_rotation_deg};
@@ -235,20 +248,9 @@ nlohmann::json pose_record(const Session& s, const PoseAngles& pose, const PoseR
       scan_record(s.joint().socket(), res.socket, res.socket_detection_ms, levels, clocks ? &socket_clock : nullptr);
   // Where each scan comes closest, classed (articular, intra- or extra-articular impingement).
   const Eigen::Matrix3d R = s.hip().femur_rotation(pose);
-  for (const bool ball : {true, false}) {
-    const ScanGaps& g = ball ? res.ball_gaps : res.socket_gaps;
-    const JointBody& body = ball ? s.joint().ball() : s.joint().socket();
-    float best = std::numeric_limits<float>::infinity();
-    std::size_t at = 0;
-    for (std::size_t i = 0; i < g.gap_mm.size(); ++i)
-      if (g.gap_mm[i] < best) best = g.gap_mm[i], at = i;
-    const Eigen::Vector3d v = body.relative.row(static_cast<Eigen::Index>(at)).transpose();
-    const ContactClass c = std::isfinite(best) ? s.hip().contact_class(ball, static_cast<std::int64_t>(at),
-                                                                       ball ? Eigen::Vector3d(R * v) : v,
-                                                                       kIntraArticularMarginMm)
-                                               : ContactClass::none;
-    j[ball ? "ball" : "socket"]["closest_contact_class"] = to_string(c);
-  }
+  for (const bool ball : {true, false})
+    j[ball ? "ball" : "socket"]["closest_contact_class"] =
+        to_string(closest_point(s, ball, ball ? res.ball_gaps : res.socket_gaps, R).contact_class);
   return j;
 }
 

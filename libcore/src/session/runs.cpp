@@ -43,7 +43,6 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
                   const std::function<void(const MotionFrame&)>& on_frame) {
   require(time_s.empty() || time_s.size() == angles.size(),
           "motion: " + std::to_string(time_s.size()) + " times for " + std::to_string(angles.size()) + " poses");
-  const JointBody& socket = s.joint().socket();
   PoseResult res;
   MotionFrame f;
   f.result = &res;
@@ -57,16 +56,9 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
     s.joint().detect(f.R, Eigen::Vector3d::Zero(), res);
     f.detection_ms = ms_since(t0);
     detect_ms += f.detection_ms;
-    // The socket vertex with the least gap.
-    float best = std::numeric_limits<float>::infinity();
-    std::size_t at = 0;
-    for (std::size_t i = 0; i < res.socket_gaps.gap_mm.size(); ++i)
-      if (res.socket_gaps.gap_mm[i] < best) best = res.socket_gaps.gap_mm[i], at = i;
-    const Eigen::Vector3d p = socket.relative.row(static_cast<Eigen::Index>(at)).transpose();
-    f.socket_closest = std::isfinite(best) ? s.report_point(p) : Eigen::Vector3d::Constant(std::nan(""));
-    f.socket_closest_class = std::isfinite(best)
-                                 ? s.hip().contact_class(false, static_cast<std::int64_t>(at), p, kIntraArticularMarginMm)
-                                 : ContactClass::none;
+    const ClosestPoint c = closest_point(s, false, res.socket_gaps, f.R);
+    f.socket_closest = c.vertex >= 0 ? s.report_point(c.p_joint) : c.p_joint;
+    f.socket_closest_class = c.contact_class;
     f.ball_clock.closest_hour = f.socket_clock.closest_hour = std::nan("");
     s.hip().clocks(res, f.ball_clock, f.socket_clock);
     on_frame(f);

@@ -87,20 +87,14 @@ LoadedInput load_input(const SessionInput& input) {
   require(input.socket_mesh || !socket.empty(), "no pelvis: give socket (a mesh file or mesh) or subject");
   require(!(input.ball_mesh && !input.ball.empty()), "give ball as a file or a mesh, not both");
   require(!(input.socket_mesh && !input.socket.empty()), "give socket as a file or a mesh, not both");
-  if (input.ball_mesh) {
-    in.femur = *input.ball_mesh;
-    in.femur_source = in.femur.source.empty() ? "ball (in memory)" : in.femur.source;
-  } else {
-    in.femur = load_mesh(ball);
-    in.femur_source = ball;
-  }
-  if (input.socket_mesh) {
-    in.pelvis = *input.socket_mesh;
-    in.pelvis_source = in.pelvis.source.empty() ? "socket (in memory)" : in.pelvis.source;
-  } else {
-    in.pelvis = load_mesh(socket);
-    in.pelvis_source = socket;
-  }
+  // A bone from memory or from its file, and what to call it in messages.
+  auto take = [](const std::optional<TriangleMesh>& mesh, const std::string& path, const char* name,
+                 TriangleMesh& out, std::string& source) {
+    out = mesh ? *mesh : load_mesh(path);
+    source = !mesh ? path : out.source.empty() ? std::string(name) + " (in memory)" : out.source;
+  };
+  take(input.ball_mesh, ball, "ball", in.femur, in.femur_source);
+  take(input.socket_mesh, socket, "socket", in.pelvis, in.pelvis_source);
   for (const auto& [name, p] : input.landmarks) {
     require(p.allFinite(), "landmark " + name + ": not three finite numbers");
     landmarks[name] = p;

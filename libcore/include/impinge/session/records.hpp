@@ -6,6 +6,7 @@
 /// JSON null, never a made-up number.
 
 #include <Eigen/Core>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -58,6 +59,16 @@ nlohmann::json acetabulum_record(const Acetabulum& acetabulum, const AnatomicalF
 /// input frame, COR and how it was found, scheme and resolution, map settings, neutral, warnings,
 /// the scan-pose overlap, and with anatomical neutral the frames, the scan pose and the acetabulum.
 nlohmann::json setup_record(const Session& session);
+
+/// Where one scan comes closest to the other bone.
+struct ClosestPoint {
+  std::int64_t vertex = -1;  ///< the tested vertex with the least gap; -1 when none was tested
+  Eigen::Vector3d p_joint = Eigen::Vector3d::Constant(std::nan(""));  ///< it, posed, joint frame, mm
+  ContactClass contact_class = ContactClass::none;  ///< HipJoint::contact_class (rim radius + 10 mm)
+};
+/// The closest point of the femur's scan (`ball`, femur posed by R: 3 x 3, joint frame) or of the
+/// pelvis' (`gaps` from the same pose). Never throws.
+ClosestPoint closest_point(const Session& session, bool ball, const ScanGaps& gaps, const Eigen::Matrix3d& R);
 
 /// Both scans at one pose: pose_deg, and ball / socket scan_record()s with clocks (anatomical
 /// neutral) and the class of each scan's closest vertex (closest_contact_class).
