@@ -115,10 +115,14 @@ void add_frame_options(CLI::App* app, FrameSettings& o) {
                   "Pelvic axes: 'isb' (Wu et al. 2002: ASIS and PSIS) or 'app' (anterior pelvic plane: ASIS and "
                   "pubic tubercles, as clinical ROM tools)")
       ->capture_default_str();
-  app->add_flag("--reseat", o.reseat,
-                "Move the femur so that its head centre lies on the acetabular sphere centre (Puls et al. 2010's "
-                "equidistant method), for segmentations whose bones overlap at the scan pose; the translation is "
-                "reported in summary.json (anatomical neutral only)");
+  app->add_option("--joint-centre", o.joint_centre,
+                  "How the femur moves at each pose (Puls et al. 2010, Comput Aided Surg 15:75): 'femoral-head' "
+                  "(rotation about the head centre: the thesis' method), 'acetabular' (about the acetabular "
+                  "centre), 'combined' (the head centre placed on the acetabular centre) or 'equidistant' (at each "
+                  "pose the femur is also translated so that the joint space over the lunate surface is as even as "
+                  "possible). The translation is reported per pose and limit. Default: equidistant with anatomical "
+                  "neutral, femoral-head with --neutral scan (which allows no other)")
+      ->check(CLI::IsMember({"femoral-head", "acetabular", "combined", "equidistant"}));
   app->add_option("--femur-frame", o.femur_frame,
                   "Femoral medio-lateral axis: 'epicondyles' (ISB) or 'posterior-condyles' (posterior condylar axis)")
       ->capture_default_str();
@@ -172,14 +176,14 @@ int run_distance(const SessionOptions& so, const TextOptions& t, const std::stri
                  const std::string& out) {
   const PoseAngles pose = parse_pose(pose_text);
   const Session s = open_session(so, t);
-  const Eigen::Matrix3d R = s.hip().femur_rotation(pose);
-  const PoseResult res = s.joint().detect(R);
+  const FemurPose femur = s.hip().femur_pose(pose);
+  const PoseResult res = s.joint().detect(femur.R, femur.t);
   fs::create_directories(out);
-  write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, R);
+  write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur);
   write_map_png(in_dir(out, "ball_map.png"), s.joint().ball().map);
   write_map_png(in_dir(out, "socket_map.png"), s.joint().socket().map);
   nlohmann::json j = setup_record(s);
-  j.update(pose_record(s, pose, res));
+  j.update(pose_record(s, pose, femur, res));
   write_json(in_dir(out, "summary.json"), j);
   if (do_render) render(out);
   std::cout << "ball: " << res.ball.vertices_tested << " tested, min gap " << res.ball.min_gap_mm << " mm, "
@@ -216,7 +220,7 @@ int run_motion(const SessionOptions& so, const TextOptions& t, const MotionOutpu
     if (f.index % static_cast<std::size_t>(every) == 0) {
       std::ostringstream name;
       name << "gaps/frame_" << std::setw(6) << std::setfill('0') << f.index << ".vtp";
-      write_pose_vtp(in_dir(out, name.str()), s, *f.result, f.R);
+      write_pose_vtp(in_dir(out, name.str()), s, *f.result, f.pose);
       pvd.push_back({f.time_s, name.str()});
     }
     if (bar && (f.index % 10 == 0 || f.index + 1 == n)) progress_bar(f.index + 1, n);
@@ -341,7 +345,13 @@ int main(int argc, char** argv) {
              "largest internal rotation over flexion 0..120 x adduction -20..40 deg, step 5 (rom_map.csv)");
   add_joint_options(rom, so, text);
   rom->add_option("--threshold", rq.search.threshold_mm,
-                  "mm: the bones meet when the minimum gap is <= this (0: bone contact; a cartilage offset > 0)")
+                  "mm: the bones meet when the minimum gap is <= this less --contact-depth (0: bone contact; a "
+                  "cartilage offset > 0)")
+      ->capture_default_str();
+  rom->add_option("--contact-depth", rq.search.contact_depth_mm,
+                  "mm: a contact must reach this far past the threshold to end a search; a shallower graze is "
+                  "within the data's error (map interpolation, an MRI surface's roughness) and the joint's play "
+                  "(0: the first touch)")
       ->capture_default_str();
   std::string contacts = "impingement";
   rom->add_option("--contacts", contacts,

@@ -96,6 +96,7 @@ SessionOptions session_options(const Subject& s, const MapSettings& maps) {
   o.input.landmarks = s.landmarks;
   o.maps = maps;
   o.frames.neutral = s.generated ? "scan" : "anatomical";
+  o.frames.joint_centre = "femoral-head";  // the thesis' method (issue 29: the thesis experiments keep it)
   if (s.generated) {
     o.cor.given = s.true_cor;
     o.cor.allow_any = true;  // the true centre: no fitted head to check it against (a partial femur)

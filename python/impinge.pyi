@@ -59,7 +59,8 @@ class Joint:
                  max_radius_mm: float = 0.0, sparse: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
                  layers: int = 0, extra_articular_radius_mm: float = 150.0, maps_only: bool = False,
                  maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
-                 pelvis_frame: str = "isb", reseat: bool = False, femur_frame: str = "epicondyles") -> None:
+                 pelvis_frame: str = "isb", joint_centre: Optional[str] = None,
+                 femur_frame: str = "epicondyles") -> None:
         """ball, socket: mesh files or (V (n, 3) float mm, F (m, 3) int); or subject: a subject.json
         (meshes, side, frame, landmarks, neutral). side: 'right'/'left'; frame: 'LPS'/'RAS' (the
         meshes' frame; default the subject's, else RAS). cor: 'auto' (the femoral head fitted) or
@@ -70,8 +71,10 @@ class Joint:
         hidden vertices (extra-articular), within extra_articular_radius_mm; maps_only: no exact
         look-ups at depth discontinuities; maps: (ball_path, socket_path) from save_maps().
         neutral: 'anatomical' (ISB frames) or 'scan' (default: the subject's, else anatomical);
-        pelvis_frame 'isb'/'app'; femur_frame 'epicondyles'/'posterior-condyles'; reseat: seat
-        the head on the acetabular centre. Raises Error naming the option, array or file."""
+        pelvis_frame 'isb'/'app'; femur_frame 'epicondyles'/'posterior-condyles'; joint_centre: how the
+        femur moves at each pose (Puls et al. 2010): 'femoral-head', 'acetabular', 'combined' or
+        'equidistant' (default: equidistant with anatomical neutral, femoral-head with scan neutral).
+        Raises Error naming the option, array or file."""
     def save_maps(self, ball_path: str, socket_path: str) -> None:
         """Save both maps for Joint(..., maps=(ball_path, socket_path))."""
     def detect(self, R: Optional[npt.ArrayLike] = None, t: Optional[Sequence[float]] = None) -> Dict[str, Any]:
@@ -80,7 +83,9 @@ class Joint:
         record as summary.json gives it)."""
     def detect_pose(self, flexion: float = 0.0, adduction: float = 0.0,
                     internal_rotation: float = 0.0) -> Dict[str, Any]:
-        """Both scans at clinical angles (degrees, ISB)."""
+        """Both scans at clinical angles (degrees, ISB), the femur placed by the joint-centre method; the
+        dict of detect() with joint_translation_mm (3,): the femur's translation from its scan position
+        after its rotation about its head centre (input frame, mm)."""
     def motion(self, angles: npt.ArrayLike) -> Dict[str, npt.NDArray[np.float64]]:
         """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each."""
     def rom_limits(self, threshold_mm: float = 0.0, step_deg: float = 2.0, max_deg: float = 150.0,
@@ -93,6 +98,10 @@ class Joint:
         """Largest internal rotation before contact, (len(flexion), len(adduction)) degrees."""
     def femur_rotation(self, flexion: float = 0.0, adduction: float = 0.0,
                        internal_rotation: float = 0.0) -> npt.NDArray[np.float64]: ...
+    def femur_pose(self, flexion: float = 0.0, adduction: float = 0.0,
+                   internal_rotation: float = 0.0) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """(R, t) at the clinical angles with the joint-centre method's translation: posed vertices =
+        (V - cor) R^T + cor + t (input frame); detect(R, t) scans that pose."""
     cor: npt.NDArray[np.float64]
     ball_map: Map
     socket_map: Map

@@ -246,7 +246,7 @@ const std::vector<std::pair<std::string, OptionSetter>>& joint_options() {
        }},
       {"neutral", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.frames.neutral = as_string(v, n); }},
       {"pelvis_frame", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.frames.pelvis_frame = as_string(v, n); }},
-      {"reseat", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.frames.reseat = as_bool(v, n); }},
+      {"joint_centre", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.frames.joint_centre = as_string(v, n); }},
       {"femur_frame", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.frames.femur_frame = as_string(v, n); }},
   };
   return t;
@@ -557,15 +557,21 @@ void add_joint_queries(py::class_<PyJoint>& c) {
           "detect_pose",
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
             PoseResult r;
+            FemurPose p;
             {
               py::gil_scoped_release release;
-              j.hip().detect(PoseAngles{flexion, adduction, internal_rotation}, r);
+              p = j.hip().femur_pose(PoseAngles{flexion, adduction, internal_rotation});
+              j.hip().joint().detect(p.R, p.t, r);
             }
-            return result_dict(*j.session, std::move(r));
+            py::dict d = result_dict(*j.session, std::move(r));
+            d["joint_translation_mm"] = Eigen::Vector3d(j.session->to_input(j.hip().femur_translation(p.t)));
+            return d;
           },
           py::arg("flexion") = 0.0, py::arg("adduction") = 0.0, py::arg("internal_rotation") = 0.0,
           "Both scans at clinical angles (degrees, ISB joint coordinate system: flexion, adduction and internal "
-          "rotation positive; zero per `neutral`) -> the same dict as detect().")
+          "rotation positive; zero per `neutral`), the femur placed by the joint-centre method (option "
+          "joint_centre) -> the same dict as detect(), with joint_translation_mm (3,): the femur's translation "
+          "(input frame, mm) after its rotation about the COR.")
       .def("motion", &motion, py::arg("angles"),
            "Both scans at every row of angles (k, 3): flexion, adduction, internal rotation in degrees -> dict of "
            "(k,) arrays, the columns of the CLI's frames.csv (ball_min_gap_mm, socket_min_gap_mm, "
@@ -606,6 +612,16 @@ void add_joint_queries(py::class_<PyJoint>& c) {
           },
           py::arg("flexion") = 0.0, py::arg("adduction") = 0.0, py::arg("internal_rotation") = 0.0,
           "Rotation (3, 3; input frame) of the femur about the COR at the clinical angles.")
+      .def(
+          "femur_pose",
+          [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
+            const FemurPose p = j.hip().femur_pose({flexion, adduction, internal_rotation});
+            return std::pair{Eigen::Matrix3d(j.session->input_rotation(p.R)), Eigen::Vector3d(j.session->input_translation(p))};
+          },
+          py::arg("flexion") = 0.0, py::arg("adduction") = 0.0, py::arg("internal_rotation") = 0.0,
+          "(R, t): the femur as scanned, rotated by R (3, 3; input frame) about the COR (`cor`) and then translated "
+          "by t (3,; mm, input frame), at the clinical angles with the joint-centre method's translation: posed "
+          "vertices = (V - cor) R^T + cor + t; detect(R, t) scans that pose.")
       .def(
           "save_maps", [](const PyJoint& j, const std::string& ball, const std::string& socket) {
             j.hip().save_maps(ball, socket);

@@ -137,9 +137,9 @@ def test_a_subject_in_lps_gives_the_cli_gaps():
 
     # Rotations are in the input frame: the pose's rotation about the COR, applied to the LPS
     # vertices, gives the same gaps, and moves the femur as the CLI's posed PLY shows it.
-    R = j.femur_rotation(30, 5, 10)
-    np.testing.assert_array_equal(j.detect(R)["ball_gap_mm"], cli_ball)
-    posed = (ball[0] - j.cor) @ R.T + j.cor
+    R, t = j.femur_pose(30, 5, 10)
+    np.testing.assert_array_equal(j.detect(R, t)["ball_gap_mm"], cli_ball)
+    posed = (ball[0] - j.cor) @ R.T + j.cor + t
     with open(d + "/cli/ball_gaps.ply", "rb") as f:
         while f.readline().strip() != b"end_header":
             pass
@@ -173,6 +173,6 @@ def test_the_head_is_found_beside_its_pelvis_as_the_cli_finds_it():
     head = impinge.locate_femoral_head(V, F, pelvis=(P, G))
     assert np.linalg.norm(head.centre - np.array([88.08, -6.13, -12.91])) < 2.0
     j = impinge.Joint(subject=os.path.join(DATA, "mc22-left", "subject.json"), precision=2)
-    np.testing.assert_allclose(j.cor, head.centre, atol=1e-9)
+    np.testing.assert_allclose(j.setup["head_centre_mm"], head.centre, atol=1e-9)
     with pytest.raises(impinge.Error, match="cannot tell which end of the femur is proximal"):
         impinge.locate_femoral_head(V, F, pelvis=(P + 300.0, G))

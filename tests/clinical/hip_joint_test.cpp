@@ -100,10 +100,12 @@ TEST(HipJoint, PosedFemurIsFemurRotationInTheWorkingFrame) {
   if (!j) GTEST_SKIP() << "shared data absent";
   const HipJoint hip(j->femur, j->pelvis, Side::right, fit_femoral_head(j->femur), {}, options(1.0));
   const PoseAngles a{60, -10, 15};
-  const Vertices V = hip.posed_femur(hip.femur_rotation(a));
+  const FemurPose pose = hip.femur_pose(a);
+  const Vertices V = hip.posed_femur(pose.R, pose.t);
   const Eigen::Matrix3d Rw = femur_rotation(hip.frames()->pelvis, hip.frames()->femur, a, Side::right);
+  const Eigen::Vector3d tw = hip.femur_translation(pose.t);  // the joint centre's (and the seat), working frame
   for (Eigen::Index i = 0; i < j->femur.V.rows(); i += 997) {
-    const Eigen::Vector3d expect = j->cor + Rw * (j->femur.V.row(i).transpose() - j->cor);
+    const Eigen::Vector3d expect = j->cor + Rw * (j->femur.V.row(i).transpose() - j->cor) + tw;
     EXPECT_LT((V.row(i).transpose() - expect).norm(), 1e-9);
   }
   const Vertices P = hip.pelvis_vertices();

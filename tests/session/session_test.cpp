@@ -92,8 +92,7 @@ TEST(Session, LpsInputGivesTheRasGapsAndReportsInLps) {
                   (std::isnan(r.ball_gaps.gap_mm[i]) && std::isnan(l.ball_gaps.gap_mm[i])));
     EXPECT_EQ(r.socket.min_gap_mm, l.socket.min_gap_mm);
     // Posed vertices come back in each input frame: LPS = flip RAS.
-    const Eigen::Matrix3d R = ras.hip().femur_rotation(a);
-    const Vertices vr = ras.femur_input(R), vl = lps.femur_input(lps.hip().femur_rotation(a));
+    const Vertices vr = ras.femur_input(ras.hip().femur_pose(a)), vl = lps.femur_input(lps.hip().femur_pose(a));
     EXPECT_LT((vl - vr * flip).cwiseAbs().maxCoeff(), 1e-9);
     // A rotation given in the input frame reaches the joint frame unchanged in effect.
     const Eigen::Matrix3d Rin = lps.input_rotation(lps.hip().femur_rotation(a));

@@ -26,6 +26,7 @@ ArticularZones find_articular_zones(const TriangleMesh& femur, const SphereFitRe
   ArticularZones z;
   z.head_tolerance_mm = tolerance(head.rms_residual, o);
   z.lunate_tolerance_mm = tolerance(acetabulum.sphere.rms_residual, o);
+  z.head_sphere_reach_mm = head.radius + z.head_tolerance_mm;
   z.femur.assign(static_cast<std::size_t>(femur.V.rows()), 0);
   z.pelvis.assign(static_cast<std::size_t>(pelvis.V.rows()), 0);
   const SphereFitResult& cup = acetabulum.sphere;

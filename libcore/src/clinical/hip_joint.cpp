@@ -28,9 +28,16 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
                    const Landmarks& given, const HipJointOptions& options)
     : side_(side), neutral_(options.neutral), cor_(head.centre) {
   require(cor_.allFinite(), "hip joint: centre of rotation is not finite");
-  require(!options.reseat || neutral_ == Neutral::anatomical,
-          "hip joint: re-seating the head needs anatomical neutral (the acetabulum's frame)");
-  head_radius_ = std::isfinite(head.radius) ? head.radius : median_radius(femur.V, cor_);
+  const JointCentreMethod method = options.joint_centre.value_or(
+      neutral_ == Neutral::anatomical ? JointCentreMethod::equidistant : JointCentreMethod::femoral_head);
+  require(method == JointCentreMethod::femoral_head || neutral_ == Neutral::anatomical,
+          std::string("hip joint: the ") + to_string(method) +
+              " joint centre needs anatomical neutral (the acetabulum); scan neutral allows femoral-head only");
+  // The head sphere of the zones, the acetabulum, the clocks and the seat: the COR's own unless the
+  // COR was given (then the fitted head's, so that they do not move with it).
+  SphereFitResult sphere = options.head_sphere.value_or(head);
+  if (!options.head_sphere) sphere.centre = cor_;
+  head_radius_ = std::isfinite(sphere.radius) ? sphere.radius : median_radius(femur.V, sphere.centre);
   require(std::isfinite(head_radius_) || neutral_ == Neutral::scan,
           femur.source + ": fewer than 10 femur vertices within 35 mm of the centre of rotation: no femoral head "
                          "there for the acetabulum and clock faces");
@@ -45,23 +52,23 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     Landmarks g = given;
     g["hip_centre"] = cor_;
     frames_ = find_hip_frames(femur, pelvis, side, g, options.frames);
-    acetabulum_ = find_acetabulum(pelvis, cor_, head_radius_, frames_->pelvis);
-    SphereFitResult head_sphere = head;
-    head_sphere.centre = cor_;
-    head_sphere.radius = head_radius_;
-    articular_ = find_articular_zones(femur, head_sphere, pelvis, *acetabulum_, options.articular);
-    const ClockFace femoral = femoral_clock_face(femur, cor_, head_radius_, frames_->femur);
-    if (options.reseat) {
-      // The femur, its frame and clock move with the head onto the acetabular centre.
+    acetabulum_ = find_acetabulum(pelvis, sphere.centre, head_radius_, frames_->pelvis);
+    sphere.radius = head_radius_;
+    articular_ = find_articular_zones(femur, sphere, pelvis, *acetabulum_, options.articular);
+    const ClockFace femoral = femoral_clock_face(femur, sphere.centre, head_radius_, frames_->femur);
+    if (method == JointCentreMethod::combined || method == JointCentreMethod::equidistant) {
+      // Seated: the femur, its frame and clock move with the head onto the acetabular centre, which
+      // becomes the COR (the maps' centre: rays from the seated head centre); the methods' translations
+      // are then relative to the seated femur (combined: none; equidistant: the small deviations).
       // Translation only: the pelvic landmarks stay, the femoral ones move with the femur, both frames
       // keep their axes and take the new COR as origin.
-      reseat_ = acetabulum_->sphere.centre - cor_;
-      femur.V.rowwise() += reseat_.transpose();
+      seat_ = acetabulum_->sphere.centre - sphere.centre;
+      femur.V.rowwise() += seat_.transpose();
       cor_ = acetabulum_->sphere.centre;
       FemurLandmarks& fl = frames_->femur_landmarks;
       for (Eigen::Vector3d* p : {&fl.head_centre, &fl.epicondyle_lateral, &fl.epicondyle_medial,
                                  &fl.posterior_condyle_lateral, &fl.posterior_condyle_medial})
-        *p += reseat_;
+        *p += seat_;
       frames_->head.centre = cor_;
       const double quality = frames_->femur.quality_mm;
       frames_->pelvis = pelvis_frame(frames_->pelvis_landmarks, cor_, options.frames.pelvis);
@@ -74,11 +81,12 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     femur_axes_joint_ = joint_to_working_.transpose() * frames_->femur.axes;
     const Eigen::Matrix3d A = joint_to_working_.transpose();
     socket_clock_ = acetabulum_->clock.transformed(A, -A * cor_);
-    ball_clock_ = femoral.transformed(A, A * (reseat_ - cor_));
+    ball_clock_ = femoral.transformed(A, A * (seat_ - cor_));
   } else {
     femur_axes_joint_ = S;  // scan neutral: both frames are the scan axes
   }
   const Eigen::Matrix3d to_joint = joint_to_working_.transpose();
+  head_centre_joint_ = to_joint * (sphere.centre + seat_ - cor_);
   for (TriangleMesh* m : {&femur, &pelvis}) m->V = ((m->V.rowwise() - cor_.transpose()) * to_joint.transpose()).eval();
   if (options.ball_map_file.empty() != options.socket_map_file.empty())
     throw Error("hip joint: give both map files (ball and socket) or neither");
@@ -98,6 +106,10 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint,
                    load(options.ball_map_file), load(options.socket_map_file));
   }
+  // The acetabular centre in the joint frame: the origin once seated.
+  if (method != JointCentreMethod::femoral_head)
+    centre_ = JointCentre(method, *joint_, joint_to_working_.transpose() * (acetabulum_->sphere.centre - cor_),
+                          articular_->pelvis, articular_->head_sphere_reach_mm, options.equidistant);
   // The COR must lie inside the femur: then every ray from it meets the femur's surface.
   const RadialDistanceMap& bm = joint_->ball().map;
   // (Counted when the map was filled: a sparse map with a finite region reads "no surface" beyond it.)
@@ -109,11 +121,16 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
                 "in the wrong frame or units? allow_cor_outside_ball (CLI: --allow-any-cor) accepts it");
 }
 
-ContactClass HipJoint::contact_class(bool ball, std::int64_t vertex, const Eigen::Vector3d& p_joint,
+ContactClass HipJoint::contact_class(bool ball, std::int64_t vertex, const FemurPose& pose,
                                      double intra_margin_mm) const {
+  const Vertices& V = ball ? joint_->ball().relative : joint_->socket().relative;
+  require(vertex >= 0 && vertex < V.rows(), "contact class: vertex " + std::to_string(vertex) + " out of range");
+  const Eigen::Vector3d v = V.row(static_cast<Eigen::Index>(vertex)).transpose();
+  const Eigen::Vector3d p_joint = ball ? Eigen::Vector3d(pose.R * v + pose.t) : v;
   if (articular_) {
     const std::vector<std::uint8_t>& zone = ball ? articular_->femur : articular_->pelvis;
-    if (vertex >= 0 && static_cast<std::size_t>(vertex) < zone.size() && zone[static_cast<std::size_t>(vertex)])
+    if (zone[static_cast<std::size_t>(vertex)]) return ContactClass::articular;
+    if (!ball && (pose.R.transpose() * (v - pose.t) - head_centre_joint_).norm() <= articular_->head_sphere_reach_mm)
       return ContactClass::articular;
   }
   const double rim = acetabulum_ ? acetabulum_->rim_radius_mm : head_radius_ + 5;
@@ -140,7 +157,8 @@ Eigen::Matrix3d HipJoint::femur_rotation(const PoseAngles& angles) const {
 }
 
 void HipJoint::detect(const PoseAngles& angles, PoseResult& out) const {
-  joint_->detect(femur_rotation(angles), Eigen::Vector3d::Zero(), out);
+  const FemurPose p = femur_pose(angles);
+  joint_->detect(p.R, p.t, out);
 }
 
 PoseResult HipJoint::detect(const PoseAngles& angles) const {
@@ -149,9 +167,10 @@ PoseResult HipJoint::detect(const PoseAngles& angles) const {
   return r;
 }
 
-Vertices HipJoint::posed_femur(const Eigen::Matrix3d& R) const {
+Vertices HipJoint::posed_femur(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const {
   const Eigen::Matrix3d A = joint_to_working_ * R;
-  return ((joint_->ball().relative * A.transpose()).rowwise() + cor_.transpose()).eval();
+  const Eigen::Vector3d shift = cor_ + joint_to_working_ * t;
+  return ((joint_->ball().relative * A.transpose()).rowwise() + shift.transpose()).eval();
 }
 
 Vertices HipJoint::pelvis_vertices() const {

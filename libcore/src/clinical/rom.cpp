@@ -54,7 +54,7 @@ std::vector<StandardMotion> standard_motions() {
 RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const RomOptions& o) {
   check(o);
   PoseResult r;
-  hip.joint().detect(R, Eigen::Vector3d::Zero(), r);
+  hip.joint().detect(R, hip.joint_translation(R), r);
   RomBaseline b;
   b.skip_ball.resize(r.ball_gaps.gap_mm.size());
   b.skip_socket.resize(r.socket_gaps.gap_mm.size());
@@ -63,14 +63,22 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
   for (auto s : b.skip_ball) b.excluded_vertices += s;
   for (auto s : b.skip_socket) b.excluded_vertices += s;
   // The joint surfaces: left out of impingement searches, the only ones counted where the joint space closes.
+  // The pelvis' other contacts are classed at each pose by the scanner: those that meet the head's
+  // joint surface are articular too (head_sphere_reach_mm).
   if (const auto& z = hip.articular(); z && o.contacts != RomContacts::all) {
     const bool keep_articular = o.contacts == RomContacts::articular;
-    for (auto [skip, zone] : {std::pair{&b.skip_ball, &z->femur}, std::pair{&b.skip_socket, &z->pelvis}})
-      for (std::size_t i = 0; i < skip->size(); ++i)
-        if (!(*skip)[i] && (((*zone)[i] != 0) != keep_articular)) (*skip)[i] = 1, ++b.articular_vertices;
+    for (std::size_t i = 0; i < b.skip_ball.size(); ++i)
+      if (!b.skip_ball[i] && ((z->femur[i] != 0) != keep_articular)) b.skip_ball[i] = 1, ++b.articular_vertices;
+    if (!keep_articular)
+      for (std::size_t i = 0; i < b.skip_socket.size(); ++i)
+        if (!b.skip_socket[i] && z->pelvis[i]) b.skip_socket[i] = 1, ++b.articular_vertices;
+    b.head_sphere_reach_mm = z->head_sphere_reach_mm;
+    b.head_centre = hip.head_centre_joint();
+    b.contacts = o.contacts;
+    if (keep_articular) b.lunate = z->pelvis;
   }
   b.min_gap_mm = std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);
-  if (o.use_bounds) b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), o.threshold_mm);
+  if (o.use_bounds) b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), cut_of(o));
   return b;
 }
 
@@ -87,20 +95,27 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
   out.excluded_vertices = base.excluded_vertices;
   require(o.vertices != RomVertices::hidden || (joint.ball().layered && joint.socket().layered),
           "rom: counting hidden vertices needs layered maps (JointOptions::layers > 0)");
-  CompactScanner scan(joint, base, bounds, o.threshold_mm, o.vertices);
-  auto gap_at = [&](double t, bool exact = false) {
+  const double cut = cut_of(o);
+  CompactScanner scan(joint, base, bounds, cut, o.vertices);
+  // The femur's translation by the joint-centre method (a function of the rotation alone).
+  auto pose_at = [&](double theta) {
+    const Eigen::Matrix3d R = rotation(theta);
+    return std::pair{R, hip.joint_translation(R)};
+  };
+  auto gap_at = [&](double theta, bool exact = false) {
     ++out.evaluations;
-    return scan(rotation(t), exact);
+    const auto [R, t] = pose_at(theta);
+    return scan(R, t, exact);
   };
   double lo = 0, hi = 0;
   const double start_gap = gap_at(0, !limit_only).gap;
   if (!limit_only) out.min_gap_at_start_mm = start_gap;
-  bool found = start_gap <= o.threshold_mm;
+  bool found = start_gap <= cut;
   out.contact_at_start = found;
   for (int k = 1; !found; ++k) {
     const double t = std::min(o.max_deg, k * o.step_deg);
     const double g = gap_at(t).gap;
-    if (g <= o.threshold_mm) {
+    if (g <= cut) {
       found = true, hi = t;
     } else {
       lo = t;
@@ -109,7 +124,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
   }
   while (hi - lo > o.tolerance_deg) {
     const double mid = 0.5 * (lo + hi);
-    (gap_at(mid).gap <= o.threshold_mm ? hi : lo) = mid;
+    (gap_at(mid).gap <= cut ? hi : lo) = mid;
   }
   if (limit_only) {
     out.vertices_looked_up = scan.vertices_looked_up;
@@ -117,29 +132,31 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
     out.limit_deg = hi;
     return out;
   }
-  const Least l = gap_at(hi, true);  // the least gap and where, not only whether they meet
+  const auto [R, t] = pose_at(hi);
+  ++out.evaluations;
+  const Least l = scan(R, t, true);  // the least gap and where, not only whether they meet
   // A transient touch: the bones part again one step farther.
-  if (hi + o.step_deg <= o.max_deg) out.monotone = gap_at(hi + o.step_deg).gap <= o.threshold_mm;
+  if (hi + o.step_deg <= o.max_deg) out.monotone = gap_at(hi + o.step_deg).gap <= cut;
   out.vertices_looked_up = scan.vertices_looked_up;
   out.vertices_skipped = scan.vertices_skipped;
   out.limit_deg = hi;
   out.min_gap_at_limit_mm = l.gap;
   out.limited_by_ball = l.ball;
+  out.joint_translation_mm = hip.femur_translation(t);
   // The contact point: the vertex, posed, in the joint frame (the pelvis does not move).
-  const Eigen::Matrix3d R = rotation(hi);
   const Eigen::Vector3d p_joint =
-      l.ball ? Eigen::Vector3d(R * joint.ball().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose())
+      l.ball ? Eigen::Vector3d(R * joint.ball().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose() + t)
              : Eigen::Vector3d(joint.socket().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose());
   out.contact_mm = hip.to_working(p_joint);
   const double rim = hip.acetabulum() ? hip.acetabulum()->rim_radius_mm : hip.head_radius_mm() + 5;
   out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? ImpingementSite::intra_articular
                                                                       : ImpingementSite::extra_articular;
   out.limited_by_hidden_vertex = l.hidden;
-  out.contact_class = hip.contact_class(l.ball, static_cast<std::int64_t>(l.vertex), p_joint, o.intra_articular_margin_mm);
+  out.contact_class = hip.contact_class(l.ball, static_cast<std::int64_t>(l.vertex), {R, t}, o.intra_articular_margin_mm);
   if (hip.socket_clock()) {
     // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.
     out.socket_clock_h = hip.socket_clock()->hour(p_joint);
-    out.femur_clock_h = hip.ball_clock()->hour(R.transpose() * p_joint);
+    out.femur_clock_h = hip.ball_clock()->hour(R.transpose() * (p_joint - t));
   }
   return out;
 }

@@ -22,8 +22,12 @@
 namespace impinge {
 namespace rom_detail {
 
+// The gap at which a search's bones meet: the threshold less the contact depth.
+inline double cut_of(const RomOptions& o) { return o.threshold_mm - o.contact_depth_mm; }
+
 inline void check(const RomOptions& o) {
   require(std::isfinite(o.threshold_mm), "rom: threshold must be finite");
+  require(std::isfinite(o.contact_depth_mm) && o.contact_depth_mm >= 0, "rom: contact depth must be >= 0 mm");
   require(o.step_deg > 0 && o.max_deg > 0 && o.tolerance_deg > 0 && o.tolerance_deg <= o.step_deg,
           "rom: need step > 0, max > 0 and 0 < tolerance <= step (degrees)");
 }
@@ -200,6 +204,10 @@ constexpr std::int64_t kLeaf = 32, kGroup = 128;
 // A cluster's bound over its cap widened by this angle serves every later pose of a search within
 // the angle (CompactScanner): two steps of the default search.
 constexpr double kReuseRad = 4.1 * M_PI / 180;
+// ... and for translations (the joint-centre methods) up to this much beyond the pose's, mm.
+constexpr double kReuseShiftMm = 0.5;
+// The ball's reachable subset holds for translations up to this, mm (beyond: every vertex).
+constexpr double kReachableShiftMm = 5;
 // Blocks across the bounding cap of a group, a leaf and a hidden cluster (measured on lhdl-ct).
 constexpr int kGroupBlocks = 8, kLeafBlocks = 8, kHiddenBlocks = 4;
 struct Cluster {
@@ -207,6 +215,9 @@ struct Cluster {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
   double rho = 0, sin_rho = 0, r_min = 0, r_max = 0;
   double sin_rho_widened = 0;  ///< sin(rho + kReuseRad), for the bounds reused at nearby poses
+  double cos_rho = 1;          ///< cos(rho)
+  double r_mid = 0;            ///< (r_min + r_max) / 2
+  double ball_radius = 0;      ///< every vertex lies within this of r_mid * axis, mm (bounds under translation)
 };
 inline std::vector<Cluster> clusters_of(const ScanSet& s, std::int64_t kSize) {
   std::vector<Cluster> out;
@@ -229,6 +240,11 @@ inline std::vector<Cluster> clusters_of(const ScanSet& s, std::int64_t kSize) {
     c.rho += 1e-9;  // rounding of the angles
     c.sin_rho = std::sin(std::min(c.rho, M_PI / 2));  // a wider cone takes whole rows (cap)
     c.sin_rho_widened = std::sin(std::min(c.rho + kReuseRad, M_PI / 2));
+    c.cos_rho = std::cos(c.rho);
+    c.r_mid = 0.5 * (c.r_min + c.r_max);
+    for (std::int64_t k = f; k < f + c.count; ++k)
+      c.ball_radius = std::max(c.ball_radius, (Eigen::Vector3d(s.x[k], s.y[k], s.z[k]) - c.r_mid * c.axis).norm());
+    c.ball_radius += 1e-9;
     out.push_back(c);
   }
   return out;
@@ -243,9 +259,10 @@ struct Least {
   bool hidden = false;  ///< a hidden vertex, tested by the other body's layered map
   std::size_t vertex = 0;
 };
-// The ball's first-surface vertices that can meet the socket at some rotation: a vertex at radius r
-// has gap >= (least finite node of the socket map) - r at every rotation (a bilinear value is at
-// least its least node), so a vertex with r < that least node - threshold never counts. Their
+// The ball's first-surface vertices that can meet the socket at some pose: a vertex at radius r
+// has gap >= (least finite node of the socket map) - (r + |t|) at every rotation and translation t
+// (a bilinear value is at least its least node), so a vertex with r < that least node - threshold
+// - kReachableShiftMm never counts while |t| <= kReachableShiftMm. Their
 // clusters serve the searches that ask only whether the bones meet; the exact least gap scans all.
 inline ScanSet reachable_subset(const ScanSet& s, double least_node, double threshold) {
   ScanSet out;
@@ -274,7 +291,7 @@ struct RomSearchBounds {
         threshold_mm(threshold),
         socket_min(rom_detail::bound_pyramid(j.socket().map, true)),
         ball_max(rom_detail::bound_pyramid(j.ball().map, false)),
-        ball_reachable(rom_detail::reachable_subset(j.ball().scan_set, socket_min.all(), threshold)),
+        ball_reachable(rom_detail::reachable_subset(j.ball().scan_set, socket_min.all(), threshold + rom_detail::kReachableShiftMm)),
         ball(j.ball().scan_set),
         socket(j.socket().scan_set),
         ball_reachable_clusters(ball_reachable) {
@@ -301,8 +318,8 @@ namespace rom_detail {
 // without bounds).
 inline std::shared_ptr<const RomSearchBounds> bounds_for(const Joint& joint, const RomOptions& o, const RomBaseline& base) {
   if (!o.use_bounds) return nullptr;
-  if (base.bounds && base.bounds->joint == &joint && base.bounds->threshold_mm == o.threshold_mm) return base.bounds;
-  return std::make_shared<const RomSearchBounds>(joint, o.threshold_mm);
+  if (base.bounds && base.bounds->joint == &joint && base.bounds->threshold_mm == cut_of(o)) return base.bounds;
+  return std::make_shared<const RomSearchBounds>(joint, cut_of(o));
 }
 }  // namespace rom_detail
 }  // namespace impinge

@@ -84,20 +84,27 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
   std::int64_t looked = 0, skipped = 0;
   auto scan_all = [&](const std::vector<std::size_t>& poses) {
     const auto m = static_cast<std::int64_t>(poses.size());
+    std::string error;  // the first error of any thread, thrown after the parallel region
 #pragma omp parallel reduction(+ : looked, skipped)
     {
-      CompactScanner scan(joint, base, bounds.get(), o.threshold_mm, o.vertices);
+      CompactScanner scan(joint, base, bounds.get(), cut_of(o), o.vertices);
 #pragma omp for schedule(dynamic, 64)
       for (std::int64_t q = 0; q < m; ++q) {
         const std::size_t p = poses[static_cast<std::size_t>(q)];
         const std::size_t k = p % n[2], j = (p / n[2]) % n[1], i = p / (std::size_t(n[1]) * n[2]);
         const Eigen::Matrix3d R =
             hip.femur_rotation(PoseAngles{out.flexion_deg[i], out.adduction_deg[j], out.internal_rotation_deg[k]});
-        state[p] = scan(R, false).gap > o.threshold_mm ? 1 : 0;
+        try {
+          state[p] = scan(R, hip.joint_translation(R), false).gap > cut_of(o) ? 1 : 0;
+        } catch (const std::exception& e) {
+#pragma omp critical(rom_envelope_error)
+          if (error.empty()) error = e.what();
+        }
       }
       looked += scan.vertices_looked_up;
       skipped += scan.vertices_skipped;
     }
+    require(error.empty(), error);
     out.poses_evaluated += m;
   };
   // The corners of a box not yet known.

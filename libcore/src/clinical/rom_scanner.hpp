@@ -22,46 +22,67 @@ class CompactScanner {
     skip_ball_hidden_ = skips(joint.ball().hidden_set, base.skip_ball);
     skip_socket_hidden_ = skips(joint.socket().hidden_set, base.skip_socket);
     if (bounds_ != nullptr) skip_ball_reachable_ = skips(bounds_->ball_reachable, base.skip_ball);
+    // The pelvis' contacts with the head's joint surface, classed at each pose (take()).
+    reach2_ = std::isnan(base.head_sphere_reach_mm) ? -1 : base.head_sphere_reach_mm * base.head_sphere_reach_mm;
+    articular_only_ = base.contacts == RomContacts::articular;
+    head_centre_ = base.head_centre;
+    if (articular_only_) {
+      lunate_socket_ = skips(joint.socket().scan_set, base.lunate);
+      lunate_socket_hidden_ = skips(joint.socket().hidden_set, base.lunate);
+    }
     buf_.resize(static_cast<std::size_t>(std::max({joint.ball().scan_set.size(), joint.socket().scan_set.size(),
                                                    joint.ball().hidden_set.size(), joint.socket().hidden_set.size()})));
   }
-  // The least counted gap at rotation R. exact: the true minimum; otherwise the true minimum when it
+  // The least counted gap with the femur posed by rotation R and translation t (joint frame, mm:
+  // a femur point p goes to R p + t), as Joint::detect computes it (exact ray casts at the maps'
+  // depth discontinuities included). exact: the true minimum; otherwise the true minimum when it
   // is <= the threshold, and some value > the threshold when it is not (clusters above it and the
   // ball vertices that no rotation brings within it are skipped). Without `exact`, the scan stops at
   // the first counted gap <= the threshold (the caller asks only whether the bones meet), starting
   // with the cluster that met last time.
-  Least operator()(const Eigen::Matrix3d& R, bool exact) {
+  Least operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, bool exact) {
     Least l;
     const double cut = exact ? std::numeric_limits<double>::infinity() : threshold_;
     exact_ = exact;
+    // The femur's vertices into the pelvis' frame (R, t); the pelvis' into the femur's (R^T, -R^T t).
+    ball_pose_ = {R, t};
+    socket_pose_ = {R.transpose(), Eigen::Vector3d(-(R.transpose() * t))};
+    shift_mm_ = t.norm();
     if (!exact && last_.cluster != nullptr) {
-      recheck(R, l);
+      recheck(l);
       if (l.gap <= threshold_) return l;
     }
     last_ = {};
     if (counted_ != RomVertices::hidden) {
+      const bool reachable = !exact && bounds_ != nullptr && shift_mm_ <= kReachableShiftMm;
       const Part ball = bounds_ == nullptr ? Part{&joint_.ball().scan_set, &skip_ball_, nullptr, true}
-                        : exact ? Part{&joint_.ball().scan_set, &skip_ball_, &bounds_->ball, true}
-                                : Part{&bounds_->ball_reachable, &skip_ball_reachable_, &bounds_->ball_reachable_clusters, true};
+                        : !reachable ? Part{&joint_.ball().scan_set, &skip_ball_, &bounds_->ball, true}
+                                     : Part{&bounds_->ball_reachable, &skip_ball_reachable_, &bounds_->ball_reachable_clusters, true};
       const Part socket{&joint_.socket().scan_set, &skip_socket_, bounds_ == nullptr ? nullptr : &bounds_->socket, false};
-      scan(R, ball, joint_.socket().map, cut, l);
+      scan(ball, cut, l);
       if (done(l)) return l;
-      scan(R.transpose(), socket, joint_.ball().map, cut, l);
+      scan(socket, cut, l);
       if (done(l)) return l;
     }
     if (counted_ == RomVertices::first_surface) return l;
     if (joint_.socket().layered)
-      scan_hidden(R, joint_.ball().hidden_set, *joint_.socket().layered, joint_.socket().caster.get(), skip_ball_hidden_,
-                  true, cut, l);
+      scan_hidden(ball_pose_, joint_.ball().hidden_set, *joint_.socket().layered, joint_.socket().caster.get(),
+                  skip_ball_hidden_, true, cut, l);
     if (done(l)) return l;
     if (joint_.ball().layered)
-      scan_hidden(R.transpose(), joint_.socket().hidden_set, *joint_.ball().layered, joint_.ball().caster.get(),
+      scan_hidden(socket_pose_, joint_.socket().hidden_set, *joint_.ball().layered, joint_.ball().caster.get(),
                   skip_socket_hidden_, false, cut, l);
     return l;
   }
   std::int64_t vertices_looked_up = 0, vertices_skipped = 0;
+  std::int64_t vertices_refined = 0;  ///< looked up by an exact ray cast at a depth discontinuity
 
  private:
+  // A rigid map from one body's frame into the other's: q = M p + s.
+  struct Rigid {
+    Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  };
   // First-surface vertices of one body, their skip flags (pre-existing overlap) and clusters (null:
   // no bounds); ball: the femur's, looked up in the socket map (inside), else the pelvis' (outside).
   struct Part {
@@ -70,48 +91,123 @@ class CompactScanner {
     const Clustered* clusters = nullptr;
     bool ball = true;
   };
-  void scan(const Eigen::Matrix3d& R, const Part& part, const RadialDistanceMap& map, double cut, Least& l) {
+  const Rigid& pose_of(bool ball) const { return ball ? ball_pose_ : socket_pose_; }
+  const RadialDistanceMap& map_of(bool ball) const { return ball ? joint_.socket().map : joint_.ball().map; }
+  const FirstHitCaster* exact_of(bool ball) const { return ball ? joint_.socket().exact.get() : joint_.ball().exact.get(); }
+  // Where a cluster's vertices lie after the pose P: every direction within rho of `axis` (sin_rho =
+  // sin(min(rho, pi/2))), every radius in [r_lo, r_hi].
+  struct Cap {
+    Eigen::Vector3d axis;
+    double rho, sin_rho, r_lo, r_hi;
+  };
+  // The cap after pose P = (M, s). Without translation: the cluster's cone turned by M. With one, for
+  // a vertex p = r u (u within rho of the axis a, r in [r_min, r_max]): |M p + s|^2 = r^2 + 2 r (M u).s
+  // + |s|^2, with (M u).s between |s| cos(phi + rho) and |s| cos(phi - rho) (phi: the angle of M a and
+  // s); and the direction turns by at most the asin of s's component across M u, at most |s| times
+  // the largest sine of an angle in [phi - rho, phi + rho], over the radius. The cluster's ball
+  // (radius ball_radius about r_mid * a), posed, bounds the directions and radii too (a translation
+  // moves the whole cluster alike): the tighter is taken.
+  // An upper bound of asin(x) for 0 <= x < 1 (x / sqrt(1 - x^2) = tan(asin x)); pi/2 and more for x >= 1.
+  static double asin_above(double x) { return x < 1 ? x / std::sqrt(1 - x * x) : M_PI; }
+  // The cap's angle widened by beta (rad, an upper bound) and an upper bound of its sine (sin is
+  // 1-Lipschitz), for BlockPyramid::cap.
+  static void widen(Cap& cap, double beta) {
+    cap.sin_rho = cap.rho + beta >= M_PI / 2 ? 1.0 : std::min(1.0, cap.sin_rho + beta);
+    cap.rho += beta;
+  }
+  static Cap cap_of(const Cluster& c, const Rigid& P) {
+    const Eigen::Vector3d axis = P.M * c.axis;
+    const double shift = P.s.norm();
+    if (shift == 0) return {axis, c.rho, c.sin_rho, c.r_min, c.r_max};
+    // cos and sin of phi - rho and phi + rho from those of phi and rho (phi in [0, pi]).
+    const double cos_phi = std::clamp(axis.dot(P.s) / shift, -1.0, 1.0), sin_phi = std::sqrt(1 - cos_phi * cos_phi);
+    const double cos_minus = cos_phi * c.cos_rho + sin_phi * c.sin_rho, sin_minus = sin_phi * c.cos_rho - cos_phi * c.sin_rho;
+    const double cos_plus = cos_phi * c.cos_rho - sin_phi * c.sin_rho, sin_plus = sin_phi * c.cos_rho + cos_phi * c.sin_rho;
+    const bool below_zero = sin_minus < 0 || c.rho >= M_PI / 2;  // phi - rho < 0: the cone holds s's direction
+    const bool above_pi = sin_plus < 0 || c.rho >= M_PI / 2;     // phi + rho > pi: it holds -s's direction
+    const double dot_hi = shift * (below_zero ? 1.0 : cos_minus), dot_lo = shift * (above_pi ? -1.0 : cos_plus);
+    auto radius2 = [&](double r, double dot) { return r * r + 2 * r * dot + shift * shift; };
+    const double r_hi = std::sqrt(std::max(radius2(c.r_min, dot_hi), radius2(c.r_max, dot_hi)));
+    const double r_lo = std::sqrt(std::max(0.0, std::min(radius2(c.r_min, dot_lo), radius2(c.r_max, dot_lo))));
+    // The largest sine over [phi - rho, phi + rho]: 1 when the range holds pi/2.
+    const bool holds_right_angle = (below_zero || cos_minus >= 0) && (above_pi || cos_plus <= 0);
+    const double across = shift * (holds_right_angle ? 1.0
+                                                     : std::max(below_zero ? 0.0 : sin_minus, above_pi ? 0.0 : sin_plus));
+    Cap cap{axis, c.rho, c.sin_rho, r_lo, r_hi};
+    widen(cap, r_lo > 0 ? asin_above(across / r_lo) : M_PI);
+    const Eigen::Vector3d centre = c.r_mid * axis + P.s;
+    const double d = centre.norm();
+    if (c.ball_radius >= d) return cap;
+    cap.r_lo = std::max(cap.r_lo, d - c.ball_radius), cap.r_hi = std::min(cap.r_hi, d + c.ball_radius);
+    const double rho_ball = asin_above(c.ball_radius / d);
+    if (rho_ball < cap.rho) cap.axis = centre / d, cap.rho = rho_ball, cap.sin_rho = c.ball_radius / d;
+    return cap;
+  }
+  // The cap of every pose (M Q, s + e) near P = (M, s): Q a rotation by at most kReuseRad, |e| <=
+  // kReuseShiftMm. Without translation (s = 0, e = 0) the cone widened by kReuseRad. Otherwise a
+  // vertex x = M p + s moves by at most |(Q - I) p| + |e| <= 2 r_max sin(kReuseRad / 2) + |e|, which
+  // turns it by at most the asin of that over its radius; its squared radius changes by at most
+  // 2 |s| |(Q - I) p| (a rotation about the origin keeps |p|), and then by |e|.
+  static Cap reuse_cap_of(const Cluster& c, const Rigid& P) {
+    if (P.s.squaredNorm() == 0) return {P.M * c.axis, c.rho + kReuseRad, c.sin_rho_widened, c.r_min, c.r_max};
+    Cap cap = cap_of(c, P);
+    static const double kChord = 2 * std::sin(kReuseRad / 2);
+    const double move = c.r_max * kChord;
+    const double r_lo = std::max(0.0, std::sqrt(std::max(0.0, cap.r_lo * cap.r_lo - 2 * P.s.norm() * move)) - kReuseShiftMm);
+    cap.r_hi = std::sqrt(cap.r_hi * cap.r_hi + 2 * P.s.norm() * move) + kReuseShiftMm;
+    widen(cap, r_lo > 0 ? asin_above((move + kReuseShiftMm) / r_lo) : M_PI);
+    cap.r_lo = r_lo;
+    return cap;
+  }
+  void scan(const Part& part, double cut, Least& l) {
     const ScanSet& set = *part.set;
     const bool ball = part.ball;
+    const Rigid& P = pose_of(ball);
     const ScanSide side = ball ? ScanSide::inside : ScanSide::outside;
+    const RadialDistanceMap& map = map_of(ball);
     const BoundPyramid* pyr = bounds_ == nullptr ? nullptr : ball ? &bounds_->socket_min : &bounds_->ball_max;
     if (pyr == nullptr || !pyr->valid() || part.clusters == nullptr) {
-      scan_gaps_compact(set, R, Eigen::Vector3d::Zero(), map, side, buf_.data());
+      vertices_refined += scan_gaps_compact(set, P.M, P.s, map, side, buf_.data(), exact_of(ball));
       take(set, *part.skip, 0, set.size(), ball, l);
       vertices_looked_up += set.size();
       return;
     }
     const std::vector<Cluster>& cl = part.clusters->leaves;
     // Lower bound of every gap in a cluster whose directions lie within `widen` of where R takes
-    // them: inside, d - r >= min d - r_max; outside, r - d >= r_min - max d.
-    auto lower_bound = [&](const Cluster& c, double widen) {  // widen: 0 or kReuseRad
-      const double rho = c.rho + widen;
-      const float bound = pyr->cap(R * c.axis, rho, widen == 0 ? c.sin_rho : c.sin_rho_widened,
-                                   c.count > kLeaf ? kGroupBlocks : kLeafBlocks);
-      return ball ? double(bound) - c.r_max : c.r_min - double(bound);
+    // them, for translations of at most `shift` mm: the radii move by at most `shift` and the
+    // directions by at most asin(shift / r): inside, d - r >= min d - (r_max + shift); outside,
+    // r - d >= (r_min - shift) - max d.
+    auto lower_bound = [&](const Cluster& c, bool reuse) {
+      const Cap cap = reuse ? reuse_cap_of(c, P) : cap_of(c, P);
+      const float bound = pyr->cap(cap.axis, cap.rho, cap.sin_rho, c.count > kLeaf ? kGroupBlocks : kLeafBlocks);
+      return ball ? double(bound) - cap.r_hi : cap.r_lo - double(bound);
     };
     auto skipped = [&](const Cluster& c) {
-      const double lb = lower_bound(c, 0);
+      const double lb = lower_bound(c, false);
       return lb > cut || lb > l.gap;
     };
-    // A search's poses follow each other closely: a cluster whose bound over a cap widened by
-    // kReuseRad stays above the cut is skipped at every later pose within that angle of this one
-    // (the directions of its vertices move by at most the angle of the relative rotation).
+    // A search's poses follow each other closely: a cluster whose bound over the cap of every pose
+    // near this one (reuse_cap_of: rotations within kReuseRad, translations within kReuseShiftMm)
+    // stays above the cut is skipped at every later pose that near.
     const bool reusable = !exact_;
     std::vector<Reuse>& reuse_g = ball ? reuse_ball_groups_ : reuse_socket_groups_;
     std::vector<Reuse>& reuse_l = ball ? reuse_ball_leaves_ : reuse_socket_leaves_;
-    if (reusable && reuse_g.size() != part.clusters->groups.size()) {
+    const Clustered*& owner = ball ? reuse_ball_owner_ : reuse_socket_owner_;
+    if (reusable && owner != part.clusters) {  // another cluster set (the ball's reachable subset or all)
       reuse_g.assign(part.clusters->groups.size(), Reuse{});
       reuse_l.assign(cl.size(), Reuse{});
+      owner = part.clusters;
     }
     auto skip_reusing = [&](const Cluster& c, Reuse& u) {
-      if (u.valid && (u.R.array() * R.array()).sum() >= kReuseMinTrace) return true;
+      if (u.valid && (u.s - P.s).squaredNorm() <= kReuseShiftMm * kReuseShiftMm &&
+          (u.M.array() * P.M.array()).sum() >= kReuseMinTrace)
+        return true;
       bool skip;
       if (!u.failed) {
-        u.valid = lower_bound(c, kReuseRad) > cut, u.R = R;
-        skip = u.valid || lower_bound(c, 0) > cut;
+        u.valid = lower_bound(c, true) > cut, u.M = P.M, u.s = P.s;
+        skip = u.valid || lower_bound(c, false) > cut;
       } else {
-        skip = lower_bound(c, 0) > cut, u.valid = false;
+        skip = lower_bound(c, false) > cut, u.valid = false;
       }
       u.failed = !skip;
       return skip;
@@ -130,47 +226,33 @@ class CompactScanner {
           vertices_skipped += c.count;
           continue;
         }
-        look_up(R, set, map, side, c);
-        take(set, *part.skip, c.first, c.first + c.count, ball, l);
-        vertices_looked_up += c.count;
+        look_up(part, c, l);
         if (l.gap <= threshold_) last_ = {part, &c};
       }
     }
   }
-  void look_up(const Eigen::Matrix3d& R, const ScanSet& set, const RadialDistanceMap& map, ScanSide side,
-               const Cluster& c) {
-    double x[kLeaf], y[kLeaf], z[kLeaf], d[kLeaf];
-    for (std::int64_t k = 0; k < c.count; ++k) {
-      const Eigen::Vector3d q = R * Eigen::Vector3d(set.x[c.first + k], set.y[c.first + k], set.z[c.first + k]);
-      x[k] = q.x(), y[k] = q.y(), z[k] = q.z();
-    }
-    map.lookup_many_soa(x, y, z, c.count, d);
-    for (std::int64_t k = 0; k < c.count; ++k) {
-      const double r = std::sqrt(x[k] * x[k] + y[k] * y[k] + z[k] * z[k]);
-      buf_[static_cast<std::size_t>(c.first + k)] = static_cast<float>(static_cast<double>(side) * (d[k] - r));
-    }
+  // One cluster's gaps, as Joint::detect computes them, taken into l.
+  void look_up(const Part& part, const Cluster& c, Least& l) {
+    const Rigid& P = pose_of(part.ball);
+    vertices_refined += scan_gaps_compact(*part.set, c.first, c.count, P.M, P.s, map_of(part.ball),
+                                          part.ball ? ScanSide::inside : ScanSide::outside, buf_.data(),
+                                          exact_of(part.ball));
+    take(*part.set, *part.skip, c.first, c.first + c.count, part.ball, l);
+    vertices_looked_up += c.count;
   }
   // The first-surface cluster that met at the previous evaluation, looked up first.
-  void recheck(const Eigen::Matrix3d& R, Least& l) {
-    const Part& p = last_.part;
-    if (p.ball)
-      look_up(R, *p.set, joint_.socket().map, ScanSide::inside, *last_.cluster);
-    else
-      look_up(R.transpose(), *p.set, joint_.ball().map, ScanSide::outside, *last_.cluster);
-    take(*p.set, *p.skip, last_.cluster->first, last_.cluster->first + last_.cluster->count, p.ball, l);
-    vertices_looked_up += last_.cluster->count;
-  }
+  void recheck(Least& l) { look_up(last_.part, *last_.cluster, l); }
   bool done(const Least& l) const { return !exact_ && l.gap <= threshold_; }
   // Hidden vertices of one body against the other's layered map: a cluster is skipped when no radial
   // shell of the other bone over its cone lies within min(cut, least gap so far) of its radii.
-  void scan_hidden(const Eigen::Matrix3d& R, const ScanSet& set, const LayeredMap& map, const FirstHitCaster* exact,
+  void scan_hidden(const Rigid& P, const ScanSet& set, const LayeredMap& map, const FirstHitCaster* exact,
                    const std::vector<std::uint8_t>& skip, bool ball, double cut, Least& l) {
     const OccupancyPyramid* pyr =
         bounds_ == nullptr ? nullptr : ball ? &*bounds_->socket_occupancy : &*bounds_->ball_occupancy;
     const std::vector<Cluster>* cl =
         bounds_ == nullptr ? nullptr : ball ? &bounds_->ball_hidden.leaves : &bounds_->socket_hidden.leaves;
     if (pyr == nullptr || !pyr->valid()) {
-      scan_layered(set, R, Eigen::Vector3d::Zero(), map, buf_.data(), exact);
+      vertices_refined += scan_layered(set, P.M, P.s, map, buf_.data(), exact);
       take(set, skip, 0, set.size(), ball, l, true);
       vertices_looked_up += set.size();
       return;
@@ -178,7 +260,9 @@ class CompactScanner {
     const std::vector<Cluster>* groups = ball ? &bounds_->ball_hidden.groups : &bounds_->socket_hidden.groups;
     auto skipped = [&](const Cluster& c) {
       const double reach = std::max(0.0, std::min(cut, l.gap));
-      return std::isfinite(reach) && (pyr->cap(R * c.axis, c.rho, c.sin_rho, kHiddenBlocks) & shells(c.r_min - reach, c.r_max + reach)) == 0;
+      if (!std::isfinite(reach)) return false;
+      const Cap cap = cap_of(c, P);
+      return (pyr->cap(cap.axis, cap.rho, cap.sin_rho, kHiddenBlocks) & shells(cap.r_lo - reach, cap.r_hi + reach)) == 0;
     };
     for (const Cluster& g : *groups) {
       if (done(l)) return;
@@ -193,7 +277,7 @@ class CompactScanner {
           vertices_skipped += c.count;
           continue;
         }
-        scan_layered(set, c.first, c.count, R, Eigen::Vector3d::Zero(), map, buf_.data(), exact);
+        vertices_refined += scan_layered(set, c.first, c.count, P.M, P.s, map, buf_.data(), exact);
         take(set, skip, c.first, c.first + c.count, ball, l, true);
         vertices_looked_up += c.count;
       }
@@ -201,24 +285,43 @@ class CompactScanner {
   }
   void take(const ScanSet& set, const std::vector<std::uint8_t>& skip, std::int64_t from, std::int64_t to, bool ball,
             Least& l, bool hidden = false) const {
-    for (std::int64_t j = from; j < to; ++j)
-      if (!skip[static_cast<std::size_t>(j)] && buf_[static_cast<std::size_t>(j)] < l.gap)
-        l.gap = buf_[static_cast<std::size_t>(j)], l.ball = ball, l.hidden = hidden,
-        l.vertex = static_cast<std::size_t>(set.index[j]);
+    const bool classed = !ball && reach2_ >= 0;
+    for (std::int64_t j = from; j < to; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      if (skip[k] || !(buf_[k] < l.gap)) continue;
+      if (classed) {
+        // A pelvis vertex meeting the femur within the head sphere's reach meets its joint surface.
+        const Eigen::Vector3d y =
+            socket_pose_.M * Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) + socket_pose_.s - head_centre_;
+        const bool on_head = y.squaredNorm() <= reach2_;
+        const bool articular = on_head || (articular_only_ && (hidden ? lunate_socket_hidden_ : lunate_socket_)[k]);
+        if (articular != articular_only_) continue;
+      }
+      l.gap = buf_[k], l.ball = ball, l.hidden = hidden, l.vertex = static_cast<std::size_t>(set.index[j]);
+    }
   }
   const Joint& joint_;
   const RomSearchBounds* bounds_;
   double threshold_;
   RomVertices counted_;
   bool exact_ = true;
-  // A group's bound at an earlier pose over a widened cap (valid: it was above the cut), or that
-  // its bound failed at the last pose (failed: try the plain cap first next time).
+  Rigid ball_pose_, socket_pose_;
+  double reach2_ = -1;           // head_sphere_reach_mm^2 (< 0: pelvis contacts not classed per pose)
+  bool articular_only_ = false;  // count the joint surfaces only (RomContacts::articular)
+  Eigen::Vector3d head_centre_ = Eigen::Vector3d::Zero();  // the femur's head centre, joint frame (unposed)
+  std::vector<std::uint8_t> lunate_socket_, lunate_socket_hidden_;  // scan-set order
+  double shift_mm_ = 0;  // |t|
+  // A group's bound at an earlier pose (M, s) over the cap of the poses near it (valid: it was above
+  // the cut), or that its bound failed at the last pose (failed: try the plain cap first next time).
   struct Reuse {
-    Eigen::Matrix3d R = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
     bool valid = false, failed = false;
   };
   static inline const double kReuseMinTrace = 1 + 2 * std::cos(kReuseRad);  // trace of a rotation by kReuseRad
   std::vector<Reuse> reuse_ball_groups_, reuse_socket_groups_, reuse_ball_leaves_, reuse_socket_leaves_;
+  const Clustered* reuse_ball_owner_ = nullptr;  // the clusters reuse_ball_* belong to
+  const Clustered* reuse_socket_owner_ = nullptr;
   struct Met {
     Part part;
     const Cluster* cluster = nullptr;

@@ -86,12 +86,19 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
     scan_gaps_compact(set, R, t, map, side, gap_mm);
     return 0;
   }
+  return scan_gaps_compact(set, 0, set.size(), R, t, map, side, gap_mm, exact);
+}
+
+template <typename Scalar>
+std::int64_t scan_gaps_compact(const ScanSet& set, std::int64_t first, std::int64_t count, const Eigen::Matrix3d& R,
+                               const Eigen::Vector3d& t, const RadialDistanceMapT<Scalar>& map, ScanSide side,
+                               float* gap_mm, const FirstHitCaster* exact) {
+  require(first >= 0 && count >= 0 && first + count <= set.size(), "scan: vertex range outside the set");
   const double s = static_cast<double>(static_cast<int>(side));
   const std::array<double, 12> Rt = pose_rows(R, t);
   constexpr std::int64_t kBlock = 256;
   double qx[kBlock], qy[kBlock], qz[kBlock], radius[kBlock], d[kBlock];
-  const std::int64_t n = set.size();
-  std::int64_t refined = 0;
+  const std::int64_t n = first + count;
   struct Pending {
     std::int64_t j;
     Eigen::Vector3d q;
@@ -99,11 +106,16 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
   };
   thread_local std::vector<Pending> pending;  // reused: no allocation per scan once grown
   pending.clear();
-  for (std::int64_t b = 0; b < n; b += kBlock) {
+  for (std::int64_t b = first; b < n; b += kBlock) {
     const int m = static_cast<int>(std::min(kBlock, n - b));
     pose_block(set.x.data() + b, set.y.data() + b, set.z.data() + b, m, Rt.data(), qx, qy, qz, radius);
-    map.lookup_many_soa_marked(qx, qy, qz, m, d);
     float* g = gap_mm + b;
+    if (exact == nullptr) {
+      map.lookup_many_soa(qx, qy, qz, m, d);
+      gap_block(d, radius, s, m, g);
+      continue;
+    }
+    map.lookup_many_soa_marked(qx, qy, qz, m, d);
     gap_block(d, radius, s, m, g);
     // Marked stencils came back as -inf, so their gaps are +-inf: noted here, resolved by the ray
     // cast after the scan, all together (the BVH stays in cache from one ray to the next).
@@ -115,8 +127,7 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
     gap_mm[q.j] = std::isfinite(h) && q.radius > 0 ? static_cast<float>(s * (h - q.radius))
                                                    : std::numeric_limits<float>::quiet_NaN();
   }
-  refined = static_cast<std::int64_t>(pending.size());
-  return refined;
+  return static_cast<std::int64_t>(pending.size());
 }
 
 std::int64_t scan_layered(const ScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const LayeredMap& map,
@@ -302,5 +313,11 @@ template std::int64_t scan_gaps_compact<double>(const ScanSet&, const Eigen::Mat
                                                 const FirstHitCaster*);
 template std::vector<std::uint8_t> first_surface_mask<double>(PointsRef, const RadialDistanceMapT<double>&,
                                                               double, double);
+template std::int64_t scan_gaps_compact<float>(const ScanSet&, std::int64_t, std::int64_t, const Eigen::Matrix3d&,
+                                               const Eigen::Vector3d&, const RadialDistanceMapT<float>&, ScanSide,
+                                               float*, const FirstHitCaster*);
+template std::int64_t scan_gaps_compact<double>(const ScanSet&, std::int64_t, std::int64_t, const Eigen::Matrix3d&,
+                                                const Eigen::Vector3d&, const RadialDistanceMapT<double>&, ScanSide,
+                                                float*, const FirstHitCaster*);
 
 }  // namespace impinge

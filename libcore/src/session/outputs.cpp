@@ -35,18 +35,18 @@ void write_body_ply(const std::string& path, const ImpingementLevels& levels, co
 }  // namespace
 
 void write_pose_plys(const std::string& ball_path, const std::string& socket_path, const Session& s,
-                     const PoseResult& res, const Eigen::Matrix3d& R) {
+                     const PoseResult& res, const FemurPose& pose) {
   const ImpingementLevels& levels = s.joint_options().levels;
-  write_body_ply(ball_path, levels, s.joint().ball(), res.ball_gaps, s.femur_input(R), true);
+  write_body_ply(ball_path, levels, s.joint().ball(), res.ball_gaps, s.femur_input(pose), true);
   write_body_ply(socket_path, levels, s.joint().socket(), res.socket_gaps, s.pelvis_input(), false);
 }
 
-void write_pose_vtp(const std::string& path, const Session& s, const PoseResult& res, const Eigen::Matrix3d& R) {
+void write_pose_vtp(const std::string& path, const Session& s, const PoseResult& res, const FemurPose& pose) {
   const JointBody& b = s.joint().ball();
   const JointBody& p = s.joint().socket();
   const Eigen::Index nb = b.mesh.V.rows(), np = p.mesh.V.rows();
   Vertices V(nb + np, 3);
-  V.topRows(nb) = s.femur_input(R);
+  V.topRows(nb) = s.femur_input(pose);
   V.bottomRows(np) = s.pelvis_input();
   Faces F(b.mesh.F.rows() + p.mesh.F.rows(), 3);
   F.topRows(b.mesh.F.rows()) = b.mesh.F;

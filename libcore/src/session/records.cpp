@@ -179,9 +179,11 @@ nlohmann::json setup_record(const Session& s) {
   j["socket_file"] = s.socket_source();
   j["side"] = s.side() == Side::right ? "right" : "left";
   j["input_frame"] = s.input_frame() == FrameConvention::LPS ? "LPS" : "RAS";
-  j["cor_mm"] = vec(s.cor_input());
+  j["cor_mm"] = vec(s.cor_input());  // the maps' centre: the acetabular centre when the head is seated
+  j["head_centre_mm"] = vec(s.to_input(s.head().centre));
   j["cor_method"] = s.cor_method();
   j["head_radius_mm"] = number_or_null(s.head().radius);
+  j["joint_centre"] = to_string(hip.joint_centre().method());
   j["sphere_fit_rms_mm"] = number_or_null(s.head().rms_residual);
   j["sphere_fit_points"] = s.head().points_used;
   j["scheme"] = opt.scheme->name();
@@ -214,15 +216,15 @@ nlohmann::json setup_record(const Session& s) {
                           {"internal_rotation", frames->scan_pose.internal_rotation_deg}};
     f["frames_ms"] = hip.frames_ms();
     f["acetabulum"] = acetabulum_record(*hip.acetabulum(), frames->pelvis, s.side(), to_input);
-    f["reseat_translation_mm"] = vec(to_input * hip.reseat_translation());
-    f["reseat_distance_mm"] = hip.reseat_translation().norm();
+    // Combined and equidistant joint centres: the head seated on the acetabular centre (then the COR).
+    f["seat_mm"] = vec(to_input * hip.seat_mm());
     f["axes_note"] = "axes and positions in the input files' frame; x anterior, y superior, z right (ISB)";
     j["frames"] = f;
   }
   return j;
 }
 
-ClosestPoint closest_point(const Session& s, bool ball, const ScanGaps& gaps, const Eigen::Matrix3d& R) {
+ClosestPoint closest_point(const Session& s, bool ball, const ScanGaps& gaps, const FemurPose& pose) {
   ClosestPoint c;
   float best = std::numeric_limits<float>::infinity();
   for (std::size_t i = 0; i < gaps.gap_mm.size(); ++i)
@@ -230,14 +232,16 @@ ClosestPoint closest_point(const Session& s, bool ball, const ScanGaps& gaps, co
   if (c.vertex < 0) return c;
   const JointBody& body = ball ? s.joint().ball() : s.joint().socket();
   const Eigen::Vector3d v = body.relative.row(static_cast<Eigen::Index>(c.vertex)).transpose();
-  c.p_joint = ball ? Eigen::Vector3d(R * v) : v;
-  c.contact_class = s.hip().contact_class(ball, c.vertex, c.p_joint, kIntraArticularMarginMm);
+  c.p_joint = ball ? Eigen::Vector3d(pose.R * v + pose.t) : v;
+  c.contact_class = s.hip().contact_class(ball, c.vertex, pose, kIntraArticularMarginMm);
   return c;
 }
 
-nlohmann::json pose_record(const Session& s, const PoseAngles& pose, const PoseResult& res) {
+nlohmann::json pose_record(const Session& s, const PoseAngles& pose, const FemurPose& femur, const PoseResult& res) {
   nlohmann::json j;
   j["pose_deg"] = {pose.flexion_deg, pose.adduction_deg, pose.internal_rotation_deg};
+  j["joint_centre"] = to_string(s.hip().joint_centre().method());
+  j["joint_translation_mm"] = vec(s.to_input(s.hip().femur_translation(femur.t)));
   j["pose_names"] = {"flexion", "adduction", "internal_rotation"};
   ClockSummary ball_clock, socket_clock;
   s.hip().clocks(res, ball_clock, socket_clock);
@@ -247,10 +251,9 @@ nlohmann::json pose_record(const Session& s, const PoseAngles& pose, const PoseR
   j["socket"] =
       scan_record(s.joint().socket(), res.socket, res.socket_detection_ms, levels, clocks ? &socket_clock : nullptr);
   // Where each scan comes closest, classed (articular, intra- or extra-articular impingement).
-  const Eigen::Matrix3d R = s.hip().femur_rotation(pose);
   for (const bool ball : {true, false})
     j[ball ? "ball" : "socket"]["closest_contact_class"] =
-        to_string(closest_point(s, ball, ball ? res.ball_gaps : res.socket_gaps, R).contact_class);
+        to_string(closest_point(s, ball, ball ? res.ball_gaps : res.socket_gaps, femur).contact_class);
   return j;
 }
 

@@ -14,7 +14,8 @@ std::vector<std::string> motion_columns(const ImpingementLevels& levels) {
                                 "penetrating_area_mm2",  "ball_penetrating_area_mm2"};
   for (int k = 0; k < levels.count(); ++k) c.push_back("socket_level" + std::to_string(k) + "_area_mm2");
   for (const char* name : {"socket_closest_clock_h", "femur_closest_clock_h", "socket_closest_x_mm",
-                           "socket_closest_y_mm", "socket_closest_z_mm", "socket_closest_class", "detection_ms"})
+                           "socket_closest_y_mm", "socket_closest_z_mm", "socket_closest_class",
+                           "joint_translation_x_mm", "joint_translation_y_mm", "joint_translation_z_mm", "detection_ms"})
     c.emplace_back(name);
   return c;
 }
@@ -35,6 +36,7 @@ nlohmann::json motion_row(const MotionFrame& f) {
   row.push_back(number_or_null(f.ball_clock.closest_hour));
   for (int c = 0; c < 3; ++c) row.push_back(number_or_null(f.socket_closest[c]));
   row.push_back(to_string(f.socket_closest_class));
+  for (int c = 0; c < 3; ++c) row.push_back(f.joint_translation[c]);
   row.push_back(f.detection_ms);
   return row;
 }
@@ -51,12 +53,13 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
     f.index = k;
     f.time_s = time_s.empty() ? static_cast<double>(k) : time_s[k];
     f.angles = angles[k];
-    f.R = s.hip().femur_rotation(angles[k]);
     const auto t0 = Clock::now();
-    s.joint().detect(f.R, Eigen::Vector3d::Zero(), res);
+    f.pose = s.hip().femur_pose(angles[k]);  // with the joint-centre method's translation (counted here)
+    s.joint().detect(f.pose.R, f.pose.t, res);
     f.detection_ms = ms_since(t0);
     detect_ms += f.detection_ms;
-    const ClosestPoint c = closest_point(s, false, res.socket_gaps, f.R);
+    f.joint_translation = s.to_input(s.hip().femur_translation(f.pose.t));
+    const ClosestPoint c = closest_point(s, false, res.socket_gaps, f.pose);
     f.socket_closest = c.vertex >= 0 ? s.report_point(c.p_joint) : c.p_joint;
     f.socket_closest_class = c.contact_class;
     f.ball_clock.closest_hour = f.socket_clock.closest_hour = std::nan("");
@@ -73,7 +76,7 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
   // Pre-existing overlap at neutral (a segmentation's) is excluded, not taken for a limit. The
   // baseline's scan and the search bounds it builds count with the limits' time.
   auto t0 = Clock::now();
-  run.baseline = rom_baseline(hip, hip.femur_rotation({}), q.search);
+  run.baseline = rom_baseline(hip, hip.femur_rotation({}), q.search);  // with its joint translation
   run.motions = standard_motions();
   run.limits = find_rom_limits(hip, run.motions, q.search, run.baseline);
   run.limits_ms = ms_since(t0);
@@ -108,14 +111,16 @@ Table rom_limits_table(const Session& s, const RomRun& run) {
   Table t;
   t.columns = {"motion",      "limit_deg",        "limited_by",   "contact_class", "socket_clock_h", "femur_clock_h",
                "min_gap_at_limit_mm", "monotone", "contact_at_start", "contact_x_mm", "contact_y_mm",
-               "contact_z_mm", "evaluations"};
+               "contact_z_mm", "joint_translation_x_mm", "joint_translation_y_mm", "joint_translation_z_mm",
+               "evaluations"};
   for (std::size_t k = 0; k < run.motions.size(); ++k) {
     const RomLimit& l = run.limits[k];
-    const Eigen::Vector3d c = s.to_input(l.contact_mm);
+    const Eigen::Vector3d c = s.to_input(l.contact_mm), tr = s.to_input(l.joint_translation_mm);
     t.add({run.motions[k].name, number_or_null(l.limit_deg), to_string(l.limited_by), to_string(l.contact_class),
            number_or_null(l.socket_clock_h),
            number_or_null(l.femur_clock_h), number_or_null(l.min_gap_at_limit_mm), l.monotone, l.contact_at_start,
-           number_or_null(c.x()), number_or_null(c.y()), number_or_null(c.z()), l.evaluations});
+           number_or_null(c.x()), number_or_null(c.y()), number_or_null(c.z()), number_or_null(tr.x()),
+           number_or_null(tr.y()), number_or_null(tr.z()), l.evaluations});
   }
   return t;
 }
@@ -153,6 +158,7 @@ nlohmann::json rom_record(const RomRun& run) {
   nlohmann::json j;
   const RomOptions& o = run.search;
   j["threshold_mm"] = o.threshold_mm;
+  j["contact_depth_mm"] = o.contact_depth_mm;
   j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
   j["neutral_min_gap_mm"] = number_or_null(run.baseline.min_gap_mm);
   j["excluded_vertices"] = run.baseline.excluded_vertices;

@@ -171,7 +171,7 @@ HipJointOptions hip_joint_options(const MapSettings& m, const FrameSettings& f, 
     o.neutral = parse_neutral(f.neutral, "neutral");
   else if (!subject_neutral.empty())
     o.neutral = parse_neutral(subject_neutral, "subject.json \"neutral\"");
-  o.reseat = f.reseat;
+  if (!f.joint_centre.empty()) o.joint_centre = parse_joint_centre(f.joint_centre, "joint-centre");
   o.frames.pelvis = parse_pelvis_frame_kind(f.pelvis_frame, "pelvis-frame");
   o.frames.femur = parse_femur_frame_kind(f.femur_frame, "femur-frame");
   JointOptions& jo = o.joint;
@@ -222,27 +222,39 @@ Session::Session(const SessionOptions& options) : options_(options) {
   subject_name_ = in.name;
   cor_ = find_centre_of_rotation(in, options.cor);
   hip_options_.allow_cor_outside_ball = options.cor.allow_any;
+  // A given COR (or the subject's hip_centre landmark): the zones, the acetabulum and the seat still
+  // come from the head the femur shows, so that they do not move with the COR.
+  if (!std::isfinite(cor_.head.radius) && hip_options_.neutral == Neutral::anatomical) {
+    try {
+      hip_options_.head_sphere = located_head(in);
+    } catch (const Error&) {
+      // No head to fit (e.g. a proximal stump): the COR's sphere, as before.
+    }
+  }
   try {
     hip_ = std::make_shared<const HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
                                             hip_options_);
   } catch (const Error& e) {
-    if (hip_options_.neutral != Neutral::anatomical || hip_options_.reseat) throw;
+    if (hip_options_.neutral != Neutral::anatomical) throw;
     throw Error(std::string(e.what()) +
                 " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan "
                 "uses the scan pose instead]");
   }
   warnings_ = hip_->warnings();
   // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).
-  const PoseResult scan = joint().detect(Eigen::Matrix3d::Identity());
+  const FemurPose scan_pose = hip_->scan_pose();
+  const PoseResult scan = joint().detect(scan_pose.R, scan_pose.t);
   scan_pose_min_gap_mm_ = std::fmin(scan.ball.min_gap_mm, scan.socket.min_gap_mm);
   if (scan_pose_min_gap_mm_ < 0)
     warnings_.push_back("the bones overlap by " + num(-scan_pose_min_gap_mm_) +
                         " mm at the scan pose (a segmentation overlap, not an impingement)" +
-                        (hip_options_.reseat ? "" : "; reseat seats the head on the acetabular centre"));
+                        (hip_->joint_centre().method() == JointCentreMethod::femoral_head
+                             ? std::string("; the equidistant joint centre seats the head in the acetabulum")
+                             : std::string()));
 }
 
-Vertices Session::femur_input(const Eigen::Matrix3d& R) const {
-  return (hip_->posed_femur(R) * to_working_).eval();  // rows: v^T M = (M^T v)^T, M^T = input <- working
+Vertices Session::femur_input(const FemurPose& pose) const {
+  return (hip_->posed_femur(pose.R, pose.t) * to_working_).eval();  // rows: v^T M = (M^T v)^T, M^T = input <- working
 }
 
 Vertices Session::pelvis_input() const { return (hip_->pelvis_vertices() * to_working_).eval(); }
@@ -251,7 +263,16 @@ std::pair<Eigen::Matrix3d, Eigen::Vector3d> Session::joint_motion(const Eigen::M
                                                                   const Eigen::Vector3d& t_in) const {
   // joint <- working <- input: A = joint_to_working^T, M = to_working.
   const Eigen::Matrix3d B = hip_->joint_to_working().transpose() * to_working_;
-  return {B * R_in * B.transpose(), B * t_in};
+  const Eigen::Matrix3d R = B * R_in * B.transpose();
+  // The joint frame's femur is the seated one: take the seat back out, rotated.
+  const Eigen::Vector3d seat = hip_->joint_to_working().transpose() * hip_->seat_mm();
+  return {R, B * t_in - R * seat};
+}
+
+Eigen::Vector3d Session::input_translation(const FemurPose& pose) const {
+  const Eigen::Matrix3d B = hip_->joint_to_working().transpose() * to_working_;
+  const Eigen::Vector3d seat = hip_->joint_to_working().transpose() * hip_->seat_mm();
+  return B.transpose() * (pose.t + pose.R * seat);
 }
 
 Eigen::Matrix3d Session::input_rotation(const Eigen::Matrix3d& R_joint) const {

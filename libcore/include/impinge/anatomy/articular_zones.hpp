@@ -18,6 +18,11 @@
 ///   sphere (the contacts that ended tlem2-mri's and mc22's searches lie 1-3 mm outside the head
 ///   sphere, in the cup). Farther femur vertices (a large cam, the neck, the trochanters) are counted
 ///   from the femur too.
+/// - A pelvis vertex that meets the femur within r_h + t_h of the head centre meets the head's
+///   joint surface, wherever on the acetabulum it lies (the lunate surface or the rim over the head):
+///   that too is the joint, not impingement, which is the head-neck junction or neck against the rim.
+///   This depends on the pose, so it is applied where a contact is found (HipJoint::contact_class, the
+///   ROM searches), with head_sphere_reach_mm.
 /// Tolerances t_h, t_a: twice the sphere fit's rms residual (the surface's own roughness about its
 /// sphere; 0.4-0.8 mm on the shared hips), at least min_tolerance_mm.
 
@@ -52,6 +57,9 @@ struct ArticularZones {
   std::vector<std::uint8_t> femur;   ///< 1: on the femoral head's articular surface (one per femur vertex)
   std::vector<std::uint8_t> pelvis;  ///< 1: on the lunate surface (one per pelvis vertex)
   double head_tolerance_mm = 0, lunate_tolerance_mm = 0;
+  /// r_h + t_h: a pelvis vertex within this of the head centre in the femur's frame meets the head's
+  /// joint surface (mm).
+  double head_sphere_reach_mm = 0;
   std::int64_t femur_vertices = 0, pelvis_vertices = 0;  ///< how many are articular
 };
 

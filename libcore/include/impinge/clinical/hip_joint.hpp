@@ -12,19 +12,28 @@
 #include "impinge/anatomy/hip_frames.hpp"
 #include "impinge/anatomy/pose.hpp"
 #include "impinge/clinical/clock_summary.hpp"
+#include "impinge/clinical/joint_centre.hpp"
 #include "impinge/detection/joint.hpp"
 
 namespace impinge {
+
+/// The femur's pose in the joint frame: a femur point p (joint frame, unposed, mm) is posed at
+/// R p + t.
+struct FemurPose {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  ///< 3 x 3 rotation
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();      ///< translation, mm (the joint-centre method's)
+};
 
 /// Options of a HipJoint.
 struct HipJointOptions {
   JointOptions joint;                     ///< maps, mode, levels
   Neutral neutral = Neutral::anatomical;  ///< what zero angles mean
   HipFrameOptions frames;                 ///< which pelvic and femoral frames (anatomical neutral only)
-  /// Re-seat the head (anatomical neutral only): translate the femur so that its head centre lies on
-  /// the acetabular sphere centre (the lunate zone's sphere; Puls et al. 2010, Comput Aided Surg
-  /// 15:75, equidistant method), for segmentations whose bones overlap at the scan pose.
-  bool reseat = false;
+  /// How the femur moves at each pose (joint_centre.hpp; Puls et al. 2010). Unset: equidistant with
+  /// anatomical neutral, femoral_head (the thesis' method) with scan neutral, which allows no other
+  /// (the others need the acetabulum).
+  std::optional<JointCentreMethod> joint_centre;
+  EquidistantOptions equidistant;  ///< the equidistant method's iteration
   /// Map files (save_map) to use instead of sampling: {ball, socket}; empty = sample. They must
   /// have been saved from a HipJoint of the same meshes and options (save_maps): their stored COR
   /// (working frame) must equal this joint's within 1e-6 mm and their scheme joint.scheme's.
@@ -32,6 +41,10 @@ struct HipJointOptions {
   /// Accept a centre of rotation outside the femur (ball) mesh, for research; otherwise that is an
   /// error (the gaps would be measured along rays that leave the head: silently wrong numbers).
   bool allow_cor_outside_ball = false;
+  /// The femoral head sphere (working frame, mm) when the COR is not its centre (a given COR): the
+  /// articular zones, the acetabulum, the clock faces and the seat of the combined and equidistant
+  /// methods use it, so that they do not move with the COR. Unset: the COR's sphere (`head`).
+  std::optional<SphereFitResult> head_sphere;
   /// Tolerances of the articular zones (anatomical neutral only; articular_zones.hpp).
   ArticularZoneOptions articular;
 };
@@ -46,12 +59,12 @@ struct HipJointOptions {
 class HipJoint {
  public:
   /// Build the frames (anatomical neutral: find_hip_frames with "hip_centre" = head.centre; the
-  /// acetabulum and both clock faces) and both maps. `femur`, `pelvis`: whole bones in the
+  /// acetabulum and both clock faces) and both maps. With the combined and equidistant joint
+  /// centres the femur is first seated (seat_mm()) and the COR is the acetabular centre. `femur`, `pelvis`: whole bones in the
   /// working frame (RAS, mm); `head`: the femoral head sphere (mm, working frame; its centre is
   /// the COR; a NaN radius is estimated as the median distance of the femur's vertices within
   /// 35 mm of the centre); `given`: landmarks that replace found ones (mm, working frame).
-  /// With options.reseat the femur is first translated by reseat_translation() and the COR is the
-  /// acetabular centre. Throws impinge::Error naming the mesh and step that failed (for example
+  /// Throws impinge::Error naming the mesh and step that failed (for example
   /// no whole pelvis with anatomical neutral: use scan neutral or give the landmarks), and naming
   /// the COR when it lies outside the femur mesh (its map leaves more than 1e-4 of the directions
   /// without surface) unless options.allow_cor_outside_ball. A head radius outside 5-60 mm (metres
@@ -62,8 +75,30 @@ class HipJoint {
   /// Rotation (3 x 3, joint frame) of the femur about the COR at `angles` (degrees, ISB signs).
   Eigen::Matrix3d femur_rotation(const PoseAngles& angles) const;
 
-  /// Both scans at `angles` (Joint::detect with femur_rotation(angles)); into `out`, reusing
-  /// its storage.
+  /// The femur's translation (mm, joint frame) at rotation R by the joint-centre method: a femur
+  /// point p (joint frame, unposed) is posed at R p + t (JointCentre::translation; a function of R
+  /// alone). Throws impinge::Error as that does.
+  Eigen::Vector3d joint_translation(const Eigen::Matrix3d& R) const { return centre_.translation(*joint_, R); }
+  /// femur_rotation(angles) with its joint_translation.
+  FemurPose femur_pose(const PoseAngles& angles) const {
+    const Eigen::Matrix3d R = femur_rotation(angles);
+    return {R, joint_translation(R)};
+  }
+  /// The femur's translation at joint-frame translation t (a pose's, mm) from where the scan put it,
+  /// after its rotation about its own head centre: working-frame axes, mm. With the combined and
+  /// equidistant methods it includes seat_mm(). Posed femur point (working frame): c_h + A R A^T
+  /// (p - c_h) + this, with c_h the fitted head centre and A = joint_to_working().
+  Eigen::Vector3d femur_translation(const Eigen::Vector3d& t) const { return seat_ + joint_to_working_ * t; }
+  /// The femur's pose at the scan pose (joint frame: R = I, t = -seat).
+  FemurPose scan_pose() const { return {Eigen::Matrix3d::Identity(), -(joint_to_working_.transpose() * seat_)}; }
+  /// Combined and equidistant methods: the translation (working frame, mm) that seats the femoral
+  /// head centre on the acetabular sphere's centre, which is then the COR (cor()); zero otherwise.
+  const Eigen::Vector3d& seat_mm() const { return seat_; }
+  /// The method in use and its state.
+  const JointCentre& joint_centre() const { return centre_; }
+
+  /// Both scans at `angles` (Joint::detect with femur_rotation(angles) and its joint_translation);
+  /// into `out`, reusing its storage.
   void detect(const PoseAngles& angles, PoseResult& out) const;
   PoseResult detect(const PoseAngles& angles) const;
 
@@ -71,14 +106,14 @@ class HipJoint {
   Eigen::Vector3d to_working(const Eigen::Vector3d& p) const { return cor_ + joint_to_working_ * p; }
   /// Rotation from joint-frame to working-frame directions (3 x 3, orthonormal).
   const Eigen::Matrix3d& joint_to_working() const { return joint_to_working_; }
-  /// Vertices (n x 3, mm, working frame) of the femur posed by R (joint frame) or of the pelvis.
-  Vertices posed_femur(const Eigen::Matrix3d& R) const;
+  /// Vertices (n x 3, mm, working frame) of the femur posed by R and t (joint frame, mm) or of the pelvis.
+  Vertices posed_femur(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const;
   Vertices pelvis_vertices() const;
 
   const Joint& joint() const { return *joint_; }
   /// The anatomical frames in the working frame (empty with scan neutral).
   const std::optional<HipFrames>& frames() const { return frames_; }
-  /// The acetabulum (working frame, before any re-seating; empty with scan neutral).
+  /// The acetabulum (working frame; empty with scan neutral).
   const std::optional<Acetabulum>& acetabulum() const { return acetabulum_; }
   /// Clock faces in the joint frame (socket: acetabular; ball: femoral head-neck, on the unposed
   /// femur); empty with scan neutral.
@@ -89,19 +124,20 @@ class HipJoint {
   /// The joint surfaces per vertex (the femoral head's, the lunate's), to tell the joint space
   /// closing from impingement (anatomical neutral only: they need the acetabulum; else empty).
   const std::optional<ArticularZones>& articular() const { return articular_; }
-  /// The class of a contact at vertex `vertex` of the femur (`ball`) or the pelvis, at joint-frame
-  /// position `p_joint` (mm): articular when the vertex is on its joint surface, else intra-articular
-  /// impingement within the acetabular rim radius (head radius + 5 mm without an acetabulum) plus
-  /// `intra_margin_mm` of the COR, else extra-articular.
-  ContactClass contact_class(bool ball, std::int64_t vertex, const Eigen::Vector3d& p_joint,
-                             double intra_margin_mm) const;
-  /// The femur's translation by re-seating (mm, working frame; zero without it).
-  const Eigen::Vector3d& reseat_translation() const { return reseat_; }
+  /// The class of a contact at vertex `vertex` of the femur (`ball`) or the pelvis with the femur at
+  /// `pose`: articular when the vertex is on its joint surface (articular()), or is a pelvis vertex
+  /// within ArticularZones::head_sphere_reach_mm of the posed head centre (it meets the head's joint
+  /// surface); else intra-articular impingement within the acetabular rim radius (head radius + 5 mm
+  /// without an acetabulum) plus `intra_margin_mm` of the COR, else extra-articular.
+  ContactClass contact_class(bool ball, std::int64_t vertex, const FemurPose& pose, double intra_margin_mm) const;
   /// Save both maps (map_io.hpp) with the working-frame COR, for options.ball_map_file and
   /// socket_map_file of a later HipJoint. Throws impinge::Error on I/O errors.
   void save_maps(const std::string& ball_path, const std::string& socket_path) const;
   /// Warnings about the input (e.g. an implausible head radius: wrong units?), one line each.
   const std::vector<std::string>& warnings() const { return warnings_; }
+  /// The femoral head centre (HipJointOptions::head_sphere, else the COR) in the joint frame, on the
+  /// unposed femur (mm; zero when the head is seated or is the COR).
+  const Eigen::Vector3d& head_centre_joint() const { return head_centre_joint_; }
   /// Head radius used for the acetabulum and clocks (mm).
   double head_radius_mm() const { return head_radius_; }
   const Eigen::Vector3d& cor() const { return cor_; }
@@ -119,10 +155,12 @@ class HipJoint {
   std::optional<Acetabulum> acetabulum_;
   std::optional<ClockFace> socket_clock_, ball_clock_;
   std::optional<ArticularZones> articular_;
-  Eigen::Vector3d reseat_ = Eigen::Vector3d::Zero();
   double head_radius_ = 0;
   std::vector<std::string> warnings_;
   std::optional<Joint> joint_;
+  JointCentre centre_;
+  Eigen::Vector3d seat_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d head_centre_joint_ = Eigen::Vector3d::Zero();
   double frames_ms_ = 0;
 };
 

@@ -42,7 +42,14 @@ inline constexpr double kIntraArticularMarginMm = 10;
 
 /// Options of a ROM search.
 struct RomOptions {
-  double threshold_mm = 0;       ///< contact when the minimum gap <= this (0: bone contact; a cartilage offset > 0)
+  double threshold_mm = 0;       ///< contact when the minimum gap <= this less contact_depth_mm (0: bone contact;
+                                 ///< a cartilage offset > 0)
+  /// A contact must reach this far past the threshold to end a search, mm: a graze shallower than
+  /// the data's own error (the maps' interpolation, about 0.05 mm at 0.1 deg; an MRI surface's
+  /// roughness about its fitted sphere, 0.4-0.8 mm rms) does not stop a motion, whose femur the
+  /// joint's play lets slide past it. Without it a graze along a motion makes the limit jump by tens
+  /// of degrees under a 1 mm change of the centre of rotation (issue 29). 0: the first touch.
+  double contact_depth_mm = 0.1;
   double step_deg = 2;           ///< coarse step along the motion, deg
   double max_deg = 150;          ///< search no farther than this from neutral, deg
   double tolerance_deg = 0.1;    ///< bisection until the bracket is this narrow, deg
@@ -93,6 +100,10 @@ struct RomLimit {
                                    ///< near the joint, such as the far side of the rim, is intra-articular)
   Eigen::Vector3d contact_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
                                    ///< the contact vertex at the limit, working frame (pelvis fixed), mm
+  /// The femur's translation at the limit by the joint-centre method (HipJoint::femur_translation:
+  /// from its scan position, after its rotation about its head centre), working-frame axes, mm; NaN
+  /// without a limit.
+  Eigen::Vector3d joint_translation_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   double socket_clock_h = std::numeric_limits<double>::quiet_NaN();  ///< contact on the acetabular clock
   double femur_clock_h = std::numeric_limits<double>::quiet_NaN();   ///< contact on the femoral head-neck clock
   std::int64_t excluded_vertices = 0;  ///< vertices within the threshold at the baseline pose (pre-existing
@@ -112,6 +123,13 @@ struct RomBaseline {
   std::vector<std::uint8_t> skip_ball, skip_socket;  ///< 1 = not counted (per vertex of each body)
   std::int64_t excluded_vertices = 0;
   std::int64_t articular_vertices = 0;  ///< not counted for RomOptions::contacts (on, or off, the joint surfaces)
+  /// How the pelvis' contacts are classed at each pose (HipJoint::contact_class): a pelvis vertex
+  /// within this of the posed head centre meets the head's joint surface (ArticularZones::
+  /// head_sphere_reach_mm). NaN: not applied (scan neutral, or RomContacts::all).
+  double head_sphere_reach_mm = std::numeric_limits<double>::quiet_NaN();
+  RomContacts contacts = RomContacts::all;  ///< the options' (with head_sphere_reach_mm)
+  Eigen::Vector3d head_centre = Eigen::Vector3d::Zero();  ///< HipJoint::head_centre_joint()
+  std::vector<std::uint8_t> lunate;         ///< per pelvis vertex, 1 on the lunate surface (RomContacts::articular)
   double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< least gap of all vertices at the baseline
   /// The bounds of the cluster search (RomOptions::use_bounds), built once by rom_baseline (about
   /// 10 ms for 0.1 deg maps) and shared by every search given this baseline with the same joint and

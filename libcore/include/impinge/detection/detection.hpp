@@ -108,6 +108,15 @@ std::int64_t scan_gaps_compact(const ScanSet& set, const Eigen::Matrix3d& R, con
                                const RadialDistanceMapT<Scalar>& map, ScanSide side, float* gap_mm,
                                const FirstHitCaster* exact);
 
+/// scan_gaps_compact with exact look-ups over the vertices [first, first + count) of `set` only:
+/// gap_mm[j] for j in that range (gap_mm still indexed like the whole set). The ROM searches' scanner
+/// looks clusters up this way, so that they see the gaps Joint::detect sees. Throws impinge::Error
+/// for a range outside the set.
+template <typename Scalar>
+std::int64_t scan_gaps_compact(const ScanSet& set, std::int64_t first, std::int64_t count, const Eigen::Matrix3d& R,
+                               const Eigen::Vector3d& t, const RadialDistanceMapT<Scalar>& map, ScanSide side,
+                               float* gap_mm, const FirstHitCaster* exact);
+
 /// The layered scan (issue 14): for every vertex j of `set`, q = R p_j + t in the map's frame (as
 /// scan_gaps_compact), gap_mm[j] = the layered map's signed radial distance at q (mm; > 0 apart, < 0
 /// inside the other bone), NaN where the other bone is nowhere along q's ray or the answer is unknown

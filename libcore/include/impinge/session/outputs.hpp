@@ -18,16 +18,16 @@ namespace impinge {
 std::vector<std::uint8_t> vertex_levels(const ScanGaps& gaps, const ImpingementLevels& levels);
 
 /// Both bones at one pose as binary PLY (write_gap_ply: x y z gap_mm; level and its colour): the
-/// femur posed by R (3 x 3, joint frame) into `ball_path`, the pelvis into `socket_path`; vertices
+/// femur at `pose` (joint frame) into `ball_path`, the pelvis into `socket_path`; vertices
 /// in the input frame, mm, in the meshes' vertex order. Throws impinge::Error naming a file on I/O
 /// errors.
 void write_pose_plys(const std::string& ball_path, const std::string& socket_path, const Session& session,
-                     const PoseResult& result, const Eigen::Matrix3d& R);
+                     const PoseResult& result, const FemurPose& pose);
 
-/// Both bones in one VTK PolyData (.vtp): the femur posed by R (joint frame), then the pelvis,
+/// Both bones in one VTK PolyData (.vtp): the femur at `pose` (joint frame), then the pelvis,
 /// with point arrays gap_mm (float32, NaN untested), level (uint8, 255 untested) and body (0
 /// femur, 1 pelvis); input frame, mm. Throws impinge::Error naming the file on I/O errors.
 void write_pose_vtp(const std::string& path, const Session& session, const PoseResult& result,
-                    const Eigen::Matrix3d& R);
+                    const FemurPose& pose);
 
 }  // namespace impinge

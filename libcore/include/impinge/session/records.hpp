@@ -66,12 +66,15 @@ struct ClosestPoint {
   Eigen::Vector3d p_joint = Eigen::Vector3d::Constant(std::nan(""));  ///< it, posed, joint frame, mm
   ContactClass contact_class = ContactClass::none;  ///< HipJoint::contact_class (rim radius + 10 mm)
 };
-/// The closest point of the femur's scan (`ball`, femur posed by R: 3 x 3, joint frame) or of the
-/// pelvis' (`gaps` from the same pose). Never throws.
-ClosestPoint closest_point(const Session& session, bool ball, const ScanGaps& gaps, const Eigen::Matrix3d& R);
+/// The closest point of the femur's scan (`ball`, femur at `pose`, joint frame) or of the pelvis'
+/// (`gaps` from the same pose). Never throws.
+ClosestPoint closest_point(const Session& session, bool ball, const ScanGaps& gaps, const FemurPose& pose);
 
 /// Both scans at one pose: pose_deg, and ball / socket scan_record()s with clocks (anatomical
 /// neutral) and the class of each scan's closest vertex (closest_contact_class).
-nlohmann::json pose_record(const Session& session, const PoseAngles& pose, const PoseResult& result);
+/// `femur`: the femur's pose at `pose` (HipJoint::femur_pose); its translation is reported as
+/// joint_translation_mm (input frame) beside the method (joint_centre).
+nlohmann::json pose_record(const Session& session, const PoseAngles& pose, const FemurPose& femur,
+                           const PoseResult& result);
 
 }  // namespace impinge

@@ -20,7 +20,9 @@ struct MotionFrame {
   std::size_t index = 0;
   double time_s = 0;
   PoseAngles angles;                         ///< degrees, ISB
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  ///< the femur's rotation, joint frame
+  FemurPose pose;                            ///< the femur's rotation and translation, joint frame
+  /// The translation by the joint-centre method (HipJoint::joint_translation), input-frame axes, mm.
+  Eigen::Vector3d joint_translation = Eigen::Vector3d::Zero();
   const PoseResult* result = nullptr;        ///< both scans (valid during the callback)
   ClockSummary ball_clock, socket_clock;     ///< closest hours (NaN with scan neutral)
   /// The socket vertex with the least gap, as Session::report_point gives it (pelvic frame with
@@ -34,7 +36,9 @@ struct MotionFrame {
 
 /// The columns of a motion table for `levels` (frames.csv): frame, time_s, the three angles, both
 /// least gaps (mm), penetrating areas (mm^2), the socket's area per level, both closest clock hours,
-/// the socket's closest point (x, y, z mm) and its contact class, and detection_ms.
+/// the socket's closest point (x, y, z mm) and its contact class, the femur's translation by the
+/// joint-centre method (joint_translation_x/y/z_mm, input-frame axes), and detection_ms (with the
+/// translation's iteration).
 std::vector<std::string> motion_columns(const ImpingementLevels& levels);
 /// One frame's row of that table.
 nlohmann::json motion_row(const MotionFrame& frame);
@@ -75,7 +79,8 @@ struct RomRun {
 RomRun run_rom(const Session& session, const RomRequest& request);
 
 /// rom_limits.csv: motion, limit_deg, limited_by, contact_class, socket_clock_h, femur_clock_h,
-/// min_gap_at_limit_mm, monotone, contact_at_start, contact_x/y/z_mm (input frame), evaluations.
+/// min_gap_at_limit_mm, monotone, contact_at_start, contact_x/y/z_mm (input frame),
+/// joint_translation_x/y/z_mm (the femur's translation at the limit, input-frame axes), evaluations.
 Table rom_limits_table(const Session& session, const RomRun& run);
 /// rom_map.csv: flexion_deg, adduction_deg, max_internal_rotation_deg, status.
 Table rom_map_table(const RomRun& run);

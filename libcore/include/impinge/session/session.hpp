@@ -81,7 +81,9 @@ struct MapSettings {
 /// Frames and neutral (HipJointOptions).
 struct FrameSettings {
   std::string neutral;  ///< "anatomical" | "scan"; empty: the subject's "neutral", else anatomical
-  bool reseat = false;  ///< Puls et al. 2010's equidistant seating at the scan pose
+  /// How the femur moves at each pose (parse_joint_centre: femoral-head, acetabular, combined,
+  /// equidistant); empty: equidistant with anatomical neutral, femoral-head with scan neutral.
+  std::string joint_centre;
   std::string pelvis_frame = "isb";         ///< isb | app
   std::string femur_frame = "epicondyles";  ///< epicondyles | posterior-condyles
 };
@@ -171,13 +173,16 @@ class Session {
   Eigen::Vector3d to_input(const Eigen::Vector3d& working) const { return to_working_.transpose() * working; }
   /// The COR in the input frame, mm.
   Eigen::Vector3d cor_input() const { return to_input(hip_->cor()); }
-  /// Vertices (n x 3, mm, input frame) of the femur posed by R (3 x 3, joint frame), of the pelvis.
-  Vertices femur_input(const Eigen::Matrix3d& R) const;
+  /// Vertices (n x 3, mm, input frame) of the femur at `pose` (joint frame), of the pelvis.
+  Vertices femur_input(const FemurPose& pose) const;
   Vertices pelvis_input() const;
-  /// A femur motion given in the input frame (rotation R_in 3 x 3 about the COR, then translation
-  /// t_in, mm) in the joint frame, for Joint::detect. Rotations checked by the caller.
+  /// A femur motion given in the input frame (the femur as scanned rotated by R_in 3 x 3 about the
+  /// COR, then translated by t_in, mm: posed = cor + R_in (p - cor) + t_in) as a joint-frame pose for
+  /// Joint::detect (which poses the seated femur: HipJoint::seat_mm()). Rotations checked by the caller.
   std::pair<Eigen::Matrix3d, Eigen::Vector3d> joint_motion(const Eigen::Matrix3d& R_in,
                                                            const Eigen::Vector3d& t_in) const;
+  /// The inverse for the translation: the input-frame t_in of joint_motion for a joint-frame pose.
+  Eigen::Vector3d input_translation(const FemurPose& pose) const;
   /// A joint-frame rotation of the femur (femur_rotation) in the input frame (3 x 3).
   Eigen::Matrix3d input_rotation(const Eigen::Matrix3d& R_joint) const;
   /// A joint-frame point (mm) as reports give it: in the pelvic frame (AnatomicalFrame::to_local:

@@ -1,0 +1,131 @@
+#include "impinge/clinical/joint_centre.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "impinge/core/error.hpp"
+
+namespace impinge {
+
+JointCentreMethod parse_joint_centre(const std::string& text, const std::string& context) {
+  std::string t = text;
+  std::replace(t.begin(), t.end(), '_', '-');
+  if (t == "femoral-head") return JointCentreMethod::femoral_head;
+  if (t == "acetabular") return JointCentreMethod::acetabular;
+  if (t == "combined") return JointCentreMethod::combined;
+  if (t == "equidistant") return JointCentreMethod::equidistant;
+  throw Error(context + " '" + text + "': expected femoral-head, acetabular, combined or equidistant");
+}
+
+const char* to_string(JointCentreMethod m) {
+  switch (m) {
+    case JointCentreMethod::acetabular: return "acetabular";
+    case JointCentreMethod::combined: return "combined";
+    case JointCentreMethod::equidistant: return "equidistant";
+    case JointCentreMethod::femoral_head: break;
+  }
+  return "femoral-head";
+}
+
+JointCentre::JointCentre(JointCentreMethod method, const Joint& joint, const Eigen::Vector3d& c_a,
+                         const std::vector<std::uint8_t>& lunate, double head_sphere_reach_mm,
+                         const EquidistantOptions& o)
+    : method_(method), c_a_(c_a), reach_mm_(head_sphere_reach_mm), options_(o) {
+  if (method == JointCentreMethod::femoral_head) return;
+  require(c_a.allFinite(), std::string("joint centre ") + to_string(method) +
+                               ": needs the acetabular centre (anatomical neutral), and it is not finite");
+  if (method != JointCentreMethod::equidistant) return;
+  require(o.max_vertices >= 16 && o.max_iterations >= 1 && o.tolerance_mm > 0,
+          "joint centre equidistant: need max_vertices >= 16, max_iterations >= 1 and tolerance > 0 mm");
+  require(std::isfinite(head_sphere_reach_mm) && head_sphere_reach_mm > 0,
+          "joint centre equidistant: the head sphere's reach must be > 0 mm");
+  const Vertices& P = joint.socket().relative;
+  require(lunate.size() == static_cast<std::size_t>(P.rows()),
+          "joint centre equidistant: the lunate flags have " + std::to_string(lunate.size()) + " entries for " +
+              std::to_string(P.rows()) + " pelvis vertices");
+  const auto flagged = static_cast<std::int64_t>(std::count(lunate.begin(), lunate.end(), std::uint8_t(1)));
+  require(flagged >= 16, joint.socket().mesh.source + ": " + std::to_string(flagged) +
+                             " vertices on the lunate surface, fewer than 16: the equidistant joint centre needs "
+                             "the acetabulum's joint surface (use --joint-centre femoral-head)");
+  // An even subset by vertex index (meshes number neighbouring vertices closely enough).
+  const std::int64_t stride = (flagged + o.max_vertices - 1) / o.max_vertices;
+  std::vector<std::uint8_t> mask(lunate.size(), 0);
+  std::int64_t k = 0;
+  for (std::size_t i = 0; i < lunate.size(); ++i)
+    if (lunate[i] && k++ % stride == 0) mask[i] = 1;
+  lunate_ = make_scan_set(P, mask);
+}
+
+void JointCentre::gaps(const Joint& joint, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float* out) const {
+  // A pelvis vertex q in the femur's frame: R^T (q - t); gap = |.| - ball map (outside the head: > 0).
+  scan_gaps_compact(lunate_, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), joint.ball().map, ScanSide::outside,
+                    out);
+}
+
+Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix3d& R) const {
+  switch (method_) {
+    case JointCentreMethod::femoral_head: return Eigen::Vector3d::Zero();
+    case JointCentreMethod::acetabular: return c_a_ - R * c_a_;
+    case JointCentreMethod::combined: return c_a_;
+    case JointCentreMethod::equidistant: break;
+  }
+  const std::int64_t n = lunate_.size();
+  thread_local std::vector<float> g;
+  thread_local std::vector<std::uint8_t> on_head;
+  g.resize(static_cast<std::size_t>(n));
+  on_head.resize(static_cast<std::size_t>(n));
+  // Which lunate vertices face the head's joint surface: decided once per pose, with the head on the
+  // acetabular centre (the combined method's t), so that t is a function of R alone (not of where
+  // the iteration starts). The femur's surface in q's direction lies |y| - gap from the head centre.
+  const Eigen::Matrix3d Rt = R.transpose();
+  gaps(joint, R, c_a_, g.data());
+  std::int64_t used = 0;
+  for (std::int64_t j = 0; j < n; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    const double r = (Rt * (Eigen::Vector3d(lunate_.x[j], lunate_.y[j], lunate_.z[j]) - c_a_)).norm();
+    on_head[k] = std::isfinite(g[k]) && r - g[k] <= reach_mm_;
+    used += on_head[k];
+  }
+  require(used >= 16, "joint centre equidistant: fewer than 16 lunate vertices face the femoral head's joint surface "
+                      "at this pose");
+  Eigen::Vector3d t = c_a_;
+  for (int it = 0; it < options_.max_iterations; ++it) {
+    if (it > 0) gaps(joint, R, t, g.data());  // the first step uses the selection's gaps
+    // gap_j(t + d) ~ gap_j(t) - w_j . d (w_j: unit direction from the head centre t to q_j; exact
+    // for a spherical head). Least squares of gap_j - w_j . d - m over d and the mean joint space m:
+    // the normal equations of a_j . (d, m) = gap_j, a_j = (w_j, 1).
+    Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d b = Eigen::Vector4d::Zero();
+    for (std::int64_t j = 0; j < n; ++j) {
+      const double gj = g[static_cast<std::size_t>(j)];
+      if (!on_head[static_cast<std::size_t>(j)] || !std::isfinite(gj)) continue;
+      const Eigen::Vector3d w = (Eigen::Vector3d(lunate_.x[j], lunate_.y[j], lunate_.z[j]) - t).normalized();
+      const Eigen::Vector4d a(w.x(), w.y(), w.z(), 1);
+      A.noalias() += a * a.transpose();
+      b.noalias() += a * gj;
+    }
+    const Eigen::Vector3d d = A.ldlt().solve(b).head<3>();
+    t += d;
+    if (!t.allFinite()) throw Error("joint centre equidistant: the iteration diverged (no joint space to even out)");
+    if (d.norm() < options_.tolerance_mm) break;
+  }
+  return t;
+}
+
+double JointCentre::joint_space_sd_mm(const Joint& joint, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const {
+  const std::int64_t n = lunate_.size();
+  if (n == 0) return std::nan("");
+  std::vector<float> g(static_cast<std::size_t>(n));
+  gaps(joint, R, t, g.data());
+  double s = 0, s2 = 0;
+  std::int64_t k = 0;
+  for (float v : g)
+    if (std::isfinite(v)) s += v, s2 += double(v) * v, ++k;
+  if (k < 2) return std::nan("");
+  const double mean = s / double(k);
+  return std::sqrt(std::max(0.0, (s2 - double(k) * mean * mean) / double(k - 1)));
+}
+
+}  // namespace impinge
