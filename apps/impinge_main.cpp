@@ -98,6 +98,10 @@ void add_map_options(CLI::App* app, MapSettings& o, TextOptions& t) {
                   "own bone's nearer surface (trochanters, shaft, ilium) are tested too: extra-articular impingement "
                   "(0 = off, the thesis' single-layer maps)")
       ->capture_default_str();
+  app->add_option("--layered-spacing", o.layered_spacing_deg,
+                  "deg: the layered maps' largest node spacing (the scheme at the coarsest resolution reaching it, "
+                  "never finer than the maps'; 0: the maps' own); their edges are exact ray casts")
+      ->capture_default_str();
   app->add_option("--extra-articular-radius", o.extra_articular_radius_mm,
                   "mm: with --layers, test hidden vertices within this distance of the COR")
       ->capture_default_str();
@@ -312,6 +316,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("impinge ") + IMPINGE_VERSION);
   app.require_subcommand(1);
   SessionOptions so;
+  so.maps.layers = 4;  // the whole bone by default (issue 29): the hidden vertices too, extra-articular
   TextOptions text;
 
   std::string pose = "0,0,0", out;

@@ -57,7 +57,8 @@ class Joint:
                  spacing: float = 0.0, sampling: str = "auto", mode: str = "exact",
                  levels: Optional[Sequence[float]] = None, occlusion_tolerance_mm: float = 1.0,
                  max_radius_mm: float = 0.0, sparse: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
-                 layers: int = 0, extra_articular_radius_mm: float = 150.0, maps_only: bool = False,
+                 layers: int = 4, extra_articular_radius_mm: float = 150.0, layered_spacing: float = 0.5,
+                 maps_only: bool = False,
                  maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
                  pelvis_frame: str = "isb", joint_centre: Optional[str] = None,
                  femur_frame: str = "epicondyles") -> None:
@@ -68,7 +69,7 @@ class Joint:
         outside the head. scheme and one of resolution/precision/turns/spacing (0: the scheme's
         0.5 deg default); sampling; mode 'exact'/'linear'; levels: thresholds mm, decreasing;
         sparse: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for
-        hidden vertices (extra-articular), within extra_articular_radius_mm; maps_only: no exact
+        hidden vertices (extra-articular), within extra_articular_radius_mm, at layered_spacing deg (0: the maps' own); maps_only: no exact
         look-ups at depth discontinuities; maps: (ball_path, socket_path) from save_maps().
         neutral: 'anatomical' (ISB frames) or 'scan' (default: the subject's, else anatomical);
         pelvis_frame 'isb'/'app'; femur_frame 'epicondyles'/'posterior-condyles'; joint_centre: how the

@@ -238,6 +238,9 @@ const std::vector<std::pair<std::string, OptionSetter>>& joint_options() {
       {"extra_articular_radius_mm", [](SessionOptions& o, const py::handle& v, const std::string& n) {
          o.maps.extra_articular_radius_mm = as_double(v, n);
        }},
+      {"layered_spacing", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         o.maps.layered_spacing_deg = as_double(v, n);
+       }},
       {"maps_only", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.maps_only = as_bool(v, n); }},
       {"maps", [](SessionOptions& o, const py::handle& v, const std::string& n) {
          const auto p = py::cast<std::pair<std::string, std::string>>(v);
@@ -254,6 +257,7 @@ const std::vector<std::pair<std::string, OptionSetter>>& joint_options() {
 
 PyJoint make_joint(const py::object& ball, const py::object& socket, const py::kwargs& kw) {
   SessionOptions o;
+  o.maps.layers = 4;  // as the CLI: the whole bone by default
   const auto& table = joint_options();
   auto set = [&](const std::string& name, const py::handle& v) {
     if (v.is_none()) return;  // None: the default

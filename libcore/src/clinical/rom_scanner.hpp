@@ -258,22 +258,46 @@ class CompactScanner {
       return;
     }
     const std::vector<Cluster>* groups = ball ? &bounds_->ball_hidden.groups : &bounds_->socket_hidden.groups;
-    auto skipped = [&](const Cluster& c) {
-      const double reach = std::max(0.0, std::min(cut, l.gap));
-      if (!std::isfinite(reach)) return false;
-      const Cap cap = cap_of(c, P);
+    auto apart = [&](const Cap& cap, double reach) {
       return (pyr->cap(cap.axis, cap.rho, cap.sin_rho, kHiddenBlocks) & shells(cap.r_lo - reach, cap.r_hi + reach)) == 0;
     };
-    for (const Cluster& g : *groups) {
+    auto skipped = [&](const Cluster& c) {
+      const double reach = std::max(0.0, std::min(cut, l.gap));
+      return std::isfinite(reach) && apart(cap_of(c, P), reach);
+    };
+    // As for the first surface (scan()): a cluster apart from the other bone over the cap of every pose
+    // near this one is skipped at every later pose that near, while only contact is asked (the reach
+    // is then at most max(0, cut)).
+    const bool reusable = !exact_;
+    std::vector<Reuse>& reuse_g = ball ? reuse_hidden_ball_groups_ : reuse_hidden_socket_groups_;
+    std::vector<Reuse>& reuse_l = ball ? reuse_hidden_ball_leaves_ : reuse_hidden_socket_leaves_;
+    if (reusable && reuse_g.size() != groups->size()) reuse_g.assign(groups->size(), Reuse{}), reuse_l.assign(cl->size(), Reuse{});
+    auto skip_reusing = [&](const Cluster& c, Reuse& u) {
+      if (u.valid && (u.s - P.s).squaredNorm() <= kReuseShiftMm * kReuseShiftMm &&
+          (u.M.array() * P.M.array()).sum() >= kReuseMinTrace)
+        return true;
+      const double reach = std::max(0.0, cut);
+      bool skip;
+      if (!u.failed) {
+        u.valid = apart(reuse_cap_of(c, P), reach), u.M = P.M, u.s = P.s;
+        skip = u.valid || skipped(c);
+      } else {
+        skip = skipped(c), u.valid = false;
+      }
+      u.failed = !skip;
+      return skip;
+    };
+    for (std::size_t gi = 0; gi < groups->size(); ++gi) {
+      const Cluster& g = (*groups)[gi];
       if (done(l)) return;
-      if (skipped(g)) {
+      if (reusable ? skip_reusing(g, reuse_g[gi]) : skipped(g)) {
         vertices_skipped += g.count;
         continue;
       }
       for (std::int64_t i = g.first / kLeaf; i < (g.first + g.count + kLeaf - 1) / kLeaf; ++i) {
         const Cluster& c = (*cl)[static_cast<std::size_t>(i)];
         if (done(l)) return;
-        if (skipped(c)) {
+        if (reusable ? skip_reusing(c, reuse_l[static_cast<std::size_t>(i)]) : skipped(c)) {
           vertices_skipped += c.count;
           continue;
         }
@@ -320,6 +344,8 @@ class CompactScanner {
   };
   static inline const double kReuseMinTrace = 1 + 2 * std::cos(kReuseRad);  // trace of a rotation by kReuseRad
   std::vector<Reuse> reuse_ball_groups_, reuse_socket_groups_, reuse_ball_leaves_, reuse_socket_leaves_;
+  std::vector<Reuse> reuse_hidden_ball_groups_, reuse_hidden_socket_groups_, reuse_hidden_ball_leaves_,
+      reuse_hidden_socket_leaves_;
   const Clustered* reuse_ball_owner_ = nullptr;  // the clusters reuse_ball_* belong to
   const Clustered* reuse_socket_owner_ = nullptr;
   struct Met {

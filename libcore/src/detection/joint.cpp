@@ -25,6 +25,8 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
   require(o.layers == 0 || FirstHitCaster::available(),
           "joint: layered maps need a ray caster (Embree or CGAL), and this build has neither");
   require(o.extra_articular_radius_mm > 0, "joint: the extra-articular radius must be > 0 mm");
+  require(std::isfinite(o.layered_spacing_deg) && o.layered_spacing_deg >= 0 && o.layered_spacing_deg <= 90,
+          "joint: the layered maps' node spacing must be 0 (the maps' own) to 90 deg");
   o.levels.validate();
   return o;
 }
@@ -75,7 +77,7 @@ JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given
   b.vertex_area = vertex_areas(b.mesh);
   if (options_.layers > 0) {
     b.caster = b.exact != nullptr ? b.exact : std::make_shared<const FirstHitCaster>(b.mesh, cor_);
-    auto layered = std::make_shared<LayeredMap>(options_.scheme, options_.layers);
+    auto layered = std::make_shared<LayeredMap>(layered_scheme(), options_.layers);
     b.layered_sampling = sample_layered_map(*layered, *b.caster);
     b.layered = std::move(layered);
     std::vector<std::uint8_t> hidden(b.mask.size(), 0);
@@ -86,6 +88,13 @@ JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given
     b.hidden_set = make_scan_set(b.relative, hidden);
   }
   return b;
+}
+
+std::shared_ptr<const SamplingScheme> Joint::layered_scheme() const {
+  const auto& s = options_.scheme;
+  const double want = options_.layered_spacing_deg;
+  if (want <= 0 || s->max_node_spacing() * 180 / M_PI >= want) return s;
+  return make_scheme(s->name(), resolution_for_spacing(s->name(), want));
 }
 
 PoseResult Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const {

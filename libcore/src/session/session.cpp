@@ -202,6 +202,9 @@ HipJointOptions hip_joint_options(const MapSettings& m, const FrameSettings& f, 
           "extra-articular-radius must be > 0 mm");
   jo.layers = m.layers;
   jo.extra_articular_radius_mm = m.extra_articular_radius_mm;
+  require(std::isfinite(m.layered_spacing_deg) && m.layered_spacing_deg >= 0 && m.layered_spacing_deg <= 90,
+          "layered-spacing " + num(m.layered_spacing_deg) + ": must be 0 (the maps' own) to 90 deg");
+  jo.layered_spacing_deg = m.layered_spacing_deg;
   require(m.ball_map_file.empty() == m.socket_map_file.empty(), "maps: give both map files (ball and socket) or none");
   o.ball_map_file = m.ball_map_file;
   o.socket_map_file = m.socket_map_file;

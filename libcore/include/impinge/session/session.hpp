@@ -75,6 +75,7 @@ struct MapSettings {
   bool maps_only = false;               ///< no exact look-ups at depth discontinuities (the thesis' algorithm)
   int layers = 0;                       ///< layered maps of this many crossings per node (0: off)
   double extra_articular_radius_mm = 150;
+  double layered_spacing_deg = 0.5;     ///< the layered maps' largest node spacing (JointOptions), deg
   std::string ball_map_file, socket_map_file;  ///< saved maps to load instead of sampling (both or neither)
 };
 
