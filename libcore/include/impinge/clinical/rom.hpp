@@ -142,8 +142,11 @@ struct RomBaseline {
 RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const RomOptions& options = {});
 
 /// Search one motion of `hip`: evaluate both scans at theta = 0, step_deg, 2 step_deg, ... up to
-/// max_deg until the minimum gap over the counted vertices (those not in `baseline`) is <=
-/// threshold, then bisect the last step to tolerance_deg. Only the minimum is computed: the
+/// max_deg, the femur rotated by the motion and translated by the hip's joint-centre method
+/// (HipJoint::joint_translation), until the minimum gap over the counted vertices (those not in
+/// `baseline`; pelvis vertices meeting the head's joint surface are classed at each pose) is <=
+/// threshold - contact_depth_mm, then bisect the last step to tolerance_deg. The gaps are those of
+/// Joint::detect (exact ray casts at the maps' depth discontinuities included). Only the minimum is computed: the
 /// first-surface vertices are taken in clusters (32 vertices in Z order, in groups of 128) with a
 /// cone of directions and a radius range, and a cluster is skipped when a bound of the other map
 /// over its cone (a pyramid of minima or maxima over the equiangular map) shows that none of its
