@@ -90,12 +90,13 @@ class Joint:
     def motion(self, angles: npt.ArrayLike) -> Dict[str, npt.NDArray[np.float64]]:
         """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each."""
     def rom_limits(self, threshold_mm: float = 0.0, step_deg: float = 2.0, max_deg: float = 150.0,
-                   contacts: str = "impingement") -> Dict[str, Any]:
+                   contacts: str = "impingement", contact_depth_mm: float = 0.25) -> Dict[str, Any]:
         """ROM limits from neutral for the standard motions -> dict motion -> the CLI's rom_limits.csv row
         (limit_deg, limited_by, contact_class, ...). contacts: 'impingement' (the joint surfaces meeting
-        is left out), 'articular' (only that: the joint space closing) or 'all'."""
+        is left out), 'articular' (only that: the joint space closing) or 'all'. contact_depth_mm: how far
+        past the threshold a contact must reach to end a search (0: the first touch)."""
     def rom_map(self, flexion: Sequence[float], adduction: Sequence[float],
-                threshold_mm: float = 0.0) -> npt.NDArray[np.float64]:
+                threshold_mm: float = 0.0, contact_depth_mm: float = 0.25) -> npt.NDArray[np.float64]:
         """Largest internal rotation before contact, (len(flexion), len(adduction)) degrees."""
     def femur_rotation(self, flexion: float = 0.0, adduction: float = 0.0,
                        internal_rotation: float = 0.0) -> npt.NDArray[np.float64]: ...

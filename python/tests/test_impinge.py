@@ -215,13 +215,13 @@ def test_real_subject_anatomical_frames():
     np.testing.assert_allclose(f["pelvis"]["axes"].T @ f["pelvis"]["axes"], np.eye(3), atol=1e-12)
     m = j.motion(np.array([[0, 0, 0], [90, 0, 0]]))
     assert np.all(np.isfinite(m["ball_min_gap_mm"]))
-    # ROM from Python: a limit is where detect_pose first shows contact.
-    lim = j.rom_limits()
+    # ROM from Python: a limit is where detect_pose first shows contact (the first touch: no contact depth).
+    lim = j.rom_limits(contact_depth_mm=0)
     fl = lim["internal_rotation_90_flexion"]["limit_deg"]
     assert 0 < fl < 150
     assert j.detect_pose(90, 0, fl)["summary"]["socket"]["min_gap_mm"] <= 0 or \
         j.detect_pose(90, 0, fl)["summary"]["ball"]["min_gap_mm"] <= 0
     assert min(j.detect_pose(90, 0, fl - 0.5)["summary"]["socket"]["min_gap_mm"],
                j.detect_pose(90, 0, fl - 0.5)["summary"]["ball"]["min_gap_mm"]) > 0
-    grid = j.rom_map([0, 90], [0, 10])
+    grid = j.rom_map([0, 90], [0, 10], contact_depth_mm=0)
     assert grid.shape == (2, 2) and grid[1, 0] == pytest.approx(fl)

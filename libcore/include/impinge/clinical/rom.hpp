@@ -48,8 +48,10 @@ struct RomOptions {
   /// the data's own error (the maps' interpolation, about 0.05 mm at 0.1 deg; an MRI surface's
   /// roughness about its fitted sphere, 0.4-0.8 mm rms) does not stop a motion, whose femur the
   /// joint's play lets slide past it. Without it a graze along a motion makes the limit jump by tens
-  /// of degrees under a 1 mm change of the centre of rotation (issue 29). 0: the first touch.
-  double contact_depth_mm = 0.1;
+  /// of degrees under a 1 mm change of the centre of rotation (issue 29: tlem2-mri's flexion 118 ->
+  /// 27 deg at 0 mm, mc22's external rotation 52 -> 4 deg at 0.1 mm; at 0.25 mm every limit of
+  /// lhdl-ct, tlem2-mri and mc22 moves by at most 2 deg). 0: the first touch.
+  double contact_depth_mm = 0.25;
   double step_deg = 2;           ///< coarse step along the motion, deg
   double max_deg = 150;          ///< search no farther than this from neutral, deg
   double tolerance_deg = 0.1;    ///< bisection until the bracket is this narrow, deg
