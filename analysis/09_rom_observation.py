@@ -3,7 +3,7 @@ ROM maps, published values beside ours, sensitivity and cost.
 
 Reads RESULTS/09_rom_observation/*.csv (and the observation_*.ply cup meshes); writes
 table_observation.tex, table_limits.tex, table_published.tex, table_sensitivity.tex, table_extra.tex,
-table_layered.tex, table_envelope.tex,
+table_layered.tex, table_envelope.tex, table_methods.tex, table_method_sensitivity.tex,
 rom_map.pdf, medial_<subject>_<patient>.pdf (Tables 12-13's panels), macros.tex."""
 import os
 
@@ -23,12 +23,15 @@ xa = read_csv(d, "extra_articular.csv")
 lay = read_csv(d, "layered.csv")
 env = read_csv(d, "envelope.csv")
 pub = read_csv(d, "published.csv")
+meth = read_csv(d, "methods.csv") if os.path.exists(os.path.join(d, "methods.csv")) else None
 t11 = read_csv(d, "thesis_table11.csv")
 subjects = list(dict.fromkeys(lim.subject))
 
 
 def f(x, n=1):
-    return "--" if np.isnan(x) else f"{x:.{n}f}"
+    if np.isnan(x):
+        return "--"
+    return "$\\infty$" if np.isinf(x) else f"{x:.{n}f}"
 
 
 # Table 11's extremities on our hips (thesis Tables 12-13: red < 2 mm, blue > 6 mm).
@@ -59,15 +62,59 @@ for p in pub.itertuples():
 write_table(d, "table_published", ["group (published)", "IR deg", "subject", "ours deg", "source"], rows,
             align="lrlrl")
 
-# Sensitivity: largest |change| of a limit per subject and variant kind.
+# Sensitivity: largest |change| of a limit per subject, method and perturbation kind. A limit that
+# appears or disappears (found in one run, none within the search range in the other) counts as an
+# unbounded change.
+def changes(g):
+    v = g.delta_deg.abs().copy()
+    v[g.limit_deg.isna() != g.delta_deg.isna()] = np.inf
+    return v
+
+
 rows = []
 for s in subjects:
-    g = sens[(sens.subject == s)]
-    for kind, sel in (("COR moved 1 mm", g.variant.str.startswith("cor")), ("resolution", g.variant.str.startswith("res"))):
-        v = g[sel].delta_deg.abs()
-        rows.append([s, kind, f(v.median(), 2), f(v.max(), 2), str(int(sel.sum()))])
-write_table(d, "table_sensitivity", ["subject", "perturbation", "median $|\\Delta|$ deg", "max $|\\Delta|$ deg", "runs"],
-            rows, align="llrrr")
+    for method in dict.fromkeys(sens.method):
+        g = sens[(sens.subject == s) & (sens.method == method)]
+        for kind, sel in (("COR moved 1 mm", g.variant.str.startswith("cor")),
+                          ("resolution", g.variant.str.startswith("res"))):
+            if sel.sum() == 0:
+                continue
+            v = changes(g[sel])
+            rows.append([s, method, kind, f(v.median(), 2), f(v.max(), 1), str(int(sel.sum()))])
+write_table(d, "table_sensitivity", ["subject", "method", "perturbation", "median $|\\Delta|$ deg",
+                                     "max $|\\Delta|$ deg", "runs"], rows, align="lllrrr")
+
+# Puls et al.'s four joint-centre methods side by side: the limits, and the worst change of each
+# limit under a 1 mm move of the initial COR (6 directions).
+method_macros = {}
+if meth is not None:
+    order = ["femoral-head", "acetabular", "combined", "equidistant"]
+    msubjects = list(dict.fromkeys(meth.subject))
+    rows = []
+    for s in msubjects:
+        for motion in dict.fromkeys(meth.motion):
+            g = meth[(meth.subject == s) & (meth.motion == motion)].set_index("method")
+            rows.append([s, motion.replace("_", " ")] + [f(g.limit_deg.get(m, np.nan)) for m in order])
+    write_table(d, "table_methods", ["subject", "motion"] + order, rows, align="llrrrr")
+    cor = sens[sens.variant.str.startswith("cor") & sens.method.isin(order)]
+    rows = []
+    for s in msubjects:
+        worst = [changes(cor[(cor.subject == s) & (cor.method == m)]).max() for m in order]
+        rows.append([s] + [f(w) for w in worst])
+    write_table(d, "table_method_sensitivity", ["subject"] + [m + " max $|\\Delta|$ deg" for m in order], rows,
+                align="lrrrr")
+    eq = cor[cor.method == "equidistant"]
+    fh = cor[cor.method == "femoral-head"]
+    per_subject = {s: changes(eq[eq.subject == s]).max() for s in msubjects}
+    method_macros = {
+        "ROMeqSensMax": f(max(per_subject.values())),
+        "ROMeqSensWorstSubject": max(per_subject, key=per_subject.get),
+        "ROMeqSensWithinThree": str(sum(1 for v in per_subject.values() if v <= 3)),
+        "ROMmethodSubjects": str(len(msubjects)),
+        "ROMfhSensMax": f(changes(fh)[np.isfinite(changes(fh))].max()),
+        "ROMfhSensVanish": str(int(np.isinf(changes(fh)).sum())),
+        "ROMeqSensMedian": f(changes(eq).median(), 2),
+    }
 
 # ROM maps.
 fig, axes = plt.subplots(1, len(subjects), figsize=(4 * len(subjects), 3.4), squeeze=False)
@@ -201,4 +248,5 @@ write_macros(d, "macros", {
                           f"{(slow.limits_ms_layered / slow.limits_ms_single).max():.1f}",
     "ROMlayeredNotAlternating": str(int(lay.nodes_not_alternating.sum())),
     "ROMlayeredTruncatedMax": f"{100 * (lay.nodes_truncated / lay.nodes).max():.1f}",
+    **method_macros,
 })

@@ -13,7 +13,12 @@
 //                     medial views of Tables 12-13
 //   rom_limits.csv    subject x motion: limit, where limited, exact-reference check 0.5 deg either side
 //   rom_map.csv       subject x flexion x adduction: the largest internal rotation
-//   sensitivity.csv   subject x variant (COR moved 1 mm along each pelvic axis, resolutions) x motion
+//   sensitivity.csv   subject x method x variant x motion: the thesis' femoral-head method at other
+//                     resolutions, and each joint-centre method with the COR moved 1 mm along each pelvic axis
+//   methods.csv       subject x joint-centre method (Puls et al. 2010: femoral-head, acetabular, combined,
+//                     equidistant) x motion: the CLI's rom_limits.csv row with its defaults (layered maps,
+//                     contact depth), the method first
+//   methods_map.csv   subject x method x flexion x adduction: the ROM map under each method
 //   timing.csv        subject: sampling, limits, map, evaluations, poses per second, share of vertices
 //                     skipped by the bounds, FCL collide per pose and its extrapolated search time
 //   extra_articular.csv  subject x motion x counted vertices (all, hidden): with layered maps (4 crossings
@@ -180,15 +185,15 @@ struct Outputs {
             {"subject", "resolution_deg", "step_deg", "coarse_steps", "threads", "poses", "poses_scanned",
              "poses_valid", "envelope_ms", "poses_per_second", "poses_per_core_second", "brute_force_ms",
              "brute_force_poses_valid", "poses_differ"}),
-        sens(dir + "/sensitivity.csv", {"subject", "variant", "motion", "limit_deg", "delta_deg"}),
+        sens(dir + "/sensitivity.csv", {"subject", "method", "variant", "motion", "limit_deg", "delta_deg"}),
         tim(dir + "/timing.csv",
             {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "evaluations",
              "poses_per_second", "share_skipped", "fcl_collide_ms_per_pose", "fcl_poses_timed",
              "fcl_search_ms_extrapolated", "fcl_over_ours", "excluded_vertices", "neutral_min_gap_mm"}) {}
   CsvWriter obs, clocks, extra, layered, env, sens, tim;
   // rom_limits.csv and rom_map.csv: the CLI's tables (session layer) with the subject first; the
-  // limits also with their exact check.
-  Table lim, map;
+  // limits also with their exact check. methods.csv, methods_map.csv: the same per joint-centre method.
+  Table lim, map, meth, meth_map;
   bool wrote_renders = false;
 };
 
@@ -384,7 +389,55 @@ void timing(const SubjectRun& r, const Settings& st, Outputs& out) {
               fcl_total, fcl_total / search_ms, run.baseline.excluded_vertices, run.baseline.min_gap_mm);
 }
 
-// Sensitivity: the COR moved 1 mm along each pelvic axis; other resolutions.
+// The rows of `t` with the subject and method first, into `into` (its columns set on first use).
+void add_prefixed(Table& into, const Table& t, const std::string& subject, const std::string& method) {
+  if (into.columns.empty()) {
+    into.columns = {"subject", "method"};
+    into.columns.insert(into.columns.end(), t.columns.begin(), t.columns.end());
+  }
+  for (const nlohmann::json& r : t.rows) {
+    nlohmann::json row = {subject, method};
+    row.insert(row.end(), r.begin(), r.end());
+    into.add(row);
+  }
+}
+
+// Puls et al. 2010's four joint-centre methods side by side (issue 29), as `impinge rom` runs them by
+// default (layered maps, contact depth): limits and maps, and each method's limits with the initial
+// COR moved 1 mm along each pelvic axis.
+void methods(const SubjectRun& r, const Settings& st, Outputs& out) {
+  if (!r.session.hip().acetabulum()) return;  // scan neutral (the generated model): femoral-head only
+  const std::vector<StandardMotion> motions = standard_motions();
+  RomRequest q;  // the CLI's defaults
+  const Eigen::Vector3d centre = r.session.head().centre;
+  const Eigen::Matrix3d axes = r.session.hip().frames()->pelvis.axes;
+  const char* axis_name[3] = {"x", "y", "z"};
+  for (const char* method : {"femoral-head", "acetabular", "combined", "equidistant"}) {
+    SessionOptions o = r.options;
+    o.frames.joint_centre = method;
+    o.maps.layers = 4;
+    const Session s(o);
+    const RomRun run = run_rom(s, q);
+    add_prefixed(out.meth, rom_limits_table(s, run), r.subject.name, method);
+    add_prefixed(out.meth_map, rom_map_table(run), r.subject.name, method);
+    for (int a = 0; a < 3; ++a)
+      for (const double sign : {1.0, -1.0}) {
+        SessionOptions m = o;
+        m.cor.given = centre + sign * axes.col(a);  // the working frame is the subject's (RAS)
+        m.cor.allow_any = true;
+        const Session moved(m);
+        const HipJoint& h = moved.hip();
+        const auto v = find_rom_limits(h, motions, q.search, rom_baseline(h, h.femur_rotation({}), q.search));
+        for (std::size_t k = 0; k < motions.size(); ++k)
+          out.sens.row(r.subject.name, method, std::string("cor_") + (sign > 0 ? "+" : "-") + axis_name[a] + "_1mm",
+                       motions[k].name, v[k].limit_deg, v[k].limit_deg - run.limits[k].limit_deg);
+      }
+  }
+  (void)st;
+}
+
+// Sensitivity of the thesis' femoral-head method: the COR moved 1 mm along each pelvic axis (scan
+// neutral only: methods() covers anatomical neutral under every method); other resolutions.
 void sensitivity(const SubjectRun& r, const Settings& st, Outputs& out) {
   const HipJoint& hip = r.session.hip();
   const std::vector<StandardMotion>& motions = r.run.motions;
@@ -399,15 +452,17 @@ void sensitivity(const SubjectRun& r, const Settings& st, Outputs& out) {
   };
   auto record = [&](const std::string& variant, const std::vector<RomLimit>& v) {
     for (std::size_t k = 0; k < motions.size(); ++k)
-      out.sens.row(r.subject.name, variant, motions[k].name, v[k].limit_deg, v[k].limit_deg - r.run.limits[k].limit_deg);
+      out.sens.row(r.subject.name, "femoral-head (thesis)", variant, motions[k].name, v[k].limit_deg,
+                   v[k].limit_deg - r.run.limits[k].limit_deg);
   };
   const Eigen::Vector3d centre = r.session.head().centre;
   const Eigen::Matrix3d axes = hip.frames() ? hip.frames()->pelvis.axes : scan_axes();
   const char* axis_name[3] = {"x", "y", "z"};
-  for (int a = 0; a < 3; ++a)
-    for (const double sign : {1.0, -1.0})
-      record(std::string("cor_") + (sign > 0 ? "+" : "-") + axis_name[a] + "_1mm",
-             limits_of(centre + sign * axes.col(a), st.resolution));
+  if (!hip.acetabulum())
+    for (int a = 0; a < 3; ++a)
+      for (const double sign : {1.0, -1.0})
+        record(std::string("cor_") + (sign > 0 ? "+" : "-") + axis_name[a] + "_1mm",
+               limits_of(centre + sign * axes.col(a), st.resolution));
   for (double res : st.sens_resolutions)
     if (res != st.resolution) record("resolution_" + std::to_string(res).substr(0, 4), limits_of(centre, res));
 }
@@ -419,6 +474,9 @@ void write_meta_of(const Args& args, const Settings& st, const std::vector<Subje
              {{"resolution_deg", st.resolution},
               {"sensitivity_resolutions_deg", st.sens_resolutions},
               {"threshold_mm", st.ro.threshold_mm},
+              {"contact_depth_mm", st.ro.contact_depth_mm},
+              {"methods", "femoral-head, acetabular, combined, equidistant (Puls et al. 2010) with the CLI's defaults: "
+                          "layered maps (4 crossings, 0.5 deg), contact depth 0.25 mm, impingement contacts"},
               {"step_deg", st.ro.step_deg},
               {"tolerance_deg", st.ro.tolerance_deg},
               {"observation_levels_mm", st.observation_levels.thresholds_mm},
@@ -451,6 +509,7 @@ int main(int argc, char** argv) {
   st.resolution = args.quick ? 0.25 : 0.1;
   st.sens_resolutions = args.quick ? std::vector<double>{0.5, 0.25} : std::vector<double>{0.5, 0.25, 0.1};
   st.observation_levels.thresholds_mm = {6, 4, 2, 0};
+  st.ro.contact_depth_mm = 0;  // the thesis' criterion: the first touch (methods() uses the CLI's defaults)
   st.threads = omp_get_max_threads();
 
   Outputs out(st.dir);
@@ -464,9 +523,14 @@ int main(int argc, char** argv) {
     envelope(r, st, out);
     timing(r, st, out);
     sensitivity(r, st, out);
+    methods(r, st, out);
   }
   write_csv(st.dir + "/rom_limits.csv", out.lim);
   write_csv(st.dir + "/rom_map.csv", out.map);
+  if (!out.meth.columns.empty()) {
+    write_csv(st.dir + "/methods.csv", out.meth);
+    write_csv(st.dir + "/methods_map.csv", out.meth_map);
+  }
   write_meta_of(args, st, subjects, generated);
   return 0;
 }
