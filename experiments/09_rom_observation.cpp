@@ -405,7 +405,7 @@ void add_prefixed(Table& into, const Table& t, const std::string& subject, const
 // Puls et al. 2010's four joint-centre methods side by side (issue 29), as `impinge rom` runs them by
 // default (layered maps, contact depth): limits and maps, and each method's limits with the initial
 // COR moved 1 mm along each pelvic axis.
-void methods(const SubjectRun& r, const Settings& st, Outputs& out) {
+void methods(const SubjectRun& r, Outputs& out) {
   if (!r.session.hip().acetabulum()) return;  // scan neutral (the generated model): femoral-head only
   const std::vector<StandardMotion> motions = standard_motions();
   RomRequest q;  // the CLI's defaults
@@ -433,7 +433,6 @@ void methods(const SubjectRun& r, const Settings& st, Outputs& out) {
                        motions[k].name, v[k].limit_deg, v[k].limit_deg - run.limits[k].limit_deg);
       }
   }
-  (void)st;
 }
 
 // Sensitivity of the thesis' femoral-head method: the COR moved 1 mm along each pelvic axis (scan
@@ -523,7 +522,7 @@ int main(int argc, char** argv) {
     envelope(r, st, out);
     timing(r, st, out);
     sensitivity(r, st, out);
-    methods(r, st, out);
+    methods(r, out);
   }
   write_csv(st.dir + "/rom_limits.csv", out.lim);
   write_csv(st.dir + "/rom_map.csv", out.map);

@@ -96,9 +96,9 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
             hip.femur_rotation(PoseAngles{out.flexion_deg[i], out.adduction_deg[j], out.internal_rotation_deg[k]});
         try {
           state[p] = scan(R, hip.joint_translation(R), false).gap > cut_of(o) ? 1 : 0;
-        } catch (const std::exception& e) {
+        } catch (const std::exception& err) {
 #pragma omp critical(rom_envelope_error)
-          if (error.empty()) error = e.what();
+          if (error.empty()) error = err.what();
         }
       }
       looked += scan.vertices_looked_up;

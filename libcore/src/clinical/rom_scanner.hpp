@@ -45,9 +45,9 @@ class CompactScanner {
     const double cut = exact ? std::numeric_limits<double>::infinity() : threshold_;
     exact_ = exact;
     // The femur's vertices into the pelvis' frame (R, t); the pelvis' into the femur's (R^T, -R^T t).
-    ball_pose_ = {R, t};
-    socket_pose_ = {R.transpose(), Eigen::Vector3d(-(R.transpose() * t))};
     shift_mm_ = t.norm();
+    ball_pose_ = {R, t, shift_mm_};
+    socket_pose_ = {R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), shift_mm_};
     if (!exact && last_.cluster != nullptr) {
       recheck(l);
       if (l.gap <= threshold_) return l;
@@ -82,6 +82,7 @@ class CompactScanner {
   struct Rigid {
     Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
     Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    double shift = 0;  // |s|, mm (computed once per pose)
   };
   // First-surface vertices of one body, their skip flags (pre-existing overlap) and clusters (null:
   // no bounds); ball: the femur's, looked up in the socket map (inside), else the pelvis' (outside).
@@ -117,7 +118,7 @@ class CompactScanner {
   }
   static Cap cap_of(const Cluster& c, const Rigid& P) {
     const Eigen::Vector3d axis = P.M * c.axis;
-    const double shift = P.s.norm();
+    const double shift = P.shift;
     if (shift == 0) return {axis, c.rho, c.sin_rho, c.r_min, c.r_max};
     // cos and sin of phi - rho and phi + rho from those of phi and rho (phi in [0, pi]).
     const double cos_phi = std::clamp(axis.dot(P.s) / shift, -1.0, 1.0), sin_phi = std::sqrt(1 - cos_phi * cos_phi);
@@ -149,12 +150,12 @@ class CompactScanner {
   // turns it by at most the asin of that over its radius; its squared radius changes by at most
   // 2 |s| |(Q - I) p| (a rotation about the origin keeps |p|), and then by |e|.
   static Cap reuse_cap_of(const Cluster& c, const Rigid& P) {
-    if (P.s.squaredNorm() == 0) return {P.M * c.axis, c.rho + kReuseRad, c.sin_rho_widened, c.r_min, c.r_max};
+    if (P.shift == 0) return {P.M * c.axis, c.rho + kReuseRad, c.sin_rho_widened, c.r_min, c.r_max};
     Cap cap = cap_of(c, P);
     static const double kChord = 2 * std::sin(kReuseRad / 2);
     const double move = c.r_max * kChord;
-    const double r_lo = std::max(0.0, std::sqrt(std::max(0.0, cap.r_lo * cap.r_lo - 2 * P.s.norm() * move)) - kReuseShiftMm);
-    cap.r_hi = std::sqrt(cap.r_hi * cap.r_hi + 2 * P.s.norm() * move) + kReuseShiftMm;
+    const double r_lo = std::max(0.0, std::sqrt(std::max(0.0, cap.r_lo * cap.r_lo - 2 * P.shift * move)) - kReuseShiftMm);
+    cap.r_hi = std::sqrt(cap.r_hi * cap.r_hi + 2 * P.shift * move) + kReuseShiftMm;
     widen(cap, r_lo > 0 ? asin_above((move + kReuseShiftMm) / r_lo) : M_PI);
     cap.r_lo = r_lo;
     return cap;
@@ -277,15 +278,15 @@ class CompactScanner {
           (u.M.array() * P.M.array()).sum() >= kReuseMinTrace)
         return true;
       const double reach = std::max(0.0, cut);
-      bool skip;
+      bool out;
       if (!u.failed) {
         u.valid = apart(reuse_cap_of(c, P), reach), u.M = P.M, u.s = P.s;
-        skip = u.valid || skipped(c);
+        out = u.valid || skipped(c);
       } else {
-        skip = skipped(c), u.valid = false;
+        out = skipped(c), u.valid = false;
       }
-      u.failed = !skip;
-      return skip;
+      u.failed = !out;
+      return out;
     };
     for (std::size_t gi = 0; gi < groups->size(); ++gi) {
       const Cluster& g = (*groups)[gi];

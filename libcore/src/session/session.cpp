@@ -131,6 +131,7 @@ CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) 
     if (!cor.allow_any) {
       // A given COR must lie in the femoral head: compare with the head the bone itself shows.
       const SphereFitResult head = located_head(in);
+      r.fitted_head = head;
       const double d = (r.head.centre - head.centre).norm();
       if (d > head.radius)
         throw Error("cor " + point_text(*cor.given) + " mm is " + num(d) + " mm from the fitted femoral head centre " +
@@ -229,7 +230,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
   // come from the head the femur shows, so that they do not move with the COR.
   if (!std::isfinite(cor_.head.radius) && hip_options_.neutral == Neutral::anatomical) {
     try {
-      hip_options_.head_sphere = located_head(in);
+      hip_options_.head_sphere = cor_.fitted_head ? *cor_.fitted_head : located_head(in);
     } catch (const Error&) {
       // No head to fit (e.g. a proximal stump): the COR's sphere, as before.
     }

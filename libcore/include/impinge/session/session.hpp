@@ -121,6 +121,8 @@ LoadedInput load_input(const SessionInput& input);
 struct CorResult {
   SphereFitResult head;  ///< centre: the COR (working frame, mm); radius and rms NaN when given
   std::string method;    ///< e.g. "automatic sphere fit (long axis, RANSAC + geometric)"
+  /// The femoral head the bone shows, when it was fitted to check a given COR (working frame, mm).
+  std::optional<SphereFitResult> fitted_head;
 };
 
 /// The COR of `in` by the policy of CorOptions (see there). Throws impinge::Error naming the
