@@ -289,6 +289,19 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
   }
   if (s.vertices_tested > 0) s.min_gap_mm = min_gap;
   if (s.vertices_tested_layered > 0) s.min_gap_layered_mm = min_layered;
+  s.min_distance_mm = std::numeric_limits<double>::quiet_NaN();
+  s.vertices_distance = s.vertices_inside = 0;
+  s.area_inside_mm2 = 0;
+  s.distance_winding = g.distance_winding;
+  double min_distance = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < g.distance_mm.size(); ++i) {
+    const float d = g.distance_mm[i];
+    if (std::isnan(d)) continue;
+    ++s.vertices_distance;
+    min_distance = std::min(min_distance, static_cast<double>(d));
+    if (d < 0) ++s.vertices_inside, s.area_inside_mm2 += area[static_cast<Eigen::Index>(i)];
+  }
+  if (s.vertices_distance > 0) s.min_distance_mm = min_distance;
 }
 
 template void scan_gaps<float>(PointsRef, const Eigen::Matrix3d&, const std::vector<std::uint8_t>&,

@@ -28,6 +28,10 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
   require(std::isfinite(o.layered_spacing_deg) && o.layered_spacing_deg >= 0 && o.layered_spacing_deg <= 90,
           "joint: the layered maps' node spacing must be 0 (the maps' own) to 90 deg");
   o.levels.validate();
+  require(!o.distances || SignedDistanceQuery::available(),
+          "joint: distances need a closest-point engine (Embree or CGAL), and this build has neither");
+  require(std::isfinite(o.distance_reach_mm) && o.distance_reach_mm >= 0,
+          "joint: the distances' reach must be 0 (the largest level threshold) or > 0 mm");
   return o;
 }
 }  // namespace
@@ -44,7 +48,8 @@ Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor,
 
 JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given) const {
   validate_mesh(mesh);
-  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0, nullptr, nullptr, {}, {}};
+  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0, nullptr, nullptr, {}, {},
+              nullptr, {}};
   b.relative = b.mesh.V.rowwise() - cor_.transpose();
   if (given) {
     const SamplingScheme& want = *options_.scheme;
@@ -86,6 +91,10 @@ JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given
       hidden[i] = !b.mask[i] && r > 0 && r <= options_.extra_articular_radius_mm;
     }
     b.hidden_set = make_scan_set(b.relative, hidden);
+  }
+  if (options_.distances) {
+    b.distance_query = std::make_shared<const SignedDistanceQuery>(b.mesh);
+    b.distance_set = make_distance_scan_set(b.relative, options_.max_radius_mm);
   }
   return b;
 }
@@ -132,6 +141,22 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
                                             *ball_.layered, gaps.data(), ball_.caster.get());
     expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
     res.socket_detection_ms = ms_since(t0);
+  }
+  if (options_.distances) {
+    t0 = std::chrono::steady_clock::now();
+    res.ball_gaps.distance_winding = scan_distances(ball_.distance_set, R, t, cor_, *socket_.distance_query,
+                                                    options_.reach_mm(), res.ball_gaps.gap_mm, res.ball_gaps.distance_mm)
+                                         .winding;
+    res.ball_distance_ms = ms_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    res.socket_gaps.distance_winding =
+        scan_distances(socket_.distance_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), cor_,
+                       *ball_.distance_query, options_.reach_mm(), res.socket_gaps.gap_mm, res.socket_gaps.distance_mm)
+            .winding;
+    res.socket_distance_ms = ms_since(t0);
+  } else {
+    res.ball_gaps.distance_mm.clear(), res.socket_gaps.distance_mm.clear();
+    res.ball_gaps.distance_winding = res.socket_gaps.distance_winding = 0;
   }
   summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels, res.ball);
   summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels, res.socket);

@@ -100,9 +100,10 @@ TriangleMesh make_cup(double inner_mm, double outer_mm, double coverage_deg, con
         tri(idx(s, i, k), idx(s, i + 1, k + 1), idx(s, i, k + 1));
       }
   }
+  // The rim band, wound as the shells are (each rim edge runs opposite to the shell's).
   for (int k = 0; k < n_beta; ++k) {
-    m.F.row(f++) << idx(0, n_alpha, k), idx(1, n_alpha, k), idx(1, n_alpha, k + 1);
-    m.F.row(f++) << idx(0, n_alpha, k), idx(1, n_alpha, k + 1), idx(0, n_alpha, k + 1);
+    m.F.row(f++) << idx(0, n_alpha, k), idx(1, n_alpha, k + 1), idx(1, n_alpha, k);
+    m.F.row(f++) << idx(0, n_alpha, k), idx(0, n_alpha, k + 1), idx(1, n_alpha, k + 1);
   }
   return m;
 }

@@ -32,6 +32,11 @@ struct ScanGaps {
   std::vector<float> gap_mm;         ///< n gaps, mm
   std::vector<std::uint8_t> status;  ///< n statuses
   std::int64_t refined = 0;          ///< look-ups at a depth discontinuity resolved by an exact ray cast
+  /// Signed Euclidean distance to the other bone's surface (issue 26; JointOptions::distances), n values,
+  /// mm, negative inside the other bone; NaN where proven farther than the reach or not measured. Empty
+  /// when distances are off.
+  std::vector<float> distance_mm;
+  std::int64_t distance_winding = 0;  ///< distances whose sign the winding number decided
 };
 
 /// Statistics of a scan (thesis sec. 3.4 colour levels; counts so nothing is dropped silently).
@@ -50,6 +55,12 @@ struct ScanSummary {
                                                                  ///< (their stencil straddles a depth discontinuity)
   std::int64_t vertices_penetrating = 0;                         ///< gap <= 0
   double area_penetrating_mm2 = 0;                               ///< their vertex area
+  double min_distance_mm = std::numeric_limits<double>::quiet_NaN();  ///< least Euclidean distance; NaN when
+                                                                     ///< none measured or distances off
+  std::int64_t vertices_distance = 0;                            ///< vertices with a Euclidean distance
+  std::int64_t vertices_inside = 0;                              ///< of them, inside the other bone (< 0)
+  double area_inside_mm2 = 0;                                    ///< their vertex area
+  std::int64_t distance_winding = 0;                             ///< signs decided by the winding number
   std::vector<std::int64_t> level_vertices;                      ///< count per impingement level
   std::vector<double> level_area_mm2;                            ///< vertex area per impingement level
 };

@@ -4,6 +4,7 @@
 /// poses queried (thesis Fig. 27: preprocessing, then simulation).
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -13,6 +14,7 @@
 #include "impinge/core/mesh.hpp"
 #include "impinge/detection/detection.hpp"
 #include "impinge/detection/impingement_levels.hpp"
+#include "impinge/detection/surface_distance.hpp"
 #include "impinge/maps/layered_map.hpp"
 #include "impinge/maps/radial_distance_map.hpp"
 #include "impinge/sampling/rasterize.hpp"
@@ -61,6 +63,16 @@ struct JointOptions {
   /// Filling a layered map by ray casts costs per node: at 0.1 deg about 3 s for both bones of
   /// lhdl-ct, at 0.5 deg about 0.12 s.
   double layered_spacing_deg = 0.5;
+  /// Euclidean distances (issue 26): with `distances` on, every detect also gives each vertex within
+  /// max_radius_mm of the COR, on the first surface or hidden, its signed distance to the other bone's
+  /// surface (ScanGaps::distance_mm; surface_distance.hpp), wherever it cannot be proven farther than
+  /// distance_reach_mm. Needs Embree or CGAL. Off: the thesis' radial gaps alone.
+  bool distances = false;
+  /// The reach of the distances, mm (> 0); 0: the largest threshold of `levels` (the cartilage offset,
+  /// 4 mm by default). Vertices proven farther get NaN.
+  double distance_reach_mm = 0;
+  /// distance_reach_mm resolved (the largest level threshold when 0), mm.
+  double reach_mm() const { return distance_reach_mm > 0 ? distance_reach_mm : std::max(levels.thresholds_mm.front(), 1e-3); }
 };
 
 /// One body of the joint after preprocessing.
@@ -84,6 +96,10 @@ struct JointBody {
   std::shared_ptr<const FirstHitCaster> caster;
   ScanSet hidden_set;
   LayeredSamplingReport layered_sampling;
+  /// With JointOptions::distances (else null / empty): the closest-point hierarchy of the mesh (the other
+  /// body's distance scan queries it), and this body's vertices grouped for its own distance scan.
+  std::shared_ptr<const SignedDistanceQuery> distance_query;
+  DistanceScanSet distance_set;
 };
 
 /// Result of both scans at one pose.
@@ -91,6 +107,7 @@ struct PoseResult {
   ScanGaps ball_gaps, socket_gaps;
   ScanSummary ball, socket;
   double ball_detection_ms = 0, socket_detection_ms = 0;  ///< both include the layered scans when on
+  double ball_distance_ms = 0, socket_distance_ms = 0;    ///< the distance scans (JointOptions::distances)
   std::vector<float> compact_gaps;  ///< scratch of detect (the compact scans), kept to reuse its storage
 };
 
@@ -112,7 +129,8 @@ class Joint {
   /// with the ball rotated by R (3 x 3) about the COR and then translated by t (mm, socket
   /// frame; zero for a pure ball-and-socket motion, nonzero to push the head into the cup).
   /// Thesis Algorithm 2 applied twice, through scan_gaps_compact; with layers, the hidden vertices of
-  /// each body against the other's layered map too (scan_layered; status tested_layered).
+  /// each body against the other's layered map too (scan_layered; status tested_layered); with
+  /// distances, the Euclidean distance scans after them (scan_distances, ScanGaps::distance_mm).
   PoseResult detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) const;
 
   /// The same into `out`, reusing its vectors: after the first pose, no allocation per pose

@@ -1,0 +1,324 @@
+#include "impinge/casters/signed_distance.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <tuple>
+#include <utility>
+
+#include "impinge/core/error.hpp"
+
+#ifdef IMPINGE_HAVE_EMBREE
+#include <embree3/rtcore.h>
+#elif defined(IMPINGE_HAVE_CGAL)
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+#endif
+
+namespace impinge {
+
+namespace {
+
+/// Closest point of triangle (a, b, c) to p (Ericson 2005, Real-Time Collision Detection, sec. 5.1.5),
+/// and its feature: 0 the face, 1 + k the edge k (0: ab, 1: bc, 2: ca), 4 + k the corner k (a, b, c).
+Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& c, int& feature) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return feature = 4, a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return feature = 5, b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return feature = 1, Eigen::Vector3d(a + (d1 / (d1 - d3)) * ab);
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return feature = 6, c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return feature = 3, Eigen::Vector3d(a + (d2 / (d2 - d6)) * ac);
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return feature = 2, Eigen::Vector3d(b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b));
+  const double denom = 1.0 / (va + vb + vc);
+  feature = 0;
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+constexpr double kBoxMarginMm = 1e-3;  // the float hierarchy's boxes against the double triangles
+
+}  // namespace
+
+struct SignedDistanceQuery::Impl {
+  std::vector<Eigen::Vector3d> a, b, c;      // the kept triangles' corners, double, mesh frame
+  std::vector<std::int64_t> face;            // kept triangle -> index in the mesh's F
+  std::vector<std::array<std::int32_t, 3>> corner;  // kept triangle -> vertex indices
+  std::vector<Eigen::Vector3d> face_normal;  // unit, outward
+  std::vector<Eigen::Vector3d> edge_normal;  // 3 per kept triangle: sum of the two faces' normals
+  std::vector<std::uint8_t> edge_irregular;  // 3 per kept triangle
+  std::vector<Eigen::Vector3d> vertex_normal;
+  std::vector<std::uint8_t> vertex_irregular;
+  int orientation = 1;
+
+  /// The closest point of kept triangle k to q, with its feature.
+  double distance_to(std::size_t k, const Eigen::Vector3d& q, Eigen::Vector3d& point, int& feature) const {
+    point = closest_on_triangle(q, a[k], b[k], c[k], feature);
+    return (q - point).norm();
+  }
+
+#ifdef IMPINGE_HAVE_EMBREE
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();  // float coordinates are about this point
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+#elif defined(IMPINGE_HAVE_CGAL)
+  using K = CGAL::Simple_cartesian<double>;
+  using Triangle = K::Triangle_3;
+  using Iterator = std::vector<Triangle>::const_iterator;
+  using Primitive = CGAL::AABB_triangle_primitive<K, Iterator>;
+  using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
+  std::vector<Triangle> triangles;
+  Tree tree;
+#endif
+};
+
+bool SignedDistanceQuery::available() {
+#if defined(IMPINGE_HAVE_EMBREE) || defined(IMPINGE_HAVE_CGAL)
+  return true;
+#else
+  return false;
+#endif
+}
+
+SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
+  validate_mesh(mesh);
+  require(available(), "signed distance: needs Embree or CGAL, and this build has neither (" + mesh.source + ")");
+  Impl& m = *impl_;
+  double volume = 0;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose(), b = mesh.V.row(mesh.F(f, 1)).transpose(),
+                          c = mesh.V.row(mesh.F(f, 2)).transpose();
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    if (!(n.norm() > 0)) continue;
+    m.a.push_back(a), m.b.push_back(b), m.c.push_back(c), m.face.push_back(f);
+    m.corner.push_back({static_cast<std::int32_t>(mesh.F(f, 0)), static_cast<std::int32_t>(mesh.F(f, 1)),
+                        static_cast<std::int32_t>(mesh.F(f, 2))});
+    m.face_normal.push_back(n.normalized());
+    volume += a.dot(b.cross(c)) / 6;
+  }
+  require(!m.a.empty(), "signed distance: " + mesh.source + " has no triangle of nonzero area");
+  orientation_ = m.orientation = volume >= 0 ? 1 : -1;
+  const std::size_t k = m.a.size();
+  for (auto& n : m.face_normal) n *= m.orientation;
+
+  // Edges: directed (from, to) of each kept triangle's edge k (0: ab, 1: bc, 2: ca), grouped undirected.
+  std::vector<std::tuple<std::int32_t, std::int32_t, std::int64_t>> edges;  // (min, max, 3 * tri + k)
+  edges.reserve(3 * k);
+  for (std::size_t t = 0; t < k; ++t)
+    for (int e = 0; e < 3; ++e) {
+      const std::int32_t u = m.corner[t][e], v = m.corner[t][(e + 1) % 3];
+      edges.emplace_back(std::min(u, v), std::max(u, v), static_cast<std::int64_t>(3 * t + e));
+    }
+  std::sort(edges.begin(), edges.end());
+  m.edge_normal.assign(3 * k, Eigen::Vector3d::Zero());
+  m.edge_irregular.assign(3 * k, 1);
+  m.vertex_normal.assign(static_cast<std::size_t>(mesh.V.rows()), Eigen::Vector3d::Zero());
+  m.vertex_irregular.assign(static_cast<std::size_t>(mesh.V.rows()), 0);
+  std::int64_t irregular = 0;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]) &&
+           std::get<1>(edges[j]) == std::get<1>(edges[i]))
+      ++j;
+    bool regular = false;
+    if (j - i == 2) {
+      const auto e0 = std::get<2>(edges[i]), e1 = std::get<2>(edges[i + 1]);
+      const auto t0 = static_cast<std::size_t>(e0 / 3), t1 = static_cast<std::size_t>(e1 / 3);
+      const std::int32_t from0 = m.corner[t0][e0 % 3], from1 = m.corner[t1][e1 % 3];
+      regular = from0 != from1;  // opposite directions: consistently wound
+      if (regular) {
+        const Eigen::Vector3d n = m.face_normal[t0] + m.face_normal[t1];
+        m.edge_normal[static_cast<std::size_t>(e0)] = m.edge_normal[static_cast<std::size_t>(e1)] = n;
+        m.edge_irregular[static_cast<std::size_t>(e0)] = m.edge_irregular[static_cast<std::size_t>(e1)] = 0;
+      }
+    }
+    if (!regular) {
+      ++irregular;
+      m.vertex_irregular[static_cast<std::size_t>(std::get<0>(edges[i]))] = 1;
+      m.vertex_irregular[static_cast<std::size_t>(std::get<1>(edges[i]))] = 1;
+    }
+    i = j;
+  }
+  irregular_edges_ = irregular;
+  // Corners: normals weighted by the triangle's angle there.
+  for (std::size_t t = 0; t < k; ++t) {
+    const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
+    for (int e = 0; e < 3; ++e) {
+      const Eigen::Vector3d u = (*p[(e + 1) % 3] - *p[e]).normalized(), v = (*p[(e + 2) % 3] - *p[e]).normalized();
+      const double angle = std::acos(std::clamp(u.dot(v), -1.0, 1.0));
+      m.vertex_normal[static_cast<std::size_t>(m.corner[t][e])] += angle * m.face_normal[t];
+    }
+  }
+
+#ifdef IMPINGE_HAVE_EMBREE
+  for (std::size_t t = 0; t < k; ++t) m.shift += (m.a[t] + m.b[t] + m.c[t]) / 3.0;
+  m.shift /= static_cast<double>(k);
+  m.device = rtcNewDevice("threads=1");
+  require(m.device != nullptr, "signed distance: rtcNewDevice failed (" + mesh.source + ")");
+  m.scene = rtcNewScene(m.device);
+  RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vb = static_cast<float*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * k));
+  auto* ib = static_cast<unsigned*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), k));
+  for (std::size_t t = 0; t < k; ++t) {
+    const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
+    for (int e = 0; e < 3; ++e) {
+      for (int d = 0; d < 3; ++d) vb[9 * t + 3 * e + d] = static_cast<float>((*p[e])[d] - m.shift[d]);
+      ib[3 * t + e] = static_cast<unsigned>(3 * t + e);
+    }
+  }
+  rtcCommitGeometry(g);
+  rtcAttachGeometry(m.scene, g);
+  rtcReleaseGeometry(g);
+  rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_HIGH);
+  rtcCommitScene(m.scene);
+  require(rtcGetDeviceError(m.device) == RTC_ERROR_NONE,
+          "signed distance: building the hierarchy of " + mesh.source + " failed");
+#elif defined(IMPINGE_HAVE_CGAL)
+  for (std::size_t t = 0; t < k; ++t)
+    m.triangles.emplace_back(Impl::K::Point_3(m.a[t].x(), m.a[t].y(), m.a[t].z()),
+                             Impl::K::Point_3(m.b[t].x(), m.b[t].y(), m.b[t].z()),
+                             Impl::K::Point_3(m.c[t].x(), m.c[t].y(), m.c[t].z()));
+  m.tree.insert(m.triangles.begin(), m.triangles.end());
+  m.tree.build();
+  m.tree.accelerate_distance_queries();
+#endif
+}
+
+SignedDistanceQuery::~SignedDistanceQuery() = default;
+SignedDistanceQuery::SignedDistanceQuery(SignedDistanceQuery&&) noexcept = default;
+SignedDistanceQuery& SignedDistanceQuery::operator=(SignedDistanceQuery&&) noexcept = default;
+
+std::int64_t SignedDistanceQuery::triangles() const { return static_cast<std::int64_t>(impl_->a.size()); }
+
+namespace {
+struct Search {
+  const SignedDistanceQuery::Impl* m;
+  Eigen::Vector3d q;
+  double best;             // mm; the radius until something is found
+  std::int64_t kept = -1;  // kept triangle
+  Eigen::Vector3d point;
+  int feature = 0;
+  bool any_only = false;
+};
+
+#ifdef IMPINGE_HAVE_EMBREE
+bool visit(RTCPointQueryFunctionArguments* args) {
+  auto* s = static_cast<Search*>(args->userPtr);
+  Eigen::Vector3d point;
+  int feature = 0;
+  const double d = s->m->distance_to(args->primID, s->q, point, feature);
+  if (!(d <= s->best)) return false;
+  s->best = d, s->kept = args->primID, s->point = point, s->feature = feature;
+  args->query->radius = s->any_only ? 0.f : static_cast<float>(d + kBoxMarginMm);
+  return true;
+}
+#endif
+
+bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius) {
+  require(radius > 0, "signed distance: the query radius must be > 0 mm");
+  s.best = radius;
+#ifdef IMPINGE_HAVE_EMBREE
+  RTCPointQuery query;
+  query.x = static_cast<float>(s.q.x() - m.shift.x());
+  query.y = static_cast<float>(s.q.y() - m.shift.y());
+  query.z = static_cast<float>(s.q.z() - m.shift.z());
+  query.time = 0.f;
+  query.radius = std::isfinite(radius) ? static_cast<float>(radius + kBoxMarginMm) : std::numeric_limits<float>::infinity();
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(m.scene, &query, &context, visit, &s);
+#elif defined(IMPINGE_HAVE_CGAL)
+  using K = SignedDistanceQuery::Impl::K;
+  const auto hit = m.tree.closest_point_and_primitive(K::Point_3(s.q.x(), s.q.y(), s.q.z()));
+  const auto t = static_cast<std::size_t>(hit.second - m.triangles.begin());
+  Eigen::Vector3d point;
+  int feature = 0;
+  const double d = m.distance_to(t, s.q, point, feature);
+  if (d <= s.best) s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
+#endif
+  return s.kept >= 0;
+}
+}  // namespace
+
+bool SignedDistanceQuery::closest(const Eigen::Vector3d& q, double radius_mm, ClosestSurfacePoint& out) const {
+  Search s{impl_.get(), q, 0, -1, {}, 0, false};
+  if (!run(*impl_, s, radius_mm)) return false;
+  out.distance_mm = s.best;
+  out.sign = 1;
+  out.triangle = impl_->face[static_cast<std::size_t>(s.kept)];
+  out.point = s.point;
+  out.rule = SignRule::pseudo_normal;
+  return true;
+}
+
+bool SignedDistanceQuery::any_within(const Eigen::Vector3d& q, double radius_mm) const {
+  Search s{impl_.get(), q, 0, -1, {}, 0, true};
+  return run(*impl_, s, radius_mm);
+}
+
+bool SignedDistanceQuery::signed_distance(const Eigen::Vector3d& q, double radius_mm, int hint,
+                                          ClosestSurfacePoint& out) const {
+  Search s{impl_.get(), q, 0, -1, {}, 0, false};
+  if (!run(*impl_, s, radius_mm)) return false;
+  const Impl& m = *impl_;
+  const auto t = static_cast<std::size_t>(s.kept);
+  bool trusted = true;
+  Eigen::Vector3d n;
+  if (s.feature == 0) {
+    n = m.face_normal[t];
+  } else if (s.feature <= 3) {
+    n = m.edge_normal[3 * t + static_cast<std::size_t>(s.feature - 1)];
+    trusted = !m.edge_irregular[3 * t + static_cast<std::size_t>(s.feature - 1)];
+  } else {
+    const auto v = static_cast<std::size_t>(m.corner[t][s.feature - 4]);
+    n = m.vertex_normal[v];
+    trusted = !m.vertex_irregular[v];
+  }
+  const Eigen::Vector3d w = q - s.point;
+  const double along = w.dot(n), scale = w.norm() * n.norm();
+  int sign = along >= 0 ? 1 : -1;
+  if (s.best > 1e-6 && !(std::abs(along) >= 1e-3 * scale)) trusted = false;  // q in the tangent plane
+  if (hint != 0 && s.best > 1e-6 && hint != sign) trusted = false;
+  out.rule = SignRule::pseudo_normal;
+  if (!trusted && s.best > 1e-6) {
+    sign = winding_number(q) >= 0.5 ? -1 : 1;
+    out.rule = SignRule::winding_number;
+  }
+  out.distance_mm = s.best;
+  out.sign = sign;
+  out.triangle = m.face[t];
+  out.point = s.point;
+  return true;
+}
+
+double SignedDistanceQuery::winding_number(const Eigen::Vector3d& q) const {
+  const Impl& m = *impl_;
+  double sum = 0;
+  for (std::size_t t = 0; t < m.a.size(); ++t) {
+    const Eigen::Vector3d a = m.a[t] - q, b = m.b[t] - q, c = m.c[t] - q;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double det = a.dot(b.cross(c));
+    const double div = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    sum += std::atan2(det, div);  // half the solid angle (van Oosterom & Strackee 1983)
+  }
+  return m.orientation * sum / (2 * M_PI);
+}
+
+}  // namespace impinge

@@ -1,0 +1,176 @@
+// The signed distance to a mesh (casters/signed_distance.hpp) against independent oracles:
+// - the unsigned distance equals CGAL's AABB-tree closest distance (ExactReference), whatever the radius;
+// - a radius below the distance finds nothing, any_within agrees with the distance;
+// - the sign matches the closed form of a sphere and of a box wound either way;
+// - on an open mesh (a sphere with a cap cut off), the winding number equals the closed-form solid angle
+//   of the hole, and decides the points whose closest feature is the hole's rim;
+// - on a self-intersecting mesh (two overlapping spheres in one mesh), a point outside one sphere but
+//   inside the other is inside: the winding number (2 in the overlap, 1 in either sphere) says so when
+//   the caller's hint disagrees with the pseudo-normal of the buried sheet.
+#include "impinge/casters/signed_distance.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
+#include "impinge/io/generated_models.hpp"
+#include "test_support.hpp"
+
+using namespace impinge;
+
+namespace {
+TriangleMesh flipped(TriangleMesh m) {
+  m.F.col(1).swap(m.F.col(2));
+  return m;
+}
+}  // namespace
+
+TEST(SignedDistance, ClosestMatchesCgalAndSignMatchesTheSphere) {
+  if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
+  const Eigen::Vector3d c(3, -2, 40);
+  const TriangleMesh s = make_uv_sphere(20, c, 96, 48, Eigen::Vector3d(0.3, 0.1, 1).normalized());
+  const SignedDistanceQuery q(s);
+  const ExactReference ref(s);
+  EXPECT_EQ(q.irregular_edges(), 0);
+  EXPECT_EQ(q.orientation(), 1);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> U(0, 1);
+  int checked = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Eigen::Vector3d u = direction(std::acos(2 * U(rng) - 1), 2 * kPi * U(rng));
+    const double r = 40 * U(rng);
+    const Eigen::Vector3d p = c + r * u;
+    ClosestSurfacePoint cp;
+    ASSERT_TRUE(q.signed_distance(p, std::numeric_limits<double>::infinity(), 0, cp));
+    const double exact = ref.closest_distance(p);
+    EXPECT_NEAR(cp.distance_mm, exact, 1e-9) << r;
+    EXPECT_NEAR((cp.point - p).norm(), cp.distance_mm, 1e-9);
+    if (std::abs(r - 20) > 0.2) {  // beyond the facets' sagitta (0.04 mm): the closed form decides
+      EXPECT_EQ(cp.sign, r < 20 ? -1 : 1) << r;
+      ++checked;
+    }
+    // The radius prunes without changing the answer.
+    ClosestSurfacePoint near;
+    EXPECT_TRUE(q.closest(p, exact + 1e-6, near));
+    EXPECT_NEAR(near.distance_mm, exact, 1e-9);
+    if (exact > 1e-3) {
+      EXPECT_FALSE(q.closest(p, exact * 0.999, near));
+      EXPECT_FALSE(q.any_within(p, exact * 0.999));
+    }
+    EXPECT_TRUE(q.any_within(p, exact + 1e-6));
+  }
+  EXPECT_GT(checked, 1900);
+}
+
+TEST(SignedDistance, BoxWoundEitherWay) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+  const TriangleMesh box = test::make_box({-5, -5, -5}, {5, 10, 5});
+  for (const bool inward : {false, true}) {
+    const SignedDistanceQuery q(inward ? flipped(box) : box);
+    EXPECT_EQ(q.orientation(), inward ? -1 : 1);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> U(-12, 16);
+    for (int k = 0; k < 2000; ++k) {
+      const Eigen::Vector3d p(U(rng), U(rng), U(rng));
+      // Closed form: the box's signed distance.
+      const Eigen::Vector3d lo(-5, -5, -5), hi(5, 10, 5);
+      const Eigen::Vector3d d = (lo - p).cwiseMax(p - hi);
+      const double exact = d.maxCoeff() > 0 ? d.cwiseMax(0.0).norm() : d.maxCoeff();
+      ClosestSurfacePoint cp;
+      ASSERT_TRUE(q.signed_distance(p, 100, 0, cp));
+      EXPECT_NEAR(cp.signed_mm(), exact, 1e-9) << p.transpose();
+      EXPECT_EQ(cp.rule, SignRule::pseudo_normal);  // closed and manifold: the pseudo-normal is exact
+    }
+  }
+}
+
+TEST(SignedDistance, OpenMeshTheWindingNumberDecidesAtTheHole) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+  const double R = 10, cut = 0.8 * R;
+  const TriangleMesh sphere = make_uv_sphere(R, Eigen::Vector3d::Zero(), 180, 90);
+  std::vector<std::uint8_t> keep(static_cast<std::size_t>(sphere.V.rows()));
+  for (Eigen::Index i = 0; i < sphere.V.rows(); ++i) keep[static_cast<std::size_t>(i)] = sphere.V(i, 2) < cut;
+  const TriangleMesh open = submesh(sphere, keep);
+  const SignedDistanceQuery q(open);
+  EXPECT_GT(q.irregular_edges(), 0);  // the hole's rim
+  // The hole's rim: the highest ring kept.
+  double rim_z = -R;
+  for (Eigen::Index i = 0; i < open.V.rows(); ++i) rim_z = std::max(rim_z, open.V(i, 2));
+  const double rim_r = std::sqrt(R * R - rim_z * rim_z);
+  for (const double z : {-5.0, 0.0, 3.0, 5.0, 7.0, 12.0, 15.0}) {
+    const Eigen::Vector3d p(0, 0, z);
+    // Closed form inside the sphere: one minus the hole's solid angle (a disk of radius rim_r at height
+    // rim_z above the point) over 4 pi.
+    const double h = rim_z - z;
+    const double hole = (1 - h / std::hypot(h, rim_r)) / 2;
+    const bool inside = std::abs(z) < R;
+    if (inside) {
+      EXPECT_NEAR(q.winding_number(p), 1 - hole, 2e-3) << z;
+    }
+    ClosestSurfacePoint cp;
+    ASSERT_TRUE(q.signed_distance(p, 100, 0, cp));
+    EXPECT_EQ(cp.sign, inside ? -1 : 1) << z;
+    if (z > 3) {
+      // The rim is the closest feature: its pseudo-normal is not trusted, the winding number decides.
+      EXPECT_NEAR(cp.distance_mm, std::hypot(rim_r, rim_z - z), 0.02) << z;
+      EXPECT_EQ(cp.rule, SignRule::winding_number) << z;
+    }
+  }
+  // Far above the hole: outside, by the winding number.
+  EXPECT_LT(q.winding_number({0, 0, 30}), 0.5);
+}
+
+TEST(SignedDistance, SelfIntersectingMeshInsideTheOverlapAndBehindABuriedSheet) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+  const double R = 10;
+  const Eigen::Vector3d ca(0, 0, 0), cb(12, 0, 0);
+  const TriangleMesh both =
+      test::concatenated(make_uv_sphere(R, ca, 120, 60), make_uv_sphere(R, cb, 120, 60, Eigen::Vector3d(0, 1, 0)));
+  const SignedDistanceQuery q(both);
+  EXPECT_NEAR(q.winding_number({6, 0, 0}), 2, 1e-6);    // in both spheres
+  EXPECT_NEAR(q.winding_number({-5, 0, 0}), 1, 1e-6);   // in A only
+  EXPECT_NEAR(q.winding_number({30, 0, 0}), 0, 1e-6);   // in neither
+  // (10.5, 0, 0): outside A, inside B; its closest point is A's sheet at x = 10, buried inside B, whose
+  // pseudo-normal says outside. A caller that knows better (the radial gap's crossings) hints inside, and
+  // the winding number decides.
+  const Eigen::Vector3d p(10.5, 0, 0);
+  ClosestSurfacePoint cp;
+  ASSERT_TRUE(q.signed_distance(p, 100, 0, cp));
+  EXPECT_NEAR(cp.distance_mm, 0.5, 0.01);
+  EXPECT_EQ(cp.sign, 1);  // the pseudo-normal alone is wrong here: stated in the rule
+  ASSERT_TRUE(q.signed_distance(p, 100, -1, cp));
+  EXPECT_EQ(cp.sign, -1);
+  EXPECT_EQ(cp.rule, SignRule::winding_number);
+  // A wrong hint cannot flip a right answer: the winding number overrules it.
+  ASSERT_TRUE(q.signed_distance({-14, 0, 0}, 100, -1, cp));
+  EXPECT_EQ(cp.sign, 1);
+  EXPECT_NEAR(cp.distance_mm, 4, 0.01);
+}
+
+TEST(SignedDistance, BadInput) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+  TriangleMesh m = test::make_box({0, 0, 0}, {1, 1, 1});
+  m.source = "bad.ply";
+  m.F(3, 1) = 99;
+  try {
+    SignedDistanceQuery q(m);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.ply"), std::string::npos) << e.what();
+  }
+  TriangleMesh flat;
+  flat.source = "flat.ply";
+  flat.V = Vertices(3, 3);
+  flat.V << 0, 0, 0, 1, 0, 0, 2, 0, 0;
+  flat.F = Faces(1, 3);
+  flat.F << 0, 1, 2;
+  EXPECT_THROW(SignedDistanceQuery{flat}, Error);
+  const SignedDistanceQuery q(test::make_box({0, 0, 0}, {1, 1, 1}));
+  ClosestSurfacePoint cp;
+  EXPECT_THROW(q.closest({0, 0, 0}, 0, cp), Error);
+  EXPECT_THROW(q.closest({0, 0, 0}, -1, cp), Error);
+}

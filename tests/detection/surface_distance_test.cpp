@@ -1,0 +1,210 @@
+// The distance scan (detection/surface_distance.hpp, Joint with distances) against CGAL:
+// - every measured vertex's distance equals CGAL's AABB-tree closest distance of the posed vertex to the
+//   other mesh (unsigned, 1e-6 mm), and its sign the inside/outside of the majority of three rays'
+//   crossing parities through CGAL (independent code), wherever the vertex is more than 0.01 mm off the
+//   surface;
+// - every vertex left without a distance is farther than the reach by CGAL;
+// - on a generated hip pushed into its cup and on every shared subject at rest and at 10 poses up to
+//   110 deg flexion (the Done-when of issue 26).
+#include "impinge/detection/surface_distance.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/detection/joint.hpp"
+#include "impinge/io/generated_models.hpp"
+#include "test_support.hpp"
+
+using namespace impinge;
+
+namespace {
+/// Inside by CGAL: the majority of three rays' crossing parities (all_hits of the closed mesh).
+bool inside_by_parity(const ExactReference& ref, const Eigen::Vector3d& q) {
+  static const Eigen::Vector3d dirs[3] = {Eigen::Vector3d(0.5377, 0.1834, -0.8229).normalized(),
+                                          Eigen::Vector3d(-0.4336, 0.8622, 0.3188).normalized(),
+                                          Eigen::Vector3d(0.3426, -0.7254, 0.5972).normalized()};
+  int votes = 0;
+  for (const auto& d : dirs) votes += ref.all_hits(q, d).size() % 2;
+  return votes >= 2;
+}
+
+struct Checked {
+  std::int64_t measured = 0, far = 0, signs = 0;
+  double worst = 0;
+};
+
+/// Check one scan's distances (body `own` posed by x -> cor + R (x - cor) + t into `other`'s frame).
+void check_scan(const TriangleMesh& own, const Eigen::Vector3d& cor, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                const ExactReference& other, const std::vector<float>& distance, double reach, double max_radius,
+                std::mt19937_64& rng, Checked& c, const std::string& what) {
+  ASSERT_EQ(static_cast<Eigen::Index>(distance.size()), own.V.rows());
+  std::uniform_real_distribution<double> U(0, 1);
+  for (Eigen::Index i = 0; i < own.V.rows(); ++i) {
+    const Eigen::Vector3d p = own.V.row(i).transpose() - cor;
+    if (p.norm() > max_radius) continue;
+    const Eigen::Vector3d q = cor + R * p + t;
+    const float d = distance[static_cast<std::size_t>(i)];
+    if (std::isnan(d)) {
+      // Left out: CGAL must put it beyond the reach.
+      if (U(rng) < 0.05) {  // a sample: the far vertices are many
+        ASSERT_GT(other.closest_distance(q), reach - 1e-6) << what << " vertex " << i;
+        ++c.far;
+      }
+      continue;
+    }
+    ++c.measured;
+    const double exact = other.closest_distance(q);
+    c.worst = std::max(c.worst, std::abs(std::abs(static_cast<double>(d)) - exact));
+    ASSERT_NEAR(std::abs(d), exact, 1e-4) << what << " vertex " << i;
+    if (exact > 0.01 && (exact < 1 || U(rng) < 0.1)) {
+      ASSERT_EQ(d < 0, inside_by_parity(other, q)) << what << " vertex " << i << " distance " << d;
+      ++c.signs;
+    }
+  }
+}
+
+void check_joint(const Joint& joint, const std::vector<Eigen::Matrix3d>& poses, const Eigen::Vector3d& t,
+                 const std::string& name) {
+  const ExactReference ball(joint.ball().mesh), socket(joint.socket().mesh);
+  std::mt19937_64 rng(11);
+  Checked c;
+  const double reach = joint.options().reach_mm();
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const Eigen::Matrix3d& R = poses[k];
+    const PoseResult r = joint.detect(R, t);
+    const std::string what = name + " pose " + std::to_string(k);
+    check_scan(joint.ball().mesh, joint.cor(), R, t, socket, r.ball_gaps.distance_mm, reach,
+               joint.options().max_radius_mm, rng, c, what + " ball");
+    // Socket vertices into the ball's frame: cor + R^T (p - cor - t).
+    check_scan(joint.socket().mesh, joint.cor(), R.transpose(), -(R.transpose() * t), ball,
+               r.socket_gaps.distance_mm, reach, joint.options().max_radius_mm, rng, c, what + " socket");
+    // The radial gap bounds the distance's size from above (its point along the ray lies on the other
+    // surface), to the maps' interpolation error.
+    for (const ScanGaps* g : {&r.ball_gaps, &r.socket_gaps})
+      for (std::size_t i = 0; i < g->gap_mm.size(); ++i)
+        if (std::isfinite(g->gap_mm[i]) && std::isfinite(g->distance_mm[i])) {
+          ASSERT_LE(std::abs(g->distance_mm[i]), std::abs(g->gap_mm[i]) + 0.05) << what << " vertex " << i;
+        }
+  }
+  EXPECT_GT(c.measured, 100) << name;
+  EXPECT_GT(c.signs, 50) << name;
+  std::cout << name << ": " << c.measured << " distances (worst " << c.worst << " mm), " << c.signs
+            << " signs, " << c.far << " far vertices checked\n";
+}
+
+std::vector<Eigen::Matrix3d> flexion_poses() {
+  std::vector<Eigen::Matrix3d> poses{Eigen::Matrix3d::Identity()};
+  for (int k = 0; k < 10; ++k) {
+    const double flex = (-20 + 13 * k) * M_PI / 180, add = (k % 3 - 1) * 10 * M_PI / 180,
+                 rot = (k % 4 - 1.5) * 12 * M_PI / 180;
+    poses.push_back((Eigen::AngleAxisd(flex, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(add, Eigen::Vector3d::UnitY()) *
+                     Eigen::AngleAxisd(rot, Eigen::Vector3d::UnitZ()))
+                        .toRotationMatrix());
+  }
+  return poses;
+}
+}  // namespace
+
+TEST(SurfaceDistance, ScanSetCoversTheRegionInSmallClusters) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(-50, 50);
+  Vertices P(1000, 3);
+  for (Eigen::Index i = 0; i < P.rows(); ++i) P.row(i) << U(rng), U(rng), U(rng);
+  const DistanceScanSet s = make_distance_scan_set(P, 60, 16);
+  std::vector<int> seen(1000, 0);
+  for (std::int64_t c = 0; c < s.clusters(); ++c) {
+    const auto b = s.cluster_begin[static_cast<std::size_t>(c)], e = s.cluster_begin[static_cast<std::size_t>(c) + 1];
+    EXPECT_LE(e - b, 16);
+    for (auto k = b; k < e; ++k) {
+      ++seen[static_cast<std::size_t>(s.index[static_cast<std::size_t>(k)])];
+      EXPECT_LE((s.position[static_cast<std::size_t>(k)] - s.centre[static_cast<std::size_t>(c)]).norm(),
+                s.radius[static_cast<std::size_t>(c)] + 1e-12);
+    }
+  }
+  for (Eigen::Index i = 0; i < P.rows(); ++i) EXPECT_EQ(seen[static_cast<std::size_t>(i)], P.row(i).norm() <= 60) << i;
+  EXPECT_THROW(make_distance_scan_set(P, 60, 0), Error);
+  EXPECT_THROW(make_distance_scan_set(P, 0, 8), Error);
+}
+
+TEST(SurfaceDistance, GeneratedHipPushedIntoItsCupMatchesCgal) {
+  if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
+  HipModelOptions ho;
+  ho.target_triangles = 6000;
+  ho.cam_height_mm = 3;
+  const HipModel m = make_hip_model(ho);
+  JointOptions o;
+  o.distances = true;
+  o.layers = 2;
+  const Joint joint(m.ball, m.socket, m.cor, o);
+  std::vector<Eigen::Matrix3d> poses;
+  for (int k = 0; k < 6; ++k)
+    poses.push_back(Eigen::AngleAxisd((15.0 * k - 20) * M_PI / 180, Eigen::Vector3d(0.6, 0.8, 0).normalized()).toRotationMatrix());
+  check_joint(joint, poses, Eigen::Vector3d::Zero(), "generated");
+}
+
+TEST(SurfaceDistance, HeadPushedIntoAWatertightCupMatchesCgal) {
+  if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
+  // A head (r 22 mm) in a closed, manifold cup (24.5 to 30.5 mm, 100 deg coverage), pushed 3.5 mm into the
+  // cup wall: the head penetrates it by about 1 mm (negative distances; signs by CGAL's ray parity).
+  const Eigen::Vector3d c(10, -5, 20);
+  const TriangleMesh head = make_uv_sphere(22, c, 120, 60, Eigen::Vector3d(0.2, 0.1, 1).normalized());
+  const TriangleMesh cup = make_cup(24.5, 30.5, 100, c, Eigen::Vector3d(0.3, 0.2, 1).normalized(), 120, 40);
+  ASSERT_EQ(SignedDistanceQuery(head).irregular_edges(), 0);
+  ASSERT_EQ(SignedDistanceQuery(cup).irregular_edges(), 0);
+  JointOptions o;
+  o.distances = true;
+  const Joint joint(head, cup, c, o);
+  std::vector<Eigen::Matrix3d> poses;
+  for (int k = 0; k < 4; ++k)
+    poses.push_back(Eigen::AngleAxisd((25.0 * k - 30) * M_PI / 180, Eigen::Vector3d(0.6, 0.8, 0).normalized()).toRotationMatrix());
+  const Eigen::Vector3d push = 3.5 * Eigen::Vector3d(0.3, 0.2, 1).normalized();
+  check_joint(joint, poses, push, "cup, pushed");
+  const PoseResult r = joint.detect(Eigen::Matrix3d::Identity(), push);
+  EXPECT_GT(r.ball.vertices_inside, 0);
+  EXPECT_NEAR(r.ball.min_distance_mm, -1.0, 0.05);
+  EXPECT_NEAR(r.socket.min_distance_mm, -1.0, 0.05);
+}
+
+TEST(SurfaceDistance, ReachAndBadInput) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+  const HipModel m = make_hip_model({});
+  JointOptions o;
+  o.distances = true;
+  o.distance_reach_mm = -1;
+  EXPECT_THROW(Joint(m.ball, m.socket, m.cor, o), Error);
+  o.distance_reach_mm = 1;
+  const Joint narrow(m.ball, m.socket, m.cor, o);
+  o.distance_reach_mm = 8;
+  const Joint wide(m.ball, m.socket, m.cor, o);
+  const PoseResult a = narrow.detect(Eigen::Matrix3d::Identity()), b = wide.detect(Eigen::Matrix3d::Identity());
+  // The head sits 2.5 mm from the cup: nothing within 1 mm, most of the head within 8 mm.
+  EXPECT_EQ(a.ball.vertices_distance, 0);
+  EXPECT_GT(b.ball.vertices_distance, 100);
+  EXPECT_NEAR(b.ball.min_distance_mm, 2.5, 0.1);
+  const SignedDistanceQuery q(m.socket);
+  const DistanceScanSet s = make_distance_scan_set(wide.ball().relative, 100);
+  std::vector<float> out, wrong(3);
+  EXPECT_THROW(scan_distances(s, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), m.cor, q, 0, {}, out), Error);
+  EXPECT_THROW(scan_distances(s, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), m.cor, q, 4, wrong, out), Error);
+}
+
+class RealDistance : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(RealDistance, EveryMeasuredVertexMatchesCgalAtRestAndTenPoses) {
+  if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
+  const auto real = test::load_real_joint(GetParam());
+  if (!real) GTEST_SKIP() << "no shared data";
+  JointOptions o;
+  o.distances = true;
+  o.layers = 4;
+  o.max_radius_mm = 150;
+  const Joint joint(real->femur, real->pelvis, real->cor, o);
+  check_joint(joint, flexion_poses(), Eigen::Vector3d::Zero(), GetParam());
+}
+
+INSTANTIATE_TEST_SUITE_P(Shared, RealDistance, ::testing::Values("lhdl-ct", "mc22", "mc22-left", "tlem2-mri"));
