@@ -105,6 +105,15 @@ void add_map_options(CLI::App* app, MapSettings& o, TextOptions& t) {
   app->add_option("--extra-articular-radius", o.extra_articular_radius_mm,
                   "mm: with --layers, test hidden vertices within this distance of the COR")
       ->capture_default_str();
+  app->add_option("--distances", o.distances,
+                  "on|off: beside each radial gap, the signed Euclidean distance to the other bone's surface (what "
+                  "3D Slicer, VTK, Open3D and libigl report; negative inside it), exact, for every vertex (hidden "
+                  "ones too) within --distance-reach of the other bone")
+      ->capture_default_str();
+  app->add_option("--distance-reach", o.distance_reach_mm,
+                  "mm: vertices proven farther than this from the other bone get no distance (0: the largest "
+                  "--levels threshold)")
+      ->capture_default_str();
   app->add_flag("--maps-only", o.maps_only,
                 "No exact look-ups at depth discontinuities: the maps answer alone (the thesis' algorithm)");
 }
@@ -317,6 +326,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   SessionOptions so;
   so.maps.layers = 4;  // the whole bone by default (issue 29): the hidden vertices too, extra-articular
+  so.maps.distances = true;  // the Euclidean distance beside the radial gap by default (issue 26)
   TextOptions text;
 
   std::string pose = "0,0,0", out;

@@ -58,7 +58,7 @@ class Joint:
                  levels: Optional[Sequence[float]] = None, occlusion_tolerance_mm: float = 1.0,
                  max_radius_mm: float = 0.0, sparse: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
                  layers: int = 4, extra_articular_radius_mm: float = 150.0, layered_spacing: float = 0.5,
-                 maps_only: bool = False,
+                 distances: bool = True, distance_reach_mm: float = 0.0, maps_only: bool = False,
                  maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
                  pelvis_frame: str = "isb", joint_centre: Optional[str] = None,
                  femur_frame: str = "epicondyles") -> None:
@@ -69,7 +69,9 @@ class Joint:
         outside the head. scheme and one of resolution/precision/turns/spacing (0: the scheme's
         0.5 deg default); sampling; mode 'exact'/'linear'; levels: thresholds mm, decreasing;
         sparse: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for
-        hidden vertices (extra-articular), within extra_articular_radius_mm, at layered_spacing deg (0: the maps' own); maps_only: no exact
+        hidden vertices (extra-articular), within extra_articular_radius_mm, at layered_spacing deg (0: the maps' own); distances: the signed
+        Euclidean distance to the other bone beside each gap (results' ball_distance_mm, socket_distance_mm),
+        for every vertex within distance_reach_mm of it (0: the largest level threshold); maps_only: no exact
         look-ups at depth discontinuities; maps: (ball_path, socket_path) from save_maps().
         neutral: 'anatomical' (ISB frames) or 'scan' (default: the subject's, else anatomical);
         pelvis_frame 'isb'/'app'; femur_frame 'epicondyles'/'posterior-condyles'; joint_centre: how the
@@ -80,8 +82,9 @@ class Joint:
         """Save both maps for Joint(..., maps=(ball_path, socket_path))."""
     def detect(self, R: Optional[npt.ArrayLike] = None, t: Optional[Sequence[float]] = None) -> Dict[str, Any]:
         """Both scans, femur rotated by R about the COR and translated by t -> dict(ball_gap_mm,
-        socket_gap_mm (float32, NaN untested), ball_status, socket_status (uint8), summary: each scan's
-        record as summary.json gives it)."""
+        socket_gap_mm (float32, NaN untested), ball_distance_mm, socket_distance_mm (float32, the signed
+        Euclidean distance to the other bone, NaN beyond the reach; with distances on), ball_status,
+        socket_status (uint8), summary: each scan's record as summary.json gives it)."""
     def detect_pose(self, flexion: float = 0.0, adduction: float = 0.0,
                     internal_rotation: float = 0.0) -> Dict[str, Any]:
         """Both scans at clinical angles (degrees, ISB), the femur placed by the joint-centre method; the

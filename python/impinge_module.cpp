@@ -241,6 +241,10 @@ const std::vector<std::pair<std::string, OptionSetter>>& joint_options() {
       {"layered_spacing", [](SessionOptions& o, const py::handle& v, const std::string& n) {
          o.maps.layered_spacing_deg = as_double(v, n);
        }},
+      {"distances", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.distances = as_bool(v, n); }},
+      {"distance_reach_mm", [](SessionOptions& o, const py::handle& v, const std::string& n) {
+         o.maps.distance_reach_mm = as_double(v, n);
+       }},
       {"maps_only", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.maps_only = as_bool(v, n); }},
       {"maps", [](SessionOptions& o, const py::handle& v, const std::string& n) {
          const auto p = py::cast<std::pair<std::string, std::string>>(v);
@@ -257,7 +261,8 @@ const std::vector<std::pair<std::string, OptionSetter>>& joint_options() {
 
 PyJoint make_joint(const py::object& ball, const py::object& socket, const py::kwargs& kw) {
   SessionOptions o;
-  o.maps.layers = 4;  // as the CLI: the whole bone by default
+  o.maps.layers = 4;        // as the CLI: the whole bone by default
+  o.maps.distances = true;  // and the Euclidean distances beside the gaps
   const auto& table = joint_options();
   auto set = [&](const std::string& name, const py::handle& v) {
     if (v.is_none()) return;  // None: the default
@@ -340,8 +345,16 @@ py::dict result_dict(const Session& session, PoseResult&& r) {
       from_json(scan_record(session.joint().socket(), r.socket, r.socket_detection_ms, levels, nullptr));
   summary["ball_detection_ms"] = r.ball_detection_ms;
   summary["socket_detection_ms"] = r.socket_detection_ms;
+  if (session.joint_options().distances) {
+    summary["ball_distance_ms"] = r.ball_distance_ms;
+    summary["socket_distance_ms"] = r.socket_distance_ms;
+  }
   d["ball_gap_mm"] = own(std::move(r.ball_gaps.gap_mm), {nb});
   d["socket_gap_mm"] = own(std::move(r.socket_gaps.gap_mm), {ns});
+  if (!r.ball_gaps.distance_mm.empty()) {
+    d["ball_distance_mm"] = own(std::move(r.ball_gaps.distance_mm), {nb});
+    d["socket_distance_mm"] = own(std::move(r.socket_gaps.distance_mm), {ns});
+  }
   d["ball_status"] = own(std::move(r.ball_gaps.status), {nb});
   d["socket_status"] = own(std::move(r.socket_gaps.status), {ns});
   d["summary"] = summary;
@@ -558,7 +571,9 @@ void add_joint_queries(py::class_<PyJoint>& c) {
        py::arg("R") = py::none(), py::arg("t") = py::none(),
        "Both scans with the femur rotated by R (3, 3; input frame) about the COR, then translated by t (3,) "
        "mm -> dict(ball_gap_mm, socket_gap_mm: float32 (n,) in the input's vertex order, NaN where not "
-       "tested; ball_status, socket_status: uint8 (0 tested, 1 no surface, 2 beyond reach); summary).")
+       "tested; ball_distance_mm, socket_distance_mm: float32 (n,), the signed Euclidean distance to the other "
+       "bone, NaN beyond the reach (with distances on); ball_status, socket_status: uint8 (0 tested, 1 no "
+       "surface, 2 beyond reach); summary).")
       .def(
           "detect_pose",
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {

@@ -17,18 +17,29 @@ CLI = os.environ.get("IMPINGE_CLI", "build/impinge")
 DATA = os.environ.get("IMPINGE_SHARED_DATA", "../shared/data/hips")
 
 
-def read_gaps(path):
-    """gap_mm per vertex of a PLY written by impinge (x y z gap_mm quality: floats; level r g b: uchar)."""
+def read_ply_vertices(path):
+    """The vertex records of a binary PLY written by impinge, by the header's property names (x y z gap_mm
+    quality [distance_mm]: float; level red green blue: uchar)."""
+    kinds = {"float": "<f4", "uchar": "u1"}
     with open(path, "rb") as f:
-        n = 0
+        n, props, elem = 0, [], None
         while True:
-            line = f.readline().decode().strip()
-            if line.startswith("element vertex"):
-                n = int(line.split()[2])
-            if line == "end_header":
+            t = f.readline().decode().split()
+            if t[:2] == ["element", "vertex"]:
+                n, elem = int(t[2]), "vertex"
+            elif t[:1] == ["element"]:
+                elem = t[1]
+            elif t[:1] == ["property"] and elem == "vertex":
+                props.append((t[2], kinds[t[1]]))
+            elif t == ["end_header"]:
                 break
-        rec = np.frombuffer(f.read(n * 24), dtype=np.dtype([("f", "<f4", 5), ("b", "u1", 4)]), count=n)
-    return rec["f"][:, 3]
+        dtype = np.dtype(props)
+        return np.frombuffer(f.read(n * dtype.itemsize), dtype=dtype, count=n)
+
+
+def read_gaps(path):
+    """gap_mm per vertex of a PLY written by impinge."""
+    return read_ply_vertices(path)["gap_mm"]
 
 
 @pytest.fixture(scope="module")
@@ -52,6 +63,16 @@ def test_gaps_equal_the_cli_on_a_generated_hip(generated):
     assert r["ball_gap_mm"].dtype == np.float32 and r["ball_gap_mm"].shape == (len(ball[0]),)
     np.testing.assert_array_equal(r["ball_gap_mm"], cli_ball)
     np.testing.assert_array_equal(r["socket_gap_mm"], cli_socket)
+    # The Euclidean distances beside them (issue 26): the CLI's, and never larger in size than a gap.
+    np.testing.assert_array_equal(r["ball_distance_mm"], read_ply_vertices(d + "/cli/ball_gaps.ply")["distance_mm"])
+    np.testing.assert_array_equal(r["socket_distance_mm"], read_ply_vertices(d + "/cli/socket_gaps.ply")["distance_mm"])
+    both = np.isfinite(r["ball_gap_mm"]) & np.isfinite(r["ball_distance_mm"])
+    assert np.count_nonzero(both) > 50
+    assert np.all(np.abs(r["ball_distance_mm"][both]) <= np.abs(r["ball_gap_mm"][both]) + 0.05)
+    assert r["summary"]["ball"]["min_distance_mm"] == pytest.approx(float(np.nanmin(r["ball_distance_mm"])))
+    # Off: no distance arrays.
+    assert "ball_distance_mm" not in impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0,
+                                                   distances=False).detect_pose(30, -10, 5)
     # The same pose as a rotation matrix.
     R = j.femur_rotation(30, -10, 5)
     np.testing.assert_array_equal(j.detect(R)["ball_gap_mm"], cli_ball)

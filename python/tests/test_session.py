@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import impinge
-from test_impinge import CLI, DATA, read_gaps
+from test_impinge import CLI, DATA, read_gaps, read_ply_vertices
 
 STUB = os.path.join(os.path.dirname(__file__), "..", "impinge.pyi")
 # CLI options of `impinge distance` that are not Joint options: where to write and what to do at one pose.
@@ -140,10 +140,8 @@ def test_a_subject_in_lps_gives_the_cli_gaps():
     R, t = j.femur_pose(30, 5, 10)
     np.testing.assert_array_equal(j.detect(R, t)["ball_gap_mm"], cli_ball)
     posed = (ball[0] - j.cor) @ R.T + j.cor + t
-    with open(d + "/cli/ball_gaps.ply", "rb") as f:
-        while f.readline().strip() != b"end_header":
-            pass
-        xyz = np.frombuffer(f.read(len(ball[0]) * 24), dtype=np.dtype([("f", "<f4", 5), ("b", "u1", 4)]))["f"][:, :3]
+    rec = read_ply_vertices(d + "/cli/ball_gaps.ply")
+    xyz = np.stack([rec["x"], rec["y"], rec["z"]], axis=1)
     np.testing.assert_allclose(posed, xyz, atol=1e-3)
 
     # Frames, when anatomical, are the CLI's (input frame).

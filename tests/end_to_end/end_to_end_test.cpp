@@ -210,14 +210,15 @@ INSTANTIATE_TEST_SUITE_P(Shared, SchemesAgree, ::testing::Values("lhdl-ct", "mc2
 
 namespace {
 struct FrameRow {
-  double ball_min, socket_min;
+  double ball_min, socket_min, ball_min_distance, socket_min_distance;  // NaN distances when the cell is empty
 };
+double cell_or_nan(const std::string& c) { return c.empty() ? std::nan("") : std::stod(c); }
 std::vector<FrameRow> read_frames_csv(const std::string& path) {
   std::ifstream in(path);
   std::string line;
   std::getline(in, line);
   EXPECT_EQ(line.rfind("frame,time_s,flexion_deg,adduction_deg,internal_rotation_deg,ball_min_gap_mm,"
-                       "socket_min_gap_mm,penetrating_area_mm2",
+                       "socket_min_gap_mm,ball_min_distance_mm,socket_min_distance_mm,penetrating_area_mm2",
                        0),
             0u)
       << line;
@@ -227,7 +228,7 @@ std::vector<FrameRow> read_frames_csv(const std::string& path) {
     std::stringstream ss(line);
     std::string cell;
     while (std::getline(ss, cell, ',')) c.push_back(cell);
-    rows.push_back({std::stod(c[5]), std::stod(c[6])});
+    rows.push_back({std::stod(c[5]), std::stod(c[6]), cell_or_nan(c[7]), cell_or_nan(c[8])});
   }
   return rows;
 }
@@ -249,6 +250,14 @@ void expect_motion_equals_distance(const std::string& subject_args, const std::s
     const nlohmann::json j = read_json(od + "/summary.json");
     EXPECT_NEAR(rows[k].ball_min, j["ball"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
     EXPECT_NEAR(rows[k].socket_min, j["socket"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
+    for (const char* body : {"ball", "socket"}) {
+      const double row = body[0] == 'b' ? rows[k].ball_min_distance : rows[k].socket_min_distance;
+      if (j[body]["min_distance_mm"].is_null()) {
+        EXPECT_TRUE(std::isnan(row)) << poses[k];
+      } else {
+        EXPECT_NEAR(row, j[body]["min_distance_mm"].get<double>(), 1e-6) << poses[k];
+      }
+    }
   }
 }
 }  // namespace
@@ -312,15 +321,57 @@ TEST(EndToEnd, MotionOnARealSubjectEqualsDistanceAndLoadsInVtk) {
   const TriangleMesh femur = load_mesh(std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/femur_r.ply");
   const TriangleMesh pelvis = load_mesh(std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/pelvis.ply");
   const auto rows = read_frames_csv(d + "/motion/frames.csv");
-  std::string expect_min;
-  for (const auto& r : rows) expect_min += std::to_string(std::min(r.ball_min, r.socket_min)) + ",";
+  std::string expect_min, expect_distance;
+  for (const auto& r : rows) {
+    expect_min += std::to_string(std::min(r.ball_min, r.socket_min)) + ",";
+    expect_distance += std::to_string(std::fmin(r.ball_min_distance, r.socket_min_distance)) + ",";
+  }
   const std::string cmd = "/usr/bin/python3 " + std::string(IMPINGE_SOURCE_DIR) + "/tests/check_pvd.py " + d +
                           "/motion/gaps.pvd " + std::to_string(femur.V.rows() + pelvis.V.rows()) + " " +
-                          std::to_string(femur.F.rows() + pelvis.F.rows()) + " " + expect_min + " 2>&1";
+                          std::to_string(femur.F.rows() + pelvis.F.rows()) + " " + expect_min + " " + expect_distance +
+                          " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
   char buf[512];
   while (fgets(buf, sizeof buf, p) != nullptr) out += buf;
   EXPECT_EQ(WEXITSTATUS(pclose(p)), 0) << out;
   EXPECT_NE(out.find("4 frames ok"), std::string::npos) << out;
+}
+
+// Issue 26's oracle: mc22's left hip at the walking trial's deepest extension, the femur rotated about the
+// head centre. An exact closest-point and winding-number oracle gave 98 femur vertices inside the pelvis, up
+// to 2.566 mm deep, and 32 pelvis vertices inside the femur, up to 1.793 mm; the radial gaps read -8.2 and
+// -27.0 mm there. The distances must match, with the layered maps and without (the distance scan covers the
+// hidden vertices itself), and the PLYs carry them.
+TEST(EndToEnd, DistancesMatchTheOracleAtMc22LeftsDeepestExtension) {
+  const std::string json = std::string(IMPINGE_SHARED_DATA) + "/mc22-left/subject.json";
+  if (!fs::exists(json)) GTEST_SKIP() << "shared data absent";
+  const std::string d = test::temp_dir("e2e_distance_oracle");
+  for (const std::string layers : {"4", "0"}) {
+    std::string out;
+    ASSERT_EQ(run("distance --subject " + json +
+                      " --precision 0.1 --pose=-20.1388166,5.28022299,-5.22400493 --joint-centre femoral-head "
+                      "--layers " + layers + " --out " + d + "/" + layers,
+                  &out),
+              0)
+        << out;
+    std::ifstream js(d + "/" + layers + "/summary.json");
+    const nlohmann::json j = nlohmann::json::parse(js);
+    EXPECT_TRUE(j["distances"].get<bool>());
+    EXPECT_NEAR(j["ball"]["min_distance_mm"].get<double>(), -2.566, 0.02) << layers;
+    EXPECT_NEAR(j["socket"]["min_distance_mm"].get<double>(), -1.793, 0.02) << layers;
+    EXPECT_EQ(j["ball"]["vertices_inside"], 98) << layers;
+    EXPECT_EQ(j["socket"]["vertices_inside"], 32) << layers;
+    EXPECT_LT(j["socket"]["min_gap_mm"].get<double>(), -20) << layers;  // the radial gap's artefact stays visible
+    std::ifstream ply(d + "/" + layers + "/ball_gaps.ply", std::ios::binary);
+    std::string header, line;
+    while (std::getline(ply, line) && line != "end_header") header += line + "\n";
+    EXPECT_NE(header.find("property float distance_mm"), std::string::npos) << header;
+  }
+  // Off: no distances anywhere.
+  ASSERT_EQ(run("distance --subject " + json + " --precision 1 --distances off --out " + d + "/off"), 0);
+  std::ifstream js(d + "/off/summary.json");
+  const nlohmann::json j = nlohmann::json::parse(js);
+  EXPECT_FALSE(j["distances"].get<bool>());
+  EXPECT_FALSE(j["ball"].contains("min_distance_mm"));
 }

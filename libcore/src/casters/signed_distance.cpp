@@ -54,6 +54,7 @@ constexpr double kBoxMarginMm = 1e-3;  // the float hierarchy's boxes against th
 struct SignedDistanceQuery::Impl {
   std::vector<Eigen::Vector3d> a, b, c;      // the kept triangles' corners, double, mesh frame
   std::vector<std::int64_t> face;            // kept triangle -> index in the mesh's F
+  std::vector<std::int64_t> kept;            // index in the mesh's F -> kept triangle, or -1
   std::vector<std::array<std::int32_t, 3>> corner;  // kept triangle -> vertex indices
   std::vector<Eigen::Vector3d> face_normal;  // unit, outward
   std::vector<Eigen::Vector3d> edge_normal;  // 3 per kept triangle: sum of the two faces' normals
@@ -112,6 +113,8 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
     volume += a.dot(b.cross(c)) / 6;
   }
   require(!m.a.empty(), "signed distance: " + mesh.source + " has no triangle of nonzero area");
+  m.kept.assign(static_cast<std::size_t>(mesh.F.rows()), -1);
+  for (std::size_t t = 0; t < m.face.size(); ++t) m.kept[static_cast<std::size_t>(m.face[t])] = static_cast<std::int64_t>(t);
   orientation_ = m.orientation = volume >= 0 ? 1 : -1;
   const std::size_t k = m.a.size();
   for (auto& n : m.face_normal) n *= m.orientation;
@@ -231,16 +234,23 @@ bool visit(RTCPointQueryFunctionArguments* args) {
 }
 #endif
 
-bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius) {
+bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int64_t seed = -1) {
   require(radius > 0, "signed distance: the query radius must be > 0 mm");
   s.best = radius;
+  if (seed >= 0 && seed < static_cast<std::int64_t>(m.kept.size()) && m.kept[static_cast<std::size_t>(seed)] >= 0) {
+    const auto t = static_cast<std::size_t>(m.kept[static_cast<std::size_t>(seed)]);
+    Eigen::Vector3d point;
+    int feature = 0;
+    const double d = m.distance_to(t, s.q, point, feature);
+    if (d <= s.best) s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
+  }
 #ifdef IMPINGE_HAVE_EMBREE
   RTCPointQuery query;
   query.x = static_cast<float>(s.q.x() - m.shift.x());
   query.y = static_cast<float>(s.q.y() - m.shift.y());
   query.z = static_cast<float>(s.q.z() - m.shift.z());
   query.time = 0.f;
-  query.radius = std::isfinite(radius) ? static_cast<float>(radius + kBoxMarginMm) : std::numeric_limits<float>::infinity();
+  query.radius = std::isfinite(s.best) ? static_cast<float>(s.best + kBoxMarginMm) : std::numeric_limits<float>::infinity();
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   rtcPointQuery(m.scene, &query, &context, visit, &s);
@@ -274,9 +284,9 @@ bool SignedDistanceQuery::any_within(const Eigen::Vector3d& q, double radius_mm)
 }
 
 bool SignedDistanceQuery::signed_distance(const Eigen::Vector3d& q, double radius_mm, int hint,
-                                          ClosestSurfacePoint& out) const {
+                                          ClosestSurfacePoint& out, std::int64_t seed) const {
   Search s{impl_.get(), q, 0, -1, {}, 0, false};
-  if (!run(*impl_, s, radius_mm)) return false;
+  if (!run(*impl_, s, radius_mm, seed)) return false;
   const Impl& m = *impl_;
   const auto t = static_cast<std::size_t>(s.kept);
   bool trusted = true;

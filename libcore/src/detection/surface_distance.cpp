@@ -97,6 +97,7 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       ++st.clusters_pruned;
       continue;
     }
+    std::int64_t seed = -1;  // the previous vertex's closest triangle: neighbours share them
     for (std::size_t k = b; k < e; ++k) {
       const auto i = static_cast<std::size_t>(set.index[k]);
       const Eigen::Vector3d q = R * set.position[k] + shift;
@@ -104,9 +105,10 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       const int hint = g > kHintMm ? 1 : (g < -kHintMm ? -1 : 0);
       double radius = reach_mm;
       if (std::isfinite(g)) radius = g < -reach_mm ? -g + kBoundMarginMm : std::min(reach_mm, std::abs(g) + kBoundMarginMm);
-      bool found = other.signed_distance(q, radius, hint, cp);
-      if (!found && radius < reach_mm) found = other.signed_distance(q, reach_mm, hint, cp);
+      bool found = other.signed_distance(q, radius, hint, cp, seed);
+      if (!found && radius < reach_mm) found = other.signed_distance(q, reach_mm, hint, cp, seed);
       if (!found) continue;
+      seed = cp.triangle;
       distance_mm[i] = static_cast<float>(cp.signed_mm());
       ++st.measured;
       st.winding += cp.rule == SignRule::winding_number;

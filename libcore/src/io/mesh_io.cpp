@@ -122,21 +122,25 @@ void write_faces(std::ofstream& os, const Faces& F) {
 
 void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const Eigen::VectorXf& gap_mm,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 1>& level,
-                   const Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor>& rgb) {
-  require(gap_mm.size() == V.rows() && level.size() == V.rows() && rgb.rows() == V.rows(),
+                   const Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor>& rgb,
+                   const Eigen::VectorXf* distance_mm) {
+  require(gap_mm.size() == V.rows() && level.size() == V.rows() && rgb.rows() == V.rows() &&
+              (distance_mm == nullptr || distance_mm->size() == V.rows()),
           path + ": per-vertex arrays do not match the vertex count");
   std::ofstream os(path, std::ios::binary);
   require(os.good(), path + ": cannot open for writing");
   os << "ply\nformat binary_little_endian 1.0\ncomment impinge per-vertex gap (mm)\n"
      << "element vertex " << V.rows() << "\n"
      << "property float x\nproperty float y\nproperty float z\n"
-     << "property float gap_mm\nproperty float quality\nproperty uchar level\n"
+     << "property float gap_mm\nproperty float quality\n"
+     << (distance_mm != nullptr ? "property float distance_mm\n" : "") << "property uchar level\n"
      << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
      << "element face " << F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     for (int k = 0; k < 3; ++k) put<float>(os, static_cast<float>(V(i, k)));
     put<float>(os, gap_mm[i]);
     put<float>(os, gap_mm[i]);
+    if (distance_mm != nullptr) put<float>(os, (*distance_mm)[i]);
     put<std::uint8_t>(os, level[i]);
     for (int k = 0; k < 3; ++k) put<std::uint8_t>(os, rgb(i, k));
   }

@@ -30,7 +30,12 @@ void write_body_ply(const std::string& path, const ImpingementLevels& levels, co
     const auto c = level_colour(level[i], levels.count(), is_ball);
     rgb.row(i) << c[0], c[1], c[2];
   }
-  write_gap_ply(path, V, body.mesh.F, gap, level, rgb);
+  if (gaps.distance_mm.empty()) {
+    write_gap_ply(path, V, body.mesh.F, gap, level, rgb);
+  } else {
+    const Eigen::VectorXf distance = Eigen::Map<const Eigen::VectorXf>(gaps.distance_mm.data(), n);
+    write_gap_ply(path, V, body.mesh.F, gap, level, rgb, &distance);
+  }
 }
 }  // namespace
 
@@ -59,7 +64,14 @@ void write_pose_vtp(const std::string& path, const Session& s, const PoseResult&
   level.u8.insert(level.u8.end(), ls.begin(), ls.end());
   body.u8.assign(static_cast<std::size_t>(nb), 0);
   body.u8.resize(static_cast<std::size_t>(nb + np), 1);
-  write_vtp(path, V, F, {gap, level, body});
+  if (res.ball_gaps.distance_mm.empty()) {
+    write_vtp(path, V, F, {gap, level, body});
+    return;
+  }
+  PointArray distance{"distance_mm", {}, {}};
+  distance.f32 = res.ball_gaps.distance_mm;
+  distance.f32.insert(distance.f32.end(), res.socket_gaps.distance_mm.begin(), res.socket_gaps.distance_mm.end());
+  write_vtp(path, V, F, {gap, distance, level, body});
 }
 
 }  // namespace impinge

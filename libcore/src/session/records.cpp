@@ -96,6 +96,13 @@ nlohmann::json scan_record(const JointBody& body, const ScanSummary& s, double d
   j["vertices_tested_layered"] = s.vertices_tested_layered;
   j["min_gap_layered_mm"] = number_or_null(s.min_gap_layered_mm);
   j["min_gap_mm"] = number_or_null(s.min_gap_mm);
+  if (body.distance_query != nullptr) {  // distances on (JointOptions::distances)
+    j["min_distance_mm"] = number_or_null(s.min_distance_mm);
+    j["vertices_distance"] = s.vertices_distance;
+    j["vertices_inside"] = s.vertices_inside;
+    j["area_inside_mm2"] = s.area_inside_mm2;
+    j["distance_signs_by_winding_number"] = s.distance_winding;
+  }
   j["vertices_penetrating"] = s.vertices_penetrating;
   j["area_penetrating_mm2"] = s.area_penetrating_mm2;
   nlohmann::json lv = nlohmann::json::array();
@@ -196,6 +203,8 @@ nlohmann::json setup_record(const Session& s) {
   j["exact_at_discontinuities"] = opt.exact_at_discontinuities && s.joint().ball().exact != nullptr;
   j["discontinuity_tolerance_mm"] = opt.discontinuity_tolerance_mm;
   j["layers"] = opt.layers;
+  j["distances"] = opt.distances;
+  if (opt.distances) j["distance_reach_mm"] = opt.reach_mm();
   j["nodes_marked"] = {{"ball", s.joint().ball().nodes_marked}, {"socket", s.joint().socket().nodes_marked}};
   j["neutral"] = hip.neutral() == Neutral::anatomical ? "anatomical" : "scan";
   j["warnings"] = s.warnings();
@@ -250,6 +259,10 @@ nlohmann::json pose_record(const Session& s, const PoseAngles& pose, const Femur
   j["ball"] = scan_record(s.joint().ball(), res.ball, res.ball_detection_ms, levels, clocks ? &ball_clock : nullptr);
   j["socket"] =
       scan_record(s.joint().socket(), res.socket, res.socket_detection_ms, levels, clocks ? &socket_clock : nullptr);
+  if (s.joint_options().distances) {
+    j["ball"]["distance_ms"] = res.ball_distance_ms;
+    j["socket"]["distance_ms"] = res.socket_distance_ms;
+  }
   // Where each scan comes closest, classed (articular, intra- or extra-articular impingement).
   for (const bool ball : {true, false})
     j[ball ? "ball" : "socket"]["closest_contact_class"] =

@@ -11,6 +11,7 @@ namespace impinge {
 std::vector<std::string> motion_columns(const ImpingementLevels& levels) {
   std::vector<std::string> c = {"frame",           "time_s",          "flexion_deg",          "adduction_deg",
                                 "internal_rotation_deg", "ball_min_gap_mm", "socket_min_gap_mm",
+                                "ball_min_distance_mm", "socket_min_distance_mm",
                                 "penetrating_area_mm2",  "ball_penetrating_area_mm2"};
   for (int k = 0; k < levels.count(); ++k) c.push_back("socket_level" + std::to_string(k) + "_area_mm2");
   for (const char* name : {"socket_closest_clock_h", "femur_closest_clock_h", "socket_closest_x_mm",
@@ -29,6 +30,8 @@ nlohmann::json motion_row(const MotionFrame& f) {
                         f.angles.internal_rotation_deg,
                         number_or_null(r.ball.min_gap_mm),
                         number_or_null(r.socket.min_gap_mm),
+                        number_or_null(r.ball.min_distance_mm),
+                        number_or_null(r.socket.min_distance_mm),
                         r.socket.area_penetrating_mm2,
                         r.ball.area_penetrating_mm2};
   for (double area : r.socket.level_area_mm2) row.push_back(area);

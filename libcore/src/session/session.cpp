@@ -206,6 +206,10 @@ HipJointOptions hip_joint_options(const MapSettings& m, const FrameSettings& f, 
   require(std::isfinite(m.layered_spacing_deg) && m.layered_spacing_deg >= 0 && m.layered_spacing_deg <= 90,
           "layered-spacing " + num(m.layered_spacing_deg) + ": must be 0 (the maps' own) to 90 deg");
   jo.layered_spacing_deg = m.layered_spacing_deg;
+  require(std::isfinite(m.distance_reach_mm) && m.distance_reach_mm >= 0,
+          "distance-reach " + num(m.distance_reach_mm) + ": must be 0 (the largest level threshold) or > 0 mm");
+  jo.distances = m.distances;
+  jo.distance_reach_mm = m.distance_reach_mm;
   require(m.ball_map_file.empty() == m.socket_map_file.empty(), "maps: give both map files (ball and socket) or none");
   o.ball_map_file = m.ball_map_file;
   o.socket_map_file = m.socket_map_file;

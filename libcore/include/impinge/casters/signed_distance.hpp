@@ -70,8 +70,12 @@ class SignedDistanceQuery {
   bool any_within(const Eigen::Vector3d& q, double radius_mm) const;
   /// The signed distance (closest, then the sign by the rule of the file comment). `hint`: the sign the
   /// caller expects (+1 outside, -1 inside) or 0 for none; where it disagrees with the pseudo-normal
-  /// the winding number decides. Returns false when nothing lies within the radius.
-  bool signed_distance(const Eigen::Vector3d& q, double radius_mm, int hint, ClosestSurfacePoint& out) const;
+  /// the winding number decides. `seed`: a triangle (index into the mesh's F, or -1) likely to be close,
+  /// for example a neighbouring point's closest: its distance shrinks the search radius before the
+  /// hierarchy is walked (the answer does not depend on it). Returns false when nothing lies within the
+  /// radius.
+  bool signed_distance(const Eigen::Vector3d& q, double radius_mm, int hint, ClosestSurfacePoint& out,
+                       std::int64_t seed = -1) const;
   /// The generalised winding number of the surface at q (Jacobson et al. 2013): 1 inside a closed
   /// surface wound outward, 0 outside, fractional near the holes of an open one. Exact sum over every
   /// triangle, O(m).

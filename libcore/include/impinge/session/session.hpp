@@ -76,6 +76,8 @@ struct MapSettings {
   int layers = 0;                       ///< layered maps of this many crossings per node (0: off)
   double extra_articular_radius_mm = 150;
   double layered_spacing_deg = 0.5;     ///< the layered maps' largest node spacing (JointOptions), deg
+  bool distances = false;               ///< Euclidean distances beside the gaps (JointOptions::distances)
+  double distance_reach_mm = 0;         ///< their reach, mm; 0: the largest level threshold
   std::string ball_map_file, socket_map_file;  ///< saved maps to load instead of sampling (both or neither)
 };
 
