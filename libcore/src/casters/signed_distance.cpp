@@ -62,6 +62,18 @@ struct SignedDistanceQuery::Impl {
   std::vector<Eigen::Vector3d> vertex_normal;
   std::vector<std::uint8_t> vertex_irregular;
   int orientation = 1;
+  // The winding number's hierarchy (Barill et al. 2018): nodes over `order` (kept triangles), each with
+  // its area vector (sum of (b - a) x (c - a) / 2 in the triangles' own winding), area-weighted centroid
+  // and the radius of a ball about it holding its triangles.
+  struct Node {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero(), area = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();  // sum of (centroid - centre) area_vector^T
+    double radius = 0;
+    std::int32_t begin = 0, end = 0, left = -1, right = -1;
+  };
+  std::vector<Node> nodes;
+  std::vector<std::int32_t> order;
+  std::int32_t build_node(std::int32_t begin, std::int32_t end);
 
   /// The closest point of kept triangle k to q, with its feature.
   double distance_to(std::size_t k, const Eigen::Vector3d& q, Eigen::Vector3d& point, int& feature) const {
@@ -87,6 +99,43 @@ struct SignedDistanceQuery::Impl {
   Tree tree;
 #endif
 };
+
+std::int32_t SignedDistanceQuery::Impl::build_node(std::int32_t begin, std::int32_t end) {
+  const auto id = static_cast<std::int32_t>(nodes.size());
+  nodes.emplace_back();
+  Node n;
+  n.begin = begin, n.end = end;
+  double total = 0;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (std::int32_t k = begin; k < end; ++k) {
+    const auto t = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
+    const Eigen::Vector3d av = (b[t] - a[t]).cross(c[t] - a[t]) / 2, g = (a[t] + b[t] + c[t]) / 3;
+    n.area += av;
+    n.centre += av.norm() * g;
+    total += av.norm();
+    lo = lo.cwiseMin(g), hi = hi.cwiseMax(g);
+  }
+  n.centre /= total;
+  for (std::int32_t k = begin; k < end; ++k) {
+    const auto t = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
+    n.radius = std::max({n.radius, (a[t] - n.centre).norm(), (b[t] - n.centre).norm(), (c[t] - n.centre).norm()});
+    const Eigen::Vector3d av = (b[t] - a[t]).cross(c[t] - a[t]) / 2, g = (a[t] + b[t] + c[t]) / 3;
+    n.moment += (g - n.centre) * av.transpose();
+  }
+  if (end - begin > 8) {
+    int axis = 0;
+    (hi - lo).maxCoeff(&axis);
+    const std::int32_t mid = begin + (end - begin) / 2;
+    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, [&](std::int32_t x, std::int32_t y) {
+      const auto i = static_cast<std::size_t>(x), j = static_cast<std::size_t>(y);
+      return a[i][axis] + b[i][axis] + c[i][axis] < a[j][axis] + b[j][axis] + c[j][axis];
+    });
+    n.left = build_node(begin, mid);
+    n.right = build_node(mid, end);
+  }
+  nodes[static_cast<std::size_t>(id)] = n;
+  return id;
+}
 
 bool SignedDistanceQuery::available() {
 #if defined(IMPINGE_HAVE_EMBREE) || defined(IMPINGE_HAVE_CGAL)
@@ -158,6 +207,9 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
     i = j;
   }
   irregular_edges_ = irregular;
+  m.order.resize(k);
+  for (std::size_t t = 0; t < k; ++t) m.order[t] = static_cast<std::int32_t>(t);
+  m.build_node(0, static_cast<std::int32_t>(k));
   // Corners: normals weighted by the triangle's angle there.
   for (std::size_t t = 0; t < k; ++t) {
     const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
@@ -308,7 +360,7 @@ bool SignedDistanceQuery::signed_distance(const Eigen::Vector3d& q, double radiu
   if (hint != 0 && s.best > 1e-6 && hint != sign) trusted = false;
   out.rule = SignRule::pseudo_normal;
   if (!trusted && s.best > 1e-6) {
-    sign = winding_number(q) >= 0.5 ? -1 : 1;
+    sign = inside_by_winding_number(q) ? -1 : 1;
     out.rule = SignRule::winding_number;
   }
   out.distance_mm = s.best;
@@ -318,17 +370,60 @@ bool SignedDistanceQuery::signed_distance(const Eigen::Vector3d& q, double radiu
   return true;
 }
 
+namespace {
+/// Half the solid angle of triangle (A, B, C) seen from q (van Oosterom & Strackee 1983).
+double half_solid_angle(const Eigen::Vector3d& q, const Eigen::Vector3d& A, const Eigen::Vector3d& B,
+                        const Eigen::Vector3d& C) {
+  const Eigen::Vector3d a = A - q, b = B - q, c = C - q;
+  const double la = a.norm(), lb = b.norm(), lc = c.norm();
+  const double det = a.dot(b.cross(c));
+  const double div = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+  return std::atan2(det, div);
+}
+constexpr double kDipoleBeta = 4;     // a cluster farther than this many of its radii away is a dipole
+constexpr double kFastMargin = 0.1;   // the hierarchical sum decides when this far from 1/2
+}  // namespace
+
 double SignedDistanceQuery::winding_number(const Eigen::Vector3d& q) const {
   const Impl& m = *impl_;
   double sum = 0;
-  for (std::size_t t = 0; t < m.a.size(); ++t) {
-    const Eigen::Vector3d a = m.a[t] - q, b = m.b[t] - q, c = m.c[t] - q;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    const double det = a.dot(b.cross(c));
-    const double div = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    sum += std::atan2(det, div);  // half the solid angle (van Oosterom & Strackee 1983)
+  for (std::size_t t = 0; t < m.a.size(); ++t) sum += half_solid_angle(q, m.a[t], m.b[t], m.c[t]);
+  return m.orientation * sum / (2 * M_PI);
+}
+
+double SignedDistanceQuery::winding_number_fast(const Eigen::Vector3d& q) const {
+  const Impl& m = *impl_;
+  double sum = 0;
+  std::int32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Impl::Node& n = m.nodes[static_cast<std::size_t>(stack[--top])];
+    const Eigen::Vector3d d = n.centre - q;
+    const double dist = d.norm();
+    if (dist > kDipoleBeta * n.radius) {
+      // Half the solid angle of the cluster's dipoles, to second order about its centre: with
+      // F(x) = x / |x|^3 and J = dF/dx = I / |d|^3 - 3 d d^T / |d|^5, sum_t a_t . F(d + e_t) ~
+      // N . F(d) + tr(J M) (Barill et al. 2018, eq. 11-12).
+      const double d2 = dist * dist, d3 = d2 * dist;
+      sum += (n.area.dot(d) / d3 + n.moment.trace() / d3 - 3 * d.dot(n.moment * d) / (d3 * d2)) / 2;
+    } else if (n.left < 0 || top + 2 > 128) {
+      for (std::int32_t k = n.begin; k < n.end; ++k) {
+        const auto t = static_cast<std::size_t>(m.order[static_cast<std::size_t>(k)]);
+        sum += half_solid_angle(q, m.a[t], m.b[t], m.c[t]);
+      }
+    } else {
+      stack[top++] = n.left;
+      stack[top++] = n.right;
+    }
   }
   return m.orientation * sum / (2 * M_PI);
+}
+
+bool SignedDistanceQuery::inside_by_winding_number(const Eigen::Vector3d& q) const {
+  const double fast = winding_number_fast(q);
+  if (std::abs(fast - 0.5) > kFastMargin) return fast > 0.5;
+  return winding_number(q) >= 0.5;
 }
 
 }  // namespace impinge

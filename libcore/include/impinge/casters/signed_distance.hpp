@@ -15,8 +15,11 @@
 ///    weighted by their angles there; outside when (q - c) . n >= 0. Exact for a closed, manifold,
 ///    consistently wound mesh without self-intersections.
 /// 2. Where that cannot be trusted, the generalised winding number (Jacobson, Kavan & Sorkine-Hornung
-///    2013, ACM TOG 32(4):33), inside when w >= 1/2: exact over every triangle (solid angles by van
-///    Oosterom & Strackee 1983), O(m) per point. It is robust on open, non-manifold and
+///    2013, ACM TOG 32(4):33), inside when w >= 1/2, solid angles by van Oosterom & Strackee 1983. It is
+///    first summed over a hierarchy whose clusters farther than 3 of their radii are dipoles (Barill et
+///    al. 2018, ACM TOG 37(4):43, second order; O(log m)); where that sum lies within 0.1 of 1/2 (its
+///    error on the shared hips stays below 0.01: tests/casters/signed_distance_test), the exact sum over
+///    every triangle decides (O(m)). It is robust on open, non-manifold and
 ///    self-intersecting meshes, where the pseudo-normal is not. It decides when the closest feature
 ///    touches a boundary or non-manifold edge, or an edge whose two faces are wound against each
 ///    other; when q lies almost in the feature's tangent plane (|cos| < 1e-3 at a distance above
@@ -80,6 +83,11 @@ class SignedDistanceQuery {
   /// surface wound outward, 0 outside, fractional near the holes of an open one. Exact sum over every
   /// triangle, O(m).
   double winding_number(const Eigen::Vector3d& q) const;
+  /// The same by the hierarchy (far clusters as dipoles; the file comment), O(log m), within about 0.01.
+  double winding_number_fast(const Eigen::Vector3d& q) const;
+  /// Whether q is inside by the winding number (>= 1/2): the hierarchical sum, or the exact one where the
+  /// hierarchical lies within 0.1 of 1/2.
+  bool inside_by_winding_number(const Eigen::Vector3d& q) const;
 
   /// Edges with other than two faces, or whose two faces are wound against each other.
   std::int64_t irregular_edges() const { return irregular_edges_; }
