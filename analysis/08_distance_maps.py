@@ -1,8 +1,10 @@
 """08_distance_maps: gap statistics on the real joints and the generated model, map images
 (thesis Fig. 31), colour-mapped renders of both bones (Fig. 41-42), RSID beside USID (Fig. 50).
 
-Reads RESULTS/08_distance_maps/gap_statistics.csv, vertex_gaps.csv, clock_faces.csv and the
-render_<subject>_<body>.ply meshes the driver wrote; writes table_finest.tex, table_convergence.tex,
+Reads RESULTS/08_distance_maps/gap_statistics.csv, vertex_gaps.csv, clock_faces.csv,
+radial_vs_distance.csv, radial_vs_distance_vertices.csv and the
+render_<subject>_<body>.ply meshes the driver wrote; writes table_radial_vs_distance.tex,
+radial_vs_distance.pdf (the radial gap against the Euclidean distance, issue 26), table_finest.tex, table_convergence.tex,
 table_acetabulum.tex, table_usid.tex, table_schemes.tex, min_gap.pdf, levels.pdf, maps_<subject>.pdf (map images with colour bars), render_<subject>.pdf (shaded, with the clock face), macros.tex."""
 import json
 import os
@@ -227,8 +229,51 @@ write_table(d, "table_schemes", ["subject", "scheme", "resolution", "equiang. mi
             align="llrrrrrrrrrr")
 others = ot[(ot.precision_deg == other_p) & (ot.scan == "ball")]
 
+# The radial gap of the thesis against the Euclidean distance (issue 26): table and scatter.
+rv = read_csv(d, "radial_vs_distance.csv")
+rvv = read_csv(d, "radial_vs_distance_vertices.csv")
+rows = []
+for _, r in rv.iterrows():
+    rows.append([r.subject, r.pose, r.scan, f"{int(r.vertices_both):,}", f"{int(r.differ_1mm):,}",
+                 f"{int(r.differ_1mm_articular)}/{int(r.differ_1mm_intra_articular)}/{int(r.differ_1mm_extra_articular)}",
+                 f"{r.max_abs_diff_mm:.1f}", f"{int(r.distance_without_gap):,}", f"{int(r.inside_by_distance)}",
+                 f"{int(r.inside_missed_by_gap)}", f"{r.min_gap_mm:.2f}", f"{r.min_distance_mm:.2f}",
+                 f"{r.area_penetrating_gap_mm2:.0f}", f"{r.area_penetrating_distance_mm2:.0f}"])
+write_table(d, "table_radial_vs_distance",
+            ["subject", "pose", "scan", "both", "$>1$ mm", "art./intra/extra", "max (mm)", "no gap", "inside",
+             "missed", "min gap", "min dist.", "pen. area gap", "pen. area dist."], rows, align="lllrrrrrrrrrrr")
+rv_subjects = list(dict.fromkeys(rvv.subject))
+fig, axes = plt.subplots(1, max(1, len(rv_subjects)), figsize=(2.4 * max(1, len(rv_subjects)), 2.6), sharey=True,
+                         squeeze=False)
+pose_colour = {"scan": "#1f77b4", "flexion90": "#ff7f0e", "extension20": "#2ca02c"}
+for ax, s_ in zip(axes[0], rv_subjects):
+    for pose, c in pose_colour.items():
+        g = rvv[(rvv.subject == s_) & (rvv.pose == pose) & np.isfinite(rvv.gap_mm)]
+        ax.scatter(np.clip(g.gap_mm, -10, 10), g.distance_mm, s=1, color=c, alpha=0.4, label=pose, rasterized=True)
+    ax.plot([-10, 10], [-10, 10], "k-", lw=0.5)
+    ax.axhline(0, color="k", lw=0.3)
+    ax.axvline(0, color="k", lw=0.3)
+    ax.set_xlim(-10.5, 10.5)
+    ax.set_ylim(-4, 6.5)
+    ax.set_title(s_, fontsize=8)
+    ax.set_xlabel("radial gap (mm; clipped at $\pm$10)", fontsize=7)
+    ax.tick_params(labelsize=7)
+axes[0][0].set_ylabel("Euclidean distance (mm)", fontsize=7)
+axes[0][-1].legend(fontsize=6, markerscale=6, loc="lower right")
+fig.tight_layout()
+save(fig, d, "radial_vs_distance")
+both = rv.vertices_both.sum()
+
 pen = st[(st.precision_deg == finest) & (st["mode"] == "exact") & (st.scan == "ball")]
 write_macros(d, "macros", {
+    "RDvertices": f"{int(both):,}",
+    "RDdifferShare": f"{100 * rv.differ_1mm.sum() / max(both, 1):.1f}",
+    "RDmaxDiff": f"{rv.max_abs_diff_mm.max():.1f}",
+    "RDwithoutGap": f"{int(rv.distance_without_gap.sum()):,}",
+    "RDinside": f"{int(rv.inside_by_distance.sum()):,}",
+    "RDmissed": f"{int(rv.inside_missed_by_gap.sum()):,}",
+    "RDreach": f"{meta['parameters']['radial_vs_distance']['reach_mm']:g}",
+    "RDprecision": f"{meta['parameters']['radial_vs_distance']['precision_deg']:g}",
     "DMfinest": f"{finest:g}",
     "DMsubjects": str(len(subjects)),
     "DMotherSpacing": f"{other_p:g}",

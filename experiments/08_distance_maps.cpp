@@ -18,6 +18,12 @@
 //                       clinical angles of poses.csv, and the pelvis within 150 mm, in the pelvic frame:
 //                       the README's figure of the ISB angles
 //   poses.csv           pose, flexion_deg, adduction_deg, internal_rotation_deg
+//   radial_vs_distance.csv  (issue 26) one row per subject x pose x scan: the radial gap of the thesis
+//                       beside the Euclidean distance (the CLI's defaults: layers 4, distances within
+//                       6 mm), where they differ by more than 1 mm and in which contact class, and what
+//                       the penetrating area and the thesis' levels become under each
+//   radial_vs_distance_vertices.csv  per vertex within 6 mm of the other bone: gap and distance (every
+//                       k-th vertex, at most 4000 per row of the table above), for the scatter figure
 //   meta.json
 // Command: build/experiments/exp_08_distance_maps --out results --data ../shared/data/hips [--quick]
 // Precisions 1, 0.5 and (outside quick mode) 0.1 and 0.05 deg, each with the helix of matched turns
@@ -35,6 +41,7 @@
 #include "impinge/anatomy/clock_face.hpp"
 #include "impinge/anatomy/sphere_fit.hpp"
 #include "impinge/clinical/hip_joint.hpp"
+#include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
 #include "impinge/detection/joint.hpp"
@@ -244,6 +251,86 @@ void write_renders(const std::vector<Subject>& subjects, const std::string& dir,
   }
 }
 
+// The radial gap against the Euclidean distance (issue 26, item 5), at the scan pose and two clinical
+// poses, with the CLI's defaults (layered maps, the joint-centre method of the neutral) and distances within
+// `reach` mm. Both quantities per vertex; their differences by contact class; and the penetrating area and
+// level areas under each.
+void radial_vs_distance(const std::vector<Subject>& subjects, const std::string& dir, double precision, double reach) {
+  CsvWriter table(dir + "/radial_vs_distance.csv",
+                  {"subject", "pose", "scan", "vertices_distance", "vertices_both", "differ_1mm", "differ_1mm_articular",
+                   "differ_1mm_intra_articular", "differ_1mm_extra_articular", "max_abs_diff_mm", "p95_abs_diff_mm",
+                   "distance_without_gap", "inside_by_distance", "inside_missed_by_gap", "min_gap_mm",
+                   "min_distance_mm", "area_penetrating_gap_mm2", "area_penetrating_distance_mm2",
+                   "area_red_gap_mm2", "area_red_distance_mm2", "signs_by_winding_number"});
+  CsvWriter vertices(dir + "/radial_vs_distance_vertices.csv", {"subject", "pose", "scan", "vertex", "gap_mm", "distance_mm"});
+  const std::vector<std::pair<std::string, PoseAngles>> poses{
+      {"scan", {0, 0, 0}}, {"flexion90", {90, 0, 0}}, {"extension20", {-20, 5, -5}}};
+  for (const Subject& s : subjects) {
+    MapSettings maps;
+    maps.precision = precision;
+    maps.layers = 4;
+    maps.distances = true;
+    maps.distance_reach_mm = reach;
+    SessionOptions so = session_options(s, maps);
+    so.frames.joint_centre.clear();  // the CLI's default for the neutral
+    const Session session(so);
+    const HipJoint& hip = session.hip();
+    const ImpingementLevels& levels = session.joint_options().levels;
+    const double red = levels.thresholds_mm[levels.thresholds_mm.size() - 2];  // the last level above contact
+    for (const auto& [name, angles] : poses) {
+      const FemurPose pose = name == "scan" ? hip.scan_pose() : hip.femur_pose(angles);
+      const PoseResult res = hip.joint().detect(pose.R, pose.t);
+      for (const bool ball : {true, false}) {
+        const ScanGaps& g = ball ? res.ball_gaps : res.socket_gaps;
+        const ScanSummary& sum = ball ? res.ball : res.socket;
+        const Eigen::VectorXd& area = ball ? hip.joint().ball().vertex_area : hip.joint().socket().vertex_area;
+        std::int64_t both = 0, differ = 0, without_gap = 0, inside = 0, missed = 0;
+        std::int64_t by_class[4] = {0, 0, 0, 0};
+        double area_pen_gap = 0, area_pen_dist = 0, area_red_gap = 0, area_red_dist = 0;
+        std::vector<double> diffs;
+        std::vector<std::size_t> within;
+        for (std::size_t i = 0; i < g.distance_mm.size(); ++i) {
+          const double gap = g.gap_mm[i], d = g.distance_mm[i];
+          const double a = area[static_cast<Eigen::Index>(i)];
+          if (std::isfinite(gap)) {
+            if (gap <= 0) area_pen_gap += a;
+            if (gap < red) area_red_gap += a;
+          }
+          if (!std::isfinite(d)) continue;
+          within.push_back(i);
+          if (d <= 0) area_pen_dist += a;
+          if (d < red) area_red_dist += a;
+          if (d < 0) {
+            ++inside;
+            if (!(gap < 0)) ++missed;
+          }
+          if (!std::isfinite(gap)) {
+            ++without_gap;
+            continue;
+          }
+          ++both;
+          diffs.push_back(std::abs(gap - d));
+          if (std::abs(gap - d) > 1) {
+            ++differ;
+            ++by_class[static_cast<int>(hip.contact_class(ball, static_cast<std::int64_t>(i), pose, kIntraArticularMarginMm))];
+          }
+        }
+        std::sort(diffs.begin(), diffs.end());
+        const double nan = std::nan("");
+        table.row(s.name, name, ball ? "ball" : "socket", sum.vertices_distance, both, differ, by_class[1], by_class[2],
+                  by_class[3], diffs.empty() ? nan : diffs.back(), diffs.empty() ? nan : quantile(diffs, 0.95),
+                  without_gap, inside, missed, sum.min_gap_mm, sum.min_distance_mm, area_pen_gap, area_pen_dist,
+                  area_red_gap, area_red_dist, sum.distance_winding);
+        const std::size_t stride = std::max<std::size_t>(1, (within.size() + 3999) / 4000);
+        for (std::size_t k = 0; k < within.size(); k += stride) {
+          const std::size_t i = within[k];
+          vertices.row(s.name, name, ball ? "ball" : "socket", static_cast<std::int64_t>(i), g.gap_mm[i], g.distance_mm[i]);
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -277,6 +364,8 @@ int main(int argc, char** argv) {
   }
   const double render_precision = 0.25, render_radius = 60;
   write_renders(subjects, dir, render_precision, render_radius);
+  const double distance_precision = args.quick ? 0.5 : 0.1, distance_reach = 6;
+  radial_vs_distance(subjects, dir, distance_precision, distance_reach);
 
   nlohmann::json subj = nlohmann::json::array();
   for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
@@ -292,6 +381,9 @@ int main(int argc, char** argv) {
               {"render", {{"precision_deg", render_precision}, {"mode", "exact"}, {"region_mm", render_radius},
                           {"frame", "pelvic (ISB, Wu et al. 2002) for real subjects; scan axes for generated"},
                           {"pose", "scan pose"}}},
+              {"radial_vs_distance", {{"precision_deg", distance_precision}, {"reach_mm", distance_reach},
+                                      {"layers", 4}, {"joint_centre", "the CLI's default for the neutral"},
+                                      {"poses", "scan pose; flexion 90; extension 20, adduction 5, rotation -5"}}},
               {"occlusion_tolerance_mm", JointOptions{}.occlusion_tolerance_mm},
               {"levels_thresholds_mm", ImpingementLevels{}.thresholds_mm}});
   return 0;
