@@ -2,6 +2,7 @@
 0.1 deg, sampling included).
 
 usage: /usr/bin/python3 benchmarks/motion_1000.py [SUBJECT_JSON] [--resolution DEG] [--repetitions N]
+       [-- MORE OPTIONS OF impinge motion, e.g. --distances off --layers 0]
 Writes a synthetic ROM trial (flexion 0..90, adduction -10..10, internal rotation -20..20 deg as
 sines, 100 Hz) as an OpenSim .mot file in a temporary folder, runs build/impinge motion on it N times
 (default 5) without VTP files and with the default ones, and prints the medians of the total wall time
@@ -19,6 +20,7 @@ args = [a for a in sys.argv[1:]]
 subject = args[0] if args and not args[0].startswith("--") else os.path.join(root, "..", "shared", "data", "hips",
                                                                             "lhdl-ct", "subject.json")
 res = args[args.index("--resolution") + 1] if "--resolution" in args else "0.1"
+extra_args = args[args.index("--") + 1:] if "--" in args else []  # more options of impinge motion
 reps = int(args[args.index("--repetitions") + 1]) if "--repetitions" in args else 5
 d = tempfile.mkdtemp(prefix="impinge_motion_")
 mot = os.path.join(d, "rom.mot")
@@ -34,7 +36,7 @@ for label, extra in (("no VTP files", ["--vtp-every", "1000000"]), ("default VTP
     for _ in range(reps):
         out = os.path.join(d, "out")
         subprocess.run([os.path.join(root, "build", "impinge"), "motion", "--subject", subject, "--motion", mot,
-                        "--resolution", res, "--quiet", "--out", out] + extra, check=True)
+                        "--resolution", res, "--quiet", "--out", out] + extra + extra_args, check=True)
         with open(os.path.join(out, "summary.json")) as f:
             t = json.load(f)["timings_ms"]
         totals.append(t["total"])
