@@ -110,6 +110,10 @@ void add_map_options(CLI::App* app, MapSettings& o, TextOptions& t) {
                   "3D Slicer, VTK, Open3D and libigl report; negative inside it), exact, for every vertex (hidden "
                   "ones too) within --distance-reach of the other bone")
       ->capture_default_str();
+  app->add_option("--levels-on", o.levels_on,
+                  "distance|radial: what the impingement levels (colours, level areas, clock sectors) classify: the "
+                  "Euclidean distance or the thesis' radial gap (default: the distance, or the radial gap with "
+                  "--distances off)");
   app->add_option("--distance-reach", o.distance_reach_mm,
                   "mm: vertices proven farther than this from the other bone get no distance (0: the largest "
                   "--levels threshold)")

@@ -58,7 +58,8 @@ class Joint:
                  levels: Optional[Sequence[float]] = None, occlusion_tolerance_mm: float = 1.0,
                  max_radius_mm: float = 0.0, sparse: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
                  layers: int = 4, extra_articular_radius_mm: float = 150.0, layered_spacing: float = 0.5,
-                 distances: bool = True, distance_reach_mm: float = 0.0, maps_only: bool = False,
+                 distances: bool = True, distance_reach_mm: float = 0.0, levels_on: Optional[str] = None,
+                 maps_only: bool = False,
                  maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
                  pelvis_frame: str = "isb", joint_centre: Optional[str] = None,
                  femur_frame: str = "epicondyles") -> None:
@@ -71,7 +72,8 @@ class Joint:
         sparse: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for
         hidden vertices (extra-articular), within extra_articular_radius_mm, at layered_spacing deg (0: the maps' own); distances: the signed
         Euclidean distance to the other bone beside each gap (results' ball_distance_mm, socket_distance_mm),
-        for every vertex within distance_reach_mm of it (0: the largest level threshold); maps_only: no exact
+        for every vertex within distance_reach_mm of it (0: the largest level threshold); levels_on: what the
+        levels classify, 'distance' or 'radial' (the thesis' gap; default: distance, radial with distances off); maps_only: no exact
         look-ups at depth discontinuities; maps: (ball_path, socket_path) from save_maps().
         neutral: 'anatomical' (ISB frames) or 'scan' (default: the subject's, else anatomical);
         pelvis_frame 'isb'/'app'; femur_frame 'epicondyles'/'posterior-condyles'; joint_centre: how the

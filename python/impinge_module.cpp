@@ -242,6 +242,7 @@ const std::vector<std::pair<std::string, OptionSetter>>& joint_options() {
          o.maps.layered_spacing_deg = as_double(v, n);
        }},
       {"distances", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.distances = as_bool(v, n); }},
+      {"levels_on", [](SessionOptions& o, const py::handle& v, const std::string& n) { o.maps.levels_on = as_string(v, n); }},
       {"distance_reach_mm", [](SessionOptions& o, const py::handle& v, const std::string& n) {
          o.maps.distance_reach_mm = as_double(v, n);
        }},

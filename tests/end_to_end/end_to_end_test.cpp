@@ -363,15 +363,40 @@ TEST(EndToEnd, DistancesMatchTheOracleAtMc22LeftsDeepestExtension) {
     EXPECT_EQ(j["ball"]["vertices_inside"], 98) << layers;
     EXPECT_EQ(j["socket"]["vertices_inside"], 32) << layers;
     EXPECT_LT(j["socket"]["min_gap_mm"].get<double>(), -20) << layers;  // the radial gap's artefact stays visible
+    // The levels classify the distance by default: the last level (<= 0 mm) holds the vertices inside.
+    EXPECT_EQ(j["levels_on"], "distance");
+    for (const char* body : {"ball", "socket"}) {
+      const auto& lv = j[body]["levels"];
+      EXPECT_EQ(lv[lv.size() - 1]["vertices"].get<std::int64_t>(), j[body]["vertices_inside"].get<std::int64_t>())
+          << body;
+    }
     std::ifstream ply(d + "/" + layers + "/ball_gaps.ply", std::ios::binary);
     std::string header, line;
     while (std::getline(ply, line) && line != "end_header") header += line + "\n";
     EXPECT_NE(header.find("property float distance_mm"), std::string::npos) << header;
   }
+  // Levels on the radial gap: the last level holds the penetrating vertices of the radial scans.
+  ASSERT_EQ(run("distance --subject " + json + " --precision 1 --levels-on radial --out " + d + "/radial"), 0);
+  {
+    std::ifstream rs(d + "/radial/summary.json");
+    const nlohmann::json r = nlohmann::json::parse(rs);
+    EXPECT_EQ(r["levels_on"], "radial");
+    const auto& lv = r["ball"]["levels"];
+    EXPECT_EQ(lv[lv.size() - 1]["vertices"].get<std::int64_t>(), r["ball"]["vertices_penetrating"].get<std::int64_t>());
+  }
+  // Contradictions are one-line errors naming the option.
+  std::string err;
+  EXPECT_NE(run("distance --subject " + json + " --precision 1 --distances off --levels-on distance --out " + d + "/x", &err), 0);
+  EXPECT_NE(err.find("levels-on distance"), std::string::npos) << err;
+  EXPECT_NE(run("distance --subject " + json + " --precision 1 --distance-reach 1 --levels-on distance --out " + d + "/x", &err), 0);
+  EXPECT_NE(err.find("distance-reach"), std::string::npos) << err;
+  EXPECT_NE(run("distance --subject " + json + " --precision 1 --levels-on euclid --out " + d + "/x", &err), 0);
+  EXPECT_NE(err.find("levels-on 'euclid'"), std::string::npos) << err;
   // Off: no distances anywhere.
   ASSERT_EQ(run("distance --subject " + json + " --precision 1 --distances off --out " + d + "/off"), 0);
   std::ifstream js(d + "/off/summary.json");
   const nlohmann::json j = nlohmann::json::parse(js);
   EXPECT_FALSE(j["distances"].get<bool>());
   EXPECT_FALSE(j["ball"].contains("min_distance_mm"));
+  EXPECT_EQ(j["levels_on"], "radial");
 }

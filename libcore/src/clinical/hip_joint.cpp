@@ -146,9 +146,10 @@ void HipJoint::save_maps(const std::string& ball_path, const std::string& socket
 void HipJoint::clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& socket) const {
   if (!socket_clock_) return;
   const JointOptions& o = joint_->options();
-  clock_summary(res.ball_gaps, joint_->ball().relative, joint_->ball().vertex_area, *ball_clock_, o.levels, ball);
+  clock_summary(res.ball_gaps, joint_->ball().relative, joint_->ball().vertex_area, *ball_clock_, o.levels, ball,
+                o.levels_on);
   clock_summary(res.socket_gaps, joint_->socket().relative, joint_->socket().vertex_area, *socket_clock_, o.levels,
-                socket);
+                socket, o.levels_on);
 }
 
 Eigen::Matrix3d HipJoint::femur_rotation(const PoseAngles& angles) const {

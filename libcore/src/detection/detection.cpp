@@ -244,13 +244,33 @@ std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMa
   return mask;
 }
 
-ScanSummary summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const ImpingementLevels& levels) {
+ScanSummary summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const ImpingementLevels& levels,
+                           LevelQuantity levels_on) {
   ScanSummary s;
-  summarize_scan(g, area, levels, s);
+  summarize_scan(g, area, levels, s, levels_on);
   return s;
 }
 
-void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const ImpingementLevels& levels, ScanSummary& s) {
+const char* to_string(LevelQuantity q) { return q == LevelQuantity::distance ? "distance" : "radial"; }
+
+LevelQuantity parse_level_quantity(const std::string& text, const std::string& context) {
+  if (text == "radial") return LevelQuantity::radial_gap;
+  if (text == "distance") return LevelQuantity::distance;
+  throw Error(context + " '" + text + "': expected 'distance' or 'radial'");
+}
+
+std::uint8_t vertex_level(const ScanGaps& g, std::size_t i, const ImpingementLevels& levels, LevelQuantity q) {
+  if (q == LevelQuantity::distance && !g.distance_mm.empty()) {
+    const float d = g.distance_mm[i];
+    if (!std::isnan(d)) return levels.level(d);
+    const bool tested = g.status[i] == ScanGaps::tested || g.status[i] == ScanGaps::tested_layered;
+    return tested ? 0 : 255;
+  }
+  return std::isnan(g.gap_mm[i]) ? 255 : levels.level(g.gap_mm[i]);
+}
+
+void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const ImpingementLevels& levels, ScanSummary& s,
+                    LevelQuantity levels_on) {
   s.level_vertices.assign(static_cast<std::size_t>(levels.count()), 0);
   s.level_area_mm2.assign(static_cast<std::size_t>(levels.count()), 0.0);
   s.vertices_tested = s.vertices_no_surface = s.vertices_beyond_reach = s.vertices_penetrating = 0;
@@ -283,10 +303,20 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
       ++s.vertices_penetrating;
       s.area_penetrating_mm2 += a;
     }
-    const std::uint8_t lv = levels.level(gap);
-    ++s.level_vertices[lv];
-    s.level_area_mm2[lv] += a;
+    if (levels_on == LevelQuantity::radial_gap || g.distance_mm.empty()) {
+      const std::uint8_t lv = levels.level(gap);
+      ++s.level_vertices[lv];
+      s.level_area_mm2[lv] += a;
+    }
   }
+  s.levels_on = g.distance_mm.empty() ? LevelQuantity::radial_gap : levels_on;
+  if (s.levels_on == LevelQuantity::distance)
+    for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
+      const std::uint8_t lv = vertex_level(g, i, levels, LevelQuantity::distance);
+      if (lv == 255) continue;
+      ++s.level_vertices[lv];
+      s.level_area_mm2[lv] += area[static_cast<Eigen::Index>(i)];
+    }
   if (s.vertices_tested > 0) s.min_gap_mm = min_gap;
   if (s.vertices_tested_layered > 0) s.min_gap_layered_mm = min_layered;
   s.min_distance_mm = std::numeric_limits<double>::quiet_NaN();

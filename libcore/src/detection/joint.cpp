@@ -32,6 +32,11 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
           "joint: distances need a closest-point engine (Embree or CGAL), and this build has neither");
   require(std::isfinite(o.distance_reach_mm) && o.distance_reach_mm >= 0,
           "joint: the distances' reach must be 0 (the largest level threshold) or > 0 mm");
+  require(o.levels_on == LevelQuantity::radial_gap || o.distances,
+          "joint: levels on the distance need distances on");
+  require(o.levels_on == LevelQuantity::radial_gap || o.reach_mm() >= o.levels.thresholds_mm.front(),
+          "joint: levels on the distance need a distance reach of at least the largest level threshold (" +
+              std::to_string(o.levels.thresholds_mm.front()) + " mm)");
   return o;
 }
 }  // namespace
@@ -158,8 +163,8 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
     res.ball_gaps.distance_mm.clear(), res.socket_gaps.distance_mm.clear();
     res.ball_gaps.distance_winding = res.socket_gaps.distance_winding = 0;
   }
-  summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels, res.ball);
-  summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels, res.socket);
+  summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels, res.ball, options_.levels_on);
+  summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels, res.socket, options_.levels_on);
 }
 
 }  // namespace impinge

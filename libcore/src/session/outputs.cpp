@@ -7,19 +7,19 @@
 
 namespace impinge {
 
-std::vector<std::uint8_t> vertex_levels(const ScanGaps& g, const ImpingementLevels& levels) {
+std::vector<std::uint8_t> vertex_levels(const ScanGaps& g, const ImpingementLevels& levels, LevelQuantity levels_on) {
   std::vector<std::uint8_t> out(g.gap_mm.size());
-  for (std::size_t i = 0; i < out.size(); ++i)
-    out[i] = std::isnan(g.gap_mm[i]) ? 255 : static_cast<std::uint8_t>(levels.level(g.gap_mm[i]));
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = vertex_level(g, i, levels, levels_on);
   return out;
 }
 
 namespace {
 // One bone's gaps as a PLY: vertices V (input frame), gap_mm, level and its colour.
-void write_body_ply(const std::string& path, const ImpingementLevels& levels, const JointBody& body,
+void write_body_ply(const std::string& path, const ImpingementLevels& levels, LevelQuantity levels_on,
+                    const JointBody& body,
                     const ScanGaps& gaps, const Vertices& V, bool is_ball) {
   const Eigen::Index n = body.mesh.V.rows();
-  const std::vector<std::uint8_t> lv = vertex_levels(gaps, levels);
+  const std::vector<std::uint8_t> lv = vertex_levels(gaps, levels, levels_on);
   Eigen::VectorXf gap(n);
   Eigen::Matrix<unsigned char, Eigen::Dynamic, 1> level(n);
   Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor> rgb(n, 3);
@@ -42,8 +42,9 @@ void write_body_ply(const std::string& path, const ImpingementLevels& levels, co
 void write_pose_plys(const std::string& ball_path, const std::string& socket_path, const Session& s,
                      const PoseResult& res, const FemurPose& pose) {
   const ImpingementLevels& levels = s.joint_options().levels;
-  write_body_ply(ball_path, levels, s.joint().ball(), res.ball_gaps, s.femur_input(pose), true);
-  write_body_ply(socket_path, levels, s.joint().socket(), res.socket_gaps, s.pelvis_input(), false);
+  const LevelQuantity on = s.joint_options().levels_on;
+  write_body_ply(ball_path, levels, on, s.joint().ball(), res.ball_gaps, s.femur_input(pose), true);
+  write_body_ply(socket_path, levels, on, s.joint().socket(), res.socket_gaps, s.pelvis_input(), false);
 }
 
 void write_pose_vtp(const std::string& path, const Session& s, const PoseResult& res, const FemurPose& pose) {
@@ -59,8 +60,8 @@ void write_pose_vtp(const std::string& path, const Session& s, const PoseResult&
   PointArray gap{"gap_mm", {}, {}}, level{"level", {}, {}}, body{"body", {}, {}};
   gap.f32 = res.ball_gaps.gap_mm;
   gap.f32.insert(gap.f32.end(), res.socket_gaps.gap_mm.begin(), res.socket_gaps.gap_mm.end());
-  level.u8 = vertex_levels(res.ball_gaps, s.joint_options().levels);
-  const auto ls = vertex_levels(res.socket_gaps, s.joint_options().levels);
+  level.u8 = vertex_levels(res.ball_gaps, s.joint_options().levels, s.joint_options().levels_on);
+  const auto ls = vertex_levels(res.socket_gaps, s.joint_options().levels, s.joint_options().levels_on);
   level.u8.insert(level.u8.end(), ls.begin(), ls.end());
   body.u8.assign(static_cast<std::size_t>(nb), 0);
   body.u8.resize(static_cast<std::size_t>(nb + np), 1);

@@ -204,6 +204,7 @@ nlohmann::json setup_record(const Session& s) {
   j["discontinuity_tolerance_mm"] = opt.discontinuity_tolerance_mm;
   j["layers"] = opt.layers;
   j["distances"] = opt.distances;
+  j["levels_on"] = to_string(opt.levels_on);
   if (opt.distances) j["distance_reach_mm"] = opt.reach_mm();
   j["nodes_marked"] = {{"ball", s.joint().ball().nodes_marked}, {"socket", s.joint().socket().nodes_marked}};
   j["neutral"] = hip.neutral() == Neutral::anatomical ? "anatomical" : "scan";

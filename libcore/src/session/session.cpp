@@ -210,6 +210,12 @@ HipJointOptions hip_joint_options(const MapSettings& m, const FrameSettings& f, 
           "distance-reach " + num(m.distance_reach_mm) + ": must be 0 (the largest level threshold) or > 0 mm");
   jo.distances = m.distances;
   jo.distance_reach_mm = m.distance_reach_mm;
+  jo.levels_on = m.levels_on.empty() ? (m.distances ? LevelQuantity::distance : LevelQuantity::radial_gap)
+                                      : parse_level_quantity(m.levels_on, "levels-on");
+  require(jo.levels_on == LevelQuantity::radial_gap || jo.distances, "levels-on distance: needs --distances on");
+  require(jo.levels_on == LevelQuantity::radial_gap || jo.reach_mm() >= jo.levels.thresholds_mm.front(),
+          "levels-on distance: --distance-reach " + num(jo.reach_mm()) + " mm is below the largest level threshold (" +
+              num(jo.levels.thresholds_mm.front()) + " mm)");
   require(m.ball_map_file.empty() == m.socket_map_file.empty(), "maps: give both map files (ball and socket) or none");
   o.ball_map_file = m.ball_map_file;
   o.socket_map_file = m.socket_map_file;

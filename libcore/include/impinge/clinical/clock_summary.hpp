@@ -21,8 +21,10 @@ struct ClockSummary {
 };
 
 /// Clock summary of one scan: `gaps` (n vertices), their positions V (n x 3, mm, the frame of
-/// `clock`, unposed: the clock moves with its bone), vertex areas (n, mm^2). Into `out`.
+/// `clock`, unposed: the clock moves with its bone), vertex areas (n, mm^2). Into `out`. Levels and the
+/// closest hour by `levels_on` (vertex_level; the radial gap, or the Euclidean distance).
 void clock_summary(const ScanGaps& gaps, PointsRef V, const Eigen::VectorXd& area, const ClockFace& clock,
-                   const ImpingementLevels& levels, ClockSummary& out);
+                   const ImpingementLevels& levels, ClockSummary& out,
+                   LevelQuantity levels_on = LevelQuantity::radial_gap);
 
 }  // namespace impinge

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "impinge/casters/embree_ray_caster.hpp"
@@ -39,6 +40,22 @@ struct ScanGaps {
   std::int64_t distance_winding = 0;  ///< distances whose sign the winding number decided
 };
 
+/// Which per-vertex quantity the impingement levels classify (issue 26): the thesis' radial gap, or the
+/// Euclidean distance (ScanGaps::distance_mm; a vertex without one is farther than the distances' reach,
+/// which is at least the largest level threshold, so level 0).
+enum class LevelQuantity : std::uint8_t { radial_gap = 0, distance = 1 };
+
+/// "radial" or "distance".
+const char* to_string(LevelQuantity q);
+/// Parse "radial" or "distance"; throws impinge::Error naming `context` otherwise.
+LevelQuantity parse_level_quantity(const std::string& text, const std::string& context);
+
+/// The level of vertex i of a scan by quantity `q`: 255 where it has no value (untested by the radial
+/// scan; for distance, neither tested nor within the distances' reach), else levels.level of the gap or
+/// of the distance (a vertex tested by the radial scan and beyond the distances' reach: level 0). With
+/// `q` distance and no distances in `g` (distances off), the radial gap's level.
+std::uint8_t vertex_level(const ScanGaps& g, std::size_t i, const ImpingementLevels& levels, LevelQuantity q);
+
 /// Statistics of a scan (thesis sec. 3.4 colour levels; counts so nothing is dropped silently).
 struct ScanSummary {
   std::int64_t vertices = 0;                                     ///< vertices in the mesh
@@ -61,6 +78,7 @@ struct ScanSummary {
   std::int64_t vertices_inside = 0;                              ///< of them, inside the other bone (< 0)
   double area_inside_mm2 = 0;                                    ///< their vertex area
   std::int64_t distance_winding = 0;                             ///< signs decided by the winding number
+  LevelQuantity levels_on = LevelQuantity::radial_gap;           ///< what level_vertices classify
   std::vector<std::int64_t> level_vertices;                      ///< count per impingement level
   std::vector<double> level_area_mm2;                            ///< vertex area per impingement level
 };
@@ -174,10 +192,11 @@ std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMa
 
 /// Summary of a scan: counts, minimum gap, penetration and levels weighted by vertex area
 /// (`vertex_area`: n values, mm^2).
-ScanSummary summarize_scan(const ScanGaps& gaps, const Eigen::VectorXd& vertex_area, const ImpingementLevels& levels);
+ScanSummary summarize_scan(const ScanGaps& gaps, const Eigen::VectorXd& vertex_area, const ImpingementLevels& levels,
+                           LevelQuantity levels_on = LevelQuantity::radial_gap);
 
 /// The same into `out`, reusing its level vectors (no allocation once they have the size).
 void summarize_scan(const ScanGaps& gaps, const Eigen::VectorXd& vertex_area, const ImpingementLevels& levels,
-                    ScanSummary& out);
+                    ScanSummary& out, LevelQuantity levels_on = LevelQuantity::radial_gap);
 
 }  // namespace impinge

@@ -71,6 +71,10 @@ struct JointOptions {
   /// The reach of the distances, mm (> 0); 0: the largest threshold of `levels` (the cartilage offset,
   /// 4 mm by default). Vertices proven farther get NaN.
   double distance_reach_mm = 0;
+  /// What the impingement levels classify (ScanSummary::level_vertices, PLY colours, clock sectors): the
+  /// radial gap (the thesis) or, with distances on, the Euclidean distance (then distance_reach_mm must be
+  /// 0 or at least the largest level threshold).
+  LevelQuantity levels_on = LevelQuantity::radial_gap;
   /// distance_reach_mm resolved (the largest level threshold when 0), mm.
   double reach_mm() const { return distance_reach_mm > 0 ? distance_reach_mm : std::max(levels.thresholds_mm.front(), 1e-3); }
 };

@@ -13,9 +13,10 @@
 
 namespace impinge {
 
-/// The impingement level of every vertex of `gaps` under `levels` (ImpingementLevels::level),
-/// 255 where the vertex was not tested (NaN gap). Length: the body's vertex count.
-std::vector<std::uint8_t> vertex_levels(const ScanGaps& gaps, const ImpingementLevels& levels);
+/// The impingement level of every vertex of `gaps` under `levels` by quantity `levels_on` (vertex_level:
+/// 255 where the vertex has no value). Length: the body's vertex count.
+std::vector<std::uint8_t> vertex_levels(const ScanGaps& gaps, const ImpingementLevels& levels,
+                                        LevelQuantity levels_on = LevelQuantity::radial_gap);
 
 /// Both bones at one pose as binary PLY (write_gap_ply: x y z gap_mm; level and its colour): the
 /// femur at `pose` (joint frame) into `ball_path`, the pelvis into `socket_path`; vertices

@@ -78,6 +78,9 @@ struct MapSettings {
   double layered_spacing_deg = 0.5;     ///< the layered maps' largest node spacing (JointOptions), deg
   bool distances = false;               ///< Euclidean distances beside the gaps (JointOptions::distances)
   double distance_reach_mm = 0;         ///< their reach, mm; 0: the largest level threshold
+  /// What the levels classify: "radial" (the thesis' gap) | "distance"; empty: the distance when
+  /// distances are on, else the radial gap.
+  std::string levels_on;
   std::string ball_map_file, socket_map_file;  ///< saved maps to load instead of sampling (both or neither)
 };
 
