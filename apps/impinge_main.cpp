@@ -266,8 +266,12 @@ int run_motion(const SessionOptions& so, const TextOptions& t, const MotionOutpu
   return 0;
 }
 
-int run_rom(const SessionOptions& so, const TextOptions& t, const RomRequest& q, const std::string& out) {
+int run_rom(const SessionOptions& options, const TextOptions& t, const RomRequest& q, const std::string& out) {
   const auto t_start = Clock::now();
+  // The searches use the radial gap (issue 26 leaves --metric distance open): no distance hierarchies.
+  SessionOptions so = options;
+  so.maps.distances = false;
+  so.maps.levels_on.clear();
   const Session s = open_session(so, t);
   const double setup_ms = ms_since(t_start);
   const RomRun run = run_rom(s, q);

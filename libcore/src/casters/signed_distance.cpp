@@ -73,6 +73,7 @@ struct SignedDistanceQuery::Impl {
   };
   std::vector<Node> nodes;
   std::vector<std::int32_t> order;
+  std::vector<Eigen::Vector3d> area_vector, centroid;  // per kept triangle, for the hierarchy's build
   std::int32_t build_node(std::int32_t begin, std::int32_t end);
 
   /// The closest point of kept triangle k to q, with its feature.
@@ -109,7 +110,8 @@ std::int32_t SignedDistanceQuery::Impl::build_node(std::int32_t begin, std::int3
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (std::int32_t k = begin; k < end; ++k) {
     const auto t = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
-    const Eigen::Vector3d av = (b[t] - a[t]).cross(c[t] - a[t]) / 2, g = (a[t] + b[t] + c[t]) / 3;
+    const Eigen::Vector3d& av = area_vector[t];
+    const Eigen::Vector3d& g = centroid[t];
     n.area += av;
     n.centre += av.norm() * g;
     total += av.norm();
@@ -118,17 +120,18 @@ std::int32_t SignedDistanceQuery::Impl::build_node(std::int32_t begin, std::int3
   n.centre /= total;
   for (std::int32_t k = begin; k < end; ++k) {
     const auto t = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
-    n.radius = std::max({n.radius, (a[t] - n.centre).norm(), (b[t] - n.centre).norm(), (c[t] - n.centre).norm()});
-    const Eigen::Vector3d av = (b[t] - a[t]).cross(c[t] - a[t]) / 2, g = (a[t] + b[t] + c[t]) / 3;
-    n.moment += (g - n.centre) * av.transpose();
+    n.radius = std::max({n.radius, (a[t] - n.centre).squaredNorm(), (b[t] - n.centre).squaredNorm(),
+                         (c[t] - n.centre).squaredNorm()});
+    n.moment += (centroid[t] - n.centre) * area_vector[t].transpose();
   }
+  n.radius = std::sqrt(n.radius);
   if (end - begin > 8) {
     int axis = 0;
     (hi - lo).maxCoeff(&axis);
     const std::int32_t mid = begin + (end - begin) / 2;
     std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, [&](std::int32_t x, std::int32_t y) {
       const auto i = static_cast<std::size_t>(x), j = static_cast<std::size_t>(y);
-      return a[i][axis] + b[i][axis] + c[i][axis] < a[j][axis] + b[j][axis] + c[j][axis];
+      return centroid[i][axis] < centroid[j][axis];
     });
     n.left = build_node(begin, mid);
     n.right = build_node(mid, end);
@@ -150,6 +153,9 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   require(available(), "signed distance: needs Embree or CGAL, and this build has neither (" + mesh.source + ")");
   Impl& m = *impl_;
   double volume = 0;
+  const auto faces = static_cast<std::size_t>(mesh.F.rows());
+  m.a.reserve(faces), m.b.reserve(faces), m.c.reserve(faces), m.face.reserve(faces), m.corner.reserve(faces);
+  m.face_normal.reserve(faces);
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
     const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose(), b = mesh.V.row(mesh.F(f, 1)).transpose(),
                           c = mesh.V.row(mesh.F(f, 2)).transpose();
@@ -208,8 +214,15 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   }
   irregular_edges_ = irregular;
   m.order.resize(k);
-  for (std::size_t t = 0; t < k; ++t) m.order[t] = static_cast<std::int32_t>(t);
+  m.area_vector.resize(k), m.centroid.resize(k);
+  for (std::size_t t = 0; t < k; ++t) {
+    m.order[t] = static_cast<std::int32_t>(t);
+    m.area_vector[t] = (m.b[t] - m.a[t]).cross(m.c[t] - m.a[t]) / 2;
+    m.centroid[t] = (m.a[t] + m.b[t] + m.c[t]) / 3;
+  }
+  m.nodes.reserve(k / 2);
   m.build_node(0, static_cast<std::int32_t>(k));
+  std::vector<Eigen::Vector3d>().swap(m.area_vector), std::vector<Eigen::Vector3d>().swap(m.centroid);
   // Corners: normals weighted by the triangle's angle there.
   for (std::size_t t = 0; t < k; ++t) {
     const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
@@ -223,7 +236,7 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
 #ifdef IMPINGE_HAVE_EMBREE
   for (std::size_t t = 0; t < k; ++t) m.shift += (m.a[t] + m.b[t] + m.c[t]) / 3.0;
   m.shift /= static_cast<double>(k);
-  m.device = rtcNewDevice("threads=1");
+  m.device = rtcNewDevice(nullptr);  // the build on every core; each query runs on its caller's thread
   require(m.device != nullptr, "signed distance: rtcNewDevice failed (" + mesh.source + ")");
   m.scene = rtcNewScene(m.device);
   RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -241,7 +254,7 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   rtcCommitGeometry(g);
   rtcAttachGeometry(m.scene, g);
   rtcReleaseGeometry(g);
-  rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_HIGH);
+  rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_MEDIUM);
   rtcCommitScene(m.scene);
   require(rtcGetDeviceError(m.device) == RTC_ERROR_NONE,
           "signed distance: building the hierarchy of " + mesh.source + " failed");
