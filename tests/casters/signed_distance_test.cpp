@@ -188,7 +188,7 @@ TEST(SignedDistance, HierarchicalWindingNumberMatchesTheExactSum) {
   for (const TriangleMesh& m : meshes) {
     const SignedDistanceQuery q(m);
     double worst = 0;
-    for (int k = 0; k < 200; ++k) {
+    for (int k = 0; k < 100; ++k) {  // each exact sum visits every triangle (30 s for 200 under the sanitizers)
       const Eigen::Index v = static_cast<Eigen::Index>(rng() % static_cast<std::uint64_t>(m.V.rows()));
       const Eigen::Vector3d p = m.V.row(v).transpose() + Eigen::Vector3d(U(rng), U(rng), U(rng)) * (k % 2);
       const double exact = q.winding_number(p), fast = q.winding_number_fast(p);
