@@ -303,20 +303,14 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
       ++s.vertices_penetrating;
       s.area_penetrating_mm2 += a;
     }
-    if (levels_on == LevelQuantity::radial_gap || g.distance_mm.empty()) {
-      const std::uint8_t lv = levels.level(gap);
-      ++s.level_vertices[lv];
-      s.level_area_mm2[lv] += a;
-    }
   }
   s.levels_on = g.distance_mm.empty() ? LevelQuantity::radial_gap : levels_on;
-  if (s.levels_on == LevelQuantity::distance)
-    for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
-      const std::uint8_t lv = vertex_level(g, i, levels, LevelQuantity::distance);
-      if (lv == 255) continue;
-      ++s.level_vertices[lv];
-      s.level_area_mm2[lv] += area[static_cast<Eigen::Index>(i)];
-    }
+  for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
+    const std::uint8_t lv = vertex_level(g, i, levels, s.levels_on);
+    if (lv == 255) continue;
+    ++s.level_vertices[lv];
+    s.level_area_mm2[lv] += area[static_cast<Eigen::Index>(i)];
+  }
   if (s.vertices_tested > 0) s.min_gap_mm = min_gap;
   if (s.vertices_tested_layered > 0) s.min_gap_layered_mm = min_layered;
   s.min_distance_mm = std::numeric_limits<double>::quiet_NaN();

@@ -3,23 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <string>
 
+#include "core/z_order.hpp"
 #include "impinge/core/error.hpp"
 
 namespace impinge {
 
 namespace {
-std::uint64_t spread(std::uint64_t x) {  // 21 bits -> every third bit
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffULL;
-  x = (x | x << 16) & 0x1f0000ff0000ffULL;
-  x = (x | x << 8) & 0x100f00f00f00f00fULL;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
-  x = (x | x << 2) & 0x1249249249249249ULL;
-  return x;
-}
 constexpr double kBoundMarginMm = 0.5;  // above the maps' interpolation error (experiment 10: < 0.04 mm)
 constexpr double kHintMm = 0.1;         // a gap whose sign is a hint
 }  // namespace
@@ -47,9 +38,7 @@ DistanceScanSet make_distance_scan_set(PointsRef P, double max_radius_mm, int cl
   keyed.reserve(keep.size());
   for (const std::int32_t i : keep) {
     const Eigen::Vector3d g = (P.row(i).transpose() - lo) / cell;
-    keyed.emplace_back(spread(static_cast<std::uint64_t>(g.x())) | spread(static_cast<std::uint64_t>(g.y())) << 1 |
-                           spread(static_cast<std::uint64_t>(g.z())) << 2,
-                       i);
+    keyed.emplace_back(detail::position_z_order(g.x(), g.y(), g.z()), i);
   }
   std::sort(keyed.begin(), keyed.end());
   for (std::size_t j = 0; j < keyed.size(); j += static_cast<std::size_t>(cluster_size)) {
