@@ -526,9 +526,16 @@ std::string joint_doc() {
          "the option, array or file on bad input; warnings (e.g. an overlap at the scan pose) as UserWarning.";
 }
 
+// The ROM metric by name; "" (the default): the distance where the joint has distances on, else the radial gap.
+RomMetric metric_of(const PyJoint& j, const std::string& metric) {
+  if (metric.empty()) return j.session->joint().options().distances ? RomMetric::distance : RomMetric::radial;
+  return parse_rom_metric(metric, "metric");
+}
+
 py::dict rom_limits(const PyJoint& j, double threshold_mm, double step_deg, double max_deg, const std::string& contacts,
-                    double contact_depth_mm) {
+                    double contact_depth_mm, const std::string& metric) {
   RomRequest q;
+  q.search.metric = metric_of(j, metric);
   q.search.contact_depth_mm = contact_depth_mm;
   q.search.contacts = parse_rom_contacts(contacts, "contacts");
   q.search.threshold_mm = threshold_mm;
@@ -601,19 +608,23 @@ void add_joint_queries(py::class_<PyJoint>& c) {
            "closest clock hours and point, detection_ms). One C++ loop; the GIL is released.")
       .def("rom_limits", &rom_limits, py::arg("threshold_mm") = 0.0, py::arg("step_deg") = 2.0,
            py::arg("max_deg") = 150.0, py::arg("contacts") = "impingement",
-           py::arg("contact_depth_mm") = RomOptions{}.contact_depth_mm,
+           py::arg("contact_depth_mm") = RomOptions{}.contact_depth_mm, py::arg("metric") = "",
            "ROM limits from neutral for the standard motions (flexion, extension, abduction, adduction, internal and "
            "external rotation, both rotations at 90 deg flexion, FADIR) -> dict motion -> the CLI's rom_limits.csv "
            "row (limit_deg (NaN: none within max_deg), limited_by, contact_class, socket_clock_h, femur_clock_h, "
            "min_gap_at_limit_mm, monotone, contact_at_start, evaluations) and contact_mm (input frame); and "
            "excluded_vertices (in contact at neutral, not counted). contacts: 'impingement' (the joint surfaces left out), "
            "'articular' (only they: where the joint space closes) or 'all'. contact_depth_mm: how far past the "
-           "threshold a contact must reach to end a search (CLI --contact-depth; 0: the first touch).")
+           "threshold a contact must reach to end a search (CLI --contact-depth; 0: the first touch). metric: 'radial' (the "
+           "thesis' radial gap) or 'distance' (the signed Euclidean distance, the CLI's default; needs distances on "
+           "with a distance_reach_mm of at least the threshold; min_gap_at_limit_mm is then a distance); default: "
+           "'distance' when the joint has distances on, else 'radial'.")
       .def(
           "rom_map",
           [](const PyJoint& j, const std::vector<double>& flexion, const std::vector<double>& adduction,
-             double threshold_mm, double contact_depth_mm) {
+             double threshold_mm, double contact_depth_mm, const std::string& metric) {
             RomOptions o;
+            o.metric = metric_of(j, metric);
             o.threshold_mm = threshold_mm;
             o.contact_depth_mm = contact_depth_mm;
             std::vector<RomMapCell> cells;
@@ -627,10 +638,10 @@ void add_joint_queries(py::class_<PyJoint>& c) {
             return own(std::move(ir), {py::ssize_t(flexion.size()), py::ssize_t(adduction.size())});
           },
           py::arg("flexion"), py::arg("adduction"), py::arg("threshold_mm") = 0.0,
-          py::arg("contact_depth_mm") = RomOptions{}.contact_depth_mm,
+          py::arg("contact_depth_mm") = RomOptions{}.contact_depth_mm, py::arg("metric") = "",
           "ROM map: the largest internal rotation (deg) before contact for every flexion x adduction (deg) -> "
           "float64 (len(flexion), len(adduction)); NaN where in contact already without rotation or free up to "
-          "150 deg.")
+          "150 deg. metric: as rom_limits'.")
       .def(
           "femur_rotation",
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {

@@ -28,6 +28,7 @@
 
 #include "impinge/anatomy/femur_frame.hpp"
 #include "impinge/casters/first_hit_caster.hpp"
+#include "impinge/casters/signed_distance.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "test_support.hpp"
@@ -377,4 +378,106 @@ TEST(Rom, EnvelopeByRefinementAgreesWithEveryPoseScanned) {
   }
   eo.step_deg = 3;  // 92 deg of adduction is not a whole number of 3-deg steps
   EXPECT_THROW(rom_envelope(hip, eo, ro, base), Error);
+}
+
+// The metric (issue 26): with a clearance h > 0 the neck's cylinder comes within Euclidean distance h
+// of the rim's inner edge (radius R, angle gamma from the neck axis) when R sin(gamma) - n = h, and the
+// rim's radial gap (R less the neck's radius n / sin(gamma) along the same ray) reaches h when
+// sin(gamma) = n / (R - h): the distance meets first. Each search finds its own closed form within
+// 0.2 deg, and the two differ by their closed forms' difference (1.1 deg at h = 1 mm).
+TEST(Rom, TheDistanceMetricMeetsAClearanceWhereTheClosedFormSays) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "no closest-point engine in this build";
+  HipModelOptions mo;
+  mo.target_triangles = 20000;
+  mo.cup_coverage_deg = 100;
+  const HipModel h = make_hip_model(mo);
+  SphereFitResult head;
+  head.centre = h.cor;
+  head.radius = mo.head_radius_mm;
+  HipJointOptions jo = scan_options(0.1);
+  jo.joint.distances = true;
+  jo.joint.distance_reach_mm = 1.5;
+  const HipJoint hip(h.ball, h.socket, Side::right, head, {}, jo);
+  const Eigen::Vector3d neck = Eigen::Vector3d(0.80, 0.25, -0.55).normalized();
+  const Eigen::Vector3d opening = -Eigen::Vector3d(-0.65, -0.2, 0.73).normalized();
+  const double psi0 = std::acos(neck.dot(opening)) * 180 / M_PI;
+  const double inner = mo.head_radius_mm + mo.cartilage_gap_mm, n = mo.neck_radius_mm, clearance = 1;
+  const double deg = 180 / M_PI;
+  const double radial_contact = (180 - mo.cup_coverage_deg) - std::asin(n / (inner - clearance)) * deg;
+  const double distance_contact = (180 - mo.cup_coverage_deg) - std::asin((n + clearance) / inner) * deg;
+  const Eigen::Vector3d k = opening.cross(neck).normalized();
+  const std::function<Eigen::Matrix3d(double)> turn = [&](double t) {
+    return Eigen::AngleAxisd(t * M_PI / 180, k).toRotationMatrix();
+  };
+  RomOptions ro;
+  ro.step_deg = 1;
+  ro.contact_depth_mm = 0;
+  ro.threshold_mm = clearance;
+  const RomLimit radial = find_rom_limit(hip, turn, ro, rom_baseline(hip, Eigen::Matrix3d::Identity(), ro));
+  ro.metric = RomMetric::distance;
+  const RomBaseline base = rom_baseline(hip, Eigen::Matrix3d::Identity(), ro);
+  EXPECT_EQ(base.excluded_vertices, 0);
+  const RomLimit distance = find_rom_limit(hip, turn, ro, base);
+  EXPECT_NEAR(radial.limit_deg, radial_contact - psi0, 0.2);
+  EXPECT_NEAR(distance.limit_deg, distance_contact - psi0, 0.2);
+  EXPECT_NEAR(radial.limit_deg - distance.limit_deg, radial_contact - distance_contact, 0.2);
+  EXPECT_GT(radial_contact - distance_contact, 1.0);  // the geometry separates the two metrics
+  // At the limit the least distance has just reached the clearance, from above.
+  EXPECT_LE(distance.min_gap_at_limit_mm, clearance);
+  EXPECT_GT(distance.min_gap_at_limit_mm, clearance - 0.05);
+  EXPECT_NEAR((distance.contact_mm - h.cor).norm(), inner, 0.3);
+  // The joint must be able to give the metric its distances.
+  const HipJoint radial_only(h.ball, h.socket, Side::right, head, {}, scan_options(0.5));
+  EXPECT_THROW(rom_baseline(radial_only, Eigen::Matrix3d::Identity(), ro), Error);
+  ro.threshold_mm = 2;  // beyond the reach of 1.5 mm
+  EXPECT_THROW(rom_baseline(hip, Eigen::Matrix3d::Identity(), ro), Error);
+  ro.threshold_mm = clearance;
+  ro.vertices = RomVertices::first_surface;
+  EXPECT_THROW(find_rom_limit(hip, turn, ro, base), Error);
+  EXPECT_EQ(parse_rom_metric("distance", "--metric"), RomMetric::distance);
+  EXPECT_THROW(parse_rom_metric("euclid", "--metric"), Error);
+}
+
+// The screened distance search (a cut at or below 0: the radial scan lists the candidates, rom_scanner.hpp)
+// against whole scans: at each limit, Joint::detect's distances (every vertex within the reach, exact
+// closest points) put a counted vertex at or below the cut, and at the bracket's other end none.
+TEST(Rom, TheScreenedDistanceSearchEndsWhereWholeScansFirstMeet) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "no closest-point engine in this build";
+  HipModelOptions mo;
+  mo.target_triangles = 12000;
+  mo.cam_height_mm = 2;
+  const HipModel h = make_hip_model(mo);
+  SphereFitResult head;
+  head.centre = h.cor;
+  head.radius = mo.head_radius_mm;
+  HipJointOptions jo = scan_options(0.25);
+  jo.joint.distances = true;
+  jo.joint.distance_reach_mm = 1;
+  const HipJoint hip(h.ball, h.socket, Side::right, head, Landmarks{}, jo);
+  RomOptions ro;
+  ro.metric = RomMetric::distance;  // contact depth 0.25 mm: the cut is -0.25 mm
+  const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), ro);
+  const double cut = ro.threshold_mm - ro.contact_depth_mm;
+  auto least = [&](double theta, const StandardMotion& m) {
+    const Eigen::Matrix3d R = hip.femur_rotation(m.angles(theta));
+    const PoseResult r = hip.joint().detect(R, hip.joint_translation(R));
+    double d = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < r.ball_gaps.distance_mm.size(); ++i)
+      if (!base.skip_ball[i] && r.ball_gaps.distance_mm[i] < d) d = r.ball_gaps.distance_mm[i];
+    for (std::size_t i = 0; i < r.socket_gaps.distance_mm.size(); ++i)
+      if (!base.skip_socket[i] && r.socket_gaps.distance_mm[i] < d) d = r.socket_gaps.distance_mm[i];
+    return d;
+  };
+  const double width = ro.step_deg / 32;  // the bisection's last bracket: 2 deg halved to <= 0.1 deg
+  int limits = 0;
+  for (const StandardMotion& m : standard_motions()) {
+    SCOPED_TRACE(m.name);
+    const RomLimit l = find_rom_limit(hip, m.angles, ro, base);
+    if (std::isnan(l.limit_deg) || l.contact_at_start) continue;
+    ++limits;
+    EXPECT_LE(least(l.limit_deg, m), cut + 1e-6);
+    EXPECT_GT(least(l.limit_deg - width, m), cut);
+    EXPECT_NEAR(l.min_gap_at_limit_mm, least(l.limit_deg, m), 1e-6);
+  }
+  EXPECT_GE(limits, 4);
 }

@@ -19,6 +19,14 @@ RomContacts parse_rom_contacts(const std::string& text, const std::string& conte
   throw Error(context + " '" + text + "': expected impingement, articular or all");
 }
 
+const char* to_string(RomMetric metric) { return metric == RomMetric::distance ? "distance" : "radial"; }
+
+RomMetric parse_rom_metric(const std::string& text, const std::string& context) {
+  if (text == "radial") return RomMetric::radial;
+  if (text == "distance") return RomMetric::distance;
+  throw Error(context + " '" + text + "': expected radial or distance");
+}
+
 const char* to_string(ImpingementSite site) {
   switch (site) {
     case ImpingementSite::intra_articular: return "intra_articular";
@@ -53,13 +61,18 @@ std::vector<StandardMotion> standard_motions() {
 
 RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const RomOptions& o) {
   check(o);
+  check_metric(hip.joint(), o);
   PoseResult r;
   hip.joint().detect(R, hip.joint_translation(R), r);
   RomBaseline b;
+  // The metric's values: the radial gaps, or the distances (NaN beyond the reach: not within the threshold).
+  const bool by_distance = o.metric == RomMetric::distance;
+  const std::vector<float>& ball_values = by_distance ? r.ball_gaps.distance_mm : r.ball_gaps.gap_mm;
+  const std::vector<float>& socket_values = by_distance ? r.socket_gaps.distance_mm : r.socket_gaps.gap_mm;
   b.skip_ball.resize(r.ball_gaps.gap_mm.size());
   b.skip_socket.resize(r.socket_gaps.gap_mm.size());
-  for (std::size_t i = 0; i < b.skip_ball.size(); ++i) b.skip_ball[i] = r.ball_gaps.gap_mm[i] <= o.threshold_mm;
-  for (std::size_t i = 0; i < b.skip_socket.size(); ++i) b.skip_socket[i] = r.socket_gaps.gap_mm[i] <= o.threshold_mm;
+  for (std::size_t i = 0; i < b.skip_ball.size(); ++i) b.skip_ball[i] = ball_values[i] <= o.threshold_mm;
+  for (std::size_t i = 0; i < b.skip_socket.size(); ++i) b.skip_socket[i] = socket_values[i] <= o.threshold_mm;
   for (auto s : b.skip_ball) b.excluded_vertices += s;
   for (auto s : b.skip_socket) b.excluded_vertices += s;
   // The joint surfaces: left out of impingement searches, the only ones counted where the joint space closes.
@@ -77,8 +90,10 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
     b.contacts = o.contacts;
     if (keep_articular) b.lunate = z->pelvis;
   }
-  b.min_gap_mm = std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);
-  if (o.use_bounds) b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), cut_of(o));
+  b.min_gap_mm = by_distance ? std::fmin(r.ball.min_distance_mm, r.socket.min_distance_mm)
+                             : std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);
+  if (o.use_bounds && (o.metric == RomMetric::radial || cut_of(o) <= 0))
+    b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), scan_cut_of(o));
   return b;
 }
 
@@ -96,7 +111,8 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
   require(o.vertices != RomVertices::hidden || (joint.ball().layered && joint.socket().layered),
           "rom: counting hidden vertices needs layered maps (JointOptions::layers > 0)");
   const double cut = cut_of(o);
-  CompactScanner scan(joint, base, bounds, cut, o.vertices);
+  check_metric(joint, o);
+  GapScanner scan(joint, base, bounds, o);
   // The femur's translation by the joint-centre method (a function of the rotation alone).
   auto pose_at = [&](double theta) {
     const Eigen::Matrix3d R = rotation(theta);
@@ -109,7 +125,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
   };
   double lo = 0, hi = 0;
   const double start_gap = gap_at(0, !limit_only).gap;
-  if (!limit_only) out.min_gap_at_start_mm = start_gap;
+  if (!limit_only) out.min_gap_at_start_mm = std::isinf(start_gap) ? std::numeric_limits<double>::quiet_NaN() : start_gap;
   bool found = start_gap <= cut;
   out.contact_at_start = found;
   for (int k = 1; !found; ++k) {
@@ -127,8 +143,8 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
     (gap_at(mid).gap <= cut ? hi : lo) = mid;
   }
   if (limit_only) {
-    out.vertices_looked_up = scan.vertices_looked_up;
-    out.vertices_skipped = scan.vertices_skipped;
+    out.vertices_looked_up = scan.vertices_looked_up();
+    out.vertices_skipped = scan.vertices_skipped();
     out.limit_deg = hi;
     return out;
   }
@@ -137,8 +153,8 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
   const Least l = scan(R, t, true);  // the least gap and where, not only whether they meet
   // A transient touch: the bones part again one step farther.
   if (hi + o.step_deg <= o.max_deg) out.monotone = gap_at(hi + o.step_deg).gap <= cut;
-  out.vertices_looked_up = scan.vertices_looked_up;
-  out.vertices_skipped = scan.vertices_skipped;
+  out.vertices_looked_up = scan.vertices_looked_up();
+  out.vertices_skipped = scan.vertices_skipped();
   out.limit_deg = hi;
   out.min_gap_at_limit_mm = l.gap;
   out.limited_by_ball = l.ball;

@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "impinge/clinical/rom.hpp"
@@ -25,11 +26,32 @@ namespace rom_detail {
 // The gap at which a search's bones meet: the threshold less the contact depth.
 inline double cut_of(const RomOptions& o) { return o.threshold_mm - o.contact_depth_mm; }
 
+// The distance metric's radial screen (GapScanner) lists the vertices whose radial gap is at most the
+// cut plus this, mm: the radial gap of a vertex inside the other bone is at most its distance, up to the
+// maps' interpolation error (about 0.05 mm at 0.1 deg, growing with the node spacing), which this covers.
+inline constexpr double kDistanceScreenSlackMm = 0.5;
+// The threshold of the cluster-bounded radial scans: the cut, or with the distance metric the screen's.
+inline double scan_cut_of(const RomOptions& o) {
+  return o.metric == RomMetric::distance ? cut_of(o) + kDistanceScreenSlackMm : cut_of(o);
+}
+
 inline void check(const RomOptions& o) {
   require(std::isfinite(o.threshold_mm), "rom: threshold must be finite");
   require(std::isfinite(o.contact_depth_mm) && o.contact_depth_mm >= 0, "rom: contact depth must be >= 0 mm");
   require(o.step_deg > 0 && o.max_deg > 0 && o.tolerance_deg > 0 && o.tolerance_deg <= o.step_deg,
           "rom: need step > 0, max > 0 and 0 < tolerance <= step (degrees)");
+  require(o.metric == RomMetric::radial || o.vertices == RomVertices::all,
+          "rom: the distance metric counts every vertex (RomVertices::all)");
+}
+
+// The joint can give the distance metric what it needs: distances within the threshold.
+inline void check_metric(const Joint& joint, const RomOptions& o) {
+  if (o.metric != RomMetric::distance) return;
+  const JointOptions& jo = joint.options();
+  require(jo.distances, "rom: the distance metric needs the joint's distances on (JointOptions::distances)");
+  require(jo.reach_mm() >= std::max(o.threshold_mm, 0.0),
+          "rom: the distance metric needs a distance reach (" + std::to_string(jo.reach_mm()) +
+              " mm) of at least the threshold (" + std::to_string(o.threshold_mm) + " mm)");
 }
 
 // ---- bounds ----------------------------------------------------------------------------------
@@ -317,9 +339,9 @@ namespace rom_detail {
 // The baseline's bounds when they were made for this joint and threshold, else new ones (null
 // without bounds).
 inline std::shared_ptr<const RomSearchBounds> bounds_for(const Joint& joint, const RomOptions& o, const RomBaseline& base) {
-  if (!o.use_bounds) return nullptr;
-  if (base.bounds && base.bounds->joint == &joint && base.bounds->threshold_mm == cut_of(o)) return base.bounds;
-  return std::make_shared<const RomSearchBounds>(joint, cut_of(o));
+  if (!o.use_bounds || (o.metric == RomMetric::distance && cut_of(o) > 0)) return nullptr;
+  if (base.bounds && base.bounds->joint == &joint && base.bounds->threshold_mm == scan_cut_of(o)) return base.bounds;
+  return std::make_shared<const RomSearchBounds>(joint, scan_cut_of(o));
 }
 }  // namespace rom_detail
 }  // namespace impinge

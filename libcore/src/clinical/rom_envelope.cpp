@@ -66,6 +66,7 @@ void split_box(const Box& b, std::vector<Box>& out) {
 RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const RomOptions& o,
                          const RomBaseline& base) {
   check(o);
+  check_metric(hip.joint(), o);
   require(e.step_deg > 0 && e.coarse_steps >= 1, "rom envelope: need step > 0 and coarse_steps >= 1");
   RomEnvelope out;
   out.flexion_deg = envelope_axis(e.flexion_min_deg, e.flexion_max_deg, e.step_deg, "flexion");
@@ -87,7 +88,7 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
     std::string error;  // the first error of any thread, thrown after the parallel region
 #pragma omp parallel reduction(+ : looked, skipped)
     {
-      CompactScanner scan(joint, base, bounds.get(), cut_of(o), o.vertices);
+      GapScanner scan(joint, base, bounds.get(), o);
 #pragma omp for schedule(dynamic, 64)
       for (std::int64_t q = 0; q < m; ++q) {
         const std::size_t p = poses[static_cast<std::size_t>(q)];
@@ -101,8 +102,8 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
           if (error.empty()) error = err.what();
         }
       }
-      looked += scan.vertices_looked_up;
-      skipped += scan.vertices_skipped;
+      looked += scan.vertices_looked_up();
+      skipped += scan.vertices_skipped();
     }
     require(error.empty(), error);
     out.poses_evaluated += m;

@@ -7,6 +7,14 @@
 
 namespace impinge {
 namespace rom_detail {
+// A counted vertex with a gap at or below a scan's threshold (CompactScanner's `collect`).
+struct Candidate {
+  float gap;    // its gap, mm
+  bool ball;    // a femur vertex (else a pelvis vertex)
+  bool hidden;  // tested by the other body's layered map
+  std::size_t vertex;
+};
+
 class CompactScanner {
  public:
   CompactScanner(const Joint& joint, const RomBaseline& base, const RomSearchBounds* bounds, double threshold,
@@ -40,15 +48,21 @@ class CompactScanner {
   // ball vertices that no rotation brings within it are skipped). Without `exact`, the scan stops at
   // the first counted gap <= the threshold (the caller asks only whether the bones meet), starting
   // with the cluster that met last time.
-  Least operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, bool exact) {
+  //
+  // With `collect`, every counted vertex whose gap is <= the threshold is listed there too (the least
+  // is then taken over the clusters the bounds cannot skip, and the scan does not stop at the first).
+  Least operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, bool exact,
+                   std::vector<Candidate>* collect = nullptr) {
     Least l;
+    collect_ = collect;
+    if (collect_ != nullptr) collect_->clear(), exact = false;
     const double cut = exact ? std::numeric_limits<double>::infinity() : threshold_;
     exact_ = exact;
     // The femur's vertices into the pelvis' frame (R, t); the pelvis' into the femur's (R^T, -R^T t).
     shift_mm_ = t.norm();
     ball_pose_ = {R, t, shift_mm_};
     socket_pose_ = {R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), shift_mm_};
-    if (!exact && last_.cluster != nullptr) {
+    if (!exact && collect_ == nullptr && last_.cluster != nullptr) {
       recheck(l);
       if (l.gap <= threshold_) return l;
     }
@@ -185,7 +199,7 @@ class CompactScanner {
     };
     auto skipped = [&](const Cluster& c) {
       const double lb = lower_bound(c, false);
-      return lb > cut || lb > l.gap;
+      return lb > cut || (collect_ == nullptr && lb > l.gap);
     };
     // A search's poses follow each other closely: a cluster whose bound over the cap of every pose
     // near this one (reuse_cap_of: rotations within kReuseRad, translations within kReuseShiftMm)
@@ -243,7 +257,7 @@ class CompactScanner {
   }
   // The first-surface cluster that met at the previous evaluation, looked up first.
   void recheck(Least& l) { look_up(last_.part, *last_.cluster, l); }
-  bool done(const Least& l) const { return !exact_ && l.gap <= threshold_; }
+  bool done(const Least& l) const { return !exact_ && collect_ == nullptr && l.gap <= threshold_; }
   // Hidden vertices of one body against the other's layered map: a cluster is skipped when no radial
   // shell of the other bone over its cone lies within min(cut, least gap so far) of its radii.
   void scan_hidden(const Rigid& P, const ScanSet& set, const LayeredMap& map, const FirstHitCaster* exact,
@@ -263,7 +277,7 @@ class CompactScanner {
       return (pyr->cap(cap.axis, cap.rho, cap.sin_rho, kHiddenBlocks) & shells(cap.r_lo - reach, cap.r_hi + reach)) == 0;
     };
     auto skipped = [&](const Cluster& c) {
-      const double reach = std::max(0.0, std::min(cut, l.gap));
+      const double reach = std::max(0.0, collect_ == nullptr ? std::min(cut, l.gap) : cut);
       return std::isfinite(reach) && apart(cap_of(c, P), reach);
     };
     // As for the first surface (scan()): a cluster apart from the other bone over the cap of every pose
@@ -309,11 +323,12 @@ class CompactScanner {
     }
   }
   void take(const ScanSet& set, const std::vector<std::uint8_t>& skip, std::int64_t from, std::int64_t to, bool ball,
-            Least& l, bool hidden = false) const {
+            Least& l, bool hidden = false) {
     const bool classed = !ball && reach2_ >= 0;
     for (std::int64_t j = from; j < to; ++j) {
       const auto k = static_cast<std::size_t>(j);
-      if (skip[k] || !(buf_[k] < l.gap)) continue;
+      const bool listed = collect_ != nullptr && buf_[k] <= threshold_;
+      if (skip[k] || !(buf_[k] < l.gap || listed)) continue;
       if (classed) {
         // A pelvis vertex meeting the femur within the head sphere's reach meets its joint surface.
         const Eigen::Vector3d y =
@@ -322,7 +337,8 @@ class CompactScanner {
         const bool articular = on_head || (articular_only_ && (hidden ? lunate_socket_hidden_ : lunate_socket_)[k]);
         if (articular != articular_only_) continue;
       }
-      l.gap = buf_[k], l.ball = ball, l.hidden = hidden, l.vertex = static_cast<std::size_t>(set.index[j]);
+      if (listed) collect_->push_back({buf_[k], ball, hidden, static_cast<std::size_t>(set.index[j])});
+      if (buf_[k] < l.gap) l.gap = buf_[k], l.ball = ball, l.hidden = hidden, l.vertex = static_cast<std::size_t>(set.index[j]);
     }
   }
   const Joint& joint_;
@@ -330,6 +346,7 @@ class CompactScanner {
   double threshold_;
   RomVertices counted_;
   bool exact_ = true;
+  std::vector<Candidate>* collect_ = nullptr;  // the listed gaps of the current scan (null: none)
   Rigid ball_pose_, socket_pose_;
   double reach2_ = -1;           // head_sphere_reach_mm^2 (< 0: pelvis contacts not classed per pose)
   bool articular_only_ = false;  // count the joint surfaces only (RomContacts::articular)
@@ -355,6 +372,111 @@ class CompactScanner {
   } last_;  ///< the first-surface cluster that met at the last evaluation (cluster null: none)
   std::vector<std::uint8_t> skip_ball_reachable_, skip_ball_, skip_socket_, skip_ball_hidden_, skip_socket_hidden_;
   std::vector<float> buf_;
+};
+
+// The least counted signed Euclidean distance (RomMetric::distance), in one of two ways:
+// - whole (operator()): Joint::detect with its distances (exact closest points, radial gaps as bounds and
+//   sign hints; surface_distance.hpp), the least taken over the vertices that the baseline counts, the
+//   pelvis' contacts with the head's joint surface classed at each pose as CompactScanner::take does.
+//   Vertices beyond the joint's distance reach (>= the threshold, check_metric) cannot meet.
+// - screened (of()): the exact signed distance of the listed vertices only (CompactScanner's `collect`,
+//   already counted and classed), each searched within its radial gap's magnitude plus 0.5 mm (the gap
+//   bounds the distance), with the gap's sign as the hint where |gap| > 0.1 mm.
+class DistanceScanner {
+ public:
+  DistanceScanner(const Joint& joint, const RomBaseline& base) : joint_(joint), base_(base) {
+    reach2_ = std::isnan(base.head_sphere_reach_mm) ? -1 : base.head_sphere_reach_mm * base.head_sphere_reach_mm;
+    articular_only_ = base.contacts == RomContacts::articular;
+  }
+  Least operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+    joint_.detect(R, t, res_);
+    Least l;
+    take(res_.ball_gaps, base_.skip_ball, true, R, t, l);
+    take(res_.socket_gaps, base_.skip_socket, false, R, t, l);
+    return l;
+  }
+  Least of(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const std::vector<Candidate>& listed) {
+    Least l;
+    const Eigen::Vector3d& cor = joint_.cor();
+    const Eigen::Matrix3d Rt = R.transpose();
+    for (const Candidate& c : listed) {
+      const auto row = static_cast<Eigen::Index>(c.vertex);
+      // Into the other body's mesh frame: a femur vertex posed (R, t); a pelvis vertex by the inverse.
+      const Eigen::Vector3d q = c.ball ? Eigen::Vector3d(cor + R * joint_.ball().relative.row(row).transpose() + t)
+                                       : Eigen::Vector3d(cor + Rt * (joint_.socket().relative.row(row).transpose() - t));
+      const SignedDistanceQuery& other = c.ball ? *joint_.socket().distance_query : *joint_.ball().distance_query;
+      const int hint = c.gap < -0.1f ? -1 : c.gap > 0.1f ? 1 : 0;
+      ClosestSurfacePoint p;
+      if (!other.signed_distance(q, std::abs(double(c.gap)) + 0.5, hint, p))
+        other.signed_distance(q, std::numeric_limits<double>::infinity(), hint, p);
+      ++vertices_looked_up;
+      const double d = p.signed_mm();
+      if (d < l.gap) l.gap = d, l.ball = c.ball, l.hidden = c.hidden, l.vertex = c.vertex;
+    }
+    return l;
+  }
+  std::int64_t vertices_looked_up = 0;
+
+ private:
+  void take(const ScanGaps& g, const std::vector<std::uint8_t>& skip, bool ball, const Eigen::Matrix3d& R,
+            const Eigen::Vector3d& t, Least& l) {
+    const bool classed = !ball && reach2_ >= 0;
+    const auto& rel = ball ? joint_.ball().relative : joint_.socket().relative;
+    for (std::size_t k = 0; k < g.distance_mm.size(); ++k) {
+      const float d = g.distance_mm[k];
+      if (std::isnan(d)) continue;
+      ++vertices_looked_up;
+      if (skip[k] || !(d < l.gap)) continue;
+      if (classed) {
+        // A pelvis vertex meeting the femur within the head sphere's reach meets its joint surface.
+        const Eigen::Vector3d y = R.transpose() * (rel.row(static_cast<Eigen::Index>(k)).transpose() - t) - base_.head_centre;
+        const bool articular = y.squaredNorm() <= reach2_ || (articular_only_ && base_.lunate[k]);
+        if (articular != articular_only_) continue;
+      }
+      l.gap = d, l.ball = ball, l.hidden = g.status[k] == ScanGaps::tested_layered, l.vertex = k;
+    }
+  }
+  const Joint& joint_;
+  const RomBaseline& base_;
+  double reach2_ = -1;
+  bool articular_only_ = false;
+  PoseResult res_;
+};
+
+// The scanner of a search's metric (RomOptions::metric): CompactScanner, or DistanceScanner.
+// At or below a cut of 0 a radial scan screens the distance's: a vertex inside the other bone lies
+// behind that bone's surface along the ray from the COR (which lies outside both bones), at least its
+// Euclidean depth behind it, so its radial gap is at most its distance (up to the maps' interpolation
+// error: kDistanceScreenSlackMm; for the vertices the radial scans test). So the cluster-bounded radial
+// scan lists the vertices whose gap is at most the cut plus the slack, and only they get a distance;
+// where none is listed, no distance reaches the cut. Where the ray runs inside the other bone (issue
+// 26) the radial gap is far below the distance, and the distance decides. Above a cut of 0 the radial
+// gap bounds an outside vertex's distance from above, not below: every pose is a whole distance scan.
+// `exact` poses (a search's start and limit) are whole distance scans too.
+class GapScanner {
+ public:
+  GapScanner(const Joint& joint, const RomBaseline& base, const RomSearchBounds* bounds, const RomOptions& o)
+      : cut_(cut_of(o)) {
+    if (o.metric == RomMetric::distance) distance_.emplace(joint, base);
+    if (o.metric == RomMetric::radial || cut_ <= 0) compact_.emplace(joint, base, bounds, scan_cut_of(o), o.vertices);
+  }
+  Least operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, bool exact) {
+    if (!distance_) return (*compact_)(R, t, exact);
+    if (!compact_ || exact) return (*distance_)(R, t);
+    const Least radial = (*compact_)(R, t, false, &listed_);
+    if (listed_.empty()) return radial;  // no radial gap within the screen: no distance within the cut
+    return distance_->of(R, t, listed_);
+  }
+  std::int64_t vertices_looked_up() const {
+    return (distance_ ? distance_->vertices_looked_up : 0) + (compact_ ? compact_->vertices_looked_up : 0);
+  }
+  std::int64_t vertices_skipped() const { return compact_ ? compact_->vertices_skipped : 0; }
+
+ private:
+  double cut_;
+  std::vector<Candidate> listed_;
+  std::optional<CompactScanner> compact_;
+  std::optional<DistanceScanner> distance_;
 };
 
 }  // namespace rom_detail

@@ -162,6 +162,7 @@ nlohmann::json rom_record(const RomRun& run) {
   const RomOptions& o = run.search;
   j["threshold_mm"] = o.threshold_mm;
   j["contact_depth_mm"] = o.contact_depth_mm;
+  j["metric"] = to_string(o.metric);
   j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
   j["neutral_min_gap_mm"] = number_or_null(run.baseline.min_gap_mm);
   j["excluded_vertices"] = run.baseline.excluded_vertices;

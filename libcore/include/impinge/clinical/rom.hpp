@@ -36,6 +36,17 @@ enum class RomContacts {
 /// Parse "impingement", "articular" or "all". Throws impinge::Error naming `context` otherwise.
 RomContacts parse_rom_contacts(const std::string& text, const std::string& context);
 
+/// What a ROM search compares with the threshold (issue 26).
+enum class RomMetric {
+  radial,    ///< the thesis' radial gap (Algorithm 2): along the ray from the COR; fast (cluster bounds)
+  distance,  ///< the signed Euclidean distance to the other bone's surface (ScanGaps::distance_mm): what a
+             ///< cartilage offset or clearance means; every pose is a full Joint::detect with distances
+};
+/// "radial" or "distance".
+const char* to_string(RomMetric metric);
+/// Parse "radial" or "distance". Throws impinge::Error naming `context` otherwise.
+RomMetric parse_rom_metric(const std::string& text, const std::string& context);
+
 /// Contacts within the acetabular rim radius plus this (mm) of the COR are intra-articular, farther
 /// ones extra-articular (RomOptions' default; the motion and distance summaries use it too).
 inline constexpr double kIntraArticularMarginMm = 10;
@@ -52,6 +63,17 @@ struct RomOptions {
   /// 27 deg at 0 mm, mc22's external rotation 52 -> 4 deg at 0.1 mm; at 0.25 mm every limit of
   /// lhdl-ct, tlem2-mri and mc22 moves by at most 2 deg). 0: the first touch.
   double contact_depth_mm = 0.25;
+  /// What is compared with the threshold: the radial gap, or the Euclidean distance (which needs the
+  /// joint's JointOptions::distances on, with a reach of at least max(threshold_mm, 0), and counts every
+  /// vertex: RomVertices::all). The two agree on whether the bones overlap; above 0 they differ, the
+  /// distance reaching a threshold earlier (the radial gap bounds it from above), and a penetration's
+  /// depth by the distance is the true one where the ray runs inside the other bone (issue 26). At or
+  /// below a cut (threshold less contact depth) of 0 the radial scan screens the distance's: only the
+  /// vertices whose radial gap is within the cut plus 0.5 mm get a distance (a vertex inside the other
+  /// bone has a radial gap at most its distance, up to the maps' interpolation error); above 0 every pose
+  /// is a whole distance scan (Joint::detect), about 10x slower. The CLI's and Python's default is the
+  /// distance; the library's and the thesis experiments' the radial gap.
+  RomMetric metric = RomMetric::radial;
   double step_deg = 2;           ///< coarse step along the motion, deg
   double max_deg = 150;          ///< search no farther than this from neutral, deg
   double tolerance_deg = 0.1;    ///< bisection until the bracket is this narrow, deg
@@ -87,8 +109,10 @@ const char* to_string(ImpingementSite site);
 struct RomLimit {
   double limit_deg = std::numeric_limits<double>::quiet_NaN();  ///< first contact angle (upper end of the final
                                                                  ///< bracket), NaN when none within max_deg
+  /// The least counted gap (RomOptions::metric: radial gap or distance) at the limit, mm.
   double min_gap_at_limit_mm = std::numeric_limits<double>::quiet_NaN();
-  double min_gap_at_start_mm = std::numeric_limits<double>::quiet_NaN();  ///< over the counted vertices
+  /// The same at the start, mm; with the distance metric, NaN when every vertex is beyond the reach.
+  double min_gap_at_start_mm = std::numeric_limits<double>::quiet_NaN();
   bool monotone = true;            ///< the bones are still in contact one step beyond the limit (false: a transient
                                    ///< touch; the gap curve crosses the threshold again)
   bool limited_by_ball = false;    ///< the least gap was a femur vertex (else a pelvis vertex)
