@@ -24,6 +24,7 @@ lay = read_csv(d, "layered.csv")
 env = read_csv(d, "envelope.csv")
 pub = read_csv(d, "published.csv")
 meth = read_csv(d, "methods.csv") if os.path.exists(os.path.join(d, "methods.csv")) else None
+bony = read_csv(d, "bony.csv") if os.path.exists(os.path.join(d, "bony.csv")) else None
 t11 = read_csv(d, "thesis_table11.csv")
 subjects = list(dict.fromkeys(lim.subject))
 
@@ -94,7 +95,7 @@ if meth is not None:
     for s in msubjects:
         for motion in dict.fromkeys(meth.motion):
             g = meth[(meth.subject == s) & (meth.motion == motion)].set_index("method")
-            rows.append([s, motion.replace("_", " ")] + [f(g.limit_deg.get(m, np.nan)) for m in order])
+            rows.append([s, motion.replace("_", " ")] + [f(g.limit_deg.get(m, np.nan), 0) for m in order])
     write_table(d, "table_methods", ["subject", "motion"] + order, rows, align="llrrrr")
     cor = sens[sens.variant.str.startswith("cor") & sens.method.isin(order)]
     rows = []
@@ -115,6 +116,74 @@ if meth is not None:
         "ROMfhSensVanish": str(int(np.isinf(changes(fh)).sum())),
         "ROMeqSensMedian": f(changes(eq).median(), 2),
     }
+
+# The thesis' ROM observation (sec. 5.2, Tables 12-13), with a verdict: red zones at 1-2 o'clock for
+# patient A, at 1-3 and 7 o'clock for patient B. Ours: the clock hour of the socket's closest point at
+# each extremity, on every subject, within half an hour of the thesis' zones. Reproduced when at least
+# three quarters of the extremities fall there, partly when at least a quarter, else not.
+THESIS_ZONES = {"A": [(1, 2)], "B": [(1, 3), (7, 7)]}
+
+
+def in_zones(hour, zones, slack=0.5):
+    return any((hour - (a - slack)) % 12 <= (b - a) + 2 * slack for a, b in zones)
+
+
+def verdict(share):
+    return "reproduced" if share >= 0.75 else "partly reproduced" if share >= 0.25 else "not reproduced"
+
+
+obs_macros = {}
+for patient, zones in THESIS_ZONES.items():
+    g = obs[obs.patient == patient]
+    hits = sum(in_zones(h, zones) for h in g.socket_closest_clock_h if np.isfinite(h))
+    posterior = sum(7.5 <= h <= 11.5 for h in g.socket_closest_clock_h if np.isfinite(h))
+    obs_macros[f"ROMobs{patient}InZone"] = str(hits)
+    obs_macros[f"ROMobs{patient}Poses"] = str(len(g))
+    obs_macros[f"ROMobs{patient}Posterior"] = str(posterior)
+    obs_macros[f"ROMobs{patient}Verdict"] = verdict(hits / max(len(g), 1))
+
+# Left against right (issue 29): mc22's two hips (the same pelvis) under the default method, for the
+# motions the issue names, and the bony measures that can explain a difference.
+lr_macros = {}
+if meth is not None and {"mc22", "mc22-left"} <= set(meth.subject):
+    eqm = meth[meth.method == "equidistant"].set_index(["subject", "motion"])
+    rows, diffs = [], []
+    for motion in ["flexion", "abduction", "internal_rotation_90_flexion", "fadir", "extension", "adduction",
+                   "internal_rotation", "external_rotation", "external_rotation_90_flexion"]:
+        right, left = eqm.limit_deg.get(("mc22", motion), np.nan), eqm.limit_deg.get(("mc22-left", motion), np.nan)
+        # A limit on one side and none within the search range on the other: at least max - limit apart.
+        diff = abs(right - left) if np.isfinite(right) and np.isfinite(left) else np.inf
+        if np.isnan(right) and np.isnan(left):
+            diff = 0.0
+        if motion in ("flexion", "abduction", "internal_rotation_90_flexion", "fadir"):
+            diffs.append(diff)
+        rows.append([motion.replace("_", " "), f(right, 0), f(left, 0), f(diff, 0),
+                     eqm.contact_class.get(("mc22", motion), "").replace("_", " ") if np.isfinite(right) else "",
+                     eqm.contact_class.get(("mc22-left", motion), "").replace("_", " ") if np.isfinite(left) else ""])
+    write_table(d, "table_left_right", ["motion", "right", "left", "$|\\Delta|$", "right: contact", "left: contact"],
+                rows, align="lrrrll")
+    lr_macros = {
+        "ROMlrWithinTen": str(sum(1 for x in diffs if x <= 10)),
+        "ROMlrCompared": str(len(diffs)),
+    }
+    if bony is not None and {"mc22", "mc22-left"} <= set(bony.subject):
+        b = bony.set_index("subject")
+        cols = [("head_radius_mm", "head radius mm", 1), ("acetabular_radius_mm", "acetabular radius mm", 1),
+                ("inclination_deg", "inclination deg", 0), ("anteversion_deg", "anteversion deg", 0),
+                ("median_coverage_deg", "median coverage deg", 0), ("notch_coverage_deg", "notch coverage deg", 0),
+                ("scan_pose_min_gap_mm", "least gap, scan pose, mm", 2), ("neutral_min_gap_mm", "least gap, neutral, mm", 2)]
+        rows = [[label, f(b.loc["mc22", c], n), f(b.loc["mc22-left", c], n)] for c, label, n in cols]
+        write_table(d, "table_bony", ["measure", "right (mc22)", "left (mc22-left)"], rows, align="lrr")
+        lr_macros.update({
+            "ROMlrRightCoverage": f(b.loc["mc22", "median_coverage_deg"], 0),
+            "ROMlrLeftCoverage": f(b.loc["mc22-left", "median_coverage_deg"], 0),
+            "ROMlrRightInclination": f(b.loc["mc22", "inclination_deg"], 0),
+            "ROMlrLeftInclination": f(b.loc["mc22-left", "inclination_deg"], 0),
+            "ROMlrRightScanGap": f(b.loc["mc22", "scan_pose_min_gap_mm"], 2),
+            "ROMlrLeftScanGap": f(b.loc["mc22-left", "scan_pose_min_gap_mm"], 2),
+            "ROMlrRightNeutralGap": f(b.loc["mc22", "neutral_min_gap_mm"], 2),
+            "ROMlrLeftNeutralGap": f(b.loc["mc22-left", "neutral_min_gap_mm"], 2),
+        })
 
 # ROM maps.
 fig, axes = plt.subplots(1, len(subjects), figsize=(4 * len(subjects), 3.4), squeeze=False)
@@ -249,4 +318,6 @@ write_macros(d, "macros", {
     "ROMlayeredNotAlternating": str(int(lay.nodes_not_alternating.sum())),
     "ROMlayeredTruncatedMax": f"{100 * (lay.nodes_truncated / lay.nodes).max():.1f}",
     **method_macros,
+    **obs_macros,
+    **lr_macros,
 })

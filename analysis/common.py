@@ -36,7 +36,11 @@ def save(fig, d, stem):
 
 
 def latex_escape(s):
-    """Escape a table cell (cells are plain text; headers are LaTeX and are not escaped)."""
+    """Escape a table cell (cells are plain text, except a cell that is one math span such as "$\\infty$";
+    headers are LaTeX and are not escaped)."""
+    t = str(s)
+    if len(t) > 1 and t.startswith("$") and t.endswith("$") and "$" not in t[1:-1]:
+        return t
     return (str(s).replace("\\", r"\textbackslash{}").replace("_", r"\_").replace("%", r"\%")
             .replace("&", r"\&").replace("^", r"\textasciicircum{}").replace("#", r"\#"))
 

@@ -52,6 +52,7 @@
 #include "impinge/core/timing.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/maps/layered_map.hpp"
+#include "impinge/session/records.hpp"
 #include "impinge/session/runs.hpp"
 
 using namespace impinge;
@@ -189,8 +190,13 @@ struct Outputs {
         tim(dir + "/timing.csv",
             {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "evaluations",
              "poses_per_second", "share_skipped", "fcl_collide_ms_per_pose", "fcl_poses_timed",
-             "fcl_search_ms_extrapolated", "fcl_over_ours", "excluded_vertices", "neutral_min_gap_mm"}) {}
+             "fcl_search_ms_extrapolated", "fcl_over_ours", "excluded_vertices", "neutral_min_gap_mm"}),
+        bony(dir + "/bony.csv",
+             {"subject", "side", "head_radius_mm", "head_fit_rms_mm", "acetabular_radius_mm", "acetabular_fit_rms_mm",
+              "inclination_deg", "anteversion_deg", "median_coverage_deg", "notch_coverage_deg", "scan_pose_min_gap_mm",
+              "neutral_min_gap_mm"}) {}
   CsvWriter obs, clocks, extra, layered, env, sens, tim;
+  CsvWriter bony;  // each hip's bony measures beside its limits (left against right: issue 29)
   // rom_limits.csv and rom_map.csv: the CLI's tables (session layer) with the subject first; the
   // limits also with their exact check. methods.csv, methods_map.csv: the same per joint-centre method.
   Table lim, map, meth, meth_map;
@@ -422,6 +428,18 @@ void methods(const SubjectRun& r, Outputs& out) {
     o.maps.levels_on = "radial";
     const Session s(o);
     const RomRun run = run_rom(s, q);
+    if (std::string(method) == "equidistant") {
+      // The measures that can explain a difference between two hips: the fitted head and acetabulum, and
+      // the joint space at the scan pose and at neutral (setup_record's values, as summary.json has them).
+      const nlohmann::json j = setup_record(s);
+      const nlohmann::json& a = j["frames"]["acetabulum"];
+      auto num = [](const nlohmann::json& x) { return x.is_number() ? x.get<double>() : std::nan(""); };
+      out.bony.row(r.subject.name, j["side"].get<std::string>(), num(j["head_radius_mm"]),
+                   num(j["frames"]["femur"]["head_fit_rms_mm"]), num(a["sphere_radius_mm"]),
+                   num(a["sphere_fit_rms_mm"]), num(a["radiographic_inclination_deg"]),
+                   num(a["radiographic_anteversion_deg"]), num(a["median_coverage_deg"]), num(a["notch_coverage_deg"]),
+                   num(j["scan_pose_min_gap_mm"]), run.baseline.min_gap_mm);
+    }
     add_prefixed(out.meth, rom_limits_table(s, run), r.subject.name, method);
     add_prefixed(out.meth_map, rom_map_table(run), r.subject.name, method);
     for (int a = 0; a < 3; ++a)
