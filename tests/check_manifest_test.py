@@ -1,5 +1,6 @@
 """experiments/manifest.tsv names every CSV each experiment's driver writes, and only those: the CSV
-names a driver writes are the "/name.csv" literals of experiments/NN_name*.cpp (inputs beside the
+names a driver writes are the "/name.csv" literals of experiments/NN_name*.cpp, or the "name.csv" literals of
+a Python driver experiments/NN_name*.py (inputs beside the
 drivers, experiments/NN_*.csv, start with a digit and are not outputs). Also: every manifest line
 names an existing driver, analysis script and paper section."""
 import csv
@@ -19,6 +20,8 @@ def written_by(name):
     out = set()
     for src in EXP.glob(name + "*.cpp"):
         out |= {m for m in re.findall(r'"/([A-Za-z0-9_]+\.csv)"', src.read_text()) if not m[0].isdigit()}
+    for src in EXP.glob(name + "*.py"):  # a Python driver names its outputs as plain string literals
+        out |= {m for m in re.findall(r'"([A-Za-z0-9_]+\.csv)"', src.read_text()) if not m[0].isdigit()}
     return out
 
 

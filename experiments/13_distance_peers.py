@@ -1,0 +1,195 @@
+"""Experiment 13 (issue 26, item 4): impinge's signed Euclidean distances beside the peers a biomechanics
+user compares with, on the same vertices and poses, one thread each, in one run:
+- impinge: both radial scans and both distance scans of a pose (Joint.detect_pose; the times from its summary,
+  each scan single-threaded);
+- Open3D (Debian python3-open3d 0.16): RaycastingScene(nthreads=1).compute_signed_distance (closest point by
+  Embree, sign by one ray's crossings), the scene built once per bone and the other bone's vertices moved
+  into its frame;
+- VTK 9 (Debian python3-vtk9): vtkImplicitPolyDataDistance.FunctionValue over the same points.
+The vertices are those impinge gives a distance at that pose (within the reach of the other bone: every
+vertex that the bounds cannot prove farther). Agreement: the largest |difference| from impinge's distance and
+the vertices whose sign differs from impinge's (its sign: the angle-weighted pseudo-normal, the winding
+number where that cannot be trusted; casters/signed_distance.hpp).
+
+Outputs (OUT/13_distance_peers/):
+  distance_peers.csv  subject x pose: vertices, impinge's radial and distance scan times (ms, medians of the
+                      repetitions), Open3D's and VTK's on the same vertices, their largest difference from
+                      impinge's distances (mm) and their sign disagreements
+  meta.json
+Every shared hip with a subject.json under --data, or (without it) the generated hip with a 2 mm cam.
+Poses: rest and 10 poses up to 110 deg flexion (issue 26's); --quick: rest and 2 poses at 0.5 deg maps.
+
+usage: exp_13_distance_peers --out DIR [--data DIR] [--quick]
+(build/experiments/exp_13_distance_peers runs this file with the module on PYTHONPATH)"""
+import csv
+import datetime
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+import impinge
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def arg(name, default=None):
+    return sys.argv[sys.argv.index(name) + 1] if name in sys.argv else default
+
+
+def o3d_scene(V, F):
+    import open3d as o3d
+    mesh = o3d.t.geometry.TriangleMesh()
+    mesh.vertex.positions = o3d.core.Tensor(np.ascontiguousarray(V, dtype=np.float32))
+    mesh.triangle.indices = o3d.core.Tensor(np.ascontiguousarray(F, dtype=np.int32))
+    scene = o3d.t.geometry.RaycastingScene(nthreads=1)
+    scene.add_triangles(mesh)
+    return scene
+
+
+def vtk_distance(V, F):
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray, vtk_to_numpy
+    pts = vtk.vtkPoints()
+    pts.SetData(numpy_to_vtk(np.ascontiguousarray(V, dtype=np.float64), deep=True))
+    cells = vtk.vtkCellArray()
+    conn = np.hstack([np.full((len(F), 1), 3), F]).astype(np.int64).ravel()
+    cells.SetCells(len(F), numpy_to_vtkIdTypeArray(conn, deep=True))
+    poly = vtk.vtkPolyData()
+    poly.SetPoints(pts)
+    poly.SetPolys(cells)
+    d = vtk.vtkImplicitPolyDataDistance()
+    d.SetInput(poly)
+
+    def evaluate(Q):
+        out = vtk.vtkDoubleArray()
+        d.FunctionValue(numpy_to_vtk(np.ascontiguousarray(Q, dtype=np.float64), deep=True), out)
+        return vtk_to_numpy(out).copy()
+    return evaluate
+
+
+def median_ms(fn, n):
+    times = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        times.append((time.perf_counter() - t0) * 1e3)
+    return statistics.median(times)
+
+
+def subjects(data):
+    """(name, Joint options, femur (V, F), pelvis (V, F)) of every shared hip, or the generated one."""
+    out = []
+    if data and os.path.isdir(data):
+        for name in sorted(os.listdir(data)):
+            path = os.path.join(data, name, "subject.json")
+            if not os.path.isfile(path):
+                continue
+            with open(path) as f:
+                info = json.load(f)
+            folder = os.path.dirname(path)
+            out.append((name, {"subject": path}, impinge.load_mesh(os.path.join(folder, info["femur"])),
+                        impinge.load_mesh(os.path.join(folder, info["pelvis"]))))
+    if not out:
+        h = impinge.generated_hip(triangles=12000, cam_mm=2.0)
+        out.append(("generated", {"ball": h["ball"], "socket": h["socket"], "neutral": "scan"}, h["ball"], h["socket"]))
+    return out
+
+
+def disagreements(a, b):
+    return int(np.count_nonzero(np.sign(a) != np.sign(b)))
+
+
+def main():
+    out_root = arg("--out")
+    if out_root is None:
+        sys.exit(__doc__)
+    quick = "--quick" in sys.argv
+    data = arg("--data")
+    d = os.path.join(out_root, "13_distance_peers")
+    os.makedirs(d, exist_ok=True)
+    resolution = 0.5 if quick else 0.1
+    reps = 3 if quick else 5
+    poses = [(0, 0, 0)] + [(-10 + 12 * k, (k % 3 - 1) * 10, (k % 4 - 1.5) * 10) for k in range(10)]
+    if quick:
+        poses = poses[:1] + poses[5:7]
+    rows = []
+    for name, options, (femur_V, femur_F), (pelvis_V, pelvis_F) in subjects(data):
+        print(f"[13_distance_peers] {name}", flush=True)
+        ball = options.pop("ball", None)
+        socket = options.pop("socket", None)
+        j = impinge.Joint(ball, socket, resolution=resolution, distances=True, **options)
+        pelvis_scene, femur_scene = o3d_scene(pelvis_V, pelvis_F), o3d_scene(femur_V, femur_F)
+        pelvis_vtk, femur_vtk = vtk_distance(pelvis_V, pelvis_F), vtk_distance(femur_V, femur_F)
+        cor = np.asarray(j.cor)
+        import open3d as o3d
+        for pose in poses:
+            R, t = j.femur_pose(*pose)
+            radial, distance = [], []
+            j.detect_pose(*pose)  # warm-up
+            for _ in range(reps):
+                r = j.detect_pose(*pose)
+                s = r["summary"]
+                radial.append(s["ball_detection_ms"] + s["socket_detection_ms"])
+                distance.append(s["ball_distance_ms"] + s["socket_distance_ms"])
+            bd, sd = r["ball_distance_mm"], r["socket_distance_mm"]
+            bi, si = np.flatnonzero(np.isfinite(bd)), np.flatnonzero(np.isfinite(sd))
+            # Femur vertices posed into the pelvis' frame; pelvis vertices into the femur's (its scene stays put).
+            qb = (femur_V[bi] - cor) @ R.T + cor + t
+            qs = (pelvis_V[si] - cor - t) @ R + cor
+            tb, ts = o3d.core.Tensor(qb.astype(np.float32)), o3d.core.Tensor(qs.astype(np.float32))
+
+            def run_open3d():
+                return pelvis_scene.compute_signed_distance(tb).numpy(), femur_scene.compute_signed_distance(ts).numpy()
+            run_open3d()
+            o3d_ms = median_ms(run_open3d, reps)
+            ob, os_ = run_open3d()
+            vtk_ms = median_ms(lambda: (pelvis_vtk(qb), femur_vtk(qs)), 1 if quick else 3)
+            vb, vs = pelvis_vtk(qb), femur_vtk(qs)
+            diff = lambda x, y: float(np.max(np.abs(x - y), initial=0))  # noqa: E731
+            rows.append({
+                "subject": name, "flexion_deg": pose[0], "adduction_deg": pose[1], "internal_rotation_deg": pose[2],
+                "vertices": len(bi) + len(si),
+                "impinge_radial_ms": statistics.median(radial),
+                "impinge_distance_ms": statistics.median(distance),
+                "open3d_ms": o3d_ms,
+                "vtk_ms": vtk_ms,
+                "open3d_max_diff_mm": max(diff(ob, bd[bi]), diff(os_, sd[si])),
+                "vtk_max_diff_mm": max(diff(vb, bd[bi]), diff(vs, sd[si])),
+                "open3d_sign_disagreements": disagreements(ob, bd[bi]) + disagreements(os_, sd[si]),
+                "vtk_sign_disagreements": disagreements(vb, bd[bi]) + disagreements(vs, sd[si]),
+            })
+    with open(os.path.join(d, "distance_peers.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    import vtk
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
+    dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"], capture_output=True,
+                           text=True).stdout.strip() != ""
+    meta = {
+        "experiment": "13_distance_peers",
+        "git_commit": commit + ("-dirty" if dirty else ""),
+        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "cores": str(os.cpu_count()),
+        "machine": platform.processor() or platform.machine(),
+        "data_folder": data if data and os.path.isdir(data) else None,
+        "quick": quick,
+        "repetitions": reps,
+        "timing": "median wall time after one warm-up run, one thread each (impinge's scans, Open3D nthreads=1, VTK)",
+        "parameters": {"resolution_deg": resolution, "scheme": "equiangular", "distance_reach_mm": "6 (the largest "
+                       "--levels threshold)", "poses_deg": poses},
+        "versions": {"open3d": __import__("open3d").__version__, "vtk": vtk.vtkVersion.GetVTKVersion(),
+                     "impinge": impinge.__version__ if hasattr(impinge, "__version__") else None},
+    }
+    with open(os.path.join(d, "meta.json"), "w") as f:
+        json.dump(meta, f, indent=2)
+
+
+if __name__ == "__main__":
+    main()
