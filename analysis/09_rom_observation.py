@@ -151,10 +151,8 @@ if meth is not None and {"mc22", "mc22-left"} <= set(meth.subject):
     for motion in ["flexion", "abduction", "internal_rotation_90_flexion", "fadir", "extension", "adduction",
                    "internal_rotation", "external_rotation", "external_rotation_90_flexion"]:
         right, left = eqm.limit_deg.get(("mc22", motion), np.nan), eqm.limit_deg.get(("mc22-left", motion), np.nan)
-        # A limit on one side and none within the search range on the other: at least max - limit apart.
-        diff = abs(right - left) if np.isfinite(right) and np.isfinite(left) else np.inf
-        if np.isnan(right) and np.isnan(left):
-            diff = 0.0
+        # None on either side: equal; a limit on one side only: an infinite difference.
+        diff = 0.0 if np.isnan(right) and np.isnan(left) else abs(right - left) if np.isfinite(right - left) else np.inf
         if motion in ("flexion", "abduction", "internal_rotation_90_flexion", "fadir"):
             diffs.append(diff)
         rows.append([motion.replace("_", " "), f(right, 0), f(left, 0), f(diff, 0),

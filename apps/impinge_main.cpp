@@ -268,14 +268,7 @@ int run_motion(const SessionOptions& so, const TextOptions& t, const MotionOutpu
 
 int run_rom(const SessionOptions& options, const TextOptions& t, const RomRequest& q, const std::string& out) {
   const auto t_start = Clock::now();
-  // The radial metric needs no distance hierarchies; the distance metric needs them within the threshold
-  // (a reach of the threshold plus 1 mm unless --distance-reach gives one). ROM uses no levels.
-  SessionOptions so = options;
-  so.maps.distances = q.search.metric == RomMetric::distance;
-  if (so.maps.distances && so.maps.distance_reach_mm == 0)
-    so.maps.distance_reach_mm = std::max(q.search.threshold_mm, 0.0) + 1;
-  so.maps.levels_on = "radial";
-  const Session s = open_session(so, t);
+  const Session s = open_session(rom_session_options(options, q.search), t);
   const double setup_ms = ms_since(t_start);
   const RomRun run = run_rom(s, q);
   if (run.baseline.excluded_vertices > 0)

@@ -414,18 +414,15 @@ void add_prefixed(Table& into, const Table& t, const std::string& subject, const
 void methods(const SubjectRun& r, Outputs& out) {
   if (!r.session.hip().acetabulum()) return;  // scan neutral (the generated model): femoral-head only
   const std::vector<StandardMotion> motions = standard_motions();
-  RomRequest q;  // the CLI's defaults: the distance metric, its distances within 1 mm (impinge rom's reach)
+  RomRequest q;  // the CLI's defaults: the distance metric
   q.search.metric = RomMetric::distance;
   const Eigen::Vector3d centre = r.session.head().centre;
   const Eigen::Matrix3d axes = r.session.hip().frames()->pelvis.axes;
   const char* axis_name[3] = {"x", "y", "z"};
   for (const char* method : {"femoral-head", "acetabular", "combined", "equidistant"}) {
-    SessionOptions o = r.options;
+    SessionOptions o = rom_session_options(r.options, q.search);
     o.frames.joint_centre = method;
     o.maps.layers = 4;
-    o.maps.distances = true;
-    o.maps.distance_reach_mm = 1;
-    o.maps.levels_on = "radial";
     const Session s(o);
     const RomRun run = run_rom(s, q);
     if (std::string(method) == "equidistant") {

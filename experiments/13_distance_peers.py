@@ -184,8 +184,7 @@ def main():
         "timing": "median wall time after one warm-up run, one thread each (impinge's scans, Open3D nthreads=1, VTK)",
         "parameters": {"resolution_deg": resolution, "scheme": "equiangular", "distance_reach_mm": "6 (the largest "
                        "--levels threshold)", "poses_deg": poses},
-        "versions": {"open3d": __import__("open3d").__version__, "vtk": vtk.vtkVersion.GetVTKVersion(),
-                     "impinge": impinge.__version__ if hasattr(impinge, "__version__") else None},
+        "versions": {"open3d": __import__("open3d").__version__, "vtk": vtk.vtkVersion.GetVTKVersion()},
     }
     with open(os.path.join(d, "meta.json"), "w") as f:
         json.dump(meta, f, indent=2)

@@ -42,16 +42,23 @@ HipJointOptions scan_options(double precision_deg) {
   o.joint.scheme = make_scheme("equiangular", precision_deg);
   return o;
 }
-// The generated 12k-triangle hip with a 2 mm cam, its true head as the COR, scan neutral.
-std::unique_ptr<HipJoint> cam_hip(double precision_deg) {
-  HipModelOptions mo;
-  mo.target_triangles = 12000;
-  mo.cam_height_mm = 2;
-  const HipModel h = make_hip_model(mo);
+// The right hip of generated model `h` (made with `mo`), its true head as the COR.
+std::unique_ptr<HipJoint> joint_of(const HipModel& h, const HipModelOptions& mo, const HipJointOptions& o) {
   SphereFitResult head;
   head.centre = h.cor;
   head.radius = mo.head_radius_mm;
-  return std::make_unique<HipJoint>(h.ball, h.socket, Side::right, head, Landmarks{}, scan_options(precision_deg));
+  return std::make_unique<HipJoint>(h.ball, h.socket, Side::right, head, Landmarks{}, o);
+}
+// The generated 12k-triangle hip with a 2 mm cam, its true head as the COR, scan neutral.
+HipModelOptions cam_model() {
+  HipModelOptions mo;
+  mo.target_triangles = 12000;
+  mo.cam_height_mm = 2;
+  return mo;
+}
+std::unique_ptr<HipJoint> cam_hip(double precision_deg, const HipJointOptions* options = nullptr) {
+  const HipModelOptions mo = cam_model();
+  return joint_of(make_hip_model(mo), mo, options ? *options : scan_options(precision_deg));
 }
 }  // namespace
 
@@ -62,10 +69,8 @@ TEST(Rom, NeckMeetsTheRimWhereTheClosedFormSays) {
     mo.target_triangles = 20000;
     mo.cup_coverage_deg = coverage;
     const HipModel h = make_hip_model(mo);
-    SphereFitResult head;
-    head.centre = h.cor;
-    head.radius = mo.head_radius_mm;
-    const HipJoint hip(h.ball, h.socket, Side::right, head, {}, scan_options(0.1));
+    const std::unique_ptr<HipJoint> joint = joint_of(h, mo, scan_options(0.1));
+    const HipJoint& hip = *joint;
     // The generator's axes (generated_models.cpp): neck direction and cup pole.
     const Eigen::Vector3d neck = Eigen::Vector3d(0.80, 0.25, -0.55).normalized();
     const Eigen::Vector3d opening = -Eigen::Vector3d(-0.65, -0.2, 0.73).normalized();
@@ -186,10 +191,8 @@ TEST(Rom, PreExistingOverlapIsExcludedAndBadOptionsAreErrors) {
   HipModelOptions mo;
   mo.target_triangles = 3000;
   const HipModel h = make_hip_model(mo);
-  SphereFitResult head;
-  head.centre = h.cor;
-  head.radius = mo.head_radius_mm;
-  const HipJoint hip(h.ball, h.socket, Side::right, head, {}, scan_options(1.0));
+  const std::unique_ptr<HipJoint> joint = joint_of(h, mo, scan_options(1.0));
+  const HipJoint& hip = *joint;
   RomOptions ro;
   ro.threshold_mm = mo.cartilage_gap_mm + 0.5;  // the whole head is "in contact" at the baseline
   const RomBaseline base = rom_baseline(hip, Eigen::Matrix3d::Identity(), ro);
@@ -391,13 +394,11 @@ TEST(Rom, TheDistanceMetricMeetsAClearanceWhereTheClosedFormSays) {
   mo.target_triangles = 20000;
   mo.cup_coverage_deg = 100;
   const HipModel h = make_hip_model(mo);
-  SphereFitResult head;
-  head.centre = h.cor;
-  head.radius = mo.head_radius_mm;
   HipJointOptions jo = scan_options(0.1);
   jo.joint.distances = true;
   jo.joint.distance_reach_mm = 1.5;
-  const HipJoint hip(h.ball, h.socket, Side::right, head, {}, jo);
+  const std::unique_ptr<HipJoint> joint = joint_of(h, mo, jo);
+  const HipJoint& hip = *joint;
   const Eigen::Vector3d neck = Eigen::Vector3d(0.80, 0.25, -0.55).normalized();
   const Eigen::Vector3d opening = -Eigen::Vector3d(-0.65, -0.2, 0.73).normalized();
   const double psi0 = std::acos(neck.dot(opening)) * 180 / M_PI;
@@ -427,8 +428,7 @@ TEST(Rom, TheDistanceMetricMeetsAClearanceWhereTheClosedFormSays) {
   EXPECT_GT(distance.min_gap_at_limit_mm, clearance - 0.05);
   EXPECT_NEAR((distance.contact_mm - h.cor).norm(), inner, 0.3);
   // The joint must be able to give the metric its distances.
-  const HipJoint radial_only(h.ball, h.socket, Side::right, head, {}, scan_options(0.5));
-  EXPECT_THROW(rom_baseline(radial_only, Eigen::Matrix3d::Identity(), ro), Error);
+  EXPECT_THROW(rom_baseline(*joint_of(h, mo, scan_options(0.5)), Eigen::Matrix3d::Identity(), ro), Error);
   ro.threshold_mm = 2;  // beyond the reach of 1.5 mm
   EXPECT_THROW(rom_baseline(hip, Eigen::Matrix3d::Identity(), ro), Error);
   ro.threshold_mm = clearance;
@@ -443,17 +443,11 @@ TEST(Rom, TheDistanceMetricMeetsAClearanceWhereTheClosedFormSays) {
 // closest points) put a counted vertex at or below the cut, and at the bracket's other end none.
 TEST(Rom, TheScreenedDistanceSearchEndsWhereWholeScansFirstMeet) {
   if (!SignedDistanceQuery::available()) GTEST_SKIP() << "no closest-point engine in this build";
-  HipModelOptions mo;
-  mo.target_triangles = 12000;
-  mo.cam_height_mm = 2;
-  const HipModel h = make_hip_model(mo);
-  SphereFitResult head;
-  head.centre = h.cor;
-  head.radius = mo.head_radius_mm;
   HipJointOptions jo = scan_options(0.25);
   jo.joint.distances = true;
   jo.joint.distance_reach_mm = 1;
-  const HipJoint hip(h.ball, h.socket, Side::right, head, Landmarks{}, jo);
+  const std::unique_ptr<HipJoint> cam = cam_hip(0.25, &jo);
+  const HipJoint& hip = *cam;
   RomOptions ro;
   ro.metric = RomMetric::distance;  // contact depth 0.25 mm: the cut is -0.25 mm
   const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), ro);

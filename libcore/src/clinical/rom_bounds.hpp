@@ -30,6 +30,9 @@ inline double cut_of(const RomOptions& o) { return o.threshold_mm - o.contact_de
 // cut plus this, mm: the radial gap of a vertex inside the other bone is at most its distance, up to the
 // maps' interpolation error (about 0.05 mm at 0.1 deg, growing with the node spacing), which this covers.
 inline constexpr double kDistanceScreenSlackMm = 0.5;
+// Whether a search scans radially (and so uses the cluster bounds): the radial metric, or the distance
+// metric's screen at or below a cut of 0 (GapScanner).
+inline bool screened_or_radial(const RomOptions& o) { return o.metric == RomMetric::radial || cut_of(o) <= 0; }
 // The threshold of the cluster-bounded radial scans: the cut, or with the distance metric the screen's.
 inline double scan_cut_of(const RomOptions& o) {
   return o.metric == RomMetric::distance ? cut_of(o) + kDistanceScreenSlackMm : cut_of(o);
@@ -339,7 +342,7 @@ namespace rom_detail {
 // The baseline's bounds when they were made for this joint and threshold, else new ones (null
 // without bounds).
 inline std::shared_ptr<const RomSearchBounds> bounds_for(const Joint& joint, const RomOptions& o, const RomBaseline& base) {
-  if (!o.use_bounds || (o.metric == RomMetric::distance && cut_of(o) > 0)) return nullptr;
+  if (!o.use_bounds || !screened_or_radial(o)) return nullptr;
   if (base.bounds && base.bounds->joint == &joint && base.bounds->threshold_mm == scan_cut_of(o)) return base.bounds;
   return std::make_shared<const RomSearchBounds>(joint, scan_cut_of(o));
 }

@@ -15,11 +15,31 @@ struct Candidate {
   std::size_t vertex;
 };
 
+// How the pelvis' contacts are counted at each pose (RomBaseline::head_sphere_reach_mm, contacts): a
+// pelvis vertex meeting the femur within the head sphere's reach meets its joint surface (articular), as
+// does a lunate vertex when only the joint surfaces are counted.
+struct PelvisContacts {
+  explicit PelvisContacts(const RomBaseline& base)
+      : reach2(std::isnan(base.head_sphere_reach_mm) ? -1 : base.head_sphere_reach_mm * base.head_sphere_reach_mm),
+        articular_only(base.contacts == RomContacts::articular),
+        head_centre(base.head_centre) {}
+  bool classed() const { return reach2 >= 0; }
+  // Whether a pelvis vertex at y (femur frame, unposed: relative to the COR) counts; lunate: it is on the
+  // lunate surface.
+  bool counts(const Eigen::Vector3d& y, bool lunate) const {
+    const bool articular = (y - head_centre).squaredNorm() <= reach2 || (articular_only && lunate);
+    return articular == articular_only;
+  }
+  double reach2;        // head_sphere_reach_mm^2 (< 0: pelvis contacts not classed per pose)
+  bool articular_only;  // count the joint surfaces only (RomContacts::articular)
+  Eigen::Vector3d head_centre;  // the femur's head centre, joint frame (unposed)
+};
+
 class CompactScanner {
  public:
   CompactScanner(const Joint& joint, const RomBaseline& base, const RomSearchBounds* bounds, double threshold,
                  RomVertices counted)
-      : joint_(joint), bounds_(bounds), threshold_(threshold), counted_(counted) {
+      : joint_(joint), bounds_(bounds), threshold_(threshold), counted_(counted), pelvis_(base) {
     auto skips = [](const ScanSet& set, const std::vector<std::uint8_t>& by_vertex) {
       std::vector<std::uint8_t> out;
       for (std::int32_t i : set.index) out.push_back(by_vertex[static_cast<std::size_t>(i)]);
@@ -31,10 +51,7 @@ class CompactScanner {
     skip_socket_hidden_ = skips(joint.socket().hidden_set, base.skip_socket);
     if (bounds_ != nullptr) skip_ball_reachable_ = skips(bounds_->ball_reachable, base.skip_ball);
     // The pelvis' contacts with the head's joint surface, classed at each pose (take()).
-    reach2_ = std::isnan(base.head_sphere_reach_mm) ? -1 : base.head_sphere_reach_mm * base.head_sphere_reach_mm;
-    articular_only_ = base.contacts == RomContacts::articular;
-    head_centre_ = base.head_centre;
-    if (articular_only_) {
+    if (pelvis_.articular_only) {
       lunate_socket_ = skips(joint.socket().scan_set, base.lunate);
       lunate_socket_hidden_ = skips(joint.socket().hidden_set, base.lunate);
     }
@@ -324,18 +341,16 @@ class CompactScanner {
   }
   void take(const ScanSet& set, const std::vector<std::uint8_t>& skip, std::int64_t from, std::int64_t to, bool ball,
             Least& l, bool hidden = false) {
-    const bool classed = !ball && reach2_ >= 0;
+    const bool classed = !ball && pelvis_.classed();
     for (std::int64_t j = from; j < to; ++j) {
       const auto k = static_cast<std::size_t>(j);
       const bool listed = collect_ != nullptr && buf_[k] <= threshold_;
       if (skip[k] || !(buf_[k] < l.gap || listed)) continue;
       if (classed) {
         // A pelvis vertex meeting the femur within the head sphere's reach meets its joint surface.
-        const Eigen::Vector3d y =
-            socket_pose_.M * Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) + socket_pose_.s - head_centre_;
-        const bool on_head = y.squaredNorm() <= reach2_;
-        const bool articular = on_head || (articular_only_ && (hidden ? lunate_socket_hidden_ : lunate_socket_)[k]);
-        if (articular != articular_only_) continue;
+        const Eigen::Vector3d y = socket_pose_.M * Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) + socket_pose_.s;
+        const bool lunate = pelvis_.articular_only && (hidden ? lunate_socket_hidden_ : lunate_socket_)[k];
+        if (!pelvis_.counts(y, lunate)) continue;
       }
       if (listed) collect_->push_back({buf_[k], ball, hidden, static_cast<std::size_t>(set.index[j])});
       if (buf_[k] < l.gap) l.gap = buf_[k], l.ball = ball, l.hidden = hidden, l.vertex = static_cast<std::size_t>(set.index[j]);
@@ -348,9 +363,7 @@ class CompactScanner {
   bool exact_ = true;
   std::vector<Candidate>* collect_ = nullptr;  // the listed gaps of the current scan (null: none)
   Rigid ball_pose_, socket_pose_;
-  double reach2_ = -1;           // head_sphere_reach_mm^2 (< 0: pelvis contacts not classed per pose)
-  bool articular_only_ = false;  // count the joint surfaces only (RomContacts::articular)
-  Eigen::Vector3d head_centre_ = Eigen::Vector3d::Zero();  // the femur's head centre, joint frame (unposed)
+  PelvisContacts pelvis_;
   std::vector<std::uint8_t> lunate_socket_, lunate_socket_hidden_;  // scan-set order
   double shift_mm_ = 0;  // |t|
   // A group's bound at an earlier pose (M, s) over the cap of the poses near it (valid: it was above
@@ -384,10 +397,7 @@ class CompactScanner {
 //   bounds the distance), with the gap's sign as the hint where |gap| > 0.1 mm.
 class DistanceScanner {
  public:
-  DistanceScanner(const Joint& joint, const RomBaseline& base) : joint_(joint), base_(base) {
-    reach2_ = std::isnan(base.head_sphere_reach_mm) ? -1 : base.head_sphere_reach_mm * base.head_sphere_reach_mm;
-    articular_only_ = base.contacts == RomContacts::articular;
-  }
+  DistanceScanner(const Joint& joint, const RomBaseline& base) : joint_(joint), base_(base), pelvis_(base) {}
   Least operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
     joint_.detect(R, t, res_);
     Least l;
@@ -420,7 +430,7 @@ class DistanceScanner {
  private:
   void take(const ScanGaps& g, const std::vector<std::uint8_t>& skip, bool ball, const Eigen::Matrix3d& R,
             const Eigen::Vector3d& t, Least& l) {
-    const bool classed = !ball && reach2_ >= 0;
+    const bool classed = !ball && pelvis_.classed();
     const auto& rel = ball ? joint_.ball().relative : joint_.socket().relative;
     for (std::size_t k = 0; k < g.distance_mm.size(); ++k) {
       const float d = g.distance_mm[k];
@@ -428,18 +438,15 @@ class DistanceScanner {
       ++vertices_looked_up;
       if (skip[k] || !(d < l.gap)) continue;
       if (classed) {
-        // A pelvis vertex meeting the femur within the head sphere's reach meets its joint surface.
-        const Eigen::Vector3d y = R.transpose() * (rel.row(static_cast<Eigen::Index>(k)).transpose() - t) - base_.head_centre;
-        const bool articular = y.squaredNorm() <= reach2_ || (articular_only_ && base_.lunate[k]);
-        if (articular != articular_only_) continue;
+        const Eigen::Vector3d y = R.transpose() * (rel.row(static_cast<Eigen::Index>(k)).transpose() - t);
+        if (!pelvis_.counts(y, pelvis_.articular_only && base_.lunate[k])) continue;
       }
       l.gap = d, l.ball = ball, l.hidden = g.status[k] == ScanGaps::tested_layered, l.vertex = k;
     }
   }
   const Joint& joint_;
   const RomBaseline& base_;
-  double reach2_ = -1;
-  bool articular_only_ = false;
+  PelvisContacts pelvis_;
   PoseResult res_;
 };
 
@@ -455,10 +462,9 @@ class DistanceScanner {
 // `exact` poses (a search's start and limit) are whole distance scans too.
 class GapScanner {
  public:
-  GapScanner(const Joint& joint, const RomBaseline& base, const RomSearchBounds* bounds, const RomOptions& o)
-      : cut_(cut_of(o)) {
+  GapScanner(const Joint& joint, const RomBaseline& base, const RomSearchBounds* bounds, const RomOptions& o) {
     if (o.metric == RomMetric::distance) distance_.emplace(joint, base);
-    if (o.metric == RomMetric::radial || cut_ <= 0) compact_.emplace(joint, base, bounds, scan_cut_of(o), o.vertices);
+    if (screened_or_radial(o)) compact_.emplace(joint, base, bounds, scan_cut_of(o), o.vertices);
   }
   Least operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, bool exact) {
     if (!distance_) return (*compact_)(R, t, exact);
@@ -473,7 +479,6 @@ class GapScanner {
   std::int64_t vertices_skipped() const { return compact_ ? compact_->vertices_skipped : 0; }
 
  private:
-  double cut_;
   std::vector<Candidate> listed_;
   std::optional<CompactScanner> compact_;
   std::optional<DistanceScanner> distance_;

@@ -1,5 +1,6 @@
 #include "impinge/session/runs.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -155,6 +156,13 @@ Table rom_envelope_table(const RomRun& run) {
         k = e + 1;
       }
   return t;
+}
+
+SessionOptions rom_session_options(SessionOptions so, const RomOptions& search) {
+  so.maps.distances = search.metric == RomMetric::distance;
+  if (so.maps.distances && so.maps.distance_reach_mm == 0) so.maps.distance_reach_mm = std::max(search.threshold_mm, 0.0) + 1;
+  so.maps.levels_on = "radial";
+  return so;
 }
 
 nlohmann::json rom_record(const RomRun& run) {
