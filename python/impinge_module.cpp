@@ -9,6 +9,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <omp.h>
+
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -24,6 +26,7 @@
 #include "impinge/core/mesh.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
+#include "impinge/io/motion.hpp"
 #include "impinge/io/subject.hpp"
 #include "impinge/maps/map_io.hpp"
 #include "impinge/sampling/sampling.hpp"
@@ -412,6 +415,46 @@ void bind_functions(py::module_& m) {
       "triangles are removed. Raises impinge.Error naming the file on a bad or missing file.");
 
   m.def(
+      "set_threads",
+      [](int n) {
+        if (n < 1) throw Error("set_threads: n = " + std::to_string(n) + ": must be >= 1");
+        omp_set_num_threads(n);
+      },
+      py::arg("n"),
+      "Threads (OpenMP) of the calling thread's later calls: ROM searches and maps, sampling. Default: one per "
+      "core (or OMP_NUM_THREADS). Studies give each task one thread (impinge.study).");
+  m.def("get_threads", []() { return omp_get_max_threads(); },
+        "Threads (OpenMP) the calling thread's next parallel call would use.");
+
+  m.def(
+      "load_motion",
+      [](const std::string& path, const std::string& side) {
+        Motion motion;
+        {
+          const Side s = parse_side(side, "side");
+          py::gil_scoped_release release;
+          motion = load_motion(path, s);
+        }
+        std::vector<double> angles(motion.frames() * 3);
+        for (std::size_t k = 0; k < motion.frames(); ++k) {
+          angles[3 * k] = motion.angles[k].flexion_deg;
+          angles[3 * k + 1] = motion.angles[k].adduction_deg;
+          angles[3 * k + 2] = motion.angles[k].internal_rotation_deg;
+        }
+        py::dict d;
+        d["time_s"] = own(std::move(motion.time_s), {py::ssize_t(motion.frames())});
+        d["angles"] = own(std::move(angles), {py::ssize_t(motion.frames()), py::ssize_t(3)});
+        d["format"] = motion.format;
+        return d;
+      },
+      py::arg("path"), py::arg("side") = "right",
+      "Read a motion file as impinge motion reads it (io/motion.hpp): CSV with time_s, flexion_deg, adduction_deg, "
+      "internal_rotation_deg, or OpenSim .mot/.sto with hip_flexion_r|l, hip_adduction_r|l, hip_rotation_r|l "
+      "(side: 'right' or 'left'; radians converted) -> dict(time_s: float64 (k,) s, angles: float64 (k, 3) degrees "
+      "(flexion, adduction, internal rotation; ISB), format: 'csv' or 'opensim'). Raises impinge.Error naming the "
+      "file, line and column.");
+
+  m.def(
       "fit_sphere",
       [](const py::handle& points) {
         const Vertices V = to_vertices(points, "points");
@@ -747,7 +790,7 @@ void bind_joint(py::module_& m) {
 }
 
 }  // namespace
-PYBIND11_MODULE(impinge, m) {
+PYBIND11_MODULE(_impinge, m) {
   m.doc() =
       "impinge: impingement detection in ball-and-socket joints (the hip) by spherical radial distance maps.\n"
       "Units: mm and degrees. Vertices: float (n, 3); faces: integer (m, 3), 0-based. Gaps: positive apart,\n"

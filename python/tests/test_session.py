@@ -17,7 +17,7 @@ import pytest
 import impinge
 from test_impinge import CLI, DATA, read_gaps, read_ply_vertices
 
-STUB = os.path.join(os.path.dirname(__file__), "..", "impinge.pyi")
+STUB = os.path.join(os.path.dirname(__file__), "..", "impinge", "__init__.pyi")
 # CLI options of `impinge distance` that are not Joint options: where to write and what to do at one pose.
 NOT_JOINT_OPTIONS = {"help", "out", "pose", "render"}
 
@@ -60,7 +60,7 @@ def test_joint_and_its_stub_take_every_distance_option():
     stub, runtime = stub_joint_parameters(), runtime_joint_options()
     missing_stub = [o for o in options if python_name(o, stub) is None]
     missing_runtime = [o for o in options if python_name(o, runtime) is None]
-    assert not missing_stub, f"impinge.pyi's Joint lacks {missing_stub}"
+    assert not missing_stub, f"impinge/__init__.pyi's Joint lacks {missing_stub}"
     assert not missing_runtime, f"Joint lacks {missing_runtime}"
     # The stub lists what the module takes, no more, no less.
     assert stub == runtime, (stub - runtime, runtime - stub)

@@ -1,6 +1,7 @@
 """Type stubs of the impinge module (pybind11): impingement detection in ball-and-socket joints.
 
 Units: mm and degrees. Vertices: float (n, 3); faces: integer (m, 3), 0-based."""
+import os
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -11,8 +12,27 @@ __version__: str
 class Error(ValueError):
     """Bad input or an impossible request; the message names the file or array and the element."""
 
-def load_mesh(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]:
-    """Load a triangle mesh (PLY, STL, OBJ, OFF) -> (V (n, 3) mm, F (m, 3))."""
+VTK_SUFFIXES: Tuple[str, ...]
+
+def load_mesh(path: Union[str, os.PathLike], scale: float = 1.0) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]:
+    """Load a triangle mesh (PLY, STL, OBJ, OFF; VTK .vtp/.vtk through VTK's readers) -> (V (n, 3) mm, F (m, 3)).
+    scale multiplies the coordinates (1000 for OpenSim's metre files)."""
+
+def read_vtk_mesh(path: Union[str, os.PathLike]) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]:
+    """A VTK file's surface (.vtp XML PolyData, .vtk legacy), triangulated by VTK -> (V (n, 3), F (m, 3))."""
+
+def is_vtk_file(path: Any) -> bool:
+    """True when path ends in .vtp or .vtk."""
+
+def set_threads(n: int) -> None:
+    """OpenMP threads of the calling thread's later calls (ROM searches and maps, sampling)."""
+
+def get_threads() -> int:
+    """OpenMP threads the calling thread's next parallel call would use."""
+
+def load_motion(path: str, side: str = "right") -> Dict[str, Any]:
+    """A motion file as impinge motion reads it (CSV or OpenSim .mot/.sto) -> dict(time_s (k,) s,
+    angles (k, 3) degrees: flexion, adduction, internal rotation; format 'csv' or 'opensim')."""
 
 def fit_sphere(points: npt.ArrayLike) -> Dict[str, Any]:
     """Geometric least-squares sphere -> dict(centre, radius, rms_residual, points_used)."""

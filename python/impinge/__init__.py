@@ -1,0 +1,153 @@
+"""impinge: impingement detection in ball-and-socket joints (the hip) by spherical radial distance maps.
+
+Units: mm and degrees. Vertices: float (n, 3); faces: integer (m, 3), 0-based. Gaps: positive apart,
+negative penetrating, NaN where a vertex was not tested.
+
+The package is the C++ extension `impinge._impinge` (every function and type, re-exported here) and, in
+Python: meshes from VTK files (`.vtp`, `.vtk`: OpenSim's bone geometry) through VTK's own readers, in
+`load_mesh` and wherever `Joint` takes a mesh file; and `impinge.study`, studies of many subjects, motions
+and perturbations on Dask (`/usr/bin/python3 -m impinge.study run STUDY.toml --out DIR`)."""
+import json as _json
+import os as _os
+
+from . import _impinge
+from ._impinge import *  # noqa: F401,F403 (the extension's functions and types)
+from ._impinge import Error, __version__  # noqa: F401
+
+VTK_SUFFIXES = (".vtp", ".vtk")
+
+
+def is_vtk_file(path):
+    """True when `path` (str or os.PathLike) names a VTK file by its suffix (.vtp XML PolyData, .vtk legacy)."""
+    return isinstance(path, (str, _os.PathLike)) and _os.fspath(path).lower().endswith(VTK_SUFFIXES)
+
+
+def _read_vtk_polydata(path):
+    """The surface of a VTK file as vtkPolyData, triangulated. Raises Error naming the file."""
+    from vtkmodules.vtkCommonCore import vtkFileOutputWindow, vtkLogger, vtkOutputWindow
+    from vtkmodules.vtkFiltersCore import vtkTriangleFilter
+    from vtkmodules.vtkFiltersGeometry import vtkGeometryFilter
+    from vtkmodules.vtkIOLegacy import vtkGenericDataObjectReader
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+
+    if not _os.path.isfile(path):
+        raise Error(f"{path}: no such file")
+    import tempfile
+
+    # VTK reports a bad file on its output window, not by raising: send that to a file we read back.
+    window = vtkFileOutputWindow()
+    with tempfile.NamedTemporaryFile(suffix=".log", delete=True) as t:
+        window.SetFileName(t.name)
+        previous = vtkOutputWindow.GetInstance()
+        vtkOutputWindow.SetInstance(window)
+        verbosity = vtkLogger.GetCurrentVerbosityCutoff()
+        vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+        try:
+            if path.lower().endswith(".vtp"):
+                reader = vtkXMLPolyDataReader()
+            else:
+                reader = vtkGenericDataObjectReader()
+            reader.SetFileName(path)
+            reader.Update()
+            data = reader.GetOutputDataObject(0)
+            surface = vtkGeometryFilter()  # unstructured grids and polydata alike to polygons
+            surface.SetInputData(data)
+            triangles = vtkTriangleFilter()  # quads and polygons to triangles (VTK's own, not ours)
+            triangles.SetInputConnection(surface.GetOutputPort())
+            triangles.PassVertsOff()
+            triangles.PassLinesOff()
+            triangles.Update()
+            out = triangles.GetOutput()
+        finally:
+            vtkOutputWindow.SetInstance(previous)
+            vtkLogger.SetStderrVerbosity(verbosity)
+        log = open(t.name, errors="replace").read()
+        complaints = [line.split("): ", 1)[-1].strip() for line in log.splitlines()
+                      if "Error" in line and not line.startswith("ERROR: In")] if "ERROR" in log else []
+    if complaints or data is None:
+        raise Error(f"{path}: VTK cannot read it" + (f" ({complaints[0]})" if complaints else ""))
+    return out
+
+
+def read_vtk_mesh(path):
+    """(V, F) of a VTK file's surface: V (n, 3) float64 in the file's units, F (m, 3) int32, 0-based; polygons
+    triangulated by VTK's vtkTriangleFilter, points kept as the file has them (unused points too).
+    `.vtp`: VTK's XML PolyData (OpenSim's bone geometry; OpenSim's files are in metres: scale them to mm);
+    `.vtk`: the legacy format (PolyData or an unstructured grid, whose surface is taken).
+    Raises Error naming the file: missing, unreadable, no triangles, or a point that is not finite."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    path = _os.fspath(path)
+    poly = _read_vtk_polydata(path)
+    if poly.GetNumberOfPoints() == 0 or poly.GetNumberOfPolys() == 0:
+        raise Error(f"{path}: no triangles (VTK read {poly.GetNumberOfPoints()} points, "
+                    f"{poly.GetNumberOfPolys()} polygons)")
+    V = np.ascontiguousarray(vtk_to_numpy(poly.GetPoints().GetData()), dtype=np.float64)
+    bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
+    if bad.size:
+        raise Error(f"{path}: point {int(bad[0])} is not three finite numbers")
+    polys = poly.GetPolys()
+    if hasattr(polys, "GetConnectivityArray"):  # VTK >= 9: offsets and connectivity
+        offsets = vtk_to_numpy(polys.GetOffsetsArray())
+        conn = vtk_to_numpy(polys.GetConnectivityArray())
+        if not np.all(np.diff(offsets) == 3):
+            raise Error(f"{path}: a polygon VTK did not triangulate")
+        F = conn.reshape(-1, 3)
+    else:  # pragma: no cover (VTK 8's legacy cell array: n, i, j, k per cell)
+        F = vtk_to_numpy(polys.GetData()).reshape(-1, 4)[:, 1:]
+    return V, np.ascontiguousarray(F, dtype=np.int32)
+
+
+def load_mesh(path, scale=1.0):
+    """(V (n, 3) float64 mm, F (m, 3) int32) of a mesh file: STL, PLY, OBJ and the other formats of assimp
+    (the extension's loader), or VTK's `.vtp` and `.vtk` (read_vtk_mesh). scale: multiplies every coordinate
+    (1000 for OpenSim's metre files). Raises Error naming the file and the element at fault."""
+    if is_vtk_file(path):
+        V, F = read_vtk_mesh(path)
+    else:
+        V, F = _impinge.load_mesh(_os.fspath(path))
+    if scale != 1.0:
+        if not (scale > 0 and scale < float("inf")):
+            raise Error(f"load_mesh: scale must be a finite number > 0 (got {scale})")
+        V = V * float(scale)
+    return V, F
+
+
+def _subject_meshes(subject):
+    """The femur and pelvis files a subject.json names, as absolute paths (relative to its folder); none when
+    it cannot be read (the extension then reports what is wrong with it)."""
+    path = _os.fspath(subject)
+    try:
+        with open(path) as f:
+            info = _json.load(f)
+    except (OSError, ValueError):
+        return {}
+    folder = _os.path.dirname(_os.path.abspath(path))
+    out = {}
+    for key in ("femur", "pelvis"):
+        if isinstance(info, dict) and isinstance(info.get(key), str):
+            out[key] = _os.path.join(folder, info[key])
+    return out
+
+
+class Joint(_impinge.Joint):
+    # The extension's Joint, with VTK files wherever it takes a mesh file: `ball=`, `socket=`, or the femur
+    # and pelvis a subject.json names. VTK files are read here (read_vtk_mesh) and handed over as arrays.
+    __doc__ = _impinge.Joint.__doc__
+
+    def __init__(self, ball=None, socket=None, **options):
+        if is_vtk_file(ball):
+            ball = read_vtk_mesh(ball)
+        if is_vtk_file(socket):
+            socket = read_vtk_mesh(socket)
+        subject = options.get("subject")
+        if subject is not None and (ball is None or socket is None):
+            meshes = _subject_meshes(subject)
+            if ball is None and is_vtk_file(meshes.get("femur")):
+                ball = read_vtk_mesh(meshes["femur"])
+            if socket is None and is_vtk_file(meshes.get("pelvis")):
+                socket = read_vtk_mesh(meshes["pelvis"])
+        super().__init__(ball, socket, **options)
+
+    __init__.__doc__ = _impinge.Joint.__init__.__doc__

@@ -1,0 +1,341 @@
+"""Study files: read a study (TOML, Python's tomllib), check every key, and expand it into tasks.
+
+A study names subjects, tasks with the parameters they sweep, and perturbations of the centre of rotation
+(COR). Expanded, it is a list of Task records, each one independent computation on one hip with one set of
+settings; a task's id is a hash of its inputs' contents, its parameters and impinge's version, so a study
+run again on the same folder finds the tasks it has already done. The file's keys are documented in
+docs/studies.md; every bad key gets a StudyError of one line naming the file and the key."""
+import glob
+import hashlib
+import json
+import math
+import os
+import tomllib
+import zlib
+
+import numpy as np
+
+import impinge
+
+KINDS = ("rom", "envelope", "motion", "distance")
+
+# The Joint keywords a study may set (in [joint] or in a [[task]]): the map, frame and joint-centre settings.
+# Left out: the inputs (ball, socket, subject, side, frame, landmarks: the subject gives them), the COR (the
+# perturbation sets it) and maps (saved maps belong to one COR).
+JOINT_KEYS = {
+    "scheme": str, "resolution": float, "precision": float, "turns": float, "spacing": float, "sampling": str,
+    "mode": str, "levels": list, "occlusion_tolerance_mm": float, "max_radius_mm": float, "sparse": float,
+    "discontinuity_tolerance_mm": float, "layers": int, "extra_articular_radius_mm": float,
+    "layered_spacing": float, "distances": bool, "distance_reach_mm": float, "levels_on": str,
+    "maps_only": bool, "neutral": str, "pelvis_frame": str, "joint_centre": str, "femur_frame": str,
+    "head_region": list, "allow_any_cor": bool,
+}
+# Each kind's own options (with their defaults): those of the Joint method the kind calls.
+ENVELOPE_FLEXION = [float(x) for x in range(0, 121, 5)]  # the CLI's rom map grid (impinge rom)
+ENVELOPE_ADDUCTION = [float(x) for x in range(-20, 41, 5)]
+KIND_KEYS = {
+    "rom": {"threshold_mm": 0.0, "step_deg": 2.0, "max_deg": 150.0, "contacts": "impingement",
+            "contact_depth_mm": 0.25, "metric": ""},
+    "envelope": {"threshold_mm": 0.0, "contact_depth_mm": 0.25, "metric": "",
+                 "flexion": ENVELOPE_FLEXION, "adduction": ENVELOPE_ADDUCTION},
+    "motion": {"motion": None},
+    "distance": {"poses": None},
+}
+KIND_TYPES = {"threshold_mm": float, "step_deg": float, "max_deg": float, "contacts": str,
+              "contact_depth_mm": float, "metric": str, "flexion": list, "adduction": list,
+              "motion": str, "poses": list}
+# Keys whose value is itself a list: a list of such lists sweeps them (not a plain list).
+LIST_VALUED = {"levels", "head_region", "flexion", "adduction"}
+TOP_KEYS = {"name", "seed", "subjects", "joint", "task", "perturb", "threads"}
+PERTURB_KEYS = {"cor_sd_mm": float, "samples": int}
+
+
+class StudyError(ValueError):
+    """A bad study file or study folder: one line naming the file and the key."""
+
+
+def _fail(path, key, message):
+    raise StudyError(f"{path}: {key}: {message}")
+
+
+def _typed(path, key, value, kind):
+    """value checked against kind (float accepts int; list stays a list)."""
+    if kind is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            _fail(path, key, f"expected a finite number, got {value!r}")
+        return float(value)
+    if kind is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            _fail(path, key, f"expected an integer, got {value!r}")
+        return value
+    if kind is bool:
+        if not isinstance(value, bool):
+            _fail(path, key, f"expected true or false, got {value!r}")
+        return value
+    if kind is str:
+        if not isinstance(value, str):
+            _fail(path, key, f"expected a string, got {value!r}")
+        return value
+    if kind is list:
+        if not isinstance(value, list) or not value:
+            _fail(path, key, f"expected a non-empty list, got {value!r}")
+        return value
+    raise AssertionError(kind)
+
+
+def _values(path, key, value, kind):
+    """The values a key sweeps: a list of values (a list of lists for list-valued keys), else the one value.
+    key: the key's path in the file (its last part names the option)."""
+    name = key.rsplit(".", 1)[-1]
+    swept = isinstance(value, list) and (name not in LIST_VALUED or (value and isinstance(value[0], list)))
+    items = value if swept else [value]
+    if swept and not items:
+        _fail(path, key, "an empty list sweeps nothing")
+    out = []
+    for k, v in enumerate(items):
+        v = _typed(path, f"{key}[{k}]" if swept else key, v, kind)
+        if kind is list and name in LIST_VALUED:
+            v = [_typed(path, f"{key}[{i}]", x, float) for i, x in enumerate(v)]
+            if name == "head_region" and len(v) != 4:
+                _fail(path, key, f"expected [x, y, z, r] mm, got {len(v)} numbers")
+        out.append(v)
+    return out
+
+
+def _subject_entries(path, entries):
+    """subjects = [...]: paths, globs or folders of subject.json (relative to the study file), or tables
+    {name = "...", generated = {cam_mm = 2.0, triangles = 6000, coverage_deg = 100.0}} (a generated hip)."""
+    if not isinstance(entries, list) or not entries:
+        _fail(path, "subjects", "expected a non-empty list of subject.json paths, globs or folders")
+    base = os.path.dirname(os.path.abspath(path))
+    subjects = []
+    for k, e in enumerate(entries):
+        key = f"subjects[{k}]"
+        if isinstance(e, dict):
+            unknown = set(e) - {"name", "generated"}
+            if unknown:
+                _fail(path, f"{key}.{sorted(unknown)[0]}", "unknown key (known: name, generated)")
+            g = e.get("generated")
+            if not isinstance(g, dict):
+                _fail(path, f"{key}.generated", "expected a table {cam_mm, triangles, coverage_deg}")
+            spec = {"cam_mm": 0.0, "triangles": 6000, "coverage_deg": 100.0}
+            for gk, gv in g.items():
+                if gk not in spec:
+                    _fail(path, f"{key}.generated.{gk}", "unknown key (known: cam_mm, triangles, coverage_deg)")
+                spec[gk] = _typed(path, f"{key}.generated.{gk}", gv, int if gk == "triangles" else float)
+            name = _typed(path, f"{key}.name", e.get("name", f"generated-{k}"), str)
+            subjects.append({"name": name, "generated": spec})
+            continue
+        if not isinstance(e, str):
+            _fail(path, key, f"expected a path, glob or table, got {e!r}")
+        pattern = os.path.join(base, os.path.expanduser(os.path.expandvars(e)))
+        if any(c in e for c in "*?["):
+            found = sorted(glob.glob(pattern))
+            if not found:
+                _fail(path, key, f"'{e}' matches no file")
+        else:
+            found = [pattern]
+        for f in found:
+            if os.path.isdir(f):
+                f = os.path.join(f, "subject.json")
+            if not os.path.isfile(f):
+                _fail(path, key, f"'{f}' is not a subject.json file")
+            f = os.path.normpath(f)
+            with open(f) as fh:
+                try:
+                    info = json.load(fh)
+                except ValueError as err:
+                    _fail(path, key, f"{f}: not JSON ({err})")
+            name = os.path.basename(os.path.dirname(f))
+            subjects.append({"name": name, "path": f, "side": info.get("side", "right") if isinstance(info, dict)
+                             else "right"})
+    names = [s["name"] for s in subjects]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        _fail(path, "subjects", f"two subjects named '{dup[0]}' (a subject is named by its folder)")
+    return subjects
+
+
+def load_study(path):
+    """Read and check a study file -> dict(path, name, seed, threads, subjects, tasks (the [[task]] tables,
+    checked, with their swept values as lists), joint, perturb). Raises StudyError naming the file and key."""
+    path = os.fspath(path)
+    try:
+        with open(path, "rb") as f:
+            doc = tomllib.load(f)
+    except OSError as e:
+        raise StudyError(f"{path}: cannot read it ({e.strerror})") from None
+    except tomllib.TOMLDecodeError as e:
+        raise StudyError(f"{path}: not TOML ({e})") from None
+    unknown = set(doc) - TOP_KEYS
+    if unknown:
+        _fail(path, sorted(unknown)[0], f"unknown key (known: {', '.join(sorted(TOP_KEYS))})")
+    study = {"path": os.path.abspath(path), "name": _typed(path, "name", doc.get("name", os.path.splitext(
+        os.path.basename(path))[0]), str), "seed": _typed(path, "seed", doc.get("seed", 0), int),
+             "threads": _typed(path, "threads", doc.get("threads", 1), int)}
+    if study["threads"] < 1:
+        _fail(path, "threads", "must be >= 1 (OpenMP threads per task)")
+    if "subjects" not in doc:
+        _fail(path, "subjects", "missing (a list of subject.json paths, globs or folders)")
+    study["subjects"] = _subject_entries(path, doc["subjects"])
+    joint = doc.get("joint", {})
+    if not isinstance(joint, dict):
+        _fail(path, "joint", "expected a table of Joint options")
+    study["joint"] = {}
+    for k, v in joint.items():
+        if k not in JOINT_KEYS:
+            _fail(path, f"joint.{k}", f"unknown Joint option (known: {', '.join(sorted(JOINT_KEYS))})")
+        study["joint"][k] = _values(path, f"joint.{k}", v, JOINT_KEYS[k])
+    perturb = doc.get("perturb", {})
+    if not isinstance(perturb, dict):
+        _fail(path, "perturb", "expected a table {cor_sd_mm, samples}")
+    for k in perturb:
+        if k not in PERTURB_KEYS:
+            _fail(path, f"perturb.{k}", f"unknown key (known: {', '.join(sorted(PERTURB_KEYS))})")
+    study["perturb"] = {"cor_sd_mm": _typed(path, "perturb.cor_sd_mm", perturb.get("cor_sd_mm", 0.0), float),
+                        "samples": _typed(path, "perturb.samples", perturb.get("samples", 0), int)}
+    if study["perturb"]["cor_sd_mm"] < 0:
+        _fail(path, "perturb.cor_sd_mm", "must be >= 0 mm")
+    if study["perturb"]["samples"] < 0:
+        _fail(path, "perturb.samples", "must be >= 0 (0: no perturbation)")
+    tasks = doc.get("task")
+    if not isinstance(tasks, list) or not tasks or not all(isinstance(t, dict) for t in tasks):
+        _fail(path, "task", "missing: give one [[task]] table per task, with kind = rom, envelope, motion or distance")
+    study["tasks"] = []
+    base = os.path.dirname(os.path.abspath(path))
+    for i, t in enumerate(tasks):
+        key = f"task[{i}]"
+        kind = t.get("kind")
+        if kind not in KINDS:
+            _fail(path, f"{key}.kind", f"expected one of {', '.join(KINDS)}, got {kind!r}")
+        entry = {"kind": kind, "label": _typed(path, f"{key}.label", t.get("label", kind), str), "joint": {},
+                 "options": {}}
+        for k, v in t.items():
+            if k in ("kind", "label"):
+                continue
+            if k in JOINT_KEYS:
+                entry["joint"][k] = _values(path, f"{key}.{k}", v, JOINT_KEYS[k])
+            elif k in KIND_KEYS[kind]:
+                entry["options"][k] = _values(path, f"{key}.{k}", v, KIND_TYPES[k])
+            else:
+                _fail(path, f"{key}.{k}", f"unknown option of a {kind} task (known: "
+                      f"{', '.join(sorted(set(KIND_KEYS[kind]) | set(JOINT_KEYS) | {'label'}))})")
+        if kind == "motion":
+            if "motion" not in entry["options"]:
+                _fail(path, f"{key}.motion", "missing: a motion file (CSV or OpenSim .mot/.sto) or a list of them")
+            files = []
+            for m in entry["options"]["motion"]:
+                f = os.path.normpath(os.path.join(base, os.path.expanduser(os.path.expandvars(m))))
+                if not os.path.isfile(f):
+                    _fail(path, f"{key}.motion", f"'{m}': no such file")
+                files.append(f)
+            entry["options"]["motion"] = files
+        if kind == "distance":
+            if "poses" not in entry["options"]:
+                _fail(path, f"{key}.poses", "missing: [[flexion, adduction, internal_rotation], ...] degrees")
+            poses = entry["options"]["poses"]
+            poses = poses[0] if len(poses) == 1 and poses[0] and isinstance(poses[0][0], list) else poses
+            checked = []
+            for p, pose in enumerate(poses):
+                if not isinstance(pose, list) or len(pose) != 3:
+                    _fail(path, f"{key}.poses[{p}]", "expected [flexion, adduction, internal_rotation] degrees")
+                checked.append([_typed(path, f"{key}.poses[{p}][{c}]", x, float) for c, x in enumerate(pose)])
+            entry["options"]["poses"] = [checked]
+        study["tasks"].append(entry)
+    return study
+
+
+_digests = {}
+
+
+def file_digest(path):
+    """sha256 of a file's bytes (cached per path and modification time)."""
+    st = os.stat(path)
+    key = (path, st.st_mtime_ns, st.st_size)
+    if key not in _digests:
+        h = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+        _digests[key] = h.hexdigest()
+    return _digests[key]
+
+
+def subject_digest(subject):
+    """A subject's inputs as a hash: subject.json and both mesh files' contents, or the generated model's spec."""
+    if "generated" in subject:
+        return hashlib.sha256(json.dumps(subject["generated"], sort_keys=True).encode()).hexdigest()
+    with open(subject["path"]) as f:
+        info = json.load(f)
+    folder = os.path.dirname(subject["path"])
+    parts = [file_digest(subject["path"])]
+    for key in ("femur", "pelvis"):
+        if isinstance(info, dict) and isinstance(info.get(key), str):
+            mesh = os.path.join(folder, info[key])
+            if not os.path.isfile(mesh):
+                raise StudyError(f"{subject['path']}: {key}: '{info[key]}': no such file")
+            parts.append(file_digest(mesh))
+    return hashlib.sha256("|".join(parts).encode()).hexdigest()
+
+
+def cor_offset(seed, subject_name, sample, sd_mm):
+    """The COR offset (3,) mm of perturbation `sample` of a subject: 0 for sample 0 (the nominal COR), else
+    drawn from N(0, sd_mm^2) per axis by numpy's PCG64 seeded with (seed, crc32(subject name), sample), so a
+    sample's offset is the same in every task, method and shard of the subject (paired comparisons)."""
+    if sample == 0 or sd_mm == 0:
+        return [0.0, 0.0, 0.0]
+    rng = np.random.default_rng([seed, zlib.crc32(subject_name.encode()), sample])
+    return [float(x) for x in rng.normal(0.0, sd_mm, 3)]
+
+
+def _product(choices):
+    """Every combination of {key: [values]} as dicts, in the keys' sorted order (the last key fastest)."""
+    combos = [{}]
+    for k in sorted(choices):
+        combos = [dict(c, **{k: v}) for c in combos for v in choices[k]]
+    return combos
+
+
+def expand(study):
+    """The study's tasks, in a fixed order (subject, task table, swept values, motion or pose, sample):
+    a list of dicts with id, kind, label, subject (the entry), subject_name, side, sample, cor_offset_mm,
+    joint (Joint keywords), options (the kind's method's keywords), item (motion file or pose) and group
+    (the tasks that share one Joint: same subject, settings and COR)."""
+    version = impinge.__version__
+    samples = study["perturb"]["samples"]
+    sd = study["perturb"]["cor_sd_mm"]
+    tasks = []
+    for subject in study["subjects"]:
+        sdigest = subject_digest(subject)
+        for t in study["tasks"]:
+            joint_choices = dict(study["joint"], **t["joint"])
+            option_choices = {k: v for k, v in t["options"].items() if k not in ("motion", "poses")}
+            items = t["options"].get("motion") or (t["options"].get("poses") or [[None]])[0]
+            item_digests = {m: file_digest(m) for m in t["options"].get("motion", [])}
+            for joint in _product(joint_choices):
+                for options in _product(option_choices):
+                    options = dict({k: v for k, v in KIND_KEYS[t["kind"]].items()
+                                    if k not in ("motion", "poses")}, **options)
+                    for item in items:
+                        for sample in range(samples + 1):
+                            offset = cor_offset(study["seed"], subject["name"], sample, sd)
+                            group_key = json.dumps([sdigest, joint, offset], sort_keys=True)
+                            identity = json.dumps({"subject": sdigest, "kind": t["kind"], "joint": joint,
+                                                   "options": options, "cor_offset_mm": offset,
+                                                   "item": item_digests[item] if isinstance(item, str) else item,
+                                                   "version": version},
+                                                  sort_keys=True)
+                            tasks.append({
+                                "id": hashlib.sha256(identity.encode()).hexdigest()[:20], "kind": t["kind"],
+                                "label": t["label"], "subject": subject, "subject_name": subject["name"],
+                                "side": subject.get("side", "right"), "sample": sample, "cor_offset_mm": offset,
+                                "joint": joint, "options": options, "item": item,
+                                "group": hashlib.sha256(group_key.encode()).hexdigest()[:16],
+                                "threads": study["threads"]})
+    ids = [t["id"] for t in tasks]
+    if len(set(ids)) != len(ids):
+        dup = next(i for i in ids if ids.count(i) > 1)
+        t = next(t for t in tasks if t["id"] == dup)
+        raise StudyError(f"{study['path']}: task: two tasks are the same computation ({t['kind']} on "
+                         f"{t['subject_name']}, sample {t['sample']}); give each [[task]] different settings")
+    return tasks

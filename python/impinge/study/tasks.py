@@ -1,0 +1,257 @@
+"""Running a study's tasks: one task, or a group of tasks that share one Joint (same subject, settings and
+COR), in whatever process runs them (this one, a Dask worker, a shard on a batch system).
+
+A task writes its outputs into DIR/tasks/.tmp-<id>-<random>/ and renames that folder to DIR/tasks/<id>/
+when it is complete, so a task folder either holds a whole task (task.json last) or does not exist. A task
+that raises is recorded (status "error", the message) and does not stop the others."""
+import collections
+import json
+import math
+import os
+import shutil
+import socket
+import time
+import traceback
+import uuid
+
+import numpy as np
+
+import impinge
+
+# The Joints this process has built, by group (subject, settings, COR), most recent last.
+_JOINTS = collections.OrderedDict()
+_JOINT_CACHE_SIZE = int(os.environ.get("IMPINGE_STUDY_JOINT_CACHE", "2"))
+_GENERATED = {}
+
+
+def worker_name():
+    """host:pid of this process (results.csv's worker column)."""
+    return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def _generated(spec):
+    key = json.dumps(spec, sort_keys=True)
+    if key not in _GENERATED:
+        _GENERATED[key] = impinge.generated_hip(triangles=spec["triangles"], cam_mm=spec["cam_mm"],
+                                                coverage_deg=spec["coverage_deg"])
+    return _GENERATED[key]
+
+
+def _nominal_cor(task):
+    """The COR the Joint finds by itself (input frame, mm): the subject's hip_centre landmark if it has one,
+    else the femoral head as the session fits it (locate_femoral_head with the pelvis)."""
+    subject = task["subject"]
+    if "generated" in subject:
+        h = _generated(subject["generated"])
+        ball, socket_ = h["ball"], h["socket"]
+    else:
+        with open(subject["path"]) as f:
+            info = json.load(f)
+        centre = info.get("landmarks", {}).get("hip_centre")
+        if centre is not None:
+            return np.asarray(centre, dtype=float)
+        folder = os.path.dirname(subject["path"])
+        ball = impinge.load_mesh(os.path.join(folder, info["femur"]))
+        socket_ = impinge.load_mesh(os.path.join(folder, info["pelvis"]))
+    return np.asarray(impinge.locate_femoral_head(ball[0], ball[1], socket_).centre, dtype=float)
+
+
+def build_joint(task):
+    """The Joint of a task: its subject, its Joint keywords, and its COR (the nominal one moved by the
+    task's cor_offset_mm; sample 0 leaves the COR to the Joint)."""
+    kw = dict(task["joint"])
+    if any(task["cor_offset_mm"]):
+        if "head_region" in kw:
+            raise impinge.Error("perturb: a COR perturbation needs the automatic COR, not head_region")
+        kw["cor"] = [float(x) for x in _nominal_cor(task) + np.asarray(task["cor_offset_mm"])]
+    subject = task["subject"]
+    if "generated" in subject:
+        h = _generated(subject["generated"])
+        kw.setdefault("neutral", "scan")  # a generated hip has no whole bones
+        return impinge.Joint(h["ball"], h["socket"], **kw)
+    return impinge.Joint(subject=subject["path"], **kw)
+
+
+def joint_for(task):
+    """(Joint, seconds spent building it here: 0 when this process holds it already)."""
+    group = task["group"]
+    if group in _JOINTS:
+        _JOINTS.move_to_end(group)
+        return _JOINTS[group], 0.0
+    t0 = time.perf_counter()
+    joint = build_joint(task)
+    built = time.perf_counter() - t0
+    _JOINTS[group] = joint
+    while len(_JOINTS) > max(_JOINT_CACHE_SIZE, 1):
+        _JOINTS.popitem(last=False)
+    return joint, built
+
+
+def _write_csv(path, columns):
+    """columns: dict name -> 1-D array-like (equal lengths) -> a CSV with a header row."""
+    names = list(columns)
+    cols = [np.asarray(columns[n]) for n in names]
+    with open(path, "w") as f:
+        f.write(",".join(names) + "\n")
+        for row in zip(*cols):
+            f.write(",".join(_cell(x) for x in row) + "\n")
+
+
+def _cell(x):
+    if isinstance(x, (bool, np.bool_)):
+        return "true" if x else "false"
+    if isinstance(x, (float, np.floating)):
+        return repr(float(x)) if math.isfinite(x) else ("nan" if math.isnan(x) else repr(float(x)))
+    if isinstance(x, (int, np.integer)):
+        return str(int(x))
+    return str(x)
+
+
+def _run_rom(joint, task, folder):
+    o = task["options"]
+    d = joint.rom_limits(threshold_mm=o["threshold_mm"], step_deg=o["step_deg"], max_deg=o["max_deg"],
+                         contacts=o["contacts"], contact_depth_mm=o["contact_depth_mm"], metric=o["metric"])
+    motions = [k for k, v in d.items() if isinstance(v, dict)]
+    fields = [k for k in d[motions[0]] if k != "contact_mm"]
+    _write_csv(os.path.join(folder, "rom_limits.csv"),
+               dict({"motion": motions}, **{k: [d[m][k] for m in motions] for k in fields}))
+    figures = {}
+    for m in motions:
+        figures[f"limit_{m}_deg"] = float(d[m]["limit_deg"])
+    for m in motions:
+        figures[f"contact_class_{m}"] = d[m]["contact_class"]
+    figures["excluded_vertices"] = int(d["excluded_vertices"])
+    return figures
+
+
+def _run_envelope(joint, task, folder):
+    o = task["options"]
+    ir = joint.rom_map(o["flexion"], o["adduction"], threshold_mm=o["threshold_mm"],
+                       contact_depth_mm=o["contact_depth_mm"], metric=o["metric"])
+    F, A = np.meshgrid(o["flexion"], o["adduction"], indexing="ij")
+    _write_csv(os.path.join(folder, "rom_map.csv"), {"flexion_deg": F.ravel(), "adduction_deg": A.ravel(),
+                                                     "max_internal_rotation_deg": ir.ravel()})
+    finite = ir[np.isfinite(ir)]
+    return {"envelope_cells": int(ir.size), "envelope_limited_cells": int(finite.size),
+            "envelope_mean_ir_deg": float(finite.mean()) if finite.size else float("nan"),
+            "envelope_min_ir_deg": float(finite.min()) if finite.size else float("nan"),
+            "envelope_max_ir_deg": float(finite.max()) if finite.size else float("nan")}
+
+
+def _run_motion(joint, task, folder):
+    m = impinge.load_motion(task["item"], task["side"])
+    r = joint.motion(m["angles"])
+    columns = {k: v for k, v in r.items() if k not in ("detection_ms",)}
+    columns["time_s"] = m["time_s"]
+    _write_csv(os.path.join(folder, "frames.csv"), columns)
+    gap = np.fmin(r["ball_min_gap_mm"], r["socket_min_gap_mm"])
+    out = {"frames": int(len(gap)), "min_gap_mm": float(np.nanmin(gap)) if np.isfinite(gap).any() else float("nan")}
+    out["min_gap_time_s"] = float(m["time_s"][int(np.nanargmin(gap))]) if np.isfinite(gap).any() else float("nan")
+    if "ball_min_distance_mm" in r:
+        dist = np.fmin(r["ball_min_distance_mm"], r["socket_min_distance_mm"])
+        out["min_distance_mm"] = float(np.nanmin(dist)) if np.isfinite(dist).any() else float("nan")
+        measure = dist
+    else:
+        measure = gap
+    inside = measure < 0
+    out["frames_penetrating"] = int(inside.sum())
+    out["first_penetration_s"] = float(m["time_s"][int(np.argmax(inside))]) if inside.any() else float("nan")
+    return out
+
+
+def _run_distance(joint, task, folder):
+    f, a, r = task["item"]
+    d = joint.detect_pose(f, a, r)
+    arrays = {k: v for k, v in d.items() if isinstance(v, np.ndarray)}
+    np.savez_compressed(os.path.join(folder, "gaps.npz"), **arrays)
+    out = {}
+    for bone in ("ball", "socket"):
+        for q in ("gap", "distance"):
+            x = d.get(f"{bone}_{q}_mm")
+            if x is None:
+                continue
+            out[f"{bone}_min_{q}_mm"] = float(np.nanmin(x)) if np.isfinite(x).any() else float("nan")
+            out[f"{bone}_penetrating_vertices_{q}"] = int(np.sum(x < 0))
+    return out
+
+
+RUNNERS = {"rom": _run_rom, "envelope": _run_envelope, "motion": _run_motion, "distance": _run_distance}
+
+
+def task_record(task):
+    """The parameters of a task as results.csv gives them (one flat dict)."""
+    rec = {"task_id": task["id"], "kind": task["kind"], "label": task["label"], "subject": task["subject_name"],
+           "side": task["side"], "sample": task["sample"], "cor_dx_mm": task["cor_offset_mm"][0],
+           "cor_dy_mm": task["cor_offset_mm"][1], "cor_dz_mm": task["cor_offset_mm"][2],
+           "cor_offset_mm": float(np.linalg.norm(task["cor_offset_mm"]))}
+    for k, v in sorted(task["joint"].items()):
+        rec[k] = json.dumps(v) if isinstance(v, list) else v
+    for k, v in sorted(task["options"].items()):
+        rec[k] = json.dumps(v) if isinstance(v, list) else v
+    if task["kind"] == "motion":
+        rec["motion"] = os.path.basename(task["item"])
+    if task["kind"] == "distance":
+        rec["flexion_deg"], rec["adduction_deg"], rec["internal_rotation_deg"] = task["item"]
+    return rec
+
+
+def read_done(tasks_dir, task):
+    """The record of a finished task (its task.json), or None when it has not finished."""
+    path = os.path.join(tasks_dir, task["id"], "task.json")
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def run_task(task, tasks_dir):
+    """Run one task here and write DIR/tasks/<id>/ (its outputs, then task.json) -> its record: parameters,
+    figures, status ('ok' or 'error'), error, time_s (the task's own time, with its Joint's build when built
+    here), joint_build_s, worker."""
+    folder = os.path.join(tasks_dir, f".tmp-{task['id']}-{uuid.uuid4().hex[:8]}")
+    os.makedirs(folder)
+    record = {"parameters": task_record(task), "figures": {}, "status": "ok", "error": "",
+              "worker": worker_name()}
+    t0 = time.perf_counter()
+    built = 0.0
+    try:
+        impinge.set_threads(task.get("threads", 1))
+        joint, built = joint_for(task)
+        record["figures"] = RUNNERS[task["kind"]](joint, task, folder)
+    except Exception as e:  # noqa: BLE001 (a task's error is recorded, the study goes on)
+        record["status"] = "error"
+        record["error"] = f"{type(e).__name__}: {e}".replace("\n", " ")
+        with open(os.path.join(folder, "traceback.txt"), "w") as f:
+            f.write(traceback.format_exc())
+    record["time_s"] = time.perf_counter() - t0
+    record["joint_build_s"] = built
+    record["task"] = task
+    with open(os.path.join(folder, "task.json"), "w") as f:
+        json.dump(record, f, indent=1, default=float)
+    target = os.path.join(tasks_dir, task["id"])
+    try:
+        os.rename(folder, target)
+    except OSError:  # done meanwhile by another worker (a task rescheduled after its worker was lost)
+        shutil.rmtree(folder, ignore_errors=True)
+        done = read_done(tasks_dir, task)
+        if done is not None:
+            return done
+        raise
+    return record
+
+
+def run_group(tasks, tasks_dir, retry_errors=False):
+    """Run the tasks of one group (one Joint) in order, skipping those already finished -> their records.
+    The group's Joint is built once, for its first unfinished task."""
+    records = []
+    for task in tasks:
+        done = read_done(tasks_dir, task)
+        if done is not None and (done["status"] == "ok" or not retry_errors):
+            done["skipped"] = True
+            records.append(done)
+            continue
+        if done is not None:
+            shutil.rmtree(os.path.join(tasks_dir, task["id"]), ignore_errors=True)
+        records.append(run_task(task, tasks_dir))
+    return records
