@@ -22,24 +22,15 @@ Poses: rest and 10 poses up to 110 deg flexion (issue 26's); --quick: rest and 2
 usage: exp_13_distance_peers --out DIR [--data DIR] [--quick]
 (build/experiments/exp_13_distance_peers runs this file with the module on PYTHONPATH)"""
 import csv
-import datetime
 import json
 import os
-import platform
 import statistics
-import subprocess
-import sys
 import time
 
 import numpy as np
+from experiment_support import experiment_args, write_meta
 
 import impinge
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-def arg(name, default=None):
-    return sys.argv[sys.argv.index(name) + 1] if name in sys.argv else default
 
 
 def o3d_scene(V, F):
@@ -106,13 +97,7 @@ def disagreements(a, b):
 
 
 def main():
-    out_root = arg("--out")
-    if out_root is None:
-        sys.exit(__doc__)
-    quick = "--quick" in sys.argv
-    data = arg("--data")
-    d = os.path.join(out_root, "13_distance_peers")
-    os.makedirs(d, exist_ok=True)
+    d, data, quick = experiment_args("13_distance_peers", __doc__)
     resolution = 0.5 if quick else 0.1
     reps = 3 if quick else 5
     poses = [(0, 0, 0)] + [(-10 + 12 * k, (k % 3 - 1) * 10, (k % 4 - 1.5) * 10) for k in range(10)]
@@ -169,15 +154,7 @@ def main():
         w.writeheader()
         w.writerows(rows)
     import vtk
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
-    dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"], capture_output=True,
-                           text=True).stdout.strip() != ""
-    meta = {
-        "experiment": "13_distance_peers",
-        "git_commit": commit + ("-dirty" if dirty else ""),
-        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "cores": str(os.cpu_count()),
-        "machine": platform.processor() or platform.machine(),
+    write_meta(d, "13_distance_peers", {
         "data_folder": data if data and os.path.isdir(data) else None,
         "quick": quick,
         "repetitions": reps,
@@ -185,9 +162,7 @@ def main():
         "parameters": {"resolution_deg": resolution, "scheme": "equiangular", "distance_reach_mm": "6 (the largest "
                        "--levels threshold)", "poses_deg": poses},
         "versions": {"open3d": __import__("open3d").__version__, "vtk": vtk.vtkVersion.GetVTKVersion()},
-    }
-    with open(os.path.join(d, "meta.json"), "w") as f:
-        json.dump(meta, f, indent=2)
+    })
 
 
 if __name__ == "__main__":

@@ -22,6 +22,9 @@ def main(argv=None):
                    "subjects at the same paths")
     r.add_argument("--shard", default=None, help="I/N: run only the I-th of N slices of the tasks (I from 0); "
                    "`merge` joins them")
+    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="set a study key over the file's (dotted, the value in TOML): --set perturb.samples=3 "
+                   "--set 'subjects=[\"data/*/subject.json\"]'")
     r.add_argument("--retry-errors", action="store_true", help="run the tasks that raised last time again")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     m = sub.add_parser("merge", help="join the shards of a study into one results.csv")
@@ -30,6 +33,7 @@ def main(argv=None):
     t = sub.add_parser("tasks", help="list the expanded tasks of a study file, one per line (id, kind, subject, "
                        "sample, group)")
     t.add_argument("study")
+    t.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="as run's")
     a = p.parse_args(argv)
     try:
         if a.command == "run":
@@ -37,12 +41,13 @@ def main(argv=None):
                 raise spec.StudyError(f"--workers {a.workers}: must be >= 0")
             shard = runner.parse_shard(a.shard) if a.shard else None
             s = runner.run(a.study, a.out, workers=a.workers, scheduler=a.scheduler, shard=shard,
-                           retry_errors=a.retry_errors, progress=False if a.no_progress else None)
+                           retry_errors=a.retry_errors, progress=False if a.no_progress else None,
+                           overrides=dict(spec.parse_override(x) for x in a.set))
             return 1 if s["errors"] else 0
         if a.command == "merge":
             runner.merge(a.out, a.shards)
             return 0
-        for task in spec.expand(spec.load_study(a.study)):
+        for task in spec.expand(spec.load_study(a.study, dict(spec.parse_override(x) for x in a.set))):
             print(task["id"], task["kind"], task["label"], task["subject_name"], task["sample"], task["group"])
         return 0
     except spec.StudyError as e:

@@ -10,7 +10,7 @@ import numpy as np  # noqa: E402
 
 
 NOT_SETTINGS = ("task_id", "sample", "cor_dx_mm", "cor_dy_mm", "cor_dz_mm", "cor_offset_mm", "time_s",
-                "joint_build_s", "worker", "excluded_vertices", "status", "error")
+                "joint_build_s", "worker", "excluded_vertices", "status", "error", "warnings")
 
 
 def _setting(r):

@@ -18,8 +18,10 @@ import impinge
 
 from . import spec, tasks as task_mod
 
+RESULTS_CSV = "results.csv"  # what a run writes in its folder
+SUMMARY_CSV = "summary.csv"
 TIMING_COLUMNS = ("time_s", "joint_build_s", "worker")  # what differs between two runs of the same tasks
-STATUS_COLUMNS = ("status", "error")
+STATUS_COLUMNS = ("status", "error", "warnings")
 BASE_COLUMNS = ("task_id", "kind", "label", "subject", "side", "sample", "cor_dx_mm", "cor_dy_mm", "cor_dz_mm",
                 "cor_offset_mm")
 
@@ -123,7 +125,7 @@ def _dask_client(workers, scheduler, threads):
 
 
 def run(study_path, out, workers=None, scheduler=None, shard=None, retry_errors=False, progress=None, log=None,
-        on_start=None):
+        on_start=None, overrides=None):
     """Run a study into folder `out` and gather its results.
 
     study_path: the study file (TOML). workers: local worker processes (None: one per core; 0: run here,
@@ -131,19 +133,19 @@ def run(study_path, out, workers=None, scheduler=None, shard=None, retry_errors=
     run only shard I of N (results-I-of-N.csv; `merge` joins the shards). retry_errors: run again the tasks
     that raised last time (else they count as finished). progress: show the progress bar (None: when stderr is
     a terminal). log: a function taking one line (None: print to stderr). on_start: called with the Dask client
-    once the workers run (tests kill a worker through it).
+    once the workers run (tests kill a worker through it). overrides: {dotted key: value} over the file's keys.
     Writes out/study.toml, out/study.json (the expanded tasks), out/tasks/<id>/, and, for a whole study,
     out/results.csv, out/summary.csv and out/figures/. -> dict(tasks, ran, skipped, errors, wall_s, setup_s,
     task_s (the tasks' own time, summed), workers)."""
     log = log or (lambda line: print(line, file=sys.stderr))
-    study = spec.load_study(study_path)
+    study = spec.load_study(study_path, overrides)
     task_list = spec.expand(study)
     tasks_dir = os.path.join(out, "tasks")
     os.makedirs(tasks_dir, exist_ok=True)
     os.makedirs(os.path.join(out, "shards"), exist_ok=True)
     _write_atomic(os.path.join(out, "study.json"), json.dumps(
         {"name": study["name"], "study_file": study["path"], "version": impinge.__version__, "seed": study["seed"],
-         "tasks": task_list}, indent=1))
+         "overrides": overrides or {}, "tasks": task_list}, indent=1))
     with open(study["path"]) as f:
         _write_atomic(os.path.join(out, "study.toml"), f.read())
     groups = shard_groups(groups_of(task_list), shard)
@@ -223,8 +225,8 @@ def rows_of(records):
     for r in records:
         row = dict(r["parameters"])
         row.update(r["figures"])
-        row.update({"status": r["status"], "error": r["error"], "time_s": r["time_s"],
-                    "joint_build_s": r["joint_build_s"], "worker": r["worker"]})
+        row.update({"status": r["status"], "error": r["error"], "warnings": r.get("warnings", ""),
+                    "time_s": r["time_s"], "joint_build_s": r["joint_build_s"], "worker": r["worker"]})
         rows.append(row)
     return rows
 
@@ -314,11 +316,11 @@ def summarise(records):
 
 def gather(out, records):
     """results.csv, summary.csv and figures/ of a whole study's records."""
-    write_results(records, os.path.join(out, "results.csv"))
+    write_results(records, os.path.join(out, RESULTS_CSV))
     stats = summarise(records)
     cols = ["kind", "label", "subject", "setting", "figure", "n", "n_nan", "errors", "nominal", "mean", "sd", "min",
             "p05", "p25", "median", "p75", "p95", "max"]
-    with open(os.path.join(out, "summary.csv"), "w", newline="") as f:
+    with open(os.path.join(out, SUMMARY_CSV), "w", newline="") as f:
         w = csv.writer(f, lineterminator="\n")
         w.writerow(cols)
         for s in stats:

@@ -156,9 +156,47 @@ def _subject_entries(path, entries):
     return subjects
 
 
-def load_study(path):
+def parse_override(text):
+    """'KEY=VALUE' (KEY dotted, e.g. perturb.samples; VALUE in TOML, e.g. 3 or ["a/*/subject.json"]) ->
+    (KEY, value). Raises StudyError."""
+    key, sep, value = text.partition("=")
+    if not sep or not key.strip():
+        raise StudyError(f"--set {text}: expected KEY=VALUE (e.g. perturb.samples=3)")
+    try:
+        return key.strip(), tomllib.loads(f"v = {value}")["v"]
+    except tomllib.TOMLDecodeError:
+        return key.strip(), value  # a bare string
+
+
+def toml_value(v):
+    """A value as TOML writes it inline (for --set): tables {k = v}, arrays, strings, numbers, booleans."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + "}"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, str):
+        return json.dumps(v)
+    return repr(v)
+
+
+def _apply(doc, overrides, path):
+    for key, value in (overrides or {}).items():
+        parts = key.split(".")
+        node = doc
+        for p in parts[:-1]:
+            node = node.setdefault(p, {})
+            if not isinstance(node, dict):
+                _fail(path, key, "cannot set a key inside a value that is not a table")
+        node[parts[-1]] = value
+
+
+def load_study(path, overrides=None):
     """Read and check a study file -> dict(path, name, seed, threads, subjects, tasks (the [[task]] tables,
-    checked, with their swept values as lists), joint, perturb). Raises StudyError naming the file and key."""
+    checked, with their swept values as lists), joint, perturb). overrides: {dotted key: value} set over the
+    file's (e.g. {"perturb.samples": 3}; checked as the file's keys are). Raises StudyError naming the file and
+    key."""
     path = os.fspath(path)
     try:
         with open(path, "rb") as f:
@@ -167,6 +205,7 @@ def load_study(path):
         raise StudyError(f"{path}: cannot read it ({e.strerror})") from None
     except tomllib.TOMLDecodeError as e:
         raise StudyError(f"{path}: not TOML ({e})") from None
+    _apply(doc, overrides, path)
     unknown = set(doc) - TOP_KEYS
     if unknown:
         _fail(path, sorted(unknown)[0], f"unknown key (known: {', '.join(sorted(TOP_KEYS))})")

@@ -13,6 +13,7 @@ import socket
 import time
 import traceback
 import uuid
+import warnings
 
 import numpy as np
 
@@ -207,17 +208,20 @@ def read_done(tasks_dir, task):
 
 def run_task(task, tasks_dir):
     """Run one task here and write DIR/tasks/<id>/ (its outputs, then task.json) -> its record: parameters,
-    figures, status ('ok' or 'error'), error, time_s (the task's own time, with its Joint's build when built
+    figures, status ('ok' or 'error'), error, warnings (the Joint's, about its input), time_s (the task's own time, with its Joint's build when built
     here), joint_build_s, worker."""
     folder = os.path.join(tasks_dir, f".tmp-{task['id']}-{uuid.uuid4().hex[:8]}")
     os.makedirs(folder)
-    record = {"parameters": task_record(task), "figures": {}, "status": "ok", "error": "",
+    record = {"parameters": task_record(task), "figures": {}, "status": "ok", "error": "", "warnings": "",
               "worker": worker_name()}
     t0 = time.perf_counter()
     built = 0.0
     try:
         impinge.set_threads(task.get("threads", 1))
-        joint, built = joint_for(task)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the Joint's warnings go to the record, from joint.warnings
+            joint, built = joint_for(task)
+        record["warnings"] = " | ".join(joint.warnings)
         record["figures"] = RUNNERS[task["kind"]](joint, task, folder)
     except Exception as e:  # noqa: BLE001 (a task's error is recorded, the study goes on)
         record["status"] = "error"

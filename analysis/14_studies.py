@@ -1,0 +1,100 @@
+"""14_studies: studies on Dask (issue 27): the local cluster against the serial run, scaling from one worker to
+two, the per-task overhead, and the estimated wall time of a large study from the measured task times.
+
+Reads RESULTS/14_studies/{equality,scaling,task_times,cohort_summary}.csv and meta.json; writes
+table_scaling.tex, table_cohort.tex, studies_times.pdf, macros.tex."""
+import json
+import os
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+
+d = experiment_dir("14_studies")
+eq = read_csv(d, "equality.csv").iloc[0]
+sc = read_csv(d, "scaling.csv").set_index("workers")
+times = read_csv(d, "task_times.csv")
+summary = read_csv(d, "cohort_summary.csv")
+with open(os.path.join(d, "meta.json")) as f:
+    meta = json.load(f)
+
+one, two, control = sc.loc[1], sc.loc[2], sc.loc[0]  # workers 0: two shards in two processes, no Dask
+ratio = two.wall_s / one.wall_s
+efficiency = one.wall_s / (2 * two.wall_s)  # 1: two workers twice as fast
+names = {1: "1 Dask worker", 2: "2 Dask workers", 0: "2 processes, no Dask"}
+write_table(d, "table_scaling", ["run", "ROM tasks", "wall s", "tasks' own s", "mean task s", "overhead",
+                                 "wall / 1 worker"],
+            [[names[int(w)], str(int(r.tasks)), f"{r.wall_s:.1f}", f"{r.task_s:.1f}", f"{r.mean_task_s:.2f}",
+              f"{100 * r.overhead:.1f}%", f"{r.wall_s / one.wall_s:.3f}"] for w, r in sc.iterrows()])
+
+# The cohort: per subject, the nominal value and the spread over the COR perturbations.
+figures = [("rom", "limit_flexion_deg", "flexion limit (deg)"),
+           ("rom", "limit_internal_rotation_90_flexion_deg", "IR at 90 flexion (deg)"),
+           ("rom", "limit_fadir_deg", "FADIR limit (deg)"),
+           ("motion", "min_distance_mm", "squat least distance (mm)")]
+rows = []
+for s in sorted(summary.subject.unique()):
+    row = [s]
+    for kind, fig, _ in figures:
+        g = summary[(summary.subject == s) & (summary.kind == kind) & (summary.figure == fig)]
+        if g.empty or not np.isfinite(g.iloc[0]["nominal"]):
+            row.append("--")
+            continue
+        r = g.iloc[0]
+        row.append(f"{r.nominal:.1f} ({r.p05:.1f} to {r.p95:.1f})")
+    rows.append(row)
+write_table(d, "table_cohort", ["subject"] + [label for _, _, label in figures], rows)
+
+fig, (a, b) = plt.subplots(1, 2, figsize=(8, 3.2))
+kinds = ["rom", "motion", "distance"]
+serial = times[times.run == "cohort-serial"]
+a.boxplot([serial[serial.kind == k].time_s for k in kinds], widths=0.6)
+a.set_xticks(range(1, len(kinds) + 1), kinds)
+a.set_yscale("log")
+a.set_ylabel("task time (s, one thread)")
+a.set_title("cohort study, serial: task times per kind", fontsize=9)
+b.bar(["1 worker", "2 workers"], [one.wall_s, two.wall_s], color=["0.6", "0.3"])
+b.bar(["1 worker", "2 workers"], [one.task_s, two.task_s / 2], fill=False, edgecolor="r", lw=1.2,
+      label="tasks' own time / workers")
+b.set_ylabel("wall time (s)")
+b.set_title(f"{int(one.tasks)} ROM tasks", fontsize=9)
+b.legend(fontsize=7)
+save(fig, d, "studies_times")
+
+# The wall time of a 1,000-subject x 100-perturbation x 4-method ROM study, from the measured mean ROM task
+# (its Joint's build included: each perturbation is a new COR, so new maps), on this machine's 2 cores at the
+# measured two-worker efficiency, and on 64 nodes of 32 cores at the same efficiency.
+tasks_large = 1000 * 100 * 4
+mean_task = one.mean_task_s
+one_machine_days = tasks_large * mean_task / (2 * efficiency) / 86400
+cluster_cores = 64 * 32
+cluster_hours = tasks_large * mean_task / (cluster_cores * efficiency) / 3600
+
+write_macros(d, "macros", {
+    "STUDYcohortTasks": str(int(eq.tasks_local)),
+    "STUDYcohortSubjects": str(len(meta["parameters"]["subjects"])),
+    "STUDYcohortPerturbations": str(meta["parameters"]["cohort_perturbations"]),
+    "STUDYcells": f"{int(eq.cells_compared):,}".replace(",", "{,}"),
+    "STUDYcellsDiffering": str(int(eq.cells_differing)),
+    "STUDYequalVerdict": "equal" if bool(eq.equal) else "not equal",
+    "STUDYlocalWorkers": str(int(eq.workers_local)),
+    "STUDYromTasks": str(int(one.tasks)),
+    "STUDYwallOne": f"{one.wall_s:.0f}",
+    "STUDYwallTwo": f"{two.wall_s:.0f}",
+    "STUDYratio": f"{ratio:.3f}",
+    "STUDYratioVerdict": "meets" if ratio <= 0.56 else "misses",
+    "STUDYratioControl": f"{control.wall_s / one.wall_s:.3f}",
+    "STUDYcontrolSlowdown": f"{100 * (control.mean_task_s / one.mean_task_s - 1):.0f}",
+    "STUDYefficiency": f"{100 * efficiency:.0f}",
+    "STUDYoverheadOne": f"{100 * one.overhead:.1f}",
+    "STUDYoverheadTwo": f"{100 * two.overhead:.1f}",
+    "STUDYtaskSlowdown": f"{100 * (two.mean_task_s / one.mean_task_s - 1):.0f}",
+    "STUDYmeanRomTask": f"{mean_task:.2f}",
+    "STUDYlargeTasks": f"{tasks_large:,}".replace(",", "{,}"),
+    "STUDYestOneMachineDays": f"{one_machine_days:.1f}",
+    "STUDYclusterCores": f"{cluster_cores:,}".replace(",", "{,}"),
+    "STUDYestClusterHours": f"{cluster_hours:.2f}",
+    "STUDYestClusterMinutes": f"{60 * cluster_hours:.0f}",
+    "STUDYdistributedVersion": meta["versions"]["distributed"],
+})

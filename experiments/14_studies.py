@@ -1,0 +1,157 @@
+"""Experiment 14 (issue 27): studies on Dask, measured.
+
+1. The example cohort study (examples/hip_cohort_study.toml: every shared hip, rom + motion + distance tasks,
+   COR perturbations) run serially (no Dask) and on the default local cluster (one worker per core); their
+   results.csv compared value for value (every column but time and worker).
+2. Scaling: a study of ROM tasks only (every shared hip, 50 COR perturbations each: >= 200 tasks) on one
+   worker and on two (the 2 cores), in one run: wall times, their ratio, and the per-task overhead
+   (scheduling, serialisation, I/O): (workers x wall - the tasks' own summed time) / the tasks' own time.
+3. The tasks' own times, per kind, for the analysis' estimate of a 1,000-subject x 100-perturbation x
+   4-method study on one machine and on a cluster.
+Without shared data, the generated hips (no cam, 2 mm cam) stand in for the subjects.
+
+Outputs (OUT/14_studies/):
+  cohort_results.csv   the cohort study's results.csv (local cluster)
+  cohort_summary.csv   its summary.csv
+  equality.csv         serial against the local cluster: tasks, cells compared, cells that differ
+  scaling.csv          workers (0: the control, two shards in two processes without Dask), tasks, wall_s,
+                       task_s (summed), overhead, mean task s
+  task_times.csv       every task of every run: run, kind, subject, time_s, joint_build_s, worker
+  meta.json
+--quick: 2 perturbations in the cohort, 2 in the scaling study (its figures then test the pipeline, not the
+1,000-subject estimate).
+
+usage: exp_14_studies --out DIR [--data DIR] [--quick]
+(build/experiments/exp_14_studies runs this file with the module on PYTHONPATH)"""
+import csv
+import glob
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+from experiment_support import ROOT, experiment_args, write_meta
+
+import impinge
+from impinge import study
+from impinge.study import runner, spec
+
+EXAMPLE = os.path.join(ROOT, "examples", "hip_cohort_study.toml")
+GENERATED = [{"name": "generated-cam0", "generated": {"cam_mm": 0.0, "triangles": 20000}},
+             {"name": "generated-cam2", "generated": {"cam_mm": 2.0, "triangles": 20000}}]
+
+
+def quiet(_):
+    pass
+
+
+def task_rows(run_name, out):
+    rows = []
+    for r in runner.read_results(os.path.join(out, runner.RESULTS_CSV)):
+        rows.append({"run": run_name, "kind": r["kind"], "subject": r["subject"], "sample": r["sample"],
+                     "time_s": r["time_s"], "joint_build_s": r["joint_build_s"], "worker": r["worker"]})
+    return rows
+
+
+def over_args(overrides):
+    """--set options for the command line of impinge.study."""
+    return [a for k, v in overrides.items() for a in ("--set", f"{k}={spec.toml_value(v)}")]
+
+
+def write_csv(path, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]), lineterminator="\n")
+        w.writeheader()
+        w.writerows(rows)
+
+
+def main():
+    d, data, quick = experiment_args("14_studies", __doc__)
+    data = os.path.abspath(data) if data else None
+    real = sorted(glob.glob(os.path.join(data, "*", "subject.json"))) if data and os.path.isdir(data) else []
+    subjects = real if real else GENERATED
+    samples = 2 if quick else 20
+    scaling_samples = 2 if quick else 50
+    work = tempfile.mkdtemp(prefix="impinge-exp14-")
+    cores = os.cpu_count() or 1
+    times, scaling = [], []
+    try:
+        # 1. The cohort study: serially, then on the local cluster; equal value for value.
+        over = {"subjects": subjects, "perturb.samples": samples}
+        print(f"[14_studies] cohort: {len(subjects)} subjects, {samples} perturbations, serially", flush=True)
+        serial = study.run(EXAMPLE, os.path.join(work, "serial"), workers=0, progress=False, log=quiet,
+                           overrides=over)
+        print(f"[14_studies] cohort on the local cluster ({cores} workers)", flush=True)
+        local = study.run(EXAMPLE, os.path.join(work, "local"), workers=None, progress=False, log=quiet,
+                          overrides=over)
+        a = runner.read_results(os.path.join(work, "serial", runner.RESULTS_CSV))
+        b = runner.read_results(os.path.join(work, "local", runner.RESULTS_CSV))
+        compared = sorted((set(a[0]) | set(b[0])) - set(runner.TIMING_COLUMNS))
+        differ = sum(x.get(k) != y.get(k) for x, y in zip(a, b) for k in compared) + abs(len(a) - len(b)) * len(compared)
+        equality = [{"study": "hip-cohort", "tasks_serial": serial["tasks"], "tasks_local": local["tasks"],
+                     "errors_serial": serial["errors"], "errors_local": local["errors"],
+                     "workers_local": local["workers"], "columns": len(compared),
+                     "cells_compared": len(a) * len(compared), "cells_differing": differ,
+                     "equal": differ == 0 and len(a) == len(b)}]
+        write_csv(os.path.join(d, "equality.csv"), equality)
+        shutil.copy(os.path.join(work, "local", runner.RESULTS_CSV), os.path.join(d, "cohort_results.csv"))
+        shutil.copy(os.path.join(work, "local", runner.SUMMARY_CSV), os.path.join(d, "cohort_summary.csv"))
+        times += task_rows("cohort-serial", os.path.join(work, "serial"))
+        times += task_rows("cohort-local", os.path.join(work, "local"))
+
+        # 2. Scaling: ROM tasks only on 1 and 2 workers (local clusters, one thread per worker).
+        rom = os.path.join(work, "rom_study.toml")
+        with open(rom, "w") as f:
+            f.write('name = "rom-scaling"\nseed = 27\nsubjects = []\n[joint]\nresolution = 0.5\n'
+                    'joint_centre = "equidistant"\n[[task]]\nkind = "rom"\nmetric = "distance"\n'
+                    '[perturb]\ncor_sd_mm = 1.0\nsamples = 0\n')
+        over = {"subjects": subjects, "perturb.samples": scaling_samples}
+        for workers in (1, 2):
+            print(f"[14_studies] scaling: ROM tasks on {workers} worker(s)", flush=True)
+            folder = os.path.join(work, f"rom{workers}")
+            s = study.run(rom, folder, workers=workers, progress=False, log=quiet, overrides=over)
+            scaling.append({"workers": s["workers"], "tasks": s["tasks"], "errors": s["errors"],
+                            "wall_s": s["wall_s"], "setup_s": s["setup_s"], "task_s": s["task_s"],
+                            "mean_task_s": s["task_s"] / s["tasks"],
+                            "overhead": (s["workers"] * s["wall_s"] - s["task_s"]) / s["task_s"]})
+            times += task_rows(f"rom-{workers}-workers", folder)
+        # The control: the same study as two shards in two processes at once, without Dask (what the 2 cores
+        # give two independent processes of this work).
+        print("[14_studies] scaling: the same tasks as two shards in two processes, without Dask", flush=True)
+        args = over_args(over)
+        t0 = time.perf_counter()
+        procs = [subprocess.Popen([sys.executable, "-m", "impinge.study", "run", rom, "--out",
+                                   os.path.join(work, "shards"), "--workers", "0", "--shard", f"{i}/2",
+                                   "--no-progress"] + args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                 for i in range(2)]
+        if any(p.wait() != 0 for p in procs):
+            raise SystemExit("14_studies: a shard of the scaling study failed")
+        wall = time.perf_counter() - t0
+        records = runner.merge(os.path.join(work, "shards"), [], log=quiet)
+        task_s = float(sum(r["time_s"] for r in records))
+        scaling.append({"workers": 0, "tasks": len(records), "errors": sum(r["status"] != "ok" for r in records),
+                        "wall_s": wall, "setup_s": 0.0, "task_s": task_s, "mean_task_s": task_s / len(records),
+                        "overhead": (2 * wall - task_s) / task_s})
+        write_csv(os.path.join(d, "scaling.csv"), scaling)
+        write_csv(os.path.join(d, "task_times.csv"), times)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+    import distributed
+    write_meta(d, "14_studies", {
+        "data_folder": data if real else None,
+        "quick": quick,
+        "timing": "wall time of the task phase (cluster started), one OpenMP thread per task; task times measured "
+                  "inside the tasks (their Joint's build included where it was built)",
+        "parameters": {"cohort_study": os.path.relpath(EXAMPLE, ROOT), "cohort_perturbations": samples,
+                       "scaling_perturbations": scaling_samples, "scaling_resolution_deg": 0.5,
+                       "subjects": [os.path.basename(os.path.dirname(s)) if isinstance(s, str) else s["name"]
+                                    for s in subjects]},
+        "versions": {"impinge": impinge.__version__, "distributed": distributed.__version__},
+    })
+
+
+if __name__ == "__main__":
+    main()
