@@ -114,9 +114,9 @@ def load_mesh(path, scale=1.0):
     return V, F
 
 
-def _subject_meshes(subject):
-    """The femur and pelvis files a subject.json names, as absolute paths (relative to its folder); none when
-    it cannot be read (the extension then reports what is wrong with it)."""
+def subject_meshes(subject):
+    """{"femur": path, "pelvis": path}: the mesh files a subject.json names, as absolute paths (they are relative
+    to its folder); {} when it cannot be read (the extension then reports what is wrong with it)."""
     path = _os.fspath(subject)
     try:
         with open(path) as f:
@@ -143,7 +143,7 @@ class Joint(_impinge.Joint):
             socket = read_vtk_mesh(socket)
         subject = options.get("subject")
         if subject is not None and (ball is None or socket is None):
-            meshes = _subject_meshes(subject)
+            meshes = subject_meshes(subject)
             if ball is None and is_vtk_file(meshes.get("femur")):
                 ball = read_vtk_mesh(meshes["femur"])
             if socket is None and is_vtk_file(meshes.get("pelvis")):

@@ -159,8 +159,9 @@ def run(study_path, out, workers=None, scheduler=None, shard=None, retry_errors=
         done = task_mod.read_done(tasks_dir, t)
         return done is not None and (done["status"] == "ok" or not retry_errors)
 
-    todo = {g: ts for g, ts in groups.items() if not all(finished(t) for t in ts)}
-    before = sum(finished(t) for t in mine)
+    done_before = {t["id"] for t in mine if finished(t)}
+    todo = {g: ts for g, ts in groups.items() if not all(t["id"] in done_before for t in ts)}
+    before = len(done_before)
     where = "here, serially" if workers == 0 and not scheduler else (f"on {scheduler}" if scheduler else "local cluster")
     log(f"impinge.study: {study['name']}: {len(mine)} tasks in {len(groups)} groups"
         + (f" (shard {shard[0]}/{shard[1]} of {len(task_list)} tasks)" if shard else "")
@@ -252,7 +253,7 @@ def write_results(records, path):
         w = csv.writer(f, lineterminator="\n")
         w.writerow(cols)
         for row in rows:
-            w.writerow([task_mod._cell(row[c]) if c in row else "" for c in cols])
+            w.writerow([task_mod.cell(row[c]) if c in row else "" for c in cols])
     os.replace(tmp, path)
 
 
@@ -262,43 +263,35 @@ def read_results(path):
         return list(csv.DictReader(f))
 
 
-def _settings(rows, kind):
-    """The parameter columns that vary among a kind's tasks (besides subject, sample and COR offset)."""
-    same = [r for r in rows if r["kind"] == kind]
+def _varying(records, kind):
+    """The parameters (besides the base columns: subject, sample, COR offset...) that vary among a kind's tasks."""
+    same = [r["parameters"] for r in records if r["parameters"]["kind"] == kind]
     keys = [k for k in columns_of(same) if k not in BASE_COLUMNS + STATUS_COLUMNS + TIMING_COLUMNS]
-    params = [k for k in keys if all(k in r for r in same) and not _is_figure(k, kind)]
-    return [k for k in params if len({json.dumps(r.get(k)) for r in same}) > 1]
-
-
-FIGURE_PREFIXES = ("limit_", "contact_class_", "excluded_vertices", "envelope_", "frames", "min_", "first_",
-                   "ball_", "socket_")
-
-
-def _is_figure(key, kind):
-    return key.startswith(FIGURE_PREFIXES) and key not in ("flexion_deg", "adduction_deg")
+    return [k for k in keys if all(k in p for p in same) and len({json.dumps(p.get(k)) for p in same}) > 1]
 
 
 def summarise(records):
-    """summary.csv's rows: per kind, label, subject, setting (the varying parameters) and figure, statistics
-    over the perturbation samples of the tasks that ran: n, nominal (sample 0), mean, sd, min, p05, p25,
-    median, p75, p95, max (NaN results left out of the statistics, counted in n_nan)."""
-    rows = rows_of(records)
+    """summary.csv's rows: per kind, label, subject, setting (the varying parameters) and numeric figure,
+    statistics over the perturbation samples of the tasks that ran: n, nominal (sample 0), mean, sd, min, p05,
+    p25, median, p75, p95, max (NaN results left out of the statistics, counted in n_nan)."""
     out = []
     by = {}
-    varying = {kind: _settings(rows, kind) for kind in {r["kind"] for r in rows}}
-    for r in rows:
-        setting = ";".join(f"{k}={r.get(k)}" for k in varying[r["kind"]])
-        by.setdefault((r["kind"], r["label"], r["subject"], setting), []).append(r)
+    varying = {kind: _varying(records, kind) for kind in {r["parameters"]["kind"] for r in records}}
+    for r in records:
+        p = r["parameters"]
+        setting = ";".join(f"{k}={p.get(k)}" for k in varying[p["kind"]])
+        by.setdefault((p["kind"], p["label"], p["subject"], setting), []).append(r)
     for (kind, label, subject, setting), group in by.items():
         ok = [r for r in group if r["status"] == "ok"]
-        figures = [k for k in columns_of(ok) if _is_figure(k, kind) and k not in varying[kind]]
-        for fig in figures:
-            values = [r.get(fig) for r in ok]
+        for fig in columns_of([r["figures"] for r in ok]):
+            if fig in BASE_COLUMNS + STATUS_COLUMNS + TIMING_COLUMNS:
+                continue
+            values = [r["figures"].get(fig) for r in ok]
             if not values or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
                 continue
             x = np.asarray(values, dtype=float)
             finite = x[np.isfinite(x)]
-            nominal = [r.get(fig) for r in ok if r["sample"] == 0]
+            nominal = [r["figures"].get(fig) for r in ok if r["parameters"]["sample"] == 0]
             stats = {"kind": kind, "label": label, "subject": subject, "setting": setting, "figure": fig,
                      "n": int(finite.size), "n_nan": int(x.size - finite.size), "errors": len(group) - len(ok),
                      "nominal": float(nominal[0]) if nominal else float("nan")}
@@ -324,7 +317,7 @@ def gather(out, records):
         w = csv.writer(f, lineterminator="\n")
         w.writerow(cols)
         for s in stats:
-            w.writerow([task_mod._cell(s[c]) for c in cols])
+            w.writerow([task_mod.cell(s[c]) for c in cols])
     try:
         from . import figures
     except ImportError:  # pragma: no cover (matplotlib missing: the tables are the results)

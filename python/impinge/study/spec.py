@@ -254,6 +254,8 @@ def load_study(path, overrides=None):
                 continue
             if k in JOINT_KEYS:
                 entry["joint"][k] = _values(path, f"{key}.{k}", v, JOINT_KEYS[k])
+            elif k == "poses":
+                entry["options"][k] = v  # a list of poses, not a sweep: checked below
             elif k in KIND_KEYS[kind]:
                 entry["options"][k] = _values(path, f"{key}.{k}", v, KIND_TYPES[k])
             else:
@@ -273,13 +275,14 @@ def load_study(path, overrides=None):
             if "poses" not in entry["options"]:
                 _fail(path, f"{key}.poses", "missing: [[flexion, adduction, internal_rotation], ...] degrees")
             poses = entry["options"]["poses"]
-            poses = poses[0] if len(poses) == 1 and poses[0] and isinstance(poses[0][0], list) else poses
+            if not isinstance(poses, list) or not poses:
+                _fail(path, f"{key}.poses", "expected [[flexion, adduction, internal_rotation], ...] degrees")
             checked = []
             for p, pose in enumerate(poses):
                 if not isinstance(pose, list) or len(pose) != 3:
                     _fail(path, f"{key}.poses[{p}]", "expected [flexion, adduction, internal_rotation] degrees")
                 checked.append([_typed(path, f"{key}.poses[{p}][{c}]", x, float) for c, x in enumerate(pose)])
-            entry["options"]["poses"] = [checked]
+            entry["options"]["poses"] = checked
         study["tasks"].append(entry)
     return study
 
@@ -304,16 +307,11 @@ def subject_digest(subject):
     """A subject's inputs as a hash: subject.json and both mesh files' contents, or the generated model's spec."""
     if "generated" in subject:
         return hashlib.sha256(json.dumps(subject["generated"], sort_keys=True).encode()).hexdigest()
-    with open(subject["path"]) as f:
-        info = json.load(f)
-    folder = os.path.dirname(subject["path"])
     parts = [file_digest(subject["path"])]
-    for key in ("femur", "pelvis"):
-        if isinstance(info, dict) and isinstance(info.get(key), str):
-            mesh = os.path.join(folder, info[key])
-            if not os.path.isfile(mesh):
-                raise StudyError(f"{subject['path']}: {key}: '{info[key]}': no such file")
-            parts.append(file_digest(mesh))
+    for key, mesh in sorted(impinge.subject_meshes(subject["path"]).items()):
+        if not os.path.isfile(mesh):
+            raise StudyError(f"{subject['path']}: {key}: '{mesh}': no such file")
+        parts.append(file_digest(mesh))
     return hashlib.sha256("|".join(parts).encode()).hexdigest()
 
 
@@ -349,7 +347,7 @@ def expand(study):
         for t in study["tasks"]:
             joint_choices = dict(study["joint"], **t["joint"])
             option_choices = {k: v for k, v in t["options"].items() if k not in ("motion", "poses")}
-            items = t["options"].get("motion") or (t["options"].get("poses") or [[None]])[0]
+            items = t["options"].get("motion") or t["options"].get("poses") or [None]
             item_digests = {m: file_digest(m) for m in t["options"].get("motion", [])}
             for joint in _product(joint_choices):
                 for options in _product(option_choices):

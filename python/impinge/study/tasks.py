@@ -21,6 +21,7 @@ import impinge
 
 # The Joints this process has built, by group (subject, settings, COR), most recent last.
 _JOINTS = collections.OrderedDict()
+_NOMINAL_COR = {}  # subject (path or generated spec) -> its nominal COR: one fit for all its perturbed samples
 _JOINT_CACHE_SIZE = int(os.environ.get("IMPINGE_STUDY_JOINT_CACHE", "2"))
 _GENERATED = {}
 
@@ -40,21 +41,25 @@ def _generated(spec):
 
 def _nominal_cor(task):
     """The COR the Joint finds by itself (input frame, mm): the subject's hip_centre landmark if it has one,
-    else the femoral head as the session fits it (locate_femoral_head with the pelvis)."""
+    else the femoral head as the session fits it (locate_femoral_head with the pelvis). Once per subject."""
     subject = task["subject"]
+    key = json.dumps(subject, sort_keys=True)
+    if key in _NOMINAL_COR:
+        return _NOMINAL_COR[key]
     if "generated" in subject:
         h = _generated(subject["generated"])
         ball, socket_ = h["ball"], h["socket"]
+        centre = None
     else:
         with open(subject["path"]) as f:
-            info = json.load(f)
-        centre = info.get("landmarks", {}).get("hip_centre")
-        if centre is not None:
-            return np.asarray(centre, dtype=float)
-        folder = os.path.dirname(subject["path"])
-        ball = impinge.load_mesh(os.path.join(folder, info["femur"]))
-        socket_ = impinge.load_mesh(os.path.join(folder, info["pelvis"]))
-    return np.asarray(impinge.locate_femoral_head(ball[0], ball[1], socket_).centre, dtype=float)
+            centre = json.load(f).get("landmarks", {}).get("hip_centre")
+        meshes = impinge.subject_meshes(subject["path"])
+        if centre is None:
+            ball, socket_ = impinge.load_mesh(meshes["femur"]), impinge.load_mesh(meshes["pelvis"])
+    if centre is None:
+        centre = impinge.locate_femoral_head(ball[0], ball[1], socket_).centre
+    _NOMINAL_COR[key] = np.asarray(centre, dtype=float)
+    return _NOMINAL_COR[key]
 
 
 def build_joint(task):
@@ -95,10 +100,11 @@ def _write_csv(path, columns):
     with open(path, "w") as f:
         f.write(",".join(names) + "\n")
         for row in zip(*cols):
-            f.write(",".join(_cell(x) for x in row) + "\n")
+            f.write(",".join(cell(x) for x in row) + "\n")
 
 
-def _cell(x):
+def cell(x):
+    """One CSV cell: exact floats (repr), nan, true/false, integers, text."""
     if isinstance(x, (bool, np.bool_)):
         return "true" if x else "false"
     if isinstance(x, (float, np.floating)):
