@@ -10,6 +10,7 @@
 // - clock_summary keeps every tested vertex's area and finds the closest vertex's hour.
 #include "impinge/anatomy/clock_face.hpp"
 #include "impinge/clinical/clock_summary.hpp"
+#include "impinge/core/error.hpp"
 
 #include <gtest/gtest.h>
 
@@ -119,4 +120,14 @@ TEST(ClockFace, SummaryKeepsEveryAreaAndFindsTheClosestHour) {
   EXPECT_DOUBLE_EQ(total, 11);  // 1 + 2 + 8: the untested vertex counts nowhere
   EXPECT_NEAR(s.closest_hour, c.hour(V.row(3).transpose()), 1e-12);
   EXPECT_DOUBLE_EQ(s.sector_level_area_mm2[static_cast<std::size_t>(2 * levels.count() + levels.level(0.5f))], 2);
+  // The hours computed once (clock_hours: a bone's hours do not change with its pose) give the same
+  // summary; hours of another length are refused.
+  const std::vector<double> hours = clock_hours(V, c);
+  ASSERT_EQ(hours.size(), 4u);
+  for (Eigen::Index i = 0; i < V.rows(); ++i) EXPECT_EQ(hours[static_cast<std::size_t>(i)], c.hour(V.row(i).transpose()));
+  ClockSummary t;
+  clock_summary(g, hours, area, levels, t);
+  EXPECT_EQ(t.closest_hour, s.closest_hour);
+  EXPECT_EQ(t.sector_level_area_mm2, s.sector_level_area_mm2);
+  EXPECT_THROW(clock_summary(g, std::vector<double>(3, 1.0), area, levels, t), Error);
 }

@@ -200,3 +200,36 @@ TEST(Detection, ScanSetRejectsAMaskOfTheWrongSize) {
   EXPECT_EQ(idx, (std::vector<std::int32_t>{0, 2, 4, 6, 8}));
   for (std::int64_t j = 0; j < s.size(); ++j) EXPECT_EQ(s.x[j], P(s.index[j], 0));
 }
+
+// The two bodies are built on two threads: a bad mesh on either side is still an error naming that
+// mesh's file, and a joint built twice gives the same maps and gaps.
+TEST(Detection, JointBuiltOnTwoThreadsNamesTheBadMeshAndIsDeterministic) {
+  const Eigen::Vector3d cor(0, 0, 0);
+  TriangleMesh ball = make_uv_sphere(22, cor, 90, 45, Eigen::Vector3d::UnitZ());
+  TriangleMesh cup = make_cup(25, 30, 100, cor, Eigen::Vector3d::UnitZ(), 90, 30);
+  ball.source = "ball.ply", cup.source = "cup.ply";
+  JointOptions o;
+  o.scheme = make_scheme("equiangular", 1.0);
+  o.layers = 2;
+  const Joint a(ball, cup, cor, o), b(ball, cup, cor, o);
+  const PoseResult ra = a.detect(Eigen::Matrix3d::Identity()), rb = b.detect(Eigen::Matrix3d::Identity());
+  for (std::int64_t i = 0; i < a.socket().map.num_nodes(); ++i) ASSERT_EQ(a.socket().map.at(i), b.socket().map.at(i));
+  ASSERT_EQ(ra.ball_gaps.gap_mm.size(), rb.ball_gaps.gap_mm.size());
+  for (std::size_t i = 0; i < ra.socket_gaps.gap_mm.size(); ++i)
+    ASSERT_TRUE(ra.socket_gaps.gap_mm[i] == rb.socket_gaps.gap_mm[i] ||
+                (std::isnan(ra.socket_gaps.gap_mm[i]) && std::isnan(rb.socket_gaps.gap_mm[i])));
+  TriangleMesh bad_cup = cup, bad_ball = ball;
+  bad_cup.V(7, 1) = std::nan("");
+  bad_ball.V(3, 0) = std::numeric_limits<double>::infinity();
+  auto message = [&](const TriangleMesh& x, const TriangleMesh& y) {
+    try {
+      const Joint j(x, y, cor, o);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(ball, bad_cup).find("cup.ply"), std::string::npos) << message(ball, bad_cup);
+  EXPECT_NE(message(bad_ball, cup).find("ball.ply"), std::string::npos) << message(bad_ball, cup);
+  EXPECT_NE(message(bad_ball, bad_cup).find(".ply"), std::string::npos);
+}

@@ -208,3 +208,67 @@ TEST_P(RealDistance, EveryMeasuredVertexMatchesCgalAtRestAndTenPoses) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, RealDistance, ::testing::Values("lhdl-ct", "mc22", "mc22-left", "tlem2-mri"));
+
+// scan_layered_near (the layered scan that leaves out clusters beyond the reach) against scan_layered
+// over the same vertices and against CGAL: a vertex it looks up gets scan_layered's gap bit for bit; a
+// vertex it skips is outside the other bone (CGAL's ray parity) and farther than the reach from it (CGAL's
+// closest distance). A head pushed 6 mm into a 6 mm cup wall, so that some vertices lie deeper inside the
+// wall than the reach: with single-vertex clusters (radius 0) the distance query alone would skip them,
+// and the inside test must keep them.
+TEST(SurfaceDistance, LayeredScanLeavesOutOnlyWhatIsOutsideAndBeyondTheReach) {
+  if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
+  const Eigen::Vector3d c(10, -5, 20), axis = Eigen::Vector3d(0.3, 0.2, 1).normalized();
+  const TriangleMesh head = make_uv_sphere(22, c, 120, 60, Eigen::Vector3d(0.2, 0.1, 1).normalized());
+  const TriangleMesh cup = make_cup(24.5, 30.5, 100, c, axis, 120, 40);
+  JointOptions o;
+  o.layers = 2;
+  const Joint joint(head, cup, c, o);
+  ASSERT_NE(joint.socket().layered, nullptr);
+  const SignedDistanceQuery other(cup);
+  const ExactReference ref(cup);
+  const ScanSet set = make_scan_set(joint.ball().relative, std::vector<std::uint8_t>(head.V.rows(), 1));
+  std::int64_t skipped = 0, scanned = 0, deep = 0;
+  for (const int cluster_size : {1, 32})
+    for (const double push : {0.0, 3.5, 6.0})
+      for (const double reach : {0.5, 2.0}) {
+        const ScanClusters clusters = cluster_scan_set(set, cluster_size);
+        const Eigen::Matrix3d R =
+            Eigen::AngleAxisd(push * M_PI / 90, Eigen::Vector3d(0.6, 0.8, 0).normalized()).toRotationMatrix();
+        const Eigen::Vector3d t = push * axis;
+        std::vector<float> all(static_cast<std::size_t>(set.size())), near(all.size());
+        scan_layered(set, R, t, *joint.socket().layered, all.data(), joint.socket().caster.get());
+        const LayeredNearStats st = scan_layered_near(set, clusters, R, t, *joint.socket().layered, c, other, reach,
+                                                      near.data(), joint.socket().caster.get());
+        std::int64_t skipped_here = 0;
+        for (std::int64_t j = 0; j < set.size(); ++j) {
+          const auto k = static_cast<std::size_t>(j);
+          const Eigen::Vector3d q = c + R * Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) + t;
+          const std::string what = "size " + std::to_string(cluster_size) + " push " + std::to_string(push) +
+                                   " reach " + std::to_string(reach) + " vertex " + std::to_string(j);
+          if (near[k] == std::numeric_limits<float>::infinity()) {
+            ++skipped_here;
+            ASSERT_GT(ref.closest_distance(q), reach) << what;
+            ASSERT_FALSE(inside_by_parity(ref, q)) << what;
+            continue;
+          }
+          ++scanned;
+          if (std::isnan(all[k])) {
+            ASSERT_TRUE(std::isnan(near[k])) << what;
+          } else {
+            ASSERT_EQ(near[k], all[k]) << what;
+          }
+          deep += inside_by_parity(ref, q) && ref.closest_distance(q) > reach;
+        }
+        EXPECT_EQ(st.vertices_scanned, set.size() - skipped_here) << cluster_size;
+        skipped += skipped_here;
+      }
+  EXPECT_GT(skipped, 0);
+  EXPECT_GT(scanned, 0);
+  EXPECT_GT(deep, 0);  // vertices deeper inside than the reach were looked up, not skipped
+  const ScanClusters clusters = cluster_scan_set(set);
+  std::vector<float> out(static_cast<std::size_t>(set.size()));
+  EXPECT_THROW(scan_layered_near(set, clusters, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(),
+                                 *joint.socket().layered, c, other, 0, out.data(), nullptr),
+               Error);
+  EXPECT_THROW(cluster_scan_set(set, 0), Error);
+}

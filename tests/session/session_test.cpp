@@ -18,6 +18,8 @@
 #include <functional>
 #include <sstream>
 
+#include <omp.h>
+
 #include "impinge/core/error.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
@@ -208,6 +210,47 @@ TEST(Session, MotionRunEqualsDetectAtEachPose) {
     EXPECT_EQ(time[k].get<double>(), 0.5 * double(k));
   }
   EXPECT_THROW(run_motion(s, poses, {0.0}, [](const MotionFrame&) {}), Error);
+}
+
+// Frames are scanned in blocks on every thread, then handed over in order: 40 poses (several blocks) on
+// one thread and on two give the same rows, frame by frame, each the detection at that frame's pose; an
+// error thrown by the callback stops the run there.
+TEST(Session, MotionRunOnTwoThreadsEqualsOneInOrder) {
+  const Session s(generated_options("RAS"));
+  std::vector<PoseAngles> poses;
+  for (int k = 0; k < 40; ++k) poses.push_back({2.5 * k, 10 * std::sin(0.3 * k), 20 * std::cos(0.2 * k)});
+  auto run_on = [&](int threads) {
+    omp_set_num_threads(threads);
+    Table t;
+    t.columns = motion_columns(s.joint_options().levels);
+    std::vector<std::size_t> order;
+    run_motion(s, poses, {}, [&](const MotionFrame& f) {
+      order.push_back(f.index);
+      PoseResult r;
+      s.joint().detect(f.pose.R, f.pose.t, r);
+      EXPECT_EQ(f.result->ball.min_gap_mm, r.ball.min_gap_mm) << f.index;
+      EXPECT_EQ(f.result->socket.min_gap_mm, r.socket.min_gap_mm) << f.index;
+      nlohmann::json row = motion_row(f);
+      row.erase(row.size() - 1);  // detection_ms
+      t.rows.push_back(row);
+    });
+    for (std::size_t k = 0; k < order.size(); ++k) EXPECT_EQ(order[k], k);
+    return t;
+  };
+  const int before = omp_get_max_threads();
+  const Table one = run_on(1), two = run_on(2);
+  omp_set_num_threads(before);
+  ASSERT_EQ(one.rows.size(), poses.size());
+  ASSERT_EQ(two.rows.size(), poses.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(one.rows[k].dump(), two.rows[k].dump()) << k;
+  std::size_t delivered = 0;
+  EXPECT_THROW(run_motion(s, poses, {},
+                          [&](const MotionFrame& f) {
+                            ++delivered;
+                            if (f.index == 20) throw Error("stop at frame 20");
+                          }),
+               Error);
+  EXPECT_EQ(delivered, 21u);
 }
 
 TEST(Session, RomRunEqualsTheLibraryCalls) {

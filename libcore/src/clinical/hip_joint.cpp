@@ -110,6 +110,10 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   if (method != JointCentreMethod::femoral_head)
     centre_ = JointCentre(method, *joint_, joint_to_working_.transpose() * (acetabulum_->sphere.centre - cor_),
                           articular_->pelvis, articular_->head_sphere_reach_mm, options.equidistant);
+  if (socket_clock_) {
+    ball_hours_ = clock_hours(joint_->ball().relative, *ball_clock_);
+    socket_hours_ = clock_hours(joint_->socket().relative, *socket_clock_);
+  }
   // The COR must lie inside the femur: then every ray from it meets the femur's surface.
   const RadialDistanceMap& bm = joint_->ball().map;
   // (Counted when the map was filled: a sparse map with a finite region reads "no surface" beyond it.)
@@ -146,9 +150,8 @@ void HipJoint::save_maps(const std::string& ball_path, const std::string& socket
 void HipJoint::clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& socket) const {
   if (!socket_clock_) return;
   const JointOptions& o = joint_->options();
-  clock_summary(res.ball_gaps, joint_->ball().relative, joint_->ball().vertex_area, *ball_clock_, o.levels, ball,
-                o.levels_on);
-  clock_summary(res.socket_gaps, joint_->socket().relative, joint_->socket().vertex_area, *socket_clock_, o.levels,
+  clock_summary(res.ball_gaps, ball_hours_, joint_->ball().vertex_area, o.levels, ball, o.levels_on);
+  clock_summary(res.socket_gaps, socket_hours_, joint_->socket().vertex_area, o.levels,
                 socket, o.levels_on);
 }
 

@@ -93,7 +93,7 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
   b.min_gap_mm = by_distance ? std::fmin(r.ball.min_distance_mm, r.socket.min_distance_mm)
                              : std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);
   if (o.use_bounds && screened_or_radial(o))
-    b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), scan_cut_of(o));
+    b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), scan_cut_of(o), &b.skip_ball, &b.skip_socket);
   return b;
 }
 

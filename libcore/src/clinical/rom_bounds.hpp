@@ -18,6 +18,7 @@
 #include "impinge/core/error.hpp"
 #include "impinge/core/fast_angles.hpp"
 #include "impinge/detection/detection.hpp"
+#include "impinge/detection/surface_distance.hpp"
 #include "impinge/schemes/equiangular_grid.hpp"
 
 namespace impinge {
@@ -306,31 +307,78 @@ struct Clustered {
   std::vector<Cluster> leaves, groups;
 };
 
+// The vertices of a scan set that a baseline counts (skip: per vertex of the body, 1 = never counted:
+// a pre-existing overlap or a joint surface left out); all of them with no skip list.
+inline ScanSet counted_subset(const ScanSet& s, const std::vector<std::uint8_t>* skip) {
+  if (skip == nullptr) return s;
+  ScanSet out;
+  out.vertices = s.vertices;
+  for (std::int64_t k = 0; k < s.size(); ++k)
+    if (!(*skip)[static_cast<std::size_t>(s.index[static_cast<std::size_t>(k)])]) {
+      out.index.push_back(s.index[static_cast<std::size_t>(k)]);
+      out.x.push_back(s.x[static_cast<std::size_t>(k)]), out.y.push_back(s.y[static_cast<std::size_t>(k)]),
+          out.z.push_back(s.z[static_cast<std::size_t>(k)]);
+    }
+  return out;
+}
+
+// The same vertices in clusters by position (a Z curve in space; cluster_scan_set), for the hidden
+// vertices: those of one direction lie at many depths (the neck and the trochanter behind the head),
+// so clusters along the directions span large radii and balls, and neither bound parts them.
+inline ScanSet by_position(const ScanSet& s) {
+  const ScanClusters c = cluster_scan_set(s, kLeaf);
+  ScanSet out;
+  out.vertices = s.vertices;
+  for (const std::int32_t j : c.member) {
+    const auto k = static_cast<std::size_t>(j);
+    out.index.push_back(s.index[k]);
+    out.x.push_back(s.x[k]), out.y.push_back(s.y[k]), out.z.push_back(s.z[k]);
+  }
+  return out;
+}
+
 }  // namespace rom_detail
 
 // Bounds for the searches of one joint at one threshold: the map pyramids and the clusters
-// (shared by every search that holds the baseline they were made with; read-only).
+// (shared by every search that holds the baseline they were made with; read-only). With the
+// baseline's skip lists, the scan sets hold only the vertices it counts (a vertex never counted is
+// never looked up: the joint surfaces left out of an impingement search are most of those near
+// contact at every pose).
 struct RomSearchBounds {
-  RomSearchBounds(const Joint& j, double threshold)
+  RomSearchBounds(const Joint& j, double threshold, const std::vector<std::uint8_t>* skip_ball = nullptr,
+                  const std::vector<std::uint8_t>* skip_socket = nullptr)
       : joint(&j),
         threshold_mm(threshold),
+        skip_ball(skip_ball != nullptr ? *skip_ball : std::vector<std::uint8_t>{}),
+        skip_socket(skip_socket != nullptr ? *skip_socket : std::vector<std::uint8_t>{}),
+        ball_set(rom_detail::counted_subset(j.ball().scan_set, skip_ball)),
+        socket_set(rom_detail::counted_subset(j.socket().scan_set, skip_socket)),
+        ball_hidden_set(rom_detail::by_position(rom_detail::counted_subset(j.ball().hidden_set, skip_ball))),
+        socket_hidden_set(rom_detail::by_position(rom_detail::counted_subset(j.socket().hidden_set, skip_socket))),
         socket_min(rom_detail::bound_pyramid(j.socket().map, true)),
         ball_max(rom_detail::bound_pyramid(j.ball().map, false)),
-        ball_reachable(rom_detail::reachable_subset(j.ball().scan_set, socket_min.all(), threshold + rom_detail::kReachableShiftMm)),
-        ball(j.ball().scan_set),
-        socket(j.socket().scan_set),
+        ball_reachable(rom_detail::reachable_subset(ball_set, socket_min.all(), threshold + rom_detail::kReachableShiftMm)),
+        ball(ball_set),
+        socket(socket_set),
         ball_reachable_clusters(ball_reachable) {
     if (j.socket().layered) {
       socket_occupancy.emplace(rom_detail::occupancy_pyramid(*j.socket().layered));
-      ball_hidden = rom_detail::Clustered(j.ball().hidden_set);
+      ball_hidden = rom_detail::Clustered(ball_hidden_set);
     }
     if (j.ball().layered) {
       ball_occupancy.emplace(rom_detail::occupancy_pyramid(*j.ball().layered));
-      socket_hidden = rom_detail::Clustered(j.socket().hidden_set);
+      socket_hidden = rom_detail::Clustered(socket_hidden_set);
     }
+  }
+  // Whether these bounds serve a search of `joint` at `threshold` whose baseline skips these vertices.
+  bool serves(const Joint& j, double threshold, const std::vector<std::uint8_t>& ball_skips,
+              const std::vector<std::uint8_t>& socket_skips) const {
+    return joint == &j && threshold_mm == threshold && skip_ball == ball_skips && skip_socket == socket_skips;
   }
   const Joint* joint;
   double threshold_mm;
+  std::vector<std::uint8_t> skip_ball, skip_socket;  // the skip lists the sets were made with (empty: none)
+  ScanSet ball_set, socket_set, ball_hidden_set, socket_hidden_set;  // the counted vertices
   rom_detail::BoundPyramid socket_min, ball_max;
   ScanSet ball_reachable;
   rom_detail::Clustered ball, socket, ball_reachable_clusters;
@@ -343,8 +391,8 @@ namespace rom_detail {
 // without bounds).
 inline std::shared_ptr<const RomSearchBounds> bounds_for(const Joint& joint, const RomOptions& o, const RomBaseline& base) {
   if (!o.use_bounds || !screened_or_radial(o)) return nullptr;
-  if (base.bounds && base.bounds->joint == &joint && base.bounds->threshold_mm == scan_cut_of(o)) return base.bounds;
-  return std::make_shared<const RomSearchBounds>(joint, scan_cut_of(o));
+  if (base.bounds && base.bounds->serves(joint, scan_cut_of(o), base.skip_ball, base.skip_socket)) return base.bounds;
+  return std::make_shared<const RomSearchBounds>(joint, scan_cut_of(o), &base.skip_ball, &base.skip_socket);
 }
 }  // namespace rom_detail
 }  // namespace impinge

@@ -39,21 +39,30 @@ class CompactScanner {
  public:
   CompactScanner(const Joint& joint, const RomBaseline& base, const RomSearchBounds* bounds, double threshold,
                  RomVertices counted)
-      : joint_(joint), bounds_(bounds), threshold_(threshold), counted_(counted), pelvis_(base) {
+      : joint_(joint),
+        bounds_(bounds),
+        threshold_(threshold),
+        counted_(counted),
+        pelvis_(base),
+        // With bounds, the counted vertices only (RomSearchBounds); their skip flags are then all 0.
+        ball_set_(bounds != nullptr ? &bounds->ball_set : &joint.ball().scan_set),
+        socket_set_(bounds != nullptr ? &bounds->socket_set : &joint.socket().scan_set),
+        ball_hidden_set_(bounds != nullptr ? &bounds->ball_hidden_set : &joint.ball().hidden_set),
+        socket_hidden_set_(bounds != nullptr ? &bounds->socket_hidden_set : &joint.socket().hidden_set) {
     auto skips = [](const ScanSet& set, const std::vector<std::uint8_t>& by_vertex) {
       std::vector<std::uint8_t> out;
       for (std::int32_t i : set.index) out.push_back(by_vertex[static_cast<std::size_t>(i)]);
       return out;
     };
-    skip_ball_ = skips(joint.ball().scan_set, base.skip_ball);
-    skip_socket_ = skips(joint.socket().scan_set, base.skip_socket);
-    skip_ball_hidden_ = skips(joint.ball().hidden_set, base.skip_ball);
-    skip_socket_hidden_ = skips(joint.socket().hidden_set, base.skip_socket);
+    skip_ball_ = skips(*ball_set_, base.skip_ball);
+    skip_socket_ = skips(*socket_set_, base.skip_socket);
+    skip_ball_hidden_ = skips(*ball_hidden_set_, base.skip_ball);
+    skip_socket_hidden_ = skips(*socket_hidden_set_, base.skip_socket);
     if (bounds_ != nullptr) skip_ball_reachable_ = skips(bounds_->ball_reachable, base.skip_ball);
     // The pelvis' contacts with the head's joint surface, classed at each pose (take()).
     if (pelvis_.articular_only) {
-      lunate_socket_ = skips(joint.socket().scan_set, base.lunate);
-      lunate_socket_hidden_ = skips(joint.socket().hidden_set, base.lunate);
+      lunate_socket_ = skips(*socket_set_, base.lunate);
+      lunate_socket_hidden_ = skips(*socket_hidden_set_, base.lunate);
     }
     buf_.resize(static_cast<std::size_t>(std::max({joint.ball().scan_set.size(), joint.socket().scan_set.size(),
                                                    joint.ball().hidden_set.size(), joint.socket().hidden_set.size()})));
@@ -86,10 +95,10 @@ class CompactScanner {
     last_ = {};
     if (counted_ != RomVertices::hidden) {
       const bool reachable = !exact && bounds_ != nullptr && shift_mm_ <= kReachableShiftMm;
-      const Part ball = bounds_ == nullptr ? Part{&joint_.ball().scan_set, &skip_ball_, nullptr, true}
-                        : !reachable ? Part{&joint_.ball().scan_set, &skip_ball_, &bounds_->ball, true}
+      const Part ball = bounds_ == nullptr ? Part{ball_set_, &skip_ball_, nullptr, true}
+                        : !reachable ? Part{ball_set_, &skip_ball_, &bounds_->ball, true}
                                      : Part{&bounds_->ball_reachable, &skip_ball_reachable_, &bounds_->ball_reachable_clusters, true};
-      const Part socket{&joint_.socket().scan_set, &skip_socket_, bounds_ == nullptr ? nullptr : &bounds_->socket, false};
+      const Part socket{socket_set_, &skip_socket_, bounds_ == nullptr ? nullptr : &bounds_->socket, false};
       scan(ball, cut, l);
       if (done(l)) return l;
       scan(socket, cut, l);
@@ -97,11 +106,11 @@ class CompactScanner {
     }
     if (counted_ == RomVertices::first_surface) return l;
     if (joint_.socket().layered)
-      scan_hidden(ball_pose_, joint_.ball().hidden_set, *joint_.socket().layered, joint_.socket().caster.get(),
+      scan_hidden(ball_pose_, *ball_hidden_set_, *joint_.socket().layered, joint_.socket().caster.get(),
                   skip_ball_hidden_, true, cut, l);
     if (done(l)) return l;
     if (joint_.ball().layered)
-      scan_hidden(socket_pose_, joint_.socket().hidden_set, *joint_.ball().layered, joint_.ball().caster.get(),
+      scan_hidden(socket_pose_, *socket_hidden_set_, *joint_.ball().layered, joint_.ball().caster.get(),
                   skip_socket_hidden_, false, cut, l);
     return l;
   }
@@ -329,7 +338,8 @@ class CompactScanner {
       for (std::int64_t i = g.first / kLeaf; i < (g.first + g.count + kLeaf - 1) / kLeaf; ++i) {
         const Cluster& c = (*cl)[static_cast<std::size_t>(i)];
         if (done(l)) return;
-        if (reusable ? skip_reusing(c, reuse_l[static_cast<std::size_t>(i)]) : skipped(c)) {
+        if ((reusable ? skip_reusing(c, reuse_l[static_cast<std::size_t>(i)]) : skipped(c)) ||
+            beyond_euclidean(c, P, map, ball, cut, l)) {
           vertices_skipped += c.count;
           continue;
         }
@@ -338,6 +348,24 @@ class CompactScanner {
         vertices_looked_up += c.count;
       }
     }
+  }
+  // The Euclidean bound of a hidden cluster where the radial shells cannot part it from the other bone
+  // (the pelvis wraps round the femoral neck): its ball (ball_radius about r_mid * axis), posed, holds no
+  // point of the other surface within the reach (min(cut, least gap so far), at least 0) plus the maps'
+  // interpolation slack, and the layered map places the ball's centre outside the bone. Then every
+  // vertex is outside and farther than that from the surface, and its radial gap, at least its
+  // distance, is above the reach (scan_layered_near's argument).
+  bool beyond_euclidean(const Cluster& c, const Rigid& P, const LayeredMap& map, bool ball, double cut,
+                        const Least& l) const {
+    const SignedDistanceQuery* other = ball ? joint_.socket().distance_query.get() : joint_.ball().distance_query.get();
+    const double reach = std::max(0.0, collect_ == nullptr ? std::min(cut, double(l.gap)) : cut);
+    if (other == nullptr || !std::isfinite(reach)) return false;
+    const Eigen::Vector3d centre = P.M * (c.r_mid * c.axis) + P.s;
+    if (other->any_within(centre + joint_.cor(), c.ball_radius + reach + kDistanceScreenSlackMm)) return false;
+    double gap = 0;
+    std::uint8_t flag = 1;
+    map.signed_distance_many_soa(&centre.x(), &centre.y(), &centre.z(), 1, &gap, &flag);
+    return gap > 0 && flag == 0;
   }
   void take(const ScanSet& set, const std::vector<std::uint8_t>& skip, std::int64_t from, std::int64_t to, bool ball,
             Least& l, bool hidden = false) {
@@ -360,10 +388,11 @@ class CompactScanner {
   const RomSearchBounds* bounds_;
   double threshold_;
   RomVertices counted_;
+  PelvisContacts pelvis_;
+  const ScanSet *ball_set_, *socket_set_, *ball_hidden_set_, *socket_hidden_set_;  // the vertices scanned
   bool exact_ = true;
   std::vector<Candidate>* collect_ = nullptr;  // the listed gaps of the current scan (null: none)
   Rigid ball_pose_, socket_pose_;
-  PelvisContacts pelvis_;
   std::vector<std::uint8_t> lunate_socket_, lunate_socket_hidden_;  // scan-set order
   double shift_mm_ = 0;  // |t|
   // A group's bound at an earlier pose (M, s) over the cap of the poses near it (valid: it was above

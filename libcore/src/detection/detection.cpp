@@ -164,6 +164,7 @@ void expand_layered_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out)
   require(out.gap_mm.size() == static_cast<std::size_t>(set.vertices) && out.status.size() == out.gap_mm.size(),
           "layered scan: expand the body's first-surface scan first");
   for (std::size_t j = 0; j < set.index.size(); ++j) {
+    if (gap_mm[j] == std::numeric_limits<float>::infinity()) continue;  // skipped (scan_layered_near)
     const auto i = static_cast<std::size_t>(set.index[j]);
     out.gap_mm[i] = gap_mm[j];
     out.status[i] = std::isnan(gap_mm[j]) ? ScanGaps::no_surface : ScanGaps::tested_layered;

@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <future>
 
 #include "impinge/core/error.hpp"
 #include "impinge/core/timing.hpp"
@@ -42,22 +44,50 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
 }  // namespace
 
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options)
-    : cor_(cor), options_(checked(options, cor)), ball_(build(std::move(ball))), socket_(build(std::move(socket))) {}
+    : Joint(cor, checked(options, cor), std::move(ball), std::move(socket), std::nullopt, std::nullopt) {}
 
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options,
              RadialDistanceMap ball_map, RadialDistanceMap socket_map)
-    : cor_(cor),
-      options_(checked(options, cor)),
-      ball_(build(std::move(ball), std::move(ball_map))),
-      socket_(build(std::move(socket), std::move(socket_map))) {}
+    : Joint(cor, checked(options, cor), std::move(ball), std::move(socket), std::move(ball_map), std::move(socket_map)) {}
 
-JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given) const {
+Joint::Joint(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh ball, TriangleMesh socket,
+             std::optional<RadialDistanceMap> ball_map, std::optional<RadialDistanceMap> socket_map)
+    : Joint(cor, options, build_bodies(cor, options, std::move(ball), std::move(socket), std::move(ball_map),
+                                       std::move(socket_map))) {}
+
+Joint::Joint(const Eigen::Vector3d& cor, const JointOptions& options, std::pair<JointBody, JointBody> bodies)
+    : cor_(cor), options_(options), ball_(std::move(bodies.first)), socket_(std::move(bodies.second)) {}
+
+std::pair<JointBody, JointBody> Joint::build_bodies(const Eigen::Vector3d& cor, const JointOptions& options,
+                                                    TriangleMesh ball, TriangleMesh socket,
+                                                    std::optional<RadialDistanceMap> ball_map,
+                                                    std::optional<RadialDistanceMap> socket_map) {
+  // The two bodies are independent: the socket's is built on a second thread while this one builds the
+  // ball's (much of a build is serial: hierarchies, marks, masks, page faults of the maps). A failure
+  // on either is rethrown here, after both have finished.
+  auto socket_future = std::async(std::launch::async, [&] {
+    return build(cor, options, std::move(socket), std::move(socket_map));
+  });
+  std::optional<JointBody> b;
+  std::exception_ptr ball_error;
+  try {
+    b.emplace(build(cor, options, std::move(ball), std::move(ball_map)));
+  } catch (...) {
+    ball_error = std::current_exception();
+  }
+  JointBody s = socket_future.get();  // rethrows the socket's error
+  if (ball_error) std::rethrow_exception(ball_error);
+  return {std::move(*b), std::move(s)};
+}
+
+JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh mesh,
+                       std::optional<RadialDistanceMap> given) {
   validate_mesh(mesh);
-  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options_.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0, nullptr, nullptr, {}, {},
+  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0, nullptr, nullptr, {}, {},
               nullptr, {}};
-  b.relative = b.mesh.V.rowwise() - cor_.transpose();
+  b.relative = b.mesh.V.rowwise() - cor.transpose();
   if (given) {
-    const SamplingScheme& want = *options_.scheme;
+    const SamplingScheme& want = *options.scheme;
     const SamplingScheme& have = given->scheme();
     require(want.conformable(have),
             b.mesh.source + ": the given map is " + have.name() + " at " + std::to_string(have.resolution()) +
@@ -66,47 +96,48 @@ JointBody Joint::build(TriangleMesh mesh, std::optional<RadialDistanceMap> given
     b.sampling.nodes_covered = b.map.nodes_covered();
   } else {
     SamplingOptions so;
-    so.mode = options_.mode;
-    so.method = options_.sampling;
+    so.mode = options.mode;
+    so.method = options.sampling;
     const auto t0 = std::chrono::steady_clock::now();
-    b.sampling = sample_surface(b.mesh, cor_, so, b.map);
+    b.sampling = sample_surface(b.mesh, cor, so, b.map);
     b.sampling_ms = ms_since(t0);
   }
-  if (options_.exact_at_discontinuities && FirstHitCaster::available()) {
+  if (options.exact_at_discontinuities && FirstHitCaster::available()) {
     const auto t0 = std::chrono::steady_clock::now();
-    b.nodes_marked = mark_depth_discontinuities(b.map, options_.discontinuity_tolerance_mm);
-    b.exact = std::make_shared<const FirstHitCaster>(b.mesh, cor_);
+    b.nodes_marked = mark_depth_discontinuities(b.map, options.discontinuity_tolerance_mm);
+    b.exact = std::make_shared<const FirstHitCaster>(b.mesh, cor);
     b.marking_ms = ms_since(t0);
-    b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm, *b.exact);
+    b.mask = first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm, options.max_radius_mm, *b.exact);
   } else {
     clear_depth_discontinuities(b.map);  // a given map may carry marks
-    b.mask = first_surface_mask(b.relative, b.map, options_.occlusion_tolerance_mm, options_.max_radius_mm);
+    b.mask = first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm, options.max_radius_mm);
   }
-  if (options_.sparse_maps) b.map.make_sparse(options_.sparse_region_mm);
+  if (options.sparse_maps) b.map.make_sparse(options.sparse_region_mm);
   b.scan_set = make_scan_set(b.relative, b.mask);
   b.vertex_area = vertex_areas(b.mesh);
-  if (options_.layers > 0) {
-    b.caster = b.exact != nullptr ? b.exact : std::make_shared<const FirstHitCaster>(b.mesh, cor_);
-    auto layered = std::make_shared<LayeredMap>(layered_scheme(), options_.layers);
+  if (options.layers > 0) {
+    b.caster = b.exact != nullptr ? b.exact : std::make_shared<const FirstHitCaster>(b.mesh, cor);
+    auto layered = std::make_shared<LayeredMap>(layered_scheme(options), options.layers);
     b.layered_sampling = sample_layered_map(*layered, *b.caster);
     b.layered = std::move(layered);
     std::vector<std::uint8_t> hidden(b.mask.size(), 0);
     for (std::size_t i = 0; i < hidden.size(); ++i) {
       const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
-      hidden[i] = !b.mask[i] && r > 0 && r <= options_.extra_articular_radius_mm;
+      hidden[i] = !b.mask[i] && r > 0 && r <= options.extra_articular_radius_mm;
     }
     b.hidden_set = make_scan_set(b.relative, hidden);
+    b.hidden_clusters = cluster_scan_set(b.hidden_set);
   }
-  if (options_.distances) {
-    b.distance_query = std::make_shared<const SignedDistanceQuery>(b.mesh);
-    b.distance_set = make_distance_scan_set(b.relative, options_.max_radius_mm);
-  }
+  if (options.distances || options.layers > 0) b.distance_query = std::make_shared<const SignedDistanceQuery>(b.mesh);
+  if (options.distances) b.distance_set = make_distance_scan_set(b.relative, options.max_radius_mm);
   return b;
 }
 
-std::shared_ptr<const SamplingScheme> Joint::layered_scheme() const {
-  const auto& s = options_.scheme;
-  const double want = options_.layered_spacing_deg;
+std::shared_ptr<const SamplingScheme> Joint::layered_scheme() const { return layered_scheme(options_); }
+
+std::shared_ptr<const SamplingScheme> Joint::layered_scheme(const JointOptions& options) {
+  const auto& s = options.scheme;
+  const double want = options.layered_spacing_deg;
   if (want <= 0 || s->max_node_spacing() * 180 / M_PI >= want) return s;
   return make_scheme(s->name(), resolution_for_spacing(s->name(), want));
 }
@@ -128,7 +159,10 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
   res.ball_gaps.refined = ball_refined;
   if (socket_.layered) {
     gaps.resize(std::max(gaps.size(), static_cast<std::size_t>(ball_.hidden_set.size())));
-    res.ball_gaps.refined += scan_layered(ball_.hidden_set, R, t, *socket_.layered, gaps.data(), socket_.caster.get());
+    res.ball_gaps.refined += scan_layered_near(ball_.hidden_set, ball_.hidden_clusters, R, t, *socket_.layered, cor_,
+                                               *socket_.distance_query, options_.reach_mm(), gaps.data(),
+                                               socket_.caster.get())
+                                 .refined;
     expand_layered_scan(ball_.hidden_set, gaps.data(), res.ball_gaps);
     res.ball_detection_ms = ms_since(t0);
   }
@@ -142,8 +176,11 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
   res.socket_gaps.refined = socket_refined;
   if (ball_.layered) {
     gaps.resize(std::max(gaps.size(), static_cast<std::size_t>(socket_.hidden_set.size())));
-    res.socket_gaps.refined += scan_layered(socket_.hidden_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)),
-                                            *ball_.layered, gaps.data(), ball_.caster.get());
+    res.socket_gaps.refined +=
+        scan_layered_near(socket_.hidden_set, socket_.hidden_clusters, R.transpose(),
+                          Eigen::Vector3d(-(R.transpose() * t)), *ball_.layered, cor_, *ball_.distance_query,
+                          options_.reach_mm(), gaps.data(), ball_.caster.get())
+            .refined;
     expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
     res.socket_detection_ms = ms_since(t0);
   }

@@ -7,6 +7,7 @@
 
 #include "core/z_order.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/sampling/layered_sampling.hpp"
 
 namespace impinge {
 
@@ -101,6 +102,102 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       distance_mm[i] = static_cast<float>(cp.signed_mm());
       ++st.measured;
       st.winding += cp.rule == SignRule::winding_number;
+    }
+  }
+  return st;
+}
+
+ScanClusters cluster_scan_set(const ScanSet& set, int cluster_size) {
+  require(cluster_size >= 1, "scan clusters: the cluster size must be >= 1");
+  ScanClusters c;
+  const std::int64_t n = set.size();
+  if (n == 0) {
+    c.cluster_begin.push_back(0);
+    return c;
+  }
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (std::int64_t j = 0; j < n; ++j) {
+    const Eigen::Vector3d p(set.x[static_cast<std::size_t>(j)], set.y[static_cast<std::size_t>(j)],
+                            set.z[static_cast<std::size_t>(j)]);
+    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  }
+  const double cell = std::max((hi - lo).maxCoeff() / 2097151.0, 1e-9);
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed;
+  keyed.reserve(static_cast<std::size_t>(n));
+  for (std::int64_t j = 0; j < n; ++j) {
+    const auto u = static_cast<std::size_t>(j);
+    keyed.emplace_back(detail::position_z_order((set.x[u] - lo.x()) / cell, (set.y[u] - lo.y()) / cell,
+                                                (set.z[u] - lo.z()) / cell),
+                       static_cast<std::int32_t>(j));
+  }
+  std::sort(keyed.begin(), keyed.end());
+  for (std::size_t b = 0; b < keyed.size(); b += static_cast<std::size_t>(cluster_size)) {
+    const std::size_t e = std::min(keyed.size(), b + static_cast<std::size_t>(cluster_size));
+    c.cluster_begin.push_back(static_cast<std::int32_t>(b));
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (std::size_t k = b; k < e; ++k) {
+      const auto j = static_cast<std::size_t>(keyed[k].second);
+      c.member.push_back(keyed[k].second);
+      centre += Eigen::Vector3d(set.x[j], set.y[j], set.z[j]);
+    }
+    centre /= static_cast<double>(e - b);
+    double r = 0;
+    for (std::size_t k = b; k < e; ++k) {
+      const auto j = static_cast<std::size_t>(keyed[k].second);
+      r = std::max(r, (Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) - centre).norm());
+    }
+    c.centre.push_back(centre);
+    c.radius.push_back(r);
+  }
+  c.cluster_begin.push_back(static_cast<std::int32_t>(keyed.size()));
+  return c;
+}
+
+LayeredNearStats scan_layered_near(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
+                                   const Eigen::Vector3d& t, const LayeredMap& map, const Eigen::Vector3d& cor,
+                                   const SignedDistanceQuery& other, double reach_mm, float* gap_mm,
+                                   const FirstHitCaster* exact) {
+  require(reach_mm > 0 && std::isfinite(reach_mm), "layered scan: the reach must be > 0 mm and finite");
+  require(static_cast<std::int64_t>(clusters.member.size()) == set.size(),
+          "layered scan: the clusters hold " + std::to_string(clusters.member.size()) + " vertices, the set " +
+              std::to_string(set.size()));
+  LayeredNearStats st;
+  constexpr int kMax = 64;
+  double qx[kMax], qy[kMax], qz[kMax], d[kMax];
+  std::uint8_t flag[kMax];
+  const double inf = std::numeric_limits<double>::infinity();
+  for (std::int64_t c = 0; c < clusters.clusters(); ++c) {
+    const auto b = static_cast<std::size_t>(clusters.cluster_begin[static_cast<std::size_t>(c)]);
+    const auto e = static_cast<std::size_t>(clusters.cluster_begin[static_cast<std::size_t>(c) + 1]);
+    const Eigen::Vector3d qc = R * clusters.centre[static_cast<std::size_t>(c)] + t;
+    if (!other.any_within(qc + cor, clusters.radius[static_cast<std::size_t>(c)] + reach_mm)) {
+      double centre_gap = 0;
+      std::uint8_t centre_flag = 1;
+      map.signed_distance_many_soa(&qc.x(), &qc.y(), &qc.z(), 1, &centre_gap, &centre_flag);
+      if (centre_gap > 0 && centre_flag == 0) {  // outside (+inf: the bone is nowhere along the ray)
+        for (std::size_t k = b; k < e; ++k) gap_mm[clusters.member[k]] = static_cast<float>(inf);
+        ++st.clusters_skipped;
+        continue;
+      }
+    }
+    for (std::size_t k0 = b; k0 < e; k0 += kMax) {
+      const int m = static_cast<int>(std::min<std::size_t>(kMax, e - k0));
+      for (int i = 0; i < m; ++i) {
+        const auto j = static_cast<std::size_t>(clusters.member[k0 + static_cast<std::size_t>(i)]);
+        const Eigen::Vector3d q = R * Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + t;
+        qx[i] = q.x(), qy[i] = q.y(), qz[i] = q.z();
+      }
+      map.signed_distance_many_soa(qx, qy, qz, m, d, exact != nullptr ? flag : nullptr);
+      for (int i = 0; i < m; ++i) {
+        double g = d[i];
+        if (exact != nullptr && flag[i]) {
+          g = signed_radial_distance_exact(*exact, Eigen::Vector3d(qx[i], qy[i], qz[i]));
+          ++st.refined;
+        }
+        gap_mm[clusters.member[k0 + static_cast<std::size_t>(i)]] =
+            std::isfinite(g) ? static_cast<float>(g) : std::numeric_limits<float>::quiet_NaN();
+      }
+      st.vertices_scanned += m;
     }
   }
   return st;

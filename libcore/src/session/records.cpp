@@ -96,7 +96,8 @@ nlohmann::json scan_record(const JointBody& body, const ScanSummary& s, double d
   j["vertices_tested_layered"] = s.vertices_tested_layered;
   j["min_gap_layered_mm"] = number_or_null(s.min_gap_layered_mm);
   j["min_gap_mm"] = number_or_null(s.min_gap_mm);
-  if (body.distance_query != nullptr) {  // distances on (JointOptions::distances)
+  if (!body.distance_set.cluster_begin.empty()) {  // distances on (JointOptions::distances; the query alone
+                                                   // is built for the layered scan too)
     j["min_distance_mm"] = number_or_null(s.min_distance_mm);
     j["vertices_distance"] = s.vertices_distance;
     j["vertices_inside"] = s.vertices_inside;

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
+
+#include <omp.h>
 
 #include "impinge/core/error.hpp"
 #include "impinge/core/timing.hpp"
@@ -49,26 +52,48 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
                   const std::function<void(const MotionFrame&)>& on_frame) {
   require(time_s.empty() || time_s.size() == angles.size(),
           "motion: " + std::to_string(time_s.size()) + " times for " + std::to_string(angles.size()) + " poses");
-  PoseResult res;
-  MotionFrame f;
-  f.result = &res;
+  // Frames are independent: a block of them is scanned on every OpenMP thread, then handed to
+  // on_frame one by one, in order, on the calling thread. Each slot keeps its PoseResult, so after the
+  // first block no pose allocates.
+  const int threads = std::max(1, omp_get_max_threads());
+  const std::size_t block = angles.size() < 2 ? 1 : static_cast<std::size_t>(8 * threads);
+  std::vector<PoseResult> results(std::min(block, std::max<std::size_t>(angles.size(), 1)));
+  std::vector<MotionFrame> frames(results.size());
   double detect_ms = 0;
-  for (std::size_t k = 0; k < angles.size(); ++k) {
-    f.index = k;
-    f.time_s = time_s.empty() ? static_cast<double>(k) : time_s[k];
-    f.angles = angles[k];
-    const auto t0 = Clock::now();
-    f.pose = s.hip().femur_pose(angles[k]);  // with the joint-centre method's translation (counted here)
-    s.joint().detect(f.pose.R, f.pose.t, res);
-    f.detection_ms = ms_since(t0);
-    detect_ms += f.detection_ms;
-    f.joint_translation = s.to_input(s.hip().femur_translation(f.pose.t));
-    const ClosestPoint c = closest_point(s, false, res.socket_gaps, f.pose);
-    f.socket_closest = c.vertex >= 0 ? s.report_point(c.p_joint) : c.p_joint;
-    f.socket_closest_class = c.contact_class;
-    f.ball_clock.closest_hour = f.socket_clock.closest_hour = std::nan("");
-    s.hip().clocks(res, f.ball_clock, f.socket_clock);
-    on_frame(f);
+  for (std::size_t first = 0; first < angles.size(); first += block) {
+    const auto m = static_cast<std::int64_t>(std::min(block, angles.size() - first));
+    const auto t_block = Clock::now();
+    std::exception_ptr error;  // the first frame's error, rethrown after the block
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (m > 1)
+    for (std::int64_t j = 0; j < m; ++j) {
+      const std::size_t k = first + static_cast<std::size_t>(j);
+      try {
+      MotionFrame& f = frames[static_cast<std::size_t>(j)];
+      PoseResult& res = results[static_cast<std::size_t>(j)];
+      f.result = &res;
+      f.index = k;
+      f.time_s = time_s.empty() ? static_cast<double>(k) : time_s[k];
+      f.angles = angles[k];
+      const auto t0 = Clock::now();
+      f.pose = s.hip().femur_pose(angles[k]);  // with the joint-centre method's translation (counted here)
+      s.joint().detect(f.pose.R, f.pose.t, res);
+      f.detection_ms = ms_since(t0);
+      f.joint_translation = s.to_input(s.hip().femur_translation(f.pose.t));
+      const ClosestPoint c = closest_point(s, false, res.socket_gaps, f.pose);
+      f.socket_closest = c.vertex >= 0 ? s.report_point(c.p_joint) : c.p_joint;
+      f.socket_closest_class = c.contact_class;
+      f.ball_clock.closest_hour = f.socket_clock.closest_hour = std::nan("");
+      s.hip().clocks(res, f.ball_clock, f.socket_clock);
+      } catch (...) {
+#pragma omp critical(impinge_motion_error)
+        if (!error) error = std::current_exception();
+      }
+    }
+    detect_ms += ms_since(t_block);
+    if (error) std::rethrow_exception(error);
+    for (std::int64_t j = 0; j < m; ++j) {
+      on_frame(frames[static_cast<std::size_t>(j)]);
+    }
   }
   return detect_ms;
 }

@@ -27,4 +27,15 @@ void clock_summary(const ScanGaps& gaps, PointsRef V, const Eigen::VectorXd& are
                    const ImpingementLevels& levels, ClockSummary& out,
                    LevelQuantity levels_on = LevelQuantity::radial_gap);
 
+/// Every vertex's clock hour (ClockFace::hour of V's rows: n x 3, mm, the clock's frame; NaN where the
+/// clock gives none). A bone's hours do not change with its pose: compute them once, then summarise
+/// each pose with the overload below.
+std::vector<double> clock_hours(PointsRef V, const ClockFace& clock);
+
+/// clock_summary with the vertices' hours given (clock_hours: n values), for many poses of one bone.
+/// Throws impinge::Error when `hours` does not have one value per vertex of `gaps`.
+void clock_summary(const ScanGaps& gaps, const std::vector<double>& hours, const Eigen::VectorXd& area,
+                   const ImpingementLevels& levels, ClockSummary& out,
+                   LevelQuantity levels_on = LevelQuantity::radial_gap);
+
 }  // namespace impinge

@@ -154,6 +154,7 @@ class HipJoint {
   std::optional<HipFrames> frames_;
   std::optional<Acetabulum> acetabulum_;
   std::optional<ClockFace> socket_clock_, ball_clock_;
+  std::vector<double> socket_hours_, ball_hours_;  ///< every vertex's clock hour (clock_hours), once
   std::optional<ArticularZones> articular_;
   double head_radius_ = 0;
   std::vector<std::string> warnings_;

@@ -162,7 +162,8 @@ std::int64_t scan_layered(const ScanSet& set, std::int64_t first, std::int64_t c
                           const Eigen::Vector3d& t, const LayeredMap& map, float* gap_mm, const FirstHitCaster* exact);
 
 /// Write a layered scan's gaps into `out` (already expanded by expand_scan for the same body): vertex
-/// set.index[j] gets gap_mm[j] with status tested_layered, or no_surface when NaN.
+/// set.index[j] gets gap_mm[j] with status tested_layered, or no_surface when NaN; +infinity (a vertex
+/// scan_layered_near skipped) leaves it as it was (beyond reach).
 void expand_layered_scan(const ScanSet& set, const float* gap_mm, ScanGaps& out);
 
 /// Expand a compact scan into per-vertex ScanGaps (n entries): vertices outside the set are

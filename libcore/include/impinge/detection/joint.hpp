@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <optional>
 #include <vector>
 
@@ -52,7 +53,10 @@ struct JointOptions {
   /// own body's nearer surface (not in the first-surface mask) within extra_articular_radius_mm of the
   /// COR are tested against the other body's layered map: the trochanters, the shaft and the neck
   /// against the ilium, ischium and AIIS (extra-articular impingement). First-surface vertices keep the
-  /// single-layer look-up (intra-articular results are unchanged, bit for bit). 0: off (the thesis).
+  /// single-layer look-up (intra-articular results are unchanged, bit for bit). A cluster of hidden
+  /// vertices that a closest-point query proves outside the other bone and farther than reach_mm() from
+  /// it is left out at that pose (scan_layered_near; its vertices stay beyond reach: their radial gaps
+  /// exceed every level threshold). 0: off (the thesis).
   /// Needs a ray caster (Embree or CGAL). Memory per map: nodes * (4 N + 1) bytes.
   int layers = 0;
   double extra_articular_radius_mm = 150;  ///< hidden vertices farther from the COR are not tested, mm (> 0)
@@ -102,8 +106,12 @@ struct JointBody {
   LayeredSamplingReport layered_sampling;
   /// With JointOptions::distances (else null / empty): the closest-point hierarchy of the mesh (the other
   /// body's distance scan queries it), and this body's vertices grouped for its own distance scan.
-  std::shared_ptr<const SignedDistanceQuery> distance_query;
-  DistanceScanSet distance_set;
+  std::shared_ptr<const SignedDistanceQuery> distance_query;  ///< also with layers > 0 (the layered scan's pruning)
+  DistanceScanSet distance_set;  ///< empty (no clusters) when distances are off
+  /// With layers > 0: hidden_set's vertices in clusters by position, so that the layered scan leaves out
+  /// the clusters proven beyond the reach of the other bone (scan_layered_near against the other body's
+  /// distance_query, which layers > 0 builds too).
+  ScanClusters hidden_clusters;
 };
 
 /// Result of both scans at one pose.
@@ -149,7 +157,17 @@ class Joint {
   std::shared_ptr<const SamplingScheme> layered_scheme() const;
 
  private:
-  JointBody build(TriangleMesh mesh, std::optional<RadialDistanceMap> map = std::nullopt) const;
+  Joint(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh ball, TriangleMesh socket,
+        std::optional<RadialDistanceMap> ball_map, std::optional<RadialDistanceMap> socket_map);
+  Joint(const Eigen::Vector3d& cor, const JointOptions& options, std::pair<JointBody, JointBody> bodies);
+  /// Both bodies, the socket's on a second thread (options already checked).
+  static std::pair<JointBody, JointBody> build_bodies(const Eigen::Vector3d& cor, const JointOptions& options,
+                                                      TriangleMesh ball, TriangleMesh socket,
+                                                      std::optional<RadialDistanceMap> ball_map,
+                                                      std::optional<RadialDistanceMap> socket_map);
+  static JointBody build(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh mesh,
+                         std::optional<RadialDistanceMap> map);
+  static std::shared_ptr<const SamplingScheme> layered_scheme(const JointOptions& options);
   Eigen::Vector3d cor_;
   JointOptions options_;
   JointBody ball_, socket_;

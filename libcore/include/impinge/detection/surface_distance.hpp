@@ -25,6 +25,8 @@
 
 #include "impinge/casters/signed_distance.hpp"
 #include "impinge/core/mesh.hpp"
+#include "impinge/detection/detection.hpp"
+#include "impinge/maps/layered_map.hpp"
 
 namespace impinge {
 
@@ -60,5 +62,40 @@ struct DistanceScanStats {
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm);
+
+/// A scan set's vertices grouped by position (pose-invariant): clusters of up to `cluster_size` vertices
+/// along a Z curve over their positions, each with a bounding ball. For the layered scan's pruning
+/// (scan_layered_near).
+struct ScanClusters {
+  std::vector<std::int32_t> member;         ///< k positions j in the scan set, cluster by cluster
+  std::vector<std::int32_t> cluster_begin;  ///< c + 1 offsets into member
+  std::vector<Eigen::Vector3d> centre;      ///< c centres, the set's frame (relative to the COR), mm
+  std::vector<double> radius;               ///< c radii, mm: every member within it of its centre
+  std::int64_t clusters() const { return static_cast<std::int64_t>(centre.size()); }
+};
+
+/// ScanClusters of every vertex of `set`. Throws impinge::Error when cluster_size < 1.
+ScanClusters cluster_scan_set(const ScanSet& set, int cluster_size = 32);
+
+/// Counts of one scan_layered_near.
+struct LayeredNearStats {
+  std::int64_t refined = 0;            ///< look-ups resolved by an exact ray cast (as scan_layered)
+  std::int64_t vertices_scanned = 0;   ///< vertices looked up
+  std::int64_t clusters_skipped = 0;   ///< clusters proven outside the other bone and beyond the reach
+};
+
+/// scan_layered (detection.hpp) over only the clusters that may come within `reach_mm` (> 0) of the
+/// other bone: a cluster (centre c, radius r_c; posed q_c = R c + t) is skipped when the other surface
+/// has no point within r_c + reach_mm of cor + q_c (`other`'s frame: its mesh's; one pruned hierarchy
+/// query) and the layered map places q_c outside the bone (a finite positive look-up whose stencil
+/// agrees: no exact decision needed). Then no surface point lies in the ball about q_c that holds the
+/// cluster, so every member is on q_c's side, outside, and farther than the reach from the surface;
+/// its radial gap, which is at least its distance, exceeds the reach too. Skipped members get
+/// gap_mm = +infinity (which scan_layered never gives: it writes NaN where no surface is along the
+/// ray), and expand_layered_scan leaves them beyond reach. Single thread.
+LayeredNearStats scan_layered_near(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
+                                   const Eigen::Vector3d& t, const LayeredMap& map, const Eigen::Vector3d& cor,
+                                   const SignedDistanceQuery& other, double reach_mm, float* gap_mm,
+                                   const FirstHitCaster* exact);
 
 }  // namespace impinge

@@ -44,8 +44,10 @@ std::vector<std::string> motion_columns(const ImpingementLevels& levels);
 nlohmann::json motion_row(const MotionFrame& frame);
 
 /// Both scans at every pose of `angles` (k poses, degrees; `time_s`: k times or empty for the
-/// index), calling `on_frame` after each. Returns the total detection time, ms. Throws what
-/// `on_frame` throws; times of another length than the angles are an error.
+/// index), calling `on_frame` for each, in order, on the calling thread. Blocks of frames are scanned
+/// on the OpenMP threads (omp_get_max_threads) first. Returns the wall time of those scans, ms (the
+/// frames' own detection_ms add up to more on several threads). Throws what `on_frame` throws, or the
+/// first error of a frame's scan; times of another length than the angles are an error.
 double run_motion(const Session& session, const std::vector<PoseAngles>& angles, const std::vector<double>& time_s,
                   const std::function<void(const MotionFrame&)>& on_frame);
 
