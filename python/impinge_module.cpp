@@ -648,7 +648,8 @@ void add_joint_queries(py::class_<PyJoint>& c) {
            "Both scans at every row of angles (k, 3): flexion, adduction, internal rotation in degrees -> dict of "
            "(k,) arrays, the columns of the CLI's frames.csv (ball_min_gap_mm, socket_min_gap_mm, "
            "penetrating_area_mm2 = socket_penetrating_area_mm2, ball_penetrating_area_mm2, socket_levelN_area_mm2, "
-           "closest clock hours and point, detection_ms). One C++ loop; the GIL is released.")
+           "closest clock hours and point, detection_ms). One C++ loop, frames in blocks on impinge.get_threads() "
+           "threads (rows in order); the GIL is released.")
       .def("rom_limits", &rom_limits, py::arg("threshold_mm") = 0.0, py::arg("step_deg") = 2.0,
            py::arg("max_deg") = 150.0, py::arg("contacts") = "impingement",
            py::arg("contact_depth_mm") = RomOptions{}.contact_depth_mm, py::arg("metric") = "",

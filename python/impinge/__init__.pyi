@@ -113,7 +113,8 @@ class Joint:
         dict of detect() with joint_translation_mm (3,): the femur's translation from its scan position
         after its rotation about its head centre (input frame, mm)."""
     def motion(self, angles: npt.ArrayLike) -> Dict[str, npt.NDArray[np.float64]]:
-        """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each."""
+        """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each. Frames
+        are scanned in blocks on impinge.get_threads() threads; rows come back in order."""
     def rom_limits(self, threshold_mm: float = 0.0, step_deg: float = 2.0, max_deg: float = 150.0,
                    contacts: str = "impingement", contact_depth_mm: float = 0.25) -> Dict[str, Any]:
         """ROM limits from neutral for the standard motions -> dict motion -> the CLI's rom_limits.csv row
