@@ -322,21 +322,6 @@ inline ScanSet counted_subset(const ScanSet& s, const std::vector<std::uint8_t>*
   return out;
 }
 
-// The same vertices in clusters by position (a Z curve in space; cluster_scan_set), for the hidden
-// vertices: those of one direction lie at many depths (the neck and the trochanter behind the head),
-// so clusters along the directions span large radii and balls, and neither bound parts them.
-inline ScanSet by_position(const ScanSet& s) {
-  const ScanClusters c = cluster_scan_set(s, kLeaf);
-  ScanSet out;
-  out.vertices = s.vertices;
-  for (const std::int32_t j : c.member) {
-    const auto k = static_cast<std::size_t>(j);
-    out.index.push_back(s.index[k]);
-    out.x.push_back(s.x[k]), out.y.push_back(s.y[k]), out.z.push_back(s.z[k]);
-  }
-  return out;
-}
-
 }  // namespace rom_detail
 
 // Bounds for the searches of one joint at one threshold: the map pyramids and the clusters
@@ -345,16 +330,16 @@ inline ScanSet by_position(const ScanSet& s) {
 // never looked up: the joint surfaces left out of an impingement search are most of those near
 // contact at every pose).
 struct RomSearchBounds {
-  RomSearchBounds(const Joint& j, double threshold, const std::vector<std::uint8_t>* skip_ball = nullptr,
-                  const std::vector<std::uint8_t>* skip_socket = nullptr)
+  RomSearchBounds(const Joint& j, double threshold, const std::vector<std::uint8_t>* ball_skips = nullptr,
+                  const std::vector<std::uint8_t>* socket_skips = nullptr)
       : joint(&j),
         threshold_mm(threshold),
-        skip_ball(skip_ball != nullptr ? *skip_ball : std::vector<std::uint8_t>{}),
-        skip_socket(skip_socket != nullptr ? *skip_socket : std::vector<std::uint8_t>{}),
-        ball_set(rom_detail::counted_subset(j.ball().scan_set, skip_ball)),
-        socket_set(rom_detail::counted_subset(j.socket().scan_set, skip_socket)),
-        ball_hidden_set(rom_detail::by_position(rom_detail::counted_subset(j.ball().hidden_set, skip_ball))),
-        socket_hidden_set(rom_detail::by_position(rom_detail::counted_subset(j.socket().hidden_set, skip_socket))),
+        skip_ball(ball_skips != nullptr ? *ball_skips : std::vector<std::uint8_t>{}),
+        skip_socket(socket_skips != nullptr ? *socket_skips : std::vector<std::uint8_t>{}),
+        ball_set(rom_detail::counted_subset(j.ball().scan_set, ball_skips)),
+        socket_set(rom_detail::counted_subset(j.socket().scan_set, socket_skips)),
+        ball_hidden_set(rom_detail::counted_subset(j.ball().hidden_set, ball_skips)),
+        socket_hidden_set(rom_detail::counted_subset(j.socket().hidden_set, socket_skips)),
         socket_min(rom_detail::bound_pyramid(j.socket().map, true)),
         ball_max(rom_detail::bound_pyramid(j.ball().map, false)),
         ball_reachable(rom_detail::reachable_subset(ball_set, socket_min.all(), threshold + rom_detail::kReachableShiftMm)),

@@ -350,22 +350,15 @@ class CompactScanner {
     }
   }
   // The Euclidean bound of a hidden cluster where the radial shells cannot part it from the other bone
-  // (the pelvis wraps round the femoral neck): its ball (ball_radius about r_mid * axis), posed, holds no
-  // point of the other surface within the reach (min(cut, least gap so far), at least 0) plus the maps'
-  // interpolation slack, and the layered map places the ball's centre outside the bone. Then every
-  // vertex is outside and farther than that from the surface, and its radial gap, at least its
-  // distance, is above the reach (scan_layered_near's argument).
+  // (the pelvis wraps round the femoral neck): cluster_apart of its ball (ball_radius about r_mid * axis,
+  // posed, grown by the maps' interpolation slack) at the reach min(cut, least gap so far), at least 0.
   bool beyond_euclidean(const Cluster& c, const Rigid& P, const LayeredMap& map, bool ball, double cut,
                         const Least& l) const {
     const SignedDistanceQuery* other = ball ? joint_.socket().distance_query.get() : joint_.ball().distance_query.get();
     const double reach = std::max(0.0, collect_ == nullptr ? std::min(cut, double(l.gap)) : cut);
-    if (other == nullptr || !std::isfinite(reach)) return false;
-    const Eigen::Vector3d centre = P.M * (c.r_mid * c.axis) + P.s;
-    if (other->any_within(centre + joint_.cor(), c.ball_radius + reach + kDistanceScreenSlackMm)) return false;
-    double gap = 0;
-    std::uint8_t flag = 1;
-    map.signed_distance_many_soa(&centre.x(), &centre.y(), &centre.z(), 1, &gap, &flag);
-    return gap > 0 && flag == 0;
+    return other != nullptr && std::isfinite(reach) &&
+           cluster_apart(P.M * (c.r_mid * c.axis) + P.s, c.ball_radius + kDistanceScreenSlackMm, map, joint_.cor(),
+                         *other, reach);
   }
   void take(const ScanSet& set, const std::vector<std::uint8_t>& skip, std::int64_t from, std::int64_t to, bool ball,
             Least& l, bool hidden = false) {

@@ -44,16 +44,12 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
 }  // namespace
 
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options)
-    : Joint(cor, checked(options, cor), std::move(ball), std::move(socket), std::nullopt, std::nullopt) {}
+    : Joint(cor, options, build_bodies(cor, options, std::move(ball), std::move(socket), std::nullopt, std::nullopt)) {}
 
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options,
              RadialDistanceMap ball_map, RadialDistanceMap socket_map)
-    : Joint(cor, checked(options, cor), std::move(ball), std::move(socket), std::move(ball_map), std::move(socket_map)) {}
-
-Joint::Joint(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh ball, TriangleMesh socket,
-             std::optional<RadialDistanceMap> ball_map, std::optional<RadialDistanceMap> socket_map)
-    : Joint(cor, options, build_bodies(cor, options, std::move(ball), std::move(socket), std::move(ball_map),
-                                       std::move(socket_map))) {}
+    : Joint(cor, options,
+            build_bodies(cor, options, std::move(ball), std::move(socket), std::move(ball_map), std::move(socket_map))) {}
 
 Joint::Joint(const Eigen::Vector3d& cor, const JointOptions& options, std::pair<JointBody, JointBody> bodies)
     : cor_(cor), options_(options), ball_(std::move(bodies.first)), socket_(std::move(bodies.second)) {}
@@ -62,6 +58,7 @@ std::pair<JointBody, JointBody> Joint::build_bodies(const Eigen::Vector3d& cor, 
                                                     TriangleMesh ball, TriangleMesh socket,
                                                     std::optional<RadialDistanceMap> ball_map,
                                                     std::optional<RadialDistanceMap> socket_map) {
+  checked(options, cor);
   // The two bodies are independent: the socket's is built on a second thread while this one builds the
   // ball's (much of a build is serial: hierarchies, marks, masks, page faults of the maps). A failure
   // on either is rethrown here, after both have finished.
@@ -125,7 +122,7 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
       const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
       hidden[i] = !b.mask[i] && r > 0 && r <= options.extra_articular_radius_mm;
     }
-    b.hidden_set = make_scan_set(b.relative, hidden);
+    b.hidden_set = order_by_position(make_scan_set(b.relative, hidden));
     b.hidden_clusters = cluster_scan_set(b.hidden_set);
   }
   if (options.distances || options.layers > 0) b.distance_query = std::make_shared<const SignedDistanceQuery>(b.mesh);

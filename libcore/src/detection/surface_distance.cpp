@@ -14,6 +14,43 @@ namespace impinge {
 namespace {
 constexpr double kBoundMarginMm = 0.5;  // above the maps' interpolation error (experiment 10: < 0.04 mm)
 constexpr double kHintMm = 0.1;         // a gap whose sign is a hint
+
+// The order of the points p along a Z curve over their positions: neighbours in space are mostly
+// neighbours in this order (the distance scan's clusters, the hidden vertices' order).
+std::vector<std::int32_t> position_order(const std::vector<Eigen::Vector3d>& p) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Eigen::Vector3d& x : p) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  const double cell = p.empty() ? 1.0 : std::max((hi - lo).maxCoeff() / 2097151.0, 1e-9);
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed;
+  keyed.reserve(p.size());
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const Eigen::Vector3d g = (p[k] - lo) / cell;
+    keyed.emplace_back(detail::position_z_order(g.x(), g.y(), g.z()), static_cast<std::int32_t>(k));
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::int32_t> order;
+  order.reserve(p.size());
+  for (const auto& [key, k] : keyed) order.push_back(k);
+  return order;
+}
+
+// The ball about the centroid of p[0..n) (n > 0) that holds them all: centre, radius (mm).
+std::pair<Eigen::Vector3d, double> bounding_ball(const Eigen::Vector3d* p, std::size_t n) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < n; ++k) c += p[k];
+  c /= static_cast<double>(n);
+  double r = 0;
+  for (std::size_t k = 0; k < n; ++k) r = std::max(r, (p[k] - c).norm());
+  return {c, r};
+}
+
+// The positions of a scan set's vertices.
+std::vector<Eigen::Vector3d> positions_of(const ScanSet& set) {
+  std::vector<Eigen::Vector3d> p;
+  p.reserve(set.x.size());
+  for (std::size_t j = 0; j < set.x.size(); ++j) p.emplace_back(set.x[j], set.y[j], set.z[j]);
+  return p;
+}
 }  // namespace
 
 DistanceScanSet make_distance_scan_set(PointsRef P, double max_radius_mm, int cluster_size) {
@@ -23,42 +60,25 @@ DistanceScanSet make_distance_scan_set(PointsRef P, double max_radius_mm, int cl
   DistanceScanSet s;
   s.vertices = P.rows();
   std::vector<std::int32_t> keep;
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<Eigen::Vector3d> kept;
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
     const Eigen::Vector3d p = P.row(i).transpose();
     if (!(p.norm() <= max_radius_mm)) continue;
     keep.push_back(static_cast<std::int32_t>(i));
-    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    kept.push_back(p);
   }
-  if (keep.empty()) {
-    s.cluster_begin.push_back(0);
-    return s;
+  for (const std::int32_t k : position_order(kept)) {
+    s.index.push_back(keep[static_cast<std::size_t>(k)]);
+    s.position.push_back(kept[static_cast<std::size_t>(k)]);
   }
-  const double cell = std::max((hi - lo).maxCoeff() / 2097151.0, 1e-9);
-  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed;
-  keyed.reserve(keep.size());
-  for (const std::int32_t i : keep) {
-    const Eigen::Vector3d g = (P.row(i).transpose() - lo) / cell;
-    keyed.emplace_back(detail::position_z_order(g.x(), g.y(), g.z()), i);
-  }
-  std::sort(keyed.begin(), keyed.end());
-  for (std::size_t j = 0; j < keyed.size(); j += static_cast<std::size_t>(cluster_size)) {
-    const std::size_t end = std::min(keyed.size(), j + static_cast<std::size_t>(cluster_size));
+  for (std::size_t j = 0; j < s.position.size(); j += static_cast<std::size_t>(cluster_size)) {
+    const std::size_t n = std::min(s.position.size() - j, static_cast<std::size_t>(cluster_size));
     s.cluster_begin.push_back(static_cast<std::int32_t>(j));
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (std::size_t k = j; k < end; ++k) {
-      const Eigen::Vector3d p = P.row(keyed[k].second).transpose();
-      s.index.push_back(keyed[k].second);
-      s.position.push_back(p);
-      c += p;
-    }
-    c /= static_cast<double>(end - j);
-    double r = 0;
-    for (std::size_t k = j; k < end; ++k) r = std::max(r, (s.position[k] - c).norm());
-    s.centre.push_back(c);
-    s.radius.push_back(r);
+    const auto [centre, radius] = bounding_ball(s.position.data() + j, n);
+    s.centre.push_back(centre);
+    s.radius.push_back(radius);
   }
-  s.cluster_begin.push_back(static_cast<std::int32_t>(keyed.size()));
+  s.cluster_begin.push_back(static_cast<std::int32_t>(s.position.size()));
   return s;
 }
 
@@ -107,50 +127,39 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
   return st;
 }
 
+ScanSet order_by_position(const ScanSet& set) {
+  ScanSet out;
+  out.vertices = set.vertices;
+  for (const std::int32_t j : position_order(positions_of(set))) {
+    const auto k = static_cast<std::size_t>(j);
+    out.index.push_back(set.index[k]);
+    out.x.push_back(set.x[k]), out.y.push_back(set.y[k]), out.z.push_back(set.z[k]);
+  }
+  return out;
+}
+
 ScanClusters cluster_scan_set(const ScanSet& set, int cluster_size) {
   require(cluster_size >= 1, "scan clusters: the cluster size must be >= 1");
   ScanClusters c;
-  const std::int64_t n = set.size();
-  if (n == 0) {
-    c.cluster_begin.push_back(0);
-    return c;
-  }
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (std::int64_t j = 0; j < n; ++j) {
-    const Eigen::Vector3d p(set.x[static_cast<std::size_t>(j)], set.y[static_cast<std::size_t>(j)],
-                            set.z[static_cast<std::size_t>(j)]);
-    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  }
-  const double cell = std::max((hi - lo).maxCoeff() / 2097151.0, 1e-9);
-  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed;
-  keyed.reserve(static_cast<std::size_t>(n));
-  for (std::int64_t j = 0; j < n; ++j) {
-    const auto u = static_cast<std::size_t>(j);
-    keyed.emplace_back(detail::position_z_order((set.x[u] - lo.x()) / cell, (set.y[u] - lo.y()) / cell,
-                                                (set.z[u] - lo.z()) / cell),
-                       static_cast<std::int32_t>(j));
-  }
-  std::sort(keyed.begin(), keyed.end());
-  for (std::size_t b = 0; b < keyed.size(); b += static_cast<std::size_t>(cluster_size)) {
-    const std::size_t e = std::min(keyed.size(), b + static_cast<std::size_t>(cluster_size));
-    c.cluster_begin.push_back(static_cast<std::int32_t>(b));
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (std::size_t k = b; k < e; ++k) {
-      const auto j = static_cast<std::size_t>(keyed[k].second);
-      c.member.push_back(keyed[k].second);
-      centre += Eigen::Vector3d(set.x[j], set.y[j], set.z[j]);
-    }
-    centre /= static_cast<double>(e - b);
-    double r = 0;
-    for (std::size_t k = b; k < e; ++k) {
-      const auto j = static_cast<std::size_t>(keyed[k].second);
-      r = std::max(r, (Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) - centre).norm());
-    }
+  const std::vector<Eigen::Vector3d> p = positions_of(set);
+  for (std::size_t j = 0; j < p.size(); j += static_cast<std::size_t>(cluster_size)) {
+    const std::size_t n = std::min(p.size() - j, static_cast<std::size_t>(cluster_size));
+    c.cluster_begin.push_back(static_cast<std::int32_t>(j));
+    const auto [centre, radius] = bounding_ball(p.data() + j, n);
     c.centre.push_back(centre);
-    c.radius.push_back(r);
+    c.radius.push_back(radius);
   }
-  c.cluster_begin.push_back(static_cast<std::int32_t>(keyed.size()));
+  c.cluster_begin.push_back(static_cast<std::int32_t>(p.size()));
   return c;
+}
+
+bool cluster_apart(const Eigen::Vector3d& centre, double radius_mm, const LayeredMap& map, const Eigen::Vector3d& cor,
+                   const SignedDistanceQuery& other, double reach_mm) {
+  if (other.any_within(centre + cor, radius_mm + reach_mm)) return false;
+  double gap = 0;
+  std::uint8_t flag = 1;
+  map.signed_distance_many_soa(&centre.x(), &centre.y(), &centre.z(), 1, &gap, &flag);
+  return gap > 0 && flag == 0;  // outside (+inf: the bone is nowhere along the ray)
 }
 
 LayeredNearStats scan_layered_near(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
@@ -158,47 +167,20 @@ LayeredNearStats scan_layered_near(const ScanSet& set, const ScanClusters& clust
                                    const SignedDistanceQuery& other, double reach_mm, float* gap_mm,
                                    const FirstHitCaster* exact) {
   require(reach_mm > 0 && std::isfinite(reach_mm), "layered scan: the reach must be > 0 mm and finite");
-  require(static_cast<std::int64_t>(clusters.member.size()) == set.size(),
-          "layered scan: the clusters hold " + std::to_string(clusters.member.size()) + " vertices, the set " +
-              std::to_string(set.size()));
+  require(!clusters.cluster_begin.empty() && clusters.cluster_begin.back() == set.size(),
+          "layered scan: the clusters are not the set's (" + std::to_string(set.size()) + " vertices)");
   LayeredNearStats st;
-  constexpr int kMax = 64;
-  double qx[kMax], qy[kMax], qz[kMax], d[kMax];
-  std::uint8_t flag[kMax];
-  const double inf = std::numeric_limits<double>::infinity();
   for (std::int64_t c = 0; c < clusters.clusters(); ++c) {
-    const auto b = static_cast<std::size_t>(clusters.cluster_begin[static_cast<std::size_t>(c)]);
-    const auto e = static_cast<std::size_t>(clusters.cluster_begin[static_cast<std::size_t>(c) + 1]);
-    const Eigen::Vector3d qc = R * clusters.centre[static_cast<std::size_t>(c)] + t;
-    if (!other.any_within(qc + cor, clusters.radius[static_cast<std::size_t>(c)] + reach_mm)) {
-      double centre_gap = 0;
-      std::uint8_t centre_flag = 1;
-      map.signed_distance_many_soa(&qc.x(), &qc.y(), &qc.z(), 1, &centre_gap, &centre_flag);
-      if (centre_gap > 0 && centre_flag == 0) {  // outside (+inf: the bone is nowhere along the ray)
-        for (std::size_t k = b; k < e; ++k) gap_mm[clusters.member[k]] = static_cast<float>(inf);
-        ++st.clusters_skipped;
-        continue;
-      }
+    const std::int64_t first = clusters.cluster_begin[static_cast<std::size_t>(c)];
+    const std::int64_t count = clusters.cluster_begin[static_cast<std::size_t>(c) + 1] - first;
+    if (cluster_apart(R * clusters.centre[static_cast<std::size_t>(c)] + t, clusters.radius[static_cast<std::size_t>(c)],
+                      map, cor, other, reach_mm)) {
+      std::fill(gap_mm + first, gap_mm + first + count, std::numeric_limits<float>::infinity());
+      ++st.clusters_skipped;
+      continue;
     }
-    for (std::size_t k0 = b; k0 < e; k0 += kMax) {
-      const int m = static_cast<int>(std::min<std::size_t>(kMax, e - k0));
-      for (int i = 0; i < m; ++i) {
-        const auto j = static_cast<std::size_t>(clusters.member[k0 + static_cast<std::size_t>(i)]);
-        const Eigen::Vector3d q = R * Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + t;
-        qx[i] = q.x(), qy[i] = q.y(), qz[i] = q.z();
-      }
-      map.signed_distance_many_soa(qx, qy, qz, m, d, exact != nullptr ? flag : nullptr);
-      for (int i = 0; i < m; ++i) {
-        double g = d[i];
-        if (exact != nullptr && flag[i]) {
-          g = signed_radial_distance_exact(*exact, Eigen::Vector3d(qx[i], qy[i], qz[i]));
-          ++st.refined;
-        }
-        gap_mm[clusters.member[k0 + static_cast<std::size_t>(i)]] =
-            std::isfinite(g) ? static_cast<float>(g) : std::numeric_limits<float>::quiet_NaN();
-      }
-      st.vertices_scanned += m;
-    }
+    st.refined += scan_layered(set, first, count, R, t, map, gap_mm, exact);
+    st.vertices_scanned += count;
   }
   return st;
 }

@@ -48,6 +48,28 @@ nlohmann::json motion_row(const MotionFrame& f) {
   return row;
 }
 
+namespace {
+// One frame of a motion into f (its result into res): the pose, both scans, the closest socket point
+// and the clock summaries.
+void scan_frame(const Session& s, std::size_t k, const PoseAngles& angles, double time_s, MotionFrame& f,
+                PoseResult& res) {
+  f.result = &res;
+  f.index = k;
+  f.time_s = time_s;
+  f.angles = angles;
+  const auto t0 = Clock::now();
+  f.pose = s.hip().femur_pose(angles);  // with the joint-centre method's translation (counted here)
+  s.joint().detect(f.pose.R, f.pose.t, res);
+  f.detection_ms = ms_since(t0);
+  f.joint_translation = s.to_input(s.hip().femur_translation(f.pose.t));
+  const ClosestPoint c = closest_point(s, false, res.socket_gaps, f.pose);
+  f.socket_closest = c.vertex >= 0 ? s.report_point(c.p_joint) : c.p_joint;
+  f.socket_closest_class = c.contact_class;
+  f.ball_clock.closest_hour = f.socket_clock.closest_hour = std::nan("");
+  s.hip().clocks(res, f.ball_clock, f.socket_clock);
+}
+}  // namespace
+
 double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const std::vector<double>& time_s,
                   const std::function<void(const MotionFrame&)>& on_frame) {
   require(time_s.empty() || time_s.size() == angles.size(),
@@ -56,9 +78,9 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
   // on_frame one by one, in order, on the calling thread. Each slot keeps its PoseResult, so after the
   // first block no pose allocates.
   const int threads = std::max(1, omp_get_max_threads());
-  const std::size_t block = angles.size() < 2 ? 1 : static_cast<std::size_t>(8 * threads);
-  std::vector<PoseResult> results(std::min(block, std::max<std::size_t>(angles.size(), 1)));
-  std::vector<MotionFrame> frames(results.size());
+  const std::size_t block = std::max<std::size_t>(1, std::min(angles.size(), static_cast<std::size_t>(8 * threads)));
+  std::vector<PoseResult> results(block);
+  std::vector<MotionFrame> frames(block);
   double detect_ms = 0;
   for (std::size_t first = 0; first < angles.size(); first += block) {
     const auto m = static_cast<std::int64_t>(std::min(block, angles.size() - first));
@@ -68,22 +90,8 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
     for (std::int64_t j = 0; j < m; ++j) {
       const std::size_t k = first + static_cast<std::size_t>(j);
       try {
-      MotionFrame& f = frames[static_cast<std::size_t>(j)];
-      PoseResult& res = results[static_cast<std::size_t>(j)];
-      f.result = &res;
-      f.index = k;
-      f.time_s = time_s.empty() ? static_cast<double>(k) : time_s[k];
-      f.angles = angles[k];
-      const auto t0 = Clock::now();
-      f.pose = s.hip().femur_pose(angles[k]);  // with the joint-centre method's translation (counted here)
-      s.joint().detect(f.pose.R, f.pose.t, res);
-      f.detection_ms = ms_since(t0);
-      f.joint_translation = s.to_input(s.hip().femur_translation(f.pose.t));
-      const ClosestPoint c = closest_point(s, false, res.socket_gaps, f.pose);
-      f.socket_closest = c.vertex >= 0 ? s.report_point(c.p_joint) : c.p_joint;
-      f.socket_closest_class = c.contact_class;
-      f.ball_clock.closest_hour = f.socket_clock.closest_hour = std::nan("");
-      s.hip().clocks(res, f.ball_clock, f.socket_clock);
+        scan_frame(s, k, angles[k], time_s.empty() ? static_cast<double>(k) : time_s[k],
+                   frames[static_cast<std::size_t>(j)], results[static_cast<std::size_t>(j)]);
       } catch (...) {
 #pragma omp critical(impinge_motion_error)
         if (!error) error = std::current_exception();
@@ -91,9 +99,7 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
     }
     detect_ms += ms_since(t_block);
     if (error) std::rethrow_exception(error);
-    for (std::int64_t j = 0; j < m; ++j) {
-      on_frame(frames[static_cast<std::size_t>(j)]);
-    }
+    for (std::int64_t j = 0; j < m; ++j) on_frame(frames[static_cast<std::size_t>(j)]);
   }
   return detect_ms;
 }

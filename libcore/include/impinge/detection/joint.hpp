@@ -99,7 +99,7 @@ struct JointBody {
   double marking_ms = 0;           ///< wall time of marking them and building the ray caster, ms
   /// With JointOptions::layers > 0 (else null / empty): the layered map about the COR, the ray caster
   /// that filled it (also resolves layered look-ups across edges of the bone), and the hidden vertices
-  /// tested against the other body's layered map.
+  /// tested against the other body's layered map (ordered by position: order_by_position).
   std::shared_ptr<const LayeredMap> layered;
   std::shared_ptr<const FirstHitCaster> caster;
   ScanSet hidden_set;
@@ -108,7 +108,7 @@ struct JointBody {
   /// body's distance scan queries it), and this body's vertices grouped for its own distance scan.
   std::shared_ptr<const SignedDistanceQuery> distance_query;  ///< also with layers > 0 (the layered scan's pruning)
   DistanceScanSet distance_set;  ///< empty (no clusters) when distances are off
-  /// With layers > 0: hidden_set's vertices in clusters by position, so that the layered scan leaves out
+  /// With layers > 0: hidden_set in runs of 32 (cluster_scan_set), so that the layered scan leaves out
   /// the clusters proven beyond the reach of the other bone (scan_layered_near against the other body's
   /// distance_query, which layers > 0 builds too).
   ScanClusters hidden_clusters;
@@ -157,10 +157,8 @@ class Joint {
   std::shared_ptr<const SamplingScheme> layered_scheme() const;
 
  private:
-  Joint(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh ball, TriangleMesh socket,
-        std::optional<RadialDistanceMap> ball_map, std::optional<RadialDistanceMap> socket_map);
   Joint(const Eigen::Vector3d& cor, const JointOptions& options, std::pair<JointBody, JointBody> bodies);
-  /// Both bodies, the socket's on a second thread (options already checked).
+  /// Both bodies, the socket's on a second thread, after checking the options (throws impinge::Error).
   static std::pair<JointBody, JointBody> build_bodies(const Eigen::Vector3d& cor, const JointOptions& options,
                                                       TriangleMesh ball, TriangleMesh socket,
                                                       std::optional<RadialDistanceMap> ball_map,

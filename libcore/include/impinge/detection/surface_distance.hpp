@@ -63,19 +63,34 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm);
 
-/// A scan set's vertices grouped by position (pose-invariant): clusters of up to `cluster_size` vertices
-/// along a Z curve over their positions, each with a bounding ball. For the layered scan's pruning
-/// (scan_layered_near).
+/// The same vertices as `set`, reordered along a Z curve over their positions (the distance scan's
+/// order), so that consecutive vertices lie close in space: for the hidden vertices, whose directions
+/// repeat at many depths (the neck and trochanter behind the head), so that runs of them have small
+/// bounding balls.
+ScanSet order_by_position(const ScanSet& set);
+
+/// Consecutive runs of a scan set's vertices (pose-invariant), each with a bounding ball: tight when the
+/// set is ordered by position (order_by_position). For the layered scan's pruning (scan_layered_near).
 struct ScanClusters {
-  std::vector<std::int32_t> member;         ///< k positions j in the scan set, cluster by cluster
-  std::vector<std::int32_t> cluster_begin;  ///< c + 1 offsets into member
+  std::vector<std::int32_t> cluster_begin;  ///< c + 1 offsets into the set (cluster j: [begin[j], begin[j+1]))
   std::vector<Eigen::Vector3d> centre;      ///< c centres, the set's frame (relative to the COR), mm
   std::vector<double> radius;               ///< c radii, mm: every member within it of its centre
   std::int64_t clusters() const { return static_cast<std::int64_t>(centre.size()); }
 };
 
-/// ScanClusters of every vertex of `set`. Throws impinge::Error when cluster_size < 1.
+/// ScanClusters of `set` in runs of up to `cluster_size` vertices. Throws impinge::Error when
+/// cluster_size < 1.
 ScanClusters cluster_scan_set(const ScanSet& set, int cluster_size = 32);
+
+/// Whether every point of the ball (centre: the layered map's frame, relative to the COR; radius_mm) is
+/// outside the other bone and farther than reach_mm (>= 0) from its surface: the other surface has no
+/// point within radius_mm + reach_mm of cor + centre (`other`'s frame: its mesh's; one pruned hierarchy
+/// query), and `map` (the other bone's layered map) places the centre outside (a finite positive look-up,
+/// or +inf, whose stencil needs no exact decision). No surface point in the grown ball means every point
+/// of the ball is on the centre's side. The radial gap of such a point, at least its distance, is then
+/// above reach_mm too. Shared by scan_layered_near and the ROM searches' hidden scan.
+bool cluster_apart(const Eigen::Vector3d& centre, double radius_mm, const LayeredMap& map, const Eigen::Vector3d& cor,
+                   const SignedDistanceQuery& other, double reach_mm);
 
 /// Counts of one scan_layered_near.
 struct LayeredNearStats {
@@ -84,15 +99,11 @@ struct LayeredNearStats {
   std::int64_t clusters_skipped = 0;   ///< clusters proven outside the other bone and beyond the reach
 };
 
-/// scan_layered (detection.hpp) over only the clusters that may come within `reach_mm` (> 0) of the
-/// other bone: a cluster (centre c, radius r_c; posed q_c = R c + t) is skipped when the other surface
-/// has no point within r_c + reach_mm of cor + q_c (`other`'s frame: its mesh's; one pruned hierarchy
-/// query) and the layered map places q_c outside the bone (a finite positive look-up whose stencil
-/// agrees: no exact decision needed). Then no surface point lies in the ball about q_c that holds the
-/// cluster, so every member is on q_c's side, outside, and farther than the reach from the surface;
-/// its radial gap, which is at least its distance, exceeds the reach too. Skipped members get
-/// gap_mm = +infinity (which scan_layered never gives: it writes NaN where no surface is along the
-/// ray), and expand_layered_scan leaves them beyond reach. Single thread.
+/// scan_layered (detection.hpp) over only the clusters that may come within `reach_mm` (> 0, finite) of the
+/// other bone: a cluster (centre c, radius r_c, posed R c + t) for which cluster_apart holds is skipped.
+/// Its members get gap_mm = +infinity (which scan_layered never gives: it writes NaN where no surface is
+/// along the ray), and expand_layered_scan leaves them beyond reach. The others are scan_layered's gaps,
+/// bit for bit. Throws impinge::Error on a bad reach or clusters of another set. Single thread.
 LayeredNearStats scan_layered_near(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
                                    const Eigen::Vector3d& t, const LayeredMap& map, const Eigen::Vector3d& cor,
                                    const SignedDistanceQuery& other, double reach_mm, float* gap_mm,
