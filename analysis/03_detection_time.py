@@ -59,7 +59,7 @@ for (s, pose), g in t[~t.generated.astype(bool)].groupby(["subject", "pose"], so
                  fmt(get(g, "cgal_radial")), fmt(get(g, "fcl_collide")), f"{get(g, 'fcl_collide', col='result'):.0f}",
                  fmt(get(g, "fcl_distance")), fmt(get(g, "pairwise")), f"{get(g, 'rsid', 0.1, 'result'):.2f}"])
 write_table(d, "table_real", ["subject", "pose", "vertices", "RSID 0.5", "RSID 0.1", "USID", "Embree", "Embree x8",
-                              "CGAL", "FCL collide", "contacts", "FCL dist.", "pair-wise", "min gap (mm)"], rows,
+                              "CGAL", "FCL collide", "contacts", "FCL distance", "pair-wise", "RSID min gap (mm)"], rows,
             align="llrrrrrrrrrrrr")
 
 rows = []

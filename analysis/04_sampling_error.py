@@ -25,7 +25,7 @@ write_table(d, "table5", ["$p$ (deg)", "$N$", "Eq. 7 (mm)", "thesis (mm)", "Eq. 
 rows = []
 for (shape, scheme, res), g in cov.groupby(["shape", "scheme", "resolution"], sort=False):
     w = g.loc[(g.max_nearest_mm / g.eq7_mm).idxmax()]
-    rows.append([shape, scheme, f"{res:g}", f"{g.max_nearest_mm.max():.4f}", f"{w.eq7_mm:.4f}",
+    rows.append([shape, scheme, f"{res:g}", f"{w.max_nearest_mm:.4f}", f"{w.eq7_mm:.4f}",
                  f"{(g.max_nearest_mm / g.eq7_mm).max():.3f}", f"{w.cap_phi_deg:.0f}"])
 write_table(d, "table_covering", ["shape", "scheme", "res.", "max nearest (mm)", "Eq. 7 (mm)", "max ratio",
                                   "at cap phi (deg)"], rows, align="lllrrrr")
@@ -124,8 +124,9 @@ ex_heads = heads[(heads["mode"] == "exact") & (heads.precision_deg == fine)]
 ex_local = rad[rad["shape"].str.startswith("head_") & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]
 hx_cov = cov[cov.scheme == "helix"]
 write_macros(d, "macros", {
-    "SElocalExact": (f"{100 * ex_local.fraction_within_local_bound.min():.0f}--"
-                     f"{100 * ex_local.fraction_within_local_bound.max():.0f}" if len(ex_local) else "n/a"),
+    # Shares rounded down to a tenth, so that the range never claims more than the data.
+    "SElocalExact": (f"{np.floor(1000 * ex_local.fraction_within_local_bound.min()) / 10:.1f}--"
+                     f"{np.floor(1000 * ex_local.fraction_within_local_bound.max()) / 10:.1f}" if len(ex_local) else "n/a"),
     "SEhelixCov": f"{(hx_cov.max_nearest_mm / hx_cov.eq7_mm).min():.2f}--{(hx_cov.max_nearest_mm / hx_cov.eq7_mm).max():.2f}",
     "SEsphereMax": f"{sph.max_mm.max():.1e}",
     "SEcovRatioMax": f"{(cov.max_nearest_mm / cov.eq7_mm).max():.2f}",

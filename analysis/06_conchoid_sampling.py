@@ -56,8 +56,26 @@ def span(v):
 
 ratio_c = (eq[eq.scheme == "conchoid"].max_mm.values / eq[eq.scheme == "equiangular"].max_mm.values)
 ratio_h = (eq[eq.scheme == "helix"].max_mm.values / eq[eq.scheme == "equiangular"].max_mm.values)
+# Thesis Fig. 53: equal-angle rays from three origins cut the hip curve into unequal segments.
+seg = read_csv(d, "segments.csv")
+seg = seg[seg.ray_to_deg - seg.ray_from_deg > 0.999]  # whole 1-deg segments (the last one is cut short)
+names = {"conchoid_origin": "conchoid's origin (thesis Fig. 53 b)", "object_centroid": "area centroid (Fig. 53 a)",
+         "object_extent_middle": "middle of the extent (Fig. 53 a)"}
+fig, ax = plt.subplots(figsize=(5.5, 3.0))
+longer = {}
+for origin, g in seg.groupby("origin", sort=False):
+    rel = g.length_mm / g.length_mm.min()
+    longer[origin] = 100 * (rel.max() - 1)
+    ax.plot(0.5 * (g.phi_from_deg + g.phi_to_deg), rel, label=names.get(origin, origin))
+ax.set_xlabel("position on the hip curve: conchoid angle phi (deg)")
+ax.set_ylabel("segment length / shortest")
+ax.grid(True, alpha=0.3)
+ax.legend(fontsize=7)
+save(fig, d, "segments")
 exact_len = ln.iloc[0]
 write_macros(d, "macros", {
+    "CSsegOrigin": f"{longer['conchoid_origin']:.0f}", "CSsegCentroid": f"{longer['object_centroid']:.0f}",
+    "CSsegExtent": f"{longer['object_extent_middle']:.0f}",
     "CSlenOverB": f"{exact_len.length_over_b:.3f}", "CSlen": f"{exact_len.length_mm:.2f}",
     "CSmaxAdjEq": f"{an.eq16_adjustment_deg.min():.2f}", "CSmaxAdjExact": f"{an.exact_adjustment_deg.min():.2f}",
     "CSmaxAdjAt": f"{an.loc[an.exact_adjustment_deg.idxmin()].original_deg:.1f}",

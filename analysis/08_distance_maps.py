@@ -10,10 +10,11 @@ import json
 import os
 
 import numpy as np
+import pandas as pd
 import matplotlib.pyplot as plt
 
 from common import experiment_dir, read_csv, save, write_macros, write_table
-from render import draw, read_gap_ply
+from render import draw, level_key, level_rgb, read_gap_ply
 
 d = experiment_dir("08_distance_maps")
 allst = read_csv(d, "gap_statistics.csv")
@@ -52,19 +53,24 @@ write_table(d, "table_convergence", ["subject", "$p$", "mode", "ball min gap", "
 
 # Figure: min gap vs precision.
 fig, axes = plt.subplots(1, 2, figsize=(8, 3.2), sharey=False)
+colour = {s: f"C{k}" for k, s in enumerate(subjects)}
 for ax, scan in zip(axes, ("ball", "socket")):
     for s in subjects:
         for mode, ls in (("exact", "-"), ("linear", "--")):
             g = st[(st.subject == s) & (st.scan == scan) & (st["mode"] == mode)].sort_values("precision_deg")
-            ax.semilogx(g.precision_deg, g.min_gap_mm, ls, marker="o", markersize=3, label=f"{s} {mode}")
+            ax.semilogx(g.precision_deg, g.min_gap_mm, ls, marker="o", markersize=3, color=colour[s])
     ax.set_title(f"{scan} scan")
     ax.set_xlabel("precision p (deg)")
     ax.set_ylabel("minimum gap (mm)")
     ax.invert_xaxis()
     ax.axhline(0, color="k", lw=0.5)
     ax.grid(True, alpha=0.3)
-axes[1].legend(fontsize=6)
-save(fig, d, "min_gap")
+# One legend beside the panels: a colour per subject, a line style per mode.
+from matplotlib.lines import Line2D  # noqa: E402
+fig.legend(handles=[Line2D([], [], color=colour[s], marker="o", markersize=3, label=s) for s in subjects] +
+           [Line2D([], [], color="k", ls=ls, label=mode) for mode, ls in (("exact", "-"), ("linear", "--"))],
+           loc="center right", fontsize=7, frameon=False)
+save(fig, d, "min_gap", rect=(0, 0, 0.8, 1))
 
 # Figure: impingement levels (area share) at the finest precision, exact mode.
 levels = ["level_none", "level_yellow", "level_orange", "level_red", "level_purple"]
@@ -88,6 +94,8 @@ ax.set_ylabel("tested vertices")
 ax.legend(fontsize=6, ncol=5)
 save(fig, d, "levels")
 
+JOINT_WINDOW_MM = 20.0  # the map images' colour range beyond the nearest surface
+
 # Map images (thesis Fig. 31) with axes and colour bars: the driver's grey PNGs turned back into
 # distances by their scale (map_images.csv: grey 40 = nearest_mm, 255 = farthest_mm, 0 = no surface).
 if os.path.exists(os.path.join(d, "map_images.csv")):
@@ -107,14 +115,16 @@ if os.path.exists(os.path.join(d, "map_images.csv")):
             dist = np.ma.masked_where(grey == 0, r.nearest_mm + (grey - 40.0) / 215.0 * (r.farthest_mm - r.nearest_mm))
             cmap = plt.get_cmap("viridis").copy()
             cmap.set_bad("0.85")
+            # The colours span the joint (the nearest surface and 20 mm beyond it: the head, the acetabulum and
+            # its rim); farther surfaces (the femoral shaft, the ilium) take the last colour.
             im = ax.imshow(dist, cmap=cmap, extent=(0, 360, 180, 0), aspect="auto", interpolation="nearest",
-                           vmin=r.nearest_mm, vmax=r.farthest_mm)
+                           vmin=r.nearest_mm, vmax=min(r.farthest_mm, r.nearest_mm + JOINT_WINDOW_MM))
             ax.set_xlabel("azimuth theta (deg)")
             ax.set_ylabel("polar angle phi (deg)")
             ax.set_xticks(range(0, 361, 90))
             ax.set_yticks(range(0, 181, 45))
             ax.set_title(f"{s_}: {title}, {r.resolution:g} deg (grey: no surface)", fontsize=8)
-            fig.colorbar(im, ax=ax, label="radial distance (mm)")
+            fig.colorbar(im, ax=ax, label="radial distance (mm)", extend="max")
         save(fig, d, f"maps_{s_}")
 
 # Acetabular orientation and scan pose per real subject (clock_faces.csv).
@@ -138,7 +148,8 @@ for s in subjects:
                  "three": [row.three_x, row.three_y, row.three_z], "radius_mm": row.rim_radius_mm}
     bodies = {}
     for b in ("ball", "socket"):
-        V, F, rgb, _ = read_gap_ply(os.path.join(d, f"render_{s}_{b}.ply"))
+        V, F, _, gap = read_gap_ply(os.path.join(d, f"render_{s}_{b}.ply"))
+        rgb = level_rgb(gap, b == "ball")
         if row.neutral == "scan":  # generated: scan axes (RAS) -> (X anterior, Y superior, Z right)
             V = V[:, [1, 2, 0]]
         bodies[b] = (V, F, rgb)
@@ -150,7 +161,28 @@ for s in subjects:
         draw(ax, [bodies[n] for n in names], view, row.side, clock if view != "anterior" else None,
              radius=cup if view == "socket_medial" else 60.0)
     fig.suptitle(f"{s}: impingement levels at the scan pose", fontsize=9)
+    level_key(fig)
     save(fig, d, f"render_{s}")
+
+# Thesis Fig. 42 (sec. 3.4): on its CT hip the impinged socket regions lie at 12-4 and 8-9 o'clock. Ours: the
+# clock hour of every socket vertex within 2 mm (the thesis' red) at the scan pose, per real subject, and the
+# share of them inside the thesis' hours (beside the share of the clock face those hours cover).
+THESIS_FIG42_HOURS = [(0, 4), (8, 9)]  # 12-4 and 8-9 o'clock
+red_rows = []
+for row in clk[clk.neutral == "anatomical"].itertuples():
+    V, _, _, gap = read_gap_ply(os.path.join(d, f"render_{row.subject}_socket.ply"))
+    v = V[gap <= 2.0] - np.array([row.centre_x_mm, row.centre_y_mm, row.centre_z_mm])
+    hours = (np.degrees(np.arctan2(v @ np.array([row.three_x, row.three_y, row.three_z]),
+                                   v @ np.array([row.twelve_x, row.twelve_y, row.twelve_z]))) / 30) % 12
+    counts = np.histogram(hours, bins=12, range=(0, 12))[0]
+    inside = sum(((hours >= a) & (hours < b)).sum() for a, b in THESIS_FIG42_HOURS)
+    main = [h for h in range(12) if len(hours) and counts[h] >= 0.1 * len(hours)]
+    red_rows.append({"subject": row.subject, "red_vertices": len(hours),
+                     "share_in_thesis_hours": inside / len(hours) if len(hours) else np.nan,
+                     "thesis_hours_share_of_clock": sum(b - a for a, b in THESIS_FIG42_HOURS) / 12,
+                     "main_hours": " ".join(f"{12 if h == 0 else h}-{h + 1}" for h in main)})
+pd.DataFrame(red_rows, columns=["subject", "red_vertices", "share_in_thesis_hours", "thesis_hours_share_of_clock",
+                                "main_hours"]).to_csv(os.path.join(d, "red_clock_hours.csv"), index=False)
 
 # The clinical angles (README figure): one real femur posed from anatomical neutral, pelvic frame.
 if os.path.exists(os.path.join(d, "poses.csv")) and len(read_csv(d, "poses.csv")):
@@ -265,7 +297,11 @@ save(fig, d, "radial_vs_distance")
 both = rv.vertices_both.sum()
 
 pen = st[(st.precision_deg == finest) & (st["mode"] == "exact") & (st.scan == "ball")]
+# USID beside RSID (thesis Fig. 50): the largest per-vertex difference of the matched helix, any mode, and exact.
+usid = allst[(allst.scheme == "helix") & (allst.vs_equiangular_compared > 0)]
 write_macros(d, "macros", {
+    "DMusidMax": f"{usid.vs_equiangular_max_abs_mm.max():.2f}" if len(usid) else "--",
+    "DMusidMaxExact": f"{usid[usid['mode'] == 'exact'].vs_equiangular_max_abs_mm.max():.3f}" if len(usid) else "--",
     "RDvertices": f"{int(both):,}",
     "RDdifferShare": f"{100 * rv.differ_1mm.sum() / max(both, 1):.1f}",
     "RDmaxDiff": f"{rv.max_abs_diff_mm.max():.1f}",

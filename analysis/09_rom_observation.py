@@ -8,10 +8,13 @@ rom_map.pdf, medial_<subject>_<patient>.pdf (Tables 12-13's panels), macros.tex.
 import os
 
 import numpy as np
+import matplotlib
+import matplotlib.colors
+import matplotlib.patches
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, read_csv, save, write_macros, write_table
-from render import draw, read_gap_ply
+from common import THESIS_ROM_ZONES, experiment_dir, in_clock_zones, read_csv, save, write_macros, write_table
+from render import draw, level_key, level_rgb, read_gap_ply
 
 d = experiment_dir("09_rom_observation")
 obs = read_csv(d, "observation.csv")
@@ -121,21 +124,15 @@ if meth is not None:
 # patient A, at 1-3 and 7 o'clock for patient B. Ours: the clock hour of the socket's closest point at
 # each extremity, on every subject, within half an hour of the thesis' zones. Reproduced when at least
 # three quarters of the extremities fall there, partly when at least a quarter, else not.
-THESIS_ZONES = {"A": [(1, 2)], "B": [(1, 3), (7, 7)]}
-
-
-def in_zones(hour, zones, slack=0.5):
-    return any((hour - (a - slack)) % 12 <= (b - a) + 2 * slack for a, b in zones)
-
 
 def verdict(share):
     return "reproduced" if share >= 0.75 else "partly reproduced" if share >= 0.25 else "not reproduced"
 
 
 obs_macros = {}
-for patient, zones in THESIS_ZONES.items():
+for patient, zones in THESIS_ROM_ZONES.items():
     g = obs[obs.patient == patient]
-    hits = sum(in_zones(h, zones) for h in g.socket_closest_clock_h if np.isfinite(h))
+    hits = sum(in_clock_zones(h, zones) for h in g.socket_closest_clock_h if np.isfinite(h))
     posterior = sum(7.5 <= h <= 11.5 for h in g.socket_closest_clock_h if np.isfinite(h))
     obs_macros[f"ROMobs{patient}InZone"] = str(hits)
     obs_macros[f"ROMobs{patient}Poses"] = str(len(g))
@@ -189,10 +186,20 @@ for ax, s in zip(axes[0], subjects):
     g = rmap[rmap.subject == s]
     fl, ad = sorted(g.flexion_deg.unique()), sorted(g.adduction_deg.unique())
     Z = np.full((len(ad), len(fl)), np.nan)
+    state = np.full((len(ad), len(fl)), np.nan)  # 0: free to the search's end, 1: in contact at zero rotation
     for r in g.itertuples():
         Z[ad.index(r.adduction_deg), fl.index(r.flexion_deg)] = r.max_internal_rotation_deg
-    im = ax.imshow(Z, origin="lower", aspect="auto", extent=[fl[0] - 2.5, fl[-1] + 2.5, ad[0] - 2.5, ad[-1] + 2.5],
+        state[ad.index(r.adduction_deg), fl.index(r.flexion_deg)] = {"free": 0, "contact_at_zero": 1}.get(r.status, np.nan)
+    extent = [fl[0] - 2.5, fl[-1] + 2.5, ad[0] - 2.5, ad[-1] + 2.5]
+    im = ax.imshow(Z, origin="lower", aspect="auto", extent=extent,
                    cmap="viridis", vmin=0, vmax=np.nanmax(rmap.max_internal_rotation_deg))
+    # The cells without a limit get their own colours, so that neither reads as a value or as the other.
+    ax.imshow(state, origin="lower", aspect="auto", extent=extent, vmin=0, vmax=1,
+              cmap=matplotlib.colors.ListedColormap(["#d9d9d9", "#8b0000"]))
+    if s == subjects[0]:
+        ax.legend(handles=[matplotlib.patches.Patch(color="#d9d9d9", label="free to the search's end"),
+                           matplotlib.patches.Patch(color="#8b0000", label="in contact at zero rotation")],
+                  fontsize=6, loc="upper right")
     ax.set_title(f"{s}: largest internal rotation (deg)", fontsize=8)
     ax.set_xlabel("flexion (deg)")
     ax.set_ylabel("adduction (deg)")
@@ -213,13 +220,14 @@ for s in clk.subject:
         fig = plt.figure(figsize=(9, 6))
         order = ["abduction", "internal_rotation", "extension", "adduction", "external_rotation", "flexion"]
         for k, m in enumerate(order):
-            V, F, rgb, _ = read_gap_ply(os.path.join(d, f"observation_{s}_{patient}_{m}.ply"))
+            V, F, _, gap = read_gap_ply(os.path.join(d, f"observation_{s}_{patient}_{m}.ply"))
+            rgb = level_rgb(gap, False)
             ang = t11[(t11.patient == patient) & (t11.motion == m)].angle_deg.iloc[0]
             ax = fig.add_subplot(2, 3, k + 1, projection="3d")
             draw(ax, [(V, F, rgb)], "socket_medial", row.side, clock, radius=row.rim_radius_mm + 3,
                  title=f"{m.replace('_', ' ')} {ang:g} deg")
-        fig.suptitle(f"{s} at patient {patient}'s extremities (thesis Table {12 if patient == 'A' else 13}): "
-                     "blue > 6, yellow 4-6, orange 2-4, red 0-2 mm, purple penetrating", fontsize=9)
+        fig.suptitle(f"{s} at patient {patient}'s extremities (thesis Table {12 if patient == 'A' else 13})", fontsize=9)
+        level_key(fig, skip=("apart, femur",))
         save(fig, d, f"medial_{s}_{patient}")
 
 # Extra-articular impingement with layered maps (issue 14): the first contact of hidden vertices per
@@ -294,7 +302,8 @@ write_macros(d, "macros", {
     "ROMenvScannedRange": f"{100 * (env.poses_scanned / env.poses).min():.1f}--{100 * (env.poses_scanned / env.poses).max():.1f}",
     "ROMenvPerCoreMin": f"{env.poses_per_core_second.min() / 1000:.0f}k",
     "ROMenvKawasakiPerPc": f"{KAWASAKI_POSES_PER_PC_SECOND / 1000:.0f}k",
-    "ROMenvOverKawasakiMin": f"{env.poses_per_core_second.min() / KAWASAKI_POSES_PER_PC_SECOND:.0f}",
+    # "at least": rounded down to a tenth.
+    "ROMenvOverKawasakiMin": f"{np.floor(10 * env.poses_per_core_second.min() / KAWASAKI_POSES_PER_PC_SECOND) / 10:.1f}",
     "ROMenvDifferMax": f(100 * (env.poses_differ / env.poses).max(), 2),
     "ROMenvBruteMax": f(env.brute_force_ms.max() / 1000, 0),
     "ROMhiddenChecked": str(len(hid)),

@@ -27,9 +27,10 @@ def read_csv(d, file):
     return pd.read_csv(path)
 
 
-def save(fig, d, stem):
-    """Save as PDF (for the paper) and PNG (for viewing)."""
-    fig.tight_layout()
+def save(fig, d, stem, rect=None):
+    """Save as PDF (for the paper) and PNG (for viewing). rect: the part of the figure (left, bottom, right,
+    top, 0-1) the axes fill, leaving the rest to a figure legend."""
+    fig.tight_layout(rect=rect)
     fig.savefig(os.path.join(d, stem + ".pdf"))
     fig.savefig(os.path.join(d, stem + ".png"), dpi=130)
     plt.close(fig)
@@ -45,12 +46,21 @@ def latex_escape(s):
             .replace("&", r"\&").replace("^", r"\textasciicircum{}").replace("#", r"\#"))
 
 
-def write_table(d, stem, header, rows, align=None):
-    """A booktabs tabular in d/stem.tex. header: list of str; rows: list of lists of str."""
+def write_table(d, stem, header, rows, align=None, caption=None, label=None):
+    """A booktabs tabular in d/stem.tex. header: list of str; rows: list of lists of str. With a caption, a
+    longtable instead (caption and label inside, the header repeated on every page), for a table too long
+    for one page: input it outside a table float."""
     align = align or "l" + "r" * (len(header) - 1)
-    lines = [r"\begin{tabular}{" + align + "}", r"\toprule", " & ".join(header) + r" \\", r"\midrule"]
+    head = " & ".join(header) + r" \\"
+    if caption is None:
+        lines = [r"\begin{tabular}{" + align + "}", r"\toprule", head, r"\midrule"]
+    else:
+        lines = [r"\begin{longtable}{" + align + "}",
+                 r"\caption{" + caption + "}" + (r"\label{" + label + "}" if label else "") + r" \\",
+                 r"\toprule", head, r"\midrule", r"\endfirsthead", r"\toprule", head, r"\midrule", r"\endhead",
+                 r"\bottomrule", r"\endfoot"]
     lines += [" & ".join(latex_escape(c) for c in r) + r" \\" for r in rows]
-    lines += [r"\bottomrule", r"\end{tabular}"]
+    lines += [r"\bottomrule", r"\end{tabular}"] if caption is None else [r"\end{longtable}"]
     with open(os.path.join(d, stem + ".tex"), "w") as f:
         f.write("\n".join(lines) + "\n")
 
@@ -75,3 +85,13 @@ def session_figures(experiment):
             out[r["key"]] = r["value"]
     return out
 
+
+
+# The thesis' ROM observation (sec. 5.2, Tables 12-13): red zones at 1-2 o'clock for patient A, at 1-3 and 7
+# o'clock for patient B (acetabular clock face: 12 superior, 3 anterior, 6 at the notch).
+THESIS_ROM_ZONES = {"A": [(1, 2)], "B": [(1, 3), (7, 7)]}
+
+
+def in_clock_zones(hour, zones, slack=0.5):
+    """Whether a clock hour (0-12) lies within `slack` hours of one of the zones [(from, to), ...]."""
+    return any((hour - (a - slack)) % 12 <= (b - a) + 2 * slack for a, b in zones)

@@ -45,6 +45,35 @@ def read_gap_ply(path):
     return V, face["i"].astype(np.int64), rgb, gap
 
 
+# The one set of impingement levels of this report's figures (mm, on the gap): beyond 6 mm apart (the thesis'
+# blue, sec. 5.2), 4-6 yellow, 2-4 orange, 0-2 red (the thesis' red: within 2 mm), at or below 0 purple (bone
+# contact or penetration); vertices without a gap (not tested) grey.
+REPORT_LEVELS_MM = (6.0, 4.0, 2.0, 0.0)
+LEVEL_COLOURS = [("apart, femur", (0.40, 0.70, 0.40)), ("apart, pelvis", (0.40, 0.58, 0.85)),
+                 ("4-6 mm", (0.95, 0.85, 0.20)), ("2-4 mm", (0.95, 0.55, 0.15)), ("0-2 mm", (0.85, 0.15, 0.15)),
+                 ("contact", (0.55, 0.20, 0.65)), ("not tested", (0.80, 0.80, 0.80))]
+
+
+def level_rgb(gap, femur):
+    """Per-vertex colours (n x 3, 0-1) of gaps (mm, NaN: not tested) by REPORT_LEVELS_MM; `femur` picks the
+    colour of vertices farther apart than the first level (green on the femur, blue on the pelvis)."""
+    colours = dict(LEVEL_COLOURS)
+    out = np.tile(colours["not tested"], (len(gap), 1))
+    g = np.asarray(gap, float)
+    t6, t4, t2, t0 = REPORT_LEVELS_MM
+    for mask, name in ((g > t6, "apart, femur" if femur else "apart, pelvis"), ((g > t4) & (g <= t6), "4-6 mm"),
+                       ((g > t2) & (g <= t4), "2-4 mm"), ((g > t0) & (g <= t2), "0-2 mm"), (g <= t0, "contact")):
+        out[mask] = colours[name]
+    return out
+
+
+def level_key(fig, skip=()):
+    """The colour key of level_rgb below the figure (one row)."""
+    from matplotlib.patches import Patch
+    fig.legend(handles=[Patch(color=c, label=n) for n, c in LEVEL_COLOURS if n not in skip], loc="lower center",
+               ncol=7, fontsize=7, frameon=False)
+
+
 def to_frame(V, origin, axes):
     """Points V (n x 3, input frame) into a frame given by its origin and axes (columns X, Y, Z)."""
     return (V - origin) @ axes

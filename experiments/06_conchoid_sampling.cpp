@@ -9,11 +9,19 @@
 //   table10.csv      30-deg example: original, Eq. 16 and exact adjusted angles
 //   angles.csv       0.1 deg (901 rays): original, Eq. 16, exact adjusted angle and adjustment
 //   equal_nodes.csv  per scheme at equal node count: radial error over the hip region
+//   segments.csv     thesis Fig. 53: equal-angle rays (1 deg) from the conchoid's origin and from the
+//                    object's centre (the area centroid of the closed curve, and its extent's middle) cut
+//                    the hip curve (phi in [0, 90] deg) into segments: each segment's curve length
 //   meta.json
 // Command: build/experiments/exp_06_conchoid_sampling --out results [--quick]
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_roots.h>
+
+#include <cmath>
 #include <random>
 
 #include "experiment_support.hpp"
+#include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
 #include "impinge/maps/radial_distance_map.hpp"
 #include "impinge/schemes/conchoid.hpp"
@@ -64,6 +72,65 @@ void angles_table(const std::string& dir, const Conchoid& exact) {
            ex[i] * kRadToDeg - 0.1 * i);
 }
 
+// The polar angle (radians, from the +x axis) about (cx, 0) of the conchoid's point at phi.
+double angle_about(const Conchoid& c, double cx, double phi) {
+  const double r = c.radius(phi);
+  return std::atan2(r * std::sin(phi), r * std::cos(phi) - cx);
+}
+
+// The conchoid angle phi in [0, phi_max] whose point is seen from (cx, 0) at angle psi (the angle is
+// monotone in phi there: the curve is star-shaped about every origin on its axis between 0 and b),
+// by GSL's Brent solver to 1e-13 rad.
+double phi_at_angle(const Conchoid& c, double cx, double psi, double phi_max) {
+  struct P {
+    const Conchoid* c;
+    double cx, psi;
+  } p{&c, cx, psi};
+  gsl_function f;
+  f.function = [](double phi, void* v) {
+    const auto* q = static_cast<P*>(v);
+    return angle_about(*q->c, q->cx, phi) - q->psi;
+  };
+  f.params = &p;
+  gsl_set_error_handler_off();
+  gsl_root_fsolver* solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+  require(gsl_root_fsolver_set(solver, &f, 0, phi_max) == GSL_SUCCESS, "06: the ray misses the hip curve");
+  double root = 0;
+  for (int it = 0; it < 200; ++it) {
+    gsl_root_fsolver_iterate(solver);
+    root = gsl_root_fsolver_root(solver);
+    if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver), gsl_root_fsolver_x_upper(solver), 1e-13, 0) ==
+        GSL_SUCCESS)
+      break;
+  }
+  gsl_root_fsolver_free(solver);
+  return root;
+}
+
+// Thesis Fig. 53 (sec. 5.1.1): equal-angle rays, 1 deg apart, from an origin (cx, 0) on the axis cut the hip
+// curve (phi in [0, 90] deg about the conchoid's origin) into segments of unequal length. The thesis: up to
+// 20 % longer in the middle with the origin at the object's centre, up to 30 % longer at the bottom with
+// the origin at the conchoid's. The object's centre, which the thesis does not define, is taken two ways:
+// the area centroid of the closed curve, x = (a^2 b + b^3 / 4) / (a^2 + b^2 / 2), and the middle of its
+// extent along the axis, x = b.
+void segments_table(const std::string& dir, const Conchoid& c) {
+  CsvWriter sg(dir + "/segments.csv",
+               {"origin", "origin_x_mm", "ray_from_deg", "ray_to_deg", "phi_from_deg", "phi_to_deg", "length_mm"});
+  const double a = c.a(), b = c.b();
+  const double centroid = (a * a * b + b * b * b / 4) / (a * a + b * b / 2);
+  for (auto [name, cx] : std::initializer_list<std::pair<const char*, double>>{
+           {"conchoid_origin", 0.0}, {"object_centroid", centroid}, {"object_extent_middle", b}}) {
+    const double psi_end = angle_about(c, cx, kPi / 2) * kRadToDeg;
+    double phi_prev = 0;
+    for (int k = 1; k <= static_cast<int>(std::ceil(psi_end - 1e-9)); ++k) {
+      const double psi = std::min(double(k), psi_end);
+      const double phi = psi >= psi_end ? kPi / 2 : phi_at_angle(c, cx, psi * kDegToRad, kPi / 2);
+      sg.row(name, cx, k - 1.0, psi, phi_prev * kRadToDeg, phi * kRadToDeg, c.arc_length(phi) - c.arc_length(phi_prev));
+      phi_prev = phi;
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -74,6 +141,7 @@ int main(int argc, char** argv) {
   length_table(dir, exact, approx_a, b);
   table10(dir, exact);
   angles_table(dir, exact);
+  segments_table(dir, exact);
   // Equal node count on a conchoid joint (origin at the conchoid origin, axis z): maps filled with
   // the exact radius at every node (the sampling itself is exact here), so only the node layout
   // and its interpolation differ. Error over uniformly random directions with phi <= 90 deg.
@@ -124,6 +192,7 @@ int main(int argc, char** argv) {
               {"precisions_deg", precisions},
               {"directions", n_dirs},
               {"helix_turns", "round(sqrt(equiangular node count)) (equal node count)"},
-              {"thesis_source", "thesis sec. 5.1, Eq. 11-16, Table 10, Fig. 58-59"}});
+              {"segments", "equal-angle rays 1 deg apart over the hip curve from three origins (Fig. 53)"},
+              {"thesis_source", "thesis sec. 5.1, Eq. 11-16, Table 10, Fig. 53, 58-59"}});
   return 0;
 }

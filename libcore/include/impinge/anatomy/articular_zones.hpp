@@ -5,7 +5,7 @@
 /// impingement is the head-neck junction or neck against the acetabular rim (intra-articular) or
 /// the trochanters or neck against the ilium, the anterior inferior iliac spine or the ischium
 /// (extra-articular) (Ganz et al. 2003, Clin Orthop 417:112; Tannast et al. 2007, J Orthop Res
-/// 25:122; issue 29).
+/// 25:122).
 ///
 /// The zones come from what impinge fits already: the femoral head sphere (centre c_h, radius
 /// r_h), the acetabular sphere (c_a, r_a) and the rim plane (find_acetabulum).

@@ -1,6 +1,6 @@
 #pragma once
 /// @file embree_ray_caster.hpp
-/// Embree 3 as a peer (issue 4): the fastest general ray caster, used as the baseline of the
+/// Embree 3 as a peer: the fastest general ray caster, used as the baseline of the
 /// radial look-up (cast the COR-to-vertex ray at the other bone) and of map filling (cast
 /// every node's ray: the modern form of the thesis' pairwise O(m n) sampling, sec. 3.2).
 /// Built only when Embree 3 is found (IMPINGE_HAVE_EMBREE); `have_embree()` says which.
@@ -46,7 +46,7 @@ class EmbreeRayCaster {
   /// (a context filter records each candidate and rejects it): appends (distance along the unit
   /// direction in mm, triangle index in the mesh given to the constructor) to `out`, unsorted; a ray
   /// through a shared edge may report both triangles. Throws impinge::Error on a scene built
-  /// without `robust`. Source: issue 14 (layered maps).
+  /// without `robust`. Source: impinge (layered maps; not in the thesis).
   void all_hits(float dx, float dy, float dz, std::vector<std::pair<float, unsigned>>& out) const;
 
   /// The radial scan through Embree, the peer of scan_gaps_compact (detection/detection.hpp, which

@@ -35,7 +35,7 @@ class ExactReference {
   /// distance: (distance mm, cosine of the angle between the triangle's normal (corner order
   /// a, b, c: (b - a) x (c - a), normalised) and the direction), one per triangle met
   /// (AABB_tree::all_intersections); a ray in a triangle's plane gives the nearer end of the segment
-  /// and cosine 0. Empty when the ray misses. Source: issue 14 (layered maps).
+  /// and cosine 0. Empty when the ray misses. Source: impinge (layered maps; not in the thesis).
   std::vector<std::pair<double, double>> all_hits(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
   /// Distance (mm) from `p` to the closest point of the mesh (AABB_tree::closest_point).
   double closest_distance(const Eigen::Vector3d& p) const;

@@ -1,6 +1,6 @@
 #pragma once
 /// @file fcl_collision.hpp
-/// FCL (the Flexible Collision Library, 0.7) as a peer (issue 4): OBBRSS bounding-volume
+/// FCL (the Flexible Collision Library, 0.7) as a peer: OBBRSS bounding-volume
 /// trees, the successor of the thesis' RAPID OBB tree (sec. 2.2.1, Tables 4 and 9). Collision
 /// per pose with every contact (triangle pair) reported, and the minimum distance per pose.
 /// Built only when FCL is found (IMPINGE_HAVE_FCL); `have_fcl()` says which.

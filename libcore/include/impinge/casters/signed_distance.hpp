@@ -2,7 +2,7 @@
 /// @file signed_distance.hpp
 /// The signed Euclidean distance from a point to a triangle mesh: the closest point of the surface
 /// (what 3D Slicer, VTK's vtkImplicitPolyDataDistance, Open3D's compute_signed_distance and libigl's
-/// signed_distance report), negative inside the solid the mesh bounds. Source: issue 26.
+/// signed_distance report), negative inside the solid the mesh bounds. Source: impinge (not in the thesis).
 ///
 /// Closest point: a bounding-volume hierarchy pruned by a query radius (Embree 3's rtcPointQuery when
 /// the build has Embree, a BVH in float whose boxes are widened by 1e-3 mm; CGAL's AABB tree otherwise),

@@ -1,6 +1,6 @@
 #pragma once
 /// @file rom.hpp
-/// Range-of-motion limits (thesis sec. 5.2; issue 14): from neutral along a motion, the first
+/// Range-of-motion limits (thesis sec. 5.2): from neutral along a motion, the first
 /// angle at which the bones meet (minimum gap <= threshold), found by steps and bisection, with
 /// where they meet; and the ROM map of clinical planning tools (Tannast et al. 2007,
 /// Kubiak-Langer et al. 2007): the largest internal rotation over flexion x adduction.
@@ -36,7 +36,7 @@ enum class RomContacts {
 /// Parse "impingement", "articular" or "all". Throws impinge::Error naming `context` otherwise.
 RomContacts parse_rom_contacts(const std::string& text, const std::string& context);
 
-/// What a ROM search compares with the threshold (issue 26).
+/// What a ROM search compares with the threshold.
 enum class RomMetric {
   radial,    ///< the thesis' radial gap (Algorithm 2): along the ray from the COR; fast (cluster bounds)
   distance,  ///< the signed Euclidean distance to the other bone's surface (ScanGaps::distance_mm): what a
@@ -59,7 +59,7 @@ struct RomOptions {
   /// the data's own error (the maps' interpolation, about 0.05 mm at 0.1 deg; an MRI surface's
   /// roughness about its fitted sphere, 0.4-0.8 mm rms) does not stop a motion, whose femur the
   /// joint's play lets slide past it. Without it a graze along a motion makes the limit jump by tens
-  /// of degrees under a 1 mm change of the centre of rotation (issue 29: tlem2-mri's flexion 118 ->
+  /// of degrees under a 1 mm change of the centre of rotation (measured: tlem2-mri's flexion 118 ->
   /// 27 deg at 0 mm, mc22's external rotation 52 -> 4 deg at 0.1 mm; at 0.25 mm every limit of
   /// lhdl-ct, tlem2-mri and mc22 moves by at most 2 deg). 0: the first touch.
   double contact_depth_mm = 0.25;
@@ -67,7 +67,7 @@ struct RomOptions {
   /// joint's JointOptions::distances on, with a reach of at least max(threshold_mm, 0), and counts every
   /// vertex: RomVertices::all). The two agree on whether the bones overlap; above 0 they differ, the
   /// distance reaching a threshold earlier (the radial gap bounds it from above), and a penetration's
-  /// depth by the distance is the true one where the ray runs inside the other bone (issue 26). At or
+  /// depth by the distance is the true one where the ray runs inside the other bone. At or
   /// below a cut (threshold less contact depth) of 0 the radial scan screens the distance's: only the
   /// vertices whose radial gap is within the cut plus 0.5 mm get a distance (a vertex inside the other
   /// bone has a radial gap at most its distance, up to the maps' interpolation error); above 0 every pose
@@ -80,7 +80,7 @@ struct RomOptions {
   bool use_bounds = true;        ///< skip vertex clusters whose bound cannot reach the threshold (same results,
                                  ///< fewer look-ups; equiangular maps)
   RomVertices vertices = RomVertices::all;  ///< which vertices are counted (hidden ones need JointOptions::layers)
-  RomContacts contacts = RomContacts::impingement;  ///< which contacts end a search (issue 29); applied by
+  RomContacts contacts = RomContacts::impingement;  ///< which contacts end a search; applied by
                                                     ///< rom_baseline, through the vertices it leaves out
   /// Contacts within the acetabular rim radius plus this (mm) of the COR are intra-articular,
   /// farther ones extra-articular.
@@ -240,7 +240,7 @@ struct RomEnvelope {
   }
 };
 
-/// The ROM envelope (issue 14): every pose of the flexion x adduction x internal rotation grid as valid
+/// The ROM envelope: every pose of the flexion x adduction x internal rotation grid as valid
 /// or in contact, by adaptive refinement: the poses of a coarse lattice (every coarse_steps steps) are
 /// scanned; a cell whose eight corners agree is filled with their answer; a cell whose corners disagree
 /// is split in two along each axis and the new corners scanned, down to single steps. Only poses near
@@ -248,7 +248,7 @@ struct RomEnvelope {
 /// (or of freedom) smaller than a cell and touching none of its corners is missed; coarse_steps = 1
 /// scans every pose. Each scan stops at the first contact (RomOptions, `baseline` as for
 /// find_rom_limit). All cores (OpenMP). Throws impinge::Error on an empty or uneven grid. Source:
-/// issue 14; the refinement of Kawasaki et al. 2007 in spirit.
+/// impinge (not in the thesis); the refinement of Kawasaki et al. 2007 in spirit.
 RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& envelope, const RomOptions& options,
                          const RomBaseline& baseline);
 

@@ -1,7 +1,7 @@
 #pragma once
 /// @file fast_angles.hpp
 /// Spherical angles of a direction without libm trigonometry: the hot path of every map look-up
-/// (issue 4's fast query path). Branch-free (selects only), so loops over them vectorise.
+/// (fast query path). Branch-free (selects only), so loops over them vectorise.
 ///
 /// Method: fold (y, x) into the first octant (0 <= mn <= mx), reduce once more with
 /// atan(t) = pi/4 + atan((t - 1) / (t + 1)) when t = mn / mx > tan(pi/8), so the argument u lies
@@ -14,7 +14,7 @@
 /// Effect on a look-up: a direction error of e radians moves the bilinear weights of a grid of
 /// spacing h by at most e / h, so the interpolated distance by at most (e / h) * (largest
 /// difference between neighbouring node values). At h = 0.05 deg and a 300 mm jump at a depth
-/// discontinuity that is 3.4e-8 mm, far below the 1e-4 mm the issue allows.
+/// discontinuity that is 3.4e-8 mm, far below the 1e-4 mm we allow.
 
 #include <algorithm>
 #include <cmath>

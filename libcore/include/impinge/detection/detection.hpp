@@ -28,19 +28,19 @@ enum class ScanSide { inside = 1, outside = -1 };
 /// out) or the other map has no surface in its direction; status[i] tells which.
 struct ScanGaps {
   /// tested: by the single-layer map (first-surface vertices); tested_layered: a vertex hidden behind its
-  /// own body's nearer surface, tested by the other body's layered map (extra-articular; issue 14).
+  /// own body's nearer surface, tested by the other body's layered map (extra-articular).
   enum Status : std::uint8_t { tested = 0, no_surface = 1, beyond_reach = 2, tested_layered = 3 };
   std::vector<float> gap_mm;         ///< n gaps, mm
   std::vector<std::uint8_t> status;  ///< n statuses
   std::int64_t refined = 0;          ///< look-ups at a depth discontinuity resolved by an exact ray cast
-  /// Signed Euclidean distance to the other bone's surface (issue 26; JointOptions::distances), n values,
+  /// Signed Euclidean distance to the other bone's surface (JointOptions::distances), n values,
   /// mm, negative inside the other bone; NaN where proven farther than the reach or not measured. Empty
   /// when distances are off.
   std::vector<float> distance_mm;
   std::int64_t distance_winding = 0;  ///< distances whose sign the winding number decided
 };
 
-/// Which per-vertex quantity the impingement levels classify (issue 26): the thesis' radial gap, or the
+/// Which per-vertex quantity the impingement levels classify: the thesis' radial gap, or the
 /// Euclidean distance (ScanGaps::distance_mm; a vertex without one is farther than the distances' reach,
 /// which is at least the largest level threshold, so level 0).
 enum class LevelQuantity : std::uint8_t { radial_gap = 0, distance = 1 };
@@ -109,7 +109,7 @@ struct ScanSet {
 /// impinge::Error when mask.size() != n or n exceeds 2^31 - 1.
 ScanSet make_scan_set(PointsRef P, const std::vector<std::uint8_t>& mask);
 
-/// The fast scan (issue 4): for every vertex j of `set`, q = R * p_j + t in the map's frame
+/// The fast scan: for every vertex j of `set`, q = R * p_j + t in the map's frame
 /// (R: 3 x 3 rotation, t: translation, mm; the identity and 0 when the bodies share the COR),
 /// gap_mm[j] = side * (map.lookup(q) - |q|), NaN where the map has no surface in q's direction
 /// or q is the COR. `gap_mm` must hold set.size() floats. Allocation-free, single thread; blocks
@@ -127,7 +127,7 @@ inline void scan_gaps_embree(const EmbreeRayCaster& caster, const ScanSet& set, 
                    gap_mm, packet8);
 }
 
-/// scan_gaps_compact with exact look-ups at depth discontinuities (issue 15): with `exact` given
+/// scan_gaps_compact with exact look-ups at depth discontinuities: with `exact` given
 /// (the ray caster of the map's mesh about the same COR, in the map's frame) and the map's nodes
 /// marked (mark_depth_discontinuities), a vertex whose stencil holds a marked node gets
 /// gap_mm[j] = side * (exact->first_hit(q) - |q|) (NaN on a miss) instead of the interpolated
@@ -146,7 +146,7 @@ std::int64_t scan_gaps_compact(const ScanSet& set, std::int64_t first, std::int6
                                const Eigen::Vector3d& t, const RadialDistanceMapT<Scalar>& map, ScanSide side,
                                float* gap_mm, const FirstHitCaster* exact);
 
-/// The layered scan (issue 14): for every vertex j of `set`, q = R p_j + t in the map's frame (as
+/// The layered scan: for every vertex j of `set`, q = R p_j + t in the map's frame (as
 /// scan_gaps_compact), gap_mm[j] = the layered map's signed radial distance at q (mm; > 0 apart, < 0
 /// inside the other bone), NaN where the other bone is nowhere along q's ray or the answer is unknown
 /// (a truncated node). With `exact` given (the other mesh's caster about the same COR, in the map's

@@ -35,7 +35,7 @@ struct JointOptions {
   double max_radius_mm = std::numeric_limits<double>::infinity();  ///< region of interest about
                                                                    ///< the COR, mm
   ImpingementLevels levels;                                        ///< gap classes
-  /// Exact look-ups at depth discontinuities (issue 15): mark each map's nodes where its
+  /// Exact look-ups at depth discontinuities: mark each map's nodes where its
   /// interpolation may be off by more than discontinuity_tolerance_mm (mark_depth_discontinuities)
   /// and resolve every look-up whose stencil holds one by a ray cast of the other mesh
   /// (FirstHitCaster), and every first-surface decision of such a vertex by a ray cast of its own.
@@ -45,10 +45,10 @@ struct JointOptions {
   /// Store both maps sparse (RadialDistanceMapT::make_sparse) once they are filled and marked: only
   /// the tiles with a surface within sparse_region_mm of the COR (default: any surface, which gives
   /// every gap bit for bit as the dense maps; a finite region answers "no surface" beyond it).
-  /// Source: issue 12.
+  /// Source: impinge (not in the thesis).
   bool sparse_maps = false;
   double sparse_region_mm = std::numeric_limits<double>::infinity();  ///< see sparse_maps, mm (> 0)
-  /// Layered maps (issue 14): with layers = N > 0, each body also gets a LayeredMap of the same scheme
+  /// Layered maps: with layers = N > 0, each body also gets a LayeredMap of the same scheme
   /// with N crossings per node (filled by ray casts, all cores), and the vertices hidden behind their
   /// own body's nearer surface (not in the first-surface mask) within extra_articular_radius_mm of the
   /// COR are tested against the other body's layered map: the trochanters, the shaft and the neck
@@ -67,7 +67,7 @@ struct JointOptions {
   /// Filling a layered map by ray casts costs per node: at 0.1 deg about 3 s for both bones of
   /// lhdl-ct, at 0.5 deg about 0.12 s.
   double layered_spacing_deg = 0.5;
-  /// Euclidean distances (issue 26): with `distances` on, every detect also gives each vertex within
+  /// Euclidean distances: with `distances` on, every detect also gives each vertex within
   /// max_radius_mm of the COR, on the first surface or hidden, its signed distance to the other bone's
   /// surface (ScanGaps::distance_mm; surface_distance.hpp), wherever it cannot be proven farther than
   /// distance_reach_mm. Needs Embree or CGAL. Off: the thesis' radial gaps alone.

@@ -2,7 +2,7 @@
 /// @file surface_distance.hpp
 /// The distance scan: for the vertices of one body at a pose, the signed Euclidean distance to the other
 /// body's surface (casters/signed_distance.hpp), beside the radial gap of the thesis (detection.hpp).
-/// Source: issue 26.
+/// Source: impinge (not in the thesis).
 ///
 /// Exact, and cheap, by leaving out what cannot be within reach:
 /// - Clusters of up to 32 nearby vertices (a Z curve over their positions), each with a bounding ball.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file depth_discontinuity.hpp
-/// Depth discontinuities of a radial distance map (issue 15): nodes next to which the map's
+/// Depth discontinuities of a radial distance map: nodes next to which the map's
 /// interpolation cannot be trusted to a tolerance, because the first surface seen from the COR
 /// jumps (the acetabular rim in front of the fossa, the femoral head in front of the neck), turns
 /// steeply, or ends (the edge of the map's coverage). Look-ups whose stencil holds such a node are

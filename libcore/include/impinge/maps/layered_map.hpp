@@ -1,6 +1,6 @@
 #pragma once
 /// @file layered_map.hpp
-/// Layered radial map (issue 14; the thesis' sec. 6 "multiple layers"): for every node of a sampling
+/// Layered radial map (the thesis' sec. 6 "multiple layers"): for every node of a sampling
 /// scheme, the ordered crossings of its ray with a bone's surface (where the ray enters the solid and
 /// where it leaves it), so that for any point the map answers whether the point lies inside the bone
 /// and how far along the ray the nearest boundary is. The single-layer map (radial_distance_map.hpp)

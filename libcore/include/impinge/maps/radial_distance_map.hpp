@@ -23,7 +23,7 @@ namespace impinge {
 ///
 /// Look-ups: the scheme computes the stencils of a block of directions (SamplingScheme::stencils_soa),
 /// the map loads and combines the node values in one fixed order, sum_k w_k d_k, so that every scheme
-/// and both storages give the same value for the same stencil (issue 12).
+/// and both storages give the same value for the same stencil.
 ///
 /// Storage: dense (one value per node, the default) or sparse (make_sparse): the nodes in tiles of
 /// kTileNodes consecutive indices, only the tiles that hold a surface within a region of interest
@@ -73,8 +73,8 @@ class RadialDistanceMapT {
   /// Turn a dense map into a sparse one: a tile is kept when one of its nodes has a surface at most
   /// `region_mm` from the COR (default: any surface, which changes no look-up at all); every other
   /// tile reads as "no surface". Returns the bytes released. Throws impinge::Error when region_mm is
-  /// NaN or not positive. A map in which every tile would be kept stays dense. Source: issue 12
-  /// (sparse maps).
+  /// NaN or not positive. A map in which every tile would be kept stays dense. Source: impinge
+  /// (sparse maps; not in the thesis).
   std::size_t make_sparse(double region_mm = std::numeric_limits<double>::infinity());
   /// Tiles stored and tiles in all (a dense map: every tile counts as stored).
   std::int64_t tiles_stored() const;

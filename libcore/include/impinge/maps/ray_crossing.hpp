@@ -6,7 +6,7 @@
 namespace impinge {
 
 /// Where a ray from the origin crosses a mesh's surface: distance (mm) and whether it enters the
-/// solid there (the surface faces the ray) or leaves it. Source: issue 14 (layered maps).
+/// solid there (the surface faces the ray) or leaves it. Source: impinge (layered maps; not in the thesis).
 struct RayCrossing {
   double distance_mm = 0;
   bool entering = false;

@@ -1,7 +1,7 @@
 #pragma once
 /// @file raster_plan.hpp
 /// A rasterisation plan: what can be prepared once per mesh and COR before rasterising it at any
-/// precision (issue 4's faster rasteriser; not in the thesis): which triangles can be the nearest hit
+/// precision (faster rasteriser; not in the thesis): which triangles can be the nearest hit
 /// of a ray from the COR (face culling), in what order to draw them, and their cones set up.
 ///
 /// Face culling: which triangles of a mesh can be the nearest hit of a ray from the COR. Along any ray from a point off a closed, consistently
@@ -26,7 +26,7 @@
 namespace impinge {
 
 /// The plan for rasterising one mesh about one COR (plan_rasterization), with the evidence for its
-/// culling. Formerly FaceCulling (issue 12 asked for a name that says what it is).
+/// culling. Formerly FaceCulling.
 struct RasterPlan {
   bool enabled = false;             ///< true when culling is exact for this mesh and COR
   int keep_sign = 0;                ///< +1 or -1: keep triangles with sign(det) == keep_sign

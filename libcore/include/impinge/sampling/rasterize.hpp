@@ -47,11 +47,11 @@ enum class MapStart {
   /// Set every node to "no surface" first: a fresh map. With a plan in exact mode the reset is
   /// done in bands of rows, each just before the cones that start in it are drawn, so that
   /// their map lines are still in the cache (the same map as std::fill followed by drawing,
-  /// and faster: issue 4).
+  /// and faster).
   reset,
 };
 
-/// How rasterize draws (issue 12: one options struct instead of a positional tail).
+/// How rasterize draws (one options struct instead of a positional tail).
 struct RasterizeOptions {
   /// Exact mode only (ignored in linear mode): plan_rasterization's plan for this mesh and COR. Its
   /// cones are rasterised (set up once; the kept triangles when culling is enabled, about half of a
@@ -79,7 +79,7 @@ struct RasterizeOptions {
 /// made for another mesh or COR (mesh_fingerprint), or the mesh is invalid (validate_mesh, checked
 /// before the map is touched). The row kernels run in vectorised clones (AVX-512 / AVX2 chosen at run
 /// time).
-/// Source: thesis sec. 3.2, Algorithm 1, Fig. 33-34; culling, cones and spans: issue 4.
+/// Source: thesis sec. 3.2, Algorithm 1, Fig. 33-34; culling, cones and spans: impinge (not in the thesis).
 template <typename Scalar>
 SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, DistanceMode mode,
                         RadialDistanceMapT<Scalar>& map, const RasterizeOptions& options = {});

@@ -21,7 +21,7 @@ enum class SamplingMethod {
   ray_cast,   ///< every node's ray against every triangle (naive, O(nodes x triangles))
   /// Every node's ray through a BVH (FirstHitCaster: Embree, else CGAL), on all cores: the exact
   /// first hit at every node of any scheme, without the bilinear error that `resample` adds.
-  /// O(nodes log triangles). Throws impinge::Error when the build has no ray caster. Source: issue 12.
+  /// O(nodes log triangles). Throws impinge::Error when the build has no ray caster. Source: impinge (not in the thesis).
   ray_cast_bvh,
 };
 
@@ -39,7 +39,7 @@ struct SamplingOptions {
   /// `resample` with resample_precision_deg = 0: the temporary equiangular precision is the matched
   /// one divided by this (>= 1). 1 is the thesis' accelerated sampling (sec. 4.2.2); its bilinear
   /// error adds to the scheme's own, so comparisons of schemes at equal error use 2 (a quarter of
-  /// that error, at four times the rasterisation). Source: issue 12.
+  /// that error, at four times the rasterisation). Source: impinge (not in the thesis).
   int resample_oversampling = 1;
   /// Exact mode: skip the triangles that can never be the nearest hit (raster_plan.hpp).
   /// With `plan` null, the plan is made here (O(m), counted in planning_ms); culling turns itself

@@ -1,7 +1,7 @@
 #pragma once
 /// @file triangle_cone.hpp
 /// The part of a triangle's exact-mode rasterisation set-up that does not depend on the map's
-/// precision (issue 4's faster rasteriser; not in the thesis). A face-culling plan
+/// precision (faster rasteriser; not in the thesis). A face-culling plan
 /// (raster_plan.hpp) holds one per kept triangle, made once per mesh and COR, so that a
 /// rasterisation only turns these angles into rows, columns and row spans.
 
@@ -19,7 +19,7 @@ namespace impinge {
 /// oriented face normal, computed as (b - a) x (c - a), which keeps the digits that the sum of
 /// the three edge normals loses for a small triangle far from the COR).
 ///
-/// Row spans (issue 4): on the row of polar angle phi, edge k's constraint
+/// Row spans: on the row of polar angle phi, edge k's constraint
 /// sin(phi) rho_k cos(theta - alpha_k) + cos(phi) e_k.z >= 0 (rho_k = |(e_k.x, e_k.y)|) holds on
 /// the azimuths within acos(k_k cot(phi)) of alpha_k, where k_k = -e_k.z / rho_k. rasterize()
 /// tests only the columns of that arc, widened by pad_k / sqrt(sin(phi)) radians (pad_k =
@@ -63,7 +63,7 @@ struct TriangleCone {
 /// whose plane passes through the COR (|det| <= 1e-12 |a| |b| |c|: they cover no direction),
 /// which are counted in `edge_on` when not null. Every face index must be valid (the caller
 /// validated the mesh). Cost O(|faces|). Source: thesis sec. 3.2 (the cone test of Algorithm 1
-/// in exact form), issue 4 (row spans).
+/// in exact form), row spans.
 std::vector<TriangleCone> triangle_cones(const TriangleMesh& mesh, const Eigen::Vector3d& cor,
                                          const std::vector<std::int32_t>& faces, std::int64_t* edge_on = nullptr);
 

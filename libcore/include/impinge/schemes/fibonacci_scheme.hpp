@@ -16,7 +16,7 @@
 /// poles a lattice corner can fall outside [0, n): it is replaced by the nearest valid node (node 0
 /// or n - 1), which is first order within about one node spacing of the pole.
 ///
-/// Source: issue 12 (new sampling schemes).
+/// Source: impinge (new sampling schemes; not in the thesis).
 
 #include <cmath>
 #include <cstdint>

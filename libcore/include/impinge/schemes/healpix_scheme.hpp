@@ -8,7 +8,7 @@
 /// z = cos(polar angle) between them; near the poles the missing ring is the pole's 4 pixels).
 /// Any N_side >= 1 (ring ordering does not need a power of two).
 ///
-/// Source: issue 12 (new sampling schemes).
+/// Source: impinge (new sampling schemes; not in the thesis).
 
 #include <cstdint>
 #include <memory>

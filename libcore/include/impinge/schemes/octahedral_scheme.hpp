@@ -10,7 +10,7 @@
 /// mirrored, so the virtual row N of column c is row N - 1 of column N - 1 - c), which keeps the
 /// look-up continuous across every seam. No libm trigonometry on the look-up path.
 ///
-/// Source: issue 12 (new sampling schemes); mapping and inverse as in Clarberg 2008, sec. 3.
+/// Source: impinge (new sampling schemes; not in the thesis); mapping and inverse as in Clarberg 2008, sec. 3.
 
 #include <cmath>
 #include <cstdint>

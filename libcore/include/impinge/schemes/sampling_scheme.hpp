@@ -55,7 +55,7 @@ class SamplingScheme {
   /// direction j in nodes[k * n + j] and its weight in w[k * n + j], weights >= 0 summing to 1 (unused
   /// entries weight 0 with a valid node). The one per-block virtual call of a look-up: the scheme
   /// computes where to look, the map (radial_distance_map.hpp) loads and combines the values, so a
-  /// scheme knows nothing of the map's value type or storage (issue 12). May differ from
+  /// scheme knows nothing of the map's value type or storage. May differ from
   /// interpolate() by the rounding of its angle computations (a vectorised kernel may use
   /// fast_angles.hpp). Source: thesis Algorithms 2 and 3 (the look-ups), split for the plug-in.
   virtual void stencils_soa(const double* x, const double* y, const double* z, int n, std::int32_t* nodes,
@@ -153,7 +153,7 @@ double default_resolution(const std::string& name);
 /// spacing (max_node_spacing) is at most `spacing_deg` degrees: the way to compare schemes at
 /// equal spacing (CLI --spacing). Equiangular-like schemes take p = 180 / n, counted schemes
 /// (helix turns) a whole number >= 2. Throws impinge::Error naming the scheme for an unknown name
-/// or a spacing outside (0, 90] degrees. Source: issue 12.
+/// or a spacing outside (0, 90] degrees. Source: impinge (not in the thesis).
 double resolution_for_spacing(const std::string& name, double spacing_deg);
 
 }  // namespace impinge

@@ -79,7 +79,7 @@ struct RomRun {
 /// The session options a ROM run with `search` needs, from `options`: the distance hierarchies only for
 /// RomMetric::distance, with a reach of max(threshold, 0) + 1 mm unless `options` gives one; levels on the
 /// radial gap (a ROM run classifies no levels, so their thresholds do not constrain the reach). Source:
-/// issue 26 (`impinge rom --metric`).
+/// `impinge rom --metric`.
 SessionOptions rom_session_options(SessionOptions options, const RomOptions& search);
 
 /// The ROM limits of the standard motions from neutral (find_rom_limits), then the map and the

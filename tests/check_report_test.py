@@ -1,0 +1,96 @@
+"""tools/check-report and analysis/claims.py: the checker reads thesis items as the manifest writes them,
+finds a run from mixed or dirty commits, a thesis item without a claim, a bad verdict and a page that runs
+over; and the committed run's claims.csv has a row for every thesis item of experiments/manifest.tsv."""
+import csv
+import importlib.machinery
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TOOL = os.path.join(ROOT, "tools", "check-report")
+_loader = importlib.machinery.SourceFileLoader("check_report", TOOL)
+check = importlib.util.module_from_spec(importlib.util.spec_from_loader("check_report", _loader))
+_loader.exec_module(check)
+
+
+def test_thesis_items_are_read_one_by_one():
+    assert check.thesis_items("Tables 2, 6, 7; Fig. 49 counts") == {"Table 2", "Table 6", "Table 7", "Fig. 49"}
+    assert check.thesis_items("Sec. 5.2, Tables 11-13, Fig. 60-63") == (
+        {"Sec. 5.2", "Table 11", "Table 12", "Table 13", "Fig. 60", "Fig. 61", "Fig. 62", "Fig. 63"})
+    assert check.thesis_items("Table 5, Eq. 7-8") == {"Table 5", "Eq. 7", "Eq. 8"}
+    assert check.thesis_items("Sec. 3.5.2, Fig. 46") == {"Sec. 3.5.2", "Fig. 46"}
+    assert check.thesis_items("(new) the Euclidean distance beside Open3D and VTK (issue 26)") == set()
+
+
+def write_run(d, commits, claims_rows, log=""):
+    for k, c in enumerate(commits):
+        os.makedirs(os.path.join(d, f"0{k}_x"), exist_ok=True)
+        with open(os.path.join(d, f"0{k}_x", "meta.json"), "w") as f:
+            json.dump({"git_commit": c}, f)
+    with open(os.path.join(d, "claims.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=["thesis_item", "claim", "thesis_value", "our_value", "verdict", "reason",
+                                          "section"])
+        w.writeheader()
+        w.writerows(claims_rows)
+    os.makedirs(os.path.join(d, "paper"), exist_ok=True)
+    with open(os.path.join(d, "paper", "impinge.log"), "w") as f:
+        f.write(log)
+
+
+def every_item_row(verdict="holds"):
+    items = sorted(set().union(*check.manifest_items().values()))
+    return [{"thesis_item": "; ".join(items), "claim": "c", "thesis_value": "t", "our_value": "o", "verdict": verdict,
+             "reason": "r", "section": "s"}]
+
+
+def run(d, *extra):
+    return subprocess.run([sys.executable, TOOL, d, *extra], capture_output=True, text=True)
+
+
+def test_a_clean_single_commit_run_covering_the_manifest_passes():
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc", "abc"], every_item_row())
+        r = run(d)
+        assert r.returncode == 0, r.stdout
+
+
+def test_mixed_and_dirty_commits_are_found():
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc", "def"], every_item_row())
+        r = run(d, "--allow-dirty")
+        assert r.returncode == 1 and r.stdout.count("provenance:") == 2, r.stdout
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc-dirty"], every_item_row())
+        assert run(d).returncode == 1
+        assert run(d, "--allow-dirty").returncode == 0
+
+
+def test_a_thesis_item_without_a_claim_and_a_bad_verdict_are_found():
+    with tempfile.TemporaryDirectory() as d:
+        rows = every_item_row()
+        rows[0]["thesis_item"] = rows[0]["thesis_item"].replace("Fig. 53; ", "")
+        write_run(d, ["abc"], rows)
+        r = run(d)
+        assert r.returncode == 1 and "no row for Fig. 53" in r.stdout, r.stdout
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc"], every_item_row("probably"))
+        r = run(d)
+        assert r.returncode == 1 and "verdict 'probably'" in r.stdout, r.stdout
+
+
+def test_a_page_that_runs_over_is_found():
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc"], every_item_row(), "Overfull \\vbox (250.3pt too high) has occurred while \\output")
+        r = run(d)
+        assert r.returncode == 1 and "vbox" in r.stdout, r.stdout
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc"], every_item_row(), "Overfull \\hbox (3.1pt too wide) in paragraph at lines 1--2")
+        assert run(d).returncode == 0
+
+
+def test_the_committed_claims_cover_the_manifest():
+    assert check.check_claims(os.path.join(ROOT, "results")) == []
