@@ -5,7 +5,7 @@ Reads RESULTS/01_lut_memory/{lut_memory,helix_match,density}.csv; writes table.t
 table_helix.tex, table_match.tex, memory.pdf/png, density.pdf/png, macros.tex."""
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, read_csv, save, write_macros, write_table
+from common import experiment_dir, read_csv, resolution_text, save, write_macros, write_table
 
 d = experiment_dir("01_lut_memory")
 df = read_csv(d, "lut_memory.csv")
@@ -66,7 +66,7 @@ sch = read_csv(d, "schemes.csv")
 rows = []
 for (name, unit), g in sch.groupby(["scheme", "resolution_name"], sort=False):
     g = g.set_index("spacing_deg")
-    rows.append([name, unit.replace("_", " ")] + [f"{g.resolution[p]:g}" for p in (1.0, 0.1)] +
+    rows.append([name, unit.replace("_", " ")] + [resolution_text(g.resolution[p]) for p in (1.0, 0.1)] +
                 [f"{int(g.nodes[p]):,}" for p in (1.0, 0.1)] + [f"{g.nodes_over_equiangular[0.1]:.2f}"])
 write_table(d, "table_schemes", ["scheme", "resolution", "at 1 deg", "at 0.1 deg", "nodes, 1 deg", "nodes, 0.1 deg",
                                  "/ equiangular"], rows, align="llrrrrr")

@@ -70,8 +70,9 @@ def legends(ax, configs, loc_shapes, loc_configs):
                    title_fontsize=6)
     ax.add_artist(l1)
     h2 = [Line2D([], [], color="0.3", ls=styles[c][0], marker=styles[c][1], markersize=3) for c in configs]
-    ax.legend(h2, [f"{a} {b}" for a, b in configs], fontsize=6, loc=loc_configs, title="scheme, mode",
-              title_fontsize=6)
+    h2.append(Line2D([], [], color="k", lw=2.5, alpha=0.6))  # the bound, named here rather than over the data
+    ax.legend(h2, [f"{a} {b}" for a, b in configs] + ["Eq. 7 (r = 22 mm)"], fontsize=6, loc=loc_configs,
+              title="scheme, mode", title_fontsize=6)
 
 
 fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
@@ -84,8 +85,6 @@ for ax, stat in zip(axes, ("max_mm", "p95_mm")):
                           color=colour[shape], lw=1)
     g = rad[(rad["shape"] == shapes[0]) & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]
     ax.loglog(g.precision_deg, g.eq7_mm, "k-", lw=2.5, alpha=0.6)
-    ax.annotate("Eq. 7 (r = 22 mm)", (g.precision_deg.iloc[-1], g.eq7_mm.iloc[-1]), fontsize=6,
-                xytext=(0, 5), textcoords="offset points", ha="right")
     ax.set_xlabel("precision p (deg; helix matched)")
     ax.set_title({"max_mm": "max", "p95_mm": "95th percentile"}[stat] + " |interpolated - exact| radial distance",
                  fontsize=8)

@@ -77,22 +77,33 @@ markers = {"equiangular": "o", "helix": "s", "helix-eq10": "v", "conchoid": "^",
 for xcol, stem, xlabel in [("query_ns_per_vertex", "pareto_time", "query time (ns per vertex)"),
                            ("bytes", "pareto_memory", "memory of both maps (bytes)"),
                            ("sampling_ms", "pareto_sampling", "sampling both maps (ms)")]:
+    # A colour and marker per scheme, a line style per mode, and a legend for each (at most 8 entries apiece).
+    from matplotlib.lines import Line2D
+    schemes = list(dict.fromkeys(g0.scheme))
+    colour = {s: f"C{k}" for k, s in enumerate(schemes)}
+    style = {"exact": "-", "exact_refined": ":", "linear": "--"}
     fig, ax = plt.subplots(figsize=(6, 3.8))
     for (scheme, mode), g in g0.groupby(["scheme", "mode"]):
         g = g.sort_values("precision_deg")
-        ax.loglog(g[xcol], g.p95_abs_mm.clip(lower=1e-7), marker=markers.get(scheme, "o"),
-                  ls={"exact": "-", "exact_refined": ":"}.get(mode, "--"), markersize=4, label=f"{scheme} {mode}")
+        ax.loglog(g[xcol], g.p95_abs_mm.clip(lower=1e-7), marker=markers.get(scheme, "o"), color=colour[scheme],
+                  ls=style.get(mode, "--"), markersize=4)
+    second = [(Line2D([], [], color="0.3", ls=ls), mode) for mode, ls in style.items() if (g0["mode"] == mode).any()]
     if xcol == "query_ns_per_vertex":
         for pname, mk in (("embree_radial", "P"), ("cgal_radial", "X")):
             g = t[(t.subject == subj) & (t.pose == "rest") & (t.scheme == pname)]
             if len(g):
-                ax.loglog(g[xcol], g.p95_abs_mm.clip(lower=1e-7), mk, color="k", markersize=8, label=pname)
+                ax.loglog(g[xcol], g.p95_abs_mm.clip(lower=1e-7), mk, color="k", markersize=8)
+                second.append((Line2D([], [], color="k", marker=mk, ls="", markersize=6), pname.replace("_", " ")))
     ax.axhline(0.05, color="r", lw=0.6, ls=":")
     ax.set_xlabel(xlabel)
     ax.set_ylabel("p95 |gap error| (mm)")
     ax.set_title(f"{subj}, rest pose (error floor clipped at 1e-7 mm)", fontsize=8)
     ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=6, ncol=2)
+    first = ax.legend([Line2D([], [], color=colour[s], marker=markers.get(s, "o"), markersize=4) for s in schemes],
+                      schemes, fontsize=6, title="scheme", title_fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1))
+    ax.add_artist(first)
+    ax.legend([h for h, _ in second], [n for _, n in second], fontsize=6, title="mode, peers", title_fontsize=6,
+              loc="lower left", bbox_to_anchor=(1.01, 0))
     save(fig, d, stem)
 
 # Where the errors are: per-vertex errors of equiangular 0.1 exact over (theta, phi).

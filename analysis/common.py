@@ -65,6 +65,12 @@ def write_table(d, stem, header, rows, align=None, caption=None, label=None):
         f.write("\n".join(lines) + "\n")
 
 
+def resolution_text(x):
+    """A scheme's resolution as a table prints it: whole numbers (turns, nodes, cells) with thousands
+    separators, never in exponent form; fractional ones (degrees) to 6 significant digits."""
+    return f"{int(round(x)):,}" if abs(x - round(x)) < 1e-9 else f"{x:.6g}"
+
+
 def write_macros(d, stem, values):
     """LaTeX macros \\name{value} for numbers quoted in the paper text."""
     with open(os.path.join(d, stem + ".tex"), "w") as f:
