@@ -109,7 +109,13 @@ for col, mk, name in [("rsid", "s", "thesis RSID"), ("fcl_collide", "^", "thesis
 ax.set_xlabel("triangles per model")
 ax.set_ylabel("ms per pose (both scans)")
 ax.grid(True, which="both", lw=0.3)
-ax.legend(fontsize=6, ncol=2)
+# Two legends (at most 8 entries each): ours beside the axes, the thesis' markers inside.
+handles, names = ax.get_legend_handles_labels()
+ours = [(h, n) for h, n in zip(handles, names) if not n.startswith("thesis")]
+thesis = [(h, n) for h, n in zip(handles, names) if n.startswith("thesis")]
+first = ax.legend(*zip(*ours), fontsize=6, title="ours", title_fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1))
+ax.add_artist(first)
+ax.legend(*zip(*thesis), fontsize=6, title="thesis", title_fontsize=6, loc="lower left", bbox_to_anchor=(1.01, 0))
 save(fig, d, "detection_time")
 
 # Numbers for the text: first real subject, pushed pose.

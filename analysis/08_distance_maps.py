@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, read_csv, save, write_macros, write_table
+from common import experiment_dir, precision_axis, read_csv, save, write_macros, write_table
 from render import draw, level_key, level_rgb, read_gap_ply
 
 d = experiment_dir("08_distance_maps")
@@ -63,6 +63,7 @@ for ax, scan in zip(axes, ("ball", "socket")):
     ax.set_xlabel("precision p (deg)")
     ax.set_ylabel("minimum gap (mm)")
     ax.invert_xaxis()
+    precision_axis(ax, st.precision_deg)
     ax.axhline(0, color="k", lw=0.5)
     ax.grid(True, alpha=0.3)
 # One legend beside the panels: a colour per subject, a line style per mode.
@@ -237,6 +238,7 @@ for s_ in subjects:
     g = hx[(hx.subject == s_) & (hx.scan == "ball") & (hx["mode"] == "exact")].sort_values("precision_deg")
     ax.loglog(g.precision_deg, g.vs_equiangular_p95_abs_mm, marker="o", label=s_)
 ax.set_xlabel("precision p (deg; helix at matched k)")
+precision_axis(ax, allst.precision_deg)
 ax.set_ylabel("p95 |USID - RSID| ball gap (mm)")
 ax.invert_xaxis()
 ax.grid(True, which="both", alpha=0.3)

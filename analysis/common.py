@@ -65,6 +65,16 @@ def write_table(d, stem, header, rows, align=None, caption=None, label=None):
         f.write("\n".join(lines) + "\n")
 
 
+def precision_axis(ax, values):
+    """A log x axis of map precisions (deg): ticks at the precisions a run used, printed plainly (no
+    exponent form, no crowded minor labels)."""
+    import matplotlib.ticker as ticker
+    v = sorted(set(float(x) for x in values))
+    ax.xaxis.set_major_locator(ticker.FixedLocator(v))
+    ax.xaxis.set_minor_locator(ticker.NullLocator())
+    ax.xaxis.set_major_formatter(ticker.FixedFormatter([f"{x:g}" for x in v]))
+
+
 def resolution_text(x):
     """A scheme's resolution as a table prints it: whole numbers (turns, nodes, cells) with thousands
     separators, never in exponent form; fractional ones (degrees) to 6 significant digits."""

@@ -14,14 +14,10 @@
 //                    the hip curve (phi in [0, 90] deg) into segments: each segment's curve length
 //   meta.json
 // Command: build/experiments/exp_06_conchoid_sampling --out results [--quick]
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_roots.h>
-
 #include <cmath>
 #include <random>
 
 #include "experiment_support.hpp"
-#include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
 #include "impinge/maps/radial_distance_map.hpp"
 #include "impinge/schemes/conchoid.hpp"
@@ -72,41 +68,6 @@ void angles_table(const std::string& dir, const Conchoid& exact) {
            ex[i] * kRadToDeg - 0.1 * i);
 }
 
-// The polar angle (radians, from the +x axis) about (cx, 0) of the conchoid's point at phi.
-double angle_about(const Conchoid& c, double cx, double phi) {
-  const double r = c.radius(phi);
-  return std::atan2(r * std::sin(phi), r * std::cos(phi) - cx);
-}
-
-// The conchoid angle phi in [0, phi_max] whose point is seen from (cx, 0) at angle psi (the angle is
-// monotone in phi there: the curve is star-shaped about every origin on its axis between 0 and b),
-// by GSL's Brent solver to 1e-13 rad.
-double phi_at_angle(const Conchoid& c, double cx, double psi, double phi_max) {
-  struct P {
-    const Conchoid* c;
-    double cx, psi;
-  } p{&c, cx, psi};
-  gsl_function f;
-  f.function = [](double phi, void* v) {
-    const auto* q = static_cast<P*>(v);
-    return angle_about(*q->c, q->cx, phi) - q->psi;
-  };
-  f.params = &p;
-  gsl_set_error_handler_off();
-  gsl_root_fsolver* solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-  require(gsl_root_fsolver_set(solver, &f, 0, phi_max) == GSL_SUCCESS, "06: the ray misses the hip curve");
-  double root = 0;
-  for (int it = 0; it < 200; ++it) {
-    gsl_root_fsolver_iterate(solver);
-    root = gsl_root_fsolver_root(solver);
-    if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver), gsl_root_fsolver_x_upper(solver), 1e-13, 0) ==
-        GSL_SUCCESS)
-      break;
-  }
-  gsl_root_fsolver_free(solver);
-  return root;
-}
-
 // Thesis Fig. 53 (sec. 5.1.1): equal-angle rays, 1 deg apart, from an origin (cx, 0) on the axis cut the hip
 // curve (phi in [0, 90] deg about the conchoid's origin) into segments of unequal length. The thesis: up to
 // 20 % longer in the middle with the origin at the object's centre, up to 30 % longer at the bottom with
@@ -120,11 +81,11 @@ void segments_table(const std::string& dir, const Conchoid& c) {
   const double centroid = (a * a * b + b * b * b / 4) / (a * a + b * b / 2);
   for (auto [name, cx] : std::initializer_list<std::pair<const char*, double>>{
            {"conchoid_origin", 0.0}, {"object_centroid", centroid}, {"object_extent_middle", b}}) {
-    const double psi_end = angle_about(c, cx, kPi / 2) * kRadToDeg;
+    const double psi_end = std::atan2(c.radius(kPi / 2), -cx) * kRadToDeg;  // the rim, seen from the origin
     double phi_prev = 0;
     for (int k = 1; k <= static_cast<int>(std::ceil(psi_end - 1e-9)); ++k) {
       const double psi = std::min(double(k), psi_end);
-      const double phi = psi >= psi_end ? kPi / 2 : phi_at_angle(c, cx, psi * kDegToRad, kPi / 2);
+      const double phi = psi >= psi_end ? kPi / 2 : c.angle_seen_from(cx, psi * kDegToRad, kPi / 2);
       sg.row(name, cx, k - 1.0, psi, phi_prev * kRadToDeg, phi * kRadToDeg, c.arc_length(phi) - c.arc_length(phi_prev));
       phi_prev = phi;
     }

@@ -29,6 +29,10 @@
 //   envelope.csv      subject: the ROM envelope (every pose of flexion -30..130 x adduction -50..40 x internal
 //                     rotation -60..60, 1 deg; quick: 2 deg) by adaptive refinement, timed, beside the brute
 //                     force that scans every pose, and the poses on which they differ
+//   cam.csv           thesis Fig. 60-61: the generated 12k hip without and with a 2 mm cam at the antero-superior
+//                     head-neck junction (scan neutral, the thesis' femoral-head method, bone contact): each
+//                     motion's limit and, where the femur limits it, how far its contact lies outside the
+//                     fitted head sphere (the thesis' colour scale of Fig. 39 and 60-61)
 //   clock_faces.csv   the acetabular clock face of each real subject in its pelvic frame
 //   thesis_table11.csv, published.csv   copies of the inputs the analysis compares with
 //   meta.json
@@ -50,6 +54,7 @@
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/timing.hpp"
+#include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/maps/layered_map.hpp"
 #include "impinge/session/records.hpp"
@@ -485,6 +490,44 @@ void sensitivity(const SubjectRun& r, const Settings& st, Outputs& out) {
     if (res != st.resolution) record("resolution_" + std::to_string(res).substr(0, 4), limits_of(centre, res));
 }
 
+// Thesis Fig. 60-61 (sec. 5.2): the patients' cam regions, the femoral head outside its fitted sphere, "will
+// most likely" be where they impinge. The patients are not available, so a generated hip without and with a
+// cam tests it: do the limits shrink with the cam, and where the femur limits a motion, does its contact lie
+// on the cam (outside the fitted sphere) rather than on the neck (inside it)?
+void cam_check(const Settings& st) {
+  CsvWriter cam(st.dir + "/cam.csv", {"cam_mm", "motion", "limit_deg", "limited_by_femur", "contact_outside_sphere_mm",
+                                      "head_radius_mm"});
+  for (double height : {0.0, 2.0}) {
+    HipModelOptions o;
+    o.target_triangles = 12000;
+    o.cam_height_mm = height;
+    const HipModel h = make_hip_model(o);
+    Subject s;
+    s.name = "generated-12k";
+    s.generated = true;
+    s.femur = h.ball;
+    s.pelvis = h.socket;
+    s.true_cor = h.cor;
+    MapSettings maps;
+    maps.precision = st.resolution;
+    const Session session(session_options(s, maps));
+    RomRequest q;
+    q.search = st.ro;
+    q.map = false;
+    const RomRun run = run_rom(session, q);
+    const HipJoint& hip = session.hip();
+    for (std::size_t k = 0; k < run.motions.size(); ++k) {
+      const RomLimit& l = run.limits[k];
+      const bool femur = !std::isnan(l.limit_deg) && !l.contact_at_start && l.limited_by_ball;
+      // The femur's contact point, posed, against the posed head sphere (the femoral-head method: the
+      // head centre stays at the COR).
+      const double outside = femur ? (l.contact_mm - hip.to_working(Eigen::Vector3d::Zero())).norm() - hip.head_radius_mm()
+                                   : std::nan("");
+      cam.row(height, run.motions[k].name, l.limit_deg, int(femur), outside, hip.head_radius_mm());
+    }
+  }
+}
+
 void write_meta_of(const Args& args, const Settings& st, const std::vector<Subject>& subjects, bool generated) {
   nlohmann::json subj = nlohmann::json::array();
   for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
@@ -543,6 +586,7 @@ int main(int argc, char** argv) {
     sensitivity(r, st, out);
     methods(r, out);
   }
+  cam_check(st);
   write_csv(st.dir + "/rom_limits.csv", out.lim);
   write_csv(st.dir + "/rom_map.csv", out.map);
   if (!out.meth.columns.empty()) {

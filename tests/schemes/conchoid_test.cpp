@@ -1,7 +1,9 @@
 // Conchoid (thesis sec. 5.1): GSL arc length against closed forms (b = 0: a circle, a * phi;
 // a -> b: the cardioid, 4 a sin(phi / 2)); Table 10 and the closed form 3.03 b to the printed
-// digits; equal-length angles cut the curve into equal lengths; the weighted grid keeps the
-// scheme invariants.
+// digits; equal-length angles cut the curve into equal lengths; a ray from an origin on the axis meets
+// the curve where the closed-form direction of that point says (and from the conchoid's own origin, at
+// its own angle), and equal-angle rays from there cut segments whose lengths follow
+// sqrt(a^2 + b^2 + 2ab cos phi) (thesis Fig. 53); the weighted grid keeps the scheme invariants.
 #include "impinge/schemes/conchoid.hpp"
 
 #include <gtest/gtest.h>
@@ -40,6 +42,25 @@ TEST(Conchoid, EqualLengthAnglesCutEqualLengths) {
   for (int i = 1; i < 31; ++i) EXPECT_NEAR(c.arc_length(a[i]) - c.arc_length(a[i - 1]), seg, 1e-9);
   // the rays near the pole (long curve, r large) are closer together than equal angles
   EXPECT_LT(a[1], kPi / 2 / 30);
+}
+
+TEST(Conchoid, RaysFromAnOriginOnTheAxisMeetTheCurveWhereItsDirectionSays) {
+  const Conchoid c(kMenschikA, kMenschikB);
+  for (double psi : {0.0, 0.2, 0.9, kPi / 2 - 1e-3}) EXPECT_NEAR(c.angle_seen_from(0, psi, kPi / 2), psi, 1e-12);
+  for (double cx : {5.0, 15.39, kMenschikB})
+    for (double psi : {0.05, 0.7, 1.5, 2.0}) {
+      const double rim = std::atan2(c.radius(kPi / 2), -cx);  // the last direction that meets phi <= 90 deg
+      if (psi > rim) continue;
+      const double phi = c.angle_seen_from(cx, psi, kPi / 2);
+      const double r = c.radius(phi);
+      EXPECT_NEAR(std::atan2(r * std::sin(phi), r * std::cos(phi) - cx), psi, 1e-11) << cx << " " << psi;
+    }
+  EXPECT_THROW(c.angle_seen_from(kMenschikB + 1, 0.5, kPi / 2), Error);  // outside [0, b]
+  EXPECT_THROW(c.angle_seen_from(5.0, 3.0, kPi / 2), Error);             // misses the hip curve
+  // Thesis Fig. 53 b: from the conchoid's origin, equal-angle segments run from (a + b) dphi at the pole to
+  // sqrt(a^2 + b^2) dphi at the rim: 40 % longer at the bottom, not the thesis' 30 %.
+  const double d = kPi / 1800, a = kMenschikA, b = kMenschikB;
+  EXPECT_NEAR(c.arc_length(d) / (c.arc_length(kPi / 2) - c.arc_length(kPi / 2 - d)), (a + b) / std::hypot(a, b), 1e-3);
 }
 
 TEST(ConchoidGrid, SchemeInvariants) {

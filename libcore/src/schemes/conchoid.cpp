@@ -43,24 +43,18 @@ double Conchoid::arc_length(double phi) const {
   return result;
 }
 
-double Conchoid::angle_at_length(double s, double phi_max) const {
-  if (s <= 0) return 0;
-  const double total = arc_length(phi_max);
-  if (s >= total) return phi_max;
-  struct Root {
-    const Conchoid* c;
-    double s;
-  } r{this, s};
-  gsl_function f;
-  f.function = [](double phi, void* p) {
-    const auto* q = static_cast<Root*>(p);
-    return q->c->arc_length(phi) - q->s;
-  };
-  f.params = &r;
+namespace {
+// The root of f in [lo, hi] (f(lo) and f(hi) of opposite signs) by GSL's Brent solver to 1e-13.
+template <class F>
+double brent_root(F f, double lo, double hi) {
+  gsl_set_error_handler_off();
+  gsl_function g;
+  g.function = [](double x, void* p) { return (*static_cast<F*>(p))(x); };
+  g.params = &f;
   gsl_root_fsolver* solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-  gsl_root_fsolver_set(solver, &f, 0, phi_max);
+  const int status = gsl_root_fsolver_set(solver, &g, lo, hi);
   double root = 0;
-  for (int it = 0; it < 200; ++it) {
+  for (int it = 0; status == GSL_SUCCESS && it < 200; ++it) {
     gsl_root_fsolver_iterate(solver);
     root = gsl_root_fsolver_root(solver);
     if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver), gsl_root_fsolver_x_upper(solver), 1e-13, 0) ==
@@ -68,7 +62,27 @@ double Conchoid::angle_at_length(double s, double phi_max) const {
       break;
   }
   gsl_root_fsolver_free(solver);
+  require(status == GSL_SUCCESS, "conchoid: no root in the interval (" + std::string(gsl_strerror(status)) + ")");
   return root;
+}
+}  // namespace
+
+double Conchoid::angle_at_length(double s, double phi_max) const {
+  if (s <= 0) return 0;
+  const double total = arc_length(phi_max);
+  if (s >= total) return phi_max;
+  return brent_root([&](double phi) { return arc_length(phi) - s; }, 0, phi_max);
+}
+
+double Conchoid::angle_seen_from(double origin_x_mm, double psi, double phi_max) const {
+  require(origin_x_mm >= 0 && origin_x_mm <= b_, "conchoid: the origin must lie on the axis within [0, b]");
+  const auto seen = [&](double phi) {
+    const double r = radius(phi);
+    return std::atan2(r * std::sin(phi), r * std::cos(phi) - origin_x_mm) - psi;
+  };
+  if (seen(0) == 0) return 0;
+  if (seen(phi_max) == 0) return phi_max;
+  return brent_root(seen, 0, phi_max);
 }
 
 std::vector<double> Conchoid::equal_length_angles(int n, double phi_max) const {

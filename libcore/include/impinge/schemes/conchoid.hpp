@@ -25,6 +25,12 @@ class Conchoid {
   double arc_length(double phi) const;
   /// phi in [0, phi_max] with arc_length(phi) = s (GSL Brent root finding to 1e-13 rad).
   double angle_at_length(double s, double phi_max) const;
+  /// The angle phi in [0, phi_max] (radians) of the point seen from (origin_x_mm, 0) at polar angle psi
+  /// (radians, from the +x axis; the curve's axis is x): where a ray from that origin meets the curve.
+  /// The origin lies on the axis with 0 <= origin_x_mm <= b, where the angle grows with phi (GSL Brent
+  /// root finding to 1e-13 rad). Throws impinge::Error when the ray misses [0, phi_max] or the origin is
+  /// outside [0, b]. Source: thesis Fig. 53 (equal-angle rays from the object's centre).
+  double angle_seen_from(double origin_x_mm, double psi, double phi_max) const;
   /// Ray angles (radians) cutting [0, phi_max] into n - 1 segments of equal curve length
   /// (the exact counterpart of thesis Eq. 15-16). n >= 2.
   std::vector<double> equal_length_angles(int n, double phi_max) const;
