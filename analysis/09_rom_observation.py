@@ -269,8 +269,8 @@ write_table(d, "table_envelope", ["subject", "poses", "scanned \\%", "valid \\%"
 KAWASAKI_POSES_PER_PC_SECOND = 360 * 360 * 180 / (20 * 64)
 e0 = env.iloc[0]
 
-# Thesis Fig. 60-61: the generated hip without and with a cam (cam.csv): each limit, and where the femur limits
-# it, how far its contact lies outside the fitted head sphere (on the cam: more than 0.5 mm).
+# Thesis Fig. 60-61: the generated hip without and with a cam (cam.csv): each limit, and the cam's height where
+# the bones meet (on the cam: more than 0.5 mm, a quarter of its 2 mm).
 cam_macros = {}
 if os.path.exists(os.path.join(d, "cam.csv")):
     cam = read_csv(d, "cam.csv")
@@ -279,13 +279,13 @@ if os.path.exists(os.path.join(d, "cam.csv")):
     for m in with_cam.index:
         a, b = without.limit_deg.get(m, np.nan), with_cam.limit_deg[m]
         shrunk += bool(b < a - 1 or (np.isfinite(b) and not np.isfinite(a)))
-        out = with_cam.contact_outside_sphere_mm[m]
-        rows.append([m.replace("_", " "), f(a), f(b), f(out, 2) if with_cam.limited_by_femur[m] else "pelvis"])
-    write_table(d, "table_cam", ["motion", "no cam (deg)", "2 mm cam (deg)", "femur contact outside the sphere (mm)"],
+        out = with_cam.cam_height_at_contact_mm[m]
+        rows.append([m.replace("_", " "), f(a), f(b), f(out, 2)])
+    write_table(d, "table_cam", ["motion", "no cam (deg)", "2 mm cam (deg)", "cam's height at the contact (mm)"],
                 rows, align="lrrr")
-    femur = with_cam[with_cam.limited_by_femur == 1]
+    femur = with_cam[np.isfinite(with_cam.cam_height_at_contact_mm)]
     cam_macros = {"ROMcamShrunk": str(shrunk), "ROMcamMotions": str(len(with_cam)), "ROMcamFemur": str(len(femur)),
-                  "ROMcamOnCam": str(int((femur.contact_outside_sphere_mm > 0.5).sum()))}
+                  "ROMcamOnCam": str(int((femur.cam_height_at_contact_mm > 0.5).sum()))}
 
 ok = lim[lim.validated != "no_limit"]
 t0 = tim.iloc[0]

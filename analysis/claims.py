@@ -341,15 +341,16 @@ if cam is not None and len(cam):
     lim = dict(zip(without.motion, without.limit_deg))
     shrunk = [m for m, x in zip(with_cam.motion, with_cam.limit_deg) if x < lim.get(m, np.inf) - 1 or
               (np.isfinite(x) and not np.isfinite(lim.get(m, np.nan)))]
-    femur = with_cam[with_cam.limited_by_femur == 1]
-    on_cam = femur[femur.contact_outside_sphere_mm > 0.5]
+    femur = with_cam[np.isfinite(with_cam.cam_height_at_contact_mm)]  # limits with a contact
+    on_cam = femur[femur.cam_height_at_contact_mm > 0.5]
     share = len(on_cam) / len(femur) if len(femur) else np.nan
     claim("Fig. 60; Fig. 61", "the cam region (the femoral head outside its fitted sphere) is where the hip impinges "
           "at the extremities", "red circles on the cam", f"a 2 mm cam shortens {len(shrunk)} of {len(with_cam)} limits; "
-          f"{len(on_cam)} of the {len(femur)} femur contacts lie on it (over 0.5 mm outside the sphere)",
+          f"the femur meets the pelvis on it (where it stands over 0.5 mm) at {len(on_cam)} of {len(femur)} limits",
           "holds" if share >= 0.75 and shrunk else "partly" if len(on_cam) else "does_not_hold",
           "a generated hip without and with a cam at the antero-superior head-neck junction (the patients' meshes are "
-          "not available)", S09)
+          "not available): a counterexample to the rule, where the neck meets the rim before the cam; it says nothing "
+          "of the thesis' patients' own cams", S09)
 else:
     missing("Fig. 60; Fig. 61", "the cam region is where the hip impinges", "red circles on the cam", "cam.csv", S09)
 claim("Fig. 62; Fig. 63", "the scene: femur rotated about the head centre, socket seen from the medial side",

@@ -31,8 +31,8 @@
 //                     force that scans every pose, and the poses on which they differ
 //   cam.csv           thesis Fig. 60-61: the generated 12k hip without and with a 2 mm cam at the antero-superior
 //                     head-neck junction (scan neutral, the thesis' femoral-head method, bone contact): each
-//                     motion's limit and, where the femur limits it, how far its contact lies outside the
-//                     fitted head sphere (the thesis' colour scale of Fig. 39 and 60-61)
+//                     motion's limit and how high the cam stands where the bones meet (the femur's vertex
+//                     nearest the contact: its distance from the head centre with the cam less without)
 //   clock_faces.csv   the acetabular clock face of each real subject in its pelvic frame
 //   thesis_table11.csv, published.csv   copies of the inputs the analysis compares with
 //   meta.json
@@ -493,13 +493,18 @@ void sensitivity(const SubjectRun& r, const Settings& st, Outputs& out) {
 // Thesis Fig. 60-61 (sec. 5.2): the patients' cam regions, the femoral head outside its fitted sphere, "will
 // most likely" be where they impinge. The patients are not available, so a generated hip without and with a
 // cam tests it: do the limits shrink with the cam, and where the femur limits a motion, does its contact lie
-// on the cam (outside the fitted sphere) rather than on the neck (inside it)?
+// on the cam? Where the bones meet, the femur's surface is its vertex nearest the contact point (either bone's
+// vertex); the cam's height there is that vertex's distance from the head centre with the cam less without
+// (the two models share their vertices' directions). A fitted sphere would not tell the cam from the neck,
+// whose surface also lies outside the head's sphere beyond the head-neck junction.
 void cam_check(const Settings& st) {
-  CsvWriter cam(st.dir + "/cam.csv", {"cam_mm", "motion", "limit_deg", "limited_by_femur", "contact_outside_sphere_mm",
-                                      "head_radius_mm"});
+  CsvWriter cam(st.dir + "/cam.csv", {"cam_mm", "motion", "limit_deg", "limited_by_femur", "cam_height_at_contact_mm",
+                                      "contact_radius_mm"});
+  HipModelOptions plain;
+  plain.target_triangles = 12000;
+  const HipModel without = make_hip_model(plain);
   for (double height : {0.0, 2.0}) {
-    HipModelOptions o;
-    o.target_triangles = 12000;
+    HipModelOptions o = plain;
     o.cam_height_mm = height;
     const HipModel h = make_hip_model(o);
     Subject s;
@@ -518,12 +523,21 @@ void cam_check(const Settings& st) {
     const HipJoint& hip = session.hip();
     for (std::size_t k = 0; k < run.motions.size(); ++k) {
       const RomLimit& l = run.limits[k];
-      const bool femur = !std::isnan(l.limit_deg) && !l.contact_at_start && l.limited_by_ball;
-      // The femur's contact point, posed, against the posed head sphere (the femoral-head method: the
-      // head centre stays at the COR).
-      const double outside = femur ? (l.contact_mm - hip.to_working(Eigen::Vector3d::Zero())).norm() - hip.head_radius_mm()
-                                   : std::nan("");
-      cam.row(height, run.motions[k].name, l.limit_deg, int(femur), outside, hip.head_radius_mm());
+      double cam_there = std::nan(""), radius = std::nan("");
+      if (!std::isnan(l.limit_deg) && !l.contact_at_start) {
+        const Eigen::Matrix3d R = hip.femur_rotation(run.motions[k].angles(l.limit_deg));
+        const Eigen::Vector3d c =
+            hip.joint_to_working().transpose() * (l.contact_mm - hip.to_working(Eigen::Vector3d::Zero()));
+        radius = c.norm();
+        double best = std::numeric_limits<double>::infinity();
+        for (Eigen::Index i = 0; i < h.ball.V.rows(); ++i) {
+          const Eigen::Vector3d v = h.ball.V.row(i).transpose() - h.cor;  // unposed, about the head centre (the COR)
+          const double d = (R * v - c).squaredNorm();
+          if (d < best)
+            best = d, cam_there = v.norm() - (without.ball.V.row(i).transpose() - without.cor).norm();
+        }
+      }
+      cam.row(height, run.motions[k].name, l.limit_deg, int(l.limited_by_ball), cam_there, radius);
     }
   }
 }
