@@ -109,6 +109,9 @@ for xcol, stem, xlabel in [("query_ns_per_vertex", "pareto_time", "query time (n
 # Where the errors are: per-vertex errors of equiangular 0.1 exact over (theta, phi).
 fig, ax = plt.subplots(figsize=(7, 3.4))
 vv = v[v.subject == subj]
+if not len(vv):  # a quick run measures per-vertex errors at other settings
+    ax.text(0.5, 0.5, f"no per-vertex errors of {subj} at this setting in this run", transform=ax.transAxes,
+            ha="center", va="center", fontsize=9)
 sc = ax.scatter(vv.theta_deg, vv.phi_deg, c=np.log10(vv.error_mm.clip(lower=1e-7)), s=3, cmap="viridis")
 big = vv[vv.stencil_spread_mm > 2]
 ax.scatter(big.theta_deg, big.phi_deg, s=12, facecolors="none", edgecolors="r", lw=0.5,
