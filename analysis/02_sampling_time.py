@@ -159,7 +159,7 @@ macros["SampOtherPelvisOverFillMin"], macros["SampOtherPelvisOverFillMax"] = spa
 macros["SampFemurMsMin"], macros["SampFemurMsMax"] = span([c for c, _ in femurs], lambda v: f"{v:.0f}")
 macros["SampFemurOverFillMin"], macros["SampFemurOverFillMax"] = span([r for _, r in femurs], lambda v: f"{v:.1f}")
 fills = fin_rows[fin_rows.method == "fill"].time_ms
-macros["SampFillMinMs"], macros["SampFillMaxMs"] = span(list(fills), lambda v: f"{v:.1f}")
+macros["SampFillMinMs"], macros["SampFillMaxMs"] = span(list(fills), lambda v: f"{v:.3g}")
 prow = g[g.method == "rsid_exact_culled"]
 if len(prow):
     macros["SampNodesM"] = f"{prow.nodes.iloc[0] / 1e6:.1f}"

@@ -413,7 +413,7 @@ lines = [r"\begin{longtable}{@{}" + ragged + "@{}}",
          r"\bottomrule \endfoot"]
 for r in rows:
     lines.append(" & ".join([tex(r["thesis_item"]), tex(r["claim"]), tex(r["thesis_value"]), tex(r["our_value"]),
-                             label[r["verdict"]], tex(r["reason"]) + r" (\S\ref{sec:" + r["section"] + "})"]) + r" \\")
+                             label[r["verdict"]], tex(r["reason"]) + r" (\S\ref{sec:" + r["section"].replace("_", "-") + "})"]) + r" \\")
 lines.append(r"\end{longtable}")
 with open(os.path.join(tex_dir, "table_claims.tex"), "w") as f:
     f.write("\n".join(lines) + "\n")
