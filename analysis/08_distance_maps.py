@@ -14,7 +14,7 @@ import pandas as pd
 import matplotlib.pyplot as plt
 
 from common import experiment_dir, precision_axis, read_csv, save, write_macros, write_table
-from render import draw, level_key, level_rgb, read_gap_ply
+from render import REPORT_LEVELS_MM, draw, level_key, level_rgb, read_gap_ply
 
 d = experiment_dir("08_distance_maps")
 allst = read_csv(d, "gap_statistics.csv")
@@ -172,7 +172,7 @@ THESIS_FIG42_HOURS = [(0, 4), (8, 9)]  # 12-4 and 8-9 o'clock
 red_rows = []
 for row in clk[clk.neutral == "anatomical"].itertuples():
     V, _, _, gap = read_gap_ply(os.path.join(d, f"render_{row.subject}_socket.ply"))
-    v = V[gap <= 2.0] - np.array([row.centre_x_mm, row.centre_y_mm, row.centre_z_mm])
+    v = V[gap <= REPORT_LEVELS_MM[2]] - np.array([row.centre_x_mm, row.centre_y_mm, row.centre_z_mm])
     hours = (np.degrees(np.arctan2(v @ np.array([row.three_x, row.three_y, row.three_z]),
                                    v @ np.array([row.twelve_x, row.twelve_y, row.twelve_z]))) / 30) % 12
     counts = np.histogram(hours, bins=12, range=(0, 12))[0]

@@ -22,7 +22,7 @@ import sys
 import numpy as np
 import pandas as pd
 
-from common import THESIS_ROM_ZONES, in_clock_zones, write_macros
+from common import THESIS_ROM_ZONES, in_clock_zones, latex_escape, write_macros
 
 ROOT = sys.argv[1] if len(sys.argv) > 1 else "results"
 VERDICTS = ("holds", "partly", "does_not_hold", "not_testable")
@@ -394,14 +394,6 @@ tex_dir = os.path.join(ROOT, "claims")
 os.makedirs(tex_dir, exist_ok=True)
 
 
-def tex(s):
-    s = str(s)
-    for a, b in (("\\", r"\textbackslash{}"), ("_", r"\_"), ("%", r"\%"), ("&", r"\&"), ("#", r"\#"),
-                 ("^", r"\textasciicircum{}"), ("~", r"\textasciitilde{}"), ("<", r"$<$"), (">", r"$>$")):
-        s = s.replace(a, b)
-    return s.replace("--", "--{}").replace("--{}{}", "--{}")
-
-
 label = {"holds": "holds", "partly": "partly", "does_not_hold": r"\textbf{does not hold}",
          "not_testable": "not testable"}
 ragged = "".join(r">{\raggedright\arraybackslash}p{%s\textwidth}" % w for w in ("0.1", "0.25", "0.12", "0.21", "0.08", "0.19"))
@@ -412,8 +404,9 @@ lines = [r"\begin{longtable}{@{}" + ragged + "@{}}",
          r"\toprule thesis & claim & thesis' value & ours & verdict & why \\ \midrule \endhead",
          r"\bottomrule \endfoot"]
 for r in rows:
-    lines.append(" & ".join([tex(r["thesis_item"]), tex(r["claim"]), tex(r["thesis_value"]), tex(r["our_value"]),
-                             label[r["verdict"]], tex(r["reason"]) + r" (\S\ref{sec:" + r["section"].replace("_", "-") + "})"]) + r" \\")
+    cells = [latex_escape(r[k]) for k in ("thesis_item", "claim", "thesis_value", "our_value")]
+    why = latex_escape(r["reason"]) + r" (\S\ref{sec:" + r["section"].replace("_", "-") + "})"
+    lines.append(" & ".join(cells + [label[r["verdict"]], why]) + r" \\")
 lines.append(r"\end{longtable}")
 with open(os.path.join(tex_dir, "table_claims.tex"), "w") as f:
     f.write("\n".join(lines) + "\n")
@@ -439,9 +432,9 @@ def first(key):
 write_macros(tex_dir, "macros", {
     "ClaimsTotal": str(len(rows)), "ClaimsHolds": str(counts["holds"]), "ClaimsPartly": str(counts["partly"]),
     "ClaimsNot": str(counts["does_not_hold"]), "ClaimsUntestable": str(counts["not_testable"]),
-    "RunCommit": tex(", ".join(c[:7] + ("-dirty" if c.endswith("-dirty") else "") for c in commits) or "unknown"),
-    "RunCommits": str(len(commits)), "RunCpu": tex(first("cpu_model")), "RunCompiler": tex(first("compiler")),
-    "RunCores": tex(first("cores")), "RunDates": tex(dates[0][:10] if dates and dates[0][:10] == dates[-1][:10]
+    "RunCommit": latex_escape(", ".join(c[:7] + ("-dirty" if c.endswith("-dirty") else "") for c in commits) or "unknown"),
+    "RunCommits": str(len(commits)), "RunCpu": latex_escape(first("cpu_model")), "RunCompiler": latex_escape(first("compiler")),
+    "RunCores": latex_escape(first("cores")), "RunDates": latex_escape(dates[0][:10] if dates and dates[0][:10] == dates[-1][:10]
                                                      else f"{dates[0][:10]} to {dates[-1][:10]}" if dates else "unknown"),
 })
 print(f"claims: {len(rows)} rows ({', '.join(f'{v} {c}' for v, c in counts.items())}) -> {out}")

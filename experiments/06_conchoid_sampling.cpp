@@ -82,12 +82,13 @@ void segments_table(const std::string& dir, const Conchoid& c) {
   for (auto [name, cx] : std::initializer_list<std::pair<const char*, double>>{
            {"conchoid_origin", 0.0}, {"object_centroid", centroid}, {"object_extent_middle", b}}) {
     const double psi_end = std::atan2(c.radius(kPi / 2), -cx) * kRadToDeg;  // the rim, seen from the origin
-    double phi_prev = 0;
+    double phi_prev = 0, s_prev = 0;  // the previous ray's angle and curve length
     for (int k = 1; k <= static_cast<int>(std::ceil(psi_end - 1e-9)); ++k) {
       const double psi = std::min(double(k), psi_end);
       const double phi = psi >= psi_end ? kPi / 2 : c.angle_seen_from(cx, psi * kDegToRad, kPi / 2);
-      sg.row(name, cx, k - 1.0, psi, phi_prev * kRadToDeg, phi * kRadToDeg, c.arc_length(phi) - c.arc_length(phi_prev));
-      phi_prev = phi;
+      const double s = c.arc_length(phi);
+      sg.row(name, cx, k - 1.0, psi, phi_prev * kRadToDeg, phi * kRadToDeg, s - s_prev);
+      phi_prev = phi, s_prev = s;
     }
   }
 }

@@ -108,10 +108,8 @@ struct Compare {
   std::map<DistanceMode, std::vector<float>> rsid_ball;  // equiangular ball gaps per mode
 };
 
-// The report's one set of impingement levels (mm): beyond 6 mm apart (the thesis' blue, sec. 5.2), 4-6, 2-4,
-// 0-2 (the thesis' red: within 2 mm), at or below 0. The thesis' Fig. 41-42 split its 4 mm cartilage offset
-// instead; one set for every figure of the report keeps the colours meaning one thing.
-const std::vector<double> kReportLevelsMm{6.0, 4.0, 2.0, 0.0};
+// Levels: the report's one set (kReportLevelsMm), not the thesis' Fig. 41-42 split of its 4 mm cartilage
+// offset, so that the colours mean one thing in every figure of the report.
 
 // Both scans at the scan pose with one scheme and mode: the statistics, the timings (fill and scan of
 // each body, medians), the differences linear - exact and scheme - equiangular, the map images

@@ -500,22 +500,17 @@ void sensitivity(const SubjectRun& r, const Settings& st, Outputs& out) {
 void cam_check(const Settings& st) {
   CsvWriter cam(st.dir + "/cam.csv", {"cam_mm", "motion", "limit_deg", "limited_by_femur", "cam_height_at_contact_mm",
                                       "contact_radius_mm"});
-  HipModelOptions plain;
-  plain.target_triangles = 12000;
-  const HipModel without = make_hip_model(plain);
-  for (double height : {0.0, 2.0}) {
-    HipModelOptions o = plain;
-    o.cam_height_mm = height;
-    const HipModel h = make_hip_model(o);
-    Subject s;
-    s.name = "generated-12k";
-    s.generated = true;
-    s.femur = h.ball;
-    s.pelvis = h.socket;
-    s.true_cor = h.cor;
+  HipModelOptions o;
+  o.target_triangles = 12000;
+  const HipModel without = make_hip_model(o);
+  o.cam_height_mm = 2.0;
+  const HipModel with_cam = make_hip_model(o);
+  for (const HipModel* model : {&without, &with_cam}) {
+    const HipModel& h = *model;
+    const double height = model == &without ? 0.0 : o.cam_height_mm;
     MapSettings maps;
     maps.precision = st.resolution;
-    const Session session(session_options(s, maps));
+    const Session session(session_options(generated_subject(h, "generated-12k", "make_hip_model (cam check)"), maps));
     RomRequest q;
     q.search = st.ro;
     q.map = false;
@@ -583,7 +578,7 @@ int main(int argc, char** argv) {
   if (generated) subjects = load_subjects(args, {12000});
   st.resolution = args.quick ? 0.25 : 0.1;
   st.sens_resolutions = args.quick ? std::vector<double>{0.5, 0.25} : std::vector<double>{0.5, 0.25, 0.1};
-  st.observation_levels.thresholds_mm = {6, 4, 2, 0};
+  st.observation_levels.thresholds_mm = kReportLevelsMm;
   st.ro.contact_depth_mm = 0;  // the thesis' criterion: the first touch (methods() uses the CLI's defaults)
   st.threads = omp_get_max_threads();
 

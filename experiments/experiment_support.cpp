@@ -63,17 +63,22 @@ std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& gen
     HipModelOptions o;
     o.target_triangles = t;
     o.cam_height_mm = 2.0;
-    const HipModel h = make_hip_model(o);
-    Subject s;
-    s.name = "generated-" + (t % 1000 == 0 ? std::to_string(t / 1000) + "k" : std::to_string(t));
-    s.source = "make_hip_model(target_triangles=" + std::to_string(t) + ", cam_height_mm=2)";
-    s.generated = true;
-    s.femur = h.ball;
-    s.pelvis = h.socket;
-    s.true_cor = h.cor;
-    out.push_back(std::move(s));
+    out.push_back(generated_subject(make_hip_model(o),
+                                    "generated-" + (t % 1000 == 0 ? std::to_string(t / 1000) + "k" : std::to_string(t)),
+                                    "make_hip_model(target_triangles=" + std::to_string(t) + ", cam_height_mm=2)"));
   }
   return out;
+}
+
+Subject generated_subject(const HipModel& h, const std::string& name, const std::string& source) {
+  Subject s;
+  s.name = name;
+  s.source = source;
+  s.generated = true;
+  s.femur = h.ball;
+  s.pelvis = h.socket;
+  s.true_cor = h.cor;
+  return s;
 }
 
 SphereFitResult subject_head(const Subject& s) {

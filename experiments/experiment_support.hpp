@@ -41,6 +41,14 @@ struct Subject {
   Eigen::Vector3d true_cor = Eigen::Vector3d::Constant(std::nan(""));  ///< known for generated
 };
 
+/// The report's one set of impingement levels (mm, on the gap): beyond 6 mm apart (the thesis' blue, sec. 5.2),
+/// 4-6, 2-4, 0-2 (the thesis' red: within 2 mm), at or below 0. Every experiment whose figures colour levels
+/// uses it (analysis/render.py's REPORT_LEVELS_MM is the same set).
+inline const std::vector<double> kReportLevelsMm{6.0, 4.0, 2.0, 0.0};
+
+/// A generated hip (make_hip_model) as a subject named `name`: its meshes, the true COR, scan neutral.
+Subject generated_subject(const HipModel& h, const std::string& name, const std::string& source);
+
 /// Every real subject under args.data (sorted by name; none when the folder is absent), then
 /// the generated hip model(s) with the given triangle counts.
 std::vector<Subject> load_subjects(const Args& args, const std::vector<int>& generated_triangles);
