@@ -1,6 +1,7 @@
 """tools/check-report and analysis/claims.py: the checker reads thesis items as the manifest writes them,
-finds a run from mixed or dirty commits, a thesis item without a claim, a bad verdict and a page that runs
-over; and the committed run's claims.csv has a row for every thesis item of experiments/manifest.tsv."""
+finds a run from mixed or dirty commits or without one of the manifest's experiments, a thesis item without a
+claim, a bad verdict and a page that runs over; and the committed run (results/) comes from one clean commit,
+holds every experiment, and its claims.csv has a row for every thesis item of experiments/manifest.tsv."""
 import csv
 import importlib.machinery
 import importlib.util
@@ -26,11 +27,12 @@ def test_thesis_items_are_read_one_by_one():
     assert check.thesis_items("(new) the Euclidean distance beside Open3D and VTK (issue 26)") == set()
 
 
-def write_run(d, commits, claims_rows, log=""):
-    for k, c in enumerate(commits):
-        os.makedirs(os.path.join(d, f"0{k}_x"), exist_ok=True)
-        with open(os.path.join(d, f"0{k}_x", "meta.json"), "w") as f:
-            json.dump({"git_commit": c}, f)
+def write_run(d, commits, claims_rows, log="", leave_out=()):
+    """A run of every manifest experiment (but leave_out), the k-th from commits[k % len(commits)]."""
+    for k, name in enumerate(n for n in check.manifest_items() if n not in leave_out):
+        os.makedirs(os.path.join(d, name), exist_ok=True)
+        with open(os.path.join(d, name, "meta.json"), "w") as f:
+            json.dump({"git_commit": commits[k % len(commits)]}, f)
     with open(os.path.join(d, "claims.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=["thesis_item", "claim", "thesis_value", "our_value", "verdict", "reason",
                                           "section"])
@@ -69,6 +71,13 @@ def test_mixed_and_dirty_commits_are_found():
         assert run(d, "--allow-dirty").returncode == 0
 
 
+def test_an_experiment_missing_from_the_run_is_found():
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc"], every_item_row(), leave_out=("13_distance_peers",))
+        r = run(d)
+        assert r.returncode == 1 and "13_distance_peers (experiments/manifest.tsv) has no meta.json" in r.stdout, r.stdout
+
+
 def test_a_thesis_item_without_a_claim_and_a_bad_verdict_are_found():
     with tempfile.TemporaryDirectory() as d:
         rows = every_item_row()
@@ -92,5 +101,7 @@ def test_a_page_that_runs_over_is_found():
         assert run(d).returncode == 0
 
 
-def test_the_committed_claims_cover_the_manifest():
-    assert check.check_claims(os.path.join(ROOT, "results")) == []
+def test_the_committed_run_is_one_clean_commit_of_every_experiment_and_its_claims_cover_the_manifest():
+    results = os.path.join(ROOT, "results")
+    assert check.check_provenance(results, allow_dirty=False) == []
+    assert check.check_claims(results) == []
