@@ -27,11 +27,12 @@ def experiment_args(name, usage):
 
 
 def write_meta(d, experiment, fields):
-    """d/meta.json: experiment, git_commit (with -dirty when tracked files differ from it), date (UTC), cores,
-    machine, then `fields`."""
+    """d/meta.json: experiment, git_commit (with -dirty when tracked files outside results/ differ from it), date
+    (UTC), cores, machine, then `fields`."""
     commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
-    dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"], capture_output=True,
-                           text=True).stdout.strip() != ""
+    # The results folder left out, as the C++ drivers' source_commit(): a reproduction rewrites it as it goes.
+    dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no", "--", ".",
+                            ":(exclude)results"], capture_output=True, text=True).stdout.strip() != ""
     meta = {"experiment": experiment, "git_commit": commit + ("-dirty" if dirty else ""),
             "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             "cores": str(os.cpu_count()), "machine": platform.processor() or platform.machine()}
