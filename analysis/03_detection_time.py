@@ -118,8 +118,10 @@ ax.add_artist(first)
 ax.legend(*zip(*thesis), fontsize=6, title="thesis", title_fontsize=6, loc="lower left", bbox_to_anchor=(1.01, 0))
 save(fig, d, "detection_time")
 
-# Numbers for the text: first real subject, pushed pose.
+# Numbers for the text: the first real subject, pushed pose; without real subjects, the largest generated model.
 real = t[~t.generated.astype(bool)]
+if not len(real):
+    real = t[t.subject == t.loc[t.femur_triangles.idxmax(), "subject"]]
 macros = {}
 if len(real):
     s = real.subject.iloc[0]

@@ -90,7 +90,9 @@ write_table(d, "table_sensitivity", ["subject", "method", "perturbation", "media
 
 # Puls et al.'s four joint-centre methods side by side: the limits, and the worst change of each
 # limit under a 1 mm move of the initial COR (6 directions).
-method_macros = {}
+# Without the shared hips (no methods.csv, no mc22 pair) the prose's numbers read "--".
+method_macros = {k: "--" for k in ["ROMeqSensMax", "ROMeqSensWorstSubject", "ROMeqSensWithinThree", "ROMmethodSubjects",
+                                   "ROMfhSensMax", "ROMfhSensVanish", "ROMeqSensMedian"]}
 if meth is not None:
     order = ["femoral-head", "acetabular", "combined", "equidistant"]
     msubjects = list(dict.fromkeys(meth.subject))
@@ -110,7 +112,7 @@ if meth is not None:
     eq = cor[cor.method == "equidistant"]
     fh = cor[cor.method == "femoral-head"]
     per_subject = {s: changes(eq[eq.subject == s]).max() for s in msubjects}
-    method_macros = {
+    method_macros.update({
         "ROMeqSensMax": f(max(per_subject.values())),
         "ROMeqSensWorstSubject": max(per_subject, key=per_subject.get),
         "ROMeqSensWithinThree": str(sum(1 for v in per_subject.values() if v <= 3)),
@@ -118,7 +120,7 @@ if meth is not None:
         "ROMfhSensMax": f(changes(fh)[np.isfinite(changes(fh))].max()),
         "ROMfhSensVanish": str(int(np.isinf(changes(fh)).sum())),
         "ROMeqSensMedian": f(changes(eq).median(), 2),
-    }
+    })
 
 # The thesis' ROM observation (sec. 5.2, Tables 12-13), with a verdict: red zones at 1-2 o'clock for
 # patient A, at 1-3 and 7 o'clock for patient B. Ours: the clock hour of the socket's closest point at
@@ -141,7 +143,9 @@ for patient, zones in THESIS_ROM_ZONES.items():
 
 # Left against right (issue 29): mc22's two hips (the same pelvis) under the default method, for the
 # motions the issue names, and the bony measures that can explain a difference.
-lr_macros = {}
+lr_macros = {"ROMlr" + k: "--" for k in ["WithinTen", "Compared", "RightCoverage", "LeftCoverage", "RightInclination",
+                                         "LeftInclination", "RightScanGap", "LeftScanGap", "RightNeutralGap",
+                                         "LeftNeutralGap"]}
 if meth is not None and {"mc22", "mc22-left"} <= set(meth.subject):
     eqm = meth[meth.method == "equidistant"].set_index(["subject", "motion"])
     rows, diffs = [], []
@@ -157,10 +161,10 @@ if meth is not None and {"mc22", "mc22-left"} <= set(meth.subject):
                      eqm.contact_class.get(("mc22-left", motion), "").replace("_", " ") if np.isfinite(left) else ""])
     write_table(d, "table_left_right", ["motion", "right", "left", "$|\\Delta|$", "right: contact", "left: contact"],
                 rows, align="lrrrll")
-    lr_macros = {
+    lr_macros.update({
         "ROMlrWithinTen": str(sum(1 for x in diffs if x <= 10)),
         "ROMlrCompared": str(len(diffs)),
-    }
+    })
     if bony is not None and {"mc22", "mc22-left"} <= set(bony.subject):
         b = bony.set_index("subject")
         cols = [("head_radius_mm", "head radius mm", 1), ("acetabular_radius_mm", "acetabular radius mm", 1),
