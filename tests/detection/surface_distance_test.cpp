@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -129,6 +130,84 @@ TEST(SurfaceDistance, ScanSetCoversTheRegionInSmallClusters) {
   for (Eigen::Index i = 0; i < P.rows(); ++i) EXPECT_EQ(seen[static_cast<std::size_t>(i)], P.row(i).norm() <= 60) << i;
   EXPECT_THROW(make_distance_scan_set(P, 60, 0), Error);
   EXPECT_THROW(make_distance_scan_set(P, 0, 8), Error);
+}
+
+// order_in_boxes: a permutation (each index with its own coordinates) whose aligned runs are compact:
+// - on a line, every aligned run of each size lies wholly before the next (median splits in 1-D sort the
+//   runs);
+// - three tight clusters 100 mm apart along x, of 32 x 13, 32 x 29 and 32 x 7 vertices (not powers of two),
+//   given shuffled: every aligned run of 32 holds one cluster's vertices only, so its ball is the cluster's
+//   size, not the distance between clusters (a range holding two clusters is split along x, its longest
+//   axis, at a multiple of 32, and so is every cluster's share of it).
+TEST(SurfaceDistance, OrderInBoxesKeepsEveryAlignedRunCompact) {
+  auto set_of = [](const std::vector<Eigen::Vector3d>& p) {
+    ScanSet s;
+    s.vertices = static_cast<std::int64_t>(p.size()) + 5;
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      s.index.push_back(static_cast<std::int32_t>(k + 5));  // indices need not be 0..k-1
+      s.x.push_back(p[k].x()), s.y.push_back(p[k].y()), s.z.push_back(p[k].z());
+    }
+    return s;
+  };
+  auto is_permutation_of = [](const ScanSet& out, const ScanSet& in) {
+    if (out.size() != in.size() || out.vertices != in.vertices) return false;
+    std::vector<int> seen(static_cast<std::size_t>(in.vertices), 0);
+    for (std::int64_t k = 0; k < out.size(); ++k) {
+      const auto j = static_cast<std::size_t>(out.index[static_cast<std::size_t>(k)] - 5);  // the input's position
+      const auto o = static_cast<std::size_t>(k);
+      if (in.x[j] != out.x[o] || in.y[j] != out.y[o] || in.z[j] != out.z[o]) return false;
+      ++seen[j];
+    }
+    return std::count(seen.begin(), seen.end(), 1) == in.size();
+  };
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> U(0, 1);
+  // On a line (1,000 vertices, 0..1000 mm, shuffled).
+  std::vector<Eigen::Vector3d> line;
+  for (int k = 0; k < 1000; ++k) line.emplace_back(1000 * U(rng), 0, 0);
+  const ScanSet in_line = set_of(line);
+  const ScanSet out_line = order_in_boxes(in_line, {32, 128});
+  EXPECT_TRUE(is_permutation_of(out_line, in_line));
+  for (const std::int64_t run : {32, 128}) {
+    for (std::int64_t a = 0; a + run < out_line.size(); a += run) {
+      double max_before = -1, min_after = 2000;
+      for (std::int64_t k = a; k < a + run; ++k) max_before = std::max(max_before, out_line.x[static_cast<std::size_t>(k)]);
+      for (std::int64_t k = a + run; k < std::min(a + 2 * run, out_line.size()); ++k)
+        min_after = std::min(min_after, out_line.x[static_cast<std::size_t>(k)]);
+      EXPECT_LE(max_before, min_after) << "runs of " << run << " at " << a;
+    }
+  }
+  // Three clusters (1 mm cubes, 100 mm apart), shuffled.
+  const std::vector<Eigen::Vector3d> corner{{0, 0, 0}, {200, 0, 0}, {100, 0, 0}};
+  const std::vector<int> sizes{32 * 13, 32 * 29, 32 * 7};
+  std::vector<Eigen::Vector3d> p;
+  for (std::size_t c = 0; c < corner.size(); ++c)
+    for (int k = 0; k < sizes[c]; ++k) p.push_back(corner[c] + Eigen::Vector3d(U(rng), U(rng), U(rng)));
+  std::shuffle(p.begin(), p.end(), rng);
+  const ScanSet in = set_of(p);
+  const ScanSet out = order_in_boxes(in, {32, 128, 1024});
+  ASSERT_TRUE(is_permutation_of(out, in));
+  auto cluster_of = [&](std::int64_t k) {
+    const Eigen::Vector3d q(out.x[static_cast<std::size_t>(k)], out.y[static_cast<std::size_t>(k)], out.z[static_cast<std::size_t>(k)]);
+    for (std::size_t c = 0; c < corner.size(); ++c)
+      if ((q - corner[c]).cwiseAbs().maxCoeff() <= 1) return static_cast<int>(c);
+    return -1;
+  };
+  int mixed = 0;
+  for (std::int64_t a = 0; a < out.size(); a += 32)
+    for (std::int64_t k = a + 1; k < a + 32; ++k) mixed += cluster_of(k) != cluster_of(a);
+  EXPECT_EQ(mixed, 0);
+  // The input order (shuffled) mixes them: the check can fail.
+  int mixed_in = 0;
+  for (std::int64_t a = 0; a < in.size(); a += 32)
+    mixed_in += (Eigen::Vector3d(in.x[static_cast<std::size_t>(a)], in.y[static_cast<std::size_t>(a)], 0) -
+                 Eigen::Vector3d(in.x[static_cast<std::size_t>(a + 1)], in.y[static_cast<std::size_t>(a + 1)], 0))
+                    .norm() > 50;
+  EXPECT_GT(mixed_in, 0);
+  EXPECT_EQ(order_in_boxes(ScanSet{}, {32}).size(), 0);
+  EXPECT_THROW(order_in_boxes(in, {}), Error);
+  EXPECT_THROW(order_in_boxes(in, {0}), Error);
+  EXPECT_THROW(order_in_boxes(in, {32, 48}), Error);
 }
 
 TEST(SurfaceDistance, GeneratedHipPushedIntoItsCupMatchesCgal) {

@@ -310,9 +310,12 @@ class CompactScanner {
     // near this one is skipped at every later pose that near, while only contact is asked (the reach
     // is then at most max(0, cut)).
     const bool reusable = !exact_;
+    const std::vector<Cluster>* blocks = ball ? &bounds_->ball_hidden.blocks : &bounds_->socket_hidden.blocks;
+    std::vector<Reuse>& reuse_b = ball ? reuse_hidden_ball_blocks_ : reuse_hidden_socket_blocks_;
     std::vector<Reuse>& reuse_g = ball ? reuse_hidden_ball_groups_ : reuse_hidden_socket_groups_;
     std::vector<Reuse>& reuse_l = ball ? reuse_hidden_ball_leaves_ : reuse_hidden_socket_leaves_;
-    if (reusable && reuse_g.size() != groups->size()) reuse_g.assign(groups->size(), Reuse{}), reuse_l.assign(cl->size(), Reuse{});
+    if (reusable && reuse_g.size() != groups->size())
+      reuse_b.assign(blocks->size(), Reuse{}), reuse_g.assign(groups->size(), Reuse{}), reuse_l.assign(cl->size(), Reuse{});
     auto skip_reusing = [&](const Cluster& c, Reuse& u) {
       if (u.valid && (u.s - P.s).squaredNorm() <= kReuseShiftMm * kReuseShiftMm &&
           (u.M.array() * P.M.array()).sum() >= kReuseMinTrace)
@@ -328,7 +331,14 @@ class CompactScanner {
       u.failed = !out;
       return out;
     };
-    for (std::size_t gi = 0; gi < groups->size(); ++gi) {
+    for (std::size_t bi = 0; bi < blocks->size(); ++bi) {
+     const Cluster& b = (*blocks)[bi];
+     if (done(l)) return;
+     if (reusable ? skip_reusing(b, reuse_b[bi]) : skipped(b)) {
+       vertices_skipped += b.count;
+       continue;
+     }
+     for (auto gi = static_cast<std::size_t>(b.first / kGroup); gi < static_cast<std::size_t>((b.first + b.count + kGroup - 1) / kGroup); ++gi) {
       const Cluster& g = (*groups)[gi];
       if (done(l)) return;
       if (reusable ? skip_reusing(g, reuse_g[gi]) : skipped(g)) {
@@ -347,6 +357,7 @@ class CompactScanner {
         take(set, skip, c.first, c.first + c.count, ball, l, true);
         vertices_looked_up += c.count;
       }
+     }
     }
   }
   // The Euclidean bound of a hidden cluster where the radial shells cannot part it from the other bone
@@ -397,6 +408,7 @@ class CompactScanner {
   };
   static inline const double kReuseMinTrace = 1 + 2 * std::cos(kReuseRad);  // trace of a rotation by kReuseRad
   std::vector<Reuse> reuse_ball_groups_, reuse_socket_groups_, reuse_ball_leaves_, reuse_socket_leaves_;
+  std::vector<Reuse> reuse_hidden_ball_blocks_, reuse_hidden_socket_blocks_;
   std::vector<Reuse> reuse_hidden_ball_groups_, reuse_hidden_socket_groups_, reuse_hidden_ball_leaves_,
       reuse_hidden_socket_leaves_;
   const Clustered* reuse_ball_owner_ = nullptr;  // the clusters reuse_ball_* belong to

@@ -138,6 +138,52 @@ ScanSet order_by_position(const ScanSet& set) {
   return out;
 }
 
+ScanSet order_in_boxes(const ScanSet& set, const std::vector<std::int64_t>& run_sizes) {
+  require(!run_sizes.empty() && run_sizes.front() >= 1, "order in boxes: needs run sizes >= 1");
+  for (std::size_t j = 1; j < run_sizes.size(); ++j)
+    require(run_sizes[j] >= run_sizes[j - 1] && run_sizes[j] % run_sizes[j - 1] == 0,
+            "order in boxes: each run size must be a multiple of the one before");
+  const auto n = static_cast<std::size_t>(set.size());
+  std::vector<std::int32_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::int32_t>(k);
+  auto coordinate = [&](std::int32_t k, int axis) {
+    const auto j = static_cast<std::size_t>(k);
+    return axis == 0 ? set.x[j] : axis == 1 ? set.y[j] : set.z[j];
+  };
+  const auto leaf = static_cast<std::size_t>(run_sizes.front());
+  std::vector<std::pair<std::size_t, std::size_t>> todo{{0, n}};  // [begin, end) still to split
+  while (!todo.empty()) {
+    const auto [begin, end] = todo.back();
+    todo.pop_back();
+    const std::size_t count = end - begin;
+    if (count <= leaf) continue;
+    std::size_t unit = leaf;  // the largest run size below the range's length
+    for (const std::int64_t r : run_sizes)
+      if (static_cast<std::size_t>(r) < count) unit = static_cast<std::size_t>(r);
+    const std::size_t half = std::clamp((count / 2 + unit / 2) / unit * unit, unit, (count - 1) / unit * unit);
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t k = begin; k < end; ++k)
+      for (int a = 0; a < 3; ++a)
+        lo[a] = std::min(lo[a], coordinate(order[k], a)), hi[a] = std::max(hi[a], coordinate(order[k], a));
+    int axis = 0;
+    (hi - lo).maxCoeff(&axis);
+    const auto first = order.begin() + static_cast<std::ptrdiff_t>(begin);
+    std::nth_element(first, first + static_cast<std::ptrdiff_t>(half), order.begin() + static_cast<std::ptrdiff_t>(end),
+                     [&](std::int32_t u, std::int32_t v) { return coordinate(u, axis) < coordinate(v, axis); });
+    todo.emplace_back(begin, begin + half);
+    todo.emplace_back(begin + half, end);
+  }
+  ScanSet out;
+  out.vertices = set.vertices;
+  out.index.reserve(n), out.x.reserve(n), out.y.reserve(n), out.z.reserve(n);
+  for (const std::int32_t k : order) {
+    const auto j = static_cast<std::size_t>(k);
+    out.index.push_back(set.index[j]);
+    out.x.push_back(set.x[j]), out.y.push_back(set.y[j]), out.z.push_back(set.z[j]);
+  }
+  return out;
+}
+
 ScanClusters cluster_scan_set(const ScanSet& set, int cluster_size) {
   require(cluster_size >= 1, "scan clusters: the cluster size must be >= 1");
   ScanClusters c;

@@ -69,6 +69,16 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
 /// bounding balls.
 ScanSet order_by_position(const ScanSet& set);
 
+/// The same vertices as `set`, reordered by median splits in space so that every run of `run_sizes[j]`
+/// vertices starting at a multiple of it is one box of the splits: compact in space whatever gaps the set
+/// has (a Z curve jumps, and a subset of a Z-ordered set leaves holes, so that a run of it can span two
+/// distant regions). A range of more than run_sizes.back() vertices is split at a multiple of the largest
+/// size from its start, a smaller one at a multiple of the largest size below its length, at the median
+/// (so rounded) along its bounding box's longest axis. For the bounds of clusters that are runs of the set
+/// (the ROM searches' leaves, groups and blocks). run_sizes: ascending, each a multiple of the one before,
+/// the first >= 1; throws impinge::Error otherwise. O(k log k).
+ScanSet order_in_boxes(const ScanSet& set, const std::vector<std::int64_t>& run_sizes);
+
 /// Consecutive runs of a scan set's vertices (pose-invariant), each with a bounding ball: tight when the
 /// set is ordered by position (order_by_position). For the layered scan's pruning (scan_layered_near).
 struct ScanClusters {
