@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -41,6 +42,10 @@ std::array<std::optional<SphereFitResult>, 2> head_candidates(const TriangleMesh
   validate_mesh(femur);
   const Eigen::Vector3d L = femur_long_axis(femur.V, Eigen::Vector3d::Constant(std::nan("")));
   std::array<std::optional<SphereFitResult>, 2> out;
+  std::array<std::string, 2> error;  // each end's, joined in order below
+  std::array<std::exception_ptr, 2> failure;
+  // The two ends are independent fits (each with its own seeded RANSAC): one thread each.
+#pragma omp parallel for schedule(static, 1) num_threads(2)
   for (int k = 0; k < 2; ++k) {
     const double s = k == 0 ? 1.0 : -1.0;
     // Rotate so that s L becomes +z, fit there, rotate the centre back.
@@ -54,9 +59,15 @@ std::array<std::optional<SphereFitResult>, 2> head_candidates(const TriangleMesh
       r.centre = Q.transpose() * r.centre;
       out[static_cast<std::size_t>(k)] = r;
     } catch (const Error& e) {
-      errors += std::string(errors.empty() ? "" : "; ") + e.what();
+      error[static_cast<std::size_t>(k)] = e.what();
+    } catch (...) {
+      failure[static_cast<std::size_t>(k)] = std::current_exception();  // not a fit's error: rethrown
     }
   }
+  for (const std::exception_ptr& f : failure)
+    if (f) std::rethrow_exception(f);
+  for (const std::string& e : error)
+    if (!e.empty()) errors += std::string(errors.empty() ? "" : "; ") + e;
   return out;
 }
 

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <string>
-#include <tuple>
 #include <utility>
 
 #include "impinge/core/error.hpp"
@@ -75,6 +74,7 @@ struct SignedDistanceQuery::Impl {
   std::vector<std::int32_t> order;
   std::vector<Eigen::Vector3d> area_vector, centroid;  // per kept triangle, for the hierarchy's build
   std::int32_t build_node(std::int32_t begin, std::int32_t end);
+  void build_hierarchy();
 
   /// The closest point of kept triangle k to q, with its feature.
   double distance_to(std::size_t k, const Eigen::Vector3d& q, Eigen::Vector3d& point, int& feature) const {
@@ -140,6 +140,20 @@ std::int32_t SignedDistanceQuery::Impl::build_node(std::int32_t begin, std::int3
   return id;
 }
 
+void SignedDistanceQuery::Impl::build_hierarchy() {
+  const std::size_t k = a.size();
+  order.resize(k);
+  area_vector.resize(k), centroid.resize(k);
+  for (std::size_t t = 0; t < k; ++t) {
+    order[t] = static_cast<std::int32_t>(t);
+    area_vector[t] = (b[t] - a[t]).cross(c[t] - a[t]) / 2;
+    centroid[t] = (a[t] + b[t] + c[t]) / 3;
+  }
+  nodes.reserve(k / 2);
+  build_node(0, static_cast<std::int32_t>(k));
+  std::vector<Eigen::Vector3d>().swap(area_vector), std::vector<Eigen::Vector3d>().swap(centroid);
+}
+
 bool SignedDistanceQuery::available() {
 #if defined(IMPINGE_HAVE_EMBREE) || defined(IMPINGE_HAVE_CGAL)
   return true;
@@ -174,15 +188,19 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   const std::size_t k = m.a.size();
   for (auto& n : m.face_normal) n *= m.orientation;
 
-  // Edges: directed (from, to) of each kept triangle's edge k (0: ab, 1: bc, 2: ca), grouped undirected.
-  std::vector<std::tuple<std::int32_t, std::int32_t, std::int64_t>> edges;  // (min, max, 3 * tri + k)
+  // Edges: directed (from, to) of each kept triangle's edge k (0: ab, 1: bc, 2: ca), grouped undirected:
+  // sorted by (min, max) packed in one key, then 3 * tri + k.
+  std::vector<std::pair<std::uint64_t, std::int64_t>> edges;  // (min << 32 | max, 3 * tri + k)
   edges.reserve(3 * k);
   for (std::size_t t = 0; t < k; ++t)
     for (int e = 0; e < 3; ++e) {
       const std::int32_t u = m.corner[t][e], v = m.corner[t][(e + 1) % 3];
-      edges.emplace_back(std::min(u, v), std::max(u, v), static_cast<std::int64_t>(3 * t + e));
+      edges.emplace_back(static_cast<std::uint64_t>(std::min(u, v)) << 32 | static_cast<std::uint32_t>(std::max(u, v)),
+                         static_cast<std::int64_t>(3 * t + e));
     }
   std::sort(edges.begin(), edges.end());
+  auto low = [&](std::size_t i) { return static_cast<std::int32_t>(edges[i].first >> 32); };
+  auto high = [&](std::size_t i) { return static_cast<std::int32_t>(edges[i].first & 0xffffffffu); };
   m.edge_normal.assign(3 * k, Eigen::Vector3d::Zero());
   m.edge_irregular.assign(3 * k, 1);
   m.vertex_normal.assign(static_cast<std::size_t>(mesh.V.rows()), Eigen::Vector3d::Zero());
@@ -190,12 +208,10 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   std::int64_t irregular = 0;
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i;
-    while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]) &&
-           std::get<1>(edges[j]) == std::get<1>(edges[i]))
-      ++j;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
     bool regular = false;
     if (j - i == 2) {
-      const auto e0 = std::get<2>(edges[i]), e1 = std::get<2>(edges[i + 1]);
+      const auto e0 = edges[i].second, e1 = edges[i + 1].second;
       const auto t0 = static_cast<std::size_t>(e0 / 3), t1 = static_cast<std::size_t>(e1 / 3);
       const std::int32_t from0 = m.corner[t0][e0 % 3], from1 = m.corner[t1][e1 % 3];
       regular = from0 != from1;  // opposite directions: consistently wound
@@ -207,22 +223,13 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
     }
     if (!regular) {
       ++irregular;
-      m.vertex_irregular[static_cast<std::size_t>(std::get<0>(edges[i]))] = 1;
-      m.vertex_irregular[static_cast<std::size_t>(std::get<1>(edges[i]))] = 1;
+      m.vertex_irregular[static_cast<std::size_t>(low(i))] = 1;
+      m.vertex_irregular[static_cast<std::size_t>(high(i))] = 1;
     }
     i = j;
   }
   irregular_edges_ = irregular;
-  m.order.resize(k);
-  m.area_vector.resize(k), m.centroid.resize(k);
-  for (std::size_t t = 0; t < k; ++t) {
-    m.order[t] = static_cast<std::int32_t>(t);
-    m.area_vector[t] = (m.b[t] - m.a[t]).cross(m.c[t] - m.a[t]) / 2;
-    m.centroid[t] = (m.a[t] + m.b[t] + m.c[t]) / 3;
-  }
-  m.nodes.reserve(k / 2);
-  m.build_node(0, static_cast<std::int32_t>(k));
-  std::vector<Eigen::Vector3d>().swap(m.area_vector), std::vector<Eigen::Vector3d>().swap(m.centroid);
+  m.build_hierarchy();
   // Corners: normals weighted by the triangle's angle there.
   for (std::size_t t = 0; t < k; ++t) {
     const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
@@ -406,12 +413,13 @@ double SignedDistanceQuery::winding_number(const Eigen::Vector3d& q) const {
 
 double SignedDistanceQuery::winding_number_fast(const Eigen::Vector3d& q) const {
   const Impl& m = *impl_;
+  const std::vector<Impl::Node>& nodes = m.nodes;
   double sum = 0;
   std::int32_t stack[128];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
-    const Impl::Node& n = m.nodes[static_cast<std::size_t>(stack[--top])];
+    const Impl::Node& n = nodes[static_cast<std::size_t>(stack[--top])];
     const Eigen::Vector3d d = n.centre - q;
     const double dist = d.norm();
     if (dist > kDipoleBeta * n.radius) {

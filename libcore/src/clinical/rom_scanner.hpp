@@ -345,7 +345,7 @@ class CompactScanner {
         vertices_skipped += g.count;
         continue;
       }
-      for (std::int64_t i = g.first / kLeaf; i < (g.first + g.count + kLeaf - 1) / kLeaf; ++i) {
+      for (std::int64_t i = g.first / kHiddenLeaf; i < (g.first + g.count + kHiddenLeaf - 1) / kHiddenLeaf; ++i) {
         const Cluster& c = (*cl)[static_cast<std::size_t>(i)];
         if (done(l)) return;
         if ((reusable ? skip_reusing(c, reuse_l[static_cast<std::size_t>(i)]) : skipped(c)) ||
