@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <Eigen/Geometry>
 
 #include "impinge/casters/exact_reference.hpp"
@@ -96,6 +97,50 @@ TEST(DepthDiscontinuity, AJumpMarksTheNodesBesideItAndOnlyThose) {
         EXPECT_EQ(out[j], plain[j]) << name << " point " << j;
       }
     }
+  }
+}
+
+// The equiangular grid's marks (read by index) are those of its neighbour stencils (the definition, as the
+// generic path computes it): on a rough map with steps, "no surface" patches and both poles, node by node.
+TEST(DepthDiscontinuity, TheEquiangularMarksAreThoseOfItsNeighbourStencils) {
+  for (const double p : {1.0, 0.25}) {
+    RadialDistanceMap map(make_scheme("equiangular", p));
+    const SamplingScheme& scheme = map.scheme();
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> U(0, 1);
+    for (std::int64_t i = 0; i < map.num_nodes(); ++i) {
+      const Eigen::Vector3d u = scheme.node_direction(i);
+      double v = 25 + 0.02 * U(rng) + (u.x() > 0.3 ? 6 : 0);  // a step, and roughness near the tolerance
+      if (u.y() > 0.8 && U(rng) < 0.5) v = std::numeric_limits<double>::infinity();  // patches of no surface
+      map.data()[i] = static_cast<float>(v);
+    }
+    RadialDistanceMap reference = map;
+    const std::int64_t marked = mark_depth_discontinuities(map, 0.05);
+    std::int64_t expected = 0;
+    std::vector<Stencil> nb(4);
+    auto value_of = [&](const Stencil& st) {
+      double v = 0;
+      for (int k = 0; k < 4; ++k)
+        if (st.weights[static_cast<std::size_t>(k)] > 0) {
+          const double u = double(reference.at(st.nodes[static_cast<std::size_t>(k)]));
+          if (!std::isfinite(u)) return std::numeric_limits<double>::infinity();
+          v += st.weights[static_cast<std::size_t>(k)] * u;
+        }
+      return v;
+    };
+    for (std::int64_t i = 0; i < map.num_nodes(); ++i) {
+      const double d = reference.at(i);
+      bool m = false;
+      if (std::isfinite(d)) {
+        scheme.neighbour_stencils(i, 1, nb.data());
+        const double dp = value_of(nb[0]) - 2 * d + value_of(nb[1]), dt = value_of(nb[2]) - 2 * d + value_of(nb[3]);
+        m = !(std::abs(dp) <= 0.05 && std::abs(dt) <= 0.05);
+      }
+      expected += m;
+      ASSERT_EQ(has_discontinuity_mark(map.at(i)), m) << "p " << p << " node " << i;
+    }
+    EXPECT_EQ(marked, expected);
+    EXPECT_GT(marked, 0);
   }
 }
 

@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "impinge/core/error.hpp"
+#include "impinge/schemes/equiangular_grid.hpp"
 #include "impinge/schemes/sampling_scheme.hpp"
 
 namespace impinge {
@@ -51,6 +53,29 @@ std::int64_t mark_depth_discontinuities(RadialDistanceMapT<Scalar>& map, double 
   // The second differences along phi and theta over each node's neighbours (the scheme's
   // neighbour_stencils: the equiangular grid's row and column neighbours; for other schemes the
   // map interpolated one node spacing away along the tangents).
+  if (const auto* grid = dynamic_cast<const EquiangularGrid*>(&scheme)) {
+    // The equiangular grid's stencils are single nodes of weight 1 (EquiangularGrid::neighbour_stencils:
+    // across a pole, the node half a turn round on the next row), read here by index: the same values
+    // (1 * u is u), without filling four stencils per node.
+    const int rows = grid->rows();
+    const int cols = grid->columns();
+    auto value = [values](std::int64_t node) {
+      const double u = double(values[node]);
+      return std::isfinite(u) ? u : std::numeric_limits<double>::infinity();
+    };
+#pragma omp parallel for schedule(dynamic, 8)
+    for (int r = 0; r < rows; ++r) {
+      auto at = [cols](int rr, int cc) { return std::int64_t(rr) * cols + cc; };
+      for (int c = 0; c < cols; ++c) {
+        const double d = values[at(r, c)];
+        if (!std::isfinite(d)) continue;
+        const int cl = c == 0 ? cols - 1 : c - 1, cr = c + 1 == cols ? 0 : c + 1, co = (c + cols / 2) % cols;
+        if (is_marked(d, value(r == 0 ? at(1, co) : at(r - 1, c)), value(r == rows - 1 ? at(rows - 2, co) : at(r + 1, c)),
+                      value(at(r, cl)), value(at(r, cr))))
+          mark[static_cast<std::size_t>(at(r, c))] = 1;
+      }
+    }
+  } else
 #pragma omp parallel
   {
     std::vector<Stencil> nb(static_cast<std::size_t>(4 * kChunk));
