@@ -235,6 +235,9 @@ constexpr std::int64_t kBlock = 1024, kHiddenLeaf = 16;
 // A cluster's bound over its cap widened by this angle serves every later pose of a search within
 // the angle (CompactScanner): two steps of the default search.
 constexpr double kReuseRad = 4.1 * M_PI / 180;
+// A wider one, tried first until it fails in a search (far clusters), serves the poses within this angle:
+// six steps (lhdl-ct's ROM map: 8.1, 12.1 and 20.1 deg save a fifth of the map's time, 12.1 the most).
+constexpr double kWideReuseRad = 12.1 * M_PI / 180;
 // ... and for translations (the joint-centre methods) up to this much beyond the pose's, mm.
 constexpr double kReuseShiftMm = 0.5;
 // The ball's reachable subset holds for translations up to this, mm (beyond: every vertex).

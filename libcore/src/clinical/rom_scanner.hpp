@@ -189,11 +189,15 @@ class CompactScanner {
   // vertex x = M p + s moves by at most |(Q - I) p| + |e| <= 2 r_max sin(kReuseRad / 2) + |e|, which
   // turns it by at most the asin of that over its radius; its squared radius changes by at most
   // 2 |s| |(Q - I) p| (a rotation about the origin keeps |p|), and then by |e|.
-  static Cap reuse_cap_of(const Cluster& c, const Rigid& P) {
-    if (P.shift == 0) return {P.M * c.axis, c.rho + kReuseRad, c.sin_rho_widened, c.r_min, c.r_max};
+  // wide: for rotations within kWideReuseRad instead (a bound that serves more poses, tried first).
+  static Cap reuse_cap_of(const Cluster& c, const Rigid& P, bool wide = false) {
+    const double angle = wide ? kWideReuseRad : kReuseRad;
+    if (P.shift == 0)
+      return {P.M * c.axis, c.rho + angle, wide ? std::sin(std::min(c.rho + angle, M_PI / 2)) : c.sin_rho_widened,
+              c.r_min, c.r_max};
     Cap cap = cap_of(c, P);
-    static const double kChord = 2 * std::sin(kReuseRad / 2);
-    const double move = c.r_max * kChord;
+    static const double kChord = 2 * std::sin(kReuseRad / 2), kWideChord = 2 * std::sin(kWideReuseRad / 2);
+    const double move = c.r_max * (wide ? kWideChord : kChord);
     const double r_lo = std::max(0.0, std::sqrt(std::max(0.0, cap.r_lo * cap.r_lo - 2 * P.shift * move)) - kReuseShiftMm);
     cap.r_hi = std::sqrt(cap.r_hi * cap.r_hi + 2 * P.shift * move) + kReuseShiftMm;
     widen(cap, r_lo > 0 ? asin_above((move + kReuseShiftMm) / r_lo) : M_PI);
@@ -218,13 +222,14 @@ class CompactScanner {
     // them, for translations of at most `shift` mm: the radii move by at most `shift` and the
     // directions by at most asin(shift / r): inside, d - r >= min d - (r_max + shift); outside,
     // r - d >= (r_min - shift) - max d.
-    auto lower_bound = [&](const Cluster& c, bool reuse) {
-      const Cap cap = reuse ? reuse_cap_of(c, P) : cap_of(c, P);
+    // tier 0: this pose's cap; 1: every pose within kReuseRad; 2: within kWideReuseRad.
+    auto lower_bound = [&](const Cluster& c, int tier) {
+      const Cap cap = tier > 0 ? reuse_cap_of(c, P, tier == 2) : cap_of(c, P);
       const float bound = pyr->cap(cap.axis, cap.rho, cap.sin_rho, c.count > kLeaf ? kGroupBlocks : kLeafBlocks);
       return ball ? double(bound) - cap.r_hi : cap.r_lo - double(bound);
     };
     auto skipped = [&](const Cluster& c) {
-      const double lb = lower_bound(c, false);
+      const double lb = lower_bound(c, 0);
       return lb > cut || (collect_ == nullptr && lb > l.gap);
     };
     // A search's poses follow each other closely: a cluster whose bound over the cap of every pose
@@ -240,15 +245,16 @@ class CompactScanner {
       owner = part.clusters;
     }
     auto skip_reusing = [&](const Cluster& c, Reuse& u) {
-      if (u.valid && (u.s - P.s).squaredNorm() <= kReuseShiftMm * kReuseShiftMm &&
-          (u.M.array() * P.M.array()).sum() >= kReuseMinTrace)
-        return true;
+      if (u.holds(P)) return true;
       bool skip;
       if (!u.failed) {
-        u.valid = lower_bound(c, true) > cut, u.M = P.M, u.s = P.s;
-        skip = u.valid || lower_bound(c, false) > cut;
+        u.M = P.M, u.s = P.s;
+        u.wide = !u.wide_failed && lower_bound(c, 2) > cut;
+        u.wide_failed = !u.wide;
+        u.valid = u.wide || lower_bound(c, 1) > cut;
+        skip = u.valid || lower_bound(c, 0) > cut;
       } else {
-        skip = lower_bound(c, false) > cut, u.valid = false;
+        skip = lower_bound(c, 0) > cut, u.valid = false;
       }
       u.failed = !skip;
       return skip;
@@ -317,13 +323,14 @@ class CompactScanner {
     if (reusable && reuse_g.size() != groups->size())
       reuse_b.assign(blocks->size(), Reuse{}), reuse_g.assign(groups->size(), Reuse{}), reuse_l.assign(cl->size(), Reuse{});
     auto skip_reusing = [&](const Cluster& c, Reuse& u) {
-      if (u.valid && (u.s - P.s).squaredNorm() <= kReuseShiftMm * kReuseShiftMm &&
-          (u.M.array() * P.M.array()).sum() >= kReuseMinTrace)
-        return true;
+      if (u.holds(P)) return true;
       const double reach = std::max(0.0, cut);
       bool out;
       if (!u.failed) {
-        u.valid = apart(reuse_cap_of(c, P), reach), u.M = P.M, u.s = P.s;
+        u.M = P.M, u.s = P.s;
+        u.wide = !u.wide_failed && apart(reuse_cap_of(c, P, true), reach);
+        u.wide_failed = !u.wide;
+        u.valid = u.wide || apart(reuse_cap_of(c, P), reach);
         out = u.valid || skipped(c);
       } else {
         out = skipped(c), u.valid = false;
@@ -401,12 +408,22 @@ class CompactScanner {
   double shift_mm_ = 0;  // |t|
   // A group's bound at an earlier pose (M, s) over the cap of the poses near it (valid: it was above
   // the cut), or that its bound failed at the last pose (failed: try the plain cap first next time).
+  // wide: the bound holds within kWideReuseRad (else kReuseRad); wide_failed: the wide bound failed once in
+  // this search (the cluster is near the other bone: not tried again, the poses only come nearer).
   struct Reuse {
     Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
     Eigen::Vector3d s = Eigen::Vector3d::Zero();
-    bool valid = false, failed = false;
+    bool valid = false, failed = false, wide = false, wide_failed = false;
+    // Whether the bound made at (M, s) serves the pose P: P's rotation relative to M within the bound's
+    // angle (the trace of M^T P.M at least that of a rotation by it) and its translation within
+    // kReuseShiftMm of s.
+    bool holds(const Rigid& P) const {
+      return valid && (s - P.s).squaredNorm() <= kReuseShiftMm * kReuseShiftMm &&
+             (M.array() * P.M.array()).sum() >= (wide ? kWideReuseMinTrace : kReuseMinTrace);
+    }
   };
   static inline const double kReuseMinTrace = 1 + 2 * std::cos(kReuseRad);  // trace of a rotation by kReuseRad
+  static inline const double kWideReuseMinTrace = 1 + 2 * std::cos(kWideReuseRad);
   std::vector<Reuse> reuse_ball_groups_, reuse_socket_groups_, reuse_ball_leaves_, reuse_socket_leaves_;
   std::vector<Reuse> reuse_hidden_ball_blocks_, reuse_hidden_socket_blocks_;
   std::vector<Reuse> reuse_hidden_ball_groups_, reuse_hidden_socket_groups_, reuse_hidden_ball_leaves_,
