@@ -50,8 +50,8 @@ class CompactScanner {
         ball_hidden_set_(bounds != nullptr ? &bounds->ball_hidden_set : &joint.ball().hidden_set),
         socket_hidden_set_(bounds != nullptr ? &bounds->socket_hidden_set : &joint.socket().hidden_set) {
     auto skips = [](const ScanSet& set, const std::vector<std::uint8_t>& by_vertex) {
-      std::vector<std::uint8_t> out;
-      for (std::int32_t i : set.index) out.push_back(by_vertex[static_cast<std::size_t>(i)]);
+      std::vector<std::uint8_t> out(set.index.size());
+      for (std::size_t k = 0; k < out.size(); ++k) out[k] = by_vertex[static_cast<std::size_t>(set.index[k])];
       return out;
     };
     skip_ball_ = skips(*ball_set_, base.skip_ball);

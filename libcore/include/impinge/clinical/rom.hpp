@@ -173,14 +173,16 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
 /// `baseline`; pelvis vertices meeting the head's joint surface are classed at each pose) is <=
 /// threshold - contact_depth_mm, then bisect the last step to tolerance_deg. The gaps are those of
 /// Joint::detect (exact ray casts at the maps' depth discontinuities included). Only the minimum is computed: the
-/// first-surface vertices are taken in clusters (32 vertices in Z order, in groups of 128) with a
-/// cone of directions and a radius range, and a cluster is skipped when a bound of the other map
-/// over its cone (a pyramid of minima or maxima over the equiangular map) shows that none of its
-/// gaps can reach the threshold. A bound over the cone widened by 4.1 deg is reused at later poses
-/// whose rotation relative to it is within that angle; femur vertices nearer the COR than the
-/// socket map's least node less the threshold are left out of the scans that ask only whether the
-/// bones meet. The others are looked up exactly, so the result is the full scan's. Throws
-/// impinge::Error on invalid options.
+/// counted first-surface vertices are taken in clusters (32 vertices, in groups of 128: boxes of median
+/// splits in space, order_in_boxes) with a cone of directions and a radius range, and a cluster is
+/// skipped when a bound of the other map over its cone (a pyramid of minima or maxima over the
+/// equiangular map) shows that none of its gaps can reach the threshold; the hidden vertices likewise
+/// (16, 128 and 1,024 vertices) against the other bone's radial shells and, for a leaf, its Euclidean
+/// distance. A bound over the cone widened by 12.1 deg is reused at later poses whose rotation relative
+/// to it is within that angle, and once that fails in a search, one widened by 4.1 deg; femur vertices
+/// nearer the COR than the socket map's least node less the threshold are left out of the scans that
+/// ask only whether the bones meet. The others are looked up exactly, so the result is the full
+/// scan's. Throws impinge::Error on invalid options.
 RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(double)>& motion,
                         const RomOptions& options, const RomBaseline& baseline);
 
