@@ -377,7 +377,7 @@ int main(int argc, char** argv) {
                   "radial|distance: what --threshold is compared with: the thesis' radial gap (along the ray from the "
                   "COR; the thesis') or the signed Euclidean distance to the other bone (what a depth or a cartilage "
                   "offset means: where the ray runs inside the other bone, the radial gap reads a depth of tens of "
-                  "mm for a graze). At or below 0 mm the radial scan screens the distance's (about 1.3x the radial "
+                  "mm for a graze). At or below 0 mm the radial scan screens the distance's (about 1.2x the radial "
                   "search's time); a --threshold above 0 costs a full distance scan per pose (about 10x)")
       ->capture_default_str();
   std::string contacts = "impingement";
