@@ -413,13 +413,12 @@ double SignedDistanceQuery::winding_number(const Eigen::Vector3d& q) const {
 
 double SignedDistanceQuery::winding_number_fast(const Eigen::Vector3d& q) const {
   const Impl& m = *impl_;
-  const std::vector<Impl::Node>& nodes = m.nodes;
   double sum = 0;
   std::int32_t stack[128];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
-    const Impl::Node& n = nodes[static_cast<std::size_t>(stack[--top])];
+    const Impl::Node& n = m.nodes[static_cast<std::size_t>(stack[--top])];
     const Eigen::Vector3d d = n.centre - q;
     const double dist = d.norm();
     if (dist > kDipoleBeta * n.radius) {

@@ -308,11 +308,14 @@ inline ScanSet reachable_subset(const ScanSet& s, double least_node, double thre
     }
   return out;
 }
-// A scan set with its two levels of clusters.
+// A scan set with its levels of clusters: leaves of `leaf` vertices in groups of kGroup, and for the
+// hidden vertices (hidden) blocks of kBlock over the groups (empty otherwise).
 struct Clustered {
   Clustered() = default;
-  explicit Clustered(const ScanSet& s, std::int64_t leaf = kLeaf)
-      : leaves(clusters_of(s, leaf)), groups(clusters_of(s, kGroup)), blocks(clusters_of(s, kBlock)) {}
+  explicit Clustered(const ScanSet& s, bool hidden = false)
+      : leaves(clusters_of(s, hidden ? kHiddenLeaf : kLeaf)),
+        groups(clusters_of(s, kGroup)),
+        blocks(hidden ? clusters_of(s, kBlock) : std::vector<Cluster>{}) {}
   std::vector<Cluster> leaves, groups, blocks;
 };
 
@@ -335,7 +338,9 @@ inline ScanSet counted_subset(const ScanSet& s, const std::vector<std::uint8_t>*
 // kGroup and kBlock vertices is compact (order_in_boxes). Taken after the baseline's skip lists
 // (counted_subset), which leave gaps in any order made before them: a run of 32 counted hidden pelvis
 // vertices in Z order was seen to span a ball of 116 mm, whose bounds never part it from the femur.
-inline ScanSet compact_order(const ScanSet& s, std::int64_t leaf = kLeaf) { return order_in_boxes(s, {leaf, kGroup, kBlock}); }
+inline ScanSet compact_order(const ScanSet& s, bool hidden = false) {
+  return order_in_boxes(s, {hidden ? kHiddenLeaf : kLeaf, kGroup, kBlock});
+}
 
 }  // namespace rom_detail
 
@@ -353,8 +358,8 @@ struct RomSearchBounds {
         skip_socket(socket_skips != nullptr ? *socket_skips : std::vector<std::uint8_t>{}),
         ball_set(rom_detail::compact_order(rom_detail::counted_subset(j.ball().scan_set, ball_skips))),
         socket_set(rom_detail::compact_order(rom_detail::counted_subset(j.socket().scan_set, socket_skips))),
-        ball_hidden_set(rom_detail::compact_order(rom_detail::counted_subset(j.ball().hidden_set, ball_skips), rom_detail::kHiddenLeaf)),
-        socket_hidden_set(rom_detail::compact_order(rom_detail::counted_subset(j.socket().hidden_set, socket_skips), rom_detail::kHiddenLeaf)),
+        ball_hidden_set(rom_detail::compact_order(rom_detail::counted_subset(j.ball().hidden_set, ball_skips), true)),
+        socket_hidden_set(rom_detail::compact_order(rom_detail::counted_subset(j.socket().hidden_set, socket_skips), true)),
         socket_min(rom_detail::bound_pyramid(j.socket().map, true)),
         ball_max(rom_detail::bound_pyramid(j.ball().map, false)),
         ball_reachable(rom_detail::reachable_subset(ball_set, socket_min.all(), threshold + rom_detail::kReachableShiftMm)),
@@ -363,11 +368,11 @@ struct RomSearchBounds {
         ball_reachable_clusters(ball_reachable) {
     if (j.socket().layered) {
       socket_occupancy.emplace(rom_detail::occupancy_pyramid(*j.socket().layered));
-      ball_hidden = rom_detail::Clustered(ball_hidden_set, rom_detail::kHiddenLeaf);
+      ball_hidden = rom_detail::Clustered(ball_hidden_set, true);
     }
     if (j.ball().layered) {
       ball_occupancy.emplace(rom_detail::occupancy_pyramid(*j.ball().layered));
-      socket_hidden = rom_detail::Clustered(socket_hidden_set, rom_detail::kHiddenLeaf);
+      socket_hidden = rom_detail::Clustered(socket_hidden_set, true);
     }
   }
   // Whether these bounds serve a search of `joint` at `threshold` whose baseline skips these vertices.

@@ -245,19 +245,8 @@ class CompactScanner {
       owner = part.clusters;
     }
     auto skip_reusing = [&](const Cluster& c, Reuse& u) {
-      if (u.holds(P)) return true;
-      bool skip;
-      if (!u.failed) {
-        u.M = P.M, u.s = P.s;
-        u.wide = !u.wide_failed && lower_bound(c, 2) > cut;
-        u.wide_failed = !u.wide;
-        u.valid = u.wide || lower_bound(c, 1) > cut;
-        skip = u.valid || lower_bound(c, 0) > cut;
-      } else {
-        skip = lower_bound(c, 0) > cut, u.valid = false;
-      }
-      u.failed = !skip;
-      return skip;
+      return reuse_or_bound(u, P, [&](bool wide) { return lower_bound(c, wide ? 2 : 1) > cut; },
+                            [&] { return lower_bound(c, 0) > cut; });
     };
     for (std::size_t gi = 0; gi < part.clusters->groups.size(); ++gi) {
       const Cluster& g = part.clusters->groups[gi];
@@ -323,48 +312,38 @@ class CompactScanner {
     if (reusable && reuse_g.size() != groups->size())
       reuse_b.assign(blocks->size(), Reuse{}), reuse_g.assign(groups->size(), Reuse{}), reuse_l.assign(cl->size(), Reuse{});
     auto skip_reusing = [&](const Cluster& c, Reuse& u) {
-      if (u.holds(P)) return true;
       const double reach = std::max(0.0, cut);
-      bool out;
-      if (!u.failed) {
-        u.M = P.M, u.s = P.s;
-        u.wide = !u.wide_failed && apart(reuse_cap_of(c, P, true), reach);
-        u.wide_failed = !u.wide;
-        u.valid = u.wide || apart(reuse_cap_of(c, P), reach);
-        out = u.valid || skipped(c);
-      } else {
-        out = skipped(c), u.valid = false;
-      }
-      u.failed = !out;
-      return out;
+      return reuse_or_bound(u, P, [&](bool wide) { return apart(reuse_cap_of(c, P, wide), reach); },
+                            [&] { return skipped(c); });
     };
     for (std::size_t bi = 0; bi < blocks->size(); ++bi) {
-     const Cluster& b = (*blocks)[bi];
-     if (done(l)) return;
-     if (reusable ? skip_reusing(b, reuse_b[bi]) : skipped(b)) {
-       vertices_skipped += b.count;
-       continue;
-     }
-     for (auto gi = static_cast<std::size_t>(b.first / kGroup); gi < static_cast<std::size_t>((b.first + b.count + kGroup - 1) / kGroup); ++gi) {
-      const Cluster& g = (*groups)[gi];
+      const Cluster& b = (*blocks)[bi];
       if (done(l)) return;
-      if (reusable ? skip_reusing(g, reuse_g[gi]) : skipped(g)) {
-        vertices_skipped += g.count;
+      if (reusable ? skip_reusing(b, reuse_b[bi]) : skipped(b)) {
+        vertices_skipped += b.count;
         continue;
       }
-      for (std::int64_t i = g.first / kHiddenLeaf; i < (g.first + g.count + kHiddenLeaf - 1) / kHiddenLeaf; ++i) {
-        const Cluster& c = (*cl)[static_cast<std::size_t>(i)];
+      const auto groups_end = static_cast<std::size_t>((b.first + b.count + kGroup - 1) / kGroup);
+      for (auto gi = static_cast<std::size_t>(b.first / kGroup); gi < groups_end; ++gi) {
+        const Cluster& g = (*groups)[gi];
         if (done(l)) return;
-        if ((reusable ? skip_reusing(c, reuse_l[static_cast<std::size_t>(i)]) : skipped(c)) ||
-            beyond_euclidean(c, P, map, ball, cut, l)) {
-          vertices_skipped += c.count;
+        if (reusable ? skip_reusing(g, reuse_g[gi]) : skipped(g)) {
+          vertices_skipped += g.count;
           continue;
         }
-        vertices_refined += scan_layered(set, c.first, c.count, P.M, P.s, map, buf_.data(), exact);
-        take(set, skip, c.first, c.first + c.count, ball, l, true);
-        vertices_looked_up += c.count;
+        for (std::int64_t i = g.first / kHiddenLeaf; i < (g.first + g.count + kHiddenLeaf - 1) / kHiddenLeaf; ++i) {
+          const Cluster& c = (*cl)[static_cast<std::size_t>(i)];
+          if (done(l)) return;
+          if ((reusable ? skip_reusing(c, reuse_l[static_cast<std::size_t>(i)]) : skipped(c)) ||
+              beyond_euclidean(c, P, map, ball, cut, l)) {
+            vertices_skipped += c.count;
+            continue;
+          }
+          vertices_refined += scan_layered(set, c.first, c.count, P.M, P.s, map, buf_.data(), exact);
+          take(set, skip, c.first, c.first + c.count, ball, l, true);
+          vertices_looked_up += c.count;
+        }
       }
-     }
     }
   }
   // The Euclidean bound of a hidden cluster where the radial shells cannot part it from the other bone
@@ -422,6 +401,26 @@ class CompactScanner {
              (M.array() * P.M.array()).sum() >= (wide ? kWideReuseMinTrace : kReuseMinTrace);
     }
   };
+  // Whether a cluster is skipped at the pose P: by the bound `u` made at an earlier pose while it holds;
+  // else by a new one over every pose near P (reused(wide): the bound over the poses within kWideReuseRad,
+  // tried until it fails once in the search, or within kReuseRad, clears the cut), kept in `u`; else by
+  // this pose's own bound (here()). After a pose where neither held, this pose's bound is tried first.
+  template <typename Reused, typename Here>
+  static bool reuse_or_bound(Reuse& u, const Rigid& P, Reused reused, Here here) {
+    if (u.holds(P)) return true;
+    bool skip;
+    if (!u.failed) {
+      u.M = P.M, u.s = P.s;
+      u.wide = !u.wide_failed && reused(true);
+      u.wide_failed = !u.wide;
+      u.valid = u.wide || reused(false);
+      skip = u.valid || here();
+    } else {
+      skip = here(), u.valid = false;
+    }
+    u.failed = !skip;
+    return skip;
+  }
   static inline const double kReuseMinTrace = 1 + 2 * std::cos(kReuseRad);  // trace of a rotation by kReuseRad
   static inline const double kWideReuseMinTrace = 1 + 2 * std::cos(kWideReuseRad);
   std::vector<Reuse> reuse_ball_groups_, reuse_socket_groups_, reuse_ball_leaves_, reuse_socket_leaves_;

@@ -1,5 +1,6 @@
 #include "impinge/maps/depth_discontinuity.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -54,26 +55,18 @@ std::int64_t mark_depth_discontinuities(RadialDistanceMapT<Scalar>& map, double 
   // neighbour_stencils: the equiangular grid's row and column neighbours; for other schemes the
   // map interpolated one node spacing away along the tangents).
   if (const auto* grid = dynamic_cast<const EquiangularGrid*>(&scheme)) {
-    // The equiangular grid's stencils are single nodes of weight 1 (EquiangularGrid::neighbour_stencils:
-    // across a pole, the node half a turn round on the next row), read here by index: the same values
-    // (1 * u is u), without filling four stencils per node.
-    const int rows = grid->rows();
-    const int cols = grid->columns();
+    // The equiangular grid's stencils are single nodes of weight 1: read by index (1 * u is u), without
+    // filling four stencils per node.
     auto value = [values](std::int64_t node) {
       const double u = double(values[node]);
       return std::isfinite(u) ? u : std::numeric_limits<double>::infinity();
     };
-#pragma omp parallel for schedule(dynamic, 8)
-    for (int r = 0; r < rows; ++r) {
-      auto at = [cols](int rr, int cc) { return std::int64_t(rr) * cols + cc; };
-      for (int c = 0; c < cols; ++c) {
-        const double d = values[at(r, c)];
-        if (!std::isfinite(d)) continue;
-        const int cl = c == 0 ? cols - 1 : c - 1, cr = c + 1 == cols ? 0 : c + 1, co = (c + cols / 2) % cols;
-        if (is_marked(d, value(r == 0 ? at(1, co) : at(r - 1, c)), value(r == rows - 1 ? at(rows - 2, co) : at(r + 1, c)),
-                      value(at(r, cl)), value(at(r, cr))))
-          mark[static_cast<std::size_t>(at(r, c))] = 1;
-      }
+#pragma omp parallel for schedule(dynamic, 8 * 1024)
+    for (std::int64_t i = 0; i < n; ++i) {
+      const double d = values[i];
+      if (!std::isfinite(d)) continue;
+      const std::array<std::int64_t, 4> nb = grid->neighbour_nodes(i);
+      if (is_marked(d, value(nb[0]), value(nb[1]), value(nb[2]), value(nb[3]))) mark[static_cast<std::size_t>(i)] = 1;
     }
   } else
 #pragma omp parallel

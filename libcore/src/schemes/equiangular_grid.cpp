@@ -77,15 +77,8 @@ void EquiangularGrid::neighbour_stencils(std::int64_t first, std::int64_t count,
     s.weights = {1, 0, 0, 0};
   };
   for (std::int64_t k = 0; k < count; ++k) {
-    const std::int64_t i = first + k;
-    const int r = static_cast<int>(i / cols_), c = static_cast<int>(i % cols_);
-    const int cl = c == 0 ? cols_ - 1 : c - 1, cr = c + 1 == cols_ ? 0 : c + 1, co = (c + cols_ / 2) % cols_;
-    auto at = [&](int rr, int cc) { return std::int64_t(rr) * cols_ + cc; };
-    Stencil* s = out + 4 * k;
-    one(s[0], r == 0 ? at(1, co) : at(r - 1, c));
-    one(s[1], r == rows_ - 1 ? at(rows_ - 2, co) : at(r + 1, c));
-    one(s[2], at(r, cl));
-    one(s[3], at(r, cr));
+    const std::array<std::int64_t, 4> nb = neighbour_nodes(first + k);
+    for (int j = 0; j < 4; ++j) one(out[4 * k + j], nb[static_cast<std::size_t>(j)]);
   }
 }
 

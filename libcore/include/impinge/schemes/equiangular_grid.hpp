@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -89,6 +90,14 @@ class EquiangularGrid : public SchemeImpl<EquiangularGrid> {
   /// neighbours (c -+ 1, wrapping at the seam) of each node, one node of weight 1 each: the nodes
   /// that the bilinear stencils join (SamplingScheme::neighbour_stencils).
   void neighbour_stencils(std::int64_t first, std::int64_t count, Stencil* out) const override;
+  /// Those four neighbours of node i (0 <= i < num_nodes()) as node indices, in the stencils' order (row
+  /// before, row after, column before, column after).
+  std::array<std::int64_t, 4> neighbour_nodes(std::int64_t i) const {
+    const int r = static_cast<int>(i / cols_), c = static_cast<int>(i % cols_);
+    const int cl = c == 0 ? cols_ - 1 : c - 1, cr = c + 1 == cols_ ? 0 : c + 1, co = (c + cols_ / 2) % cols_;
+    auto at = [this](int rr, int cc) { return std::int64_t(rr) * cols_ + cc; };
+    return {r == 0 ? at(1, co) : at(r - 1, c), r == rows_ - 1 ? at(rows_ - 2, co) : at(r + 1, c), at(r, cl), at(r, cr)};
+  }
   /// The rows within the cap's polar range, and in each the columns within the azimuth half-width
   /// where the cap's boundary crosses the row (whole rows around a pole), each node confirmed by the
   /// same distance test as the default (SamplingScheme::nodes_in_cap): O(nodes in the cap + rows).
