@@ -3,9 +3,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "impinge/core/error.hpp"
+#include "core/simd_clones.hpp"
 
 namespace impinge {
 
@@ -64,6 +66,72 @@ void JointCentre::gaps(const Joint& joint, const Eigen::Matrix3d& R, const Eigen
                     out);
 }
 
+namespace {
+/// The equidistant normal equations' sums over n lunate vertices (X, Y, Z: n each, joint frame, mm) at the
+/// head centre t (3, mm): with a_j = (w_j, 1), w_j the unit direction from t to vertex j, the lower
+/// triangle of sum a_j a_j^T row by row (out[0..9]: 00, 10, 11, 20, 21, 22, 30, 31, 32, 33) and
+/// sum a_j g_j (out[10..13]), leaving out the vertices with use[j] == 0 or a non-finite gap g[j] (mm).
+/// Eight lanes (j mod 8) are summed apart and then together, so that the loop vectorises (clones).
+IMPINGE_SIMD_CLONES
+void normal_sums(const double* __restrict X, const double* __restrict Y, const double* __restrict Z,
+                 const float* __restrict g, const std::uint8_t* __restrict use, std::int64_t n,
+                 const double* __restrict t, double* __restrict out) {
+  constexpr int kLanes = 8;
+  typedef double Lanes __attribute__((vector_size(8 * kLanes)));
+  typedef float FloatLanes __attribute__((vector_size(4 * kLanes)));
+  typedef std::uint8_t ByteLanes __attribute__((vector_size(kLanes)));
+  Lanes acc[14] = {};
+  const double tx = t[0], ty = t[1], tz = t[2];
+  // One block of kLanes vertices; past n, the last vertex repeated and left out (use 0).
+  auto block = [&](const Lanes& x, const Lanes& y, const Lanes& z, const Lanes& gap, const Lanes& used) {
+    const Lanes dx = x - tx, dy = y - ty, dz = z - tz;
+    const Lanes n2 = dx * dx + dy * dy + dz * dz;
+    const Lanes finite = gap - gap == 0 ? Lanes{} + 1.0 : Lanes{};  // inf - inf and NaN - NaN are NaN
+    const Lanes on = used * finite;
+    Lanes len = n2 > 0 ? n2 : Lanes{} + 1.0;  // a vertex at t: w = 0
+    for (int l = 0; l < kLanes; ++l) len[l] = std::sqrt(len[l]);
+    const Lanes a0 = dx / len * on, a1 = dy / len * on, a2 = dz / len * on, a3 = on;
+    const Lanes gg = gap - gap == 0 ? gap * on : Lanes{};
+    acc[0] += a0 * a0;
+    acc[1] += a1 * a0;
+    acc[2] += a1 * a1;
+    acc[3] += a2 * a0;
+    acc[4] += a2 * a1;
+    acc[5] += a2 * a2;
+    acc[6] += a3 * a0;
+    acc[7] += a3 * a1;
+    acc[8] += a3 * a2;
+    acc[9] += a3 * a3;
+    acc[10] += a0 * gg;
+    acc[11] += a1 * gg;
+    acc[12] += a2 * gg;
+    acc[13] += a3 * gg;
+  };
+  const std::int64_t full = n / kLanes * kLanes;
+  for (std::int64_t j0 = 0; j0 < full; j0 += kLanes) {
+    Lanes x, y, z;
+    FloatLanes gf;
+    ByteLanes u;
+    std::memcpy(&x, X + j0, sizeof x), std::memcpy(&y, Y + j0, sizeof y), std::memcpy(&z, Z + j0, sizeof z);
+    std::memcpy(&gf, g + j0, sizeof gf), std::memcpy(&u, use + j0, sizeof u);
+    block(x, y, z, __builtin_convertvector(gf, Lanes), __builtin_convertvector(u != 0, Lanes) * -1.0);
+  }
+  if (full < n) {
+    Lanes x, y, z, gap, used;
+    for (int l = 0; l < kLanes; ++l) {
+      const std::int64_t j = std::min(full + l, n - 1);
+      x[l] = X[j], y[l] = Y[j], z[l] = Z[j], gap[l] = g[j], used[l] = full + l < n && use[j] != 0 ? 1.0 : 0.0;
+    }
+    block(x, y, z, gap, used);
+  }
+  for (int k = 0; k < 14; ++k) {
+    double sum = 0;
+    for (int l = 0; l < kLanes; ++l) sum += acc[k][l];
+    out[k] = sum;
+  }
+}
+}  // namespace
+
 Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix3d& R) const {
   switch (method_) {
     case JointCentreMethod::femoral_head: return Eigen::Vector3d::Zero();
@@ -96,16 +164,12 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
     // gap_j(t + d) ~ gap_j(t) - w_j . d (w_j: unit direction from the head centre t to q_j; exact
     // for a spherical head). Least squares of gap_j - w_j . d - m over d and the mean joint space m:
     // the normal equations of a_j . (d, m) = gap_j, a_j = (w_j, 1).
-    Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d b = Eigen::Vector4d::Zero();
-    for (std::int64_t j = 0; j < n; ++j) {
-      const double gj = g[static_cast<std::size_t>(j)];
-      if (!on_head[static_cast<std::size_t>(j)] || !std::isfinite(gj)) continue;
-      const Eigen::Vector3d w = (Eigen::Vector3d(lunate_.x[j], lunate_.y[j], lunate_.z[j]) - t).normalized();
-      const Eigen::Vector4d a(w.x(), w.y(), w.z(), 1);
-      A.noalias() += a * a.transpose();
-      b.noalias() += a * gj;
-    }
+    double sums[14];
+    normal_sums(lunate_.x.data(), lunate_.y.data(), lunate_.z.data(), g.data(), on_head.data(), n, t.data(), sums);
+    Eigen::Matrix4d A;
+    for (int i = 0, k = 0; i < 4; ++i)
+      for (int c = 0; c <= i; ++c, ++k) A(i, c) = A(c, i) = sums[k];
+    const Eigen::Vector4d b(sums[10], sums[11], sums[12], sums[13]);
     const Eigen::Vector3d d = A.ldlt().solve(b).head<3>();
     t += d;
     if (!t.allFinite()) throw Error("joint centre equidistant: the iteration diverged (no joint space to even out)");
