@@ -6,7 +6,9 @@
 //   of the hole, and decides the points whose closest feature is the hole's rim;
 // - on a self-intersecting mesh (two overlapping spheres in one mesh), a point outside one sphere but
 //   inside the other is inside: the winding number (2 in the overlap, 1 in either sphere) says so when
-//   the caller's hint disagrees with the pseudo-normal of the buried sheet.
+//   the caller's hint disagrees with the pseudo-normal of the buried sheet;
+// - irregular edges counted by hand on small meshes: a border edge, an edge whose two triangles run
+//   it the same way (inconsistent winding) and an edge of three triangles (a fin) are each one.
 #include "impinge/casters/signed_distance.hpp"
 
 #include <gtest/gtest.h>
@@ -88,6 +90,24 @@ TEST(SignedDistance, BoxWoundEitherWay) {
   }
 }
 
+TEST(SignedDistance, IrregularEdgesCountedByHand) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+  TriangleMesh m;
+  m.V.resize(5, 3);
+  m.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0.5, 0.5, 1;
+  // Two triangles sharing the edge 1-2, wound consistently: only the four border edges are irregular.
+  m.F.resize(2, 3);
+  m.F << 0, 1, 2, 2, 1, 3;
+  EXPECT_EQ(SignedDistanceQuery(m).irregular_edges(), 4);
+  // The second wound the other way: the shared edge runs 1 -> 2 in both, so it is irregular too.
+  m.F << 0, 1, 2, 1, 2, 3;
+  EXPECT_EQ(SignedDistanceQuery(m).irregular_edges(), 5);
+  // A third triangle on the edge 1-2 (a fin): that edge and the fin's two other edges, with the four.
+  m.F.resize(3, 3);
+  m.F << 0, 1, 2, 2, 1, 3, 1, 2, 4;
+  EXPECT_EQ(SignedDistanceQuery(m).irregular_edges(), 7);
+}
+
 TEST(SignedDistance, OpenMeshTheWindingNumberDecidesAtTheHole) {
   if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
   const double R = 10, cut = 0.8 * R;
@@ -96,7 +116,7 @@ TEST(SignedDistance, OpenMeshTheWindingNumberDecidesAtTheHole) {
   for (Eigen::Index i = 0; i < sphere.V.rows(); ++i) keep[static_cast<std::size_t>(i)] = sphere.V(i, 2) < cut;
   const TriangleMesh open = submesh(sphere, keep);
   const SignedDistanceQuery q(open);
-  EXPECT_GT(q.irregular_edges(), 0);  // the hole's rim
+  EXPECT_EQ(q.irregular_edges(), 180);  // the hole's rim: one edge per segment of the ring
   // The hole's rim: the highest ring kept.
   double rim_z = -R;
   for (Eigen::Index i = 0; i < open.V.rows(); ++i) rim_z = std::max(rim_z, open.V(i, 2));

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
 #include <cmath>
 #include <vector>
 
@@ -42,12 +41,17 @@ FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& 
   // of a segmentation) are welded: Embree's watertightness holds for identical corners only, and a
   // ray along such a seam would otherwise slip through it.
   {
-    std::map<std::array<std::int64_t, 3>, int> cell;
-    std::vector<int> to(static_cast<std::size_t>(clean.V.rows()));
-    for (Eigen::Index i = 0; i < clean.V.rows(); ++i) {
-      const std::array<std::int64_t, 3> key{std::llround(clean.V(i, 0) * 1e6), std::llround(clean.V(i, 1) * 1e6),
-                                            std::llround(clean.V(i, 2) * 1e6)};
-      to[static_cast<std::size_t>(i)] = cell.emplace(key, static_cast<int>(i)).first->second;
+    // Each vertex goes to the first vertex (lowest index) of its 1e-6 mm cell: sorted by (cell, index).
+    std::vector<std::pair<std::array<std::int64_t, 3>, int>> cell(static_cast<std::size_t>(clean.V.rows()));
+    for (Eigen::Index i = 0; i < clean.V.rows(); ++i)
+      cell[static_cast<std::size_t>(i)] = {{std::llround(clean.V(i, 0) * 1e6), std::llround(clean.V(i, 1) * 1e6),
+                                            std::llround(clean.V(i, 2) * 1e6)},
+                                           static_cast<int>(i)};
+    std::sort(cell.begin(), cell.end());
+    std::vector<int> to(cell.size());
+    for (std::size_t k = 0, first = 0; k < cell.size(); ++k) {
+      if (cell[k].first != cell[first].first) first = k;
+      to[static_cast<std::size_t>(cell[k].second)] = cell[first].second;
     }
     for (Eigen::Index f = 0; f < clean.F.rows(); ++f)
       for (int k = 0; k < 3; ++k) clean.F(f, k) = to[static_cast<std::size_t>(clean.F(f, k))];

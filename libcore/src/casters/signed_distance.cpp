@@ -189,44 +189,54 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   for (auto& n : m.face_normal) n *= m.orientation;
 
   // Edges: directed (from, to) of each kept triangle's edge k (0: ab, 1: bc, 2: ca), grouped undirected:
-  // sorted by (min, max) packed in one key, then 3 * tri + k.
-  std::vector<std::pair<std::uint64_t, std::int64_t>> edges;  // (min << 32 | max, 3 * tri + k)
-  edges.reserve(3 * k);
-  for (std::size_t t = 0; t < k; ++t)
-    for (int e = 0; e < 3; ++e) {
-      const std::int32_t u = m.corner[t][e], v = m.corner[t][(e + 1) % 3];
-      edges.emplace_back(static_cast<std::uint64_t>(std::min(u, v)) << 32 | static_cast<std::uint32_t>(std::max(u, v)),
-                         static_cast<std::int64_t>(3 * t + e));
+  // bucketed by their lower vertex (counting sort), each bucket ordered by the higher vertex, then by
+  // 3 * tri + k (the half-edges are placed in that order and the bucket sort is stable).
+  const std::size_t nv = static_cast<std::size_t>(mesh.V.rows());
+  std::vector<std::int64_t> start(nv + 1, 0);
+  auto ends = [&](std::size_t h) {
+    const std::int32_t u = m.corner[h / 3][h % 3], v = m.corner[h / 3][(h % 3 + 1) % 3];
+    return std::pair{std::min(u, v), std::max(u, v)};
+  };
+  for (std::size_t h = 0; h < 3 * k; ++h) ++start[static_cast<std::size_t>(ends(h).first) + 1];
+  for (std::size_t w = 0; w < nv; ++w) start[w + 1] += start[w];
+  std::vector<std::pair<std::int32_t, std::int64_t>> bucket(3 * k);  // (higher vertex, 3 * tri + k)
+  {
+    std::vector<std::int64_t> next(start.begin(), start.end() - 1);
+    for (std::size_t h = 0; h < 3 * k; ++h) {
+      const auto [lo, hi] = ends(h);
+      bucket[static_cast<std::size_t>(next[static_cast<std::size_t>(lo)]++)] = {hi, static_cast<std::int64_t>(h)};
     }
-  std::sort(edges.begin(), edges.end());
-  auto low = [&](std::size_t i) { return static_cast<std::int32_t>(edges[i].first >> 32); };
-  auto high = [&](std::size_t i) { return static_cast<std::int32_t>(edges[i].first & 0xffffffffu); };
+  }
   m.edge_normal.assign(3 * k, Eigen::Vector3d::Zero());
   m.edge_irregular.assign(3 * k, 1);
-  m.vertex_normal.assign(static_cast<std::size_t>(mesh.V.rows()), Eigen::Vector3d::Zero());
-  m.vertex_irregular.assign(static_cast<std::size_t>(mesh.V.rows()), 0);
+  m.vertex_normal.assign(nv, Eigen::Vector3d::Zero());
+  m.vertex_irregular.assign(nv, 0);
   std::int64_t irregular = 0;
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
-    bool regular = false;
-    if (j - i == 2) {
-      const auto e0 = edges[i].second, e1 = edges[i + 1].second;
-      const auto t0 = static_cast<std::size_t>(e0 / 3), t1 = static_cast<std::size_t>(e1 / 3);
-      const std::int32_t from0 = m.corner[t0][e0 % 3], from1 = m.corner[t1][e1 % 3];
-      regular = from0 != from1;  // opposite directions: consistently wound
-      if (regular) {
-        const Eigen::Vector3d n = m.face_normal[t0] + m.face_normal[t1];
-        m.edge_normal[static_cast<std::size_t>(e0)] = m.edge_normal[static_cast<std::size_t>(e1)] = n;
-        m.edge_irregular[static_cast<std::size_t>(e0)] = m.edge_irregular[static_cast<std::size_t>(e1)] = 0;
+  for (std::size_t w = 0; w < nv; ++w) {
+    const auto first = bucket.begin() + start[w], last = bucket.begin() + start[w + 1];
+    std::stable_sort(first, last, [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (auto i = first; i != last;) {
+      auto j = i;
+      while (j != last && j->first == i->first) ++j;
+      bool regular = false;
+      if (j - i == 2) {
+        const auto e0 = i->second, e1 = (i + 1)->second;
+        const auto t0 = static_cast<std::size_t>(e0 / 3), t1 = static_cast<std::size_t>(e1 / 3);
+        const std::int32_t from0 = m.corner[t0][e0 % 3], from1 = m.corner[t1][e1 % 3];
+        regular = from0 != from1;  // opposite directions: consistently wound
+        if (regular) {
+          const Eigen::Vector3d n = m.face_normal[t0] + m.face_normal[t1];
+          m.edge_normal[static_cast<std::size_t>(e0)] = m.edge_normal[static_cast<std::size_t>(e1)] = n;
+          m.edge_irregular[static_cast<std::size_t>(e0)] = m.edge_irregular[static_cast<std::size_t>(e1)] = 0;
+        }
       }
+      if (!regular) {
+        ++irregular;
+        m.vertex_irregular[w] = 1;
+        m.vertex_irregular[static_cast<std::size_t>(i->first)] = 1;
+      }
+      i = j;
     }
-    if (!regular) {
-      ++irregular;
-      m.vertex_irregular[static_cast<std::size_t>(low(i))] = 1;
-      m.vertex_irregular[static_cast<std::size_t>(high(i))] = 1;
-    }
-    i = j;
   }
   irregular_edges_ = irregular;
   m.build_hierarchy();
