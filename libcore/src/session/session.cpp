@@ -1,6 +1,8 @@
 #include "impinge/session/session.hpp"
 
 #include <cmath>
+#include <exception>
+#include <future>
 #include <limits>
 #include <sstream>
 
@@ -93,8 +95,17 @@ LoadedInput load_input(const SessionInput& input) {
     out = mesh ? *mesh : load_mesh(path);
     source = !mesh ? path : out.source.empty() ? std::string(name) + " (in memory)" : out.source;
   };
-  take(input.ball_mesh, ball, "ball", in.femur, in.femur_source);
-  take(input.socket_mesh, socket, "socket", in.pelvis, in.pelvis_source);
+  // The two files are read at once (the pelvis on a second thread); the femur's error first, as before.
+  auto pelvis = std::async(std::launch::async, [&] { take(input.socket_mesh, socket, "socket", in.pelvis, in.pelvis_source); });
+  std::exception_ptr femur_error;
+  try {
+    take(input.ball_mesh, ball, "ball", in.femur, in.femur_source);
+  } catch (...) {
+    femur_error = std::current_exception();
+  }
+  pelvis.wait();
+  if (femur_error) std::rethrow_exception(femur_error);
+  pelvis.get();
   for (const auto& [name, p] : input.landmarks) {
     require(p.allFinite(), "landmark " + name + ": not three finite numbers");
     landmarks[name] = p;
