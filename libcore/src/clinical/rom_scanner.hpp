@@ -190,12 +190,24 @@ class CompactScanner {
   // turns it by at most the asin of that over its radius; its squared radius changes by at most
   // 2 |s| |(Q - I) p| (a rotation about the origin keeps |p|), and then by |e|.
   // wide: for rotations within kWideReuseRad instead (a bound that serves more poses, tried first).
-  static Cap reuse_cap_of(const Cluster& c, const Rigid& P, bool wide = false) {
+  // This pose's cap of one cluster (cap_of), computed once however many of its bounds ask for it.
+  struct PoseCap {
+    const Cluster& c;
+    const Rigid& P;
+    std::optional<Cap> cap;
+    PoseCap(const Cluster& cluster, const Rigid& pose) : c(cluster), P(pose) {}
+    const Cap& get() {
+      if (!cap) cap = cap_of(c, P);
+      return *cap;
+    }
+  };
+  // here: the cluster's PoseCap at P.
+  static Cap reuse_cap_of(const Cluster& c, const Rigid& P, bool wide, PoseCap& here) {
     const double angle = wide ? kWideReuseRad : kReuseRad;
     if (P.shift == 0)
       return {P.M * c.axis, c.rho + angle, wide ? std::sin(std::min(c.rho + angle, M_PI / 2)) : c.sin_rho_widened,
               c.r_min, c.r_max};
-    Cap cap = cap_of(c, P);
+    Cap cap = here.get();
     static const double kChord = 2 * std::sin(kReuseRad / 2), kWideChord = 2 * std::sin(kWideReuseRad / 2);
     const double move = c.r_max * (wide ? kWideChord : kChord);
     const double r_lo = std::max(0.0, std::sqrt(std::max(0.0, cap.r_lo * cap.r_lo - 2 * P.shift * move)) - kReuseShiftMm);
@@ -223,13 +235,14 @@ class CompactScanner {
     // directions by at most asin(shift / r): inside, d - r >= min d - (r_max + shift); outside,
     // r - d >= (r_min - shift) - max d.
     // tier 0: this pose's cap; 1: every pose within kReuseRad; 2: within kWideReuseRad.
-    auto lower_bound = [&](const Cluster& c, int tier) {
-      const Cap cap = tier > 0 ? reuse_cap_of(c, P, tier == 2) : cap_of(c, P);
+    auto lower_bound = [&](const Cluster& c, int tier, PoseCap& here) {
+      const Cap& cap = tier > 0 ? reuse_cap_of(c, P, tier == 2, here) : here.get();
       const float bound = pyr->cap(cap.axis, cap.rho, cap.sin_rho, c.count > kLeaf ? kGroupBlocks : kLeafBlocks);
       return ball ? double(bound) - cap.r_hi : cap.r_lo - double(bound);
     };
     auto skipped = [&](const Cluster& c) {
-      const double lb = lower_bound(c, 0);
+      PoseCap here(c, P);
+      const double lb = lower_bound(c, 0, here);
       return lb > cut || (collect_ == nullptr && lb > l.gap);
     };
     // A search's poses follow each other closely: a cluster whose bound over the cap of every pose
@@ -245,8 +258,9 @@ class CompactScanner {
       owner = part.clusters;
     }
     auto skip_reusing = [&](const Cluster& c, Reuse& u) {
-      return reuse_or_bound(u, P, [&](bool wide) { return lower_bound(c, wide ? 2 : 1) > cut; },
-                            [&] { return lower_bound(c, 0) > cut; });
+      PoseCap here(c, P);
+      return reuse_or_bound(u, P, [&](bool wide) { return lower_bound(c, wide ? 2 : 1, here) > cut; },
+                            [&] { return lower_bound(c, 0, here) > cut; });
     };
     for (std::size_t gi = 0; gi < part.clusters->groups.size(); ++gi) {
       const Cluster& g = part.clusters->groups[gi];
@@ -297,9 +311,13 @@ class CompactScanner {
     auto apart = [&](const Cap& cap, double reach) {
       return (pyr->cap(cap.axis, cap.rho, cap.sin_rho, kHiddenBlocks) & shells(cap.r_lo - reach, cap.r_hi + reach)) == 0;
     };
-    auto skipped = [&](const Cluster& c) {
+    auto skipped_at = [&](PoseCap& here) {
       const double reach = std::max(0.0, collect_ == nullptr ? std::min(cut, l.gap) : cut);
-      return std::isfinite(reach) && apart(cap_of(c, P), reach);
+      return std::isfinite(reach) && apart(here.get(), reach);
+    };
+    auto skipped = [&](const Cluster& c) {
+      PoseCap here(c, P);
+      return skipped_at(here);
     };
     // As for the first surface (scan()): a cluster apart from the other bone over the cap of every pose
     // near this one is skipped at every later pose that near, while only contact is asked (the reach
@@ -313,8 +331,9 @@ class CompactScanner {
       reuse_b.assign(blocks->size(), Reuse{}), reuse_g.assign(groups->size(), Reuse{}), reuse_l.assign(cl->size(), Reuse{});
     auto skip_reusing = [&](const Cluster& c, Reuse& u) {
       const double reach = std::max(0.0, cut);
-      return reuse_or_bound(u, P, [&](bool wide) { return apart(reuse_cap_of(c, P, wide), reach); },
-                            [&] { return skipped(c); });
+      PoseCap here(c, P);
+      return reuse_or_bound(u, P, [&](bool wide) { return apart(reuse_cap_of(c, P, wide, here), reach); },
+                            [&] { return skipped_at(here); });
     };
     for (std::size_t bi = 0; bi < blocks->size(); ++bi) {
       const Cluster& b = (*blocks)[bi];
