@@ -146,6 +146,12 @@ class BlockPyramid {
   // sin(rho)). Angles by fast_angles.hpp (within 1e-13 rad; the row and column ranges are padded by a
   // node on each side).
   V cap(const Eigen::Vector3d& u, double rho, double sin_rho, int blocks_per_span) const {
+    return cap(u, rho, sin_rho, blocks_per_span, [](const V&) { return false; });
+  }
+  // The same, but returned as soon as stop(the value so far) holds after a row of blocks (callers that
+  // only compare the value with a threshold: once stop holds, the rest cannot change the comparison).
+  template <typename Stop>
+  V cap(const Eigen::Vector3d& u, double rho, double sin_rho, int blocks_per_span, Stop stop) const {
     double phi, theta;
     fast_spherical_angles(u.x(), u.y(), u.z(), phi, theta);
     double r_lo = (phi - rho) / step_, r_hi = (phi + rho) / step_ + 1;
@@ -183,6 +189,7 @@ class BlockPyramid {
     for (int i = i0; i <= i1; ++i) {
       const V* row = v + static_cast<std::size_t>(i) * stride;
       for (int j = j0; j <= j1; ++j) m = combine_(m, row[j]);
+      if (stop(m)) return m;
     }
     return m;
   }

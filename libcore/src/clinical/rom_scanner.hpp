@@ -235,15 +235,20 @@ class CompactScanner {
     // directions by at most asin(shift / r): inside, d - r >= min d - (r_max + shift); outside,
     // r - d >= (r_min - shift) - max d.
     // tier 0: this pose's cap; 1: every pose within kReuseRad; 2: within kWideReuseRad.
-    auto lower_bound = [&](const Cluster& c, int tier, PoseCap& here) {
+    // Only whether the bound exceeds `limit` matters: the blocks are read until it cannot.
+    auto lower_bound_above = [&](const Cluster& c, int tier, PoseCap& here, double limit) {
       const Cap& cap = tier > 0 ? reuse_cap_of(c, P, tier == 2, here) : here.get();
-      const float bound = pyr->cap(cap.axis, cap.rho, cap.sin_rho, c.count > kLeaf ? kGroupBlocks : kLeafBlocks);
-      return ball ? double(bound) - cap.r_hi : cap.r_lo - double(bound);
+      const int blocks = c.count > kLeaf ? kGroupBlocks : kLeafBlocks;
+      // ball: bound - r_hi > limit while the least so far > limit + r_hi; else r_lo - bound > limit
+      // while the greatest so far < r_lo - limit.
+      const double edge = ball ? limit + cap.r_hi : cap.r_lo - limit;
+      const float bound = pyr->cap(cap.axis, cap.rho, cap.sin_rho, blocks,
+                                   [&](float m) { return ball ? double(m) <= edge : double(m) >= edge; });
+      return (ball ? double(bound) - cap.r_hi : cap.r_lo - double(bound)) > limit;
     };
     auto skipped = [&](const Cluster& c) {
       PoseCap here(c, P);
-      const double lb = lower_bound(c, 0, here);
-      return lb > cut || (collect_ == nullptr && lb > l.gap);
+      return lower_bound_above(c, 0, here, collect_ == nullptr ? std::min(cut, l.gap) : cut);
     };
     // A search's poses follow each other closely: a cluster whose bound over the cap of every pose
     // near this one (reuse_cap_of: rotations within kReuseRad, translations within kReuseShiftMm)
@@ -259,8 +264,8 @@ class CompactScanner {
     }
     auto skip_reusing = [&](const Cluster& c, Reuse& u) {
       PoseCap here(c, P);
-      return reuse_or_bound(u, P, [&](bool wide) { return lower_bound(c, wide ? 2 : 1, here) > cut; },
-                            [&] { return lower_bound(c, 0, here) > cut; });
+      return reuse_or_bound(u, P, [&](bool wide) { return lower_bound_above(c, wide ? 2 : 1, here, cut); },
+                            [&] { return lower_bound_above(c, 0, here, cut); });
     };
     for (std::size_t gi = 0; gi < part.clusters->groups.size(); ++gi) {
       const Cluster& g = part.clusters->groups[gi];
@@ -309,7 +314,9 @@ class CompactScanner {
     }
     const std::vector<Cluster>* groups = ball ? &bounds_->ball_hidden.groups : &bounds_->socket_hidden.groups;
     auto apart = [&](const Cap& cap, double reach) {
-      return (pyr->cap(cap.axis, cap.rho, cap.sin_rho, kHiddenBlocks) & shells(cap.r_lo - reach, cap.r_hi + reach)) == 0;
+      const std::uint64_t near = shells(cap.r_lo - reach, cap.r_hi + reach);
+      return (pyr->cap(cap.axis, cap.rho, cap.sin_rho, kHiddenBlocks, [near](std::uint64_t m) { return (m & near) != 0; }) &
+              near) == 0;
     };
     auto skipped_at = [&](PoseCap& here) {
       const double reach = std::max(0.0, collect_ == nullptr ? std::min(cut, l.gap) : cut);
