@@ -144,6 +144,9 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
     if (V(i, 2) >= zmax - o.proximal_extent_mm) cand.push_back(i);
   require(cand.size() >= 4, femur.source + ": too few proximal vertices for a head fit");
 
+  // The candidates' coordinates side by side, for the inlier counts (3000 passes over them).
+  std::vector<double> cx(cand.size()), cy(cand.size()), cz(cand.size());
+  for (std::size_t k = 0; k < cand.size(); ++k) cx[k] = V(cand[k], 0), cy[k] = V(cand[k], 1), cz[k] = V(cand[k], 2);
   std::mt19937_64 rng(o.seed);
   std::uniform_int_distribution<std::size_t> pick(0, cand.size() - 1);
   std::size_t best_count = 0;
@@ -155,11 +158,17 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
     Eigen::Vector3d c;
     double r;
     if (!sphere_through(p, c, r) || r < o.min_radius_mm || r > o.max_radius_mm) continue;
-    std::size_t count = 0;
-    for (Eigen::Index i : cand)
-      if (std::abs((V.row(i).transpose() - c).norm() - r) < o.inlier_threshold_mm) ++count;
-    if (count > best_count) {
-      best_count = count;
+    // |d - r| < threshold, as r - threshold < d < r + threshold, squared (no root per candidate).
+    const double lo = r - o.inlier_threshold_mm, hi = r + o.inlier_threshold_mm;
+    const double lo2 = lo > 0 ? lo * lo : -1.0, hi2 = hi * hi;
+    std::int64_t count = 0;
+    for (std::size_t k = 0; k < cand.size(); ++k) {
+      const double dx = cx[k] - c.x(), dy = cy[k] - c.y(), dz = cz[k] - c.z();
+      const double d2 = dx * dx + dy * dy + dz * dz;
+      count += (d2 > lo2) & (d2 < hi2);
+    }
+    if (static_cast<std::size_t>(count) > best_count) {
+      best_count = static_cast<std::size_t>(count);
       best_c = c;
       best_r = r;
     }
