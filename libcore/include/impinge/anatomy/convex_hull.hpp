@@ -1,7 +1,9 @@
 #pragma once
 /// @file convex_hull.hpp
 /// Convex hull of a point set through CGAL (`CGAL::convex_hull_3`, quickhull with exact
-/// predicates), with the hull's vertices and triangles given as indices into the input.
+/// predicates), with the hull's vertices and triangles given as indices into the input. The
+/// points strictly inside the hull of 26 extreme points are left out first (Akl and Toussaint
+/// 1978, Inf. Process. Lett. 7:219): they lie on no face of the whole hull.
 
 #include <Eigen/Core>
 #include <vector>
