@@ -19,67 +19,78 @@ namespace impinge {
 #ifdef IMPINGE_HAVE_CGAL
 bool have_convex_hull() { return true; }
 
-ConvexHull convex_hull(PointsRef P) {
-  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-  using Point = K::Point_3;
-  require(P.rows() >= 4, "convex hull: needs at least 4 points, got " + std::to_string(P.rows()));
-  require(P.allFinite(), "convex hull: a point has a non-finite coordinate");
-  using Mesh = CGAL::Surface_mesh<Point>;
-  // Points strictly inside the hull of a few extreme points (along the 26 directions of a cube's
-  // faces, edges and corners) are on no face of the whole hull: left out before the quickhull (Akl and
-  // Toussaint 1978), by a margin far above the planes' rounding. The others keep their order.
-  std::vector<Point> pts;
-  pts.reserve(static_cast<std::size_t>(P.rows()));
-  std::vector<Eigen::Index> kept;  // pts[k] is input point kept[k]
-  {
-    std::vector<Eigen::Vector3d> dirs;
-    for (int a = -1; a <= 1; ++a)
-      for (int b = -1; b <= 1; ++b)
-        for (int c = -1; c <= 1; ++c)
-          if (a != 0 || b != 0 || c != 0) dirs.emplace_back(a, b, c);
-    std::vector<Eigen::Index> extreme(dirs.size(), 0);
-    std::vector<double> most(dirs.size(), -std::numeric_limits<double>::infinity());
-    for (Eigen::Index i = 0; i < P.rows(); ++i) {
-      const Eigen::Vector3d p = P.row(i).transpose();
-      for (std::size_t k = 0; k < dirs.size(); ++k) {
-        const double x = p.dot(dirs[k]);
-        if (x > most[k]) most[k] = x, extreme[k] = i;
-      }
+namespace {
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = K::Point_3;
+using Mesh = CGAL::Surface_mesh<Point>;
+
+// The corners of each triangle of a CGAL hull, through `corner` (Point -> T).
+template <typename T, typename Corner>
+std::vector<std::array<T, 3>> hull_triangles(const Mesh& hull, Corner corner) {
+  std::vector<std::array<T, 3>> out;
+  for (auto face : hull.faces()) {
+    int k = 0;
+    std::array<T, 3> t{};
+    for (auto v : CGAL::vertices_around_face(hull.halfedge(face), hull)) {
+      require(k < 3, "convex hull: a hull face is not a triangle");
+      t[static_cast<std::size_t>(k++)] = corner(hull.point(v));
     }
-    std::sort(extreme.begin(), extreme.end());
-    extreme.erase(std::unique(extreme.begin(), extreme.end()), extreme.end());
-    std::vector<Point> ext;
-    for (Eigen::Index i : extreme) ext.emplace_back(P(i, 0), P(i, 1), P(i, 2));
-    Mesh inner;
-    if (ext.size() >= 4) CGAL::convex_hull_3(ext.begin(), ext.end(), inner);
-    std::vector<std::pair<Eigen::Vector3d, double>> planes;  // unit outward normal, offset
-    if (inner.number_of_faces() >= 4)
-      for (auto f : inner.faces()) {
-        std::array<Eigen::Vector3d, 3> q;
-        int k = 0;
-        for (auto v : CGAL::vertices_around_face(inner.halfedge(f), inner)) {
-          const Point& p = inner.point(v);
-          if (k < 3) q[static_cast<std::size_t>(k)] = Eigen::Vector3d(p.x(), p.y(), p.z());
-          ++k;
-        }
-        const Eigen::Vector3d n = (q[1] - q[0]).cross(q[2] - q[0]);
-        if (k == 3 && n.norm() > 0) planes.emplace_back(n.normalized(), n.normalized().dot(q[0]));
-      }
-    const double scale = (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
-    const double margin = 1e-6 * scale;
-    for (Eigen::Index i = 0; i < P.rows(); ++i) {
-      const Eigen::Vector3d p = P.row(i).transpose();
-      bool inside = !planes.empty();
-      for (const auto& [n, offset] : planes)
-        if (!(n.dot(p) - offset < -margin)) {
-          inside = false;
-          break;
-        }
-      if (inside) continue;
-      pts.emplace_back(p.x(), p.y(), p.z());
-      kept.push_back(i);
+    out.push_back(t);
+  }
+  return out;
+}
+
+// The indices of the points of P not strictly inside the hull of its extreme points along the 26
+// directions of a cube's faces, edges and corners (in order): those inside lie on no face of the whole
+// hull (Akl and Toussaint 1978). "Strictly" by a margin of 1e-6 x the points' extent, far above the
+// planes' rounding.
+std::vector<Eigen::Index> beyond_extreme_hull(PointsRef P) {
+  std::vector<Eigen::Vector3d> dirs;
+  for (int a = -1; a <= 1; ++a)
+    for (int b = -1; b <= 1; ++b)
+      for (int c = -1; c <= 1; ++c)
+        if (a != 0 || b != 0 || c != 0) dirs.emplace_back(a, b, c);
+  std::vector<Eigen::Index> extreme(dirs.size(), 0);
+  std::vector<double> most(dirs.size(), -std::numeric_limits<double>::infinity());
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const Eigen::Vector3d p = P.row(i).transpose();
+    for (std::size_t k = 0; k < dirs.size(); ++k) {
+      const double x = p.dot(dirs[k]);
+      if (x > most[k]) most[k] = x, extreme[k] = i;
     }
   }
+  std::sort(extreme.begin(), extreme.end());
+  extreme.erase(std::unique(extreme.begin(), extreme.end()), extreme.end());
+  std::vector<Point> ext;
+  for (Eigen::Index i : extreme) ext.emplace_back(P(i, 0), P(i, 1), P(i, 2));
+  Mesh inner;
+  if (ext.size() >= 4) CGAL::convex_hull_3(ext.begin(), ext.end(), inner);
+  std::vector<std::pair<Eigen::Vector3d, double>> planes;  // unit outward normal, offset
+  if (inner.number_of_faces() >= 4)
+    for (const auto& q : hull_triangles<Eigen::Vector3d>(inner, [](const Point& p) { return Eigen::Vector3d(p.x(), p.y(), p.z()); })) {
+      const Eigen::Vector3d n = (q[1] - q[0]).cross(q[2] - q[0]);
+      if (n.norm() > 0) planes.emplace_back(n.normalized(), n.normalized().dot(q[0]));
+    }
+  const double margin = 1e-6 * (P.colwise().maxCoeff() - P.colwise().minCoeff()).norm();
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const Eigen::Vector3d p = P.row(i).transpose();
+    const bool inside = !planes.empty() && std::all_of(planes.begin(), planes.end(), [&](const auto& plane) {
+      return plane.first.dot(p) - plane.second < -margin;
+    });
+    if (!inside) kept.push_back(i);
+  }
+  return kept;
+}
+}  // namespace
+
+ConvexHull convex_hull(PointsRef P) {
+  require(P.rows() >= 4, "convex hull: needs at least 4 points, got " + std::to_string(P.rows()));
+  require(P.allFinite(), "convex hull: a point has a non-finite coordinate");
+  const std::vector<Eigen::Index> kept = beyond_extreme_hull(P);  // pts[k] is input point kept[k]
+  std::vector<Point> pts;
+  pts.reserve(kept.size());
+  for (Eigen::Index i : kept) pts.emplace_back(P(i, 0), P(i, 1), P(i, 2));
   // The hull as a Surface_mesh whose vertices carry their input index.
   Mesh hull;
   CGAL::convex_hull_3(pts.begin(), pts.end(), hull);
@@ -97,18 +108,10 @@ ConvexHull convex_hull(PointsRef P) {
   };
   ConvexHull out;
   for (auto v : hull.vertices()) out.vertices.push_back(index_of(hull.point(v)));
-  out.triangles.resize(static_cast<Eigen::Index>(hull.number_of_faces()), 3);
-  Eigen::Index f = 0;
-  for (auto face : hull.faces()) {
-    int k = 0;
-    std::array<Eigen::Index, 3> idx{};
-    for (auto v : CGAL::vertices_around_face(hull.halfedge(face), hull)) {
-      require(k < 3, "convex hull: a hull face is not a triangle");
-      idx[static_cast<std::size_t>(k++)] = index_of(hull.point(v));
-    }
-    for (int c = 0; c < 3; ++c) out.triangles(f, c) = static_cast<int>(idx[static_cast<std::size_t>(c)]);
-    ++f;
-  }
+  const auto triangles = hull_triangles<Eigen::Index>(hull, index_of);
+  out.triangles.resize(static_cast<Eigen::Index>(triangles.size()), 3);
+  for (std::size_t f = 0; f < triangles.size(); ++f)
+    for (int c = 0; c < 3; ++c) out.triangles(static_cast<Eigen::Index>(f), c) = static_cast<int>(triangles[f][static_cast<std::size_t>(c)]);
   return out;
 }
 #else

@@ -161,14 +161,14 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
     // |d - r| < threshold, as r - threshold < d < r + threshold, squared (no root per candidate).
     const double lo = r - o.inlier_threshold_mm, hi = r + o.inlier_threshold_mm;
     const double lo2 = lo > 0 ? lo * lo : -1.0, hi2 = hi * hi;
-    std::int64_t count = 0;
+    std::size_t count = 0;
     for (std::size_t k = 0; k < cand.size(); ++k) {
       const double dx = cx[k] - c.x(), dy = cy[k] - c.y(), dz = cz[k] - c.z();
       const double d2 = dx * dx + dy * dy + dz * dz;
-      count += (d2 > lo2) & (d2 < hi2);
+      count += static_cast<std::size_t>((d2 > lo2) & (d2 < hi2));
     }
-    if (static_cast<std::size_t>(count) > best_count) {
-      best_count = static_cast<std::size_t>(count);
+    if (count > best_count) {
+      best_count = count;
       best_c = c;
       best_r = r;
     }

@@ -86,12 +86,12 @@ void normal_sums(const double* __restrict X, const double* __restrict Y, const d
   auto block = [&](const Lanes& x, const Lanes& y, const Lanes& z, const Lanes& gap, const Lanes& used) {
     const Lanes dx = x - tx, dy = y - ty, dz = z - tz;
     const Lanes n2 = dx * dx + dy * dy + dz * dz;
-    const Lanes finite = gap - gap == 0 ? Lanes{} + 1.0 : Lanes{};  // inf - inf and NaN - NaN are NaN
-    const Lanes on = used * finite;
+    const auto finite = gap - gap == 0;  // inf - inf and NaN - NaN are NaN
+    const Lanes on = finite ? used : Lanes{};
     Lanes len = n2 > 0 ? n2 : Lanes{} + 1.0;  // a vertex at t: w = 0
     for (int l = 0; l < kLanes; ++l) len[l] = std::sqrt(len[l]);
     const Lanes a0 = dx / len * on, a1 = dy / len * on, a2 = dz / len * on, a3 = on;
-    const Lanes gg = gap - gap == 0 ? gap * on : Lanes{};
+    const Lanes gg = finite ? gap * on : Lanes{};
     acc[0] += a0 * a0;
     acc[1] += a1 * a0;
     acc[2] += a1 * a1;

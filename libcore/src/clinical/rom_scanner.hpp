@@ -184,12 +184,6 @@ class CompactScanner {
     if (rho_ball < cap.rho) cap.axis = centre / d, cap.rho = rho_ball, cap.sin_rho = c.ball_radius / d;
     return cap;
   }
-  // The cap of every pose (M Q, s + e) near P = (M, s): Q a rotation by at most kReuseRad, |e| <=
-  // kReuseShiftMm. Without translation (s = 0, e = 0) the cone widened by kReuseRad. Otherwise a
-  // vertex x = M p + s moves by at most |(Q - I) p| + |e| <= 2 r_max sin(kReuseRad / 2) + |e|, which
-  // turns it by at most the asin of that over its radius; its squared radius changes by at most
-  // 2 |s| |(Q - I) p| (a rotation about the origin keeps |p|), and then by |e|.
-  // wide: for rotations within kWideReuseRad instead (a bound that serves more poses, tried first).
   // This pose's cap of one cluster (cap_of), computed once however many of its bounds ask for it.
   struct PoseCap {
     const Cluster& c;
@@ -201,7 +195,13 @@ class CompactScanner {
       return *cap;
     }
   };
-  // here: the cluster's PoseCap at P.
+  // The cap of every pose (M Q, s + e) near P = (M, s): Q a rotation by at most kReuseRad, |e| <=
+  // kReuseShiftMm. Without translation (s = 0, e = 0) the cone widened by kReuseRad. Otherwise a
+  // vertex x = M p + s moves by at most |(Q - I) p| + |e| <= 2 r_max sin(kReuseRad / 2) + |e|, which
+  // turns it by at most the asin of that over its radius; its squared radius changes by at most
+  // 2 |s| |(Q - I) p| (a rotation about the origin keeps |p|), and then by |e|.
+  // wide: for rotations within kWideReuseRad instead (a bound that serves more poses, tried first).
+  // here: the cluster's PoseCap at P (its cap_of, computed once).
   static Cap reuse_cap_of(const Cluster& c, const Rigid& P, bool wide, PoseCap& here) {
     const double angle = wide ? kWideReuseRad : kReuseRad;
     if (P.shift == 0)
