@@ -68,6 +68,57 @@ TEST(SignedDistance, ClosestMatchesCgalAndSignMatchesTheSphere) {
   EXPECT_GT(checked, 1900);
 }
 
+// A soup of triangles of every shape (acute, right, obtuse, needles and slivers a thousand times
+// longer than wide), at every scale from 0.01 to 10 mm: the closest distance equals CGAL's for points
+// near and among them, with and without a seed (each triangle is first tested by its bounding ball,
+// which must hold it whatever its shape).
+TEST(SignedDistance, ClosestMatchesCgalOnTrianglesOfEveryShape) {
+  if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> U(0, 1);
+  TriangleMesh soup;
+  const int n = 600;
+  soup.V.resize(3 * n, 3);
+  soup.F.resize(n, 3);
+  for (int t = 0; t < n; ++t) {
+    const Eigen::Vector3d o(40 * U(rng), 40 * U(rng), 40 * U(rng));
+    const double size = std::pow(10.0, -2 + 3 * U(rng));
+    const Eigen::Vector3d e = direction(std::acos(2 * U(rng) - 1), 2 * kPi * U(rng));
+    Eigen::Vector3d f = e.unitOrthogonal();
+    f = Eigen::AngleAxisd(2 * kPi * U(rng), e) * f;
+    Eigen::Vector3d a = o, b = o + size * e, c;
+    switch (t % 4) {
+      case 0: c = o + size * (U(rng) * e + U(rng) * f); break;                   // any
+      case 1: c = o + size * f; break;                                            // right
+      case 2: c = o + size * ((1.5 + U(rng)) * e + 0.2 * U(rng) * f); break;      // obtuse, long
+      default: c = o + size * (U(rng) * e + 1e-3 * (0.5 + U(rng)) * f); break;    // sliver
+    }
+    soup.V.row(3 * t) = a.transpose(), soup.V.row(3 * t + 1) = b.transpose(), soup.V.row(3 * t + 2) = c.transpose();
+    soup.F.row(t) << 3 * t, 3 * t + 1, 3 * t + 2;
+  }
+  soup.source = "soup";
+  const SignedDistanceQuery q(soup);
+  const ExactReference ref(soup);
+  std::int64_t seed = -1;
+  for (int k = 0; k < 3000; ++k) {
+    Eigen::Vector3d p;
+    if (k % 2 == 0) {  // near a triangle's corner
+      p = soup.V.row(static_cast<Eigen::Index>(rng() % (3 * n))).transpose();
+      p += 0.05 * Eigen::Vector3d(U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5);
+    } else {
+      p = Eigen::Vector3d(-5 + 50 * U(rng), -5 + 50 * U(rng), -5 + 50 * U(rng));
+    }
+    const double exact = ref.closest_distance(p);
+    ClosestSurfacePoint cp;
+    ASSERT_TRUE(q.closest(p, std::numeric_limits<double>::infinity(), cp));
+    EXPECT_NEAR(cp.distance_mm, exact, 1e-9) << k;
+    ClosestSurfacePoint seeded;
+    ASSERT_TRUE(q.signed_distance(p, exact + 1e-6, 0, seeded, seed));
+    EXPECT_NEAR(seeded.distance_mm, exact, 1e-9) << k;
+    seed = seeded.triangle;
+  }
+}
+
 TEST(SignedDistance, BoxWoundEitherWay) {
   if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
   const TriangleMesh box = test::make_box({-5, -5, -5}, {5, 10, 5});

@@ -48,6 +48,19 @@ Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vecto
 
 constexpr double kBoxMarginMm = 1e-3;  // the float hierarchy's boxes against the double triangles
 
+/// The centre of the smallest ball holding triangle (a, b, c): the middle of the longest edge when the
+/// angle opposite it is not acute, the circumcentre otherwise (the radius is taken from the corners).
+Eigen::Vector3d smallest_ball_centre(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const std::array<const Eigen::Vector3d*, 3> p{&a, &b, &c};
+  for (int e = 0; e < 3; ++e) {  // corner e, opposite edge (e + 1, e + 2)
+    const Eigen::Vector3d& u = *p[(e + 1) % 3];
+    const Eigen::Vector3d& v = *p[(e + 2) % 3];
+    if ((u - *p[e]).dot(v - *p[e]) <= 0) return (u + v) / 2;
+  }
+  const Eigen::Vector3d ab = b - a, ac = c - a, n = ab.cross(ac);
+  return a + (ac.squaredNorm() * n.cross(ab) + ab.squaredNorm() * ac.cross(n)) / (2 * n.squaredNorm());
+}
+
 }  // namespace
 
 struct SignedDistanceQuery::Impl {
@@ -73,6 +86,7 @@ struct SignedDistanceQuery::Impl {
   std::vector<Node> nodes;
   std::vector<std::int32_t> order;
   std::vector<Eigen::Vector3d> area_vector, centroid;  // per kept triangle, for the hierarchy's build
+  std::vector<Eigen::Vector4d> sphere;  // per kept triangle: its smallest bounding ball (centre, radius)
   std::int32_t build_node(std::int32_t begin, std::int32_t end);
   void build_hierarchy();
 
@@ -240,6 +254,12 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   }
   irregular_edges_ = irregular;
   m.build_hierarchy();
+  m.sphere.resize(k);
+  for (std::size_t t = 0; t < k; ++t) {
+    const Eigen::Vector3d o = smallest_ball_centre(m.a[t], m.b[t], m.c[t]);
+    const double r2 = std::max({(m.a[t] - o).squaredNorm(), (m.b[t] - o).squaredNorm(), (m.c[t] - o).squaredNorm()});
+    m.sphere[t] << o, std::sqrt(r2) * (1 + 1e-12) + 1e-12;
+  }
   // Corners: normals weighted by the triangle's angle there.
   for (std::size_t t = 0; t < k; ++t) {
     const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
@@ -306,6 +326,9 @@ struct Search {
 #ifdef IMPINGE_HAVE_EMBREE
 bool visit(RTCPointQueryFunctionArguments* args) {
   auto* s = static_cast<Search*>(args->userPtr);
+  const Eigen::Vector4d& ball = s->m->sphere[args->primID];
+  const double reach = s->best + ball[3];
+  if ((s->q - ball.head<3>()).squaredNorm() > reach * reach) return false;  // its ball is farther than the best
   Eigen::Vector3d point;
   int feature = 0;
   const double d = s->m->distance_to(args->primID, s->q, point, feature);
