@@ -132,12 +132,18 @@ std::int32_t SignedDistanceQuery::Impl::build_node(std::int32_t begin, std::int3
     lo = lo.cwiseMin(g), hi = hi.cwiseMax(g);
   }
   n.centre /= total;
+  double moment[3][3] = {};  // summed in plain accumulators (an Eigen temporary per term went through memory)
   for (std::int32_t k = begin; k < end; ++k) {
     const auto t = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
     n.radius = std::max({n.radius, (a[t] - n.centre).squaredNorm(), (b[t] - n.centre).squaredNorm(),
                          (c[t] - n.centre).squaredNorm()});
-    n.moment += (centroid[t] - n.centre) * area_vector[t].transpose();
+    const Eigen::Vector3d d = centroid[t] - n.centre;
+    const Eigen::Vector3d& av = area_vector[t];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) moment[i][j] += d[i] * av[j];
   }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) n.moment(i, j) = moment[i][j];
   n.radius = std::sqrt(n.radius);
   if (end - begin > 8) {
     int axis = 0;
