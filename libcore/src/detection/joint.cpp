@@ -81,7 +81,7 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
                        std::optional<RadialDistanceMap> given) {
   validate_mesh(mesh);
   JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0, nullptr, nullptr, {}, {},
-              nullptr, {}};
+              nullptr, {}, {}};
   b.relative = b.mesh.V.rowwise() - cor.transpose();
   if (given) {
     const SamplingScheme& want = *options.scheme;
