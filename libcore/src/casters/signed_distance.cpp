@@ -47,6 +47,7 @@ Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vecto
 }
 
 constexpr double kBoxMarginMm = 1e-3;  // the float hierarchy's boxes against the double triangles
+constexpr double kPlaneMarginMm = 1e-9;  // a triangle's plane distance against its exact distance
 
 /// The centre of the smallest ball holding triangle (a, b, c): the middle of the longest edge when the
 /// angle opposite it is not acute, the circumcentre otherwise (the radius is taken from the corners).
@@ -86,7 +87,15 @@ struct SignedDistanceQuery::Impl {
   std::vector<Node> nodes;
   std::vector<std::int32_t> order;
   std::vector<Eigen::Vector3d> area_vector, centroid;  // per kept triangle, for the hierarchy's build
-  std::vector<Eigen::Vector4d> sphere;  // per kept triangle: its smallest bounding ball (centre, radius)
+  // Per kept triangle, two lower bounds of the distance from q to it: its smallest bounding ball
+  // (|q - centre| - radius) and its plane (|normal . q - offset|, normal unit).
+  struct Bound {
+    Eigen::Vector3d centre;
+    double radius;
+    Eigen::Vector3d normal;
+    double offset;
+  };
+  std::vector<Bound> bound;
   std::int32_t build_node(std::int32_t begin, std::int32_t end);
   void build_hierarchy();
 
@@ -260,11 +269,15 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   }
   irregular_edges_ = irregular;
   m.build_hierarchy();
-  m.sphere.resize(k);
+  m.bound.resize(k);
   for (std::size_t t = 0; t < k; ++t) {
-    const Eigen::Vector3d o = smallest_ball_centre(m.a[t], m.b[t], m.c[t]);
-    const double r2 = std::max({(m.a[t] - o).squaredNorm(), (m.b[t] - o).squaredNorm(), (m.c[t] - o).squaredNorm()});
-    m.sphere[t] << o, std::sqrt(r2) * (1 + 1e-12) + 1e-12;
+    Impl::Bound& b = m.bound[t];
+    b.centre = smallest_ball_centre(m.a[t], m.b[t], m.c[t]);
+    const double r2 = std::max({(m.a[t] - b.centre).squaredNorm(), (m.b[t] - b.centre).squaredNorm(),
+                                (m.c[t] - b.centre).squaredNorm()});
+    b.radius = std::sqrt(r2) * (1 + 1e-12) + 1e-12;
+    b.normal = m.face_normal[t];
+    b.offset = b.normal.dot(m.a[t]);
   }
   // Corners: normals weighted by the triangle's angle there.
   for (std::size_t t = 0; t < k; ++t) {
@@ -332,9 +345,11 @@ struct Search {
 #ifdef IMPINGE_HAVE_EMBREE
 bool visit(RTCPointQueryFunctionArguments* args) {
   auto* s = static_cast<Search*>(args->userPtr);
-  const Eigen::Vector4d& ball = s->m->sphere[args->primID];
-  const double reach = s->best + ball[3];
-  if ((s->q - ball.head<3>()).squaredNorm() > reach * reach) return false;  // its ball is farther than the best
+  const SignedDistanceQuery::Impl::Bound& b = s->m->bound[args->primID];
+  const double reach = s->best + b.radius;
+  if ((s->q - b.centre).squaredNorm() > reach * reach) return false;  // its ball is farther than the best
+  // Its plane is farther (the margin: rounding of the dot product at bone coordinates, about 1e-13 mm).
+  if (std::abs(b.normal.dot(s->q) - b.offset) > s->best + kPlaneMarginMm) return false;
   Eigen::Vector3d point;
   int feature = 0;
   const double d = s->m->distance_to(args->primID, s->q, point, feature);
