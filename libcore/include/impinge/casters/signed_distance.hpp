@@ -8,8 +8,9 @@
 /// the build has Embree, a BVH in float whose boxes are widened by 1e-3 mm; CGAL's AABB tree otherwise),
 /// and the closest point of each candidate triangle in double (Ericson 2005, Real-Time Collision
 /// Detection, sec. 5.1.5), which also names the feature (face, edge or corner) it lies on. With Embree,
-/// a candidate whose smallest bounding ball lies farther than the best distance so far is left out
-/// before that (about half of them near a bone).
+/// a candidate is left out before that when either of two lower bounds of its distance exceeds the best
+/// distance so far: its smallest bounding ball's (|q - o| - r) or its plane's (|n . q - n . a|, beyond a
+/// 1e-9 mm margin for rounding). Near a bone that settles about half the candidates.
 ///
 /// Sign, the rule (SignRule):
 /// 1. The angle-weighted pseudo-normal of the closest feature (Baerentzen & Aanaes 2005, IEEE TVCG
