@@ -17,6 +17,7 @@
 #include <fstream>
 #include <functional>
 #include <sstream>
+#include <thread>
 
 #include <omp.h>
 
@@ -212,9 +213,9 @@ TEST(Session, MotionRunEqualsDetectAtEachPose) {
   EXPECT_THROW(run_motion(s, poses, {0.0}, [](const MotionFrame&) {}), Error);
 }
 
-// Frames are scanned in blocks on every thread, then handed over in order: 40 poses (several blocks) on
-// one thread and on two give the same rows, frame by frame, each the detection at that frame's pose; an
-// error thrown by the callback stops the run there.
+// Frames are scanned in blocks on every thread and handed over in order, on the calling thread, while the
+// next block is scanned: 40 poses (several blocks) on one thread and on two give the same rows, frame by
+// frame, each the detection at that frame's pose; an error thrown by the callback stops the run there.
 TEST(Session, MotionRunOnTwoThreadsEqualsOneInOrder) {
   const Session s(generated_options("RAS"));
   std::vector<PoseAngles> poses;
@@ -224,7 +225,9 @@ TEST(Session, MotionRunOnTwoThreadsEqualsOneInOrder) {
     Table t;
     t.columns = motion_columns(s.joint_options().levels);
     std::vector<std::size_t> order;
+    const std::thread::id caller = std::this_thread::get_id();
     run_motion(s, poses, {}, [&](const MotionFrame& f) {
+      EXPECT_EQ(std::this_thread::get_id(), caller) << f.index;  // on the calling thread, as documented
       order.push_back(f.index);
       PoseResult r;
       s.joint().detect(f.pose.R, f.pose.t, r);
@@ -251,6 +254,18 @@ TEST(Session, MotionRunOnTwoThreadsEqualsOneInOrder) {
                           }),
                Error);
   EXPECT_EQ(delivered, 21u);
+  // A pose that cannot be scanned (a NaN angle) at frame 25: every frame before it is handed over, in
+  // order, then its error is thrown; on one thread and on two.
+  std::vector<PoseAngles> bad = poses;
+  bad[25].flexion_deg = std::nan("");
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    std::vector<std::size_t> seen;
+    EXPECT_THROW(run_motion(s, bad, {}, [&](const MotionFrame& f) { seen.push_back(f.index); }), Error) << threads;
+    ASSERT_EQ(seen.size(), 25u) << threads;
+    for (std::size_t k = 0; k < seen.size(); ++k) EXPECT_EQ(seen[k], k);
+  }
+  omp_set_num_threads(before);
 }
 
 TEST(Session, RomRunEqualsTheLibraryCalls) {

@@ -1,9 +1,12 @@
 #include "impinge/session/runs.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <memory>
+#include <thread>
 
 #include <omp.h>
 
@@ -74,33 +77,77 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
                   const std::function<void(const MotionFrame&)>& on_frame) {
   require(time_s.empty() || time_s.size() == angles.size(),
           "motion: " + std::to_string(time_s.size()) + " times for " + std::to_string(angles.size()) + " poses");
-  // Frames are independent: a block of them is scanned on every OpenMP thread, then handed to
-  // on_frame one by one, in order, on the calling thread. Each slot keeps its PoseResult, so after the
-  // first block no pose allocates.
+  // Frames are independent, and are scanned on every OpenMP thread, each taking the next frame as soon
+  // as it is free (no block waits for its slowest frame). They go through a ring of slots, each keeping
+  // its PoseResult (after the first lap no pose allocates): frame k is scanned into slot k % ring once
+  // frame k - ring has been handed over. The calling thread (OpenMP's master) hands the frames to
+  // on_frame in order as they become ready (writing a VTP file then hides behind the other threads'
+  // scans), and scans a frame itself whenever the next one to hand over is not ready yet.
+  const auto n = static_cast<std::int64_t>(angles.size());
+  if (n == 0) return 0;
   const int threads = std::max(1, omp_get_max_threads());
-  const std::size_t block = std::max<std::size_t>(1, std::min(angles.size(), static_cast<std::size_t>(8 * threads)));
-  std::vector<PoseResult> results(block);
-  std::vector<MotionFrame> frames(block);
-  double detect_ms = 0;
-  for (std::size_t first = 0; first < angles.size(); first += block) {
-    const auto m = static_cast<std::int64_t>(std::min(block, angles.size() - first));
-    const auto t_block = Clock::now();
-    std::exception_ptr error;  // the first frame's error, rethrown after the block
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (m > 1)
-    for (std::int64_t j = 0; j < m; ++j) {
-      const std::size_t k = first + static_cast<std::size_t>(j);
-      try {
-        scan_frame(s, k, angles[k], time_s.empty() ? static_cast<double>(k) : time_s[k],
-                   frames[static_cast<std::size_t>(j)], results[static_cast<std::size_t>(j)]);
-      } catch (...) {
-#pragma omp critical(impinge_motion_error)
-        if (!error) error = std::current_exception();
+  const auto ring = static_cast<std::int64_t>(std::min<std::size_t>(angles.size(), 16 * static_cast<std::size_t>(threads)));
+  std::vector<PoseResult> results(static_cast<std::size_t>(ring));
+  std::vector<MotionFrame> frames(static_cast<std::size_t>(ring));
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(ring));  // a frame's scan error, in its slot
+  std::unique_ptr<std::atomic<std::int64_t>[]> scanned(new std::atomic<std::int64_t>[static_cast<std::size_t>(ring)]);
+  for (std::int64_t r = 0; r < ring; ++r) scanned[static_cast<std::size_t>(r)] = -1;  // the frame in the slot
+  std::atomic<std::int64_t> next{0};       // the next frame to scan
+  std::atomic<std::int64_t> handed{0};     // frames handed over (frame k may use its slot once k < handed + ring)
+  std::atomic<bool> stop{false};           // an error: scan no more
+  std::exception_ptr error;                // rethrown after the threads end: on_frame's, or the first frame's scan error
+  auto scan = [&](std::int64_t k) {
+    const auto slot = static_cast<std::size_t>(k % ring);
+    errors[slot] = nullptr;
+    try {
+      scan_frame(s, static_cast<std::size_t>(k), angles[static_cast<std::size_t>(k)],
+                 time_s.empty() ? static_cast<double>(k) : time_s[static_cast<std::size_t>(k)], frames[slot], results[slot]);
+    } catch (...) {
+      errors[slot] = std::current_exception();
+    }
+    scanned[slot].store(k, std::memory_order_release);
+  };
+  const auto t0 = Clock::now();
+#pragma omp parallel num_threads(threads)
+  {
+    if (omp_get_thread_num() == 0) {
+      for (std::int64_t d = 0; d < n && !stop;) {
+        const auto slot = static_cast<std::size_t>(d % ring);
+        if (scanned[slot].load(std::memory_order_acquire) == d) {
+          if (errors[slot]) {
+            error = errors[slot];
+            stop = true;
+            break;
+          }
+          try {
+            on_frame(frames[slot]);
+          } catch (...) {
+            error = std::current_exception();
+            stop = true;
+            break;
+          }
+          handed.store(++d, std::memory_order_release);
+          continue;
+        }
+        std::int64_t k = next.load();  // help: scan the next frame if its slot is free
+        if (k < n && k < d + ring && next.compare_exchange_strong(k, k + 1))
+          scan(k);
+        else
+          std::this_thread::yield();
+      }
+      stop = true;
+    } else {
+      for (;;) {
+        const std::int64_t k = next.fetch_add(1);
+        if (k >= n) break;
+        while (k >= handed.load(std::memory_order_acquire) + ring && !stop) std::this_thread::yield();
+        if (stop) break;
+        scan(k);
       }
     }
-    detect_ms += ms_since(t_block);
-    if (error) std::rethrow_exception(error);
-    for (std::int64_t j = 0; j < m; ++j) on_frame(frames[static_cast<std::size_t>(j)]);
   }
+  const double detect_ms = ms_since(t0);
+  if (error) std::rethrow_exception(error);
   return detect_ms;
 }
 

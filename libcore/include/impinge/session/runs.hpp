@@ -44,10 +44,14 @@ std::vector<std::string> motion_columns(const ImpingementLevels& levels);
 nlohmann::json motion_row(const MotionFrame& frame);
 
 /// Both scans at every pose of `angles` (k poses, degrees; `time_s`: k times or empty for the
-/// index), calling `on_frame` for each, in order, on the calling thread. Blocks of frames are scanned
-/// on the OpenMP threads (omp_get_max_threads) first. Returns the wall time of those scans, ms (the
-/// frames' own detection_ms add up to more on several threads). Throws what `on_frame` throws, or the
-/// first error of a frame's scan; times of another length than the angles are an error.
+/// index), calling `on_frame` for each, in order, on the calling thread. The frames are scanned on the
+/// OpenMP threads (omp_get_max_threads), each taking the next frame, at most 16 per thread ahead of the
+/// last frame handed over; the calling thread hands the frames over as they become ready and scans when
+/// the next one is not, so that what `on_frame` does (writing a file) overlaps the other threads' scans.
+/// Returns the wall time of the scans and the hand-overs, ms (the frames' own detection_ms add up to
+/// more on several threads). Throws what `on_frame` throws (no frame after it is handed over), or the
+/// error of the first frame whose scan failed (after the frames before it are handed over); times of
+/// another length than the angles are an error.
 double run_motion(const Session& session, const std::vector<PoseAngles>& angles, const std::vector<double>& time_s,
                   const std::function<void(const MotionFrame&)>& on_frame);
 
