@@ -159,12 +159,14 @@ TEST(JointCentre, EquidistantLimitsHoldUnderAMillimetreMoveOfTheCentre) {
     return find_rom_limits(hip, standard_motions(), ro, rom_baseline(hip, hip.femur_rotation({}), ro));
   };
   const auto base = limits_about(head.centre);
-  for (const Eigen::Vector3d d : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1)}) {
+  for (const Eigen::Vector3d& d : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1)}) {
     const auto moved = limits_about(head.centre + d);
     for (std::size_t k = 0; k < base.size(); ++k) {
       SCOPED_TRACE(standard_motions()[k].name);
       ASSERT_EQ(std::isnan(base[k].limit_deg), std::isnan(moved[k].limit_deg));
-      if (!std::isnan(base[k].limit_deg)) EXPECT_LE(std::abs(moved[k].limit_deg - base[k].limit_deg), 3.0);
+      if (!std::isnan(base[k].limit_deg)) {
+        EXPECT_LE(std::abs(moved[k].limit_deg - base[k].limit_deg), 3.0);
+      }
     }
   }
 }

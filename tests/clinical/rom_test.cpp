@@ -179,8 +179,12 @@ TEST(Rom, OnlyTheJointSurfacesMeetingIsArticularAndItNeverEndsASearch) {
           EXPECT_TRUE(s.contact_at_start);
         }
       }
-      if (!std::isnan(li[k].limit_deg)) EXPECT_NE(li[k].contact_class, ContactClass::articular);
-      if (!std::isnan(lj[k].limit_deg)) EXPECT_EQ(lj[k].contact_class, ContactClass::articular);
+      if (!std::isnan(li[k].limit_deg)) {
+        EXPECT_NE(li[k].contact_class, ContactClass::articular);
+      }
+      if (!std::isnan(lj[k].limit_deg)) {
+        EXPECT_EQ(lj[k].contact_class, ContactClass::articular);
+      }
     }
   }
   if (subjects == 0) GTEST_SKIP() << "shared data absent";
