@@ -88,7 +88,8 @@ struct SignedDistanceQuery::Impl {
   std::vector<std::int32_t> order;
   std::vector<Eigen::Vector3d> area_vector, centroid;  // per kept triangle, for the hierarchy's build
   // Per kept triangle, two lower bounds of the distance from q to it: its smallest bounding ball
-  // (|q - centre| - radius) and its plane (|normal . q - offset|, normal unit).
+  // (|q - centre| - radius) and its plane (|normal . q - offset|; normal is face_normal's, copied so
+  // that the point query's callback reads one cache line per candidate).
   struct Bound {
     Eigen::Vector3d centre;
     double radius;

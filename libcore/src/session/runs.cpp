@@ -5,7 +5,6 @@
 #include <cmath>
 #include <exception>
 #include <limits>
-#include <memory>
 #include <thread>
 
 #include <omp.h>
@@ -90,11 +89,11 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
   std::vector<PoseResult> results(static_cast<std::size_t>(ring));
   std::vector<MotionFrame> frames(static_cast<std::size_t>(ring));
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(ring));  // a frame's scan error, in its slot
-  std::unique_ptr<std::atomic<std::int64_t>[]> scanned(new std::atomic<std::int64_t>[static_cast<std::size_t>(ring)]);
-  for (std::int64_t r = 0; r < ring; ++r) scanned[static_cast<std::size_t>(r)] = -1;  // the frame in the slot
+  std::vector<std::atomic<std::int64_t>> scanned(static_cast<std::size_t>(ring));  // the frame in the slot
+  for (auto& k : scanned) k = -1;
   std::atomic<std::int64_t> next{0};       // the next frame to scan
   std::atomic<std::int64_t> handed{0};     // frames handed over (frame k may use its slot once k < handed + ring)
-  std::atomic<bool> stop{false};           // an error: scan no more
+  std::atomic<bool> stop{false};           // the hand-overs ended (done, or an error): scan no more
   std::exception_ptr error;                // rethrown after the threads end: on_frame's, or the first frame's scan error
   auto scan = [&](std::int64_t k) {
     const auto slot = static_cast<std::size_t>(k % ring);
@@ -111,19 +110,14 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
 #pragma omp parallel num_threads(threads)
   {
     if (omp_get_thread_num() == 0) {
-      for (std::int64_t d = 0; d < n && !stop;) {
+      for (std::int64_t d = 0; d < n;) {
         const auto slot = static_cast<std::size_t>(d % ring);
         if (scanned[slot].load(std::memory_order_acquire) == d) {
-          if (errors[slot]) {
-            error = errors[slot];
-            stop = true;
-            break;
-          }
-          try {
+          try {  // the frame's scan error, or on_frame's, ends the hand-overs
+            if (errors[slot]) std::rethrow_exception(errors[slot]);
             on_frame(frames[slot]);
           } catch (...) {
             error = std::current_exception();
-            stop = true;
             break;
           }
           handed.store(++d, std::memory_order_release);
