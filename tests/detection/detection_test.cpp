@@ -6,7 +6,8 @@
 //  - a ball pushed into the cup reports penetration with the analytic depth;
 //  - vertices hidden behind their own first surface are skipped and counted, not reported;
 //  - the fast scan with a translation matches CGAL's exact radial gap, and Joint::detect the
-//    fast scan; a scan set keeps exactly the masked vertices.
+//    fast scan; a scan set keeps exactly the masked vertices;
+//  - a scan's summary and clock summary match brute-force counts on random scans.
 #include "impinge/detection/detection.hpp"
 
 #include <gtest/gtest.h>
@@ -14,8 +15,10 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "impinge/anatomy/pose.hpp"
+#include "impinge/clinical/clock_summary.hpp"
 #include "impinge/casters/exact_reference.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
@@ -146,6 +149,105 @@ TEST(Detection, ScanOfMaskedAndNoSurfaceVertices) {
   EXPECT_EQ(s.vertices_beyond_reach, 1);
   EXPECT_EQ(s.vertices_penetrating, 1);
   EXPECT_FLOAT_EQ(s.min_gap_mm, -2);
+}
+
+// summarize_scan against a brute-force reading of its documentation, on random scans that mix every status
+// with and without a gap and a distance (a vertex beyond reach may still carry either: ScanGaps is public),
+// levels on the radial gap and on the distance; and clock_summary against the same reading of its own.
+TEST(Detection, ScanSummaryMatchesABruteForceCount) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  const ImpingementLevels levels;  // 4, 2.667, 1.333, 0 mm
+  for (int trial = 0; trial < 40; ++trial) {
+    const std::size_t n = 1 + static_cast<std::size_t>(u(rng) * 300);
+    ScanGaps g;
+    const bool has_distance = trial % 4 != 0;
+    Eigen::VectorXd area(static_cast<Eigen::Index>(n));
+    std::vector<double> hours(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto status = static_cast<std::uint8_t>(std::min(3.0, std::floor(u(rng) * 4)));
+      g.status.push_back(status);
+      const bool gap = status == ScanGaps::tested || status == ScanGaps::tested_layered || u(rng) < 0.1;
+      g.gap_mm.push_back(gap ? static_cast<float>(u(rng) * 12 - 4) : std::nanf(""));
+      if (has_distance) g.distance_mm.push_back(u(rng) < 0.5 ? static_cast<float>(u(rng) * 10 - 3) : std::nanf(""));
+      area[static_cast<Eigen::Index>(i)] = 0.1 + u(rng);
+      hours[i] = u(rng) < 0.1 ? std::nan("") : u(rng) * 12;
+    }
+    g.distance_winding = trial;
+    for (LevelQuantity q : {LevelQuantity::radial_gap, LevelQuantity::distance}) {
+      const ScanSummary s = summarize_scan(g, area, levels, q);
+      const bool by_distance = q == LevelQuantity::distance && has_distance;
+      std::int64_t tested = 0, layered = 0, no_surface = 0, beyond = 0, penetrating = 0, measured = 0, inside = 0;
+      double min_gap = INFINITY, min_layered = INFINITY, min_distance = INFINITY, a_pen = 0, a_in = 0;
+      std::vector<std::int64_t> count(static_cast<std::size_t>(levels.count()), 0);
+      std::vector<double> level_area(count.size(), 0.0), sector(static_cast<std::size_t>(12 * levels.count()), 0.0);
+      double closest = INFINITY, closest_hour = std::nan("");
+      for (std::size_t i = 0; i < n; ++i) {
+        const double a = area[static_cast<Eigen::Index>(i)], gap = g.gap_mm[i];
+        const double d = has_distance ? g.distance_mm[i] : std::nan("");
+        const bool is_tested = g.status[i] == ScanGaps::tested || g.status[i] == ScanGaps::tested_layered;
+        beyond += g.status[i] == ScanGaps::beyond_reach;
+        no_surface += g.status[i] == ScanGaps::no_surface;
+        if (is_tested) {
+          ++tested;
+          min_gap = std::min(min_gap, gap);
+          if (g.status[i] == ScanGaps::tested_layered) ++layered, min_layered = std::min(min_layered, gap);
+          if (gap <= 0) ++penetrating, a_pen += a;
+        }
+        if (!std::isnan(d)) {
+          ++measured;
+          min_distance = std::min(min_distance, d);
+          if (d < 0) ++inside, a_in += a;
+        }
+        int level = 255;
+        if (by_distance)
+          level = !std::isnan(d) ? levels.level(d) : is_tested ? 0 : 255;
+        else if (!std::isnan(gap))
+          level = levels.level(gap);
+        if (level == 255) continue;
+        ++count[static_cast<std::size_t>(level)];
+        level_area[static_cast<std::size_t>(level)] += a;
+        if (std::isnan(hours[i])) continue;
+        sector[static_cast<std::size_t>(ClockFace::sector(hours[i]) * levels.count() + level)] += a;
+        const double value = by_distance ? d : gap;
+        if (value < closest) closest = value, closest_hour = hours[i];
+      }
+      EXPECT_EQ(s.vertices, static_cast<std::int64_t>(n));
+      EXPECT_EQ(s.vertices_tested, tested);
+      EXPECT_EQ(s.vertices_tested_layered, layered);
+      EXPECT_EQ(s.vertices_no_surface, no_surface);
+      EXPECT_EQ(s.vertices_beyond_reach, beyond);
+      EXPECT_EQ(s.vertices_penetrating, penetrating);
+      EXPECT_NEAR(s.area_penetrating_mm2, a_pen, 1e-9);
+      EXPECT_EQ(s.vertices_distance, measured);
+      EXPECT_EQ(s.vertices_inside, inside);
+      EXPECT_NEAR(s.area_inside_mm2, a_in, 1e-9);
+      EXPECT_EQ(s.distance_winding, trial);
+      if (tested > 0) EXPECT_EQ(s.min_gap_mm, min_gap); else EXPECT_TRUE(std::isnan(s.min_gap_mm));
+      if (layered > 0) EXPECT_EQ(s.min_gap_layered_mm, min_layered); else EXPECT_TRUE(std::isnan(s.min_gap_layered_mm));
+      if (measured > 0) EXPECT_EQ(s.min_distance_mm, min_distance); else EXPECT_TRUE(std::isnan(s.min_distance_mm));
+      EXPECT_EQ(s.levels_on, by_distance ? LevelQuantity::distance : LevelQuantity::radial_gap);
+      EXPECT_EQ(s.level_vertices, count);
+      for (std::size_t k = 0; k < count.size(); ++k) EXPECT_NEAR(s.level_area_mm2[k], level_area[k], 1e-9);
+      ClockSummary c;
+      clock_summary(g, hours, area, levels, c, q);
+      ASSERT_EQ(c.sector_level_area_mm2.size(), sector.size());
+      for (std::size_t k = 0; k < sector.size(); ++k) EXPECT_NEAR(c.sector_level_area_mm2[k], sector[k], 1e-9);
+      if (std::isnan(closest_hour)) EXPECT_TRUE(std::isnan(c.closest_hour)); else EXPECT_EQ(c.closest_hour, closest_hour);
+    }
+  }
+  // Arrays of different lengths are refused, naming the counts.
+  ScanGaps bad;
+  bad.gap_mm = {1.0f, 2.0f};
+  bad.status = {ScanGaps::tested};
+  EXPECT_THROW(summarize_scan(bad, Eigen::VectorXd::Ones(2), levels), Error);
+  ClockSummary c;
+  EXPECT_THROW(clock_summary(bad, std::vector<double>(2, 1.0), Eigen::VectorXd::Ones(2), levels, c), Error);
+  bad.status.push_back(ScanGaps::tested);
+  EXPECT_THROW(summarize_scan(bad, Eigen::VectorXd::Ones(3), levels), Error);
+  bad.distance_mm = {0.5f};
+  EXPECT_THROW(summarize_scan(bad, Eigen::VectorXd::Ones(2), levels), Error);
+  EXPECT_THROW(clock_summary(bad, std::vector<double>(2, 1.0), Eigen::VectorXd::Ones(2), levels, c), Error);
 }
 
 // The fast scan with a translation against the exact radial gap (CGAL), and the scan set: the

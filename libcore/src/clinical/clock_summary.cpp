@@ -22,11 +22,20 @@ void clock_summary(const ScanGaps& gaps, const std::vector<double>& hours, const
                    const ImpingementLevels& levels, ClockSummary& out, LevelQuantity levels_on) {
   require(hours.size() == gaps.gap_mm.size(), "clock summary: " + std::to_string(hours.size()) + " hours for " +
                                                   std::to_string(gaps.gap_mm.size()) + " vertices");
+  require(gaps.status.size() == gaps.gap_mm.size() &&
+              (gaps.distance_mm.empty() || gaps.distance_mm.size() == gaps.gap_mm.size()),
+          "clock summary: " + std::to_string(gaps.gap_mm.size()) + " gaps with " + std::to_string(gaps.status.size()) +
+              " statuses and " + std::to_string(gaps.distance_mm.size()) + " distances");
   const bool by_distance = levels_on == LevelQuantity::distance && !gaps.distance_mm.empty();
   out.sector_level_area_mm2.assign(static_cast<std::size_t>(12 * levels.count()), 0.0);
   out.closest_hour = std::nan("");
   float best = std::numeric_limits<float>::infinity();
+  const bool has_distance = !gaps.distance_mm.empty();
   for (std::size_t i = 0; i < gaps.gap_mm.size(); ++i) {
+    // Most vertices are beyond reach, with neither a gap nor a distance: no level (vertex_level's 255).
+    if (gaps.status[i] == ScanGaps::beyond_reach && std::isnan(gaps.gap_mm[i]) &&
+        (!has_distance || std::isnan(gaps.distance_mm[i])))
+      continue;
     const double h = hours[i];
     if (std::isnan(h)) continue;
     const std::uint8_t level = vertex_level(gaps, i, levels, levels_on);

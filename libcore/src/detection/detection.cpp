@@ -272,6 +272,11 @@ std::uint8_t vertex_level(const ScanGaps& g, std::size_t i, const ImpingementLev
 
 void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const ImpingementLevels& levels, ScanSummary& s,
                     LevelQuantity levels_on) {
+  require(g.status.size() == g.gap_mm.size() && (g.distance_mm.empty() || g.distance_mm.size() == g.gap_mm.size()) &&
+              area.size() == static_cast<Eigen::Index>(g.gap_mm.size()),
+          "scan summary: " + std::to_string(g.gap_mm.size()) + " gaps with " + std::to_string(g.status.size()) +
+              " statuses, " + std::to_string(g.distance_mm.size()) + " distances and " + std::to_string(area.size()) +
+              " vertex areas");
   s.level_vertices.assign(static_cast<std::size_t>(levels.count()), 0);
   s.level_area_mm2.assign(static_cast<std::size_t>(levels.count()), 0.0);
   s.vertices_tested = s.vertices_no_surface = s.vertices_beyond_reach = s.vertices_penetrating = 0;
@@ -282,50 +287,56 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
   s.min_gap_mm = std::numeric_limits<double>::quiet_NaN();
   s.vertices = static_cast<std::int64_t>(g.gap_mm.size());
   s.vertices_refined = g.refined;
-  double min_gap = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
-    if (g.status[i] == ScanGaps::beyond_reach) {
-      ++s.vertices_beyond_reach;
-      continue;
-    }
-    if (g.status[i] == ScanGaps::no_surface) {
-      ++s.vertices_no_surface;
-      continue;
-    }
-    ++s.vertices_tested;
-    const double gap = g.gap_mm[i];
-    if (g.status[i] == ScanGaps::tested_layered) {
-      ++s.vertices_tested_layered;
-      min_layered = std::min(min_layered, gap);
-    }
-    const double a = area[static_cast<Eigen::Index>(i)];
-    min_gap = std::min(min_gap, gap);
-    if (gap <= 0) {
-      ++s.vertices_penetrating;
-      s.area_penetrating_mm2 += a;
-    }
-  }
   s.levels_on = g.distance_mm.empty() ? LevelQuantity::radial_gap : levels_on;
-  for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
-    const std::uint8_t lv = vertex_level(g, i, levels, s.levels_on);
-    if (lv == 255) continue;
-    ++s.level_vertices[lv];
-    s.level_area_mm2[lv] += area[static_cast<Eigen::Index>(i)];
-  }
-  if (s.vertices_tested > 0) s.min_gap_mm = min_gap;
-  if (s.vertices_tested_layered > 0) s.min_gap_layered_mm = min_layered;
   s.min_distance_mm = std::numeric_limits<double>::quiet_NaN();
   s.vertices_distance = s.vertices_inside = 0;
   s.area_inside_mm2 = 0;
   s.distance_winding = g.distance_winding;
+  double min_gap = std::numeric_limits<double>::infinity();
   double min_distance = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < g.distance_mm.size(); ++i) {
-    const float d = g.distance_mm[i];
-    if (std::isnan(d)) continue;
-    ++s.vertices_distance;
-    min_distance = std::min(min_distance, static_cast<double>(d));
-    if (d < 0) ++s.vertices_inside, s.area_inside_mm2 += area[static_cast<Eigen::Index>(i)];
+  // One pass over the vertices (each sum still adds its terms in vertex order). Most vertices of a scan are
+  // beyond reach, with neither a gap nor a distance: they only count, and have no level (255).
+  const bool has_distance = !g.distance_mm.empty();
+  const float* distance = has_distance ? g.distance_mm.data() : nullptr;
+  const std::size_t n = g.gap_mm.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t status = g.status[i];
+    const float d = has_distance ? distance[i] : std::numeric_limits<float>::quiet_NaN();
+    if (status == ScanGaps::beyond_reach && std::isnan(g.gap_mm[i]) && std::isnan(d)) {
+      ++s.vertices_beyond_reach;
+      continue;
+    }
+    const double a = area[static_cast<Eigen::Index>(i)];
+    if (status == ScanGaps::beyond_reach) {
+      ++s.vertices_beyond_reach;
+    } else if (status == ScanGaps::no_surface) {
+      ++s.vertices_no_surface;
+    } else {
+      ++s.vertices_tested;
+      const double gap = g.gap_mm[i];
+      if (status == ScanGaps::tested_layered) {
+        ++s.vertices_tested_layered;
+        min_layered = std::min(min_layered, gap);
+      }
+      min_gap = std::min(min_gap, gap);
+      if (gap <= 0) {
+        ++s.vertices_penetrating;
+        s.area_penetrating_mm2 += a;
+      }
+    }
+    const std::uint8_t lv = vertex_level(g, i, levels, s.levels_on);
+    if (lv != 255) {
+      ++s.level_vertices[lv];
+      s.level_area_mm2[lv] += a;
+    }
+    if (!std::isnan(d)) {
+      ++s.vertices_distance;
+      min_distance = std::min(min_distance, static_cast<double>(d));
+      if (d < 0) ++s.vertices_inside, s.area_inside_mm2 += a;
+    }
   }
+  if (s.vertices_tested > 0) s.min_gap_mm = min_gap;
+  if (s.vertices_tested_layered > 0) s.min_gap_layered_mm = min_layered;
   if (s.vertices_distance > 0) s.min_distance_mm = min_distance;
 }
 

@@ -33,7 +33,8 @@ void clock_summary(const ScanGaps& gaps, PointsRef V, const Eigen::VectorXd& are
 std::vector<double> clock_hours(PointsRef V, const ClockFace& clock);
 
 /// clock_summary with the vertices' hours given (clock_hours: n values), for many poses of one bone.
-/// Throws impinge::Error when `hours` does not have one value per vertex of `gaps`.
+/// Throws impinge::Error when `hours` does not have one value per vertex of `gaps`, or `gaps` has not one
+/// status (and, when it has distances, one distance) per gap.
 void clock_summary(const ScanGaps& gaps, const std::vector<double>& hours, const Eigen::VectorXd& area,
                    const ImpingementLevels& levels, ClockSummary& out,
                    LevelQuantity levels_on = LevelQuantity::radial_gap);

@@ -192,7 +192,8 @@ std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMa
                                              const FirstHitCaster& own_exact);
 
 /// Summary of a scan: counts, minimum gap, penetration and levels weighted by vertex area
-/// (`vertex_area`: n values, mm^2).
+/// (`vertex_area`: n values, mm^2). Throws impinge::Error unless `gaps` has n statuses (and, when it has
+/// distances, n distances) and `vertex_area` n values.
 ScanSummary summarize_scan(const ScanGaps& gaps, const Eigen::VectorXd& vertex_area, const ImpingementLevels& levels,
                            LevelQuantity levels_on = LevelQuantity::radial_gap);
 
