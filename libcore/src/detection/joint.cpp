@@ -82,6 +82,12 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
   validate_mesh(mesh);
   JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0, nullptr, nullptr, {}, {},
               nullptr, {}, {}};
+  // The closest-point query needs the mesh alone: it is built on a thread of its own meanwhile, so that
+  // it fills the core the other body's build leaves idle when it ends first (the query's hierarchy is
+  // serial). Joined before b is returned or the build fails (the future's destructor waits).
+  std::future<std::shared_ptr<const SignedDistanceQuery>> query;
+  if (options.distances || options.layers > 0)
+    query = std::async(std::launch::async, [&mesh = b.mesh] { return std::make_shared<const SignedDistanceQuery>(mesh); });
   b.relative = b.mesh.V.rowwise() - cor.transpose();
   if (given) {
     const SamplingScheme& want = *options.scheme;
@@ -125,7 +131,7 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
     b.hidden_set = order_by_position(make_scan_set(b.relative, hidden));
     b.hidden_clusters = cluster_scan_set(b.hidden_set);
   }
-  if (options.distances || options.layers > 0) b.distance_query = std::make_shared<const SignedDistanceQuery>(b.mesh);
+  if (query.valid()) b.distance_query = query.get();
   if (options.distances) b.distance_set = make_distance_scan_set(b.relative, options.max_radius_mm);
   return b;
 }
