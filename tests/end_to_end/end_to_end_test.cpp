@@ -25,8 +25,8 @@ using namespace impinge;
 namespace fs = std::filesystem;
 
 namespace {
-int run(const std::string& args, std::string* output = nullptr) {
-  const std::string cmd = std::string(IMPINGE_CLI) + " " + args + " 2>&1";
+int run(const std::string& args, std::string* output = nullptr, const std::string& env = "") {
+  const std::string cmd = (env.empty() ? std::string() : env + " ") + std::string(IMPINGE_CLI) + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
   char buf[512];
@@ -63,6 +63,27 @@ TEST(EndToEnd, CliOnGeneratedSubject) {
                             "map_nodes_covered", "map_bytes", "sampling_ms", "detection_ms"})
       EXPECT_TRUE(j[body].contains(key)) << body << "." << key;
   EXPECT_EQ(j["mode"], "linear");
+  // The allocator the CLI was linked with, as in force (apps/allocator.cpp): jemalloc's embedded options
+  // took effect (huge pages), and the MALLOC_CONF environment variable still overrides them.
+#ifdef IMPINGE_CLI_JEMALLOC
+  EXPECT_EQ(j["allocator"].get<std::string>().rfind("jemalloc ", 0), 0u) << j["allocator"];
+  EXPECT_NE(j["allocator"].get<std::string>().find("transparent huge pages: always"), std::string::npos) << j["allocator"];
+  ASSERT_EQ(run("distance --subject " + d + "/subject/subject.json --precision 1 --mode linear --pose 30,10,5 --out " +
+                    d + "/thp_off",
+                &out, "MALLOC_CONF=thp:never"),
+            0)
+      << out;
+  {
+    std::ifstream off(d + "/thp_off/summary.json");
+    const nlohmann::json k = nlohmann::json::parse(off);
+    EXPECT_NE(k["allocator"].get<std::string>().find("transparent huge pages: never"), std::string::npos)
+        << k["allocator"];
+    EXPECT_EQ(k["ball"]["min_gap_mm"], j["ball"]["min_gap_mm"]);
+    EXPECT_EQ(k["socket"]["min_gap_mm"], j["socket"]["min_gap_mm"]);
+  }
+#else
+  EXPECT_EQ(j["allocator"], "C library");
+#endif
   EXPECT_NEAR(j["head_radius_mm"].get<double>(), 22, 0.05);
   EXPECT_EQ(j["ball"]["map_nodes"], 65160);
   const TriangleMesh femur = load_mesh(d + "/subject/femur_r.ply");
