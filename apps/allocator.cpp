@@ -1,5 +1,5 @@
-// The impinge CLI's allocator: jemalloc with transparent huge pages (only compiled when CMake finds
-// jemalloc; see IMPINGE_JEMALLOC in CMakeLists.txt).
+// The impinge CLI's allocator: jemalloc with transparent huge pages when CMake links it
+// (IMPINGE_WITH_JEMALLOC; see IMPINGE_JEMALLOC in CMakeLists.txt), otherwise the C library's.
 //
 // Why: one run of impinge rom touches 150-250 MB of new memory within a second (two 0.1-deg maps of
 // 26 MB each, layered maps, the closest-point and ray-casting hierarchies). In 4 KiB pages that is
@@ -11,6 +11,7 @@
 
 #include "allocator.hpp"
 
+#ifdef IMPINGE_WITH_JEMALLOC
 #include <jemalloc/jemalloc.h>
 
 // jemalloc(3): "malloc_conf: a string embedded in the program"; the MALLOC_CONF environment variable,
@@ -18,10 +19,14 @@
 extern "C" {
 const char* malloc_conf = "thp:always,metadata_thp:always";
 }
+#endif
 
 namespace impinge {
 
 std::string allocator_description() {
+#ifndef IMPINGE_WITH_JEMALLOC
+  return "C library";
+#else
   const char* version = nullptr;
   const char* thp = nullptr;
   std::size_t size = sizeof(const char*);
@@ -31,6 +36,7 @@ std::string allocator_description() {
   if (mallctl("opt.thp", static_cast<void*>(&thp), &size, nullptr, 0) != 0 || thp == nullptr)
     return std::string("jemalloc ") + version;
   return std::string("jemalloc ") + version + ", transparent huge pages: " + thp;
+#endif
 }
 
 }  // namespace impinge

@@ -33,12 +33,14 @@
 using namespace impinge;
 namespace fs = std::filesystem;
 
-#ifndef IMPINGE_WITH_JEMALLOC
-std::string impinge::allocator_description() { return "C library"; }
-#endif
-
 namespace {
 
+// summary.json's common part: the session's set-up (setup_record) and the CLI's allocator.
+nlohmann::json run_record(const Session& s) {
+  nlohmann::json j = setup_record(s);
+  j["allocator"] = allocator_description();
+  return j;
+}
 
 // ---- options -------------------------------------------------------------------------------
 
@@ -205,8 +207,7 @@ int run_distance(const SessionOptions& so, const TextOptions& t, const std::stri
   write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur);
   write_map_png(in_dir(out, "ball_map.png"), s.joint().ball().map);
   write_map_png(in_dir(out, "socket_map.png"), s.joint().socket().map);
-  nlohmann::json j = setup_record(s);
-  j["allocator"] = allocator_description();
+  nlohmann::json j = run_record(s);
   j.update(pose_record(s, pose, femur, res));
   write_json(in_dir(out, "summary.json"), j);
   if (do_render) render(out);
@@ -252,8 +253,7 @@ int run_motion(const SessionOptions& so, const TextOptions& t, const MotionOutpu
   write_csv(in_dir(out, "frames.csv"), frames);
   write_pvd(in_dir(out, "gaps.pvd"), pvd);
   const double write_ms = ms_since(t_loop) - detect_ms;
-  nlohmann::json j = setup_record(s);
-  j["allocator"] = allocator_description();
+  nlohmann::json j = run_record(s);
   j["motion_file"] = mo.file;
   j["motion_format"] = motion.format;
   j["motion_frames"] = n;
@@ -287,8 +287,7 @@ int run_rom(const SessionOptions& options, const TextOptions& t, const RomReques
   write_csv(in_dir(out, "rom_limits.csv"), rom_limits_table(s, run));
   if (q.map) write_csv(in_dir(out, "rom_map.csv"), rom_map_table(run));
   if (q.envelope) write_csv(in_dir(out, "rom_envelope.csv"), rom_envelope_table(run));
-  nlohmann::json j = setup_record(s);
-  j["allocator"] = allocator_description();
+  nlohmann::json j = run_record(s);
   j.update(rom_record(run));
   j["timings_ms"] = {{"setup_total", setup_ms},
                      {"ball_sampling", s.joint().ball().sampling_ms},

@@ -30,12 +30,8 @@ void clock_summary(const ScanGaps& gaps, const std::vector<double>& hours, const
   out.sector_level_area_mm2.assign(static_cast<std::size_t>(12 * levels.count()), 0.0);
   out.closest_hour = std::nan("");
   float best = std::numeric_limits<float>::infinity();
-  const bool has_distance = !gaps.distance_mm.empty();
   for (std::size_t i = 0; i < gaps.gap_mm.size(); ++i) {
-    // Most vertices are beyond reach, with neither a gap nor a distance: no level (vertex_level's 255).
-    if (gaps.status[i] == ScanGaps::beyond_reach && std::isnan(gaps.gap_mm[i]) &&
-        (!has_distance || std::isnan(gaps.distance_mm[i])))
-      continue;
+    if (vertex_unmeasured(gaps, i)) continue;  // most vertices: no level
     const double h = hours[i];
     if (std::isnan(h)) continue;
     const std::uint8_t level = vertex_level(gaps, i, levels, levels_on);

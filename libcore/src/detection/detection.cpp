@@ -294,18 +294,16 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
   s.distance_winding = g.distance_winding;
   double min_gap = std::numeric_limits<double>::infinity();
   double min_distance = std::numeric_limits<double>::infinity();
-  // One pass over the vertices (each sum still adds its terms in vertex order). Most vertices of a scan are
-  // beyond reach, with neither a gap nor a distance: they only count, and have no level (255).
+  // One pass over the vertices (each sum still adds its terms in vertex order).
   const bool has_distance = !g.distance_mm.empty();
-  const float* distance = has_distance ? g.distance_mm.data() : nullptr;
   const std::size_t n = g.gap_mm.size();
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t status = g.status[i];
-    const float d = has_distance ? distance[i] : std::numeric_limits<float>::quiet_NaN();
-    if (status == ScanGaps::beyond_reach && std::isnan(g.gap_mm[i]) && std::isnan(d)) {
+    if (vertex_unmeasured(g, i)) {
       ++s.vertices_beyond_reach;
       continue;
     }
+    const std::uint8_t status = g.status[i];
+    const float d = has_distance ? g.distance_mm[i] : std::numeric_limits<float>::quiet_NaN();
     const double a = area[static_cast<Eigen::Index>(i)];
     if (status == ScanGaps::beyond_reach) {
       ++s.vertices_beyond_reach;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -49,6 +50,14 @@ enum class LevelQuantity : std::uint8_t { radial_gap = 0, distance = 1 };
 const char* to_string(LevelQuantity q);
 /// Parse "radial" or "distance"; throws impinge::Error naming `context` otherwise.
 LevelQuantity parse_level_quantity(const std::string& text, const std::string& context);
+
+/// Whether vertex i of a scan has no value at all: beyond the radial scan's reach, with neither a gap
+/// nor a distance (most vertices of a scan). Such a vertex only counts, and has no level (vertex_level's
+/// 255). `g`'s distances are empty (distances off) or one per gap; i < g.gap_mm.size().
+inline bool vertex_unmeasured(const ScanGaps& g, std::size_t i) {
+  return g.status[i] == ScanGaps::beyond_reach && std::isnan(g.gap_mm[i]) &&
+         (g.distance_mm.empty() || std::isnan(g.distance_mm[i]));
+}
 
 /// The level of vertex i of a scan by quantity `q`: 255 where it has no value (untested by the radial
 /// scan; for distance, neither tested nor within the distances' reach), else levels.level of the gap or
