@@ -53,8 +53,9 @@ double number(const std::string& cell, const std::string& where) {
     ok = used == cell.size();
   } catch (const std::exception&) {
   }
-  require(ok, where + ": '" + cell + "' is not a number");
-  require(std::isfinite(v), where + ": '" + cell + "' is not finite");
+  // Tested before the messages are built (once per cell of the file).
+  if (!ok) throw Error(where + ": '" + cell + "' is not a number");
+  if (!std::isfinite(v)) throw Error(where + ": '" + cell + "' is not finite");
   return v;
 }
 
