@@ -272,6 +272,49 @@ TEST(SurfaceDistance, ReachAndBadInput) {
   EXPECT_THROW(scan_distances(s, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), m.cor, q, 4, wrong, out), Error);
 }
 
+TEST(SurfaceDistance, SeedsChangeNoDistanceOrSign) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+  // The generated hip pushed 3 mm into its cup (distances of both signs), scanned without seeds, with the
+  // seeds of the poses before it along a motion, with seeds of another pose far off, and with seeds that
+  // are no triangle of the mesh: every distance equal bit for bit (a seed only narrows the search).
+  HipModelOptions ho;
+  ho.target_triangles = 6000;
+  const HipModel m = make_hip_model(ho);
+  const SignedDistanceQuery q(m.socket);
+  const Vertices P = m.ball.V.rowwise() - m.cor.transpose();
+  const DistanceScanSet s = make_distance_scan_set(P, 100);
+  const double reach = 4;
+  auto pose = [](double deg) {
+    return Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(0.6, 0.8, 0).normalized()).toRotationMatrix();
+  };
+  const Eigen::Vector3d push = 3 * Eigen::Vector3d::UnitZ();
+  std::vector<float> plain, seeded;
+  std::vector<std::int32_t> seeds;
+  std::int64_t measured = 0, negative = 0;
+  for (double deg : {-10.0, -9.0, -8.0, 30.0, -7.0}) {  // a motion, one pose far off, and back
+    scan_distances(s, pose(deg), push, m.cor, q, reach, {}, plain);
+    scan_distances(s, pose(deg), push, m.cor, q, reach, {}, seeded, &seeds);
+    ASSERT_EQ(seeds.size(), s.index.size());
+    for (std::size_t i = 0; i < plain.size(); ++i) {
+      ASSERT_EQ(std::isnan(plain[i]), std::isnan(seeded[i])) << deg << " deg, vertex " << i;
+      if (!std::isnan(plain[i])) EXPECT_EQ(plain[i], seeded[i]) << deg << " deg, vertex " << i;
+      measured += !std::isnan(plain[i]), negative += plain[i] < 0;
+    }
+  }
+  EXPECT_GT(measured, 500);
+  EXPECT_GT(negative, 10);
+  std::vector<std::int32_t> garbage(s.index.size(), 0);
+  for (std::size_t k = 0; k < garbage.size(); ++k) garbage[k] = static_cast<std::int32_t>(k % 3 == 0 ? -5 : 1000000 + k);
+  scan_distances(s, pose(-7), push, m.cor, q, reach, {}, seeded, &garbage);
+  for (std::size_t i = 0; i < plain.size(); ++i)
+    if (!std::isnan(plain[i])) EXPECT_EQ(plain[i], seeded[i]) << "garbage seeds, vertex " << i;
+  std::vector<std::int32_t> sized_wrong(3, 7);  // of another set: reset, not read
+  scan_distances(s, pose(-7), push, m.cor, q, reach, {}, seeded, &sized_wrong);
+  EXPECT_EQ(sized_wrong.size(), s.index.size());
+  for (std::size_t i = 0; i < plain.size(); ++i)
+    if (!std::isnan(plain[i])) EXPECT_EQ(plain[i], seeded[i]) << "reset seeds, vertex " << i;
+}
+
 class RealDistance : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(RealDistance, EveryMeasuredVertexMatchesCgalAtRestAndTenPoses) {

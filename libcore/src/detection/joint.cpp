@@ -188,15 +188,21 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
     res.socket_detection_ms = ms_since(t0);
   }
   if (options_.distances) {
+    // Each vertex's closest triangle at the last pose this thread scanned, tried first at this one (a
+    // motion's frames follow each other closely; scan_distances' seeds narrow the search and do not change
+    // its answers, so seeds left by another joint or pose only cost time).
+    thread_local std::vector<std::int32_t> ball_seeds, socket_seeds;
     t0 = std::chrono::steady_clock::now();
     res.ball_gaps.distance_winding = scan_distances(ball_.distance_set, R, t, cor_, *socket_.distance_query,
-                                                    options_.reach_mm(), res.ball_gaps.gap_mm, res.ball_gaps.distance_mm)
+                                                    options_.reach_mm(), res.ball_gaps.gap_mm, res.ball_gaps.distance_mm,
+                                                    &ball_seeds)
                                          .winding;
     res.ball_distance_ms = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
     res.socket_gaps.distance_winding =
         scan_distances(socket_.distance_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), cor_,
-                       *ball_.distance_query, options_.reach_mm(), res.socket_gaps.gap_mm, res.socket_gaps.distance_mm)
+                       *ball_.distance_query, options_.reach_mm(), res.socket_gaps.gap_mm, res.socket_gaps.distance_mm,
+                       &socket_seeds)
             .winding;
     res.socket_distance_ms = ms_since(t0);
   } else {

@@ -84,13 +84,15 @@ DistanceScanSet make_distance_scan_set(PointsRef P, double max_radius_mm, int cl
 
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
-                                 const std::vector<float>& gap_mm, std::vector<float>& distance_mm) {
+                                 const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
+                                 std::vector<std::int32_t>* seeds) {
   require(reach_mm > 0 && std::isfinite(reach_mm), "distance scan: the reach must be > 0 mm and finite");
   require(gap_mm.empty() || static_cast<std::int64_t>(gap_mm.size()) == set.vertices,
           "distance scan: " + std::to_string(gap_mm.size()) + " gaps for " + std::to_string(set.vertices) +
               " vertices");
   DistanceScanStats st;
   distance_mm.assign(static_cast<std::size_t>(set.vertices), std::numeric_limits<float>::quiet_NaN());
+  if (seeds != nullptr && seeds->size() != set.index.size()) seeds->assign(set.index.size(), -1);
   const Eigen::Vector3d shift = cor + t;
   ClosestSurfacePoint cp;
   for (std::int64_t c = 0; c < set.clusters(); ++c) {
@@ -115,10 +117,13 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       const int hint = g > kHintMm ? 1 : (g < -kHintMm ? -1 : 0);
       double radius = reach_mm;
       if (std::isfinite(g)) radius = g < -reach_mm ? -g + kBoundMarginMm : std::min(reach_mm, std::abs(g) + kBoundMarginMm);
-      bool found = other.signed_distance(q, radius, hint, cp, seed);
-      if (!found && radius < reach_mm) found = other.signed_distance(q, reach_mm, hint, cp, seed);
+      const std::int64_t start = seeds != nullptr && (*seeds)[k] >= 0 ? (*seeds)[k] : seed;
+      bool found = other.signed_distance(q, radius, hint, cp, start);
+      if (!found && radius < reach_mm) found = other.signed_distance(q, reach_mm, hint, cp, start);
       if (!found) continue;
       seed = cp.triangle;
+      if (seeds != nullptr)
+        (*seeds)[k] = cp.triangle <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(cp.triangle) : -1;
       distance_mm[i] = static_cast<float>(cp.signed_mm());
       ++st.measured;
       st.winding += cp.rule == SignRule::winding_number;

@@ -58,10 +58,17 @@ struct DistanceScanStats {
 /// (mm, negative inside), or NaN when it is proven farther than `reach_mm` (> 0). `gap_mm`: the body's
 /// radial gaps (n values, NaN where not tested; empty: none), used as bounds and sign hints (the file
 /// comment). `distance_mm` is resized to n and NaN outside the set. Single thread, allocation-free once
-/// `distance_mm` has its size.
+/// `distance_mm` and `seeds` have their sizes.
+///
+/// `seeds` (optional; k values in the set's order, reset to -1 when of another size): each vertex's closest
+/// triangle (index into `other`'s mesh F) at an earlier pose, or -1; tried first in place of the previous
+/// vertex's (SignedDistanceQuery::signed_distance's seed, which only narrows the search: the distances and
+/// signs do not depend on it), and updated. Along a motion a vertex's closest triangle is mostly the one
+/// of the frame before, or its neighbour.
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
-                                 const std::vector<float>& gap_mm, std::vector<float>& distance_mm);
+                                 const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
+                                 std::vector<std::int32_t>* seeds = nullptr);
 
 /// The same vertices as `set`, reordered along a Z curve over their positions (the distance scan's
 /// order), so that consecutive vertices lie close in space: for the hidden vertices, whose directions
