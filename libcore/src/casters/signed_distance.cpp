@@ -70,8 +70,10 @@ struct SignedDistanceQuery::Impl {
   std::vector<std::int64_t> kept;            // index in the mesh's F -> kept triangle, or -1
   std::vector<std::array<std::int32_t, 3>> corner;  // kept triangle -> vertex indices
   std::vector<Eigen::Vector3d> face_normal;  // unit, outward
-  std::vector<Eigen::Vector3d> edge_normal;  // 3 per kept triangle: sum of the two faces' normals
-  std::vector<std::uint8_t> edge_irregular;  // 3 per kept triangle
+  // 3 per kept triangle: the kept triangle across the edge when exactly two faces share it, wound against
+  // each other (a regular edge: its pseudo-normal is the sum of the two face normals), else -1. 4 bytes
+  // where the sum itself took 24 (the pelvis' 95,000 triangles: 6 MB less to fill at every build).
+  std::vector<std::int32_t> edge_twin;
   std::vector<Eigen::Vector3d> vertex_normal;
   std::vector<std::uint8_t> vertex_irregular;
   int orientation = 1;
@@ -237,8 +239,7 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
       bucket[static_cast<std::size_t>(next[static_cast<std::size_t>(lo)]++)] = {hi, static_cast<std::int64_t>(h)};
     }
   }
-  m.edge_normal.assign(3 * k, Eigen::Vector3d::Zero());
-  m.edge_irregular.assign(3 * k, 1);
+  m.edge_twin.assign(3 * k, -1);
   m.vertex_normal.assign(nv, Eigen::Vector3d::Zero());
   m.vertex_irregular.assign(nv, 0);
   std::int64_t irregular = 0;
@@ -255,9 +256,8 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
         const std::int32_t from0 = m.corner[t0][e0 % 3], from1 = m.corner[t1][e1 % 3];
         regular = from0 != from1;  // opposite directions: consistently wound
         if (regular) {
-          const Eigen::Vector3d n = m.face_normal[t0] + m.face_normal[t1];
-          m.edge_normal[static_cast<std::size_t>(e0)] = m.edge_normal[static_cast<std::size_t>(e1)] = n;
-          m.edge_irregular[static_cast<std::size_t>(e0)] = m.edge_irregular[static_cast<std::size_t>(e1)] = 0;
+          m.edge_twin[static_cast<std::size_t>(e0)] = static_cast<std::int32_t>(t1);
+          m.edge_twin[static_cast<std::size_t>(e1)] = static_cast<std::int32_t>(t0);
         }
       }
       if (!regular) {
@@ -421,8 +421,12 @@ bool SignedDistanceQuery::signed_distance(const Eigen::Vector3d& q, double radiu
   if (s.feature == 0) {
     n = m.face_normal[t];
   } else if (s.feature <= 3) {
-    n = m.edge_normal[3 * t + static_cast<std::size_t>(s.feature - 1)];
-    trusted = !m.edge_irregular[3 * t + static_cast<std::size_t>(s.feature - 1)];
+    // The sum of the two faces' normals (addition commutes: the same bits from either face), zero on an
+    // irregular edge.
+    const std::int32_t twin = m.edge_twin[3 * t + static_cast<std::size_t>(s.feature - 1)];
+    trusted = twin >= 0;
+    n = trusted ? Eigen::Vector3d(m.face_normal[t] + m.face_normal[static_cast<std::size_t>(twin)])
+                : Eigen::Vector3d::Zero();
   } else {
     const auto v = static_cast<std::size_t>(m.corner[t][s.feature - 4]);
     n = m.vertex_normal[v];
