@@ -297,7 +297,9 @@ TEST(SurfaceDistance, SeedsChangeNoDistanceOrSign) {
     ASSERT_EQ(seeds.size(), s.index.size());
     for (std::size_t i = 0; i < plain.size(); ++i) {
       ASSERT_EQ(std::isnan(plain[i]), std::isnan(seeded[i])) << deg << " deg, vertex " << i;
-      if (!std::isnan(plain[i])) EXPECT_EQ(plain[i], seeded[i]) << deg << " deg, vertex " << i;
+      if (!std::isnan(plain[i])) {
+        EXPECT_EQ(plain[i], seeded[i]) << deg << " deg, vertex " << i;
+      }
       measured += !std::isnan(plain[i]), negative += plain[i] < 0;
     }
   }
@@ -307,12 +309,16 @@ TEST(SurfaceDistance, SeedsChangeNoDistanceOrSign) {
   for (std::size_t k = 0; k < garbage.size(); ++k) garbage[k] = static_cast<std::int32_t>(k % 3 == 0 ? -5 : 1000000 + k);
   scan_distances(s, pose(-7), push, m.cor, q, reach, {}, seeded, &garbage);
   for (std::size_t i = 0; i < plain.size(); ++i)
-    if (!std::isnan(plain[i])) EXPECT_EQ(plain[i], seeded[i]) << "garbage seeds, vertex " << i;
+    if (!std::isnan(plain[i])) {
+      EXPECT_EQ(plain[i], seeded[i]) << "garbage seeds, vertex " << i;
+    }
   std::vector<std::int32_t> sized_wrong(3, 7);  // of another set: reset, not read
   scan_distances(s, pose(-7), push, m.cor, q, reach, {}, seeded, &sized_wrong);
   EXPECT_EQ(sized_wrong.size(), s.index.size());
   for (std::size_t i = 0; i < plain.size(); ++i)
-    if (!std::isnan(plain[i])) EXPECT_EQ(plain[i], seeded[i]) << "reset seeds, vertex " << i;
+    if (!std::isnan(plain[i])) {
+      EXPECT_EQ(plain[i], seeded[i]) << "reset seeds, vertex " << i;
+    }
 }
 
 class RealDistance : public ::testing::TestWithParam<std::string> {};

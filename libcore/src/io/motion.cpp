@@ -53,9 +53,8 @@ double number(const std::string& cell, const std::string& where) {
     ok = used == cell.size();
   } catch (const std::exception&) {
   }
-  // Tested before the messages are built (once per cell of the file).
-  if (!ok) throw Error(where + ": '" + cell + "' is not a number");
-  if (!std::isfinite(v)) throw Error(where + ": '" + cell + "' is not finite");
+  require(ok, [&] { return where + ": '" + cell + "' is not a number"; });
+  require(std::isfinite(v), [&] { return where + ": '" + cell + "' is not finite"; });
   return v;
 }
 

@@ -57,29 +57,20 @@ std::int64_t mark_depth_discontinuities(RadialDistanceMapT<Scalar>& map, double 
   if (const auto* grid = dynamic_cast<const EquiangularGrid*>(&scheme)) {
     // The equiangular grid's stencils are single nodes of weight 1: read by index (1 * u is u), without
     // filling four stencils per node.
-    auto value_at = [](Scalar v) {
-      const double u = double(v);
+    auto value = [values](std::int64_t node) {
+      const double u = double(values[node]);
       return std::isfinite(u) ? u : std::numeric_limits<double>::infinity();
     };
-    // Row by row, the neighbours by offset (EquiangularGrid::neighbour_nodes' nodes, without its two
-    // divisions per node): the rows above and below, across the pole at the first and last rows (the
-    // column half a turn away), and the columns either side, wrapping at the seam.
+    // Row by row (the grid's neighbours by row and column, without two divisions per node).
     const int rows = grid->rows(), cols = grid->columns();
 #pragma omp parallel for schedule(dynamic, 16)
     for (int r = 0; r < rows; ++r) {
-      const Scalar* row = values + std::int64_t(r) * cols;
-      const Scalar* up = values + std::int64_t(r == 0 ? 1 : r - 1) * cols;
-      const Scalar* down = values + std::int64_t(r == rows - 1 ? rows - 2 : r + 1) * cols;
-      const bool up_across = r == 0, down_across = r == rows - 1;
-      std::uint8_t* m = mark.data() + std::int64_t(r) * cols;
+      const std::int64_t first = std::int64_t(r) * cols;
       for (int c = 0; c < cols; ++c) {
-        const double d = row[c];
+        const double d = values[first + c];
         if (!std::isfinite(d)) continue;
-        const int co = up_across || down_across ? (c + cols / 2) % cols : c;  // across the pole
-        const int cl = c == 0 ? cols - 1 : c - 1, cr = c + 1 == cols ? 0 : c + 1;
-        if (is_marked(d, value_at(up[up_across ? co : c]), value_at(down[down_across ? co : c]), value_at(row[cl]),
-                      value_at(row[cr])))
-          m[c] = 1;
+        const std::array<std::int64_t, 4> nb = grid->neighbour_nodes(r, c);
+        if (is_marked(d, value(nb[0]), value(nb[1]), value(nb[2]), value(nb[3]))) mark[static_cast<std::size_t>(first + c)] = 1;
       }
     }
   } else

@@ -35,8 +35,7 @@ LayeredMap::LayeredMap(std::shared_ptr<const SamplingScheme> scheme, int layers)
 }
 
 void LayeredMap::set(std::int64_t i, const std::vector<RayCrossing>& c) {
-  // Tested before the message is built: called once per node while the map is sampled.
-  if (!(i >= 0 && i < num_nodes_)) throw Error("layered map: node " + std::to_string(i) + " out of range");
+  require(i >= 0 && i < num_nodes_, [&] { return "layered map: node " + std::to_string(i) + " out of range"; });
   const int k = std::min<int>(layers_, static_cast<int>(c.size()));
   float* v = value_.data() + static_cast<std::size_t>(i) * static_cast<std::size_t>(layers_);
   for (int j = 0; j < layers_; ++j)

@@ -106,8 +106,9 @@ RadialDistanceMapT<Scalar> load_map(const std::string& path, Eigen::Vector3d* co
   std::memcpy(map.data(), b.data() + r.pos, static_cast<std::size_t>(n) * sizeof(Scalar));
   for (std::int64_t i = 0; i < n; ++i) {
     const Scalar d = map.at(i);
-    if (!(d > 0 && !std::isnan(d)))  // tested before the message is built (once per node)
-      throw Error(path + ": node " + std::to_string(i) + " has distance " + std::to_string(d) + " (must be > 0 or +inf)");
+    require(d > 0 && !std::isnan(d), [&] {
+      return path + ": node " + std::to_string(i) + " has distance " + std::to_string(d) + " (must be > 0 or +inf)";
+    });
   }
   if (cor != nullptr) *cor = c;
   return map;

@@ -42,9 +42,10 @@ void SamplingScheme::neighbour_stencils(std::int64_t first, std::int64_t count, 
 }
 
 void SamplingScheme::neighbours(std::int64_t i, std::vector<std::int64_t>& out) const {
-  if (!(i >= 0 && i < num_nodes()))  // tested before the message is built (called per node)
-    throw Error("sampling scheme '" + name() + "': node " + std::to_string(i) + " outside [0, " +
-                std::to_string(num_nodes()) + ")");
+  require(i >= 0 && i < num_nodes(), [&] {
+    return "sampling scheme '" + name() + "': node " + std::to_string(i) + " outside [0, " +
+           std::to_string(num_nodes()) + ")";
+  });
   Stencil s[4];
   neighbour_stencils(i, 1, s);
   out.clear();

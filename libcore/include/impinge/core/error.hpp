@@ -4,6 +4,8 @@
 
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 namespace impinge {
 
@@ -17,5 +19,13 @@ class Error : public std::runtime_error {
 
 /// Throw impinge::Error(message) unless `condition` holds.
 void require(bool condition, const std::string& message);
+
+/// Throw impinge::Error(message()) unless `condition` holds; `message` (a callable returning the text)
+/// is called only then. For checks made once per node, vertex or cell, where building the text every
+/// time would cost more than the check (sampling a layered map built a million strings).
+template <typename Message, typename = std::enable_if_t<std::is_invocable_r_v<std::string, Message>>>
+void require(bool condition, Message&& message) {
+  if (!condition) throw Error(std::forward<Message>(message)());
+}
 
 }  // namespace impinge

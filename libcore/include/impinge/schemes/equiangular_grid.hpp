@@ -93,8 +93,12 @@ class EquiangularGrid : public SchemeImpl<EquiangularGrid> {
   /// Those four neighbours of node i (0 <= i < num_nodes()) as node indices, in the stencils' order (row
   /// before, row after, column before, column after).
   std::array<std::int64_t, 4> neighbour_nodes(std::int64_t i) const {
-    const int r = static_cast<int>(i / cols_), c = static_cast<int>(i % cols_);
-    const int cl = c == 0 ? cols_ - 1 : c - 1, cr = c + 1 == cols_ ? 0 : c + 1, co = (c + cols_ / 2) % cols_;
+    return neighbour_nodes(static_cast<int>(i / cols_), static_cast<int>(i % cols_));
+  }
+  /// The same for the node at row r, column c (no division: for callers that walk the rows).
+  std::array<std::int64_t, 4> neighbour_nodes(int r, int c) const {
+    const int cl = c == 0 ? cols_ - 1 : c - 1, cr = c + 1 == cols_ ? 0 : c + 1;
+    const int co = r == 0 || r == rows_ - 1 ? (c + cols_ / 2) % cols_ : c;  // across the pole (first, last rows)
     auto at = [this](int rr, int cc) { return std::int64_t(rr) * cols_ + cc; };
     return {r == 0 ? at(1, co) : at(r - 1, c), r == rows_ - 1 ? at(rows_ - 2, co) : at(r + 1, c), at(r, cl), at(r, cr)};
   }
