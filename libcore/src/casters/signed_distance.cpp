@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <string>
 #include <utility>
 
+#include "core/simd_clones.hpp"
 #include "impinge/core/error.hpp"
 
 #ifdef IMPINGE_HAVE_EMBREE
@@ -49,18 +52,65 @@ Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vecto
 constexpr double kBoxMarginMm = 1e-3;  // the float hierarchy's boxes against the double triangles
 constexpr double kPlaneMarginMm = 1e-9;  // a triangle's plane distance against its exact distance
 
-/// The centre of the smallest ball holding triangle (a, b, c): the middle of the longest edge when the
-/// angle opposite it is not acute, the circumcentre otherwise (the radius is taken from the corners).
-Eigen::Vector3d smallest_ball_centre(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const std::array<const Eigen::Vector3d*, 3> p{&a, &b, &c};
-  for (int e = 0; e < 3; ++e) {  // corner e, opposite edge (e + 1, e + 2)
-    const Eigen::Vector3d& u = *p[(e + 1) % 3];
-    const Eigen::Vector3d& v = *p[(e + 2) % 3];
-    if ((u - *p[e]).dot(v - *p[e]) <= 0) return (u + v) / 2;
-  }
-  const Eigen::Vector3d ab = b - a, ac = c - a, n = ab.cross(ac);
-  return a + (ac.squaredNorm() * n.cross(ab) + ab.squaredNorm() * ac.cross(n)) / (2 * n.squaredNorm());
+#ifdef IMPINGE_HAVE_EMBREE
+constexpr int kGroup = 8;  // triangles per group of the point query's hierarchy (one vector of lanes)
+typedef float GroupLanes __attribute__((vector_size(4 * kGroup)));
+
+/// The squared lower bounds of the distance from q (float, about the query's shift) to the triangles of a
+/// group (Impl::Group's rows: plane, then the three edges' lines), lane by lane: h^2 + max(0, s_0, s_1,
+/// s_2)^2, with h the distance to the triangle's plane and s_e the distance of q's foot point in that plane
+/// beyond edge e's line (negative inside). The in-plane distance to the triangle is at least the largest
+/// s_e (the triangle is the intersection of the three half-planes), and equal to it where the closest point
+/// lies on the face or an edge; below it only in a corner's region. Compiled for AVX-512, AVX2 and the
+/// baseline (clones), eight lanes.
+IMPINGE_SIMD_CLONES
+void group_lower_bounds(const float (*v)[kGroup], float x, float y, float z, float* lb2) {
+  GroupLanes row[16];
+  for (int r = 0; r < 16; ++r) std::memcpy(&row[r], v[r], sizeof(GroupLanes));
+  const GroupLanes h = row[0] * x + row[1] * y + row[2] * z - row[3];
+  const GroupLanes s0 = row[4] * x + row[5] * y + row[6] * z - row[7];
+  const GroupLanes s1 = row[8] * x + row[9] * y + row[10] * z - row[11];
+  const GroupLanes s2 = row[12] * x + row[13] * y + row[14] * z - row[15];
+  GroupLanes s = s0 > s1 ? s0 : s1;
+  s = s > s2 ? s : s2;
+  s = s > 0 ? s : GroupLanes{};
+  const GroupLanes out = h * h + s * s;
+  std::memcpy(lb2, &out, sizeof(GroupLanes));
 }
+
+/// Kept triangles (their centroids) in groups of kGroup, each compact in space: [begin, end) split at the
+/// median along the longest axis of its centroids' box, rounded to a multiple of kGroup, down to single
+/// groups (so every group but the last is full).
+std::vector<std::int32_t> group_order(const std::vector<Eigen::Vector3d>& centroid) {
+  const std::size_t n = centroid.size();
+  std::vector<std::int32_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::int32_t>(k);
+  std::vector<std::pair<std::size_t, std::size_t>> todo{{0, n}};
+  while (!todo.empty()) {
+    const auto [begin, end] = todo.back();
+    todo.pop_back();
+    const std::size_t count = end - begin;
+    if (count <= static_cast<std::size_t>(kGroup)) continue;
+    const std::size_t half = std::clamp((count / 2 + kGroup / 2) / kGroup * kGroup, static_cast<std::size_t>(kGroup),
+                                        (count - 1) / kGroup * kGroup);
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t k = begin; k < end; ++k) {
+      const Eigen::Vector3d& g = centroid[static_cast<std::size_t>(order[k])];
+      lo = lo.cwiseMin(g), hi = hi.cwiseMax(g);
+    }
+    int axis = 0;
+    (hi - lo).maxCoeff(&axis);
+    const auto first = order.begin() + static_cast<std::ptrdiff_t>(begin);
+    std::nth_element(first, first + static_cast<std::ptrdiff_t>(half), order.begin() + static_cast<std::ptrdiff_t>(end),
+                     [&](std::int32_t u, std::int32_t w) {
+                       return centroid[static_cast<std::size_t>(u)][axis] < centroid[static_cast<std::size_t>(w)][axis];
+                     });
+    todo.emplace_back(begin, begin + half);
+    todo.emplace_back(begin + half, end);
+  }
+  return order;
+}
+#endif
 
 }  // namespace
 
@@ -89,16 +139,6 @@ struct SignedDistanceQuery::Impl {
   std::vector<Node> nodes;
   std::vector<std::int32_t> order;
   std::vector<Eigen::Vector3d> area_vector, centroid;  // per kept triangle, for the hierarchy's build
-  // Per kept triangle, two lower bounds of the distance from q to it: its smallest bounding ball
-  // (|q - centre| - radius) and its plane (|normal . q - offset|; normal is face_normal's, copied so
-  // that the point query's callback reads one cache line per candidate).
-  struct Bound {
-    Eigen::Vector3d centre;
-    double radius;
-    Eigen::Vector3d normal;
-    double offset;
-  };
-  std::vector<Bound> bound;
   std::int32_t build_node(std::int32_t begin, std::int32_t end);
   void build_hierarchy();
 
@@ -109,6 +149,18 @@ struct SignedDistanceQuery::Impl {
   }
 
 #ifdef IMPINGE_HAVE_EMBREE
+  // The point query's primitives: groups of kGroup kept triangles close in space (group_order), each with
+  // its rows of group_lower_bounds' lower bounds (float, about `shift`): the unit normal and the plane's
+  // offset (rows 0-3), then per edge e the in-plane unit normal pointing away from the triangle and its
+  // line's offset (rows 4 + 4e .. 7 + 4e). A lane past the kept triangles has triangle -1 and a plane
+  // 1e18 mm away.
+  struct Group {
+    alignas(4 * kGroup) float v[16][kGroup];
+    std::int32_t triangle[kGroup];
+  };
+  std::vector<Group> groups;
+  std::vector<std::array<float, 6>> group_box;  // lower x, y, z, upper x, y, z: float, about `shift`, widened
+  double extent = 0;  // the largest |corner - shift| (any axis), mm: the float rows' rounding grows with it
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();  // float coordinates are about this point
@@ -194,6 +246,18 @@ bool SignedDistanceQuery::available() {
 #endif
 }
 
+#ifdef IMPINGE_HAVE_EMBREE
+namespace {
+// The point query's groups to Embree: a group's box; no ray queries (only point queries reach them).
+void group_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto& b = static_cast<const SignedDistanceQuery::Impl*>(args->geometryUserPtr)->group_box[args->primID];
+  *args->bounds_o = RTCBounds{b[0], b[1], b[2], 0.f, b[3], b[4], b[5], 0.f};
+}
+void no_ray_queries(const RTCIntersectFunctionNArguments*) {}
+void no_ray_queries(const RTCOccludedFunctionNArguments*) {}
+}  // namespace
+#endif
+
 SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
   validate_mesh(mesh);
   require(available(), "signed distance: needs Embree or CGAL, and this build has neither (" + mesh.source + ")");
@@ -270,16 +334,6 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   }
   irregular_edges_ = irregular;
   m.build_hierarchy();
-  m.bound.resize(k);
-  for (std::size_t t = 0; t < k; ++t) {
-    Impl::Bound& b = m.bound[t];
-    b.centre = smallest_ball_centre(m.a[t], m.b[t], m.c[t]);
-    const double r2 = std::max({(m.a[t] - b.centre).squaredNorm(), (m.b[t] - b.centre).squaredNorm(),
-                                (m.c[t] - b.centre).squaredNorm()});
-    b.radius = std::sqrt(r2) * (1 + 1e-12) + 1e-12;
-    b.normal = m.face_normal[t];
-    b.offset = b.normal.dot(m.a[t]);
-  }
   // Corners: normals weighted by the triangle's angle there.
   for (std::size_t t = 0; t < k; ++t) {
     const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
@@ -296,18 +350,54 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   m.device = rtcNewDevice(nullptr);  // the build on every core; each query runs on its caller's thread
   require(m.device != nullptr, "signed distance: rtcNewDevice failed (" + mesh.source + ")");
   m.scene = rtcNewScene(m.device);
-  RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vb = static_cast<float*>(
-      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * k));
-  auto* ib = static_cast<unsigned*>(
-      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), k));
-  for (std::size_t t = 0; t < k; ++t) {
-    const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
-    for (int e = 0; e < 3; ++e) {
-      for (int d = 0; d < 3; ++d) vb[9 * t + 3 * e + d] = static_cast<float>((*p[e])[d] - m.shift[d]);
-      ib[3 * t + e] = static_cast<unsigned>(3 * t + e);
+  for (std::size_t t = 0; t < k; ++t)
+    for (const Eigen::Vector3d* p : {&m.a[t], &m.b[t], &m.c[t]}) m.extent = std::max(m.extent, (*p - m.shift).cwiseAbs().maxCoeff());
+  {
+    std::vector<Eigen::Vector3d> centroid(k);
+    for (std::size_t t = 0; t < k; ++t) centroid[t] = (m.a[t] + m.b[t] + m.c[t]) / 3.0;
+    const std::vector<std::int32_t> order = group_order(centroid);
+    const std::size_t groups = (k + kGroup - 1) / kGroup;
+    m.groups.resize(groups);
+    m.group_box.resize(groups);
+    const double widen = kBoxMarginMm + 1e-6 * m.extent;  // the boxes' and rows' float rounding, and more
+    for (std::size_t g = 0; g < groups; ++g) {
+      Impl::Group& G = m.groups[g];
+      Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+      for (int l = 0; l < kGroup; ++l) {
+        const std::size_t j = g * kGroup + static_cast<std::size_t>(l);
+        if (j >= k) {  // past the kept triangles: a plane far away, never a candidate
+          for (auto& row : G.v) row[l] = 0.f;
+          G.v[3][l] = -1e18f;
+          G.triangle[l] = -1;
+          continue;
+        }
+        const auto t = static_cast<std::size_t>(order[j]);
+        G.triangle[l] = static_cast<std::int32_t>(t);
+        const std::array<Eigen::Vector3d, 3> p{m.a[t] - m.shift, m.b[t] - m.shift, m.c[t] - m.shift};
+        const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+        for (int d = 0; d < 3; ++d) G.v[d][l] = static_cast<float>(n[d]);
+        G.v[3][l] = static_cast<float>(n.dot(p[0]));
+        for (int e = 0; e < 3; ++e) {  // edge e from corner e to corner e + 1; the in-plane normal away from the third
+          const Eigen::Vector3d& u = p[static_cast<std::size_t>(e)];
+          Eigen::Vector3d w = (p[static_cast<std::size_t>((e + 1) % 3)] - u).cross(n).normalized();
+          if (w.dot(p[static_cast<std::size_t>((e + 2) % 3)] - u) > 0) w = -w;
+          for (int d = 0; d < 3; ++d) G.v[4 + 4 * e + d][l] = static_cast<float>(w[d]);
+          G.v[7 + 4 * e][l] = static_cast<float>(w.dot(u));
+        }
+        for (const Eigen::Vector3d& x : p) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+      }
+      for (int d = 0; d < 3; ++d) {
+        m.group_box[g][static_cast<std::size_t>(d)] = static_cast<float>(lo[d] - widen);
+        m.group_box[g][static_cast<std::size_t>(d) + 3] = static_cast<float>(hi[d] + widen);
+      }
     }
   }
+  RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(m.groups.size()));
+  rtcSetGeometryUserData(g, &m);
+  rtcSetGeometryBoundsFunction(g, group_bounds, &m);
+  rtcSetGeometryIntersectFunction(g, no_ray_queries);
+  rtcSetGeometryOccludedFunction(g, no_ray_queries);
   rtcCommitGeometry(g);
   rtcAttachGeometry(m.scene, g);
   rtcReleaseGeometry(g);
@@ -341,23 +431,32 @@ struct Search {
   Eigen::Vector3d point;
   int feature = 0;
   bool any_only = false;
+  double margin = kBoxMarginMm;  // mm: the float lower bounds' rounding at q, and more (run sets it)
 };
 
 #ifdef IMPINGE_HAVE_EMBREE
+// A group whose box the query's ball reaches: the triangles whose lower bound (group_lower_bounds, widened
+// by the search's margin for float rounding) is within the best distance so far get the exact test.
 bool visit(RTCPointQueryFunctionArguments* args) {
   auto* s = static_cast<Search*>(args->userPtr);
-  const SignedDistanceQuery::Impl::Bound& b = s->m->bound[args->primID];
-  const double reach = s->best + b.radius;
-  if ((s->q - b.centre).squaredNorm() > reach * reach) return false;  // its ball is farther than the best
-  // Its plane is farther (the margin: rounding of the dot product at bone coordinates, about 1e-13 mm).
-  if (std::abs(b.normal.dot(s->q) - b.offset) > s->best + kPlaneMarginMm) return false;
-  Eigen::Vector3d point;
-  int feature = 0;
-  const double d = s->m->distance_to(args->primID, s->q, point, feature);
-  if (!(d <= s->best)) return false;
-  s->best = d, s->kept = args->primID, s->point = point, s->feature = feature;
-  args->query->radius = s->any_only ? 0.f : static_cast<float>(d + kBoxMarginMm);
-  return true;
+  const SignedDistanceQuery::Impl::Group& g = s->m->groups[args->primID];
+  float lb2[kGroup];
+  group_lower_bounds(g.v, args->query->x, args->query->y, args->query->z, lb2);
+  bool closer = false;
+  for (int l = 0; l < kGroup; ++l) {
+    const float limit = static_cast<float>(s->best + s->margin);
+    if (!(lb2[l] <= limit * limit) || g.triangle[l] < 0) continue;
+    const auto t = static_cast<std::size_t>(g.triangle[l]);
+    Eigen::Vector3d point;
+    int feature = 0;
+    const double d = s->m->distance_to(t, s->q, point, feature);
+    if (!(d <= s->best)) continue;
+    s->best = d, s->kept = static_cast<std::int64_t>(t), s->point = point, s->feature = feature;
+    closer = true;
+    if (s->any_only) break;
+  }
+  if (closer) args->query->radius = s->any_only ? 0.f : static_cast<float>(s->best + kBoxMarginMm);
+  return closer;
 }
 #endif
 
@@ -372,6 +471,7 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
     if (d <= s.best) s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
   }
 #ifdef IMPINGE_HAVE_EMBREE
+  s.margin = kBoxMarginMm + 1e-6 * (m.extent + (s.q - m.shift).cwiseAbs().maxCoeff());
   RTCPointQuery query;
   query.x = static_cast<float>(s.q.x() - m.shift.x());
   query.y = static_cast<float>(s.q.y() - m.shift.y());

@@ -5,12 +5,16 @@
 /// signed_distance report), negative inside the solid the mesh bounds. Source: impinge (not in the thesis).
 ///
 /// Closest point: a bounding-volume hierarchy pruned by a query radius (Embree 3's rtcPointQuery when
-/// the build has Embree, a BVH in float whose boxes are widened by 1e-3 mm; CGAL's AABB tree otherwise),
-/// and the closest point of each candidate triangle in double (Ericson 2005, Real-Time Collision
-/// Detection, sec. 5.1.5), which also names the feature (face, edge or corner) it lies on. With Embree,
-/// a candidate is left out before that when either of two lower bounds of its distance exceeds the best
-/// distance so far: its smallest bounding ball's (|q - o| - r) or its plane's (|n . q - n . a|, beyond a
-/// 1e-9 mm margin for rounding). Near a bone that settles about half the candidates.
+/// the build has Embree; CGAL's AABB tree otherwise), and the closest point of each candidate triangle in
+/// double (Ericson 2005, Real-Time Collision Detection, sec. 5.1.5), which also names the feature (face,
+/// edge or corner) it lies on. With Embree the hierarchy's primitives are groups of 8 triangles close in
+/// space (float boxes widened by 1e-3 mm and more), and a group the query reaches first bounds each of its
+/// triangles' distances from below, eight at once in float: sqrt(h^2 + max(0, s_0, s_1, s_2)^2), h the
+/// distance to the triangle's plane and s_e how far q's foot point in that plane lies beyond edge e's line.
+/// That is the exact distance where the closest point lies on the face or an edge, and below it in a
+/// corner's region. Only a triangle whose bound is within the best distance so far (plus a margin above
+/// the float rounding: 1e-3 mm + 1e-6 of the coordinates' size) gets the exact test: near a bone about
+/// one per query, where a plane and a bounding ball alone left about 14.
 ///
 /// Sign, the rule (SignRule):
 /// 1. The angle-weighted pseudo-normal of the closest feature (Baerentzen & Aanaes 2005, IEEE TVCG
