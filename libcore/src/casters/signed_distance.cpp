@@ -50,10 +50,9 @@ Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vecto
 }
 
 constexpr double kBoxMarginMm = 1e-3;  // the float hierarchy's boxes against the double triangles
-constexpr double kPlaneMarginMm = 1e-9;  // a triangle's plane distance against its exact distance
 
 #ifdef IMPINGE_HAVE_EMBREE
-constexpr int kGroup = 8;  // triangles per group of the point query's hierarchy (one vector of lanes)
+constexpr int kGroup = 16;  // triangles per group of the point query's hierarchy (8 and 32 were slower)
 typedef float GroupLanes __attribute__((vector_size(4 * kGroup)));
 
 /// The squared lower bounds of the distance from q (float, about the query's shift) to the triangles of a
@@ -62,7 +61,7 @@ typedef float GroupLanes __attribute__((vector_size(4 * kGroup)));
 /// beyond edge e's line (negative inside). The in-plane distance to the triangle is at least the largest
 /// s_e (the triangle is the intersection of the three half-planes), and equal to it where the closest point
 /// lies on the face or an edge; below it only in a corner's region. Compiled for AVX-512, AVX2 and the
-/// baseline (clones), eight lanes.
+/// baseline (clones), kGroup lanes.
 IMPINGE_SIMD_CLONES
 void group_lower_bounds(const float (*v)[kGroup], float x, float y, float z, float* lb2) {
   GroupLanes row[16];

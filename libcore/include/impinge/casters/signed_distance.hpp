@@ -7,9 +7,9 @@
 /// Closest point: a bounding-volume hierarchy pruned by a query radius (Embree 3's rtcPointQuery when
 /// the build has Embree; CGAL's AABB tree otherwise), and the closest point of each candidate triangle in
 /// double (Ericson 2005, Real-Time Collision Detection, sec. 5.1.5), which also names the feature (face,
-/// edge or corner) it lies on. With Embree the hierarchy's primitives are groups of 8 triangles close in
+/// edge or corner) it lies on. With Embree the hierarchy's primitives are groups of 16 triangles close in
 /// space (float boxes widened by 1e-3 mm and more), and a group the query reaches first bounds each of its
-/// triangles' distances from below, eight at once in float: sqrt(h^2 + max(0, s_0, s_1, s_2)^2), h the
+/// triangles' distances from below, sixteen at once in float: sqrt(h^2 + max(0, s_0, s_1, s_2)^2), h the
 /// distance to the triangle's plane and s_e how far q's foot point in that plane lies beyond edge e's line.
 /// That is the exact distance where the closest point lies on the face or an edge, and below it in a
 /// corner's region. Only a triangle whose bound is within the best distance so far (plus a margin above
