@@ -272,11 +272,12 @@ TEST(SurfaceDistance, ReachAndBadInput) {
   EXPECT_THROW(scan_distances(s, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), m.cor, q, 4, wrong, out), Error);
 }
 
-TEST(SurfaceDistance, SeedsChangeNoDistanceOrSign) {
+TEST(SurfaceDistance, MemoryChangesNoDistanceOrSign) {
   if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
-  // The generated hip pushed 3 mm into its cup (distances of both signs), scanned without seeds, with the
-  // seeds of the poses before it along a motion, with seeds of another pose far off, and with seeds that
-  // are no triangle of the mesh: every distance equal bit for bit (a seed only narrows the search).
+  // The generated hip pushed 3 mm into its cup (distances of both signs), scanned without memory and with
+  // the memory of the poses before it along a motion (seeds and empty balls), of a pose far off, of garbage
+  // seeds, of another surface and of another size: every distance equal bit for bit, and the memory's empty
+  // balls do spare searches (or the test would not test them).
   HipModelOptions ho;
   ho.target_triangles = 6000;
   const HipModel m = make_hip_model(ho);
@@ -288,37 +289,60 @@ TEST(SurfaceDistance, SeedsChangeNoDistanceOrSign) {
     return Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(0.6, 0.8, 0).normalized()).toRotationMatrix();
   };
   const Eigen::Vector3d push = 3 * Eigen::Vector3d::UnitZ();
-  std::vector<float> plain, seeded;
-  std::vector<std::int32_t> seeds;
-  std::int64_t measured = 0, negative = 0;
-  for (double deg : {-10.0, -9.0, -8.0, 30.0, -7.0}) {  // a motion, one pose far off, and back
-    scan_distances(s, pose(deg), push, m.cor, q, reach, {}, plain);
-    scan_distances(s, pose(deg), push, m.cor, q, reach, {}, seeded, &seeds);
-    ASSERT_EQ(seeds.size(), s.index.size());
+  std::vector<float> plain, remembered;
+  DistanceScanMemory memory;
+  std::int64_t measured = 0, negative = 0, recalled = 0;
+  auto same = [&](const std::string& what) {
+    ASSERT_EQ(plain.size(), remembered.size());
     for (std::size_t i = 0; i < plain.size(); ++i) {
-      ASSERT_EQ(std::isnan(plain[i]), std::isnan(seeded[i])) << deg << " deg, vertex " << i;
+      ASSERT_EQ(std::isnan(plain[i]), std::isnan(remembered[i])) << what << ", vertex " << i;
       if (!std::isnan(plain[i])) {
-        EXPECT_EQ(plain[i], seeded[i]) << deg << " deg, vertex " << i;
+        EXPECT_EQ(plain[i], remembered[i]) << what << ", vertex " << i;
       }
-      measured += !std::isnan(plain[i]), negative += plain[i] < 0;
     }
+  };
+  for (double deg : {-10.0, -9.5, -9.0, -8.5, -8.0, 30.0, -7.0, -7.5}) {  // a motion, one pose far off, and back
+    const DistanceScanStats a = scan_distances(s, pose(deg), push, m.cor, q, reach, {}, plain);
+    const DistanceScanStats b = scan_distances(s, pose(deg), push, m.cor, q, reach, {}, remembered, &memory);
+    ASSERT_EQ(memory.seed.size(), s.index.size());
+    EXPECT_EQ(memory.query, q.id());
+    same(std::to_string(deg) + " deg");
+    EXPECT_EQ(a.measured, b.measured);
+    EXPECT_EQ(a.clusters_pruned, b.clusters_pruned);
+    EXPECT_LE(b.searches, a.searches);
+    recalled += b.vertices_recalled + b.clusters_recalled;
+    for (const float d : plain) measured += !std::isnan(d), negative += d < 0;
   }
   EXPECT_GT(measured, 500);
   EXPECT_GT(negative, 10);
-  std::vector<std::int32_t> garbage(s.index.size(), 0);
-  for (std::size_t k = 0; k < garbage.size(); ++k) garbage[k] = static_cast<std::int32_t>(k % 3 == 0 ? -5 : 1000000 + k);
-  scan_distances(s, pose(-7), push, m.cor, q, reach, {}, seeded, &garbage);
-  for (std::size_t i = 0; i < plain.size(); ++i)
-    if (!std::isnan(plain[i])) {
-      EXPECT_EQ(plain[i], seeded[i]) << "garbage seeds, vertex " << i;
-    }
-  std::vector<std::int32_t> sized_wrong(3, 7);  // of another set: reset, not read
-  scan_distances(s, pose(-7), push, m.cor, q, reach, {}, seeded, &sized_wrong);
-  EXPECT_EQ(sized_wrong.size(), s.index.size());
-  for (std::size_t i = 0; i < plain.size(); ++i)
-    if (!std::isnan(plain[i])) {
-      EXPECT_EQ(plain[i], seeded[i]) << "reset seeds, vertex " << i;
-    }
+  EXPECT_GT(recalled, 100);
+  for (std::size_t k = 0; k < memory.seed.size(); ++k)
+    memory.seed[k] = static_cast<std::int32_t>(k % 3 == 0 ? -5 : 1000000 + k);  // no triangle of the mesh
+  scan_distances(s, pose(-7), push, m.cor, q, reach, {}, plain);
+  scan_distances(s, pose(-7), push, m.cor, q, reach, {}, remembered, &memory);
+  same("garbage seeds");
+  // The memory of another surface (the cup 20 mm away: its empty balls are not this cup's) is reset,
+  // not read.
+  TriangleMesh moved = m.socket;
+  moved.V.rowwise() += Eigen::RowVector3d(0, 0, 20);
+  const SignedDistanceQuery other(moved);
+  ASSERT_NE(other.id(), q.id());
+  DistanceScanMemory elsewhere;
+  for (double deg : {-7.0, -6.5}) scan_distances(s, pose(deg), push, m.cor, other, reach, {}, remembered, &elsewhere);
+  EXPECT_EQ(elsewhere.query, other.id());
+  scan_distances(s, pose(-6.5), push, m.cor, q, reach, {}, plain);
+  const DistanceScanStats c = scan_distances(s, pose(-6.5), push, m.cor, q, reach, {}, remembered, &elsewhere);
+  same("memory of another surface");
+  EXPECT_EQ(elsewhere.query, q.id());
+  EXPECT_EQ(c.vertices_recalled + c.clusters_recalled, 0);
+  DistanceScanMemory sized_wrong;  // of another set: reset, not read
+  sized_wrong.query = q.id();
+  sized_wrong.seed.assign(3, 7);
+  sized_wrong.empty_radius.assign(3, 1e6f);
+  sized_wrong.empty_centre.assign(3, Eigen::Vector3f::Zero());
+  scan_distances(s, pose(-6.5), push, m.cor, q, reach, {}, remembered, &sized_wrong);
+  EXPECT_EQ(sized_wrong.seed.size(), s.index.size());
+  same("memory of another size");
 }
 
 class RealDistance : public ::testing::TestWithParam<std::string> {};

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -61,9 +62,9 @@ typedef float GroupLanes __attribute__((vector_size(4 * kGroup)));
 /// beyond edge e's line (negative inside). The in-plane distance to the triangle is at least the largest
 /// s_e (the triangle is the intersection of the three half-planes), and equal to it where the closest point
 /// lies on the face or an edge; below it only in a corner's region. Compiled for AVX-512, AVX2 and the
-/// baseline (clones), kGroup lanes.
+/// baseline (clones), kGroup lanes. Returns the lanes whose bound is at most limit2 (bit l: lane l).
 IMPINGE_SIMD_CLONES
-void group_lower_bounds(const float (*v)[kGroup], float x, float y, float z, float* lb2) {
+std::uint32_t group_lower_bounds(const float (*v)[kGroup], float x, float y, float z, float limit2, float* lb2) {
   GroupLanes row[16];
   for (int r = 0; r < 16; ++r) std::memcpy(&row[r], v[r], sizeof(GroupLanes));
   const GroupLanes h = row[0] * x + row[1] * y + row[2] * z - row[3];
@@ -75,6 +76,10 @@ void group_lower_bounds(const float (*v)[kGroup], float x, float y, float z, flo
   s = s > 0 ? s : GroupLanes{};
   const GroupLanes out = h * h + s * s;
   std::memcpy(lb2, &out, sizeof(GroupLanes));
+  const auto within = out <= limit2;  // -1 where within, lane by lane
+  std::uint32_t bits = 0;
+  for (int l = 0; l < kGroup; ++l) bits |= static_cast<std::uint32_t>(within[l] & 1) << l;
+  return bits;
 }
 
 /// Kept triangles (their centroids) in groups of kGroup, each compact in space: [begin, end) split at the
@@ -114,6 +119,7 @@ std::vector<std::int32_t> group_order(const std::vector<Eigen::Vector3d>& centro
 }  // namespace
 
 struct SignedDistanceQuery::Impl {
+  std::uint64_t serial = 0;  // SignedDistanceQuery::id
   std::vector<Eigen::Vector3d> a, b, c;      // the kept triangles' corners, double, mesh frame
   std::vector<std::int64_t> face;            // kept triangle -> index in the mesh's F
   std::vector<std::int64_t> kept;            // index in the mesh's F -> kept triangle, or -1
@@ -261,6 +267,8 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   validate_mesh(mesh);
   require(available(), "signed distance: needs Embree or CGAL, and this build has neither (" + mesh.source + ")");
   Impl& m = *impl_;
+  static std::atomic<std::uint64_t> built{0};
+  m.serial = ++built;
   double volume = 0;
   const auto faces = static_cast<std::size_t>(mesh.F.rows());
   m.a.reserve(faces), m.b.reserve(faces), m.c.reserve(faces), m.face.reserve(faces), m.corner.reserve(faces);
@@ -421,6 +429,8 @@ SignedDistanceQuery& SignedDistanceQuery::operator=(SignedDistanceQuery&&) noexc
 
 std::int64_t SignedDistanceQuery::triangles() const { return static_cast<std::int64_t>(impl_->a.size()); }
 
+std::uint64_t SignedDistanceQuery::id() const { return impl_->serial; }
+
 namespace {
 struct Search {
   const SignedDistanceQuery::Impl* m;
@@ -440,12 +450,15 @@ bool visit(RTCPointQueryFunctionArguments* args) {
   auto* s = static_cast<Search*>(args->userPtr);
   const SignedDistanceQuery::Impl::Group& g = s->m->groups[args->primID];
   float lb2[kGroup];
-  group_lower_bounds(g.v, args->query->x, args->query->y, args->query->z, lb2);
+  const float first = static_cast<float>(s->best + s->margin);
+  std::uint32_t bits = group_lower_bounds(g.v, args->query->x, args->query->y, args->query->z, first * first, lb2);
   bool closer = false;
-  for (int l = 0; l < kGroup; ++l) {
+  for (; bits != 0; bits &= bits - 1) {  // the lanes within the first limit, in order; the limit shrinks
+    const int l = __builtin_ctz(bits);
     const float limit = static_cast<float>(s->best + s->margin);
     if (!(lb2[l] <= limit * limit) || g.triangle[l] < 0) continue;
     const auto t = static_cast<std::size_t>(g.triangle[l]);
+    if (static_cast<std::int64_t>(t) == s->kept) continue;  // the best so far (a seed): tested already
     Eigen::Vector3d point;
     int feature = 0;
     const double d = s->m->distance_to(t, s->q, point, feature);

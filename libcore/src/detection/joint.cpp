@@ -128,8 +128,9 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
       const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
       hidden[i] = !b.mask[i] && r > 0 && r <= options.extra_articular_radius_mm;
     }
-    b.hidden_set = order_by_position(make_scan_set(b.relative, hidden));
-    b.hidden_clusters = cluster_scan_set(b.hidden_set);
+    // In boxes of 32 (order_in_boxes), each run of the clusters below compact in space.
+    b.hidden_set = order_in_boxes(make_scan_set(b.relative, hidden), {32});
+    b.hidden_clusters = cluster_scan_set(b.hidden_set, 32);
   }
   if (query.valid()) b.distance_query = query.get();
   if (options.distances) b.distance_set = make_distance_scan_set(b.relative, options.max_radius_mm);
@@ -188,21 +189,21 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
     res.socket_detection_ms = ms_since(t0);
   }
   if (options_.distances) {
-    // Each vertex's closest triangle at the last pose this thread scanned, tried first at this one (a
-    // motion's frames follow each other closely; scan_distances' seeds narrow the search and do not change
-    // its answers, so seeds left by another joint or pose only cost time).
-    thread_local std::vector<std::int32_t> ball_seeds, socket_seeds;
+    // What this thread's scans learnt at the poses before (a motion's frames follow each other closely):
+    // seeds and empty balls, which change no answer (scan_distances), and are tied to the surface they are
+    // about, so that another joint's only cost a reset.
+    thread_local DistanceScanMemory ball_memory, socket_memory;
     t0 = std::chrono::steady_clock::now();
     res.ball_gaps.distance_winding = scan_distances(ball_.distance_set, R, t, cor_, *socket_.distance_query,
                                                     options_.reach_mm(), res.ball_gaps.gap_mm, res.ball_gaps.distance_mm,
-                                                    &ball_seeds)
+                                                    &ball_memory)
                                          .winding;
     res.ball_distance_ms = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
     res.socket_gaps.distance_winding =
         scan_distances(socket_.distance_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), cor_,
                        *ball_.distance_query, options_.reach_mm(), res.socket_gaps.gap_mm, res.socket_gaps.distance_mm,
-                       &socket_seeds)
+                       &socket_memory)
             .winding;
     res.socket_distance_ms = ms_since(t0);
   } else {

@@ -67,7 +67,15 @@ DistanceScanSet make_distance_scan_set(PointsRef P, double max_radius_mm, int cl
     keep.push_back(static_cast<std::int32_t>(i));
     kept.push_back(p);
   }
-  for (const std::int32_t k : position_order(kept)) {
+  // In boxes of cluster_size (order_in_boxes): compact clusters, whose balls prune far more than runs of a
+  // Z curve (lhdl-ct: mean radius 5 to 7 mm against 11 to 13, the largest 28 mm against 140).
+  ScanSet loose;
+  loose.vertices = static_cast<std::int64_t>(kept.size());
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    loose.index.push_back(static_cast<std::int32_t>(k));
+    loose.x.push_back(kept[k].x()), loose.y.push_back(kept[k].y()), loose.z.push_back(kept[k].z());
+  }
+  for (const std::int32_t k : order_in_boxes(loose, {static_cast<std::int64_t>(cluster_size)}).index) {
     s.index.push_back(keep[static_cast<std::size_t>(k)]);
     s.position.push_back(kept[static_cast<std::size_t>(k)]);
   }
@@ -82,32 +90,73 @@ DistanceScanSet make_distance_scan_set(PointsRef P, double max_radius_mm, int cl
   return s;
 }
 
+namespace {
+constexpr double kEmptySlackMm = 2;         // a vertex's search beyond the reach looks this much farther
+constexpr double kClusterEmptySlackMm = 4;  // a cluster's test likewise
+constexpr double kFloatMarginMm = 1e-3;     // an empty ball kept in float: its centre and radius rounded
+
+// Whether the ball (q, radius_mm) lies inside the remembered empty ball (centre, empty), so that no point
+// of the surface lies within radius_mm of q.
+bool inside_empty(const Eigen::Vector3d& q, double radius_mm, const Eigen::Vector3f& centre, float empty) {
+  return empty > 0 && (q - centre.cast<double>()).norm() + radius_mm < static_cast<double>(empty) - kFloatMarginMm;
+}
+}  // namespace
+
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
-                                 std::vector<std::int32_t>* seeds) {
+                                 DistanceScanMemory* memory) {
   require(reach_mm > 0 && std::isfinite(reach_mm), "distance scan: the reach must be > 0 mm and finite");
   require(gap_mm.empty() || static_cast<std::int64_t>(gap_mm.size()) == set.vertices,
           "distance scan: " + std::to_string(gap_mm.size()) + " gaps for " + std::to_string(set.vertices) +
               " vertices");
   DistanceScanStats st;
   distance_mm.assign(static_cast<std::size_t>(set.vertices), std::numeric_limits<float>::quiet_NaN());
-  if (seeds != nullptr && seeds->size() != set.index.size()) seeds->assign(set.index.size(), -1);
+  const std::size_t k_all = set.index.size(), c_all = static_cast<std::size_t>(set.clusters());
+  if (memory != nullptr && (memory->query != other.id() || memory->seed.size() != k_all ||
+                            memory->empty_radius.size() != k_all || memory->empty_centre.size() != k_all ||
+                            memory->cluster_empty_radius.size() != c_all ||
+                            memory->cluster_empty_centre.size() != c_all)) {
+    memory->query = other.id();
+    memory->seed.assign(k_all, -1);
+    memory->empty_centre.assign(k_all, Eigen::Vector3f::Zero());
+    memory->empty_radius.assign(k_all, 0.f);
+    memory->cluster_empty_centre.assign(c_all, Eigen::Vector3f::Zero());
+    memory->cluster_empty_radius.assign(c_all, 0.f);
+  }
   const Eigen::Vector3d shift = cor + t;
   ClosestSurfacePoint cp;
   for (std::int64_t c = 0; c < set.clusters(); ++c) {
-    const auto b = static_cast<std::size_t>(set.cluster_begin[static_cast<std::size_t>(c)]);
-    const auto e = static_cast<std::size_t>(set.cluster_begin[static_cast<std::size_t>(c) + 1]);
+    const auto cs = static_cast<std::size_t>(c);
+    const auto b = static_cast<std::size_t>(set.cluster_begin[cs]);
+    const auto e = static_cast<std::size_t>(set.cluster_begin[cs + 1]);
     double deepest = 0;  // the most negative gap of the cluster below -reach
     if (!gap_mm.empty())
       for (std::size_t k = b; k < e; ++k) {
         const float g = gap_mm[static_cast<std::size_t>(set.index[k])];
         if (g < -reach_mm) deepest = std::min(deepest, static_cast<double>(g));
       }
-    const Eigen::Vector3d centre = R * set.centre[static_cast<std::size_t>(c)] + shift;
-    if (deepest == 0 && !other.any_within(centre, set.radius[static_cast<std::size_t>(c)] + reach_mm)) {
-      ++st.clusters_pruned;
-      continue;
+    const Eigen::Vector3d centre = R * set.centre[cs] + shift;
+    if (deepest == 0) {
+      // No point of the surface within the cluster's ball grown by the reach: every vertex is beyond it.
+      const double grown = set.radius[cs] + reach_mm;
+      bool apart = false;
+      if (memory == nullptr) {
+        apart = !other.any_within(centre, grown);
+      } else if (inside_empty(centre, grown, memory->cluster_empty_centre[cs], memory->cluster_empty_radius[cs])) {
+        apart = true;
+        ++st.clusters_recalled;
+      } else if (!other.any_within(centre, grown + kClusterEmptySlackMm)) {
+        apart = true;  // nothing within the grown ball and the slack: remember that ball
+        memory->cluster_empty_centre[cs] = centre.cast<float>();
+        memory->cluster_empty_radius[cs] = static_cast<float>(grown + kClusterEmptySlackMm);
+      } else {
+        apart = !other.any_within(centre, grown);
+      }
+      if (apart) {
+        ++st.clusters_pruned;
+        continue;
+      }
     }
     std::int64_t seed = -1;  // the previous vertex's closest triangle: neighbours share them
     for (std::size_t k = b; k < e; ++k) {
@@ -117,13 +166,30 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       const int hint = g > kHintMm ? 1 : (g < -kHintMm ? -1 : 0);
       double radius = reach_mm;
       if (std::isfinite(g)) radius = g < -reach_mm ? -g + kBoundMarginMm : std::min(reach_mm, std::abs(g) + kBoundMarginMm);
-      const std::int64_t start = seeds != nullptr && (*seeds)[k] >= 0 ? (*seeds)[k] : seed;
-      bool found = other.signed_distance(q, radius, hint, cp, start);
-      if (!found && radius < reach_mm) found = other.signed_distance(q, reach_mm, hint, cp, start);
+      if (memory != nullptr && radius <= reach_mm && inside_empty(q, reach_mm, memory->empty_centre[k], memory->empty_radius[k])) {
+        ++st.vertices_recalled;  // no point of the surface within the reach: NaN, as a search would find
+        continue;
+      }
+      const std::int64_t start = memory != nullptr && memory->seed[k] >= 0 ? memory->seed[k] : seed;
+      ++st.searches;
+      bool found = false;
+      if (memory != nullptr && radius == reach_mm && !(g < reach_mm)) {
+        // Likely beyond the reach (a gap beyond it, or none): the unsigned closest point within the reach
+        // plus the slack, then the sign only when it lies within the reach.
+        if (!other.any_within(q, reach_mm + kEmptySlackMm)) {
+          memory->empty_centre[k] = q.cast<float>();
+          memory->empty_radius[k] = static_cast<float>(reach_mm + kEmptySlackMm);
+        } else {
+          found = other.signed_distance(q, reach_mm, hint, cp, start);
+        }
+      } else {
+        found = other.signed_distance(q, radius, hint, cp, start);
+        if (!found && radius < reach_mm) found = other.signed_distance(q, reach_mm, hint, cp, start);
+      }
       if (!found) continue;
       seed = cp.triangle;
-      if (seeds != nullptr)
-        (*seeds)[k] = cp.triangle <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(cp.triangle) : -1;
+      if (memory != nullptr)
+        memory->seed[k] = cp.triangle <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(cp.triangle) : -1;
       distance_mm[i] = static_cast<float>(cp.signed_mm());
       ++st.measured;
       st.winding += cp.rule == SignRule::winding_number;

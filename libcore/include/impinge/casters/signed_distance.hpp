@@ -102,6 +102,10 @@ class SignedDistanceQuery {
   int orientation() const { return orientation_; }
   /// Triangles in the hierarchy (degenerate ones left out).
   std::int64_t triangles() const;
+  /// A number no other query built in this process has (from 1): facts learnt about this query's surface
+  /// (DistanceScanMemory) are tied to it, so that they are never applied to another surface, even one built
+  /// at the same address after this one is gone.
+  std::uint64_t id() const;
 
   struct Impl;  ///< the hierarchy and the pseudo-normals (implementation detail)
 

@@ -99,7 +99,8 @@ struct JointBody {
   double marking_ms = 0;           ///< wall time of marking them and building the ray caster, ms
   /// With JointOptions::layers > 0 (else null / empty): the layered map about the COR, the ray caster
   /// that filled it (also resolves layered look-ups across edges of the bone), and the hidden vertices
-  /// tested against the other body's layered map (ordered by position: order_by_position).
+  /// tested against the other body's layered map (in boxes of 32, order_in_boxes: compact clusters, so that
+  /// scan_layered_near leaves out all but the hidden vertices near the other bone).
   std::shared_ptr<const LayeredMap> layered;
   std::shared_ptr<const FirstHitCaster> caster;
   ScanSet hidden_set;

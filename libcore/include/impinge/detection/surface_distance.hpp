@@ -5,7 +5,8 @@
 /// Source: impinge (not in the thesis).
 ///
 /// Exact, and cheap, by leaving out what cannot be within reach:
-/// - Clusters of up to 32 nearby vertices (a Z curve over their positions), each with a bounding ball.
+/// - Clusters of up to 32 nearby vertices (boxes of median splits, order_in_boxes), each with a bounding
+///   ball.
 ///   A cluster whose ball, grown by the reach, holds no point of the other surface (one pruned
 ///   hierarchy query that stops at the first triangle found) is proven farther than the reach, vertex
 ///   by vertex: |p - s| >= |c - s| - r_c > reach for every vertex p and surface point s.
@@ -51,6 +52,24 @@ struct DistanceScanStats {
   std::int64_t measured = 0;        ///< vertices given a distance
   std::int64_t clusters_pruned = 0; ///< clusters proven beyond the reach
   std::int64_t winding = 0;         ///< signs decided by the winding number
+  std::int64_t searches = 0;        ///< closest-point searches of single vertices
+  std::int64_t vertices_recalled = 0;  ///< vertices proven beyond the reach by the memory's empty balls
+  std::int64_t clusters_recalled = 0;  ///< clusters so proven (counted in clusters_pruned too)
+};
+
+/// What a thread's distance scans of one set against one surface have learnt, for the poses after (a
+/// motion's frames): facts about the other surface, which does not move in its own frame, so that they hold
+/// at any later pose, in any order. scan_distances fills and reads it; a memory about another surface
+/// (`query` is not its SignedDistanceQuery::id()) or of another size is reset first.
+struct DistanceScanMemory {
+  std::uint64_t query = 0;                    ///< the id of the surface the facts are about (0: none yet)
+  std::vector<std::int32_t> seed;             ///< k: each vertex's closest triangle at an earlier pose, or -1
+  /// k: a ball about which no point of the surface lies (centre in the surface's frame, mm; radius 0: none
+  /// known), from a search that found nothing nearer at an earlier pose.
+  std::vector<Eigen::Vector3f> empty_centre;
+  std::vector<float> empty_radius;
+  std::vector<Eigen::Vector3f> cluster_empty_centre;  ///< c: the same about the clusters' centres
+  std::vector<float> cluster_empty_radius;
 };
 
 /// The distance scan at one pose. For every vertex i of `set`: q = cor + R p_i + t (the other body's
@@ -58,17 +77,23 @@ struct DistanceScanStats {
 /// (mm, negative inside), or NaN when it is proven farther than `reach_mm` (> 0). `gap_mm`: the body's
 /// radial gaps (n values, NaN where not tested; empty: none), used as bounds and sign hints (the file
 /// comment). `distance_mm` is resized to n and NaN outside the set. Single thread, allocation-free once
-/// `distance_mm` and `seeds` have their sizes.
+/// `distance_mm` and `memory` have their sizes.
 ///
-/// `seeds` (optional; k values in the set's order, reset to -1 when of another size): each vertex's closest
-/// triangle (index into `other`'s mesh F) at an earlier pose, or -1; tried first in place of the previous
-/// vertex's (SignedDistanceQuery::signed_distance's seed, which only narrows the search: the distances and
-/// signs do not depend on it), and updated. Along a motion a vertex's closest triangle is mostly the one
-/// of the frame before, or its neighbour.
+/// `memory` (optional): what earlier scans of the set against the same surface learnt (DistanceScanMemory),
+/// used and updated. Neither kind of fact changes an answer, only what it costs:
+/// - Seeds: each vertex's closest triangle at an earlier pose is tried first in place of the previous
+///   vertex's (SignedDistanceQuery::signed_distance's seed, which only narrows the search). Along a motion
+///   a vertex's closest triangle is mostly the one of the frame before, or its neighbour.
+/// - Empty balls: a search that finds nothing within the reach looks on to the reach plus
+///   kEmptySlackMm (2 mm; a cluster's test to its grown ball plus kClusterEmptySlackMm, 4 mm) and keeps the
+///   ball about q it found empty. At a later pose, a vertex whose ball of the reach lies inside its empty
+///   ball (|q - centre| + reach < radius, less 1e-3 mm for the float storage) is beyond the reach without a
+///   search, and a cluster likewise without its test. Along a motion the vertices and clusters beyond the
+///   reach are then searched every few frames instead of at each.
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
-                                 std::vector<std::int32_t>* seeds = nullptr);
+                                 DistanceScanMemory* memory = nullptr);
 
 /// The same vertices as `set`, reordered along a Z curve over their positions (the distance scan's
 /// order), so that consecutive vertices lie close in space: for the hidden vertices, whose directions
@@ -87,7 +112,8 @@ ScanSet order_by_position(const ScanSet& set);
 ScanSet order_in_boxes(const ScanSet& set, const std::vector<std::int64_t>& run_sizes);
 
 /// Consecutive runs of a scan set's vertices (pose-invariant), each with a bounding ball: tight when the
-/// set is ordered by position (order_by_position). For the layered scan's pruning (scan_layered_near).
+/// set is ordered in boxes of the runs' size (order_in_boxes; runs of a Z curve, order_by_position, can
+/// span distant regions). For the layered scan's pruning (scan_layered_near).
 struct ScanClusters {
   std::vector<std::int32_t> cluster_begin;  ///< c + 1 offsets into the set (cluster j: [begin[j], begin[j+1]))
   std::vector<Eigen::Vector3d> centre;      ///< c centres, the set's frame (relative to the COR), mm
@@ -120,7 +146,9 @@ struct LayeredNearStats {
 /// other bone: a cluster (centre c, radius r_c, posed R c + t) for which cluster_apart holds is skipped.
 /// Its members get gap_mm = +infinity (which scan_layered never gives: it writes NaN where no surface is
 /// along the ray), and expand_layered_scan leaves them beyond reach. The others are scan_layered's gaps,
-/// bit for bit. Throws impinge::Error on a bad reach or clusters of another set. Single thread.
+/// bit for bit, the far members of a cluster that comes near included: which hidden vertices are tested
+/// (and so count in a summary's level 0) depends on the clusters, the tighter the fewer. Throws
+/// impinge::Error on a bad reach or clusters of another set. Single thread.
 LayeredNearStats scan_layered_near(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
                                    const Eigen::Vector3d& t, const LayeredMap& map, const Eigen::Vector3d& cor,
                                    const SignedDistanceQuery& other, double reach_mm, float* gap_mm,
