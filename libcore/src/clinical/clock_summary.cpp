@@ -30,8 +30,14 @@ void clock_summary(const ScanGaps& gaps, const std::vector<double>& hours, const
   out.sector_level_area_mm2.assign(static_cast<std::size_t>(12 * levels.count()), 0.0);
   out.closest_hour = std::nan("");
   float best = std::numeric_limits<float>::infinity();
-  for (std::size_t i = 0; i < gaps.gap_mm.size(); ++i) {
-    if (vertex_unmeasured(gaps, i)) continue;  // most vertices: no level
+  const std::size_t n = gaps.gap_mm.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    int no_surface = 0;
+    if (i % 8 == 0 && i + 8 <= n && eight_without_value(gaps, i, no_surface)) {  // most vertices: no level
+      i += 7;
+      continue;
+    }
+    if (vertex_unmeasured(gaps, i)) continue;
     const double h = hours[i];
     if (std::isnan(h)) continue;
     const std::uint8_t level = vertex_level(gaps, i, levels, levels_on);

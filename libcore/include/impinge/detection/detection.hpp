@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -57,6 +58,26 @@ LevelQuantity parse_level_quantity(const std::string& text, const std::string& c
 inline bool vertex_unmeasured(const ScanGaps& g, std::size_t i) {
   return g.status[i] == ScanGaps::beyond_reach && std::isnan(g.gap_mm[i]) &&
          (g.distance_mm.empty() || std::isnan(g.distance_mm[i]));
+}
+
+/// Whether the eight vertices i .. i + 7 of a scan all have no value: each beyond the reach or without
+/// surface in its direction (ScanGaps::no_surface), with neither a gap nor a distance, so that none has a
+/// level. `no_surface` gets how many are without surface. Tested side by side: most runs of a scan's
+/// vertices are so, and the summaries count them eight at a time. i + 8 <= n.
+inline bool eight_without_value(const ScanGaps& g, std::size_t i, int& no_surface) {
+  static_assert(ScanGaps::no_surface == 1 && ScanGaps::beyond_reach == 2,
+                "eight_without_value reads the statuses' bytes as 1 or 2");
+  std::uint64_t status = 0;
+  std::memcpy(&status, g.status.data() + i, sizeof(status));
+  constexpr std::uint64_t kLow = 0x0101010101010101ull;
+  // Every byte 1 or 2: no bit above the lowest two, and bit 0 differs from bit 1.
+  if ((status & ~(3 * kLow)) != 0 || ((status ^ (status >> 1)) & kLow) != kLow) return false;
+  bool none = true;
+  for (std::size_t k = i; k < i + 8; ++k) none &= std::isnan(g.gap_mm[k]);
+  if (!g.distance_mm.empty())
+    for (std::size_t k = i; k < i + 8; ++k) none &= std::isnan(g.distance_mm[k]);
+  no_surface = __builtin_popcountll(status & kLow);
+  return none;
 }
 
 /// The level of vertex i of a scan by quantity `q`: 255 where it has no value (untested by the radial
