@@ -153,6 +153,10 @@ PoseResult Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) con
 }
 
 void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& res) const {
+  detect(R, t, res, nullptr);
+}
+
+void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& res, DetectionMemory* memory) const {
   std::vector<float>& gaps = res.compact_gaps;
   gaps.resize(static_cast<std::size_t>(std::max(ball_.scan_set.size(), socket_.scan_set.size())));
   auto t0 = std::chrono::steady_clock::now();
@@ -189,21 +193,17 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
     res.socket_detection_ms = ms_since(t0);
   }
   if (options_.distances) {
-    // What this thread's scans learnt at the poses before (a motion's frames follow each other closely):
-    // seeds and empty balls, which change no answer (scan_distances), and are tied to the surface they are
-    // about, so that another joint's only cost a reset.
-    thread_local DistanceScanMemory ball_memory, socket_memory;
     t0 = std::chrono::steady_clock::now();
     res.ball_gaps.distance_winding = scan_distances(ball_.distance_set, R, t, cor_, *socket_.distance_query,
                                                     options_.reach_mm(), res.ball_gaps.gap_mm, res.ball_gaps.distance_mm,
-                                                    &ball_memory)
+                                                    memory != nullptr ? &memory->ball : nullptr)
                                          .winding;
     res.ball_distance_ms = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
     res.socket_gaps.distance_winding =
         scan_distances(socket_.distance_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), cor_,
                        *ball_.distance_query, options_.reach_mm(), res.socket_gaps.gap_mm, res.socket_gaps.distance_mm,
-                       &socket_memory)
+                       memory != nullptr ? &memory->socket : nullptr)
             .winding;
     res.socket_distance_ms = ms_since(t0);
   } else {

@@ -124,6 +124,12 @@ struct PoseResult {
   std::vector<float> compact_gaps;  ///< scratch of detect (the compact scans), kept to reuse its storage
 };
 
+/// What a sequence of Joint::detect calls learns for the next (a motion's frames, one thread's): each
+/// distance scan's DistanceScanMemory. Changes no result, only the cost; tied to the surfaces it is about.
+struct DetectionMemory {
+  DistanceScanMemory ball, socket;  ///< the ball's scan (against the socket's surface), the socket's
+};
+
 /// Ball (femur) and socket (pelvis) about a fixed COR.
 class Joint {
  public:
@@ -149,6 +155,11 @@ class Joint {
   /// The same into `out`, reusing its vectors: after the first pose, no allocation per pose
   /// (for motions and ROM searches over many poses).
   void detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& out) const;
+
+  /// The same, with the distance scans using and updating `memory` (null: none; DetectionMemory): the
+  /// same result at less cost when the poses follow each other closely, as a motion's frames do. One
+  /// memory per thread.
+  void detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& out, DetectionMemory* memory) const;
 
   const JointBody& ball() const { return ball_; }
   const JointBody& socket() const { return socket_; }
