@@ -96,9 +96,13 @@ constexpr double kClusterEmptySlackMm = 4;  // a cluster's test likewise
 constexpr double kFloatMarginMm = 1e-3;     // an empty ball kept in float: its centre and radius rounded
 
 // Whether the ball (q, radius_mm) lies inside the remembered empty ball (centre, empty), so that no point
-// of the surface lies within radius_mm of q.
+// of the surface lies within radius_mm of q. The float centre and radius were rounded from double by at
+// most 2^-24 of their size each: the margin covers that at any coordinates, and more.
 bool inside_empty(const Eigen::Vector3d& q, double radius_mm, const Eigen::Vector3f& centre, float empty) {
-  return empty > 0 && (q - centre.cast<double>()).norm() + radius_mm < static_cast<double>(empty) - kFloatMarginMm;
+  if (!(empty > 0)) return false;
+  const Eigen::Vector3d c = centre.cast<double>();
+  const double margin = kFloatMarginMm + 0x1p-20 * (c.cwiseAbs().maxCoeff() + static_cast<double>(empty));
+  return (q - c).norm() + radius_mm < static_cast<double>(empty) - margin;
 }
 }  // namespace
 
@@ -174,8 +178,8 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       ++st.searches;
       bool found = false;
       if (memory != nullptr && radius == reach_mm && !(g < reach_mm)) {
-        // Likely beyond the reach (a gap beyond it, or none): the unsigned closest point within the reach
-        // plus the slack, then the sign only when it lies within the reach.
+        // Likely beyond the reach (a gap beyond it, or none): whether the surface comes within the reach
+        // plus the slack (if not, that ball is remembered empty), and only then the search within the reach.
         if (!other.any_within(q, reach_mm + kEmptySlackMm)) {
           memory->empty_centre[k] = q.cast<float>();
           memory->empty_radius[k] = static_cast<float>(reach_mm + kEmptySlackMm);

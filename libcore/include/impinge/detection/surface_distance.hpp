@@ -84,12 +84,14 @@ struct DistanceScanMemory {
 /// - Seeds: each vertex's closest triangle at an earlier pose is tried first in place of the previous
 ///   vertex's (SignedDistanceQuery::signed_distance's seed, which only narrows the search). Along a motion
 ///   a vertex's closest triangle is mostly the one of the frame before, or its neighbour.
-/// - Empty balls: a search that finds nothing within the reach looks on to the reach plus
-///   kEmptySlackMm (2 mm; a cluster's test to its grown ball plus kClusterEmptySlackMm, 4 mm) and keeps the
-///   ball about q it found empty. At a later pose, a vertex whose ball of the reach lies inside its empty
-///   ball (|q - centre| + reach < radius, less 1e-3 mm for the float storage) is beyond the reach without a
-///   search, and a cluster likewise without its test. Along a motion the vertices and clusters beyond the
-///   reach are then searched every few frames instead of at each.
+/// - Empty balls: a vertex whose radial gap is at or beyond the reach (or missing) is first tested for any
+///   point of the surface within the reach plus 2 mm, a cluster for any within its ball grown by the reach
+///   plus 4 mm; where there is none, that ball about q (or the cluster's centre) is kept as empty. At a
+///   later pose, a vertex whose ball of the reach lies inside its empty ball (|q - centre| + reach <
+///   radius, less 1e-3 mm and 2^-20 of the coordinates' size for the float storage) is beyond the reach
+///   without a search, and a cluster likewise without its test. Along a motion the vertices and clusters
+///   beyond the reach are then tested every few frames instead of at each (lhdl-ct's 1,000-frame trial:
+///   about 40 % fewer searches).
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
