@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "core/box_order.hpp"
 #include "core/simd_clones.hpp"
 #include "impinge/core/error.hpp"
 
@@ -82,38 +83,6 @@ std::uint32_t group_lower_bounds(const float (*v)[kGroup], float x, float y, flo
   return bits;
 }
 
-/// Kept triangles (their centroids) in groups of kGroup, each compact in space: [begin, end) split at the
-/// median along the longest axis of its centroids' box, rounded to a multiple of kGroup, down to single
-/// groups (so every group but the last is full).
-std::vector<std::int32_t> group_order(const std::vector<Eigen::Vector3d>& centroid) {
-  const std::size_t n = centroid.size();
-  std::vector<std::int32_t> order(n);
-  for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::int32_t>(k);
-  std::vector<std::pair<std::size_t, std::size_t>> todo{{0, n}};
-  while (!todo.empty()) {
-    const auto [begin, end] = todo.back();
-    todo.pop_back();
-    const std::size_t count = end - begin;
-    if (count <= static_cast<std::size_t>(kGroup)) continue;
-    const std::size_t half = std::clamp((count / 2 + kGroup / 2) / kGroup * kGroup, static_cast<std::size_t>(kGroup),
-                                        (count - 1) / kGroup * kGroup);
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (std::size_t k = begin; k < end; ++k) {
-      const Eigen::Vector3d& g = centroid[static_cast<std::size_t>(order[k])];
-      lo = lo.cwiseMin(g), hi = hi.cwiseMax(g);
-    }
-    int axis = 0;
-    (hi - lo).maxCoeff(&axis);
-    const auto first = order.begin() + static_cast<std::ptrdiff_t>(begin);
-    std::nth_element(first, first + static_cast<std::ptrdiff_t>(half), order.begin() + static_cast<std::ptrdiff_t>(end),
-                     [&](std::int32_t u, std::int32_t w) {
-                       return centroid[static_cast<std::size_t>(u)][axis] < centroid[static_cast<std::size_t>(w)][axis];
-                     });
-    todo.emplace_back(begin, begin + half);
-    todo.emplace_back(begin + half, end);
-  }
-  return order;
-}
 #endif
 
 }  // namespace
@@ -154,7 +123,7 @@ struct SignedDistanceQuery::Impl {
   }
 
 #ifdef IMPINGE_HAVE_EMBREE
-  // The point query's primitives: groups of kGroup kept triangles close in space (group_order), each with
+  // The point query's primitives: groups of kGroup kept triangles close in space (detail::box_order), each with
   // its rows of group_lower_bounds' lower bounds (float, about `shift`): the unit normal and the plane's
   // offset (rows 0-3), then per edge e the in-plane unit normal pointing away from the triangle and its
   // line's offset (rows 4 + 4e .. 7 + 4e). A lane past the kept triangles has triangle -1 and a plane
@@ -362,7 +331,9 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
   {
     std::vector<Eigen::Vector3d> centroid(k);
     for (std::size_t t = 0; t < k; ++t) centroid[t] = (m.a[t] + m.b[t] + m.c[t]) / 3.0;
-    const std::vector<std::int32_t> order = group_order(centroid);
+    // Groups compact in space: the centroids in boxes of kGroup (every group but the last full).
+    const std::vector<std::int32_t> order = detail::box_order(
+        k, {kGroup}, [&](std::int32_t t, int axis) { return centroid[static_cast<std::size_t>(t)][axis]; });
     const std::size_t groups = (k + kGroup - 1) / kGroup;
     m.groups.resize(groups);
     m.group_box.resize(groups);

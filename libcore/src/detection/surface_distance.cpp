@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "core/box_order.hpp"
 #include "core/z_order.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/sampling/layered_sampling.hpp"
@@ -67,15 +68,10 @@ DistanceScanSet make_distance_scan_set(PointsRef P, double max_radius_mm, int cl
     keep.push_back(static_cast<std::int32_t>(i));
     kept.push_back(p);
   }
-  // In boxes of cluster_size (order_in_boxes): compact clusters, whose balls prune far more than runs of a
-  // Z curve (lhdl-ct: mean radius 5 to 7 mm against 11 to 13, the largest 28 mm against 140).
-  ScanSet loose;
-  loose.vertices = static_cast<std::int64_t>(kept.size());
-  for (std::size_t k = 0; k < kept.size(); ++k) {
-    loose.index.push_back(static_cast<std::int32_t>(k));
-    loose.x.push_back(kept[k].x()), loose.y.push_back(kept[k].y()), loose.z.push_back(kept[k].z());
-  }
-  for (const std::int32_t k : order_in_boxes(loose, {static_cast<std::int64_t>(cluster_size)}).index) {
+  // In boxes of cluster_size (as order_in_boxes): compact clusters, whose balls prune far more than runs of
+  // a Z curve (lhdl-ct: mean radius 5 to 7 mm against 11 to 13, the largest 28 mm against 140).
+  for (const std::int32_t k : detail::box_order(kept.size(), {static_cast<std::int64_t>(cluster_size)},
+                                                [&](std::int32_t j, int axis) { return kept[static_cast<std::size_t>(j)][axis]; })) {
     s.index.push_back(keep[static_cast<std::size_t>(k)]);
     s.position.push_back(kept[static_cast<std::size_t>(k)]);
   }
@@ -219,35 +215,10 @@ ScanSet order_in_boxes(const ScanSet& set, const std::vector<std::int64_t>& run_
     require(run_sizes[j] >= run_sizes[j - 1] && run_sizes[j] % run_sizes[j - 1] == 0,
             "order in boxes: each run size must be a multiple of the one before");
   const auto n = static_cast<std::size_t>(set.size());
-  std::vector<std::int32_t> order(n);
-  for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::int32_t>(k);
-  auto coordinate = [&](std::int32_t k, int axis) {
+  const std::vector<std::int32_t> order = detail::box_order(n, run_sizes, [&](std::int32_t k, int axis) {
     const auto j = static_cast<std::size_t>(k);
     return axis == 0 ? set.x[j] : axis == 1 ? set.y[j] : set.z[j];
-  };
-  const auto leaf = static_cast<std::size_t>(run_sizes.front());
-  std::vector<std::pair<std::size_t, std::size_t>> todo{{0, n}};  // [begin, end) still to split
-  while (!todo.empty()) {
-    const auto [begin, end] = todo.back();
-    todo.pop_back();
-    const std::size_t count = end - begin;
-    if (count <= leaf) continue;
-    std::size_t unit = leaf;  // the largest run size below the range's length
-    for (const std::int64_t r : run_sizes)
-      if (static_cast<std::size_t>(r) < count) unit = static_cast<std::size_t>(r);
-    const std::size_t half = std::clamp((count / 2 + unit / 2) / unit * unit, unit, (count - 1) / unit * unit);
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (std::size_t k = begin; k < end; ++k)
-      for (int a = 0; a < 3; ++a)
-        lo[a] = std::min(lo[a], coordinate(order[k], a)), hi[a] = std::max(hi[a], coordinate(order[k], a));
-    int axis = 0;
-    (hi - lo).maxCoeff(&axis);
-    const auto first = order.begin() + static_cast<std::ptrdiff_t>(begin);
-    std::nth_element(first, first + static_cast<std::ptrdiff_t>(half), order.begin() + static_cast<std::ptrdiff_t>(end),
-                     [&](std::int32_t u, std::int32_t v) { return coordinate(u, axis) < coordinate(v, axis); });
-    todo.emplace_back(begin, begin + half);
-    todo.emplace_back(begin + half, end);
-  }
+  });
   ScanSet out;
   out.vertices = set.vertices;
   out.index.reserve(n), out.x.reserve(n), out.y.reserve(n), out.z.reserve(n);
