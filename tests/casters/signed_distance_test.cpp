@@ -7,6 +7,7 @@
 // - on a self-intersecting mesh (two overlapping spheres in one mesh), a point outside one sphere but
 //   inside the other is inside: the winding number (2 in the overlap, 1 in either sphere) says so when
 //   the caller's hint disagrees with the pseudo-normal of the buried sheet;
+// - the triangles kept near an earlier query point (NearbyTriangles) change no answer, bit for bit;
 // - irregular edges counted by hand on small meshes: a border edge, an edge whose two triangles run
 //   it the same way (inconsistent winding) and an edge of three triangles (a fin) are each one.
 #include "impinge/casters/signed_distance.hpp"
@@ -66,6 +67,68 @@ TEST(SignedDistance, ClosestMatchesCgalAndSignMatchesTheSphere) {
     EXPECT_TRUE(q.any_within(p, exact + 1e-6));
   }
   EXPECT_GT(checked, 1900);
+}
+
+// The triangles near an earlier query point (NearbyTriangles), carried along straight walks near a sphere's
+// surface in steps of 0.3 mm (as a vertex moves along a motion): every answer is the one without them, bit
+// for bit (distance, sign, triangle, point), and CGAL's distance. The walks leave their listed balls
+// (2 mm beyond the search's radius), so that both kinds of search happen: read from the list (its centre
+// stays put) and refilled. A list filled against another surface, or one that overflowed (a radius of
+// 100 mm meets more groups than a list keeps), is not read.
+TEST(SignedDistance, NearbyTrianglesChangeNoAnswer) {
+  if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
+  const Eigen::Vector3d c(3, -2, 40);
+  const TriangleMesh s = make_uv_sphere(20, c, 96, 48, Eigen::Vector3d(0.3, 0.1, 1).normalized());
+  const SignedDistanceQuery q(s), other(make_uv_sphere(20, c, 64, 32));
+  const ExactReference ref(s);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(0, 1);
+  int read = 0, refilled = 0;
+  for (int walk = 0; walk < 60; ++walk) {
+    const Eigen::Vector3d u = direction(std::acos(2 * U(rng) - 1), 2 * kPi * U(rng));
+    Eigen::Vector3d p = c + (20 + 8 * (U(rng) - 0.5)) * u;
+    const Eigen::Vector3d heading = direction(std::acos(2 * U(rng) - 1), 2 * kPi * U(rng));  // 9 mm in all
+    NearbyTriangles nearby;
+    std::int64_t seed = -1;
+    for (int step = 0; step < 30; ++step) {
+      const float before[4] = {nearby.centre[0], nearby.centre[1], nearby.centre[2], nearby.radius};
+      ClosestSurfacePoint with, without;
+      const bool found = q.signed_distance(p, 6, 0, with, seed, &nearby);
+      ASSERT_EQ(found, q.signed_distance(p, 6, 0, without, seed));
+      if (found) {
+        EXPECT_EQ(with.distance_mm, without.distance_mm) << walk << " " << step;
+        EXPECT_EQ(with.sign, without.sign);
+        EXPECT_EQ(with.triangle, without.triangle);
+        EXPECT_EQ(with.point, without.point);
+        EXPECT_NEAR(with.distance_mm, ref.closest_distance(p), 1e-9);
+        seed = with.triangle;
+      }
+      const bool same = before[0] == nearby.centre[0] && before[1] == nearby.centre[1] &&
+                        before[2] == nearby.centre[2] && before[3] == nearby.radius && nearby.radius > 0;
+      if (step > 0) (same ? read : refilled) += 1;
+      p += 0.3 * heading;
+    }
+  }
+  // Of the 1,740 searches after each walk's first (measured: 1,285 read, 455 refilled).
+  EXPECT_GT(read, 800);
+  EXPECT_GT(refilled, 200);
+  // Filled against another surface: refilled, not read.
+  const Eigen::Vector3d p = c + 21 * Eigen::Vector3d(0, 0.6, 0.8);
+  NearbyTriangles foreign;
+  ClosestSurfacePoint a, b;
+  ASSERT_TRUE(q.signed_distance(p, 6, 0, b));
+  ASSERT_TRUE(other.signed_distance(p, 6, 0, a, -1, &foreign));
+  ASSERT_GT(foreign.radius, 0.f);
+  ASSERT_EQ(foreign.query, other.id());
+  ASSERT_TRUE(q.signed_distance(p, 6, 0, a, b.triangle, &foreign));
+  EXPECT_EQ(a.distance_mm, b.distance_mm);
+  EXPECT_EQ(a.triangle, b.triangle);
+  EXPECT_EQ(foreign.query, q.id());
+  // Too many groups within the ball: nothing kept, the answer as without.
+  NearbyTriangles wide;
+  ASSERT_TRUE(q.signed_distance(p, 100, 0, a, -1, &wide));
+  EXPECT_LT(wide.radius, 0.f);
+  EXPECT_EQ(a.distance_mm, b.distance_mm);
 }
 
 // A soup of triangles of every shape (acute, right, obtuse, needles and slivers a thousand times

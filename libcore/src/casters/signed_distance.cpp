@@ -52,6 +52,7 @@ Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vecto
 }
 
 constexpr double kBoxMarginMm = 1e-3;  // the float hierarchy's boxes against the double triangles
+constexpr double kNearbySlackMm = 2;   // a NearbyTriangles' ball: the search's own radius plus this
 
 #ifdef IMPINGE_HAVE_EMBREE
 constexpr int kGroup = 16;  // triangles per group of the point query's hierarchy (8 and 32 were slower)
@@ -412,17 +413,33 @@ struct Search {
   int feature = 0;
   bool any_only = false;
   double margin = kBoxMarginMm;  // mm: the float lower bounds' rounding at q, and more (run sets it)
+  NearbyTriangles* collect = nullptr;  // filling: every group the walk reaches (the radius stays put)
 };
 
+// Whether kept triangle t at distance d replaces the best so far: nearer, or as near with a lower index
+// (ties: at a shared edge or corner; the answer then does not depend on the order of the tests). With
+// nothing found yet, anything within the radius.
+bool better(const Search& s, double d, std::int64_t t) {
+  return d < s.best || (d == s.best && (s.kept < 0 || t < s.kept));
+}
+
 #ifdef IMPINGE_HAVE_EMBREE
-// A group whose box the query's ball reaches: the triangles whose lower bound (group_lower_bounds, widened
-// by the search's margin for float rounding) is within the best distance so far get the exact test.
-bool visit(RTCPointQueryFunctionArguments* args) {
-  auto* s = static_cast<Search*>(args->userPtr);
-  const SignedDistanceQuery::Impl::Group& g = s->m->groups[args->primID];
+// The distance from (x, y, z) to box b (lower x, y, z, upper x, y, z), float, mm.
+float box_distance(const std::array<float, 6>& b, float x, float y, float z) {
+  const float dx = std::max(std::max(b[0] - x, x - b[3]), 0.f);
+  const float dy = std::max(std::max(b[1] - y, y - b[4]), 0.f);
+  const float dz = std::max(std::max(b[2] - z, z - b[5]), 0.f);
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+// A group whose box the query's ball reaches (q = (x, y, z), float, about the shift): the triangles whose
+// lower bound (group_lower_bounds, widened by the search's margin for float rounding) is within the best
+// distance so far get the exact test. Whether one of them became the best.
+bool visit_group(Search* s, std::uint32_t group, float x, float y, float z) {
+  const SignedDistanceQuery::Impl::Group& g = s->m->groups[group];
   float lb2[kGroup];
   const float first = static_cast<float>(s->best + s->margin);
-  std::uint32_t bits = group_lower_bounds(g.v, args->query->x, args->query->y, args->query->z, first * first, lb2);
+  std::uint32_t bits = group_lower_bounds(g.v, x, y, z, first * first, lb2);
   bool closer = false;
   for (; bits != 0; bits &= bits - 1) {  // the lanes within the first limit, in order; the limit shrinks
     const int l = __builtin_ctz(bits);
@@ -433,17 +450,38 @@ bool visit(RTCPointQueryFunctionArguments* args) {
     Eigen::Vector3d point;
     int feature = 0;
     const double d = s->m->distance_to(t, s->q, point, feature);
-    if (!(d <= s->best)) continue;
+    if (!better(*s, d, static_cast<std::int64_t>(t))) continue;
     s->best = d, s->kept = static_cast<std::int64_t>(t), s->point = point, s->feature = feature;
     closer = true;
     if (s->any_only) break;
   }
+  return closer;
+}
+
+// Embree's callback for a group the walk reaches (visit_group); a walk that fills a NearbyTriangles also
+// lists the group, and keeps its radius.
+bool visit(RTCPointQueryFunctionArguments* args) {
+  auto* s = static_cast<Search*>(args->userPtr);
+  if (s->collect != nullptr) {  // filling: list the group; the walk's radius stays that of the list's ball
+    NearbyTriangles& n = *s->collect;
+    if (n.count < NearbyTriangles::kMax) {  // in order of the box's distance from the centre (insertion)
+      const float d = box_distance(s->m->group_box[args->primID], args->query->x, args->query->y, args->query->z);
+      int i = n.count;
+      for (; i > 0 && n.box_distance[i - 1] > d; --i) n.group[i] = n.group[i - 1], n.box_distance[i] = n.box_distance[i - 1];
+      n.group[i] = static_cast<std::int32_t>(args->primID), n.box_distance[i] = d;
+    }
+    ++n.count;
+    visit_group(s, args->primID, args->query->x, args->query->y, args->query->z);
+    return false;
+  }
+  const bool closer = visit_group(s, args->primID, args->query->x, args->query->y, args->query->z);
   if (closer) args->query->radius = s->any_only ? 0.f : static_cast<float>(s->best + kBoxMarginMm);
   return closer;
 }
 #endif
 
-bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int64_t seed = -1) {
+bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int64_t seed = -1,
+         NearbyTriangles* nearby = nullptr) {
   require(radius > 0, "signed distance: the query radius must be > 0 mm");
   s.best = radius;
   if (seed >= 0 && seed < static_cast<std::int64_t>(m.kept.size()) && m.kept[static_cast<std::size_t>(seed)] >= 0) {
@@ -451,7 +489,7 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
     Eigen::Vector3d point;
     int feature = 0;
     const double d = m.distance_to(t, s.q, point, feature);
-    if (d <= s.best) s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
+    if (better(s, d, static_cast<std::int64_t>(t))) s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
   }
 #ifdef IMPINGE_HAVE_EMBREE
   s.margin = kBoxMarginMm + 1e-6 * (m.extent + (s.q - m.shift).cwiseAbs().maxCoeff());
@@ -461,6 +499,39 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
   query.z = static_cast<float>(s.q.z() - m.shift.z());
   query.time = 0.f;
   query.radius = std::isfinite(s.best) ? static_cast<float>(s.best + kBoxMarginMm) : std::numeric_limits<float>::infinity();
+  if (nearby != nullptr && std::isfinite(s.best)) {
+    const Eigen::Vector3d q(query.x, query.y, query.z);  // about the shift, as the groups' boxes
+    const Eigen::Vector3d c(nearby->centre[0], nearby->centre[1], nearby->centre[2]);
+    const double off = (q - c).norm();
+    if (nearby->query == m.serial && nearby->radius > 0 &&
+        off + s.best + 2 * kBoxMarginMm <= static_cast<double>(nearby->radius)) {
+      // This search's ball (and the boxes' margin) lies inside the listed ball: every group it would
+      // reach is listed. A group's box lies at least its distance from the centre less `off` from q, so
+      // the groups are visited nearest first until that exceeds the best distance so far.
+      for (std::int32_t i = 0; i < nearby->count; ++i) {
+        if (static_cast<double>(nearby->box_distance[i]) - off > s.best + 2 * kBoxMarginMm) break;
+        visit_group(&s, static_cast<std::uint32_t>(nearby->group[i]), query.x, query.y, query.z);
+      }
+      return s.kept >= 0;
+    }
+    // Refill about q: the walk keeps the radius of the list's ball (a little more than this search's own).
+    nearby->query = 0, nearby->radius = -1.f, nearby->count = 0;
+    const double listed = s.best + kNearbySlackMm;
+    query.radius = static_cast<float>(listed + kBoxMarginMm);
+    s.collect = nearby;
+    RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    rtcPointQuery(m.scene, &query, &context, visit, &s);
+    s.collect = nullptr;
+    if (nearby->count <= NearbyTriangles::kMax) {
+      nearby->query = m.serial;
+      nearby->centre[0] = query.x, nearby->centre[1] = query.y, nearby->centre[2] = query.z;
+      nearby->radius = static_cast<float>(listed) * (1.f - 0x1p-20f);  // rounded down, below the ball walked
+    } else {
+      nearby->count = 0;
+    }
+    return s.kept >= 0;
+  }
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   rtcPointQuery(m.scene, &query, &context, visit, &s);
@@ -471,7 +542,7 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
   Eigen::Vector3d point;
   int feature = 0;
   const double d = m.distance_to(t, s.q, point, feature);
-  if (d <= s.best) s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
+  if (better(s, d, static_cast<std::int64_t>(t))) s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
 #endif
   return s.kept >= 0;
 }
@@ -494,9 +565,9 @@ bool SignedDistanceQuery::any_within(const Eigen::Vector3d& q, double radius_mm)
 }
 
 bool SignedDistanceQuery::signed_distance(const Eigen::Vector3d& q, double radius_mm, int hint,
-                                          ClosestSurfacePoint& out, std::int64_t seed) const {
+                                          ClosestSurfacePoint& out, std::int64_t seed, NearbyTriangles* nearby) const {
   Search s{impl_.get(), q, 0, -1, {}, 0, false};
-  if (!run(*impl_, s, radius_mm, seed)) return false;
+  if (!run(*impl_, s, radius_mm, seed, nearby)) return false;
   const Impl& m = *impl_;
   const auto t = static_cast<std::size_t>(s.kept);
   bool trusted = true;

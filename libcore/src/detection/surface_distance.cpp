@@ -116,13 +116,15 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
   if (memory != nullptr && (memory->query != other.id() || memory->seed.size() != k_all ||
                             memory->empty_radius.size() != k_all || memory->empty_centre.size() != k_all ||
                             memory->cluster_empty_radius.size() != c_all ||
-                            memory->cluster_empty_centre.size() != c_all)) {
+                            memory->cluster_empty_centre.size() != c_all || memory->nearby_slot.size() != k_all)) {
     memory->query = other.id();
     memory->seed.assign(k_all, -1);
     memory->empty_centre.assign(k_all, Eigen::Vector3f::Zero());
     memory->empty_radius.assign(k_all, 0.f);
     memory->cluster_empty_centre.assign(c_all, Eigen::Vector3f::Zero());
     memory->cluster_empty_radius.assign(c_all, 0.f);
+    memory->nearby_slot.assign(k_all, -1);
+    memory->nearby.clear();
   }
   const Eigen::Vector3d shift = cor + t;
   ClosestSurfacePoint cp;
@@ -171,6 +173,14 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
         continue;
       }
       const std::int64_t start = memory != nullptr && memory->seed[k] >= 0 ? memory->seed[k] : seed;
+      NearbyTriangles* nearby = nullptr;
+      if (memory != nullptr) {
+        if (memory->nearby_slot[k] < 0) {
+          memory->nearby_slot[k] = static_cast<std::int32_t>(memory->nearby.size());
+          memory->nearby.emplace_back();
+        }
+        nearby = &memory->nearby[static_cast<std::size_t>(memory->nearby_slot[k])];
+      }
       ++st.searches;
       bool found = false;
       if (memory != nullptr && radius == reach_mm && !(g < reach_mm)) {
@@ -180,11 +190,11 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
           memory->empty_centre[k] = q.cast<float>();
           memory->empty_radius[k] = static_cast<float>(reach_mm + kEmptySlackMm);
         } else {
-          found = other.signed_distance(q, reach_mm, hint, cp, start);
+          found = other.signed_distance(q, reach_mm, hint, cp, start, nearby);
         }
       } else {
-        found = other.signed_distance(q, radius, hint, cp, start);
-        if (!found && radius < reach_mm) found = other.signed_distance(q, reach_mm, hint, cp, start);
+        found = other.signed_distance(q, radius, hint, cp, start, nearby);
+        if (!found && radius < reach_mm) found = other.signed_distance(q, reach_mm, hint, cp, start, nearby);
       }
       if (!found) continue;
       seed = cp.triangle;

@@ -79,8 +79,8 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
                   const std::function<void(const MotionFrame&)>& on_frame) {
   require(time_s.empty() || time_s.size() == angles.size(),
           "motion: " + std::to_string(time_s.size()) + " times for " + std::to_string(angles.size()) + " poses");
-  // Frames are independent, and are scanned on every OpenMP thread, each taking the next frame as soon
-  // as it is free (no block waits for its slowest frame). They go through a ring of slots, each keeping
+  // Frames are independent, and are scanned on every OpenMP thread, each taking the next frames as soon
+  // as it is free (no block waits for its slowest frame; a worker takes a run of consecutive frames). They go through a ring of slots, each keeping
   // its PoseResult (after the first lap no pose allocates): frame k is scanned into slot k % ring once
   // frame k - ring has been handed over. The calling thread (OpenMP's master) hands the frames to
   // on_frame in order as they become ready (writing a VTP file then hides behind the other threads'
@@ -89,6 +89,7 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
   if (n == 0) return 0;
   const int threads = std::max(1, omp_get_max_threads());
   const auto ring = static_cast<std::int64_t>(std::min<std::size_t>(angles.size(), 16 * static_cast<std::size_t>(threads)));
+  constexpr std::int64_t kRun = 8;  // frames a worker takes at once (the master takes one at a time)
   std::vector<PoseResult> results(static_cast<std::size_t>(ring));
   std::vector<MotionFrame> frames(static_cast<std::size_t>(ring));
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(ring));  // a frame's scan error, in its slot
@@ -134,12 +135,15 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
       }
       stop = true;
     } else {
-      for (;;) {
-        const std::int64_t k = next.fetch_add(1);
-        if (k >= n) break;
-        while (k >= handed.load(std::memory_order_acquire) + ring && !stop) std::this_thread::yield();
-        if (stop) break;
-        scan(k);
+      // Runs of kRun consecutive frames: a thread's distance memory then meets each vertex a frame
+      // later, not several, and its facts (seeds, nearby triangles) hold more often.
+      for (bool more = true; more && !stop;) {
+        const std::int64_t first = next.fetch_add(kRun);
+        more = first < n;
+        for (std::int64_t k = first; k < std::min(first + kRun, n) && !stop; ++k) {
+          while (k >= handed.load(std::memory_order_acquire) + ring && !stop) std::this_thread::yield();
+          if (!stop) scan(k);
+        }
       }
     }
   }

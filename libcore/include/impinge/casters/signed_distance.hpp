@@ -15,7 +15,9 @@
 /// corner's region. Only a triangle whose bound is within the best distance so far (plus a margin above
 /// the float rounding: 1e-3 mm + 1e-6 of the coordinates' size) gets the exact test: near a bone the
 /// closest triangle and those tied with it at a shared edge or corner, about 4 per seeded query on the
-/// shared hips, where a plane and a bounding ball alone left about 14.
+/// shared hips, where a plane and a bounding ball alone left about 14. Of tied triangles the one with the
+/// lower index wins, so that the answer does not depend on the order in which they are tried (the
+/// hierarchy's, or a NearbyTriangles' list).
 ///
 /// Sign, the rule (SignRule):
 /// 1. The angle-weighted pseudo-normal of the closest feature (Baerentzen & Aanaes 2005, IEEE TVCG
@@ -59,6 +61,24 @@ struct ClosestSurfacePoint {
   double signed_mm() const { return sign * distance_mm; }         ///< sign * distance_mm
 };
 
+/// The triangles near a point, kept from one search for the next searches near it (along a motion;
+/// DistanceScanMemory keeps one per vertex): the hierarchy's groups of triangles whose boxes meet a ball
+/// (centre and radius, mm, the mesh frame, float). A later search whose own ball (its seed's distance, or
+/// its radius, about its point) lies inside that ball reads these groups instead of walking the hierarchy:
+/// every triangle it could find lies in one of them, so the answer is the same (the closest triangle,
+/// ties broken by the lower index, whichever order the triangles are tried in). Filled by a search given
+/// one that cannot use it; tied to the surface by its query's id(); radius < 0: nothing known (more than
+/// kMax groups met the ball, or none filled yet). Source: impinge.
+struct NearbyTriangles {
+  static constexpr int kMax = 24;          ///< groups kept at most
+  std::uint64_t query = 0;                 ///< SignedDistanceQuery::id() of the surface
+  float centre[3] = {0.f, 0.f, 0.f};       ///< mm, mesh frame, less the query's own shift (internal)
+  float radius = -1.f;                     ///< mm
+  std::int32_t count = 0;                  ///< groups in `group`
+  std::int32_t group[kMax] = {};           ///< the groups (internal indices), nearest box first
+  float box_distance[kMax] = {};           ///< mm: each group's box from the centre, ascending
+};
+
 /// Closest points and signed distances to one triangle mesh. Build once (O(m log m)); queries are const
 /// and thread-safe.
 class SignedDistanceQuery {
@@ -85,8 +105,11 @@ class SignedDistanceQuery {
   /// for example a neighbouring point's closest: its distance shrinks the search radius before the
   /// hierarchy is walked (the answer does not depend on it). Returns false when nothing lies within the
   /// radius.
+  /// `nearby` (optional; Embree builds only, ignored otherwise): the triangles near an earlier query
+  /// point (NearbyTriangles), read when this search's ball lies inside its ball, else refilled about q.
+  /// Only the cost depends on it.
   bool signed_distance(const Eigen::Vector3d& q, double radius_mm, int hint, ClosestSurfacePoint& out,
-                       std::int64_t seed = -1) const;
+                       std::int64_t seed = -1, NearbyTriangles* nearby = nullptr) const;
   /// The generalised winding number of the surface at q (Jacobson et al. 2013): 1 inside a closed
   /// surface wound outward, 0 outside, fractional near the holes of an open one. Exact sum over every
   /// triangle, O(m).

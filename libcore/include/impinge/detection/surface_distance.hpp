@@ -70,6 +70,9 @@ struct DistanceScanMemory {
   std::vector<float> empty_radius;
   std::vector<Eigen::Vector3f> cluster_empty_centre;  ///< c: the same about the clusters' centres
   std::vector<float> cluster_empty_radius;
+  /// k: each vertex's NearbyTriangles in `nearby`, or -1 (none yet: given at its first search).
+  std::vector<std::int32_t> nearby_slot;
+  std::vector<NearbyTriangles> nearby;
 };
 
 /// The distance scan at one pose. For every vertex i of `set`: q = cor + R p_i + t (the other body's
@@ -80,7 +83,7 @@ struct DistanceScanMemory {
 /// `distance_mm` and `memory` have their sizes.
 ///
 /// `memory` (optional): what earlier scans of the set against the same surface learnt (DistanceScanMemory),
-/// used and updated. Neither kind of fact changes an answer, only what it costs:
+/// used and updated. None of these facts changes an answer, only what it costs:
 /// - Seeds: each vertex's closest triangle at an earlier pose is tried first in place of the previous
 ///   vertex's (SignedDistanceQuery::signed_distance's seed, which only narrows the search). Along a motion
 ///   a vertex's closest triangle is mostly the one of the frame before, or its neighbour.
@@ -92,6 +95,10 @@ struct DistanceScanMemory {
 ///   without a search, and a cluster likewise without its test. Along a motion the vertices and clusters
 ///   beyond the reach are then tested every few frames instead of at each (lhdl-ct's 1,000-frame trial:
 ///   about 40 % fewer searches).
+/// - Nearby triangles: each searched vertex keeps the hierarchy's groups within 2 mm beyond its search's
+///   ball (NearbyTriangles); while its later searches' balls stay inside that ball, they read those groups
+///   instead of walking the hierarchy (lhdl-ct's trial: about 9 of 10 searches, the distance scans
+///   about 15 % cheaper on one thread).
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
