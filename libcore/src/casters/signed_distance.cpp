@@ -466,14 +466,16 @@ bool visit(RTCPointQueryFunctionArguments* args) {
   auto* s = static_cast<Search*>(args->userPtr);
   if (s->collect != nullptr) {  // filling: list the group; the walk's radius stays that of the list's ball
     NearbyTriangles& n = *s->collect;
+    const float d = box_distance(s->m->group_box[args->primID], args->query->x, args->query->y, args->query->z);
     if (n.count < NearbyTriangles::kMax) {  // in order of the box's distance from the centre (insertion)
-      const float d = box_distance(s->m->group_box[args->primID], args->query->x, args->query->y, args->query->z);
       int i = n.count;
       for (; i > 0 && n.box_distance[i - 1] > d; --i) n.group[i] = n.group[i - 1], n.box_distance[i] = n.box_distance[i - 1];
       n.group[i] = static_cast<std::int32_t>(args->primID), n.box_distance[i] = d;
     }
     ++n.count;
-    visit_group(s, args->primID, args->query->x, args->query->y, args->query->z);
+    // Its triangles only where its box comes within the best distance so far (as a walk that shrinks).
+    if (static_cast<double>(d) <= s->best + 2 * kBoxMarginMm)
+      visit_group(s, args->primID, args->query->x, args->query->y, args->query->z);
     return false;
   }
   const bool closer = visit_group(s, args->primID, args->query->x, args->query->y, args->query->z);
