@@ -80,9 +80,9 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
   require(time_s.empty() || time_s.size() == angles.size(),
           "motion: " + std::to_string(time_s.size()) + " times for " + std::to_string(angles.size()) + " poses");
   // Frames are independent, and are scanned on every OpenMP thread, each taking the next frames as soon
-  // as it is free (no block waits for its slowest frame; a worker takes a run of consecutive frames). They go through a ring of slots, each keeping
-  // its PoseResult (after the first lap no pose allocates): frame k is scanned into slot k % ring once
-  // frame k - ring has been handed over. The calling thread (OpenMP's master) hands the frames to
+  // as it is free (no block waits for its slowest frame; a worker takes a run of consecutive frames).
+  // They go through a ring of slots, each keeping its PoseResult (after the first lap no pose
+  // allocates): frame k is scanned into slot k % ring once frame k - ring has been handed over. The calling thread (OpenMP's master) hands the frames to
   // on_frame in order as they become ready (writing a VTP file then hides behind the other threads'
   // scans), and scans a frame itself whenever the next one to hand over is not ready yet.
   const auto n = static_cast<std::int64_t>(angles.size());

@@ -80,7 +80,8 @@ struct DistanceScanMemory {
 /// (mm, negative inside), or NaN when it is proven farther than `reach_mm` (> 0). `gap_mm`: the body's
 /// radial gaps (n values, NaN where not tested; empty: none), used as bounds and sign hints (the file
 /// comment). `distance_mm` is resized to n and NaN outside the set. Single thread, allocation-free once
-/// `distance_mm` and `memory` have their sizes.
+/// `distance_mm` and `memory` have their sizes (but for `memory`'s nearby triangles, a slot of 224 bytes
+/// added at a vertex's first search: at most k of them).
 ///
 /// `memory` (optional): what earlier scans of the set against the same surface learnt (DistanceScanMemory),
 /// used and updated. None of these facts changes an answer, only what it costs:
