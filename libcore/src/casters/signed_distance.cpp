@@ -54,6 +54,7 @@ Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vecto
 
 constexpr double kBoxMarginMm = 1e-3;  // the float hierarchy's boxes against the double triangles
 constexpr double kNearbySlackMm = 2;   // a NearbyTriangles' ball: the search's own radius plus this
+constexpr double kBoxReachMm = 2 * kBoxMarginMm;  // a group's box within the best distance plus this may hold it
 
 #ifdef IMPINGE_HAVE_EMBREE
 constexpr int kGroup = 16;  // triangles per group of the point query's hierarchy (8 and 32 were slower)
@@ -474,7 +475,7 @@ bool visit(RTCPointQueryFunctionArguments* args) {
     }
     ++n.count;
     // Its triangles only where its box comes within the best distance so far (as a walk that shrinks).
-    if (static_cast<double>(d) <= s->best + 2 * kBoxMarginMm)
+    if (static_cast<double>(d) <= s->best + kBoxReachMm)
       visit_group(s, args->primID, args->query->x, args->query->y, args->query->z);
     return false;
   }
@@ -503,29 +504,32 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
   query.z = static_cast<float>(s.q.z() - m.shift.z());
   query.time = 0.f;
   query.radius = std::isfinite(s.best) ? static_cast<float>(s.best + kBoxMarginMm) : std::numeric_limits<float>::infinity();
+  double listed = 0;  // mm: the ball of a NearbyTriangles this walk refills
   if (nearby != nullptr && std::isfinite(s.best)) {
     const Eigen::Vector3d q(query.x, query.y, query.z);  // about the shift, as the groups' boxes
     const Eigen::Vector3d c(nearby->centre[0], nearby->centre[1], nearby->centre[2]);
     const double off = (q - c).norm();
     if (nearby->query == m.serial && nearby->radius > 0 &&
-        off + s.best + 2 * kBoxMarginMm <= static_cast<double>(nearby->radius)) {
+        off + s.best + kBoxReachMm <= static_cast<double>(nearby->radius)) {
       // This search's ball (and the boxes' margin) lies inside the listed ball: every group it would
       // reach is listed. A group's box lies at least its distance from the centre less `off` from q, so
       // the groups are visited nearest first until that exceeds the best distance so far.
       for (std::int32_t i = 0; i < nearby->count; ++i) {
-        if (static_cast<double>(nearby->box_distance[i]) - off > s.best + 2 * kBoxMarginMm) break;
+        if (static_cast<double>(nearby->box_distance[i]) - off > s.best + kBoxReachMm) break;
         visit_group(&s, static_cast<std::uint32_t>(nearby->group[i]), query.x, query.y, query.z);
       }
       return s.kept >= 0;
     }
     // Refill about q: the walk keeps the radius of the list's ball (a little more than this search's own).
     nearby->query = 0, nearby->radius = -1.f, nearby->count = 0;
-    const double listed = s.best + kNearbySlackMm;
+    listed = s.best + kNearbySlackMm;
     query.radius = static_cast<float>(listed + kBoxMarginMm);
     s.collect = nearby;
-    RTCPointQueryContext context;
-    rtcInitPointQueryContext(&context);
-    rtcPointQuery(m.scene, &query, &context, visit, &s);
+  }
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(m.scene, &query, &context, visit, &s);
+  if (s.collect != nullptr) {
     s.collect = nullptr;
     if (nearby->count <= NearbyTriangles::kMax) {
       nearby->query = m.serial;
@@ -534,11 +538,7 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
     } else {
       nearby->count = 0;
     }
-    return s.kept >= 0;
   }
-  RTCPointQueryContext context;
-  rtcInitPointQueryContext(&context);
-  rtcPointQuery(m.scene, &query, &context, visit, &s);
 #elif defined(IMPINGE_HAVE_CGAL)
   using K = SignedDistanceQuery::Impl::K;
   const auto hit = m.tree.closest_point_and_primitive(K::Point_3(s.q.x(), s.q.y(), s.q.z()));
