@@ -19,6 +19,10 @@ RomContacts parse_rom_contacts(const std::string& text, const std::string& conte
   throw Error(context + " '" + text + "': expected impingement, articular or all");
 }
 
+const char* to_string(RomContacts contacts) {
+  return contacts == RomContacts::impingement ? "impingement" : contacts == RomContacts::articular ? "articular" : "all";
+}
+
 const char* to_string(RomMetric metric) { return metric == RomMetric::distance ? "distance" : "radial"; }
 
 RomMetric parse_rom_metric(const std::string& text, const std::string& context) {

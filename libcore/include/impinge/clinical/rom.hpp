@@ -35,6 +35,8 @@ enum class RomContacts {
 
 /// Parse "impingement", "articular" or "all". Throws impinge::Error naming `context` otherwise.
 RomContacts parse_rom_contacts(const std::string& text, const std::string& context);
+/// "impingement", "articular" or "all" (the CLI's spelling).
+const char* to_string(RomContacts contacts);
 
 /// What a ROM search compares with the threshold.
 enum class RomMetric {
