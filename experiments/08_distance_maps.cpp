@@ -44,6 +44,7 @@
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
+#include "impinge/session/option_table.hpp"
 #include "impinge/detection/joint.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/maps/map_image.hpp"
@@ -271,11 +272,9 @@ void radial_vs_distance(const std::vector<Subject>& subjects, const std::string&
   const std::vector<std::pair<std::string, PoseAngles>> poses{
       {"scan", {0, 0, 0}}, {"flexion90", {90, 0, 0}}, {"extension20", {-20, 5, -5}}};
   for (const Subject& s : subjects) {
-    MapSettings maps;
+    MapSettings maps = RunOptions::clinical().session.maps;  // the CLI's: layered maps and distances
     maps.precision = precision;
     maps.levels = kReportLevelsMm;
-    maps.layers = 4;
-    maps.distances = true;
     maps.distance_reach_mm = reach;
     SessionOptions so = session_options(s, maps);
     so.frames.joint_centre.clear();  // the CLI's default for the neutral

@@ -58,6 +58,7 @@
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/maps/layered_map.hpp"
 #include "impinge/session/records.hpp"
+#include "impinge/session/option_table.hpp"
 #include "impinge/session/runs.hpp"
 
 using namespace impinge;
@@ -419,8 +420,7 @@ void add_prefixed(Table& into, const Table& t, const std::string& subject, const
 void methods(const SubjectRun& r, Outputs& out) {
   if (!r.session.hip().acetabulum()) return;  // scan neutral (the generated model): femoral-head only
   const std::vector<StandardMotion> motions = standard_motions();
-  RomRequest q;  // the CLI's defaults: the distance metric
-  q.search.metric = RomMetric::distance;
+  const RomRequest q = RunOptions::clinical().rom;  // the CLI's defaults: the distance metric
   const Eigen::Vector3d centre = r.session.head().centre;
   const Eigen::Matrix3d axes = r.session.hip().frames()->pelvis.axes;
   const char* axis_name[3] = {"x", "y", "z"};

@@ -131,23 +131,37 @@ def subject_meshes(subject):
     return out
 
 
+def _with_vtk_meshes(ball, socket, options):
+    """ball and socket with VTK files (given, or named by options' subject) read here as (V, F) arrays."""
+    if is_vtk_file(ball):
+        ball = read_vtk_mesh(ball)
+    if is_vtk_file(socket):
+        socket = read_vtk_mesh(socket)
+    subject = options.get("subject")
+    if subject is not None and (ball is None or socket is None):
+        meshes = subject_meshes(subject)
+        if ball is None and is_vtk_file(meshes.get("femur")):
+            ball = read_vtk_mesh(meshes["femur"])
+        if socket is None and is_vtk_file(meshes.get("pelvis")):
+            socket = read_vtk_mesh(meshes["pelvis"])
+    return ball, socket
+
+
+def femoral_head_centre(ball=None, socket=None, **options):
+    ball, socket = _with_vtk_meshes(ball, socket, options)
+    return _impinge.femoral_head_centre(ball, socket, **options)
+
+
+femoral_head_centre.__doc__ = _impinge.femoral_head_centre.__doc__
+
+
 class Joint(_impinge.Joint):
     # The extension's Joint, with VTK files wherever it takes a mesh file: `ball=`, `socket=`, or the femur
     # and pelvis a subject.json names. VTK files are read here (read_vtk_mesh) and handed over as arrays.
     __doc__ = _impinge.Joint.__doc__
 
     def __init__(self, ball=None, socket=None, **options):
-        if is_vtk_file(ball):
-            ball = read_vtk_mesh(ball)
-        if is_vtk_file(socket):
-            socket = read_vtk_mesh(socket)
-        subject = options.get("subject")
-        if subject is not None and (ball is None or socket is None):
-            meshes = subject_meshes(subject)
-            if ball is None and is_vtk_file(meshes.get("femur")):
-                ball = read_vtk_mesh(meshes["femur"])
-            if socket is None and is_vtk_file(meshes.get("pelvis")):
-                socket = read_vtk_mesh(meshes["pelvis"])
+        ball, socket = _with_vtk_meshes(ball, socket, options)
         super().__init__(ball, socket, **options)
 
     __init__.__doc__ = _impinge.Joint.__init__.__doc__

@@ -42,6 +42,17 @@ def locate_femoral_head(V: npt.ArrayLike, F: npt.ArrayLike,
     """Femoral head sphere of a femur in any orientation; with its pelvis (same frame), the end that
     sits in the acetabulum, as the CLI finds it."""
 
+def options() -> List[Dict[str, Any]]:
+    """The option table (the session layer's): one dict per option with name (the CLI's), key (Python's and the
+    study files'), type, unit, choices, min, max, required, default (the clinical preset's), thesis_default,
+    help and uses (CLI commands, joint, rom_limits, rom_map, study)."""
+
+def femoral_head_centre(ball: Optional[Union[str, os.PathLike, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
+                        socket: Optional[Union[str, os.PathLike, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
+                        **options: Any) -> Dict[str, Any]:
+    """The femoral head centre as Joint(...) finds it from the same keywords, without building maps ->
+    dict(centre (3,) mm in the input frame, radius mm (NaN when given), method)."""
+
 def generated_hip(triangles: int = 3000, cam_mm: float = 0.0, coverage_deg: float = 100.0) -> Dict[str, Any]:
     """A generated hip -> dict(ball=(V, F), socket=(V, F), cor, head_radius_mm); use neutral='scan'."""
 
@@ -69,24 +80,24 @@ class Joint:
     or returned are in the input frame (`frame`)."""
     def __init__(self, ball: Optional[Union[str, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
                  socket: Optional[Union[str, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None, *,
-                 subject: Optional[str] = None, side: Optional[str] = None, frame: Optional[str] = None,
-                 cor: Optional[Union[str, Sequence[float]]] = None, allow_any_cor: bool = False,
-                 head_region: Optional[Sequence[float]] = None,
+                 preset: str = 'clinical', subject: Optional[Union[str, os.PathLike]] = None,
+                 side: Optional[str] = None, frame: Optional[str] = None,
                  landmarks: Optional[Dict[str, Sequence[float]]] = None,
-                 scheme: str = "equiangular", resolution: float = 0.0, precision: float = 0.0, turns: float = 0.0,
-                 spacing: float = 0.0, sampling: str = "auto", mode: str = "exact",
-                 levels: Optional[Sequence[float]] = None, occlusion_tolerance_mm: float = 1.0,
+                 cor: Optional[Union[str, Sequence[float]]] = None, allow_any_cor: bool = False,
+                 head_region: Optional[Sequence[float]] = None, scheme: str = 'equiangular', resolution: float = 0.0,
+                 precision: float = 0.0, turns: float = 0.0, spacing: float = 0.0, sampling: str = 'auto',
+                 mode: str = 'exact', levels: Optional[Sequence[float]] = None, occlusion_tolerance_mm: float = 1.0,
                  max_radius_mm: float = 0.0, sparse: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
-                 layers: int = 4, extra_articular_radius_mm: float = 150.0, layered_spacing: float = 0.5,
-                 distances: bool = True, distance_reach_mm: float = 0.0, levels_on: Optional[str] = None,
-                 maps_only: bool = False,
-                 maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
-                 pelvis_frame: str = "isb", joint_centre: Optional[str] = None,
-                 femur_frame: str = "epicondyles") -> None:
-        """ball, socket: mesh files or (V (n, 3) float mm, F (m, 3) int); or subject: a subject.json
+                 layers: int = 4, layered_spacing: float = 0.5, extra_articular_radius_mm: float = 150.0,
+                 distances: bool = True, levels_on: Optional[str] = None, distance_reach_mm: float = 0.0,
+                 maps_only: bool = False, maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
+                 pelvis_frame: str = 'isb', joint_centre: Optional[str] = None, femur_frame: str = "epicondyles") -> None:
+        """Every keyword is a row of impinge.options() (the session layer's option table, shared with the CLI
+        and study files), its default the clinical preset's; preset='thesis' starts from the thesis' set-up.
+        ball, socket: mesh files or (V (n, 3) float mm, F (m, 3) int); or subject: a subject.json
         (meshes, side, frame, landmarks, neutral). side: 'right'/'left'; frame: 'LPS'/'RAS' (the
         meshes' frame; default the subject's, else RAS). cor: 'auto' (the femoral head fitted) or
-        (x, y, z) mm; head_region: (x, y, z, r) mm, fit the head there; allow_any_cor: accept a COR
+        (x, y, z) mm, the femoral head centre about which the radial gaps at the scan pose are measured; head_region: (x, y, z, r) mm, fit the head there; allow_any_cor: accept a COR
         outside the head. scheme and one of resolution/precision/turns/spacing (0: the scheme's
         0.5 deg default); sampling; mode 'exact'/'linear'; levels: thresholds mm, decreasing;
         sparse: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for
@@ -115,15 +126,22 @@ class Joint:
     def motion(self, angles: npt.ArrayLike) -> Dict[str, npt.NDArray[np.float64]]:
         """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each. Frames
         are scanned in blocks on impinge.get_threads() threads; rows come back in order."""
-    def rom_limits(self, threshold_mm: float = 0.0, step_deg: float = 2.0, max_deg: float = 150.0,
-                   contacts: str = "impingement", contact_depth_mm: float = 0.25) -> Dict[str, Any]:
+    def rom_limits(self, threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
+                   contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0) -> Dict[str, Any]:
         """ROM limits from neutral for the standard motions -> dict motion -> the CLI's rom_limits.csv row
-        (limit_deg, limited_by, contact_class, ...). contacts: 'impingement' (the joint surfaces meeting
-        is left out), 'articular' (only that: the joint space closing) or 'all'. contact_depth_mm: how far
-        past the threshold a contact must reach to end a search (0: the first touch)."""
-    def rom_map(self, flexion: Sequence[float], adduction: Sequence[float],
-                threshold_mm: float = 0.0, contact_depth_mm: float = 0.25) -> npt.NDArray[np.float64]:
-        """Largest internal rotation before contact, (len(flexion), len(adduction)) degrees."""
+        (limit_deg, limited_by, contact_class, ...). The keywords and defaults are `impinge rom`'s (the option
+        table). contacts: 'impingement' (the joint surfaces meeting is left out), 'articular' (only that: the
+        joint space closing) or 'all'. contact_depth_mm: how far past the threshold a contact must reach to end a
+        search (0: the first touch). metric: 'distance' (needs the Joint's distances) or 'radial'."""
+    def rom_map(self, flexion: Sequence[float] = [0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0,
+                                                  55.0, 60.0, 65.0, 70.0, 75.0, 80.0, 85.0, 90.0, 95.0, 100.0,
+                                                  105.0, 110.0, 115.0, 120.0],
+                adduction: Sequence[float] = [-20.0, -15.0, -10.0, -5.0, 0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0,
+                                              35.0, 40.0],
+                threshold_mm: float = 0.0, contact_depth_mm: float = 0.25,
+                metric: str = 'distance') -> npt.NDArray[np.float64]:
+        """Largest internal rotation before contact, (len(flexion), len(adduction)) degrees: `impinge rom`'s
+        ROM map (the same search)."""
     def femur_rotation(self, flexion: float = 0.0, adduction: float = 0.0,
                        internal_rotation: float = 0.0) -> npt.NDArray[np.float64]: ...
     def femur_pose(self, flexion: float = 0.0, adduction: float = 0.0,

@@ -181,7 +181,7 @@ def test_bad_arrays_raise_clear_errors(generated):
         j.motion(np.zeros((4, 2)))
     with pytest.raises(impinge.Error, match="not finite"):
         j.motion(np.array([[0, np.nan, 0]]))
-    with pytest.raises(impinge.Error, match="sampling scheme 'hexagon'"):
+    with pytest.raises(impinge.Error, match="scheme: 'hexagon' is not one of equiangular"):
         impinge.Joint((V, F), S, neutral="scan", scheme="hexagon")
     with pytest.raises(impinge.Error, match="nope.ply"):
         impinge.load_mesh(d + "/nope.ply")

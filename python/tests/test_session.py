@@ -1,13 +1,10 @@
 """Python's Joint against the CLI through the one set-up they share (the session layer).
 
-Invariants: Joint takes every option `impinge distance` takes, at run time and in the stub file;
-a subject given in LPS gives the CLI's gaps bit for bit, whether Python reads subject.json or gets
+Invariants (the options themselves: test_options.py): a subject given in LPS gives the CLI's gaps bit for bit, whether Python reads subject.json or gets
 the LPS arrays with frame='LPS'; results given in the input frame (COR, frames, rotations) are the
 CLI's; bad options raise impinge.Error naming the option."""
-import ast
 import json
 import os
-import re
 import subprocess
 import tempfile
 
@@ -16,55 +13,6 @@ import pytest
 
 import impinge
 from test_impinge import CLI, DATA, read_gaps, read_ply_vertices
-
-STUB = os.path.join(os.path.dirname(__file__), "..", "impinge", "__init__.pyi")
-# CLI options of `impinge distance` that are not Joint options: where to write and what to do at one pose.
-NOT_JOINT_OPTIONS = {"help", "out", "pose", "render"}
-
-
-def cli_options(command):
-    """The long options of `impinge COMMAND --help`, as Python names (dashes to underscores)."""
-    text = subprocess.run([CLI, command, "--help"], check=True, capture_output=True, text=True).stdout
-    return sorted({m.replace("-", "_") for m in re.findall(r"^\s+(?:-\w, )?--([a-z][a-z-]*)", text, re.M)}
-                  - NOT_JOINT_OPTIONS)
-
-
-def stub_joint_parameters():
-    tree = ast.parse(open(STUB).read())
-    joint = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Joint")
-    init = next(n for n in joint.body if isinstance(n, ast.FunctionDef) and n.name == "__init__")
-    a = init.args
-    return {x.arg for x in a.args + a.kwonlyargs} - {"self"}
-
-
-def runtime_joint_options():
-    """The options the module's Joint accepts, from its docstring's list (the C++ option table)."""
-    doc = impinge.Joint.__init__.__doc__
-    listed = re.search(r"Options, named as the CLI's with underscores \(None or absent: the default\): ([a-z_, ]+)\.",
-                       doc)
-    assert listed, doc
-    return {x.strip() for x in listed.group(1).split(",")}
-
-
-def python_name(option, names):
-    """The Joint keyword for a CLI option: the same name, or with _mm for a length."""
-    for n in (option, option + "_mm"):
-        if n in names:
-            return n
-    return None
-
-
-def test_joint_and_its_stub_take_every_distance_option():
-    options = cli_options("distance")
-    assert len(options) > 25, options  # the parse found the options
-    stub, runtime = stub_joint_parameters(), runtime_joint_options()
-    missing_stub = [o for o in options if python_name(o, stub) is None]
-    missing_runtime = [o for o in options if python_name(o, runtime) is None]
-    assert not missing_stub, f"impinge/__init__.pyi's Joint lacks {missing_stub}"
-    assert not missing_runtime, f"Joint lacks {missing_runtime}"
-    # The stub lists what the module takes, no more, no less.
-    assert stub == runtime, (stub - runtime, runtime - stub)
-
 
 def test_an_unknown_or_bad_option_names_itself():
     with pytest.raises(impinge.Error, match="unknown option 'layer'.*layers"):

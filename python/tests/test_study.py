@@ -192,7 +192,7 @@ joint_centre = ["femoral-head", "no-such-method"]
     assert r.returncode == 1, r.stderr  # the study finished, with an error to report
     rows = read(str(tmp_path / "o"))
     assert [x["status"] for x in rows] == ["ok", "error"]
-    assert "joint-centre 'no-such-method'" in rows[1]["error"] and rows[1]["limit_flexion_deg"] == ""
+    assert "joint_centre: 'no-such-method' is not one of" in rows[1]["error"] and rows[1]["limit_flexion_deg"] == ""
     assert float(rows[0]["limit_flexion_deg"]) > 0
 
 

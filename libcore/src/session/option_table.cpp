@@ -482,12 +482,12 @@ void add_command_rows(Rows& t) {
             [](auto& o) -> auto& { return o.command.vtp_every; });
   t.flag("quiet", "quiet", OptionType::flag, use_motion, "No progress bar or final line",
          [](auto& o) -> auto& { return o.command.quiet; });
-  t.integer("triangles", "triangles", "", use_generate, 20, 2e7,
+  t.integer("triangles", "triangles", "", use_generate | use_generated_hip, 20, 2e7,
             "Target triangles per model (at most 20 million: about 2 GB of mesh)",
             [](auto& o) -> auto& { return o.generate.target_triangles; });
-  t.number("cam", "cam_mm", "mm", use_generate, 0, 15, "Cam bump height",
+  t.number("cam", "cam_mm", "mm", use_generate | use_generated_hip, 0, 15, "Cam bump height",
            [](auto& o) -> auto& { return o.generate.cam_height_mm; });
-  t.number("coverage", "coverage_deg", "deg", use_generate, 30, 170, "Cup coverage angle from the cup pole",
+  t.number("coverage", "coverage_deg", "deg", use_generate | use_generated_hip, 30, 170, "Cup coverage angle from the cup pole",
            [](auto& o) -> auto& { return o.generate.cup_coverage_deg; });
 }
 

@@ -160,8 +160,10 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
   // baseline's scan and the search bounds it builds count with the limits' time.
   auto t0 = Clock::now();
   run.baseline = rom_baseline(hip, hip.femur_rotation({}), q.search);  // with its joint translation
-  run.motions = standard_motions();
-  run.limits = find_rom_limits(hip, run.motions, q.search, run.baseline);
+  if (q.limits) {
+    run.motions = standard_motions();
+    run.limits = find_rom_limits(hip, run.motions, q.search, run.baseline);
+  }
   run.limits_ms = ms_since(t0);
   auto count = [&run](const auto& x) {  // a limit's, a cell's or the envelope's look-ups
     run.vertices_looked_up += x.vertices_looked_up;

@@ -19,33 +19,31 @@ import impinge
 
 KINDS = ("rom", "envelope", "motion", "distance")
 
-# The Joint keywords a study may set (in [joint] or in a [[task]]): the map, frame and joint-centre settings.
-# Left out: the inputs (ball, socket, subject, side, frame, landmarks: the subject gives them), the COR (the
-# perturbation sets it) and maps (saved maps belong to one COR).
-JOINT_KEYS = {
-    "scheme": str, "resolution": float, "precision": float, "turns": float, "spacing": float, "sampling": str,
-    "mode": str, "levels": list, "occlusion_tolerance_mm": float, "max_radius_mm": float, "sparse": float,
-    "discontinuity_tolerance_mm": float, "layers": int, "extra_articular_radius_mm": float,
-    "layered_spacing": float, "distances": bool, "distance_reach_mm": float, "levels_on": str,
-    "maps_only": bool, "neutral": str, "pelvis_frame": str, "joint_centre": str, "femur_frame": str,
-    "head_region": list, "allow_any_cor": bool,
-}
+# Every key below comes from the option table (the session layer's, impinge.options()): a study cannot expose an
+# option, a default or a type that the CLI and Python do not share.
+_PY_TYPES = {"number": float, "integer": int, "flag": bool, "on_off": bool, "text": str, "choice": str, "path": str,
+             "numbers": list, "region": list, "point": list}
+
+
+def _table(use):
+    return [o for o in impinge.options() if use in o["uses"]]
+
+
+# The Joint keywords a study may set (in [joint] or in a [[task]]): the map, frame and joint-centre settings (the
+# table's rows with "study" in their uses). Left out: the inputs (ball, socket, subject, side, frame, landmarks: the
+# subject gives them), the COR (the perturbation sets it) and maps (saved maps belong to one COR).
+JOINT_KEYS = {o["key"]: _PY_TYPES[o["type"]] for o in _table("study")}
 # Each kind's own options (with their defaults): those of the Joint method the kind calls.
-ENVELOPE_FLEXION = [float(x) for x in range(0, 121, 5)]  # the CLI's rom map grid (impinge rom)
-ENVELOPE_ADDUCTION = [float(x) for x in range(-20, 41, 5)]
 KIND_KEYS = {
-    "rom": {"threshold_mm": 0.0, "step_deg": 2.0, "max_deg": 150.0, "contacts": "impingement",
-            "contact_depth_mm": 0.25, "metric": ""},
-    "envelope": {"threshold_mm": 0.0, "contact_depth_mm": 0.25, "metric": "",
-                 "flexion": ENVELOPE_FLEXION, "adduction": ENVELOPE_ADDUCTION},
+    "rom": {o["key"]: o["default"] for o in _table("rom_limits")},
+    "envelope": {o["key"]: o["default"] for o in _table("rom_map")},
     "motion": {"motion": None},
     "distance": {"poses": None},
 }
-KIND_TYPES = {"threshold_mm": float, "step_deg": float, "max_deg": float, "contacts": str,
-              "contact_depth_mm": float, "metric": str, "flexion": list, "adduction": list,
-              "motion": str, "poses": list}
+KIND_TYPES = dict({o["key"]: _PY_TYPES[o["type"]] for o in _table("rom_limits") + _table("rom_map")},
+                  motion=str, poses=list)
 # Keys whose value is itself a list: a list of such lists sweeps them (not a plain list).
-LIST_VALUED = {"levels", "head_region", "flexion", "adduction"}
+LIST_VALUED = {o["key"] for o in impinge.options() if o["type"] in ("numbers", "region", "point")}
 TOP_KEYS = {"name", "seed", "subjects", "joint", "task", "perturb", "threads"}
 PERTURB_KEYS = {"cor_sd_mm": float, "samples": int}
 

@@ -40,25 +40,17 @@ def _generated(spec):
 
 
 def _nominal_cor(task):
-    """The COR the Joint finds by itself (input frame, mm): the subject's hip_centre landmark if it has one,
-    else the femoral head as the session fits it (locate_femoral_head with the pelvis). Once per subject."""
+    """The COR the Joint finds by itself (input frame, mm), by the session's own policy
+    (impinge.femoral_head_centre). Once per subject."""
     subject = task["subject"]
     key = json.dumps(subject, sort_keys=True)
-    if key in _NOMINAL_COR:
-        return _NOMINAL_COR[key]
-    if "generated" in subject:
-        h = _generated(subject["generated"])
-        ball, socket_ = h["ball"], h["socket"]
-        centre = None
-    else:
-        with open(subject["path"]) as f:
-            centre = json.load(f).get("landmarks", {}).get("hip_centre")
-        meshes = impinge.subject_meshes(subject["path"])
-        if centre is None:
-            ball, socket_ = impinge.load_mesh(meshes["femur"]), impinge.load_mesh(meshes["pelvis"])
-    if centre is None:
-        centre = impinge.locate_femoral_head(ball[0], ball[1], socket_).centre
-    _NOMINAL_COR[key] = np.asarray(centre, dtype=float)
+    if key not in _NOMINAL_COR:
+        if "generated" in subject:
+            h = _generated(subject["generated"])
+            found = impinge.femoral_head_centre(h["ball"], h["socket"])
+        else:
+            found = impinge.femoral_head_centre(subject=subject["path"])
+        _NOMINAL_COR[key] = np.asarray(found["centre"], dtype=float)
     return _NOMINAL_COR[key]
 
 

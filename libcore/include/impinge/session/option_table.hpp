@@ -79,11 +79,12 @@ enum OptionUse : unsigned {
   use_distance = 1u << 0,     ///< `impinge distance`
   use_motion = 1u << 1,       ///< `impinge motion`
   use_rom = 1u << 2,          ///< `impinge rom`
-  use_generate = 1u << 3,     ///< `impinge generate`; Python generated_hip(...)
+  use_generate = 1u << 3,     ///< `impinge generate`
   use_joint = 1u << 4,        ///< Python Joint(...)
   use_rom_limits = 1u << 5,   ///< Python Joint.rom_limits(...); a study's `rom` task
   use_rom_map = 1u << 6,      ///< Python Joint.rom_map(...); a study's `envelope` task
   use_study = 1u << 7,        ///< a study's [joint] and [[task]] keys
+  use_generated_hip = 1u << 8,  ///< Python generated_hip(...)
   use_cli_commands = use_distance | use_motion | use_rom | use_generate,
 };
 

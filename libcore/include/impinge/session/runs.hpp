@@ -55,9 +55,11 @@ nlohmann::json motion_row(const MotionFrame& frame);
 double run_motion(const Session& session, const std::vector<PoseAngles>& angles, const std::vector<double>& time_s,
                   const std::function<void(const MotionFrame&)>& on_frame);
 
-/// What a ROM run computes (RomOptions: threshold, search step and range).
+/// What a ROM run computes (RomOptions: threshold, search step and range). The front ends' defaults are
+/// RunOptions::clinical()'s (option_table.hpp); these are the library's.
 struct RomRequest {
   RomOptions search;
+  bool limits = true;                     ///< the limits of the standard motions (rom_limits.csv)
   bool map = true;                        ///< the ROM map: the largest internal rotation per flexion x adduction
   std::vector<double> map_flexion_deg;    ///< empty: 0..120 step 5
   std::vector<double> map_adduction_deg;  ///< empty: -20..40 step 5

@@ -67,7 +67,7 @@ struct MapSettings {
   double spacing = 0;                  ///< largest node spacing wanted, degrees: the coarsest resolution reaching it
   std::string sampling = "auto";       ///< auto, rasterize, resample, ray-cast, ray-cast-bvh
   std::string mode = "exact";          ///< exact | linear (thesis Alg. 1)
-  std::vector<double> levels;          ///< impingement thresholds, mm, decreasing; empty: the thesis' (6, 2 mm)
+  std::vector<double> levels;          ///< impingement thresholds, mm, decreasing; empty: ImpingementLevels' (4, 8/3, 4/3, 0)
   double occlusion_tolerance_mm = 1.0;
   double max_radius_mm = 0;             ///< test only vertices within this of the COR; 0: all
   double sparse_mm = 0;                 ///< sparse maps keeping tiles with a surface within this (inf: any); 0: dense
@@ -94,7 +94,9 @@ struct FrameSettings {
   std::string femur_frame = "epicondyles";  ///< epicondyles | posterior-condyles
 };
 
-/// Everything a Session needs.
+/// Everything a Session needs. Default-constructed: the library's defaults (the thesis' single-layer maps,
+/// no distances); the front ends start from RunOptions::clinical() (option_table.hpp), whose table holds each
+/// option's name, unit, range, help and default.
 struct SessionOptions {
   SessionInput input;
   CorOptions cor;

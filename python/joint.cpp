@@ -1,0 +1,348 @@
+// The Python Joint: a Session (session/session.hpp) as the CLI builds it, its options from the option table.
+#include <omp.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "bindings.hpp"
+#include "impinge/clinical/rom.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/session/runs.hpp"
+
+namespace impinge::python {
+
+namespace {
+
+
+
+PyJoint make_joint(const py::object& ball, const py::object& socket, const py::kwargs& kw) {
+  RunOptions run = RunOptions::clinical();
+  py::dict given(kw);
+  if (given.contains("ball") || given.contains("socket")) throw Error("Joint: give ball and socket once");
+  given["ball"] = ball;
+  given["socket"] = socket;
+  set_options(run, given, use_joint, "Joint");
+  PyJoint j;
+  {
+    py::gil_scoped_release release;
+    j.session = std::make_shared<const Session>(run.session);
+  }
+  for (const std::string& w : j.session->warnings())
+    if (PyErr_WarnEx(PyExc_UserWarning, ("impinge: " + w).c_str(), 1) != 0) throw py::error_already_set();
+  return j;
+}
+
+// Both scans as Python: the gaps and statuses as numpy arrays (owning the C++ buffers), and each
+// scan's summary as summary.json records it (scan_record).
+py::dict result_dict(const Session& session, PoseResult&& r) {
+  py::dict d;
+  const auto nb = static_cast<py::ssize_t>(r.ball_gaps.gap_mm.size());
+  const auto ns = static_cast<py::ssize_t>(r.socket_gaps.gap_mm.size());
+  const ImpingementLevels& levels = session.joint_options().levels;
+  py::dict summary;
+  summary["ball"] = from_json(scan_record(session.joint().ball(), r.ball, r.ball_detection_ms, levels, nullptr));
+  summary["socket"] =
+      from_json(scan_record(session.joint().socket(), r.socket, r.socket_detection_ms, levels, nullptr));
+  summary["ball_detection_ms"] = r.ball_detection_ms;
+  summary["socket_detection_ms"] = r.socket_detection_ms;
+  if (session.joint_options().distances) {
+    summary["ball_distance_ms"] = r.ball_distance_ms;
+    summary["socket_distance_ms"] = r.socket_distance_ms;
+  }
+  d["ball_gap_mm"] = own(std::move(r.ball_gaps.gap_mm), {nb});
+  d["socket_gap_mm"] = own(std::move(r.socket_gaps.gap_mm), {ns});
+  if (!r.ball_gaps.distance_mm.empty()) {
+    d["ball_distance_mm"] = own(std::move(r.ball_gaps.distance_mm), {nb});
+    d["socket_distance_mm"] = own(std::move(r.socket_gaps.distance_mm), {ns});
+  }
+  d["ball_status"] = own(std::move(r.ball_gaps.status), {nb});
+  d["socket_status"] = own(std::move(r.socket_gaps.status), {ns});
+  d["summary"] = summary;
+  return d;
+}
+
+// Both scans at every pose: the motion table's columns (frames.csv's), one C++ loop without the GIL.
+py::dict motion(const PyJoint& j, const py::handle& angles_obj) {
+  const std::vector<PoseAngles> poses = to_angles(angles_obj);
+  Table t;
+  t.columns = motion_columns(j.session->joint_options().levels);
+  t.rows.reserve(poses.size());
+  {
+    py::gil_scoped_release release;
+    run_motion(*j.session, poses, {}, [&](const MotionFrame& f) { t.rows.push_back(motion_row(f)); });
+  }
+  py::dict d = table_columns(t);
+  d["socket_penetrating_area_mm2"] = d["penetrating_area_mm2"];
+  return d;
+}
+
+std::string joint_doc() {
+  std::string names;
+  for (const OptionRow& r : option_table())
+    if (r.uses & use_joint) names += (names.empty() ? "" : ", ") + r.key;
+  return "Joint(ball=None, socket=None, **options): a hip set up as `impinge distance` sets it up (the session "
+         "layer): femur (ball) and pelvis (socket) from a subject.json, mesh files or (V, F) arrays, in their input "
+         "frame (frame='LPS' or 'RAS', mm); both maps built once (the GIL is released), then any number of poses. "
+         "Options, the rows of impinge.options() with 'joint' in their uses (the CLI's names with underscores; "
+         "None or absent: the clinical preset's default): " + names +
+         ". cor: the femoral head centre, 'auto' or (x, y, z) mm in the input frame; head_region: (x, y, z, r) mm; "
+         "landmarks: dict name -> (x, y, z) mm; levels: thresholds in mm, decreasing; maps: (ball_path, "
+         "socket_path) saved by save_maps(); preset: 'clinical' or 'thesis'. Positions, rotations and frames given "
+         "or returned are in the input frame. Raises impinge.Error naming the option, array or file on bad input; "
+         "warnings (e.g. an overlap at the scan pose) as UserWarning.";
+}
+
+// The ROM request of rom_limits or rom_map (`use`): the clinical preset and the keywords given. The distance
+// metric needs the Joint's distances.
+RomRequest rom_request(const PyJoint& j, const py::dict& given, unsigned use, const std::string& caller) {
+  RunOptions run = RunOptions::clinical();
+  set_options(run, given, use, caller);
+  require(run.rom.search.metric == RomMetric::radial || j.session->joint_options().distances,
+          caller + ": metric 'distance' needs a Joint with distances=True (the default); give metric='radial' for "
+                   "the thesis' radial gap");
+  return run.rom;
+}
+
+py::dict rom_limits(const PyJoint& j, const py::object& threshold_mm, const py::object& contact_depth_mm,
+                    const py::object& metric, const py::object& contacts, const py::object& step_deg,
+                    const py::object& max_deg) {
+  py::dict given;
+  given["threshold_mm"] = threshold_mm, given["contact_depth_mm"] = contact_depth_mm, given["metric"] = metric;
+  given["contacts"] = contacts, given["step_deg"] = step_deg, given["max_deg"] = max_deg;
+  RomRequest q = rom_request(j, given, use_rom_limits, "rom_limits");
+  q.map = false;
+  RomRun run;
+  {
+    py::gil_scoped_release release;
+    run = run_rom(*j.session, q);
+  }
+  const Table t = rom_limits_table(*j.session, run);
+  py::dict d;
+  for (std::size_t k = 0; k < t.rows.size(); ++k) {
+    py::dict e;
+    for (std::size_t c = 1; c < t.columns.size(); ++c) {
+      const nlohmann::json& x = t.rows[k][c];
+      e[py::str(t.columns[c])] = x.is_null() ? py::object(py::float_(std::nan(""))) : from_json(x);
+    }
+    e["contact_mm"] = Eigen::Vector3d(j.session->to_input(run.limits[k].contact_mm));
+    d[py::str(run.motions[k].name)] = e;
+  }
+  d["excluded_vertices"] = run.baseline.excluded_vertices;
+  return d;
+}
+
+py::array_t<double> rom_map(const PyJoint& j, const py::object& flexion, const py::object& adduction,
+                            const py::object& threshold_mm, const py::object& contact_depth_mm, const py::object& metric) {
+  py::dict given;
+  given["flexion"] = flexion, given["adduction"] = adduction, given["threshold_mm"] = threshold_mm;
+  given["contact_depth_mm"] = contact_depth_mm, given["metric"] = metric;
+  RomRequest q = rom_request(j, given, use_rom_map, "rom_map");
+  q.limits = false;
+  RomRun run;
+  {
+    py::gil_scoped_release release;
+    run = run_rom(*j.session, q);
+  }
+  std::vector<double> ir(run.map.size());
+  for (std::size_t k = 0; k < run.map.size(); ++k) ir[k] = run.map[k].max_internal_rotation_deg;
+  return own(std::move(ir), {py::ssize_t(run.map_flexion_deg.size()), py::ssize_t(run.map_adduction_deg.size())});
+}
+
+void add_joint_queries(py::class_<PyJoint>& c) {
+  c.def(
+       "detect",
+       [](const PyJoint& j, const py::handle& R, const py::handle& t) {
+         const Eigen::Matrix3d Rin = to_rotation(R);
+         const Eigen::Vector3d tin = t.is_none() ? Eigen::Vector3d::Zero() : to_point(t, "t");
+         const auto [Rj, tj] = j.session->joint_motion(Rin, tin);
+         PoseResult r;
+         {
+           py::gil_scoped_release release;
+           j.session->joint().detect(Rj, tj, r);
+         }
+         return result_dict(*j.session, std::move(r));
+       },
+       py::arg("R") = py::none(), py::arg("t") = py::none(),
+       "Both scans with the femur rotated by R (3, 3; input frame) about the COR, then translated by t (3,) "
+       "mm -> dict(ball_gap_mm, socket_gap_mm: float32 (n,) in the input's vertex order, NaN where not "
+       "tested; ball_distance_mm, socket_distance_mm: float32 (n,), the signed Euclidean distance to the other "
+       "bone, NaN beyond the reach (with distances on); ball_status, socket_status: uint8 (0 tested, 1 no "
+       "surface, 2 beyond reach); summary).")
+      .def(
+          "detect_pose",
+          [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
+            PoseResult r;
+            FemurPose p;
+            {
+              py::gil_scoped_release release;
+              p = j.hip().femur_pose(PoseAngles{flexion, adduction, internal_rotation});
+              j.hip().joint().detect(p.R, p.t, r);
+            }
+            py::dict d = result_dict(*j.session, std::move(r));
+            d["joint_translation_mm"] = Eigen::Vector3d(j.session->to_input(j.hip().femur_translation(p.t)));
+            return d;
+          },
+          py::arg("flexion") = 0.0, py::arg("adduction") = 0.0, py::arg("internal_rotation") = 0.0,
+          "Both scans at clinical angles (degrees, ISB joint coordinate system: flexion, adduction and internal "
+          "rotation positive; zero per `neutral`), the femur placed by the joint-centre method (option "
+          "joint_centre) -> the same dict as detect(), with joint_translation_mm (3,): the femur's translation "
+          "(input frame, mm) after its rotation about the COR.")
+      .def("motion", &motion, py::arg("angles"),
+           "Both scans at every row of angles (k, 3): flexion, adduction, internal rotation in degrees -> dict of "
+           "(k,) arrays, the columns of the CLI's frames.csv (ball_min_gap_mm, socket_min_gap_mm, "
+           "penetrating_area_mm2 = socket_penetrating_area_mm2, ball_penetrating_area_mm2, socket_levelN_area_mm2, "
+           "closest clock hours and point, detection_ms). One C++ loop, frames in blocks on impinge.get_threads() "
+           "threads (rows in order); the GIL is released.")
+      .def("rom_limits", &rom_limits, py::arg("threshold_mm") = default_of("threshold_mm"),
+           py::arg("contact_depth_mm") = default_of("contact_depth_mm"), py::arg("metric") = default_of("metric"),
+           py::arg("contacts") = default_of("contacts"), py::arg("step_deg") = default_of("step_deg"),
+           py::arg("max_deg") = default_of("max_deg"),
+           "ROM limits from neutral for the standard motions (flexion, extension, abduction, adduction, internal and "
+           "external rotation, both rotations at 90 deg flexion, FADIR) -> dict motion -> the CLI's rom_limits.csv "
+           "row (limit_deg (NaN: none within max_deg), limited_by, contact_class, socket_clock_h, femur_clock_h, "
+           "min_gap_at_limit_mm, monotone, contact_at_start, evaluations) and contact_mm (input frame); and "
+           "excluded_vertices (in contact at neutral, not counted). The keywords are the option table's "
+           "(impinge.options(): `impinge rom`'s --threshold, --contact-depth, --metric, --contacts, --step, --max), "
+           "with its defaults. metric 'distance' needs the Joint's distances (the default).")
+      .def("rom_map", &rom_map, py::arg("flexion") = default_of("flexion"),
+           py::arg("adduction") = default_of("adduction"), py::arg("threshold_mm") = default_of("threshold_mm"),
+           py::arg("contact_depth_mm") = default_of("contact_depth_mm"), py::arg("metric") = default_of("metric"),
+           "ROM map: the largest internal rotation (deg) before contact for every flexion x adduction (deg; default "
+           "`impinge rom`'s grid) -> float64 (len(flexion), len(adduction)); NaN where in contact already without "
+           "rotation or free up to 150 deg. The same search as `impinge rom`'s rom_map.csv (run_rom).")
+      .def(
+          "femur_rotation",
+          [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
+            return j.session->input_rotation(j.hip().femur_rotation({flexion, adduction, internal_rotation}));
+          },
+          py::arg("flexion") = 0.0, py::arg("adduction") = 0.0, py::arg("internal_rotation") = 0.0,
+          "Rotation (3, 3; input frame) of the femur about the COR at the clinical angles.")
+      .def(
+          "femur_pose",
+          [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
+            const FemurPose p = j.hip().femur_pose({flexion, adduction, internal_rotation});
+            return std::pair{Eigen::Matrix3d(j.session->input_rotation(p.R)), Eigen::Vector3d(j.session->input_translation(p))};
+          },
+          py::arg("flexion") = 0.0, py::arg("adduction") = 0.0, py::arg("internal_rotation") = 0.0,
+          "(R, t): the femur as scanned, rotated by R (3, 3; input frame) about the COR (`cor`) and then translated "
+          "by t (3,; mm, input frame), at the clinical angles with the joint-centre method's translation: posed "
+          "vertices = (V - cor) R^T + cor + t; detect(R, t) scans that pose.")
+      .def(
+          "save_maps", [](const PyJoint& j, const std::string& ball, const std::string& socket) {
+            j.hip().save_maps(ball, socket);
+          },
+          py::arg("ball_path"), py::arg("socket_path"),
+          "Save both maps (impinge map files with scheme, resolution, COR and checksum) for Joint(..., maps=...).");
+}
+
+py::object frames_dict(const PyJoint& j) {
+  if (!j.hip().frames()) return py::none();
+  const HipFrames& f = *j.hip().frames();
+  const Session& s = *j.session;
+  py::dict d;
+  for (const auto& [name, frame] : {std::pair{"pelvis", &f.pelvis}, std::pair{"femur", &f.femur}}) {
+    py::dict fr;
+    fr["origin"] = Eigen::Vector3d(s.to_input(frame->origin));
+    fr["axes"] = Eigen::Matrix3d(s.to_input() * frame->axes);
+    py::dict lm;
+    for (const auto& [k, p] : frame->landmarks) lm[py::str(k)] = Eigen::Vector3d(s.to_input(p));
+    fr["landmarks"] = lm;
+    d[name] = fr;
+  }
+  d["scan_pose"] = std::vector<double>{f.scan_pose.flexion_deg, f.scan_pose.adduction_deg,
+                                       f.scan_pose.internal_rotation_deg};
+  return d;
+}
+
+void add_joint_properties(py::class_<PyJoint>& c) {
+  c.def_property_readonly("cor", [](const PyJoint& j) { return j.session->cor_input(); },
+                          "Centre of rotation (3,), mm, input frame.")
+      .def_property_readonly("ball_map",
+                             [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().ball().map}; })
+      .def_property_readonly(
+          "socket_map", [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().socket().map}; })
+      .def_property_readonly("frames", &frames_dict,
+                             "Anatomical frames (anatomical neutral; None with scan neutral), input frame: origin (3,), "
+                             "axes (3, 3; columns X anterior, Y superior, Z right), landmarks; scan_pose in degrees.")
+      .def_property_readonly(
+          "setup", [](const PyJoint& j) { return from_json(setup_record(*j.session)); },
+          "The set-up as the CLI's summary.json reports it (inputs, input frame, COR and its method, scheme, maps, "
+          "frames and acetabulum in the input frame, warnings) -> dict.")
+      .def_property_readonly("warnings", [](const PyJoint& j) { return j.session->warnings(); },
+                             "Warnings about the input, one line each (also raised as UserWarning).");
+}
+
+void add_joint_benchmarks(py::class_<PyJoint>& c) {
+  c.def(
+       "_bench_detect_ns",
+       [](const PyJoint& j, const py::handle& R, int repetitions) {
+         // Median ns of Joint::detect (C++ loop, reused buffers): the reference for the binding's overhead.
+         const auto [Rj, tj] = j.session->joint_motion(to_rotation(R), Eigen::Vector3d::Zero());
+         std::vector<double> ns;
+         PoseResult r;
+         py::gil_scoped_release release;
+         for (int k = 0; k < repetitions; ++k) {
+           const auto t0 = std::chrono::steady_clock::now();
+           j.hip().joint().detect(Rj, tj, r);
+           ns.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count());
+         }
+         std::nth_element(ns.begin(), ns.begin() + static_cast<std::ptrdiff_t>(ns.size() / 2), ns.end());
+         return ns[ns.size() / 2];
+       },
+       py::arg("R") = py::none(), py::arg("repetitions") = 50)
+      .def(
+          "_bench_motion_ns",
+          [](const PyJoint& j, const py::handle& angles) {
+            // ns of the C++ loop motion() runs, timed inside C++: the reference for motion()'s overhead.
+            const std::vector<PoseAngles> poses = to_angles(angles);
+            std::vector<nlohmann::json> rows;
+            rows.reserve(poses.size());
+            py::gil_scoped_release release;
+            const auto t0 = std::chrono::steady_clock::now();
+            run_motion(*j.session, poses, {}, [&](const MotionFrame& f) { rows.push_back(motion_row(f)); });
+            return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
+          },
+          py::arg("angles"));
+}
+
+}  // namespace
+
+void bind_joint(py::module_& m) {
+  m.def(
+      "femoral_head_centre",
+      [](const py::object& ball, const py::object& socket, const py::kwargs& kw) {
+        RunOptions run = RunOptions::clinical();
+        py::dict given(kw);
+        given["ball"] = ball;
+        given["socket"] = socket;
+        set_options(run, given, use_joint, "femoral_head_centre");
+        CorResult c;
+        Eigen::Matrix3d to_input;
+        {
+          py::gil_scoped_release release;
+          const LoadedInput in = load_input(run.session.input);
+          c = find_centre_of_rotation(in, run.session.cor);
+          to_input = in.to_working.transpose();
+        }
+        py::dict d;
+        d["centre"] = Eigen::Vector3d(to_input * c.head.centre);
+        d["radius"] = c.head.radius;
+        d["method"] = c.method;
+        return d;
+      },
+      py::arg("ball") = py::none(), py::arg("socket") = py::none(),
+      "The femoral head centre, the centre of rotation, as Joint(...) finds it from the same keywords (the "
+      "session's policy: head_region, cor, the subject's hip_centre landmark, else the head fitted on the femur "
+      "that sits in the acetabulum), without building maps -> dict(centre (3,) mm in the input frame, radius mm "
+      "(NaN when given), method).");
+
+  py::class_<PyJoint> c(m, "Joint", "A hip set up as the CLI sets it up (the session layer); see __init__.");
+  static const std::string doc = joint_doc();  // pybind11 keeps the pointer
+  c.def(py::init(&make_joint), py::arg("ball") = py::none(), py::arg("socket") = py::none(), doc.c_str());
+  add_joint_queries(c);
+  add_joint_properties(c);
+  add_joint_benchmarks(c);
+}
+
+}  // namespace impinge::python

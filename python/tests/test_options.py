@@ -1,0 +1,188 @@
+"""Every front end against the one option table (the session layer's, impinge.options()).
+
+Invariants: the CLI's commands, Python's Joint, rom_limits, rom_map and generated_hip, the stub file and the
+study spec expose exactly the table's options, with its defaults, units and types; the stub's signatures are
+the module's; every study key is documented. Each test fails on one option added, dropped or changed in one
+place only."""
+import ast
+import os
+import re
+import subprocess
+
+import pytest
+
+import impinge
+from impinge.study import spec
+from test_impinge import CLI
+
+HERE = os.path.dirname(__file__)
+STUB = os.path.join(HERE, "..", "impinge", "__init__.pyi")
+STUDIES_DOC = os.path.join(HERE, "..", "..", "docs", "studies.md")
+OPTIONS = impinge.options()
+
+
+def rows(use):
+    return [o for o in OPTIONS if use in o["uses"]]
+
+
+def same_value(o, shown, expected):
+    """A value as the CLI shows it (text) against the table's default (Python)."""
+    if o["type"] in ("number", "integer"):
+        return float(shown) == float(expected)
+    if o["type"] == "numbers":
+        return [float(x) for x in shown.split(",")] == [float(x) for x in expected]
+    if o["type"] == "on_off":
+        return shown == ("on" if expected else "off")
+    if o["type"] == "point" and expected is None:
+        return shown == "auto"
+    return shown == str(expected)
+
+
+def type_name(o):
+    """The value's name in --help (apps/impinge_main.cpp): its choices, or its kind with the unit."""
+    unit = f" {o['unit']}" if o["unit"] else ""
+    return {"choice": "|".join(o["choices"]), "on_off": "on|off", "point": "auto|X,Y,Z mm", "region": "X,Y,Z,R mm",
+            "numbers": "A,B,..." + unit, "path": "PATH", "mesh": "PATH", "integer": "INT" + unit,
+            "number": "NUMBER" + unit, "text": "TEXT", "flag": ""}[o["type"]]
+
+
+def cli_help(command):
+    """{option: the rest of its line} of `impinge COMMAND --help`."""
+    text = subprocess.run([CLI, command, "--help"], check=True, capture_output=True, text=True).stdout
+    return {m.group(1): m.group(2) for m in re.finditer(r"^[ \t]+--([a-z][a-z-]*)[ \t]?(.*)$", text, re.M)
+            if m.group(1) != "help"}
+
+
+@pytest.mark.parametrize("command", ["distance", "motion", "rom", "generate"])
+def test_cli_options_are_the_tables(command):
+    shown = cli_help(command)
+    table = {o["name"]: o for o in rows(command)}
+    assert set(shown) == set(table), (sorted(set(shown) - set(table)), sorted(set(table) - set(shown)))
+    for name, rest in shown.items():
+        o = table[name]
+        assert rest.startswith(type_name(o)), (name, rest, type_name(o))  # the unit or the choices
+        after = rest[len(type_name(o)):]
+        default = after[1:].split()[0] if after.startswith("=") else None
+        if o["type"] == "flag" or (o["default"] is None and o["type"] != "point"):
+            assert default is None, (name, default)
+        else:
+            assert default is not None and same_value(o, default, o["default"]), (name, default, o["default"])
+
+
+def stub_functions():
+    """{name: ast.FunctionDef} of the stub: module functions and Joint's methods as 'Joint.name'."""
+    tree = ast.parse(open(STUB).read())
+    out = {n.name: n for n in tree.body if isinstance(n, ast.FunctionDef)}
+    for c in (n for n in tree.body if isinstance(n, ast.ClassDef)):
+        out.update({f"{c.name}.{f.name}": f for f in c.body if isinstance(f, ast.FunctionDef)})
+    return out
+
+
+def stub_parameters(fn):
+    """[(name, default or ...)] of a stub function, self and **kwargs left out."""
+    a = fn.args
+    positional = a.posonlyargs + a.args
+    defaults = [...] * (len(positional) - len(a.defaults)) + [ast.literal_eval(d) for d in a.defaults]
+    out = [(x.arg, d) for x, d in zip(positional, defaults) if x.arg != "self"]
+    out += [(x.arg, ... if d is None else ast.literal_eval(d)) for x, d in zip(a.kwonlyargs, a.kw_defaults)]
+    return out
+
+
+def module_parameters(obj):
+    """[(name, default or ...)] from a pybind11 function's signature line (its docstring's first line)."""
+    line = obj.__doc__.strip().splitlines()[0]
+    inside = line[line.index("(") + 1:line.rindex(") ->")]
+    params, depth, cur = [], 0, ""
+    for ch in inside + ",":
+        depth += ch in "([{"
+        depth -= ch in ")]}"
+        if ch == "," and depth == 0:
+            params.append(cur.strip())
+            cur = ""
+        else:
+            cur += ch
+    out = []
+    for p in params:
+        if not p or p.startswith("self") or p.startswith("**"):
+            continue
+        name, _, default = p.partition(" = ")
+        name = name.split(":")[0].strip()
+        out.append((name, ast.literal_eval(default) if default else ...))
+    return out
+
+
+def test_joint_keywords_are_the_tables_in_the_stub_with_its_defaults():
+    init = stub_parameters(stub_functions()["Joint.__init__"])
+    table = {o["key"]: o["default"] for o in rows("joint")}
+    assert {k for k, _ in init} == set(table), ({k for k, _ in init} ^ set(table))
+    for key, default in init:
+        expect = table[key]
+        assert default == expect or (default is ... and expect is None), (key, default, expect)
+    # The module's own list (its docstring) is the table's too.
+    doc = impinge._impinge.Joint.__init__.__doc__
+    listed = re.search(r"default\): ([a-z_, ]+)\.", doc).group(1)
+    assert {x.strip() for x in listed.split(",")} == set(table)
+
+
+@pytest.mark.parametrize("method,use", [("rom_limits", "rom_limits"), ("rom_map", "rom_map")])
+def test_rom_keywords_are_the_tables_in_module_and_stub(method, use):
+    table = {o["key"]: o["default"] for o in rows(use)}
+    runtime = dict(module_parameters(getattr(impinge._impinge.Joint, method)))
+    stub = dict(stub_parameters(stub_functions()[f"Joint.{method}"]))
+    assert runtime == table and stub == table, (runtime, stub, table)
+
+
+def test_generated_hip_keywords_are_the_tables():
+    table = {o["key"]: o["default"] for o in rows("generated_hip")}
+    assert dict(module_parameters(impinge._impinge.generated_hip)) == table
+    assert dict(stub_parameters(stub_functions()["generated_hip"])) == table
+
+
+def test_stub_signatures_are_the_modules():
+    """Every function and method of the extension has a stub entry with the same parameters and defaults."""
+    stubs = stub_functions()
+    checked = 0
+    for owner, prefix in ((impinge._impinge, ""), (impinge._impinge.Joint, "Joint."), (impinge._impinge.Map, "Map.")):
+        for name in dir(owner):
+            obj = getattr(owner, name)
+            if name.startswith("_") or not callable(obj) or isinstance(obj, type) or not obj.__doc__:
+                continue
+            if not obj.__doc__.startswith(name + "("):
+                continue  # not a pybind11 function (an exception type, a property)
+            assert prefix + name in stubs, f"the stub lacks {prefix + name}"
+            if prefix + name == "load_mesh":  # the package's own load_mesh adds scale=
+                continue
+            stub = stub_parameters(stubs[prefix + name])
+            assert module_parameters(obj) == stub, (prefix + name, module_parameters(obj), stub)
+            checked += 1
+    assert checked >= 15, checked
+
+
+def test_study_keys_are_the_tables_and_documented():
+    types = {"number": float, "integer": int, "flag": bool, "on_off": bool, "choice": str, "text": str,
+             "numbers": list, "region": list}
+    assert spec.JOINT_KEYS == {o["key"]: types[o["type"]] for o in rows("study")}
+    assert spec.KIND_KEYS["rom"] == {o["key"]: o["default"] for o in rows("rom_limits")}
+    assert spec.KIND_KEYS["envelope"] == {o["key"]: o["default"] for o in rows("rom_map")}
+    doc = open(STUDIES_DOC).read()
+    missing = [k for k in list(spec.JOINT_KEYS) + list(spec.KIND_KEYS["rom"]) + list(spec.KIND_KEYS["envelope"])
+               if f"`{k}`" not in doc]
+    assert not missing, f"docs/studies.md does not name {missing}"
+
+
+def test_bad_values_name_the_option_the_value_and_the_range():
+    with pytest.raises(impinge.Error, match=r"max_radius_mm: -1 mm is outside the valid range \[0, 10000\] mm"):
+        impinge.Joint(subject="x.json", max_radius_mm=-1)
+    with pytest.raises(impinge.Error, match=r"layers: 2.5 is not a whole number"):
+        impinge.Joint(subject="x.json", layers=2.5)
+    with pytest.raises(impinge.Error, match=r"mode: 'fast' is not one of exact, linear"):
+        impinge.Joint(subject="x.json", mode="fast")
+    with pytest.raises(impinge.Error, match=r"cam_mm: nan is not a finite number"):
+        impinge.generated_hip(cam_mm=float("nan"))
+    with pytest.raises(impinge.Error, match=r"triangles: 2000000000 is outside the valid range"):
+        impinge.generated_hip(triangles=2_000_000_000)
+    r = subprocess.run([CLI, "rom", "--subject", "x.json", "--step", "0", "--out", "/tmp/never"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "--step: 0 deg is outside the valid range [0.01, 90] deg" in r.stderr, r.stderr
+    r = subprocess.run([CLI, "generate", "--cam", "nan", "--out", "/tmp/never"], capture_output=True, text=True)
+    assert r.returncode == 2 and "--cam: 'nan' is not a finite number" in r.stderr, r.stderr
