@@ -25,7 +25,7 @@ def main():
     d = sys.argv[1]
     with open(os.path.join(d, "summary.json")) as f:
         s = json.load(f)
-    cor = np.array(s["cor_mm"], float)
+    cor = np.array(s["map_centre_mm"], float)  # the pelvic frame's origin
     lps = s["input_frame"] == "LPS"
     if "frames" in s:
         p = s["frames"]["pelvis"]

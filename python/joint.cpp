@@ -164,7 +164,7 @@ void add_joint_queries(py::class_<PyJoint>& c) {
          return result_dict(*j.session, std::move(r));
        },
        py::arg("R") = py::none(), py::arg("t") = py::none(),
-       "Both scans with the femur rotated by R (3, 3; input frame) about the COR, then translated by t (3,) "
+       "Both scans with the femur rotated by R (3, 3; input frame) about its head centre (`cor`), then translated by t (3,) "
        "mm -> dict(ball_gap_mm, socket_gap_mm: float32 (n,) in the input's vertex order, NaN where not "
        "tested; ball_distance_mm, socket_distance_mm: float32 (n,), the signed Euclidean distance to the other "
        "bone, NaN beyond the reach (with distances on); ball_status, socket_status: uint8 (0 tested, 1 no "
@@ -256,8 +256,21 @@ py::object frames_dict(const PyJoint& j) {
 }
 
 void add_joint_properties(py::class_<PyJoint>& c) {
-  c.def_property_readonly("cor", [](const PyJoint& j) { return j.session->cor_input(); },
-                          "Centre of rotation (3,), mm, input frame.")
+  c.def_property_readonly("cor", [](const PyJoint& j) { return j.session->head_centre_input(); },
+                          "The femoral head centre, the centre of rotation (3,), mm, input frame: the `cor` given, "
+                          "else the fitted one; detect(R, t) rotates the femur about it.")
+      .def_property_readonly("map_centre", [](const PyJoint& j) { return j.session->map_centre_input(); },
+                             "The maps' centre, where the rays of the radial gaps start (3,), mm, input frame: the "
+                             "head centre, or the acetabular centre where a fitted head was seated before sampling "
+                             "(the combined and equidistant joint centres).")
+      .def_property_readonly(
+          "acetabular_centre",
+          [](const PyJoint& j) -> py::object {
+            const auto a = j.session->acetabular_centre_input();
+            return a ? py::cast(Eigen::Vector3d(*a)) : py::none();
+          },
+          "The acetabular centre (the sphere fitted to the acetabulum) (3,), mm, input frame; None with scan "
+          "neutral.")
       .def_property_readonly("ball_map",
                              [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().ball().map}; })
       .def_property_readonly(

@@ -19,7 +19,7 @@ std::string fspath(const py::handle& v) {
 }
 
 std::vector<double> numbers(const py::handle& v, const std::string& as) {
-  if (py::isinstance<py::str>(v) || !py::isinstance<py::sequence>(v) && !py::isinstance<py::array>(v))
+  if (py::isinstance<py::str>(v) || (!py::isinstance<py::sequence>(v) && !py::isinstance<py::array>(v)))
     throw Error(as + ": expected a list of numbers, got " + type_of(v));
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(v);
   if (!a || a.ndim() != 1) throw Error(as + ": expected a flat list of numbers");

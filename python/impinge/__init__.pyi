@@ -114,7 +114,7 @@ class Joint:
     def save_maps(self, ball_path: str, socket_path: str) -> None:
         """Save both maps for Joint(..., maps=(ball_path, socket_path))."""
     def detect(self, R: Optional[npt.ArrayLike] = None, t: Optional[Sequence[float]] = None) -> Dict[str, Any]:
-        """Both scans, femur rotated by R about the COR and translated by t -> dict(ball_gap_mm,
+        """Both scans, femur rotated by R about its head centre (`cor`) and translated by t -> dict(ball_gap_mm,
         socket_gap_mm (float32, NaN untested), ball_distance_mm, socket_distance_mm (float32, the signed
         Euclidean distance to the other bone, NaN beyond the reach; with distances on), ball_status,
         socket_status (uint8), summary: each scan's record as summary.json gives it)."""
@@ -149,6 +149,12 @@ class Joint:
         """(R, t) at the clinical angles with the joint-centre method's translation: posed vertices =
         (V - cor) R^T + cor + t (input frame); detect(R, t) scans that pose."""
     cor: npt.NDArray[np.float64]
+    """The femoral head centre, the centre of rotation (input frame, mm): the `cor` given, else fitted."""
+    map_centre: npt.NDArray[np.float64]
+    """The maps' centre (the rays' origin): the head centre, or the acetabular centre where a fitted head
+    was seated before sampling."""
+    acetabular_centre: Optional[npt.NDArray[np.float64]]
+    """The acetabular centre (anatomical neutral), input frame, mm."""
     ball_map: Map
     socket_map: Map
     frames: Optional[Dict[str, Any]]

@@ -56,7 +56,7 @@ def test_gaps_equal_the_cli_on_a_generated_hip(generated):
                     "--out", d + "/cli"], check=True, capture_output=True)
     cli_ball, cli_socket = read_gaps(d + "/cli/ball_gaps.ply"), read_gaps(d + "/cli/socket_gaps.ply")
     with open(d + "/cli/summary.json") as f:
-        cor = json.load(f)["cor_mm"]
+        cor = json.load(f)["head_centre_mm"]
     ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
     j = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0)
     r = j.detect_pose(30, -10, 5)

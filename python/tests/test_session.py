@@ -71,8 +71,10 @@ def test_a_subject_in_lps_gives_the_cli_gaps():
     r = j.detect_pose(30, 5, 10)
     np.testing.assert_array_equal(r["ball_gap_mm"], cli_ball)
     np.testing.assert_array_equal(r["socket_gap_mm"], cli_socket)
-    np.testing.assert_allclose(j.cor, summary["cor_mm"], rtol=0, atol=1e-9)
-    assert j.setup["input_frame"] == "LPS" and j.setup["cor_mm"] == pytest.approx(summary["cor_mm"], abs=1e-9)
+    np.testing.assert_allclose(j.cor, summary["head_centre_mm"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(j.map_centre, summary["map_centre_mm"], rtol=0, atol=1e-9)
+    assert j.setup["input_frame"] == "LPS"
+    assert j.setup["head_centre_mm"] == pytest.approx(summary["head_centre_mm"], abs=1e-9)
 
     # Python given the LPS arrays and frame='LPS': the same joint, the same gaps.
     with open(subject) as f:

@@ -56,7 +56,7 @@ TEST(EndToEnd, CliOnGeneratedSubject) {
       << out;
   std::ifstream js(d + "/out/summary.json");
   const nlohmann::json j = nlohmann::json::parse(js);
-  for (const char* key : {"cor_mm", "head_radius_mm", "sphere_fit_rms_mm", "precision_deg", "mode", "pose_deg"})
+  for (const char* key : {"head_centre_mm", "map_centre_mm", "head_radius_mm", "sphere_fit_rms_mm", "precision_deg", "mode", "pose_deg"})
     EXPECT_TRUE(j.contains(key)) << key;
   for (const char* body : {"ball", "socket"})
     for (const char* key : {"vertices_tested", "vertices_no_surface", "min_gap_mm", "vertices_penetrating", "map_nodes",

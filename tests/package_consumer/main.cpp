@@ -30,8 +30,8 @@ int main() {
   const impinge::PoseResult plain = joint.detect(Eigen::Matrix3d::Identity());
 
   std::cout << "consumer: ball min gap " << r.ball.min_gap_mm << " mm (plain Joint " << plain.ball.min_gap_mm
-            << " mm), COR " << setup["cor_mm"].dump() << "\n";
+            << " mm), COR " << setup["head_centre_mm"].dump() << "\n";
   const bool ok = std::isfinite(r.ball.min_gap_mm) && r.ball.min_gap_mm > 0 &&
-                  r.ball.min_gap_mm == plain.ball.min_gap_mm && setup["cor_mm"][0].get<double>() == h.cor.x();
+                  r.ball.min_gap_mm == plain.ball.min_gap_mm && setup["head_centre_mm"][0].get<double>() == h.cor.x();
   return ok ? 0 : 1;
 }

@@ -12,15 +12,18 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iostream>
 #include <sstream>
 #include <thread>
 
 #include <omp.h>
 
+#include "impinge/casters/embree_ray_caster.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
@@ -85,8 +88,8 @@ std::string error_of(const std::function<void()>& f) {
 TEST(Session, LpsInputGivesTheRasGapsAndReportsInLps) {
   const Session ras(generated_options("RAS")), lps(generated_options("LPS"));
   const Eigen::Matrix3d flip = Eigen::Vector3d(-1, -1, 1).asDiagonal();
-  EXPECT_TRUE(lps.cor_input().isApprox(flip * ras.cor_input(), 1e-12));
-  EXPECT_TRUE(ras.cor_input().isApprox(model().cor, 1e-12));
+  EXPECT_TRUE(lps.head_centre_input().isApprox(flip * ras.head_centre_input(), 1e-12));
+  EXPECT_TRUE(ras.head_centre_input().isApprox(model().cor, 1e-12));
   for (const PoseAngles& a : {PoseAngles{0, 0, 0}, PoseAngles{30, -10, 5}, PoseAngles{-20, 15, 40}}) {
     const PoseResult r = ras.hip().detect(a), l = lps.hip().detect(a);
     ASSERT_EQ(r.ball_gaps.gap_mm.size(), l.ball_gaps.gap_mm.size());
@@ -105,7 +108,7 @@ TEST(Session, LpsInputGivesTheRasGapsAndReportsInLps) {
   }
   const nlohmann::json rec = setup_record(lps);
   EXPECT_EQ(rec["input_frame"], "LPS");
-  EXPECT_NEAR(rec["cor_mm"][0].get<double>(), -model().cor.x(), 1e-9);
+  EXPECT_NEAR(rec["head_centre_mm"][0].get<double>(), -model().cor.x(), 1e-9);
 }
 
 TEST(Session, HeadRegionFindsTheAnalyticHead) {
@@ -115,7 +118,7 @@ TEST(Session, HeadRegionFindsTheAnalyticHead) {
   const Eigen::Vector3d c = model(false).cor;
   o.cor.head_region = Eigen::Vector4d(c.x() + 0.2, c.y(), c.z(), r + 0.5);  // the head, not the neck
   const Session s(o);
-  EXPECT_LT((s.cor_input() - c).norm(), 0.05);
+  EXPECT_LT((s.head_centre_input() - c).norm(), 0.05);
   EXPECT_NEAR(s.head().radius, r, 0.05);
   EXPECT_EQ(s.cor_method(), "sphere fit in region");
 }
@@ -306,3 +309,64 @@ TEST(Session, TablesRefuseRaggedRowsAndQuoteText) {
   ss << is.rdbuf();
   EXPECT_EQ(ss.str(), "a,b\n1,\"x,y\"\nnan,\"say \"\"hi\"\"\"\n");
 }
+
+namespace {
+// The 95th percentile of |x|.
+double p95(std::vector<double> x) {
+  for (double& v : x) v = std::fabs(v);
+  std::sort(x.begin(), x.end());
+  return x.empty() ? std::nan("") : x[static_cast<std::size_t>(0.95 * double(x.size() - 1))];
+}
+}  // namespace
+
+// A given COR is the femoral head centre the radial gaps at the scan pose are measured about, under the
+// default (equidistant) joint-centre method too: the femur's gaps at detect(I, 0) against an exact ray
+// cast from that centre (Embree, watertight) on the first-surface vertices; and the outputs name the
+// head, acetabular and maps' centres apart.
+class GivenCor : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(GivenCor, IsTheCentreOfTheRadialGapsAtTheScanPose) {
+  const std::string json = std::string(IMPINGE_SHARED_DATA) + "/" + GetParam() + "/subject.json";
+  if (!fs::exists(json)) GTEST_SKIP() << "shared data absent: " << json;
+  if (!have_embree()) GTEST_SKIP() << "no Embree in this build";
+  SessionOptions o;
+  o.input.subject = json;
+  const LoadedInput in = load_input(o.input);
+  const Eigen::Vector3d fitted = find_centre_of_rotation(in, {}).head.centre;  // working frame
+  // A head centre 0.6 mm off the fitted one, given in the input frame.
+  const Eigen::Vector3d given_working = fitted + Eigen::Vector3d(0.4, -0.3, 0.33);
+  o.cor.given = in.to_working.transpose() * given_working;
+  o.maps.precision = 0.1;
+  o.maps.layers = 4;
+  o.maps.distances = true;
+  const Session s(o);
+  ASSERT_EQ(s.hip().joint_centre().method(), JointCentreMethod::equidistant);
+  EXPECT_LT((s.head_centre_input() - *o.cor.given).norm(), 1e-9);
+  EXPECT_LT((s.map_centre_input() - *o.cor.given).norm(), 1e-9);
+  ASSERT_TRUE(s.acetabular_centre_input());
+  EXPECT_GT((*s.acetabular_centre_input() - *o.cor.given).norm(), 0.1);
+  const auto [R, t] = s.joint_motion(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  const PoseResult r = s.joint().detect(R, t);
+  const Vertices femur = s.femur_input(FemurPose{R, t});  // input frame, as scanned
+  EXPECT_LT((femur - in.femur.V * in.to_working).norm(), 1e-6);
+  // The reference: exact first hits from the given centre (working frame).
+  const EmbreeRayCaster pelvis(in.pelvis, given_working, true), own(in.femur, given_working, true);
+  std::vector<double> err;
+  for (Eigen::Index i = 0; i < in.femur.V.rows(); ++i) {
+    if (r.ball_gaps.status[static_cast<std::size_t>(i)] != ScanGaps::tested) continue;
+    const Eigen::Vector3d d = in.femur.V.row(i).transpose() - given_working;
+    const float first_own = own.first_hit(float(d.x()), float(d.y()), float(d.z()));
+    if (first_own < d.norm() - 0.05) continue;  // behind the femur's own nearer surface
+    const float hit = pelvis.first_hit(float(d.x()), float(d.y()), float(d.z()));
+    if (!std::isfinite(hit)) continue;
+    err.push_back(double(r.ball_gaps.gap_mm[static_cast<std::size_t>(i)]) - (double(hit) - d.norm()));
+  }
+  ASSERT_GT(err.size(), 500u);
+  std::cout << GetParam() << ": p95 " << p95(err) << " mm over " << err.size() << " first-surface femur vertices\n";
+  EXPECT_LT(p95(err), 0.05) << err.size() << " first-surface femur vertices";
+  const nlohmann::json rec = setup_record(s);
+  for (const char* key : {"head_centre_mm", "acetabular_centre_mm", "map_centre_mm"}) EXPECT_TRUE(rec.contains(key)) << key;
+  EXPECT_FALSE(rec.contains("cor_mm"));
+}
+
+INSTANTIATE_TEST_SUITE_P(Shared, GivenCor, ::testing::Values("lhdl-ct", "mc22", "mc22-left", "tlem2-mri"));

@@ -56,7 +56,8 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     sphere.radius = head_radius_;
     articular_ = find_articular_zones(femur, sphere, pelvis, *acetabulum_, options.articular);
     const ClockFace femoral = femoral_clock_face(femur, sphere.centre, head_radius_, frames_->femur);
-    if (method == JointCentreMethod::combined || method == JointCentreMethod::equidistant) {
+    if (options.seat_before_sampling &&
+        (method == JointCentreMethod::combined || method == JointCentreMethod::equidistant)) {
       // Seated: the femur, its frame and clock move with the head onto the acetabular centre, which
       // becomes the COR (the maps' centre: rays from the seated head centre); the methods' translations
       // are then relative to the seated femur (combined: none; equidistant: the small deviations).

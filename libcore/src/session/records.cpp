@@ -187,8 +187,12 @@ nlohmann::json setup_record(const Session& s) {
   j["socket_file"] = s.socket_source();
   j["side"] = s.side() == Side::right ? "right" : "left";
   j["input_frame"] = s.input_frame() == FrameConvention::LPS ? "LPS" : "RAS";
-  j["cor_mm"] = vec(s.cor_input());  // the maps' centre: the acetabular centre when the head is seated
-  j["head_centre_mm"] = vec(s.to_input(s.head().centre));
+  // Three centres, each with its own name: the femoral head centre (the COR the femur rotates about: given or
+  // fitted), the acetabular centre, and the maps' centre (the rays' origin: the head centre, or the acetabular
+  // centre when a fitted head was seated before sampling).
+  j["head_centre_mm"] = vec(s.head_centre_input());
+  if (const auto a = s.acetabular_centre_input()) j["acetabular_centre_mm"] = vec(*a);
+  j["map_centre_mm"] = vec(s.map_centre_input());
   j["cor_method"] = s.cor_method();
   j["head_radius_mm"] = number_or_null(s.head().radius);
   j["joint_centre"] = to_string(hip.joint_centre().method());

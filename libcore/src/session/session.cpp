@@ -247,6 +247,10 @@ Session::Session(const SessionOptions& options) : options_(options) {
   subject_name_ = in.name;
   cor_ = find_centre_of_rotation(in, options.cor);
   hip_options_.allow_cor_outside_ball = options.cor.allow_any;
+  // A COR the user gave (--cor, cor=) is the femoral head centre the radial gaps are measured about at the
+  // scan pose, whatever the joint-centre method: the maps stay about it, and the combined and equidistant
+  // methods move the femur by the seat at every pose instead of sampling the seated femur.
+  hip_options_.seat_before_sampling = !options.cor.given;
   // A given COR (or the subject's hip_centre landmark): the zones, the acetabulum and the seat still
   // come from the head the femur shows, so that they do not move with the COR.
   if (!std::isfinite(cor_.head.radius) && hip_options_.neutral == Neutral::anatomical) {
@@ -289,15 +293,16 @@ std::pair<Eigen::Matrix3d, Eigen::Vector3d> Session::joint_motion(const Eigen::M
   // joint <- working <- input: A = joint_to_working^T, M = to_working.
   const Eigen::Matrix3d B = hip_->joint_to_working().transpose() * to_working_;
   const Eigen::Matrix3d R = B * R_in * B.transpose();
-  // The joint frame's femur is the seated one: take the seat back out, rotated.
+  // The joint frame's femur is the seated one (its head centre at the origin) and h = cor - seat: the
+  // rotation about h leaves the head centre at h, which is -seat in the joint frame.
   const Eigen::Vector3d seat = hip_->joint_to_working().transpose() * hip_->seat_mm();
-  return {R, B * t_in - R * seat};
+  return {R, B * t_in - seat};
 }
 
 Eigen::Vector3d Session::input_translation(const FemurPose& pose) const {
   const Eigen::Matrix3d B = hip_->joint_to_working().transpose() * to_working_;
   const Eigen::Vector3d seat = hip_->joint_to_working().transpose() * hip_->seat_mm();
-  return B.transpose() * (pose.t + pose.R * seat);
+  return B.transpose() * (pose.t + seat);
 }
 
 Eigen::Matrix3d Session::input_rotation(const Eigen::Matrix3d& R_joint) const {

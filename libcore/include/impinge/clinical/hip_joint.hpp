@@ -47,6 +47,11 @@ struct HipJointOptions {
   std::optional<SphereFitResult> head_sphere;
   /// Tolerances of the articular zones (anatomical neutral only; articular_zones.hpp).
   ArticularZoneOptions articular;
+  /// Combined and equidistant methods: seat the femur before sampling, so that the maps' centre (cor())
+  /// is the acetabular centre with the femoral head on it (true: the COR was fitted), or keep the maps
+  /// about the given head centre `head.centre` and move the femur by the seat at every pose instead
+  /// (false: a COR the user gave, about which the radial gaps at the scan pose are then measured).
+  bool seat_before_sampling = true;
 };
 
 /// Femur (ball) and pelvis (socket) of one hip about the centre of rotation, posed by clinical
@@ -60,7 +65,8 @@ class HipJoint {
  public:
   /// Build the frames (anatomical neutral: find_hip_frames with "hip_centre" = head.centre; the
   /// acetabulum and both clock faces) and both maps. With the combined and equidistant joint
-  /// centres the femur is first seated (seat_mm()) and the COR is the acetabular centre. `femur`, `pelvis`: whole bones in the
+  /// centres and options.seat_before_sampling the femur is first seated (seat_mm()) and the maps' centre
+  /// (cor()) is the acetabular centre; otherwise it is `head.centre`. `femur`, `pelvis`: whole bones in the
   /// working frame (RAS, mm); `head`: the femoral head sphere (mm, working frame; its centre is
   /// the COR; a NaN radius is estimated as the median distance of the femur's vertices within
   /// 35 mm of the centre); `given`: landmarks that replace found ones (mm, working frame).

@@ -181,13 +181,26 @@ class Session {
 
   /// A working-frame point or direction (mm) in the input frame.
   Eigen::Vector3d to_input(const Eigen::Vector3d& working) const { return to_working_.transpose() * working; }
-  /// The COR in the input frame, mm.
-  Eigen::Vector3d cor_input() const { return to_input(hip_->cor()); }
+  /// The femoral head centre, the centre of rotation (COR): the one given (CorOptions::given) or fitted;
+  /// input frame, mm. The femur rotates about it (joint_motion) and, when given, the radial gaps at the
+  /// scan pose are measured about it.
+  Eigen::Vector3d head_centre_input() const { return to_input(hip_->cor() - hip_->seat_mm()); }
+  /// The maps' centre, where every ray of a radial gap starts (HipJoint::cor()): the head centre, or the
+  /// acetabular centre when the combined or equidistant method seated a fitted head before sampling; input
+  /// frame, mm.
+  Eigen::Vector3d map_centre_input() const { return to_input(hip_->cor()); }
+  /// The acetabular centre (the sphere fitted to the acetabulum, find_acetabulum; anatomical neutral
+  /// only), input frame, mm.
+  std::optional<Eigen::Vector3d> acetabular_centre_input() const {
+    if (!hip_->acetabulum()) return std::nullopt;
+    return to_input(hip_->acetabulum()->sphere.centre);
+  }
   /// Vertices (n x 3, mm, input frame) of the femur at `pose` (joint frame), of the pelvis.
   Vertices femur_input(const FemurPose& pose) const;
   Vertices pelvis_input() const;
   /// A femur motion given in the input frame (the femur as scanned rotated by R_in 3 x 3 about the
-  /// COR, then translated by t_in, mm: posed = cor + R_in (p - cor) + t_in) as a joint-frame pose for
+  /// femoral head centre h (head_centre_input()), then translated by t_in, mm: posed = h + R_in (p - h) +
+  /// t_in) as a joint-frame pose for
   /// Joint::detect (which poses the seated femur: HipJoint::seat_mm()). Rotations checked by the caller.
   std::pair<Eigen::Matrix3d, Eigen::Vector3d> joint_motion(const Eigen::Matrix3d& R_in,
                                                            const Eigen::Vector3d& t_in) const;

@@ -1,0 +1,330 @@
+// The option table's rows: every option of the CLI, Python and the study files (option_table.hpp).
+#include <limits>
+
+#include "impinge/detection/impingement_levels.hpp"
+#include "impinge/schemes/sampling_scheme.hpp"
+#include "option_builders.hpp"
+
+namespace impinge {
+
+namespace {
+
+using namespace detail;
+
+constexpr unsigned kJointCommands = use_distance | use_motion | use_rom;
+constexpr unsigned kInput = kJointCommands | use_joint;
+constexpr unsigned kSetting = kJointCommands | use_joint | use_study;
+
+std::vector<std::string> registered_schemes() {
+  std::vector<std::string> v;
+  for (const auto& [name, res] : scheme_names()) v.push_back(name);
+  return v;
+}
+
+std::string scheme_help() {
+  std::string s;
+  for (const auto& [name, res] : scheme_names()) s += (s.empty() ? "" : ", ") + name + " (" + res + ")";
+  return "Sampling scheme of the maps: " + s;
+}
+
+std::string levels_help() {
+  std::string d;
+  for (double t : ImpingementLevels{}.thresholds_mm) d += (d.empty() ? "" : ",") + shortest(t);
+  return "Impingement thresholds, decreasing, e.g. 4,2.667,1.333,0 (default: " + d + ", the thesis' 4 mm cartilage "
+         "offset in thirds)";
+}
+
+void add_input_rows(Rows& t) {
+  t.text("preset", "preset", OptionType::choice, kSetting, {"clinical", "thesis"},
+         "Named defaults, applied before every other option: 'clinical' (layered maps, Euclidean distances, the ROM "
+         "metric the distance, the equidistant joint centre at anatomical neutral) or 'thesis' (single-layer maps, "
+         "radial gaps only, rotation about the femoral head centre, the thesis' ROM criterion)",
+         [](auto& o) -> auto& { return o.preset; });
+  t.rows.back().set = [](RunOptions& o, const OptionValue& v, const std::string& as) {
+    const RunOptions p = RunOptions::named(value_as<std::string>(v, as, "a string"), as);
+    o.preset = p.preset, o.session.maps = p.session.maps, o.session.frames = p.session.frames, o.rom = p.rom;
+  };
+  t.text("subject", "subject", OptionType::path, kInput, {},
+         "subject.json giving side, frame (LPS or RAS) and optional landmarks; supplies --ball/--socket",
+         [](auto& o) -> auto& { return o.session.input.subject; });
+  for (const bool ball : {true, false}) {
+    OptionRow& r = t.add(ball ? "ball" : "socket", ball ? "ball" : "socket", OptionType::mesh, "", kInput,
+                         ball ? "Ball mesh (femur): PLY, STL, OBJ or OFF, mm (Python: also VTK files or (V, F))"
+                              : "Socket mesh (pelvis): PLY, STL, OBJ or OFF, mm (Python: also VTK files or (V, F))");
+    r.set = [ball](RunOptions& o, const OptionValue& v, const std::string& as) {
+      SessionInput& in = o.session.input;
+      set_mesh(o, v, as, [&](RunOptions&) -> std::string& { return ball ? in.ball : in.socket; },
+               [&](RunOptions&) -> std::optional<TriangleMesh>& { return ball ? in.ball_mesh : in.socket_mesh; });
+    };
+    r.get = [ball](const RunOptions& o) -> OptionValue {
+      const std::string& p = ball ? o.session.input.ball : o.session.input.socket;
+      if (p.empty()) return std::monostate{};
+      return p;
+    };
+  }
+  t.text("side", "side", OptionType::choice, kInput, {"right", "left"},
+         "right or left (default: the subject's, else right; contradicting it is an error)",
+         [](auto& o) -> auto& { return o.session.input.side; });
+  t.text("frame", "frame", OptionType::choice, kInput, {"LPS", "RAS"},
+         "Input frame LPS or RAS (default: the subject's, else RAS; contradicting it is an error)",
+         [](auto& o) -> auto& { return o.session.input.frame; });
+  OptionRow& lm = t.add("landmarks", "landmarks", OptionType::landmarks, "mm", use_joint,
+                        "Landmarks, input frame, mm, named as subject.json's (over the subject's)");
+  lm.set = [](RunOptions& o, const OptionValue& v, const std::string& as) {
+    if (std::holds_alternative<std::monostate>(v)) return;
+    for (const auto& [name, p] : value_as<Landmarks>(v, as, "a dict name -> (x, y, z) mm")) {
+      require(p.allFinite(), [&] { return as + "['" + name + "']: not three finite numbers"; });
+      o.session.input.landmarks[name] = p;
+    }
+  };
+  lm.get = [](const RunOptions& o) -> OptionValue {
+    if (o.session.input.landmarks.empty()) return std::monostate{};
+    return o.session.input.landmarks;
+  };
+  OptionRow& cor = t.add("cor", "cor", OptionType::point, "mm", kInput,
+                         "The femoral head centre, the centre of rotation: 'auto' (a sphere fitted to the femoral head, "
+                         "in any scan orientation) or X,Y,Z in the input files' frame; the radial gaps at the scan "
+                         "pose are measured about it");
+  cor.set = [](RunOptions& o, const OptionValue& v, const std::string& as) {
+    if (std::holds_alternative<std::monostate>(v)) {
+      o.session.cor.given.reset();
+      return;
+    }
+    const std::vector<double> x = checked_numbers(v, as, 3);
+    o.session.cor.given = Eigen::Vector3d(x[0], x[1], x[2]);
+  };
+  cor.get = [](const RunOptions& o) -> OptionValue {
+    if (!o.session.cor.given) return std::monostate{};
+    const Eigen::Vector3d& c = *o.session.cor.given;
+    return std::vector<double>{c.x(), c.y(), c.z()};
+  };
+  t.flag("allow-any-cor", "allow_any_cor", OptionType::flag, kSetting,
+         "Accept a --cor outside the femoral head (research; otherwise an error naming the COR and the fitted head "
+         "centre)",
+         [](auto& o) -> auto& { return o.session.cor.allow_any; });
+  OptionRow& hr = t.add("head-region", "head_region", OptionType::region, "mm", kSetting,
+                        "X,Y,Z,R: fit the head sphere to femur vertices within R mm of (X,Y,Z), input frame");
+  hr.set = [](RunOptions& o, const OptionValue& v, const std::string& as) {
+    if (std::holds_alternative<std::monostate>(v)) {
+      o.session.cor.head_region.reset();
+      return;
+    }
+    const std::vector<double> x = checked_numbers(v, as, 4);
+    require(x[3] > 0, [&] { return as + ": the radius R = " + shortest(x[3]) + " mm must be > 0 mm"; });
+    o.session.cor.head_region = Eigen::Vector4d(x[0], x[1], x[2], x[3]);
+  };
+  hr.get = [](const RunOptions& o) -> OptionValue {
+    if (!o.session.cor.head_region) return std::monostate{};
+    const Eigen::Vector4d& c = *o.session.cor.head_region;
+    return std::vector<double>{c[0], c[1], c[2], c[3]};
+  };
+}
+
+void add_map_rows(Rows& t) {
+  const double inf = std::numeric_limits<double>::infinity();
+  t.text("scheme", "scheme", OptionType::choice, kSetting, registered_schemes(), scheme_help(),
+         [](auto& o) -> auto& { return o.session.maps.scheme; });
+  t.number("resolution", "resolution", "", kSetting, 0, 1e6,
+           "Resolution of the scheme (its own unit, listed with --scheme); 0: the scheme's equivalent of 0.5 deg "
+           "node spacing",
+           [](auto& o) -> auto& { return o.session.maps.resolution; });
+  t.number("precision", "precision", "deg", kSetting, 0, 180,
+           "Alias of --resolution for equiangular grids: precision p in degrees (0: not given)",
+           [](auto& o) -> auto& { return o.session.maps.precision; });
+  t.number("turns", "turns", "", kSetting, 0, 1e6, "Alias of --resolution for the helix: k turns (w = k^2 nodes; 0: not given)",
+           [](auto& o) -> auto& { return o.session.maps.turns; });
+  t.number("spacing", "spacing", "deg", kSetting, 0, 180,
+           "Largest node spacing wanted, degrees, for any scheme: the coarsest resolution that reaches it (instead "
+           "of --resolution; 0: not given)",
+           [](auto& o) -> auto& { return o.session.maps.spacing; });
+  t.text("sampling", "sampling", OptionType::choice, kSetting, {"auto", "rasterize", "resample", "ray-cast", "ray-cast-bvh"},
+         "auto, rasterize, resample, ray-cast (naive, small meshes only) or ray-cast-bvh (exact node values for any "
+         "scheme)",
+         [](auto& o) -> auto& { return o.session.maps.sampling; });
+  t.text("mode", "mode", OptionType::choice, kSetting, {"exact", "linear"},
+         "Distance mode: 'linear' (thesis Alg. 1) or 'exact' (ray-plane)",
+         [](auto& o) -> auto& { return o.session.maps.mode; });
+  t.numbers("levels", "levels", "mm", kSetting, levels_help(), [](auto& o) -> auto& { return o.session.maps.levels; });
+  t.number("occlusion-tolerance", "occlusion_tolerance_mm", "mm", kSetting, 0, 1e3,
+           "Vertices farther than their own first surface plus this are skipped (beyond reach)",
+           [](auto& o) -> auto& { return o.session.maps.occlusion_tolerance_mm; });
+  t.number("max-radius", "max_radius_mm", "mm", kSetting, 0, 1e4,
+           "Test only vertices within this distance of the COR (0 = all)",
+           [](auto& o) -> auto& { return o.session.maps.max_radius_mm; });
+  t.number("sparse", "sparse", "mm", kSetting, 0, inf,
+           "Store both maps sparse, in tiles, keeping only tiles with a surface within this distance of the COR "
+           "('inf': any surface, the same gaps bit for bit; 0 = dense maps)",
+           [](auto& o) -> auto& { return o.session.maps.sparse_mm; });
+  t.number("discontinuity-tolerance", "discontinuity_tolerance_mm", "mm", kSetting, 0, 1e3,
+           "Look-ups whose stencil may be off by more than this (depth discontinuities: rims, coverage edges) are "
+           "resolved by an exact ray cast",
+           [](auto& o) -> auto& { return o.session.maps.discontinuity_tolerance_mm; });
+  t.integer("layers", "layers", "", kSetting, 0, 64,
+            "N: also a layered map of N crossings per node for each bone, so that vertices hidden behind their own "
+            "bone's nearer surface (trochanters, shaft, ilium) are tested too: extra-articular impingement (0 = off, "
+            "the thesis' single-layer maps)",
+            [](auto& o) -> auto& { return o.session.maps.layers; });
+  t.number("layered-spacing", "layered_spacing", "deg", kSetting, 0, 180,
+           "The layered maps' largest node spacing (the scheme at the coarsest resolution reaching it, never finer "
+           "than the maps'; 0: the maps' own); their edges are exact ray casts",
+           [](auto& o) -> auto& { return o.session.maps.layered_spacing_deg; });
+  t.number("extra-articular-radius", "extra_articular_radius_mm", "mm", kSetting, 0, 1e4,
+           "With --layers, test hidden vertices within this distance of the COR",
+           [](auto& o) -> auto& { return o.session.maps.extra_articular_radius_mm; });
+  t.flag("distances", "distances", OptionType::on_off, kSetting,
+         "on|off: beside each radial gap, the signed Euclidean distance to the other bone's surface (what 3D "
+         "Slicer, VTK, Open3D and libigl report; negative inside it), exact, for every vertex (hidden ones too) "
+         "within --distance-reach of the other bone",
+         [](auto& o) -> auto& { return o.session.maps.distances; });
+  t.text("levels-on", "levels_on", OptionType::choice, kSetting, {"distance", "radial"},
+         "What the impingement levels (colours, level areas, clock sectors) classify: the Euclidean distance or the "
+         "thesis' radial gap (default: the distance, or the radial gap with --distances off)",
+         [](auto& o) -> auto& { return o.session.maps.levels_on; });
+  t.number("distance-reach", "distance_reach_mm", "mm", kSetting, 0, 1e4,
+           "Vertices proven farther than this from the other bone get no distance (0: the largest --levels "
+           "threshold)",
+           [](auto& o) -> auto& { return o.session.maps.distance_reach_mm; });
+  t.flag("maps-only", "maps_only", OptionType::flag, kSetting,
+         "No exact look-ups at depth discontinuities: the maps answer alone (the thesis' algorithm)",
+         [](auto& o) -> auto& { return o.session.maps.maps_only; });
+  OptionRow& mp = t.add("maps", "maps", OptionType::path_pair, "", use_joint,
+                        "(ball_path, socket_path): maps saved by save_maps() to load instead of sampling");
+  mp.set = [](RunOptions& o, const OptionValue& v, const std::string& as) {
+    if (std::holds_alternative<std::monostate>(v)) {
+      o.session.maps.ball_map_file.clear(), o.session.maps.socket_map_file.clear();
+      return;
+    }
+    const auto& p = value_as<std::vector<std::string>>(v, as, "a pair (ball_path, socket_path)");
+    require(p.size() == 2, [&] { return as + ": expected a pair (ball_path, socket_path), got " + std::to_string(p.size()) + " items"; });
+    o.session.maps.ball_map_file = p[0], o.session.maps.socket_map_file = p[1];
+  };
+  mp.get = [](const RunOptions& o) -> OptionValue {
+    if (o.session.maps.ball_map_file.empty()) return std::monostate{};
+    return std::vector<std::string>{o.session.maps.ball_map_file, o.session.maps.socket_map_file};
+  };
+}
+
+void add_frame_rows(Rows& t) {
+  t.text("neutral", "neutral", OptionType::choice, kSetting, {"anatomical", "scan"},
+         "Zero pose: 'anatomical' (the femoral ISB frame parallel to the pelvic one, both found from the bones or "
+         "given as landmarks in subject.json) or 'scan' (the pose in the scanner; angles about the input frame's "
+         "axes: flexion about left-right, adduction about antero-posterior, rotation about superior-inferior). "
+         "Default: subject.json's \"neutral\", else anatomical",
+         [](auto& o) -> auto& { return o.session.frames.neutral; });
+  t.text("pelvis-frame", "pelvis_frame", OptionType::choice, kSetting, {"isb", "app"},
+         "Pelvic axes: 'isb' (Wu et al. 2002: ASIS and PSIS) or 'app' (anterior pelvic plane: ASIS and pubic "
+         "tubercles, as clinical ROM tools)",
+         [](auto& o) -> auto& { return o.session.frames.pelvis_frame; });
+  t.text("joint-centre", "joint_centre", OptionType::choice, kSetting,
+         {"femoral-head", "acetabular", "combined", "equidistant"},
+         "How the femur moves at each pose (Puls et al. 2010, Comput Aided Surg 15:75): 'femoral-head' (rotation "
+         "about the head centre: the thesis' method), 'acetabular' (about the acetabular centre), 'combined' (the "
+         "head centre placed on the acetabular centre) or 'equidistant' (at each pose the femur is also translated "
+         "so that the joint space over the lunate surface is as even as possible). The translation is reported per "
+         "pose and limit. Default: equidistant with anatomical neutral, femoral-head with --neutral scan (which "
+         "allows no other)",
+         [](auto& o) -> auto& { return o.session.frames.joint_centre; });
+  t.text("femur-frame", "femur_frame", OptionType::choice, kSetting, {"epicondyles", "posterior-condyles"},
+         "Femoral medio-lateral axis: 'epicondyles' (ISB) or 'posterior-condyles' (posterior condylar axis)",
+         [](auto& o) -> auto& { return o.session.frames.femur_frame; });
+}
+
+void add_rom_rows(Rows& t) {
+  const unsigned both = use_rom | use_rom_limits | use_rom_map;
+  t.number("threshold", "threshold_mm", "mm", both, -100, 100,
+           "The bones meet when the least gap (--metric) is <= this less --contact-depth (0: bone contact; a "
+           "cartilage offset > 0)",
+           [](auto& o) -> auto& { return o.rom.search.threshold_mm; });
+  t.number("contact-depth", "contact_depth_mm", "mm", both, 0, 100,
+           "A contact must reach this far past the threshold to end a search; a shallower graze is within the "
+           "data's error (map interpolation, an MRI surface's roughness) and the joint's play (0: the first touch)",
+           [](auto& o) -> auto& { return o.rom.search.contact_depth_mm; });
+  t.choice("metric", "metric", both, {"distance", "radial"},
+           "What --threshold is compared with: the signed Euclidean distance to the other bone (what a depth or a "
+           "cartilage offset means) or the thesis' radial gap (along the ray from the COR; where the ray runs inside "
+           "the other bone it reads a depth of tens of mm for a graze). The distance needs distances on: a Python "
+           "Joint built with distances=False uses the radial gap unless metric is given",
+           [](auto& o) -> auto& { return o.rom.search.metric; }, parse_rom_metric,
+           [](RomMetric m) { return to_string(m); });
+  t.choice("contacts", "contacts", use_rom | use_rom_limits, {"impingement", "articular", "all"},
+           "Which contacts end a search: 'impingement' (the head-neck junction, neck or trochanters against the rim "
+           "or the pelvis beyond it; the head's joint surface meeting the lunate surface, the joint space closing, "
+           "is left out), 'articular' (only that: where the joint space closes) or 'all' (every vertex, the thesis' "
+           "criterion). Anatomical neutral only (the zones need the acetabulum)",
+           [](auto& o) -> auto& { return o.rom.search.contacts; }, parse_rom_contacts,
+           [](RomContacts c) { return to_string(c); });
+  t.number("step", "step_deg", "deg", use_rom | use_rom_limits, 0.01, 90,
+           "Coarse search step (then bisection to 0.1 deg)", [](auto& o) -> auto& { return o.rom.search.step_deg; });
+  t.number("max", "max_deg", "deg", use_rom | use_rom_limits, 0.1, 360, "Search no farther than this from the start",
+           [](auto& o) -> auto& { return o.rom.search.max_deg; });
+  t.numbers("map-flexion", "flexion", "deg", use_rom | use_rom_map, "The ROM map's flexion angles",
+            [](auto& o) -> auto& { return o.rom.map_flexion_deg; });
+  t.numbers("map-adduction", "adduction", "deg", use_rom | use_rom_map, "The ROM map's adduction angles",
+            [](auto& o) -> auto& { return o.rom.map_adduction_deg; });
+  t.flag("no-map", "no_map", OptionType::flag, use_rom, "Limits only, no ROM map",
+         [](auto& o) -> auto& { return o.rom.map; }, true);
+  t.flag("envelope", "envelope", OptionType::flag, use_rom,
+         "Also the ROM envelope: every pose of flexion -30..130 x adduction -50..40 x internal rotation -60..60 deg "
+         "(1 deg steps) valid or in contact, by adaptive refinement (rom_envelope.csv: the valid runs of internal "
+         "rotation)",
+         [](auto& o) -> auto& { return o.rom.envelope; });
+  t.integer("envelope-coarse", "envelope_coarse", "", use_rom, 1, 64,
+            "Steps between the envelope's first poses (1: scan every pose; larger is faster and can miss a region of "
+            "contact smaller than a cell)",
+            [](auto& o) -> auto& { return o.rom.envelope_options.coarse_steps; });
+}
+
+void add_command_rows(Rows& t) {
+  OptionRow& out = t.text("out", "out", OptionType::path, use_cli_commands, {}, "Output folder",
+                          [](auto& o) -> auto& { return o.command.out; });
+  out.required = true;
+  t.text("pose", "pose", OptionType::text, use_distance, {},
+         "FLEX,ADD,IR in degrees, ISB joint coordinate system (Wu et al. 2002): flexion about the pelvic "
+         "medio-lateral axis (+ = knee forward), adduction about the floating axis (+ = knee towards the midline, "
+         "negative = abduction), internal rotation about the femoral long axis (+ = front of the thigh turns "
+         "inwards); mirrored for the left side so the signs mean the same. Zero is set by --neutral",
+         [](auto& o) -> auto& { return o.command.pose; });
+  t.flag("render", "render", OptionType::flag, use_distance,
+         "Also write shaded renders (render.png: anterior, lateral and the socket's medial view with the acetabular "
+         "clock face) with matplotlib",
+         [](auto& o) -> auto& { return o.command.render; });
+  OptionRow& motion = t.text("motion", "motion", OptionType::path, use_motion, {}, "Motion file: .csv, .mot or .sto",
+                             [](auto& o) -> auto& { return o.command.motion; });
+  motion.required = true;
+  t.integer("vtp-every", "vtp_every", "", use_motion, 0, 1e9,
+            "Write the posed bones (gaps/frame_N.vtp) every N frames; 0 = every frame up to 100 frames, else at most "
+            "100 files",
+            [](auto& o) -> auto& { return o.command.vtp_every; });
+  t.flag("quiet", "quiet", OptionType::flag, use_motion, "No progress bar or final line",
+         [](auto& o) -> auto& { return o.command.quiet; });
+  t.integer("triangles", "triangles", "", use_generate | use_generated_hip, 20, 2e7,
+            "Target triangles per model (at most 20 million: about 2 GB of mesh)",
+            [](auto& o) -> auto& { return o.generate.target_triangles; });
+  t.number("cam", "cam_mm", "mm", use_generate | use_generated_hip, 0, 15, "Cam bump height",
+           [](auto& o) -> auto& { return o.generate.cam_height_mm; });
+  t.number("coverage", "coverage_deg", "deg", use_generate | use_generated_hip, 30, 170, "Cup coverage angle from the cup pole",
+           [](auto& o) -> auto& { return o.generate.cup_coverage_deg; });
+}
+
+}  // namespace
+
+const std::vector<OptionRow>& option_table() {
+  static const std::vector<OptionRow> table = [] {
+    Rows t;
+    add_input_rows(t);
+    add_map_rows(t);
+    add_frame_rows(t);
+    add_rom_rows(t);
+    add_command_rows(t);
+    return std::move(t.rows);
+  }();
+  return table;
+}
+
+const OptionRow* find_option(const std::string& name) {
+  for (const OptionRow& r : option_table())
+    if (r.name == name || r.key == name) return &r;
+  return nullptr;
+}
+
+}  // namespace impinge
