@@ -236,25 +236,6 @@ void add_joint_queries(py::class_<PyJoint>& c) {
           "Save both maps (impinge map files with scheme, resolution, COR and checksum) for Joint(..., maps=...).");
 }
 
-py::object frames_dict(const PyJoint& j) {
-  if (!j.hip().frames()) return py::none();
-  const HipFrames& f = *j.hip().frames();
-  const Session& s = *j.session;
-  py::dict d;
-  for (const auto& [name, frame] : {std::pair{"pelvis", &f.pelvis}, std::pair{"femur", &f.femur}}) {
-    py::dict fr;
-    fr["origin"] = Eigen::Vector3d(s.to_input(frame->origin));
-    fr["axes"] = Eigen::Matrix3d(s.to_input() * frame->axes);
-    py::dict lm;
-    for (const auto& [k, p] : frame->landmarks) lm[py::str(k)] = Eigen::Vector3d(s.to_input(p));
-    fr["landmarks"] = lm;
-    d[name] = fr;
-  }
-  d["scan_pose"] = std::vector<double>{f.scan_pose.flexion_deg, f.scan_pose.adduction_deg,
-                                       f.scan_pose.internal_rotation_deg};
-  return d;
-}
-
 void add_joint_properties(py::class_<PyJoint>& c) {
   c.def_property_readonly("cor", [](const PyJoint& j) { return j.session->head_centre_input(); },
                           "The femoral head centre, the centre of rotation (3,), mm, input frame: the `cor` given, "
@@ -275,9 +256,15 @@ void add_joint_properties(py::class_<PyJoint>& c) {
                              [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().ball().map}; })
       .def_property_readonly(
           "socket_map", [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().socket().map}; })
-      .def_property_readonly("frames", &frames_dict,
-                             "Anatomical frames (anatomical neutral; None with scan neutral), input frame: origin (3,), "
-                             "axes (3, 3; columns X anterior, Y superior, Z right), landmarks; scan_pose in degrees.")
+      .def_property_readonly(
+          "frames",
+          [](const PyJoint& j) -> py::object {
+            const nlohmann::json r = setup_record(*j.session);
+            return r.contains("frames") ? from_json(r["frames"]) : py::none();
+          },
+          "Anatomical frames as summary.json's \"frames\" records them (anatomical neutral; None with scan neutral), "
+          "input frame: per bone origin_mm, x_axis, y_axis, z_axis (ISB: x anterior, y superior, z right), "
+          "landmarks with their sources; scan_pose_deg, the acetabulum, seat_mm.")
       .def_property_readonly(
           "setup", [](const PyJoint& j) { return from_json(setup_record(*j.session)); },
           "The set-up as the CLI's summary.json reports it (inputs, input frame, COR and its method, scheme, maps, "

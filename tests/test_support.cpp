@@ -16,8 +16,8 @@ std::optional<RealJoint> load_real_joint(const std::string& name) {
   if (!std::filesystem::exists(dir + "/subject.json")) return std::nullopt;
   const SubjectInfo info = load_subject(dir + "/subject.json");
   RealJoint j{load_mesh(info.femur_path), load_mesh(info.pelvis_path), Eigen::Vector3d::Zero()};
-  transform_vertices(j.femur.V, to_anatomical(info.frame));
-  transform_vertices(j.pelvis.V, to_anatomical(info.frame));
+  transform_vertices(j.femur.V, to_working_frame(info.frame));
+  transform_vertices(j.pelvis.V, to_working_frame(info.frame));
   j.cor = fit_femoral_head(j.femur).centre;
   return j;
 }

@@ -158,6 +158,7 @@ class Joint:
     ball_map: Map
     socket_map: Map
     frames: Optional[Dict[str, Any]]
+    """summary.json's "frames" record (anatomical neutral; None with scan neutral), input frame."""
     setup: Dict[str, Any]
     """The set-up as the CLI's summary.json reports it."""
     warnings: List[str]

@@ -232,8 +232,9 @@ def test_real_subject_anatomical_frames():
     ball, socket = (femur[0] @ lps, femur[1]), (pelvis[0] @ lps, pelvis[1])
     j = impinge.Joint(ball, socket, resolution=0.5)
     f = j.frames
-    assert set(f) == {"pelvis", "femur", "scan_pose"}
-    np.testing.assert_allclose(f["pelvis"]["axes"].T @ f["pelvis"]["axes"], np.eye(3), atol=1e-12)
+    assert {"pelvis", "femur", "scan_pose_deg", "acetabulum"} <= set(f)
+    axes = np.column_stack([f["pelvis"]["x_axis"], f["pelvis"]["y_axis"], f["pelvis"]["z_axis"]])
+    np.testing.assert_allclose(axes.T @ axes, np.eye(3), atol=1e-12)
     m = j.motion(np.array([[0, 0, 0], [90, 0, 0]]))
     assert np.all(np.isfinite(m["ball_min_gap_mm"]))
     # ROM from Python: a limit is where detect_pose first shows contact (the first touch: no contact depth).

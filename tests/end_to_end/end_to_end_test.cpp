@@ -135,8 +135,8 @@ TEST_P(RealSubject, ExactModeAgreesWithExactRayCastAtTenthDegree) {
   if (!fs::exists(json)) GTEST_SKIP() << "shared data absent: " << json;
   const SubjectInfo s = load_subject(json);
   TriangleMesh femur = load_mesh(s.femur_path), pelvis = load_mesh(s.pelvis_path);
-  transform_vertices(femur.V, to_anatomical(s.frame));
-  transform_vertices(pelvis.V, to_anatomical(s.frame));
+  transform_vertices(femur.V, to_working_frame(s.frame));
+  transform_vertices(pelvis.V, to_working_frame(s.frame));
   const SphereFitResult fit = fit_femoral_head(femur);
   EXPECT_GT(fit.radius, 18);
   EXPECT_LT(fit.radius, 30);

@@ -16,10 +16,10 @@ TEST(Subject, ParsesAndResolvesPaths) {
   EXPECT_EQ(s.side, Side::left);
   EXPECT_EQ(s.frame, FrameConvention::LPS);
   EXPECT_EQ(s.femur_path, d + "/f.ply");
-  const Eigen::Matrix3d M = to_anatomical(FrameConvention::LPS);
+  const Eigen::Matrix3d M = to_working_frame(FrameConvention::LPS);
   EXPECT_EQ(M * Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(-1, -2, 3));  // left -> right negated
   EXPECT_EQ(M * M, Eigen::Matrix3d::Identity());
-  EXPECT_EQ(to_anatomical(FrameConvention::RAS), Eigen::Matrix3d::Identity());
+  EXPECT_EQ(to_working_frame(FrameConvention::RAS), Eigen::Matrix3d::Identity());
 }
 
 TEST(Subject, BadFilesNameFileAndKey) {

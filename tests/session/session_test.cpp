@@ -55,7 +55,7 @@ const HipModel& model(bool cam = true) {
 // Options for the generated hip given in `frame` (its meshes converted from RAS), true COR given.
 SessionOptions generated_options(const std::string& frame, bool cam = true) {
   const HipModel& h = model(cam);
-  const Eigen::Matrix3d M = to_anatomical(frame == "LPS" ? FrameConvention::LPS : FrameConvention::RAS);
+  const Eigen::Matrix3d M = to_working_frame(frame == "LPS" ? FrameConvention::LPS : FrameConvention::RAS);
   SessionOptions o;
   o.input.ball_mesh = h.ball;
   o.input.socket_mesh = h.socket;

@@ -70,7 +70,7 @@ SubjectInfo load_subject(const std::string& json_path) {
   return s;
 }
 
-Eigen::Matrix3d to_anatomical(FrameConvention frame) {
+Eigen::Matrix3d to_working_frame(FrameConvention frame) {
   Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
   if (frame == FrameConvention::LPS) {
     M(0, 0) = -1;

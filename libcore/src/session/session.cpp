@@ -110,7 +110,7 @@ LoadedInput load_input(const SessionInput& input) {
     require(p.allFinite(), "landmark " + name + ": not three finite numbers");
     landmarks[name] = p;
   }
-  in.to_working = to_anatomical(in.frame);
+  in.to_working = to_working_frame(in.frame);
   transform_vertices(in.femur.V, in.to_working);
   transform_vertices(in.pelvis.V, in.to_working);
   for (auto& [name, p] : landmarks) in.landmarks[name] = in.to_working * p;

@@ -36,7 +36,7 @@ SphereFitResult fit_sphere_geometric(PointsRef P);
 /// Options of the automatic femoral-head fit.
 struct HeadFitOptions {
   double proximal_extent_mm = 70;  ///< candidates: vertices within this height of the most
-                                   ///< superior vertex (+z of the anatomical frame)
+                                   ///< superior vertex (+z of the working frame, RAS)
   double min_radius_mm = 12;       ///< plausible head radius range for RANSAC spheres
   double max_radius_mm = 40;
   double inlier_threshold_mm = 1.0;  ///< |distance - r| below this counts as an inlier
@@ -47,7 +47,7 @@ struct HeadFitOptions {
 
 /// Automatic centre of rotation of a femur: RANSAC sphere detection on the proximal femur
 /// (4-point minimal spheres with radius in range, most inliers wins), then geometric fits on
-/// the re-selected inliers. `femur`: vertices in the anatomical frame (+z superior), mm.
+/// the re-selected inliers. `femur`: vertices in the working frame (RAS, +z superior), mm.
 /// Throws impinge::Error naming the mesh when no plausible sphere is found.
 SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options = {});
 

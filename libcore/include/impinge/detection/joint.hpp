@@ -85,7 +85,7 @@ struct JointOptions {
 
 /// One body of the joint after preprocessing.
 struct JointBody {
-  TriangleMesh mesh;               ///< anatomical frame, mm
+  TriangleMesh mesh;               ///< the frame the joint was given (Session: the joint frame), mm
   Vertices relative;               ///< n x 3, vertices minus the COR, mm
   RadialDistanceMap map;           ///< its radial distance map about the COR
   std::vector<std::uint8_t> mask;  ///< 1 for vertices on the first surface within the region
@@ -133,7 +133,7 @@ struct DetectionMemory {
 /// Ball (femur) and socket (pelvis) about a fixed COR.
 class Joint {
  public:
-  /// Rasterise both meshes (anatomical frame, mm) about `cor` (mm) and compute the first-
+  /// Rasterise both meshes (one frame, mm) about `cor` (mm) and compute the first-
   /// surface masks. Throws impinge::Error on invalid options or a non-finite COR.
   Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options);
 

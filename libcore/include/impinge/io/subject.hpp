@@ -12,7 +12,7 @@
 namespace impinge {
 
 /// Frame convention of a scan. LPS: +x left, +y posterior, +z superior (DICOM);
-/// RAS: +x right, +y anterior, +z superior. impinge's anatomical frame is RAS.
+/// RAS: +x right, +y anterior, +z superior. impinge's working frame is RAS (the ISB bone frames, anatomy/anatomical_frame.hpp, are another thing).
 enum class FrameConvention { LPS, RAS };
 
 /// Parsed subject.json: {"side": "right"|"left", "frame": "LPS"|"RAS", "units": "mm",
@@ -37,9 +37,9 @@ struct SubjectInfo {
 /// not three finite numbers, or unreadable JSON.
 SubjectInfo load_subject(const std::string& json_path);
 
-/// Linear map (3 x 3) from `frame` coordinates to the anatomical frame (RAS). Orthogonal and
+/// Linear map (3 x 3) from `frame` coordinates (the input frame) to the working frame (RAS). Orthogonal and
 /// its own inverse for LPS (diag(-1, -1, 1)).
-Eigen::Matrix3d to_anatomical(FrameConvention frame);
+Eigen::Matrix3d to_working_frame(FrameConvention frame);
 
 /// Apply a 3 x 3 linear map to every vertex in place (V <- V * M^T).
 void transform_vertices(Vertices& V, const Eigen::Matrix3d& M);
