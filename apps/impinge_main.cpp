@@ -139,14 +139,15 @@ int run_distance(const RunOptions& o) {
   const Session s = open_session(o.session);
   const FemurPose femur = s.hip().femur_pose(pose);
   const PoseResult res = s.joint().detect(femur.R, femur.t);
-  fs::create_directories(out);
+  begin_output_folder(out, "distance");
   write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur);
   write_map_png(in_dir(out, "ball_map.png"), s.joint().ball().map);
   write_map_png(in_dir(out, "socket_map.png"), s.joint().socket().map);
   nlohmann::json j = run_record(s);
   j.update(pose_record(s, pose, femur, res));
   write_json(in_dir(out, "summary.json"), j);
-  if (o.command.render) render(out);
+  if (o.command.render) render(out);  // reads summary.json; a failure leaves the folder marked incomplete
+  end_output_folder(out);
   std::cout << "ball: " << res.ball.vertices_tested << " tested, min gap " << res.ball.min_gap_mm << " mm, "
             << res.ball.vertices_penetrating << " penetrating; socket: " << res.socket.vertices_tested
             << " tested, min gap " << res.socket.min_gap_mm << " mm, " << res.socket.vertices_penetrating
@@ -163,7 +164,7 @@ int run_motion(const RunOptions& o) {
   const Session s = open_session(o.session);
   const double setup_ms = ms_since(t_start);
 
-  fs::create_directories(fs::path(out) / "gaps");
+  begin_output_folder(out, "motion", {"gaps"});
   const std::size_t n = motion.frames();
   const int every = mo.vtp_every > 0 ? mo.vtp_every : static_cast<int>((n + 99) / 100);
   Table frames;
@@ -199,6 +200,7 @@ int run_motion(const RunOptions& o) {
                      {"output", write_ms},
                      {"total", ms_since(t_start)}};
   write_json(in_dir(out, "summary.json"), j);
+  end_output_folder(out);
   if (!mo.quiet)
     std::cout << "motion: " << n << " frames in " << std::fixed << std::setprecision(1) << ms_since(t_start)
               << " ms (setup " << setup_ms << " ms, detection " << detect_ms << " ms); written to " << out << "\n";
@@ -216,7 +218,7 @@ int run_rom(const RunOptions& o) {
     std::cerr << "impinge: warning: " << run.baseline.excluded_vertices << " vertices are within "
               << q.search.threshold_mm
               << " mm at neutral (overlap before any motion); they are not counted in the limits\n";
-  fs::create_directories(out);
+  begin_output_folder(out, "rom");
   write_csv(in_dir(out, "rom_limits.csv"), rom_limits_table(s, run));
   if (q.map) write_csv(in_dir(out, "rom_map.csv"), rom_map_table(run));
   if (q.envelope) write_csv(in_dir(out, "rom_envelope.csv"), rom_envelope_table(run));
@@ -230,6 +232,7 @@ int run_rom(const RunOptions& o) {
                      {"envelope", run.envelope_ms},
                      {"total", ms_since(t_start)}};
   write_json(in_dir(out, "summary.json"), j);
+  end_output_folder(out);
   std::cout << "rom: " << run.limits.size() << " limits in " << std::fixed << std::setprecision(0) << run.limits_ms
             << " ms, ROM map (" << run.map.size() << " cells) in " << run.map_ms << " ms"
             << (q.envelope ? ", envelope in " + std::to_string(std::lround(run.envelope_ms)) + " ms" : std::string())
@@ -241,7 +244,7 @@ int run_generate(const RunOptions& run) {
   const HipModelOptions& o = run.generate;
   const std::string& out = run.command.out;
   const HipModel h = make_hip_model(o);
-  fs::create_directories(out);
+  begin_output_folder(out, "generate");
   write_ply(in_dir(out, "femur_r.ply"), h.ball);
   write_ply(in_dir(out, "pelvis.ply"), h.socket);
   write_json(in_dir(out, "subject.json"), {{"side", "right"},
@@ -253,6 +256,7 @@ int run_generate(const RunOptions& run) {
                                            {"neutral", "scan"},
                                            {"true_cor_mm", {h.cor.x(), h.cor.y(), h.cor.z()}},
                                            {"head_radius_mm", o.head_radius_mm}});
+  end_output_folder(out);
   std::cout << "generated hip model: " << h.ball.F.rows() << " + " << h.socket.F.rows() << " triangles in " << out
             << " (a proximal femur and a cup: neutral is the scan pose)\n";
   return 0;

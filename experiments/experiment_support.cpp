@@ -1,5 +1,7 @@
 #include "experiment_support.hpp"
 
+#include "impinge/core/atomic_file.hpp"
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -182,15 +184,23 @@ void write_meta(const std::string& dir, const Args& args, nlohmann::json params)
   char buf[64];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   m["date"] = buf;
-  std::ofstream os(fs::path(dir) / "meta.json");
-  require(os.good(), dir + "/meta.json: cannot open for writing");
-  os << m.dump(2) << "\n";
+  write_file_atomically((fs::path(dir) / "meta.json").string(), m.dump(2) + "\n");
 }
 
-CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header) : os_(path) {
-  require(os_.good(), path + ": cannot open for writing");
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header) : path_(path) {
+  require(fs::is_directory(fs::path(path).parent_path().empty() ? "." : fs::path(path).parent_path()),
+          path + ": its folder does not exist");
   for (std::size_t k = 0; k < header.size(); ++k) os_ << (k ? "," : "") << header[k];
   os_ << "\n";
+}
+
+CsvWriter::~CsvWriter() {
+  try {
+    write_file_atomically(path_, os_.str());
+  } catch (const std::exception& e) {  // a result not written is a failed experiment, not a warning
+    std::cerr << "experiment: error: " << e.what() << std::endl;
+    std::_Exit(2);
+  }
 }
 
 void progress(const std::string& experiment, int done, int total, const std::string& what) {

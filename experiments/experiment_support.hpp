@@ -81,9 +81,14 @@ std::string experiment_dir(const Args& args, const std::string& name);
 void write_meta(const std::string& dir, const Args& args, nlohmann::json params);
 
 /// Minimal CSV writer: header once, then rows of already-formatted cells.
+/// A CSV file written whole when the writer goes out of scope (write_file_atomically): a killed or failed
+/// run leaves no truncated CSV. A write failure then ends the process with exit code 2, naming the file.
 class CsvWriter {
  public:
   CsvWriter(const std::string& path, const std::vector<std::string>& header);
+  ~CsvWriter();
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
   template <typename... T>
   void row(const T&... cells) {
     std::size_t k = 0;
@@ -112,7 +117,8 @@ class CsvWriter {
       return std::to_string(x);
     }
   }
-  std::ofstream os_;
+  std::string path_;
+  std::ostringstream os_;
 };
 
 /// Write the part of `body` within `radius_mm` of the COR as a gap PLY (write_gap_ply): its vertices

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
 #include "io/mesh_readers.hpp"
 
@@ -108,11 +109,11 @@ TriangleMesh load_mesh(const std::string& path) {
 
 namespace {
 template <typename T>
-void put(std::ofstream& os, T value) {
+void put(std::ostream& os, T value) {
   os.write(reinterpret_cast<const char*>(&value), sizeof(T));
 }
 
-void write_faces(std::ofstream& os, const Faces& F) {
+void write_faces(std::ostream& os, const Faces& F) {
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     put<std::uint8_t>(os, 3);
     for (int k = 0; k < 3; ++k) put<std::int32_t>(os, F(f, k));
@@ -127,8 +128,7 @@ void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const E
   require(gap_mm.size() == V.rows() && level.size() == V.rows() && rgb.rows() == V.rows() &&
               (distance_mm == nullptr || distance_mm->size() == V.rows()),
           path + ": per-vertex arrays do not match the vertex count");
-  std::ofstream os(path, std::ios::binary);
-  require(os.good(), path + ": cannot open for writing");
+  std::ostringstream os(std::ios::binary);
   os << "ply\nformat binary_little_endian 1.0\ncomment impinge per-vertex gap (mm)\n"
      << "element vertex " << V.rows() << "\n"
      << "property float x\nproperty float y\nproperty float z\n"
@@ -145,20 +145,19 @@ void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const E
     for (int k = 0; k < 3; ++k) put<std::uint8_t>(os, rgb(i, k));
   }
   write_faces(os, F);
-  require(os.good(), path + ": write failed");
+  write_file_atomically(path, os.str());
 }
 
 void write_ply(const std::string& path, const TriangleMesh& mesh) {
   validate_mesh(mesh);
-  std::ofstream os(path, std::ios::binary);
-  require(os.good(), path + ": cannot open for writing");
+  std::ostringstream os(std::ios::binary);
   os << "ply\nformat binary_little_endian 1.0\nelement vertex " << mesh.V.rows() << "\n"
      << "property float x\nproperty float y\nproperty float z\n"
      << "element face " << mesh.F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
     for (int k = 0; k < 3; ++k) put<float>(os, static_cast<float>(mesh.V(i, k)));
   write_faces(os, mesh.F);
-  require(os.good(), path + ": write failed");
+  write_file_atomically(path, os.str());
 }
 
 }  // namespace impinge

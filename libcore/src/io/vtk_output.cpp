@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
 
 namespace impinge {
@@ -65,8 +66,7 @@ void write_vtp(const std::string& path, PointsRef V, const Faces& F, const std::
   element(connectivity);
   element(offsets);
   xml << "      </Polys>\n    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _";
-  std::ofstream os(path, std::ios::binary);
-  require(os.good(), path + ": cannot open for writing");
+  std::ostringstream os(std::ios::binary);
   const std::string head = xml.str();
   os.write(head.data(), static_cast<std::streamsize>(head.size()));
   auto raw = [&](const Block& b) {
@@ -79,19 +79,18 @@ void write_vtp(const std::string& path, PointsRef V, const Faces& F, const std::
   raw(connectivity);
   raw(offsets);
   os << "\n  </AppendedData>\n</VTKFile>\n";
-  require(os.good(), path + ": write failed");
+  write_file_atomically(path, os.str());
 }
 
 void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {
-  std::ofstream os(path);
-  require(os.good(), path + ": cannot open for writing");
+  std::ostringstream os;
   os << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
         "  <Collection>\n";
   os << std::setprecision(9);
   for (const PvdEntry& e : entries)
     os << "    <DataSet timestep=\"" << e.time_s << "\" group=\"\" part=\"0\" file=\"" << e.file << "\"/>\n";
   os << "  </Collection>\n</VTKFile>\n";
-  require(os.good(), path + ": write failed");
+  write_file_atomically(path, os.str());
 }
 
 }  // namespace impinge

@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
 #include "impinge/schemes/equiangular_grid.hpp"
@@ -16,8 +17,8 @@ namespace impinge {
 
 namespace {
 /// libpng's error handling longjmps: keep this frame free of locals computed before setjmp.
-void write_grey_png(const std::string& path, const unsigned char* pixels, int w, int h) {
-  FILE* fp = std::fopen(path.c_str(), "wb");
+void write_grey_png(const std::string& file, const std::string& path, const unsigned char* pixels, int w, int h) {
+  FILE* fp = std::fopen(file.c_str(), "wb");
   require(fp != nullptr, path + ": cannot open for writing");
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
@@ -63,7 +64,9 @@ MapImageScale write_map_png(const std::string& path, const RadialDistanceMap& ma
   std::vector<unsigned char> pixels(value.size());
   for (std::size_t i = 0; i < value.size(); ++i)
     pixels[i] = std::isfinite(value[i]) ? static_cast<unsigned char>(40 + 215.0 * (value[i] - lo) / span) : 0;
-  write_grey_png(path, pixels.data(), w, h);
+  AtomicFile file(path);  // written whole or not at all
+  write_grey_png(file.temp_path(), path, pixels.data(), w, h);
+  file.commit();
   return {std::isfinite(lo) ? lo : 0.0, hi};
 }
 

@@ -1,11 +1,13 @@
 #include "impinge/maps/map_io.hpp"
 
+#include <sstream>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <vector>
 
+#include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
 
 namespace impinge {
@@ -61,10 +63,7 @@ void save_map(const std::string& path, const RadialDistanceMapT<Scalar>& map, co
     for (std::int64_t i = 0; i < map.num_nodes(); ++i) put(b, map.at(i));
   }
   put(b, fnv1a64(b.data(), b.size()));
-  std::ofstream os(path, std::ios::binary);
-  require(os.good(), path + ": cannot open for writing");
-  os.write(b.data(), static_cast<std::streamsize>(b.size()));
-  require(os.good(), path + ": write failed");
+  write_file_atomically(path, std::string_view(b.data(), b.size()));
 }
 
 template <typename Scalar>

@@ -1,11 +1,44 @@
 #include "impinge/session/outputs.hpp"
 
 #include <cmath>
+#include <ctime>
+#include <filesystem>
 
+#include "impinge/core/atomic_file.hpp"
+#include "impinge/core/error.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/vtk_output.hpp"
 
 namespace impinge {
+
+namespace fs = std::filesystem;
+
+void begin_output_folder(const std::string& dir, const std::string& command, const std::vector<std::string>& subfolders) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  require(fs::is_directory(dir), [&] { return dir + ": cannot create the output folder (" + ec.message() + ")"; });
+  for (const std::string& sub : subfolders) {
+    const fs::path p = fs::path(dir) / sub;
+    require(!fs::is_symlink(fs::symlink_status(p)),
+            [&] { return p.string() + ": a symbolic link in the output folder; refusing to write through it"; });
+    fs::create_directories(p, ec);
+    require(fs::is_directory(p), [&] { return p.string() + ": cannot create it (" + ec.message() + ")"; });
+  }
+  const std::time_t now = std::time(nullptr);
+  char when[32];
+  std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  write_file_atomically((fs::path(dir) / kIncompleteMarker).string(),
+                        "impinge " + command + " started writing here at " + std::string(when) +
+                            "; the outputs are complete when summary.json is written and this file is removed.\n");
+  fs::remove(fs::path(dir) / "summary.json", ec);
+  require(!ec, [&] { return dir + "/summary.json: cannot remove a previous run's (" + ec.message() + ")"; });
+}
+
+void end_output_folder(const std::string& dir) {
+  std::error_code ec;
+  fs::remove(fs::path(dir) / kIncompleteMarker, ec);
+  require(!ec, [&] { return dir + "/" + kIncompleteMarker + ": cannot remove it (" + ec.message() + ")"; });
+}
 
 std::vector<std::uint8_t> vertex_levels(const ScanGaps& g, const ImpingementLevels& levels, LevelQuantity levels_on) {
   std::vector<std::uint8_t> out(g.gap_mm.size());

@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/spherical_frame.hpp"
@@ -55,22 +56,18 @@ std::string csv_cell(const nlohmann::json& c) {
 }  // namespace
 
 void write_csv(const std::string& path, const Table& t) {
-  std::ofstream os(path);
-  require(os.good(), path + ": cannot open for writing");
+  std::ostringstream os;
   for (std::size_t k = 0; k < t.columns.size(); ++k) os << (k ? "," : "") << t.columns[k];
   os << '\n';
   for (const auto& r : t.rows) {
     for (std::size_t k = 0; k < r.size(); ++k) os << (k ? "," : "") << csv_cell(r[k]);
     os << '\n';
   }
-  require(os.good(), path + ": write failed");
+  write_file_atomically(path, os.str());
 }
 
 void write_json(const std::string& path, const nlohmann::json& j) {
-  std::ofstream os(path);
-  require(os.good(), path + ": cannot open for writing");
-  os << j.dump(2) << "\n";
-  require(os.good(), path + ": write failed");
+  write_file_atomically(path, j.dump(2) + "\n");
 }
 
 nlohmann::json scan_record(const JointBody& body, const ScanSummary& s, double detection_ms,

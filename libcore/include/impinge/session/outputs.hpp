@@ -1,7 +1,8 @@
 #pragma once
 /// @file outputs.hpp
-/// Posed bones with their gaps as mesh files, in the input frame: PLY per bone (the CLI's
-/// ball_gaps.ply and socket_gaps.ply) and one VTK PolyData per motion frame (ParaView).
+/// A run's output folder, and the posed bones with their gaps as mesh files, in the input frame: PLY per
+/// bone (the CLI's ball_gaps.ply and socket_gaps.ply) and one VTK PolyData per motion frame (ParaView).
+/// Every file is written whole or not at all (core/atomic_file.hpp).
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -12,6 +13,18 @@
 #include "impinge/session/session.hpp"
 
 namespace impinge {
+
+/// The file a run keeps in its output folder while it writes: its outputs are complete only when
+/// summary.json is there and this file is not.
+inline constexpr const char* kIncompleteMarker = "INCOMPLETE";
+
+/// Open `dir` for a run's outputs: create it and `subfolders` inside it (a subfolder that is a symbolic
+/// link is refused: files would be written outside `dir`), remove a previous run's summary.json, and
+/// write kIncompleteMarker (saying which command started when). Throws impinge::Error naming the folder.
+void begin_output_folder(const std::string& dir, const std::string& command,
+                         const std::vector<std::string>& subfolders = {});
+/// Mark `dir`'s outputs complete (remove kIncompleteMarker): call after its last file, summary.json.
+void end_output_folder(const std::string& dir);
 
 /// The impingement level of every vertex of `gaps` under `levels` by quantity `levels_on` (vertex_level:
 /// 255 where the vertex has no value). Length: the body's vertex count.
