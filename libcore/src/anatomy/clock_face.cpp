@@ -40,12 +40,15 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
   require(c.allFinite() && std::isfinite(r) && r > 0, ctx + ": head centre and radius must be finite");
   const Vertices& V = pelvis.V;
   Acetabulum A;
+  // Each vertex stands for a third of its triangles' area: the pole and the sphere are the surface's, not
+  // its vertices' (a file that splits or duplicates them gives the same acetabulum).
+  const Eigen::VectorXd area = vertex_areas(pelvis);
   std::vector<Eigen::Index> cup;
   Eigen::Vector3d mean_dir = Eigen::Vector3d::Zero();
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     const Eigen::Vector3d d = V.row(i).transpose() - c;
     const double n = d.norm();
-    if (n > 0 && n < r + margin) cup.push_back(i), mean_dir += d / n;
+    if (n > 0 && n < r + margin) cup.push_back(i), mean_dir += area[i] * d / n;
   }
   A.cup_vertices = static_cast<std::int64_t>(cup.size());
   require(cup.size() >= 50, ctx + ": only " + std::to_string(cup.size()) + " pelvis vertices within " +
@@ -57,8 +60,10 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
     if ((V.row(i).transpose() - c).norm() < r + 4) lunate.push_back(i);
   require(lunate.size() >= 20, ctx + ": fewer than 20 pelvis vertices within 4 mm of the head sphere");
   Eigen::Matrix<double, Eigen::Dynamic, 3> pts(static_cast<Eigen::Index>(lunate.size()), 3);
-  for (std::size_t k = 0; k < lunate.size(); ++k) pts.row(static_cast<Eigen::Index>(k)) = V.row(lunate[k]);
-  A.sphere = fit_sphere_geometric(pts);
+  std::vector<double> w(lunate.size());
+  for (std::size_t k = 0; k < lunate.size(); ++k)
+    pts.row(static_cast<Eigen::Index>(k)) = V.row(lunate[k]), w[k] = area[lunate[k]];
+  A.sphere = fit_sphere_geometric(pts, w);
   // The cup's pole (its deepest direction) and axis out of the cup.
   const Eigen::Vector3d pole = mean_dir.normalized();
   const Eigen::Vector3d axis = -pole;

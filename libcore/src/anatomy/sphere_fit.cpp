@@ -78,7 +78,12 @@ SphereFitResult fit_sphere_algebraic(PointsRef P) {
   return res;
 }
 
-SphereFitResult fit_sphere_geometric(PointsRef P) {
+SphereFitResult fit_sphere_geometric(PointsRef P) { return fit_sphere_geometric(P, {}); }
+
+SphereFitResult fit_sphere_geometric(PointsRef P, const std::vector<double>& weights) {
+  require(weights.empty() || weights.size() == static_cast<std::size_t>(P.rows()),
+          "sphere fit: " + std::to_string(weights.size()) + " weights for " + std::to_string(P.rows()) + " points");
+  for (double w : weights) require(std::isfinite(w) && w >= 0, "sphere fit: a weight is negative or not finite");
   SphereFitResult start = fit_sphere_algebraic(P);
   const gsl_multifit_nlinear_type* T = gsl_multifit_nlinear_trust;
   gsl_multifit_nlinear_parameters params = gsl_multifit_nlinear_default_parameters();
@@ -94,7 +99,14 @@ SphereFitResult fit_sphere_geometric(PointsRef P) {
   gsl_vector* x0 = gsl_vector_alloc(p);
   for (int k = 0; k < 3; ++k) gsl_vector_set(x0, static_cast<std::size_t>(k), start.centre[k]);
   gsl_vector_set(x0, 3, start.radius);
-  gsl_multifit_nlinear_init(x0, &fdf, w);
+  gsl_vector* wts = nullptr;
+  if (weights.empty()) {
+    gsl_multifit_nlinear_init(x0, &fdf, w);
+  } else {
+    wts = gsl_vector_alloc(n);
+    for (std::size_t i = 0; i < n; ++i) gsl_vector_set(wts, i, weights[i]);
+    gsl_multifit_nlinear_winit(x0, wts, &fdf, w);
+  }
   int info = 0;
   const int status = gsl_multifit_nlinear_driver(200, 1e-12, 1e-12, 1e-12, nullptr, nullptr, &info, w);
   const gsl_vector* x = gsl_multifit_nlinear_position(w);
@@ -104,9 +116,19 @@ SphereFitResult fit_sphere_geometric(PointsRef P) {
   res.iterations = static_cast<int>(gsl_multifit_nlinear_niter(w));
   res.converged = (status == GSL_SUCCESS);
   gsl_vector_free(x0);
+  if (wts != nullptr) gsl_vector_free(wts);
   gsl_multifit_nlinear_free(w);
   require(res.centre.allFinite() && std::isfinite(res.radius), "sphere fit: solver diverged");
-  res.rms_residual = rms_of(P, res.centre, res.radius);
+  if (weights.empty()) {
+    res.rms_residual = rms_of(P, res.centre, res.radius);
+  } else {
+    double sw = 0, se = 0;
+    for (Eigen::Index i = 0; i < P.rows(); ++i) {
+      const double e = (P.row(i).transpose() - res.centre).norm() - res.radius;
+      sw += weights[static_cast<std::size_t>(i)], se += weights[static_cast<std::size_t>(i)] * e * e;
+    }
+    res.rms_residual = sw > 0 ? std::sqrt(se / sw) : std::nan("");
+  }
   res.points_used = P.rows();
   return res;
 }

@@ -26,6 +26,8 @@ struct FirstHitCaster::Impl {
 
 bool FirstHitCaster::available() { return have_embree() || have_exact_reference(); }
 
+const Eigen::Vector3d& FirstHitCaster::origin() const { return impl_->origin; }
+
 FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin)
     : impl_(std::make_unique<Impl>()) {
   require(available(), "first-hit ray caster: this build has neither Embree nor CGAL (" + mesh.source + ")");

@@ -108,9 +108,12 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
                    load(options.ball_map_file), load(options.socket_map_file));
   }
   // The acetabular centre in the joint frame: the origin once seated.
-  if (method != JointCentreMethod::femoral_head)
+  if (method != JointCentreMethod::femoral_head) {
+    EquidistantOptions equidistant = options.equidistant;
+    equidistant.mirror_x = side_ == Side::left;  // the joint frame's x is medio-lateral: mirrored hips alike
     centre_ = JointCentre(method, *joint_, joint_to_working_.transpose() * (acetabulum_->sphere.centre - cor_),
-                          articular_->pelvis, articular_->head_sphere_reach_mm, options.equidistant);
+                          articular_->pelvis, articular_->head_sphere_reach_mm, equidistant);
+  }
   if (socket_clock_) {
     ball_hours_ = clock_hours(joint_->ball().relative, *ball_clock_);
     socket_hours_ = clock_hours(joint_->socket().relative, *socket_clock_);

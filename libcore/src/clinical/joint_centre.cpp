@@ -5,8 +5,11 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <tuple>
 
 #include "impinge/core/error.hpp"
+#include "impinge/casters/first_hit_caster.hpp"
+#include "impinge/schemes/fibonacci_scheme.hpp"
 #include "core/simd_clones.hpp"
 
 namespace impinge {
@@ -31,6 +34,48 @@ const char* to_string(JointCentreMethod m) {
   return "femoral-head";
 }
 
+ScanSet lunate_sample(PointsRef P, const std::vector<std::uint8_t>& lunate, const Eigen::Vector3d& c_a,
+                      int max_vertices, const FirstHitCaster* surface, bool mirror_x) {
+  const Eigen::Vector3d flip(mirror_x ? -1.0 : 1.0, 1.0, 1.0);  // lattice frame <-> joint frame (its own inverse)
+  std::vector<std::int32_t> flagged;
+  for (std::size_t i = 0; i < lunate.size(); ++i)
+    if (lunate[i]) flagged.push_back(static_cast<std::int32_t>(i));
+  std::vector<Eigen::Vector3d> u(flagged.size());  // directions from c_a
+  for (std::size_t k = 0; k < flagged.size(); ++k) u[k] = (P.row(flagged[k]).transpose() - c_a).normalized();
+  // Cells of a Fibonacci lattice about c_a, coarse enough (8 max_vertices nodes over the sphere: 4.5 deg apart
+  // for 256) that every cell over the lunate surface holds a vertex however finely it is tessellated.
+  const double nodes = 8.0 * std::max(16, max_vertices);
+  const FibonacciScheme lattice(nodes);
+  std::vector<std::int64_t> cell(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k)
+    cell[k] = u[k].allFinite() ? lattice.node(Eigen::Vector3d(flip.cwiseProduct(u[k]))) : -1;
+  // In each cell the vertex nearest its node's direction; ties (duplicated vertices) by position.
+  std::vector<std::size_t> order(flagged.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  auto key = [&](std::size_t k) {
+    const Eigen::Vector3d p = P.row(flagged[k]).transpose();
+    return std::make_tuple(cell[k], -u[k].dot(flip.cwiseProduct(lattice.node_direction(std::max<std::int64_t>(cell[k], 0)))),
+                           flip.x() * p.x(), p.y(), p.z());
+  };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+  ScanSet set;
+  set.vertices = P.rows();
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    const std::size_t k = order[j];
+    if (cell[k] < 0 || (j > 0 && cell[order[j - 1]] == cell[k])) continue;  // one per cell
+    Eigen::Vector3d p = P.row(flagged[k]).transpose();
+    if (surface != nullptr) {  // the surface point in the cell's own direction: the same however tessellated
+      const Eigen::Vector3d d = flip.cwiseProduct(lattice.node_direction(cell[k]));
+      const Eigen::Vector3d o = surface->origin();
+      const double r = surface->first_hit(c_a + d - o);
+      if (std::isfinite(r) && (c_a - o).norm() < 1e-9) p = o + r * d;
+    }
+    set.index.push_back(flagged[k]);
+    set.x.push_back(p.x()), set.y.push_back(p.y()), set.z.push_back(p.z());
+  }
+  return set;
+}
+
 JointCentre::JointCentre(JointCentreMethod method, const Joint& joint, const Eigen::Vector3d& c_a,
                          const std::vector<std::uint8_t>& lunate, double head_sphere_reach_mm,
                          const EquidistantOptions& o)
@@ -51,13 +96,7 @@ JointCentre::JointCentre(JointCentreMethod method, const Joint& joint, const Eig
   require(flagged >= 16, joint.socket().mesh.source + ": " + std::to_string(flagged) +
                              " vertices on the lunate surface, fewer than 16: the equidistant joint centre needs "
                              "the acetabulum's joint surface (use --joint-centre femoral-head)");
-  // An even subset by vertex index (meshes number neighbouring vertices closely enough).
-  const std::int64_t stride = (flagged + o.max_vertices - 1) / o.max_vertices;
-  std::vector<std::uint8_t> mask(lunate.size(), 0);
-  std::int64_t k = 0;
-  for (std::size_t i = 0; i < lunate.size(); ++i)
-    if (lunate[i] && k++ % stride == 0) mask[i] = 1;
-  lunate_ = make_scan_set(P, mask);
+  lunate_ = lunate_sample(P, lunate, c_a, o.max_vertices, joint.socket().exact.get(), o.mirror_x);
 }
 
 void JointCentre::gaps(const Joint& joint, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float* out) const {

@@ -32,6 +32,10 @@ SphereFitResult fit_sphere_algebraic(PointsRef P);
 /// from the algebraic fit. P: k x 3 points, mm, k >= 4. Throws impinge::Error on too few or
 /// coplanar points.
 SphereFitResult fit_sphere_geometric(PointsRef P);
+/// The same with a weight per point (k weights >= 0, e.g. the area each vertex stands for: the fit of a
+/// surface rather than of its vertices; GSL's weighted least squares); rms_residual is then the weighted
+/// rms. Throws impinge::Error on a weight count other than k, a negative or non-finite weight.
+SphereFitResult fit_sphere_geometric(PointsRef P, const std::vector<double>& weights);
 
 /// Options of the automatic femoral-head fit.
 struct HeadFitOptions {

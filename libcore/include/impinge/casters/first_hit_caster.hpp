@@ -51,6 +51,8 @@ class FirstHitCaster {
   void crossings(const Eigen::Vector3d& direction, std::vector<RayCrossing>& out) const;
   /// +1 when the mesh is wound outward (signed volume >= 0), -1 when crossings() flips its facings.
   int orientation() const { return orientation_; }
+  /// The rays' origin (mm, the mesh's frame).
+  const Eigen::Vector3d& origin() const;
   /// Whether the origin lies inside the solid (the majority of 13 rays' first crossings).
   bool origin_inside() const { return origin_inside_; }
   /// Triangles whose plane passes through the origin (to 1e-6 of their distance): a ray from the

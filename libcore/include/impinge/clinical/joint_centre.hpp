@@ -38,6 +38,8 @@
 
 namespace impinge {
 
+class FirstHitCaster;
+
 /// Puls et al. 2010's four methods (see the file comment).
 enum class JointCentreMethod { femoral_head, acetabular, combined, equidistant };
 
@@ -49,10 +51,28 @@ const char* to_string(JointCentreMethod method);
 
 /// Options of the equidistant method.
 struct EquidistantOptions {
-  int max_vertices = 256;      ///< lunate vertices used, at most (an even subset by index); more: slower, no better
+  /// Sets the lunate sample's lattice (lunate_sample: 8 max_vertices cells over the sphere, the lunate
+  /// surface covering some of them); more: slower, no better.
+  int max_vertices = 256;
   int max_iterations = 6;      ///< Gauss-Newton steps, at most
+  /// Bin the lunate directions with x negated (lunate_sample): a left hip in the joint frame, whose x is
+  /// medio-lateral, so that a mirrored hip is sampled at the mirrored points (HipJoint sets it by side).
+  bool mirror_x = false;
   double tolerance_mm = 5e-3;  ///< stop when a step moves t by less than this, mm
 };
+
+/// The lunate vertices the equidistant method measures the joint space at, chosen by position so that the
+/// choice depends on the surface, not on how its file numbers, duplicates or splits the vertices: their
+/// directions from the acetabular centre `c_a` (joint frame, mm) binned on a Fibonacci lattice of
+/// 8 max_vertices nodes (4.5 deg apart for 256: coarser than any bone mesh's vertices), and
+/// in each cell the vertex whose direction is nearest the cell's node (ties, such as duplicated vertices,
+/// by position); in cell order. `P`: the pelvis vertices (n x 3, joint frame, mm); `lunate`: n flags.
+/// With `surface` (the pelvis' exact ray caster) about `c_a`, each cell's point is the surface's first hit in
+/// the cell's node direction instead of the vertex: the same points however the surface is tessellated
+/// (split triangles, duplicated or renumbered vertices), but for cells at the lunate surface's border.
+/// `mirror_x`: bin with x negated (EquidistantOptions::mirror_x).
+ScanSet lunate_sample(PointsRef P, const std::vector<std::uint8_t>& lunate, const Eigen::Vector3d& c_a,
+                      int max_vertices, const FirstHitCaster* surface = nullptr, bool mirror_x = false);
 
 /// The translation of the femur at each pose by one method.
 class JointCentre {
