@@ -60,6 +60,14 @@ TEST(Motion, OpenSimDegreesRadiansSidesAndPathLabels) {
   const Motion b = load_motion(d + "/b.sto", Side::right);
   EXPECT_NEAR(b.angles[0].flexion_deg, 90, 1e-12);
   EXPECT_NEAR(b.angles[0].internal_rotation_deg, -0.5 * 180 / M_PI, 1e-12);
+  // An empty cell in a column the motion does not use leaves the row's angles where they are (a whitespace
+  // split would move flexion to adduction's value).
+  write_text(d + "/c.mot", std::string(kMotHeader) +
+                               "time\tpelvis_tilt\thip_flexion_r\thip_adduction_r\thip_rotation_r\n0\t\t30\t-5\t7\n");
+  const Motion c = load_motion(d + "/c.mot", Side::right);
+  EXPECT_EQ(c.angles[0].flexion_deg, 30);
+  EXPECT_EQ(c.angles[0].adduction_deg, -5);
+  EXPECT_EQ(c.angles[0].internal_rotation_deg, 7);
 }
 
 TEST(Motion, BadFilesAreOneLineErrorsNamingFileLineAndColumn) {
@@ -76,8 +84,12 @@ TEST(Motion, BadFilesAreOneLineErrorsNamingFileLineAndColumn) {
         ":3: column 'adduction_deg': 'abc' is not a number");
   check("nan.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,nan,2,3\n",
         ":2: column 'flexion_deg': 'nan' is not finite");
-  check("short.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,1,2\n",
-        ":2: column 'internal_rotation_deg': the row has only 3 cells");
+  check("short.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,1,2\n", ":2: the row has 3 cells, the header 4");
+  // An empty cell of a tab-separated OpenSim file is a cell, not a gap that shifts the row (issue 48).
+  check("empty_cell.mot", std::string(kMotHeader) +
+                              "time\tpelvis_tilt\thip_flexion_r\thip_adduction_r\thip_rotation_r\n0\t1\t30\t-5\t7\n"
+                              "0.5\t1\t\t-6\t8\n",
+        ":9: column 'hip_flexion_r'");
   check("back.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n1,1,2,3\n0.5,1,2,3\n",
         ":3: column 'time_s': time decreases");
   check("empty.csv", "", "empty motion file");

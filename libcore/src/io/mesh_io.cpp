@@ -45,15 +45,18 @@ TriangleMesh load_mesh(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   require(in.good(), path + ": cannot open file for reading");
   const std::string ext = lower_extension(path);
-  if (ext == ".ply" || ext == ".off") {
+  if (ext == ".ply" || ext == ".off" || ext == ".obj") {  // our readers: the file's vertex order
     std::ostringstream bytes;
     bytes << in.rdbuf();
-    return checked(ext == ".ply" ? detail::read_ply(path, bytes.str()) : detail::read_off(path, bytes.str()), path);
+    const std::string b = bytes.str();
+    return checked(ext == ".ply" ? detail::read_ply(path, b) : ext == ".off" ? detail::read_off(path, b)
+                                                                             : detail::read_obj(path, b),
+                   path);
   }
   in.close();  // assimp opens the file itself
   unsigned flags = 0;
   Assimp::Importer importer;
-  if (ext == ".stl" || ext == ".obj") {
+  if (ext == ".stl") {
     // Weld corners by position only: drop the per-face normals and texture coordinates that
     // would otherwise keep identical positions apart.
     importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TEXCOORDS |

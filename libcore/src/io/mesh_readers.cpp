@@ -436,4 +436,61 @@ TriangleMesh read_off(const std::string& path, const std::string& bytes) {
   return mesh;
 }
 
+// ---------------------------------------------------------------------------------------------
+// OBJ (Wavefront): "v x y z [w]" and "f i j k" lines (i, i/t, i//n, i/t/n; negative indices count back from
+// the last vertex read), every other line ignored. Vertices in the file's order, as PLY and OFF give them.
+
+TriangleMesh read_obj(const std::string& path, const std::string& bytes) {
+  std::istringstream in(bytes);
+  std::string raw;
+  std::size_t line_no = 0;
+  auto fail = [&](const std::string& message) {
+    throw Error(path + ": cannot parse OBJ: line " + std::to_string(line_no) + ": " + message);
+  };
+  std::vector<double> v;
+  std::vector<int> f;
+  while (std::getline(in, raw)) {
+    ++line_no;
+    const std::size_t hash = raw.find('#');
+    const std::vector<std::string> t = tokens(hash == std::string::npos ? raw : raw.substr(0, hash));
+    if (t.empty()) continue;
+    if (t[0] == "v") {
+      if (t.size() < 4) fail("a vertex needs x y z");
+      for (int c = 1; c <= 3; ++c) {
+        double x = 0;
+        if (!parse_real(t[static_cast<std::size_t>(c)], x)) fail("'" + t[static_cast<std::size_t>(c)] + "' is not a number");
+        v.push_back(x);
+      }
+      require(v.size() / 3 <= static_cast<std::size_t>(INT_MAX), [&] { return path + ": more vertices than 2^31 - 1"; });
+    } else if (t[0] == "f") {
+      const std::size_t face = f.size() / 3;
+      if (t.size() != 4) {
+        std::ostringstream os;
+        os << path << ": face " << face << " (line " << line_no << ") has " << t.size() - 1
+           << " vertices; only triangles are supported";
+        throw Error(os.str());
+      }
+      const long long nv = static_cast<long long>(v.size() / 3);
+      for (std::size_t c = 1; c <= 3; ++c) {
+        const std::string index = t[c].substr(0, t[c].find('/'));
+        long long i = 0;
+        if (!parse_integer(index, -nv, nv, i) || i == 0) {
+          std::ostringstream os;
+          os << path << ": face " << face << " (line " << line_no << ") has vertex index '" << index << "' outside [1, "
+             << nv << "] (or -" << nv << "..-1)";
+          throw Error(os.str());
+        }
+        f.push_back(static_cast<int>(i > 0 ? i - 1 : nv + i));
+      }
+    }
+  }
+  TriangleMesh mesh;
+  mesh.source = path;
+  mesh.V.resize(static_cast<Eigen::Index>(v.size() / 3), 3);
+  for (std::size_t k = 0; k < v.size(); ++k) mesh.V(static_cast<Eigen::Index>(k / 3), static_cast<Eigen::Index>(k % 3)) = v[k];
+  mesh.F.resize(static_cast<Eigen::Index>(f.size() / 3), 3);
+  for (std::size_t k = 0; k < f.size(); ++k) mesh.F(static_cast<Eigen::Index>(k / 3), static_cast<Eigen::Index>(k % 3)) = f[k];
+  return mesh;
+}
+
 }  // namespace impinge::detail

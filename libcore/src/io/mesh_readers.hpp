@@ -24,5 +24,8 @@ TriangleMesh read_ply(const std::string& path, const std::string& bytes);
 /// lines `n i_1 .. i_n [colour]`; `#` comments). Faces must be triangles. Throws impinge::Error naming
 /// `path` and the line on any malformed or missing value.
 TriangleMesh read_off(const std::string& path, const std::string& bytes);
+/// Wavefront OBJ (v and f lines; f's i, i/t, i//n, i/t/n and negative indices) from its bytes, vertices in the
+/// file's order. Throws impinge::Error naming `path`, the line and the face or value.
+TriangleMesh read_obj(const std::string& path, const std::string& bytes);
 
 }  // namespace impinge::detail

@@ -27,6 +27,14 @@ std::vector<std::string> split(const std::string& line, bool csv) {
     std::string item;
     while (std::getline(ss, item, ',')) out.push_back(trim(item));
     if (!line.empty() && line.back() == ',') out.emplace_back();
+  } else if (line.find('\t') != std::string::npos) {
+    // OpenSim writes tabs: every tab separates two cells, so an empty cell stays a cell (collapsing the
+    // white space would shift the row's values one column left).
+    std::stringstream ss(line);
+    std::string item;
+    while (std::getline(ss, item, '\t')) out.push_back(trim(item));
+    if (line.back() == '\t') out.emplace_back();
+    while (!out.empty() && out.back().empty()) out.pop_back();  // trailing tabs: no cells
   } else {
     std::stringstream ss(line);
     std::string item;
@@ -119,6 +127,11 @@ Motion load_motion(const std::string& path, Side side) {
     ++line_no;
     if (trim(line).empty()) continue;
     const std::vector<std::string> cells = split(line, !opensim);
+    require(cells.size() == labels.size(), [&] {
+      return path + ":" + std::to_string(line_no) + ": the row has " + std::to_string(cells.size()) +
+             " cells, the header " + std::to_string(labels.size()) + ": a missing or extra value would shift the "
+             "columns";
+    });
     double v[4];
     for (int k = 0; k < 4; ++k) {
       const std::string where = path + ":" + std::to_string(line_no) + ": column '" + labels[col[k]] + "'";
