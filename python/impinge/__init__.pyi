@@ -90,7 +90,7 @@ class Joint:
                  max_radius_mm: float = 0.0, sparse: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
                  layers: int = 4, layered_spacing: float = 0.5, extra_articular_radius_mm: float = 150.0,
                  distances: bool = True, levels_on: Optional[str] = None, distance_reach_mm: float = 0.0,
-                 maps_only: bool = False, maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
+                 max_memory_gb: float = 0.0, maps_only: bool = False, maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
                  pelvis_frame: str = 'isb', joint_centre: Optional[str] = None, femur_frame: str = "epicondyles") -> None:
         """Every keyword is a row of impinge.options() (the session layer's option table, shared with the CLI
         and study files), its default the clinical preset's; preset='thesis' starts from the thesis' set-up.

@@ -1,5 +1,7 @@
 #include "impinge/detection/impingement_levels.hpp"
 
+#include <sstream>
+
 #include <algorithm>
 #include <cmath>
 
@@ -20,10 +22,17 @@ std::uint8_t ImpingementLevels::level(double gap_mm) const {
 void ImpingementLevels::validate() const {
   require(!thresholds_mm.empty() && thresholds_mm.size() < 250, "impingement levels: need 1 to 249 thresholds");
   for (std::size_t i = 0; i < thresholds_mm.size(); ++i) {
-    require(std::isfinite(thresholds_mm[i]), "impingement levels: threshold " + std::to_string(i) + " is not finite");
+    require(std::isfinite(thresholds_mm[i]), [&] {
+      return "impingement levels: threshold " + std::to_string(i + 1) + " (" + std::to_string(thresholds_mm[i]) +
+             " mm) is not finite";
+    });
     if (i > 0)
-      require(thresholds_mm[i] < thresholds_mm[i - 1],
-              "impingement levels: threshold " + std::to_string(i) + " is not below the one before");
+      require(thresholds_mm[i] < thresholds_mm[i - 1], [&] {
+        std::ostringstream o;
+        o << "impingement levels: threshold " << i + 1 << " (" << thresholds_mm[i] << " mm) is not below threshold "
+          << i << " (" << thresholds_mm[i - 1] << " mm): the thresholds must decrease, e.g. 4,2.667,1.333,0";
+        return o.str();
+      });
   }
 }
 

@@ -78,6 +78,12 @@ double resolution_for_spacing(const std::string& name, double spacing_deg) {
   const Entry& e = entry(name);
   require(std::isfinite(spacing_deg) && spacing_deg > 0 && spacing_deg <= 90,
           "sampling scheme '" + name + "': node spacing " + std::to_string(spacing_deg) + " deg outside (0, 90]");
+  // The finest spacing searched: 0.01 deg is 6.5e8 nodes (2.6 GB) per equiangular map; below 0.0055 deg no
+  // equiangular grid fits a map's 2^31 - 1 nodes, and the search for one would not end.
+  require(spacing_deg >= 0.01, [&] {
+    return "sampling scheme '" + name + "': node spacing " + std::to_string(spacing_deg) +
+           " deg is finer than the finest searched, 0.01 deg (6.5e8 nodes, 2.6 GB per map)";
+  });
   const double target = spacing_deg * kDegToRad * (1 + 1e-12);
   auto spacing = [&](double r) { return e.make(r)->max_node_spacing(); };
   if (e.kind == Resolution::degrees_dividing_180) {

@@ -124,16 +124,16 @@ void add_map_rows(Rows& t) {
   const double inf = std::numeric_limits<double>::infinity();
   t.text("scheme", "scheme", OptionType::choice, kSetting, registered_schemes(), scheme_help(),
          [](auto& o) -> auto& { return o.session.maps.scheme; });
-  t.number("resolution", "resolution", "", kSetting, 0, 1e6,
+  t.number("resolution", "resolution", "", kSetting, 0, 2147483647,
            "Resolution of the scheme (its own unit, listed with --scheme); 0: the scheme's equivalent of 0.5 deg "
            "node spacing",
            [](auto& o) -> auto& { return o.session.maps.resolution; });
   t.number("precision", "precision", "deg", kSetting, 0, 180,
            "Alias of --resolution for equiangular grids: precision p in degrees (0: not given)",
            [](auto& o) -> auto& { return o.session.maps.precision; });
-  t.number("turns", "turns", "", kSetting, 0, 1e6, "Alias of --resolution for the helix: k turns (w = k^2 nodes; 0: not given)",
+  t.number("turns", "turns", "", kSetting, 0, 2147483647, "Alias of --resolution for the helix: k turns (w = k^2 nodes; 0: not given)",
            [](auto& o) -> auto& { return o.session.maps.turns; });
-  t.number("spacing", "spacing", "deg", kSetting, 0, 180,
+  t.number("spacing", "spacing", "deg", kSetting, 0, 90,
            "Largest node spacing wanted, degrees, for any scheme: the coarsest resolution that reaches it (instead "
            "of --resolution; 0: not given)",
            [](auto& o) -> auto& { return o.session.maps.spacing; });
@@ -184,6 +184,10 @@ void add_map_rows(Rows& t) {
            "Vertices proven farther than this from the other bone get no distance (0: the largest --levels "
            "threshold)",
            [](auto& o) -> auto& { return o.session.maps.distance_reach_mm; });
+  t.number("max-memory", "max_memory_gb", "GB", kSetting, 0, 1e6,
+           "The most memory the maps may take; a resolution whose maps need more is refused before anything is "
+           "allocated (0: three quarters of this machine's memory)",
+           [](auto& o) -> auto& { return o.session.maps.max_memory_gb; });
   t.flag("maps-only", "maps_only", OptionType::flag, kSetting,
          "No exact look-ups at depth discontinuities: the maps answer alone (the thesis' algorithm)",
          [](auto& o) -> auto& { return o.session.maps.maps_only; });

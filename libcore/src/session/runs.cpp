@@ -153,6 +153,11 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
 }
 
 RomRun run_rom(const Session& s, const RomRequest& q) {
+  // Only the articular zones tell the joint surfaces apart; without them (scan neutral) 'articular' would
+  // count every vertex under its name.
+  require(q.search.contacts != RomContacts::articular || s.hip().articular(),
+          "contacts articular: needs anatomical neutral (the lunate surface and the head's joint surface); with "
+          "scan neutral every vertex counts (contacts all)");
   RomRun run;
   run.search = q.search;
   const HipJoint& hip = s.hip();
@@ -255,7 +260,9 @@ nlohmann::json rom_record(const RomRun& run) {
   j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
   j["neutral_min_gap_mm"] = number_or_null(run.baseline.min_gap_mm);
   j["excluded_vertices"] = run.baseline.excluded_vertices;
-  j["contacts_counted"] = o.contacts == RomContacts::impingement ? "impingement (the joint surfaces left out)"
+  j["contacts_counted"] = run.baseline.articular_vertices == 0 && o.contacts != RomContacts::all
+                              ? "all (no articular zones: scan neutral)"
+                          : o.contacts == RomContacts::impingement ? "impingement (the joint surfaces left out)"
                           : o.contacts == RomContacts::articular ? "articular (the joint surfaces only)"
                                                                  : "all";
   j["articular_vertices_left_out"] = run.baseline.articular_vertices;

@@ -1,5 +1,7 @@
 #include "impinge/session/session.hpp"
 
+#include <unistd.h>
+
 #include <cmath>
 #include <exception>
 #include <future>
@@ -109,6 +111,16 @@ LoadedInput load_input(const SessionInput& input) {
   for (const auto& [name, p] : input.landmarks) {
     require(p.allFinite(), "landmark " + name + ": not three finite numbers");
     landmarks[name] = p;
+  }
+  // Units: a femur or pelvis (or a part of one holding the joint) spans tens to hundreds of millimetres.
+  for (const auto& [mesh, source] : {std::pair{&in.femur, &in.femur_source}, std::pair{&in.pelvis, &in.pelvis_source}}) {
+    const double span = (mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff()).norm();
+    require(span >= 20 && span <= 3000, [&, span = span, source = source] {
+      return *source + ": the bone spans " + num(span) + " (its bounding box's diagonal) in the file's units; a femur or "
+             "pelvis in millimetres spans about 50 to 1,000: " +
+             (span < 20 ? std::string("metres (scale by 1000) or inches (by 25.4)?") : std::string("micrometres?")) +
+             " impinge reads millimetres";
+    });
   }
   in.to_working = to_working_frame(in.frame);
   transform_vertices(in.femur.V, in.to_working);
@@ -233,10 +245,39 @@ HipJointOptions hip_joint_options(const MapSettings& m, const FrameSettings& f, 
   return o;
 }
 
+double map_memory_bytes(const SamplingScheme& scheme) { return 2.0 * 5.0 * double(scheme.num_nodes()); }
+
+namespace {
+// Refuse maps that would not fit: before anything is allocated (a map at 0.005 deg met the kernel's OOM killer).
+void check_map_memory(const MapSettings& m, const SamplingScheme& scheme) {
+  require(std::isfinite(m.max_memory_gb) && m.max_memory_gb >= 0,
+          "max-memory " + num(m.max_memory_gb) + ": must be >= 0 GB (0: three quarters of this machine's)");
+  const double machine = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE));
+  const double limit = m.max_memory_gb > 0 ? m.max_memory_gb * 1e9 : 0.75 * machine;
+  const double need = map_memory_bytes(scheme);
+  require(need <= limit, [&] {
+    return "the maps at " + scheme.resolution_name() + " " + num(scheme.resolution()) + " (" + scheme.name() + ", " +
+           num(double(scheme.num_nodes())) + " nodes each) need about " + num(std::round(need / 1e8) / 10) +
+           " GB, more than " + (m.max_memory_gb > 0 ? "--max-memory " : "three quarters of this machine's ") +
+           num(std::round(limit / 1e8) / 10) + " GB: coarsen the resolution or raise --max-memory";
+  });
+}
+}  // namespace
+
 Session::Session(const SessionOptions& options) : options_(options) {
   // The cheap options are checked before anything is read or built.
   hip_options_ = hip_joint_options(options.maps, options.frames);
+  check_map_memory(options.maps, *hip_options_.joint.scheme);
   LoadedInput in = load_input(options.input);
+  // The naive ray cast tests every triangle for every node: refuse what would run for minutes.
+  if (hip_options_.joint.sampling == SamplingMethod::ray_cast) {
+    const double tests = double(hip_options_.joint.scheme->num_nodes()) * double(in.femur.F.rows() + in.pelvis.F.rows());
+    require(tests <= 5e9, [&] {
+      return "sampling ray-cast: " + num(double(hip_options_.joint.scheme->num_nodes())) + " nodes x " +
+             num(double(in.femur.F.rows() + in.pelvis.F.rows())) + " triangles = " + num(tests) +
+             " ray-triangle tests (minutes; at most 5e9): use ray-cast-bvh, the same exact node values through a BVH";
+    });
+  }
   if (options.frames.neutral.empty() && !in.neutral.empty())
     hip_options_.neutral = parse_neutral(in.neutral, options.input.subject + ": \"neutral\"");
   side_ = in.side;
@@ -290,6 +331,13 @@ Vertices Session::pelvis_input() const { return (hip_->pelvis_vertices() * to_wo
 
 std::pair<Eigen::Matrix3d, Eigen::Vector3d> Session::joint_motion(const Eigen::Matrix3d& R_in,
                                                                   const Eigen::Vector3d& t_in) const {
+  // The radial gaps are measured along rays from the centre of rotation: a femur moved farther than its head's
+  // radius has its head off that centre, and its gaps would read as deep penetrations of nothing.
+  const double most = std::isfinite(hip_->head_radius_mm()) ? hip_->head_radius_mm() : 25.0;
+  require(t_in.allFinite() && t_in.norm() <= most, [&] {
+    return "t: the femur translated by " + num(t_in.norm()) + " mm; the radial gaps are measured along rays from "
+           "the centre of rotation, so a translation may be at most the head radius, " + num(most) + " mm";
+  });
   // joint <- working <- input: A = joint_to_working^T, M = to_working.
   const Eigen::Matrix3d B = hip_->joint_to_working().transpose() * to_working_;
   const Eigen::Matrix3d R = B * R_in * B.transpose();

@@ -82,7 +82,14 @@ struct MapSettings {
   /// distances are on, else the radial gap.
   std::string levels_on;
   std::string ball_map_file, socket_map_file;  ///< saved maps to load instead of sampling (both or neither)
+  /// The most memory the maps may take, GB; 0: three quarters of this machine's memory. A resolution whose
+  /// maps would need more is refused before anything is allocated (map_memory_bytes).
+  double max_memory_gb = 0;
 };
+
+/// About how many bytes the two maps of `scheme` take (float node values, their marks and bound pyramids:
+/// 5 bytes a node, doubled for the two bones; the layered maps, at most 0.5 deg by default, come on top).
+double map_memory_bytes(const SamplingScheme& scheme);
 
 /// Frames and neutral (HipJointOptions).
 struct FrameSettings {
