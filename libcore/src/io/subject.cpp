@@ -37,6 +37,21 @@ SubjectInfo load_subject(const std::string& json_path) {
     require(j[key].is_string(), json_path + ": key '" + key + "' must be a string");
     return j[key].get<std::string>();
   };
+  // Every key is one impinge reads (a misspelled one would be dropped without a word); keys starting with '_'
+  // are the writer's own notes. `impinge generate` adds generated, true_cor_mm and head_radius_mm.
+  require(j.is_object(), json_path + ": expected a JSON object {\"side\": ..., \"frame\": ..., ...}");
+  static const char* const kKeys[] = {"side",     "frame",     "units",       "femur",         "pelvis",
+                                      "neutral",  "landmarks", "generated",   "true_cor_mm",   "head_radius_mm",
+                                      "name",     "source",    "citation",    "description"};
+  for (const auto& [key, value] : j.items()) {
+    bool known = !key.empty() && key[0] == '_';
+    for (const char* k : kKeys) known = known || key == k;
+    require(known, [&] {
+      std::string list;
+      for (const char* k : kKeys) list += (list.empty() ? "" : ", ") + std::string(k);
+      return json_path + ": unknown key '" + key + "' (known: " + list + "; keys starting with '_' are notes)";
+    });
+  }
   SubjectInfo s;
   const fs::path dir = fs::path(json_path).parent_path();
   s.name = fs::absolute(dir).filename().string();

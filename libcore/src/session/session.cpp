@@ -109,6 +109,11 @@ LoadedInput load_input(const SessionInput& input) {
   if (femur_error) std::rethrow_exception(femur_error);
   pelvis.get();
   for (const auto& [name, p] : input.landmarks) {
+    bool known = name == "hip_centre";
+    std::string names = "hip_centre";
+    for (const char* n : kPelvisLandmarkNames) known = known || name == n, names += std::string(", ") + n;
+    for (const char* n : kFemurLandmarkNames) known = known || name == n, names += std::string(", ") + n;
+    require(known, [&] { return "landmarks: unknown name '" + name + "' (known: " + names + ")"; });
     require(p.allFinite(), "landmark " + name + ": not three finite numbers");
     landmarks[name] = p;
   }
