@@ -1,6 +1,10 @@
 #include "impinge/core/mesh.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <tuple>
+#include <vector>
 #include <sstream>
 
 #include "impinge/core/error.hpp"
@@ -92,6 +96,74 @@ TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>& 
   for (std::size_t k = 0; k < faces.size(); ++k) out.F.row(static_cast<Eigen::Index>(k)) = faces[k].transpose();
   if (kept != nullptr) *kept = std::move(used);
   return out;
+}
+
+std::int64_t orient_consistently(TriangleMesh& mesh, std::int64_t* conflicts) {
+  const Eigen::Index m = mesh.F.rows();
+  // Every directed edge (a, b) of every triangle under its undirected key, sorted so that the triangles
+  // sharing an edge stand together.
+  struct HalfEdge {
+    std::uint64_t key;
+    std::int32_t tri;
+    bool forward;  // a < b as the triangle runs
+  };
+  std::vector<HalfEdge> e;
+  e.reserve(static_cast<std::size_t>(3 * m));
+  for (Eigen::Index t = 0; t < m; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const auto a = static_cast<std::uint64_t>(mesh.F(t, k)), b = static_cast<std::uint64_t>(mesh.F(t, (k + 1) % 3));
+      e.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<std::int32_t>(t), a < b});
+    }
+  std::sort(e.begin(), e.end(), [](const HalfEdge& x, const HalfEdge& y) {
+    return std::tie(x.key, x.tri) < std::tie(y.key, y.tri);
+  });
+  // Neighbours across manifold edges: (other triangle, whether they run the edge the same way).
+  std::vector<std::vector<std::pair<std::int32_t, bool>>> next(static_cast<std::size_t>(m));
+  for (std::size_t i = 0; i < e.size();) {
+    std::size_t j = i;
+    while (j < e.size() && e[j].key == e[i].key) ++j;
+    if (j - i == 2) {
+      const bool same = e[i].forward == e[i + 1].forward;
+      next[static_cast<std::size_t>(e[i].tri)].push_back({e[i + 1].tri, same});
+      next[static_cast<std::size_t>(e[i + 1].tri)].push_back({e[i].tri, same});
+    }
+    i = j;
+  }
+  std::vector<std::int8_t> flip(static_cast<std::size_t>(m), -1);
+  std::int64_t flipped = 0, bad = 0;
+  std::vector<std::int32_t> part, queue;
+  for (Eigen::Index seed = 0; seed < m; ++seed) {
+    if (flip[static_cast<std::size_t>(seed)] >= 0) continue;
+    part.clear();
+    queue.assign(1, static_cast<std::int32_t>(seed));
+    flip[static_cast<std::size_t>(seed)] = 0;
+    while (!queue.empty()) {
+      const std::int32_t t = queue.back();
+      queue.pop_back();
+      part.push_back(t);
+      for (const auto& [n, same] : next[static_cast<std::size_t>(t)]) {
+        const std::int8_t want = static_cast<std::int8_t>(flip[static_cast<std::size_t>(t)] ^ (same ? 1 : 0));
+        if (flip[static_cast<std::size_t>(n)] < 0) {
+          flip[static_cast<std::size_t>(n)] = want;
+          queue.push_back(n);
+        } else if (flip[static_cast<std::size_t>(n)] != want && t < n) {
+          ++bad;
+        }
+      }
+    }
+    // The part's majority keeps its winding.
+    std::int64_t count = 0;
+    for (std::int32_t t : part) count += flip[static_cast<std::size_t>(t)];
+    const bool invert = 2 * count > static_cast<std::int64_t>(part.size());
+    for (std::int32_t t : part) {
+      if ((flip[static_cast<std::size_t>(t)] != 0) != invert) {
+        std::swap(mesh.F(t, 1), mesh.F(t, 2));
+        ++flipped;
+      }
+    }
+  }
+  if (conflicts != nullptr) *conflicts = bad;
+  return flipped;
 }
 
 }  // namespace impinge

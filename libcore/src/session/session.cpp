@@ -117,6 +117,19 @@ LoadedInput load_input(const SessionInput& input) {
     require(p.allFinite(), "landmark " + name + ": not three finite numbers");
     landmarks[name] = p;
   }
+  // Winding: triangles that face against their neighbours would flip the sign of the distances around them
+  // (a femur 1.15 mm from the pelvis read as 123 mm inside it): flipped to agree, and said.
+  for (const auto& [mesh, source] : {std::pair{&in.femur, &in.femur_source}, std::pair{&in.pelvis, &in.pelvis_source}}) {
+    std::int64_t conflicts = 0;
+    const std::int64_t flipped = orient_consistently(*mesh, &conflicts);
+    if (flipped > 0)
+      in.warnings.push_back(*source + ": " + std::to_string(flipped) + " of " + std::to_string(mesh->F.rows()) +
+                            " triangles were wound against their neighbours; flipped to agree with them");
+    if (conflicts > 0)
+      in.warnings.push_back(*source + ": " + std::to_string(conflicts) +
+                            " shared edges cannot be wound consistently (a non-orientable surface): distances' signs "
+                            "near them are not to be trusted");
+  }
   // Units: a femur or pelvis (or a part of one holding the joint) spans tens to hundreds of millimetres.
   for (const auto& [mesh, source] : {std::pair{&in.femur, &in.femur_source}, std::pair{&in.pelvis, &in.pelvis_source}}) {
     const double span = (mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff()).norm();
@@ -274,6 +287,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
   hip_options_ = hip_joint_options(options.maps, options.frames);
   check_map_memory(options.maps, *hip_options_.joint.scheme);
   LoadedInput in = load_input(options.input);
+  const std::vector<std::string> load_warnings = in.warnings;
   // The naive ray cast tests every triangle for every node: refuse what would run for minutes.
   if (hip_options_.joint.sampling == SamplingMethod::ray_cast) {
     const double tests = double(hip_options_.joint.scheme->num_nodes()) * double(in.femur.F.rows() + in.pelvis.F.rows());
@@ -315,7 +329,8 @@ Session::Session(const SessionOptions& options) : options_(options) {
                 " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan "
                 "uses the scan pose instead]");
   }
-  warnings_ = hip_->warnings();
+  warnings_ = load_warnings;
+  for (const std::string& w : hip_->warnings()) warnings_.push_back(w);
   // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).
   const FemurPose scan_pose = hip_->scan_pose();
   const PoseResult scan = joint().detect(scan_pose.R, scan_pose.t);

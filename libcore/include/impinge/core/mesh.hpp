@@ -46,6 +46,14 @@ int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2 = 1e-12);
 TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>& keep_vertex,
                      std::vector<Eigen::Index>* kept = nullptr);
 
+/// Make the triangles' winding consistent across the edges they share: within each edge-connected part
+/// (across edges of exactly two triangles), the triangles wound against the majority of their part are
+/// flipped (two corners swapped), so a file whose triangles face in and out at random reads as one surface
+/// (the signed distance's sign comes from the winding). Vertices and the triangles' order are kept. Returns
+/// the number of triangles flipped (0 for a consistent mesh); `conflicts` (optional) receives the number of
+/// shared edges no flip can make consistent (a non-orientable part such as a Moebius strip). O(m log m).
+std::int64_t orient_consistently(TriangleMesh& mesh, std::int64_t* conflicts = nullptr);
+
 /// Per-vertex area (mm^2): one third of the area of every incident triangle (barycentric dual
 /// area), so the sum over vertices equals the surface area. Returns n values. Validates the mesh
 /// first (impinge::Error on a bad index or coordinate).

@@ -121,6 +121,8 @@ struct LoadedInput {
   Landmarks landmarks;     ///< working frame, mm
   std::string neutral;     ///< the subject's "neutral" (empty when none)
   std::string name;        ///< the subject's folder name (empty without a subject)
+  /// What was repaired on reading (triangles wound against their neighbours, flipped), one line each.
+  std::vector<std::string> warnings;
 };
 
 /// The side of `input` without reading its meshes (subject.json's, or `side`, else right), to
