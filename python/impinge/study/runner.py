@@ -9,6 +9,7 @@ import csv
 import json
 import os
 import shutil
+import socket
 import sys
 import time
 
@@ -109,8 +110,16 @@ def _dask_client(workers, scheduler, threads):
         client.wait_for_workers(1, timeout=120)
         return client, None
     if scheduler:
-        client = Client(scheduler, timeout="30s")
-        client.wait_for_workers(1, timeout=120)
+        try:
+            client = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError) as e:  # one line, not Dask's traceback
+            raise spec.StudyError(f"--scheduler {scheduler}: cannot reach a Dask scheduler there within 10 s "
+                                  f"({type(e).__name__}: {str(e).splitlines()[0] if str(e) else 'no answer'})") from None
+        try:
+            client.wait_for_workers(1, timeout=120)
+        except (OSError, TimeoutError):
+            client.close()
+            raise spec.StudyError(f"--scheduler {scheduler}: no worker joined within 120 s") from None
         return client, None
     # Workers are new processes: they find the package where this one did, with `threads` OpenMP threads each.
     path = os.environ.get("PYTHONPATH", "")
@@ -142,6 +151,59 @@ def run(study_path, out, workers=None, scheduler=None, shard=None, retry_errors=
     task_list = spec.expand(study)
     tasks_dir = os.path.join(out, "tasks")
     os.makedirs(tasks_dir, exist_ok=True)
+    with _OutLock(out):
+        return _run_locked(study, task_list, out, tasks_dir, workers, scheduler, shard, retry_errors, progress, log,
+                           on_start, overrides)
+
+
+class _OutLock:
+    """out/.lock, held while a runner writes into `out`: a second runner on the same folder refuses with the first
+    one's host and pid (it would delete the first's half-written task folders). A lock whose process is gone (same
+    host) is taken over."""
+
+    def __init__(self, out):
+        self.path = os.path.join(out, ".lock")
+
+    def __enter__(self):
+        me = f"{socket.gethostname()} {os.getpid()}"
+        for _ in range(2):
+            try:
+                fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+            except FileExistsError:
+                try:
+                    with open(self.path) as f:
+                        host, pid = f.read().split()
+                except (OSError, ValueError):
+                    host, pid = "", "0"
+                alive = host != socket.gethostname()  # another host's runner: assume it runs
+                if not alive:
+                    try:
+                        os.kill(int(pid), 0)
+                        alive = True
+                    except (ProcessLookupError, ValueError):
+                        alive = False
+                    except PermissionError:
+                        alive = True
+                if alive:
+                    raise spec.StudyError(f"{os.path.dirname(self.path)}: another runner ({host}, pid {pid}) is "
+                                          f"writing here; wait for it, or remove {self.path} if it is gone") from None
+                os.unlink(self.path)  # its runner died: take the folder over
+                continue
+            with os.fdopen(fd, "w") as f:
+                f.write(me + "\n")
+            return self
+        raise spec.StudyError(f"{self.path}: cannot take the lock")
+
+    def __exit__(self, *exc):
+        try:
+            os.unlink(self.path)
+        except OSError:
+            pass
+        return False
+
+
+def _run_locked(study, task_list, out, tasks_dir, workers, scheduler, shard, retry_errors, progress, log, on_start,
+                overrides):
     os.makedirs(os.path.join(out, "shards"), exist_ok=True)
     _write_atomic(os.path.join(out, "study.json"), json.dumps(
         {"name": study["name"], "study_file": study["path"], "version": impinge.__version__, "seed": study["seed"],

@@ -5,6 +5,7 @@ A task writes its outputs into DIR/tasks/.tmp-<id>-<random>/ and renames that fo
 when it is complete, so a task folder either holds a whole task (task.json last) or does not exist. A task
 that raises is recorded (status "error", the message) and does not stop the others."""
 import collections
+import hashlib
 import json
 import math
 import os
@@ -194,14 +195,44 @@ def task_record(task):
     return rec
 
 
+def _file_records(folder):
+    """{name: {bytes, sha256}} of a task folder's outputs (all but task.json), to notice damage on a rerun."""
+    out = {}
+    for name in sorted(os.listdir(folder)):
+        path = os.path.join(folder, name)
+        if name == "task.json" or not os.path.isfile(path):
+            continue
+        h = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+        out[name] = {"bytes": os.path.getsize(path), "sha256": h.hexdigest()}
+    return out
+
+
 def read_done(tasks_dir, task):
-    """The record of a finished task (its task.json), or None when it has not finished."""
-    path = os.path.join(tasks_dir, task["id"], "task.json")
-    try:
-        with open(path) as f:
-            return json.load(f)
-    except (OSError, ValueError):
+    """The record of a finished task (its task.json), or None when it has not finished. A task folder whose
+    task.json is unreadable, or whose outputs differ from the sizes and checksums task.json recorded (a file
+    truncated, emptied or deleted since), is damaged: it is moved aside (tasks/.damaged-<id>-<random>) and the
+    task counts as not finished, so that the run does it again."""
+    folder = os.path.join(tasks_dir, task["id"])
+    if not os.path.isdir(folder):
         return None
+    try:
+        with open(os.path.join(folder, "task.json")) as f:
+            record = json.load(f)
+        files = record["files"]
+        damaged = _file_records(folder) != files
+    except (OSError, ValueError, KeyError, TypeError):
+        damaged = True
+    if damaged:
+        aside = os.path.join(tasks_dir, f".damaged-{task['id']}-{uuid.uuid4().hex[:8]}")
+        try:
+            os.rename(folder, aside)
+        except OSError:
+            pass  # moved aside or redone by another worker meanwhile
+        return None
+    return record
 
 
 def run_task(task, tasks_dir):
@@ -229,6 +260,7 @@ def run_task(task, tasks_dir):
     record["time_s"] = time.perf_counter() - t0
     record["joint_build_s"] = built
     record["task"] = task
+    record["files"] = _file_records(folder)
     with open(os.path.join(folder, "task.json"), "w") as f:
         json.dump(record, f, indent=1, default=float)
     target = os.path.join(tasks_dir, task["id"])
