@@ -298,6 +298,10 @@ int main(int argc, char** argv) {
   try {
     for (const Command& c : commands)
       if (*c.app) return c.run(given_options(c.app, c.use, values));
+  } catch (const std::bad_alloc&) {
+    std::cerr << "impinge: error: out of memory: the meshes or maps do not fit in this machine's memory; try a "
+                 "coarser --resolution, fewer --layers or a larger --layered-spacing\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "impinge: error: " << e.what() << "\n";
     return 2;

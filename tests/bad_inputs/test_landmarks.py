@@ -62,3 +62,22 @@ def test_a_misspelled_landmark_keyword_in_python_is_named():
     impinge = pytest.importorskip("impinge")
     with pytest.raises(impinge.Error, match="landmarks: unknown name 'asis_rigth'"):
         impinge.Joint(subject=SUBJECT, landmarks={"asis_rigth": [0, 0, 0]})
+
+
+@pytest.mark.parametrize("args,fragments", [
+    (["--side", "left"], ["side left: the femoral head lies", "to the right of the pelvis' centre", "--side"]),
+    (["--frame", "RAS"], ["side right: the femoral head lies", "read as RAS", "(--frame) is wrong"]),
+    (["--cor", "1e300,0,0", "--allow-any-cor"], ["outside the femur's bounding box"]),
+])
+def test_a_wrong_side_frame_or_centre_is_named(tmp_path, args, fragments):
+    base = os.path.dirname(SUBJECT)
+    r = run(["distance", "--ball", os.path.join(base, "femur_r.ply"), "--socket", os.path.join(base, "pelvis.ply"),
+             "--precision", "2", "--out", tmp_path / "o"] + (["--frame", "LPS"] if "--frame" not in args else [])
+            + args)
+    one_line_error(r, *fragments)
+
+
+def test_the_same_mesh_twice_is_named(tmp_path):
+    femur = os.path.join(os.path.dirname(SUBJECT), "femur_r.ply")
+    r = run(["distance", "--ball", femur, "--socket", femur, "--frame", "LPS", "--out", tmp_path / "o"])
+    one_line_error(r, "ball and socket are the same file")

@@ -122,9 +122,12 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   const RadialDistanceMap& bm = joint_->ball().map;
   // (Counted when the map was filled: a sparse map with a finite region reads "no surface" beyond it.)
   const double uncovered = 1.0 - double(joint_->ball().sampling.nodes_covered) / double(bm.num_nodes());
+  const Eigen::Vector3d reported_cor = options.to_report * cor_;
   if (uncovered > 1e-4 && !options.allow_cor_outside_ball)
-    throw Error(joint_->ball().mesh.source + ": the centre of rotation (" + std::to_string(cor_.x()) + ", " +
-                std::to_string(cor_.y()) + ", " + std::to_string(cor_.z()) + ") mm is outside the femur mesh (" +
+    throw Error(joint_->ball().mesh.source + ": the centre of rotation (" + std::to_string(reported_cor.x()) + ", " +
+                std::to_string(reported_cor.y()) + ", " + std::to_string(reported_cor.z()) + ") mm" +
+                (options.report_frame_name.empty() ? "" : " (" + options.report_frame_name + ")") +
+                " is outside the femur mesh (" +
                 std::to_string(100 * uncovered) + " % of the directions from it meet no femur surface): a COR "
                 "in the wrong frame or units? allow_cor_outside_ball (CLI: --allow-any-cor) accepts it");
 }

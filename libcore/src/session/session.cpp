@@ -88,6 +88,8 @@ LoadedInput load_input(const SessionInput& input) {
     in.frame = f;
   }
   require(input.ball_mesh || !ball.empty(), "no femur: give ball (a mesh file or mesh) or subject");
+  require(input.ball_mesh || input.socket_mesh || ball.empty() || ball != socket,
+          "ball and socket are the same file (" + ball + "): give the femur and the pelvis");
   require(input.socket_mesh || !socket.empty(), "no pelvis: give socket (a mesh file or mesh) or subject");
   require(!(input.ball_mesh && !input.ball.empty()), "give ball as a file or a mesh, not both");
   require(!(input.socket_mesh && !input.socket.empty()), "give socket as a file or a mesh, not both");
@@ -108,6 +110,9 @@ LoadedInput load_input(const SessionInput& input) {
   pelvis.wait();
   if (femur_error) std::rethrow_exception(femur_error);
   pelvis.get();
+  require(!(in.femur.V.rows() == in.pelvis.V.rows() && in.femur.F.rows() == in.pelvis.F.rows() &&
+            in.femur.V.isApprox(in.pelvis.V, 1e-12)),
+          in.femur_source + " and " + in.pelvis_source + ": the femur and the pelvis are the same mesh");
   for (const auto& [name, p] : input.landmarks) {
     bool known = name == "hip_centre";
     std::string names = "hip_centre";
@@ -169,6 +174,13 @@ CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) 
     r.head.centre = M * *cor.given;
     r.head.radius = r.head.rms_residual = std::nan("");
     r.method = "given";
+    // Even a research COR (allow_any) lies at the femur: far from it, every ray misses the head.
+    const Eigen::Vector3d lo = in.femur.V.colwise().minCoeff().transpose(), hi = in.femur.V.colwise().maxCoeff().transpose();
+    const double outside = (r.head.centre.cwiseMax(lo).cwiseMin(hi) - r.head.centre).norm();
+    require(outside <= 50, [&] {
+      return "cor " + point_text(*cor.given) + " mm lies " + num(outside) + " mm outside the femur's bounding box " +
+             "(input frame, mm): a COR in another frame or unit?";
+    });
     if (!cor.allow_any) {
       // A given COR must lie in the femoral head: compare with the head the bone itself shows.
       const SphereFitResult head = located_head(in);
@@ -282,6 +294,29 @@ void check_map_memory(const MapSettings& m, const SamplingScheme& scheme) {
 }
 }  // namespace
 
+namespace {
+// The side and the input frame against the bones: on a whole pelvis (over 200 mm wide) the femoral head lies
+// 60-100 mm to its own side of the pelvis' centroid (the shared hips: 82-94 mm); a head on the other side means
+// the side or the frame (LPS read as RAS mirrors left and right) is wrong, which would give a mirrored hip's
+// numbers without a word.
+void check_side_and_frame(const LoadedInput& in, const Eigen::Vector3d& head, const SessionInput& given) {
+  if (in.pelvis.V.rows() == 0) return;
+  const double width = in.pelvis.V.col(0).maxCoeff() - in.pelvis.V.col(0).minCoeff();
+  const double lateral = head.x() - in.pelvis.V.col(0).mean();  // working frame: +x right
+  if (width < 200 || std::abs(lateral) < 30) return;
+  const bool right = in.side == Side::right;
+  require(right == (lateral > 0), [&] {
+    const char* frame = in.frame == FrameConvention::LPS ? "LPS" : "RAS";
+    return std::string("side ") + (right ? "right" : "left") + ": the femoral head lies " +
+           num(std::round(std::abs(lateral))) + " mm to the " + (lateral > 0 ? "right" : "left") +
+           " of the pelvis' centre when the meshes are read as " + frame + ": the side (" +
+           (given.side.empty() ? (given.subject.empty() ? "the default right" : "the subject's") : "--side") + ") or the frame (" +
+           (given.frame.empty() ? (given.subject.empty() ? "the default RAS" : "the subject's") : "--frame") +
+           ") is wrong";
+  });
+}
+}  // namespace
+
 Session::Session(const SessionOptions& options) : options_(options) {
   // The cheap options are checked before anything is read or built.
   hip_options_ = hip_joint_options(options.maps, options.frames);
@@ -306,11 +341,14 @@ Session::Session(const SessionOptions& options) : options_(options) {
   socket_source_ = in.pelvis_source;
   subject_name_ = in.name;
   cor_ = find_centre_of_rotation(in, options.cor);
+  check_side_and_frame(in, cor_.head.centre, options.input);
   hip_options_.allow_cor_outside_ball = options.cor.allow_any;
   // A COR the user gave (--cor, cor=) is the femoral head centre the radial gaps are measured about at the
   // scan pose, whatever the joint-centre method: the maps stay about it, and the combined and equidistant
   // methods move the femur by the seat at every pose instead of sampling the seated femur.
   hip_options_.seat_before_sampling = !options.cor.given;
+  hip_options_.to_report = in.to_working.transpose();
+  hip_options_.report_frame_name = std::string("input frame, ") + (in.frame == FrameConvention::LPS ? "LPS" : "RAS");
   // A given COR (or the subject's hip_centre landmark): the zones, the acetabulum and the seat still
   // come from the head the femur shows, so that they do not move with the COR.
   if (!std::isfinite(cor_.head.radius) && hip_options_.neutral == Neutral::anatomical) {

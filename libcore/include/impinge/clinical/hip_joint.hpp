@@ -52,6 +52,9 @@ struct HipJointOptions {
   /// about the given head centre `head.centre` and move the femur by the seat at every pose instead
   /// (false: a COR the user gave, about which the radial gaps at the scan pose are then measured).
   bool seat_before_sampling = true;
+  /// The frame errors give positions in: working frame -> it (3 x 3; Session: the input frame), and its name.
+  Eigen::Matrix3d to_report = Eigen::Matrix3d::Identity();
+  std::string report_frame_name;
 };
 
 /// Femur (ball) and pelvis (socket) of one hip about the centre of rotation, posed by clinical
