@@ -126,7 +126,8 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
     std::vector<std::uint8_t> hidden(b.mask.size(), 0);
     for (std::size_t i = 0; i < hidden.size(); ++i) {
       const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
-      hidden[i] = !b.mask[i] && r > 0 && r <= options.extra_articular_radius_mm;
+      // max_radius_mm bounds every vertex tested, the hidden ones too.
+      hidden[i] = !b.mask[i] && r > 0 && r <= std::min(options.extra_articular_radius_mm, options.max_radius_mm);
     }
     // In boxes of 32 (order_in_boxes), each run of the clusters below compact in space.
     b.hidden_set = order_in_boxes(make_scan_set(b.relative, hidden), {32});

@@ -33,7 +33,7 @@ struct JointOptions {
   double occlusion_tolerance_mm = 1.0;                             ///< a vertex farther than its own map's surface
                                                                    ///< plus this is hidden (not on the first surface)
   double max_radius_mm = std::numeric_limits<double>::infinity();  ///< region of interest about
-                                                                   ///< the COR, mm
+                                                                   ///< the COR, mm: no vertex farther is tested (hidden ones neither)
   ImpingementLevels levels;                                        ///< gap classes
   /// Exact look-ups at depth discontinuities: mark each map's nodes where its
   /// interpolation may be off by more than discontinuity_tolerance_mm (mark_depth_discontinuities)
