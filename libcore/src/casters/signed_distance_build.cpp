@@ -1,0 +1,197 @@
+// SignedDistanceQuery's constructor: the kept triangles, their normals and edge twins, and the point query's
+// hierarchy (Embree's groups of detail::kGroup triangles, or CGAL's AABB tree).
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <mutex>
+#include <string>
+#include <utility>
+
+#include "casters/signed_distance_impl.hpp"
+#include "core/box_order.hpp"
+#include "impinge/core/error.hpp"
+
+namespace impinge {
+
+#ifdef IMPINGE_HAVE_EMBREE
+using detail::kBoxMarginMm;
+using detail::kGroup;
+#endif
+
+#ifdef IMPINGE_HAVE_EMBREE
+namespace {
+// The point query's groups to Embree: a group's box; no ray queries (only point queries reach them).
+void group_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto& b = static_cast<const SignedDistanceQuery::Impl*>(args->geometryUserPtr)->group_box[args->primID];
+  *args->bounds_o = RTCBounds{b[0], b[1], b[2], 0.f, b[3], b[4], b[5], 0.f};
+}
+void no_ray_queries(const RTCIntersectFunctionNArguments*) {}
+void no_ray_queries(const RTCOccludedFunctionNArguments*) {}
+}  // namespace
+#endif
+
+SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
+  validate_mesh(mesh);
+  require(available(), "signed distance: needs Embree or CGAL, and this build has neither (" + mesh.source + ")");
+  Impl& m = *impl_;
+  static std::atomic<std::uint64_t> built{0};
+  m.serial = ++built;
+  double volume = 0;
+  const auto faces = static_cast<std::size_t>(mesh.F.rows());
+  m.a.reserve(faces), m.b.reserve(faces), m.c.reserve(faces), m.face.reserve(faces), m.corner.reserve(faces);
+  m.face_normal.reserve(faces);
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose(), b = mesh.V.row(mesh.F(f, 1)).transpose(),
+                          c = mesh.V.row(mesh.F(f, 2)).transpose();
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    if (!(n.norm() > 0)) continue;
+    m.a.push_back(a), m.b.push_back(b), m.c.push_back(c), m.face.push_back(f);
+    m.corner.push_back({static_cast<std::int32_t>(mesh.F(f, 0)), static_cast<std::int32_t>(mesh.F(f, 1)),
+                        static_cast<std::int32_t>(mesh.F(f, 2))});
+    m.face_normal.push_back(n.normalized());
+    volume += a.dot(b.cross(c)) / 6;
+  }
+  require(!m.a.empty(), "signed distance: " + mesh.source + " has no triangle of nonzero area");
+  m.kept.assign(static_cast<std::size_t>(mesh.F.rows()), -1);
+  for (std::size_t t = 0; t < m.face.size(); ++t) m.kept[static_cast<std::size_t>(m.face[t])] = static_cast<std::int64_t>(t);
+  orientation_ = m.orientation = volume >= 0 ? 1 : -1;
+  const std::size_t k = m.a.size();
+  for (auto& n : m.face_normal) n *= m.orientation;
+
+  // Edges: directed (from, to) of each kept triangle's edge k (0: ab, 1: bc, 2: ca), grouped undirected:
+  // bucketed by their lower vertex (counting sort), each bucket ordered by the higher vertex, then by
+  // 3 * tri + k (the half-edges are placed in that order and the bucket sort is stable).
+  const std::size_t nv = static_cast<std::size_t>(mesh.V.rows());
+  std::vector<std::int64_t> start(nv + 1, 0);
+  auto ends = [&](std::size_t h) {
+    const std::int32_t u = m.corner[h / 3][h % 3], v = m.corner[h / 3][(h % 3 + 1) % 3];
+    return std::pair{std::min(u, v), std::max(u, v)};
+  };
+  for (std::size_t h = 0; h < 3 * k; ++h) ++start[static_cast<std::size_t>(ends(h).first) + 1];
+  for (std::size_t w = 0; w < nv; ++w) start[w + 1] += start[w];
+  std::vector<std::pair<std::int32_t, std::int64_t>> bucket(3 * k);  // (higher vertex, 3 * tri + k)
+  {
+    std::vector<std::int64_t> next(start.begin(), start.end() - 1);
+    for (std::size_t h = 0; h < 3 * k; ++h) {
+      const auto [lo, hi] = ends(h);
+      bucket[static_cast<std::size_t>(next[static_cast<std::size_t>(lo)]++)] = {hi, static_cast<std::int64_t>(h)};
+    }
+  }
+  m.edge_twin.assign(3 * k, -1);
+  m.vertex_normal.assign(nv, Eigen::Vector3d::Zero());
+  m.vertex_irregular.assign(nv, 0);
+  std::int64_t irregular = 0;
+  for (std::size_t w = 0; w < nv; ++w) {
+    const auto first = bucket.begin() + start[w], last = bucket.begin() + start[w + 1];
+    std::stable_sort(first, last, [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (auto i = first; i != last;) {
+      auto j = i;
+      while (j != last && j->first == i->first) ++j;
+      bool regular = false;
+      if (j - i == 2) {
+        const auto e0 = i->second, e1 = (i + 1)->second;
+        const auto t0 = static_cast<std::size_t>(e0 / 3), t1 = static_cast<std::size_t>(e1 / 3);
+        const std::int32_t from0 = m.corner[t0][e0 % 3], from1 = m.corner[t1][e1 % 3];
+        regular = from0 != from1;  // opposite directions: consistently wound
+        if (regular) {
+          m.edge_twin[static_cast<std::size_t>(e0)] = static_cast<std::int32_t>(t1);
+          m.edge_twin[static_cast<std::size_t>(e1)] = static_cast<std::int32_t>(t0);
+        }
+      }
+      if (!regular) {
+        ++irregular;
+        m.vertex_irregular[w] = 1;
+        m.vertex_irregular[static_cast<std::size_t>(i->first)] = 1;
+      }
+      i = j;
+    }
+  }
+  irregular_edges_ = irregular;
+  // Corners: normals weighted by the triangle's angle there.
+  for (std::size_t t = 0; t < k; ++t) {
+    const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
+    for (int e = 0; e < 3; ++e) {
+      const Eigen::Vector3d u = (*p[(e + 1) % 3] - *p[e]).normalized(), v = (*p[(e + 2) % 3] - *p[e]).normalized();
+      const double angle = std::acos(std::clamp(u.dot(v), -1.0, 1.0));
+      m.vertex_normal[static_cast<std::size_t>(m.corner[t][e])] += angle * m.face_normal[t];
+    }
+  }
+
+#ifdef IMPINGE_HAVE_EMBREE
+  for (std::size_t t = 0; t < k; ++t) m.shift += (m.a[t] + m.b[t] + m.c[t]) / 3.0;
+  m.shift /= static_cast<double>(k);
+  m.device = rtcNewDevice(nullptr);  // the build on every core; each query runs on its caller's thread
+  require(m.device != nullptr, "signed distance: rtcNewDevice failed (" + mesh.source + ")");
+  m.scene = rtcNewScene(m.device);
+  for (std::size_t t = 0; t < k; ++t)
+    for (const Eigen::Vector3d* p : {&m.a[t], &m.b[t], &m.c[t]}) m.extent = std::max(m.extent, (*p - m.shift).cwiseAbs().maxCoeff());
+  {
+    std::vector<Eigen::Vector3d> centroid(k);
+    for (std::size_t t = 0; t < k; ++t) centroid[t] = (m.a[t] + m.b[t] + m.c[t]) / 3.0;
+    // Groups compact in space: the centroids in boxes of kGroup (every group but the last full).
+    const std::vector<std::int32_t> order = detail::box_order(
+        k, {kGroup}, [&](std::int32_t t, int axis) { return centroid[static_cast<std::size_t>(t)][axis]; });
+    const std::size_t groups = (k + kGroup - 1) / kGroup;
+    m.groups.resize(groups);
+    m.group_box.resize(groups);
+    const double widen = kBoxMarginMm + 1e-6 * m.extent;  // the boxes' and rows' float rounding, and more
+    for (std::size_t g = 0; g < groups; ++g) {
+      Impl::Group& G = m.groups[g];
+      Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+      for (int l = 0; l < kGroup; ++l) {
+        const std::size_t j = g * kGroup + static_cast<std::size_t>(l);
+        if (j >= k) {  // past the kept triangles: a plane far away, never a candidate
+          for (auto& row : G.v) row[l] = 0.f;
+          G.v[3][l] = -1e18f;
+          G.triangle[l] = -1;
+          continue;
+        }
+        const auto t = static_cast<std::size_t>(order[j]);
+        G.triangle[l] = static_cast<std::int32_t>(t);
+        const std::array<Eigen::Vector3d, 3> p{m.a[t] - m.shift, m.b[t] - m.shift, m.c[t] - m.shift};
+        const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+        for (int d = 0; d < 3; ++d) G.v[d][l] = static_cast<float>(n[d]);
+        G.v[3][l] = static_cast<float>(n.dot(p[0]));
+        for (int e = 0; e < 3; ++e) {  // edge e from corner e to corner e + 1; the in-plane normal away from the third
+          const Eigen::Vector3d& u = p[static_cast<std::size_t>(e)];
+          Eigen::Vector3d w = (p[static_cast<std::size_t>((e + 1) % 3)] - u).cross(n).normalized();
+          if (w.dot(p[static_cast<std::size_t>((e + 2) % 3)] - u) > 0) w = -w;
+          for (int d = 0; d < 3; ++d) G.v[4 + 4 * e + d][l] = static_cast<float>(w[d]);
+          G.v[7 + 4 * e][l] = static_cast<float>(w.dot(u));
+        }
+        for (const Eigen::Vector3d& x : p) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+      }
+      for (int d = 0; d < 3; ++d) {
+        m.group_box[g][static_cast<std::size_t>(d)] = static_cast<float>(lo[d] - widen);
+        m.group_box[g][static_cast<std::size_t>(d) + 3] = static_cast<float>(hi[d] + widen);
+      }
+    }
+  }
+  RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(m.groups.size()));
+  rtcSetGeometryUserData(g, &m);
+  rtcSetGeometryBoundsFunction(g, group_bounds, &m);
+  rtcSetGeometryIntersectFunction(g, no_ray_queries);
+  rtcSetGeometryOccludedFunction(g, no_ray_queries);
+  rtcCommitGeometry(g);
+  rtcAttachGeometry(m.scene, g);
+  rtcReleaseGeometry(g);
+  rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_MEDIUM);
+  rtcCommitScene(m.scene);
+  require(rtcGetDeviceError(m.device) == RTC_ERROR_NONE,
+          "signed distance: building the hierarchy of " + mesh.source + " failed");
+#elif defined(IMPINGE_HAVE_CGAL)
+  for (std::size_t t = 0; t < k; ++t)
+    m.triangles.emplace_back(Impl::K::Point_3(m.a[t].x(), m.a[t].y(), m.a[t].z()),
+                             Impl::K::Point_3(m.b[t].x(), m.b[t].y(), m.b[t].z()),
+                             Impl::K::Point_3(m.c[t].x(), m.c[t].y(), m.c[t].z()));
+  m.tree.insert(m.triangles.begin(), m.triangles.end());
+  m.tree.build();
+  m.tree.accelerate_distance_queries();
+#endif
+}
+
+}  // namespace impinge
