@@ -6,7 +6,7 @@
 #include <memory>
 #include <optional>
 
-#include "clinical/rom_scanner.hpp"
+#include "clinical/rom_gap_scanner.hpp"
 #include "impinge/core/error.hpp"
 
 namespace impinge {

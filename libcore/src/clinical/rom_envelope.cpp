@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "clinical/rom_scanner.hpp"
+#include "clinical/rom_gap_scanner.hpp"
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
 
