@@ -31,6 +31,7 @@
 #include "impinge/session/session.hpp"
 
 #include "allocator.hpp"
+#include "vtk_meshes.hpp"
 
 using namespace impinge;
 namespace fs = std::filesystem;
@@ -100,8 +101,9 @@ RunOptions given_options(const CLI::App* cmd, unsigned use, const CliValues& v) 
 
 // ---- set-up and output --------------------------------------------------------------------
 
-// The session of a command, its warnings printed.
-Session open_session(const SessionOptions& options) {
+// The session of a command (VTK meshes read through VTK's Python bindings), its warnings printed.
+Session open_session(SessionOptions options) {
+  cli::read_vtk_inputs(options.input);
   Session session(options);
   for (const std::string& w : session.warnings()) std::cerr << "impinge: warning: " << w << "\n";
   return session;
@@ -114,12 +116,7 @@ void render(const std::string& out_dir) {
   const char* env = std::getenv("IMPINGE_ANALYSIS_DIR");
   const std::string script = std::string(env != nullptr ? env : IMPINGE_ANALYSIS_DIR) + "/render_hip.py";
   require(fs::exists(script), script + ": render script not found (set IMPINGE_ANALYSIS_DIR to impinge's analysis/ folder)");
-  auto quote = [](const std::string& x) {
-    std::string q = "'";
-    for (char c : x) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-  };
-  const int rc = std::system(("/usr/bin/python3 " + quote(script) + " " + quote(out_dir)).c_str());
+  const int rc = std::system(("/usr/bin/python3 " + cli::shell_quote(script) + " " + cli::shell_quote(out_dir)).c_str());
   require(rc == 0, out_dir + ": --render failed (needs /usr/bin/python3 with numpy and matplotlib; "
                              "tools/install-deps installs them)");
 }

@@ -13,6 +13,7 @@ import os as _os
 from . import _impinge
 from ._impinge import *  # noqa: F401,F403 (the extension's functions and types)
 from ._impinge import Error, __version__  # noqa: F401
+from . import vtk_meshes as _vtk_meshes
 
 VTK_SUFFIXES = (".vtp", ".vtk")
 
@@ -22,81 +23,14 @@ def is_vtk_file(path):
     return isinstance(path, (str, _os.PathLike)) and _os.fspath(path).lower().endswith(VTK_SUFFIXES)
 
 
-def _read_vtk_polydata(path):
-    """The surface of a VTK file as vtkPolyData, triangulated. Raises Error naming the file."""
-    from vtkmodules.vtkCommonCore import vtkFileOutputWindow, vtkLogger, vtkOutputWindow
-    from vtkmodules.vtkFiltersCore import vtkTriangleFilter
-    from vtkmodules.vtkFiltersGeometry import vtkGeometryFilter
-    from vtkmodules.vtkIOLegacy import vtkGenericDataObjectReader
-    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
-
-    if not _os.path.isfile(path):
-        raise Error(f"{path}: no such file")
-    import tempfile
-
-    # VTK reports a bad file on its output window, not by raising: send that to a file we read back.
-    window = vtkFileOutputWindow()
-    with tempfile.NamedTemporaryFile(suffix=".log", delete=True) as t:
-        window.SetFileName(t.name)
-        previous = vtkOutputWindow.GetInstance()
-        vtkOutputWindow.SetInstance(window)
-        verbosity = vtkLogger.GetCurrentVerbosityCutoff()
-        vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
-        try:
-            if path.lower().endswith(".vtp"):
-                reader = vtkXMLPolyDataReader()
-            else:
-                reader = vtkGenericDataObjectReader()
-            reader.SetFileName(path)
-            reader.Update()
-            data = reader.GetOutputDataObject(0)
-            surface = vtkGeometryFilter()  # unstructured grids and polydata alike to polygons
-            surface.SetInputData(data)
-            triangles = vtkTriangleFilter()  # quads and polygons to triangles (VTK's own, not ours)
-            triangles.SetInputConnection(surface.GetOutputPort())
-            triangles.PassVertsOff()
-            triangles.PassLinesOff()
-            triangles.Update()
-            out = triangles.GetOutput()
-        finally:
-            vtkOutputWindow.SetInstance(previous)
-            vtkLogger.SetStderrVerbosity(verbosity)
-        log = open(t.name, errors="replace").read()
-        complaints = [line.split("): ", 1)[-1].strip() for line in log.splitlines()
-                      if "Error" in line and not line.startswith("ERROR: In")] if "ERROR" in log else []
-    if complaints or data is None:
-        raise Error(f"{path}: VTK cannot read it" + (f" ({complaints[0]})" if complaints else ""))
-    return out
-
-
 def read_vtk_mesh(path):
-    """(V, F) of a VTK file's surface: V (n, 3) float64 in the file's units, F (m, 3) int32, 0-based; polygons
-    triangulated by VTK's vtkTriangleFilter, points kept as the file has them (unused points too).
-    `.vtp`: VTK's XML PolyData (OpenSim's bone geometry; OpenSim's files are in metres: scale them to mm);
-    `.vtk`: the legacy format (PolyData or an unstructured grid, whose surface is taken).
-    Raises Error naming the file: missing, unreadable, no triangles, or a point that is not finite."""
-    import numpy as np
-    from vtkmodules.util.numpy_support import vtk_to_numpy
+    try:
+        return _vtk_meshes.read_vtk_mesh(path)
+    except _vtk_meshes.VtkMeshError as e:
+        raise Error(str(e)) from None
 
-    path = _os.fspath(path)
-    poly = _read_vtk_polydata(path)
-    if poly.GetNumberOfPoints() == 0 or poly.GetNumberOfPolys() == 0:
-        raise Error(f"{path}: no triangles (VTK read {poly.GetNumberOfPoints()} points, "
-                    f"{poly.GetNumberOfPolys()} polygons)")
-    V = np.ascontiguousarray(vtk_to_numpy(poly.GetPoints().GetData()), dtype=np.float64)
-    bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
-    if bad.size:
-        raise Error(f"{path}: point {int(bad[0])} is not three finite numbers")
-    polys = poly.GetPolys()
-    if hasattr(polys, "GetConnectivityArray"):  # VTK >= 9: offsets and connectivity
-        offsets = vtk_to_numpy(polys.GetOffsetsArray())
-        conn = vtk_to_numpy(polys.GetConnectivityArray())
-        if not np.all(np.diff(offsets) == 3):
-            raise Error(f"{path}: a polygon VTK did not triangulate")
-        F = conn.reshape(-1, 3)
-    else:  # pragma: no cover (VTK 8's legacy cell array: n, i, j, k per cell)
-        F = vtk_to_numpy(polys.GetData()).reshape(-1, 4)[:, 1:]
-    return V, np.ascontiguousarray(F, dtype=np.int32)
+
+read_vtk_mesh.__doc__ = _vtk_meshes.read_vtk_mesh.__doc__
 
 
 def load_mesh(path, scale=1.0):

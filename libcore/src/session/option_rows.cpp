@@ -49,8 +49,10 @@ void add_input_rows(Rows& t) {
          [](auto& o) -> auto& { return o.session.input.subject; });
   for (const bool ball : {true, false}) {
     OptionRow& r = t.add(ball ? "ball" : "socket", ball ? "ball" : "socket", OptionType::mesh, "", kInput,
-                         ball ? "Ball mesh (femur): PLY, STL, OBJ or OFF, mm (Python: also VTK files or (V, F))"
-                              : "Socket mesh (pelvis): PLY, STL, OBJ or OFF, mm (Python: also VTK files or (V, F))");
+                         ball ? "Ball mesh (femur): PLY, STL, OBJ, OFF, or VTK .vtp/.vtk (through VTK's Python bindings), mm "
+                                     "(Python: also (V, F) arrays)"
+                              : "Socket mesh (pelvis): PLY, STL, OBJ, OFF, or VTK .vtp/.vtk (through VTK's Python "
+                                "bindings), mm (Python: also (V, F) arrays)");
     r.set = [ball](RunOptions& o, const OptionValue& v, const std::string& as) {
       SessionInput& in = o.session.input;
       set_mesh(o, v, as, [&](RunOptions&) -> std::string& { return ball ? in.ball : in.socket; },
