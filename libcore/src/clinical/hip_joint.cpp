@@ -33,6 +33,29 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   require(method == JointCentreMethod::femoral_head || neutral_ == Neutral::anatomical,
           std::string("hip joint: the ") + to_string(method) +
               " joint centre needs anatomical neutral (the acetabulum); scan neutral allows femoral-head only");
+  SphereFitResult sphere = head_sphere(femur, head, options);
+  if (neutral_ == Neutral::anatomical)
+    build_anatomy(femur, pelvis, sphere, given, options, method);
+  else
+    femur_axes_joint_ = scan_axes();  // scan neutral: both frames are the scan axes
+  head_centre_joint_ = joint_to_working_.transpose() * (sphere.centre + seat_ - cor_);
+  build_joint(std::move(femur), std::move(pelvis), options);
+  // The acetabular centre in the joint frame: the origin once seated.
+  if (method != JointCentreMethod::femoral_head) {
+    EquidistantOptions equidistant = options.equidistant;
+    equidistant.mirror_x = side_ == Side::left;  // the joint frame's x is medio-lateral: mirrored hips alike
+    centre_ = JointCentre(method, *joint_, joint_to_working_.transpose() * (acetabulum_->sphere.centre - cor_),
+                          articular_->pelvis, articular_->head_sphere_reach_mm, equidistant);
+  }
+  if (socket_clock_) {
+    ball_hours_ = clock_hours(joint_->ball().relative, *ball_clock_);
+    socket_hours_ = clock_hours(joint_->socket().relative, *socket_clock_);
+  }
+  check_cor_inside_femur(options);
+}
+
+SphereFitResult HipJoint::head_sphere(const TriangleMesh& femur, const SphereFitResult& head,
+                                      const HipJointOptions& options) {
   // The head sphere of the zones, the acetabulum, the clocks and the seat: the COR's own unless the
   // COR was given (then the fitted head's, so that they do not move with it).
   SphereFitResult sphere = options.head_sphere.value_or(head);
@@ -46,78 +69,75 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   else if (!(head_radius_ >= 5 && head_radius_ <= 60))
     warnings_.push_back(femur.source + ": the femoral head radius is " + std::to_string(head_radius_) +
                         " mm, outside 5-60 mm: are the meshes in millimetres?");
-  const Eigen::Matrix3d S = scan_axes();
-  if (neutral_ == Neutral::anatomical) {
-    const auto t0 = std::chrono::steady_clock::now();
-    Landmarks g = given;
-    g["hip_centre"] = cor_;
-    frames_ = find_hip_frames(femur, pelvis, side, g, options.frames);
-    acetabulum_ = find_acetabulum(pelvis, sphere.centre, head_radius_, frames_->pelvis);
-    sphere.radius = head_radius_;
-    articular_ = find_articular_zones(femur, sphere, pelvis, *acetabulum_, options.articular);
-    const ClockFace femoral = femoral_clock_face(femur, sphere.centre, head_radius_, frames_->femur);
-    if (options.seat_before_sampling &&
-        (method == JointCentreMethod::combined || method == JointCentreMethod::equidistant)) {
-      // Seated: the femur, its frame and clock move with the head onto the acetabular centre, which
-      // becomes the COR (the maps' centre: rays from the seated head centre); the methods' translations
-      // are then relative to the seated femur (combined: none; equidistant: the small deviations).
-      // Translation only: the pelvic landmarks stay, the femoral ones move with the femur, both frames
-      // keep their axes and take the new COR as origin.
-      seat_ = acetabulum_->sphere.centre - sphere.centre;
-      femur.V.rowwise() += seat_.transpose();
-      cor_ = acetabulum_->sphere.centre;
-      FemurLandmarks& fl = frames_->femur_landmarks;
-      for (Eigen::Vector3d* p : {&fl.head_centre, &fl.epicondyle_lateral, &fl.epicondyle_medial,
-                                 &fl.posterior_condyle_lateral, &fl.posterior_condyle_medial})
-        *p += seat_;
-      frames_->head.centre = cor_;
-      const double quality = frames_->femur.quality_mm;
-      frames_->pelvis = pelvis_frame(frames_->pelvis_landmarks, cor_, options.frames.pelvis);
-      frames_->femur = femur_frame(fl, side, options.frames.femur);
-      frames_->femur.quality_mm = quality;
-    }
-    frames_ms_ = ms_since(t0);
-    // Joint frame: pelvic axes arranged as the scan frame, p_joint = S P^T (p - cor).
-    joint_to_working_ = frames_->pelvis.axes * S.transpose();
-    femur_axes_joint_ = joint_to_working_.transpose() * frames_->femur.axes;
-    const Eigen::Matrix3d A = joint_to_working_.transpose();
-    socket_clock_ = acetabulum_->clock.transformed(A, -A * cor_);
-    ball_clock_ = femoral.transformed(A, A * (seat_ - cor_));
-  } else {
-    femur_axes_joint_ = S;  // scan neutral: both frames are the scan axes
-  }
+  return sphere;
+}
+
+void HipJoint::build_anatomy(TriangleMesh& femur, const TriangleMesh& pelvis, SphereFitResult& sphere,
+                             const Landmarks& given, const HipJointOptions& options, JointCentreMethod method) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Landmarks g = given;
+  g["hip_centre"] = cor_;
+  frames_ = find_hip_frames(femur, pelvis, side_, g, options.frames);
+  acetabulum_ = find_acetabulum(pelvis, sphere.centre, head_radius_, frames_->pelvis);
+  sphere.radius = head_radius_;
+  articular_ = find_articular_zones(femur, sphere, pelvis, *acetabulum_, options.articular);
+  const ClockFace femoral = femoral_clock_face(femur, sphere.centre, head_radius_, frames_->femur);
+  if (options.seat_before_sampling &&
+      (method == JointCentreMethod::combined || method == JointCentreMethod::equidistant))
+    seat_femur(femur, sphere, options);
+  frames_ms_ = ms_since(t0);
+  // Joint frame: pelvic axes arranged as the scan frame, p_joint = S P^T (p - cor).
+  joint_to_working_ = frames_->pelvis.axes * scan_axes().transpose();
+  femur_axes_joint_ = joint_to_working_.transpose() * frames_->femur.axes;
+  const Eigen::Matrix3d A = joint_to_working_.transpose();
+  socket_clock_ = acetabulum_->clock.transformed(A, -A * cor_);
+  ball_clock_ = femoral.transformed(A, A * (seat_ - cor_));
+}
+
+void HipJoint::seat_femur(TriangleMesh& femur, const SphereFitResult& sphere, const HipJointOptions& options) {
+  // Seated: the femur, its frame and clock move with the head onto the acetabular centre, which becomes the
+  // COR (the maps' centre: rays from the seated head centre); the methods' translations are then relative to
+  // the seated femur (combined: none; equidistant: the small deviations). Translation only: the pelvic
+  // landmarks stay, the femoral ones move with the femur, both frames keep their axes and take the new COR
+  // as origin.
+  seat_ = acetabulum_->sphere.centre - sphere.centre;
+  femur.V.rowwise() += seat_.transpose();
+  cor_ = acetabulum_->sphere.centre;
+  FemurLandmarks& fl = frames_->femur_landmarks;
+  for (Eigen::Vector3d* p : {&fl.head_centre, &fl.epicondyle_lateral, &fl.epicondyle_medial,
+                             &fl.posterior_condyle_lateral, &fl.posterior_condyle_medial})
+    *p += seat_;
+  frames_->head.centre = cor_;
+  const double quality = frames_->femur.quality_mm;
+  frames_->pelvis = pelvis_frame(frames_->pelvis_landmarks, cor_, options.frames.pelvis);
+  frames_->femur = femur_frame(fl, side_, options.frames.femur);
+  frames_->femur.quality_mm = quality;
+}
+
+void HipJoint::build_joint(TriangleMesh femur, TriangleMesh pelvis, const HipJointOptions& options) {
   const Eigen::Matrix3d to_joint = joint_to_working_.transpose();
-  head_centre_joint_ = to_joint * (sphere.centre + seat_ - cor_);
   for (TriangleMesh* m : {&femur, &pelvis}) m->V = ((m->V.rowwise() - cor_.transpose()) * to_joint.transpose()).eval();
   if (options.ball_map_file.empty() != options.socket_map_file.empty())
     throw Error("hip joint: give both map files (ball and socket) or neither");
   if (options.ball_map_file.empty()) {
     joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint);
-  } else {
-    auto load = [&](const std::string& path) {
-      Eigen::Vector3d c;
-      RadialDistanceMap m = load_map<float>(path, &c);
-      require((c - cor_).norm() <= 1e-6, path + ": saved about the COR (" + std::to_string(c.x()) + ", " +
-                                             std::to_string(c.y()) + ", " + std::to_string(c.z()) +
-                                             ") mm, this joint's is (" + std::to_string(cor_.x()) + ", " +
-                                             std::to_string(cor_.y()) + ", " + std::to_string(cor_.z()) +
-                                             "): another subject or COR");
-      return m;
-    };
-    joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint,
-                   load(options.ball_map_file), load(options.socket_map_file));
+    return;
   }
-  // The acetabular centre in the joint frame: the origin once seated.
-  if (method != JointCentreMethod::femoral_head) {
-    EquidistantOptions equidistant = options.equidistant;
-    equidistant.mirror_x = side_ == Side::left;  // the joint frame's x is medio-lateral: mirrored hips alike
-    centre_ = JointCentre(method, *joint_, joint_to_working_.transpose() * (acetabulum_->sphere.centre - cor_),
-                          articular_->pelvis, articular_->head_sphere_reach_mm, equidistant);
-  }
-  if (socket_clock_) {
-    ball_hours_ = clock_hours(joint_->ball().relative, *ball_clock_);
-    socket_hours_ = clock_hours(joint_->socket().relative, *socket_clock_);
-  }
+  auto load = [&](const std::string& path) {
+    Eigen::Vector3d c;
+    RadialDistanceMap m = load_map<float>(path, &c);
+    require((c - cor_).norm() <= 1e-6, path + ": saved about the COR (" + std::to_string(c.x()) + ", " +
+                                           std::to_string(c.y()) + ", " + std::to_string(c.z()) +
+                                           ") mm, this joint's is (" + std::to_string(cor_.x()) + ", " +
+                                           std::to_string(cor_.y()) + ", " + std::to_string(cor_.z()) +
+                                           "): another subject or COR");
+    return m;
+  };
+  joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint,
+                 load(options.ball_map_file), load(options.socket_map_file));
+}
+
+void HipJoint::check_cor_inside_femur(const HipJointOptions& options) const {
   // The COR must lie inside the femur: then every ray from it meets the femur's surface.
   const RadialDistanceMap& bm = joint_->ball().map;
   // (Counted when the map was filled: a sparse map with a finite region reads "no surface" beyond it.)

@@ -155,6 +155,16 @@ class HipJoint {
   double frames_ms() const { return frames_ms_; }
 
  private:
+  // The constructor's steps, in order: the head sphere (radius, warnings); the frames, acetabulum, zones and
+  // clocks (anatomical neutral), seating the femur where the method asks; the maps about the COR; the check
+  // that the COR lies in the femur.
+  SphereFitResult head_sphere(const TriangleMesh& femur, const SphereFitResult& head, const HipJointOptions& options);
+  void build_anatomy(TriangleMesh& femur, const TriangleMesh& pelvis, SphereFitResult& sphere, const Landmarks& given,
+                     const HipJointOptions& options, JointCentreMethod method);
+  void seat_femur(TriangleMesh& femur, const SphereFitResult& sphere, const HipJointOptions& options);
+  void build_joint(TriangleMesh femur, TriangleMesh pelvis, const HipJointOptions& options);
+  void check_cor_inside_femur(const HipJointOptions& options) const;
+
   Side side_;
   Neutral neutral_;
   Eigen::Vector3d cor_;
