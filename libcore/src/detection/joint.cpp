@@ -80,8 +80,7 @@ std::pair<JointBody, JointBody> Joint::build_bodies(const Eigen::Vector3d& cor, 
 JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh mesh,
                        std::optional<RadialDistanceMap> given) {
   validate_mesh(mesh);
-  JointBody b{std::move(mesh), Vertices{}, RadialDistanceMap{options.scheme}, {}, {}, {}, {}, 0, nullptr, 0, 0, nullptr, nullptr, {}, {},
-              nullptr, {}, {}};
+  JointBody b(std::move(mesh), options.scheme);
   // The closest-point query needs the mesh alone: it is built on a thread of its own meanwhile, so that
   // it fills the core the other body's build leaves idle when it ends first (the query's hierarchy is
   // serial). Joined before b is returned or the build fails (the future's destructor waits).

@@ -85,6 +85,9 @@ struct JointOptions {
 
 /// One body of the joint after preprocessing.
 struct JointBody {
+  /// A body of `mesh` whose map uses `scheme` (empty until sampled); every other member default.
+  JointBody(TriangleMesh mesh_in, std::shared_ptr<const SamplingScheme> scheme)
+      : mesh(std::move(mesh_in)), map(std::move(scheme)) {}
   TriangleMesh mesh;               ///< the frame the joint was given (Session: the joint frame), mm
   Vertices relative;               ///< n x 3, vertices minus the COR, mm
   RadialDistanceMap map;           ///< its radial distance map about the COR
