@@ -98,3 +98,19 @@ def test_an_unreachable_scheduler_is_one_line(study):
                         "tcp://127.0.0.1:9", "--no-progress"], env=ENV, capture_output=True, text=True, timeout=60)
     lines = [x for x in r.stderr.splitlines() if x.startswith("impinge.study: --scheduler")]
     assert r.returncode == 2 and len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
+
+
+def test_shards_share_a_folder_but_a_whole_run_waits_for_them(study, tmp_path):
+    path, _, first = study
+    out = tmp_path / "shared"
+    procs = [subprocess.Popen([PY, "-m", "impinge.study", "run", str(path), "--out", str(out), "--workers", "0",
+                               "--no-progress", "--shard", f"{i}/2"], env=ENV, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for i in (0, 1)]
+    for p in procs:
+        _, err = p.communicate(timeout=60)
+        assert p.returncode == 0, err
+    import socket
+    with open(out / ".lock-0-of-2", "w") as f:  # a live shard runner: this process
+        f.write(f"{socket.gethostname()} {os.getpid()}\n")
+    r = run_study(path, out)
+    assert r.returncode == 2 and "another runner" in r.stderr, r.stderr

@@ -151,48 +151,59 @@ def run(study_path, out, workers=None, scheduler=None, shard=None, retry_errors=
     task_list = spec.expand(study)
     tasks_dir = os.path.join(out, "tasks")
     os.makedirs(tasks_dir, exist_ok=True)
-    with _OutLock(out):
+    with _OutLock(out, shard):
         return _run_locked(study, task_list, out, tasks_dir, workers, scheduler, shard, retry_errors, progress, log,
                            on_start, overrides)
 
 
 class _OutLock:
-    """out/.lock, held while a runner writes into `out`: a second runner on the same folder refuses with the first
-    one's host and pid (it would delete the first's half-written task folders). A lock whose process is gone (same
-    host) is taken over."""
+    """OUT/.lock (a whole run) or OUT/.lock-I-of-N (shard I of N), holding the runner's host and pid while it
+    writes into OUT: a second runner whose tasks overlap (a whole run and anything, or the same shard twice)
+    refuses with the first one's host and pid (it would delete the first's half-written task folders). Shards of
+    one study share the folder (their tasks are disjoint). A lock whose process is gone (same host) is taken
+    over."""
 
-    def __init__(self, out):
-        self.path = os.path.join(out, ".lock")
+    def __init__(self, out, shard=None):
+        self.out = out
+        self.path = os.path.join(out, ".lock" if not shard else f".lock-{shard[0]}-of-{shard[1]}")
+        self.shard = shard
+
+    @staticmethod
+    def _holder(path):
+        """(host, pid) of a live lock at path; None when there is none or its process is gone (it is removed)."""
+        try:
+            with open(path) as f:
+                host, pid = f.read().split()
+        except (OSError, ValueError):
+            return None
+        if host == socket.gethostname():
+            try:
+                os.kill(int(pid), 0)
+            except (ProcessLookupError, ValueError):
+                try:
+                    os.unlink(path)  # its runner died: the folder is free
+                except OSError:
+                    pass
+                return None
+            except PermissionError:
+                pass
+        return host, pid
 
     def __enter__(self):
-        me = f"{socket.gethostname()} {os.getpid()}"
-        for _ in range(2):
-            try:
-                fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
-            except FileExistsError:
-                try:
-                    with open(self.path) as f:
-                        host, pid = f.read().split()
-                except (OSError, ValueError):
-                    host, pid = "", "0"
-                alive = host != socket.gethostname()  # another host's runner: assume it runs
-                if not alive:
-                    try:
-                        os.kill(int(pid), 0)
-                        alive = True
-                    except (ProcessLookupError, ValueError):
-                        alive = False
-                    except PermissionError:
-                        alive = True
-                if alive:
-                    raise spec.StudyError(f"{os.path.dirname(self.path)}: another runner ({host}, pid {pid}) is "
-                                          f"writing here; wait for it, or remove {self.path} if it is gone") from None
-                os.unlink(self.path)  # its runner died: take the folder over
-                continue
-            with os.fdopen(fd, "w") as f:
-                f.write(me + "\n")
-            return self
-        raise spec.StudyError(f"{self.path}: cannot take the lock")
+        others = [os.path.join(self.out, n) for n in os.listdir(self.out) if n.startswith(".lock")] \
+            if not self.shard else [os.path.join(self.out, ".lock"), self.path]
+        for other in others:
+            held = self._holder(other)
+            if held:
+                raise spec.StudyError(f"{self.out}: another runner ({held[0]}, pid {held[1]}) is writing here; wait "
+                                      f"for it, or remove {other} if it is gone")
+        try:
+            fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        except FileExistsError:
+            raise spec.StudyError(f"{self.out}: another runner took {self.path} just now") from None
+        with os.fdopen(fd, "w") as f:
+            f.write(f"{socket.gethostname()} {os.getpid()}\n")
+        return self
 
     def __exit__(self, *exc):
         try:
