@@ -360,9 +360,11 @@ TEST(EndToEnd, MotionOnARealSubjectEqualsDistanceAndLoadsInVtk) {
 }
 
 // Issue 26's oracle: mc22's left hip at the walking trial's deepest extension, the femur rotated about the
-// head centre. An exact closest-point and winding-number oracle gave 98 femur vertices inside the pelvis, up
-// to 2.566 mm deep, and 32 pelvis vertices inside the femur, up to 1.793 mm; the radial gaps read -8.2 and
-// -27.0 mm there. The distances must match, with the layered maps and without (the distance scan covers the
+// head centre. VTK's vtkImplicitPolyDataDistance on the posed meshes (the PLYs this run writes), with the head
+// fitted to its fixed point (session 47; the head moved 0.14 mm), gives 95 femur vertices inside the pelvis, up
+// to 2.526 mm deep, and 31 pelvis vertices inside the femur, up to 1.737 mm (issue 26's exact closest-point
+// oracle at the earlier fit: 98 and 32, 2.566 and 1.793 mm); the radial gaps part from them there.
+// The distances must match, with the layered maps and without (the distance scan covers the
 // hidden vertices itself), and the PLYs carry them.
 TEST(EndToEnd, DistancesMatchTheOracleAtMc22LeftsDeepestExtension) {
   const std::string json = std::string(IMPINGE_SHARED_DATA) + "/mc22-left/subject.json";
@@ -379,11 +381,14 @@ TEST(EndToEnd, DistancesMatchTheOracleAtMc22LeftsDeepestExtension) {
     std::ifstream js(d + "/" + layers + "/summary.json");
     const nlohmann::json j = nlohmann::json::parse(js);
     EXPECT_TRUE(j["distances"].get<bool>());
-    EXPECT_NEAR(j["ball"]["min_distance_mm"].get<double>(), -2.566, 0.02) << layers;
-    EXPECT_NEAR(j["socket"]["min_distance_mm"].get<double>(), -1.793, 0.02) << layers;
-    EXPECT_EQ(j["ball"]["vertices_inside"], 98) << layers;
-    EXPECT_EQ(j["socket"]["vertices_inside"], 32) << layers;
-    EXPECT_LT(j["socket"]["min_gap_mm"].get<double>(), -20) << layers;  // the radial gap's artefact stays visible
+    EXPECT_NEAR(j["ball"]["min_distance_mm"].get<double>(), -2.526, 0.02) << layers;
+    EXPECT_NEAR(j["socket"]["min_distance_mm"].get<double>(), -1.737, 0.02) << layers;
+    EXPECT_EQ(j["ball"]["vertices_inside"], 95) << layers;
+    EXPECT_EQ(j["socket"]["vertices_inside"], 31) << layers;
+    // The radial gap parts from the distance here (at the earlier head fit it read -27 mm; at this one the rays miss
+    // the 1.7 mm penetration and it reads +0.9 mm): the artefact stays visible.
+    EXPECT_GT(std::abs(j["socket"]["min_gap_mm"].get<double>() - j["socket"]["min_distance_mm"].get<double>()), 1.0)
+        << layers;
     // The levels classify the distance by default: the last level (<= 0 mm) holds the vertices inside.
     EXPECT_EQ(j["levels_on"], "distance");
     for (const char* body : {"ball", "socket"}) {

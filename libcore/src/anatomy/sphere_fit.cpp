@@ -224,6 +224,19 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
     const double sigma = 1.4826 * abs_res[abs_res.size() / 2];
     threshold = std::clamp(3 * sigma, 0.2 * o.inlier_threshold_mm, o.inlier_threshold_mm);
   }
+  // Then to the fixed point at the last band: refit until the inliers no longer change, so that the sphere
+  // depends on the surface and not on which RANSAC draw led here (the draws follow the vertex numbering).
+  std::vector<Eigen::Index> last;
+  for (int round = 0; round < 50; ++round) {
+    std::vector<Eigen::Index> in;
+    for (Eigen::Index i : cand)
+      if (std::abs((V.row(i).transpose() - c).norm() - r) < threshold) in.push_back(i);
+    if (in == last || in.size() < 4) break;
+    res = fit_sphere_geometric(gather(V, in));
+    c = res.centre;
+    r = res.radius;
+    last = std::move(in);
+  }
   res.iterations = o.refinement_rounds;
   return res;
 }
