@@ -8,7 +8,6 @@
 #include <tuple>
 
 #include "impinge/core/error.hpp"
-#include "impinge/casters/first_hit_caster.hpp"
 #include "impinge/schemes/fibonacci_scheme.hpp"
 #include "core/simd_clones.hpp"
 
@@ -35,7 +34,7 @@ const char* to_string(JointCentreMethod m) {
 }
 
 ScanSet lunate_sample(PointsRef P, const std::vector<std::uint8_t>& lunate, const Eigen::Vector3d& c_a,
-                      int max_vertices, const FirstHitCaster* surface, bool mirror_x) {
+                      int max_vertices, bool mirror_x) {
   const Eigen::Vector3d flip(mirror_x ? -1.0 : 1.0, 1.0, 1.0);  // lattice frame <-> joint frame (its own inverse)
   std::vector<std::int32_t> flagged;
   for (std::size_t i = 0; i < lunate.size(); ++i)
@@ -63,13 +62,7 @@ ScanSet lunate_sample(PointsRef P, const std::vector<std::uint8_t>& lunate, cons
   for (std::size_t j = 0; j < order.size(); ++j) {
     const std::size_t k = order[j];
     if (cell[k] < 0 || (j > 0 && cell[order[j - 1]] == cell[k])) continue;  // one per cell
-    Eigen::Vector3d p = P.row(flagged[k]).transpose();
-    if (surface != nullptr) {  // the surface point in the cell's own direction: the same however tessellated
-      const Eigen::Vector3d d = flip.cwiseProduct(lattice.node_direction(cell[k]));
-      const Eigen::Vector3d o = surface->origin();
-      const double r = surface->first_hit(c_a + d - o);
-      if (std::isfinite(r) && (c_a - o).norm() < 1e-9) p = o + r * d;
-    }
+    const Eigen::Vector3d p = P.row(flagged[k]).transpose();
     set.index.push_back(flagged[k]);
     set.x.push_back(p.x()), set.y.push_back(p.y()), set.z.push_back(p.z());
   }
@@ -96,7 +89,7 @@ JointCentre::JointCentre(JointCentreMethod method, const Joint& joint, const Eig
   require(flagged >= 16, joint.socket().mesh.source + ": " + std::to_string(flagged) +
                              " vertices on the lunate surface, fewer than 16: the equidistant joint centre needs "
                              "the acetabulum's joint surface (use --joint-centre femoral-head)");
-  lunate_ = lunate_sample(P, lunate, c_a, o.max_vertices, joint.socket().exact.get(), o.mirror_x);
+  lunate_ = lunate_sample(P, lunate, c_a, o.max_vertices, o.mirror_x);
 }
 
 void JointCentre::gaps(const Joint& joint, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float* out) const {

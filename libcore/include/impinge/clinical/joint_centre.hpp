@@ -38,7 +38,6 @@
 
 namespace impinge {
 
-class FirstHitCaster;
 
 /// Puls et al. 2010's four methods (see the file comment).
 enum class JointCentreMethod { femoral_head, acetabular, combined, equidistant };
@@ -67,12 +66,12 @@ struct EquidistantOptions {
 /// 8 max_vertices nodes (4.5 deg apart for 256: coarser than any bone mesh's vertices), and
 /// in each cell the vertex whose direction is nearest the cell's node (ties, such as duplicated vertices,
 /// by position); in cell order. `P`: the pelvis vertices (n x 3, joint frame, mm); `lunate`: n flags.
-/// With `surface` (the pelvis' exact ray caster) about `c_a`, each cell's point is the surface's first hit in
-/// the cell's node direction instead of the vertex: the same points however the surface is tessellated
-/// (split triangles, duplicated or renumbered vertices), but for cells at the lunate surface's border.
-/// `mirror_x`: bin with x negated (EquidistantOptions::mirror_x).
+/// Renumbered or duplicated vertices give the same sample; split triangles add vertices that may be nearer a
+/// cell's node. (Sampling each cell at the surface's exact hit in its node direction instead, tessellation-free,
+/// made the equidistant translations of the MRI hips swing by millimetres: the node directions reach past the
+/// lunate surface's border.) `mirror_x`: bin with x negated (EquidistantOptions::mirror_x).
 ScanSet lunate_sample(PointsRef P, const std::vector<std::uint8_t>& lunate, const Eigen::Vector3d& c_a,
-                      int max_vertices, const FirstHitCaster* surface = nullptr, bool mirror_x = false);
+                      int max_vertices, bool mirror_x = false);
 
 /// The translation of the femur at each pose by one method.
 class JointCentre {
