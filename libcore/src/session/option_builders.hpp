@@ -94,12 +94,11 @@ struct Rows {
                   bool inverted = false) {
     OptionRow& r = add(std::move(name), std::move(key), type, "", uses, std::move(help));
     r.set = [ref, inverted](RunOptions& o, const OptionValue& v, const std::string& as) {
-      ref(o) = value_as<bool>(v, as, type_name_bool()) != inverted;
+      ref(o) = value_as<bool>(v, as, "true or false") != inverted;
     };
     r.get = [ref, inverted](const RunOptions& o) -> OptionValue { return bool(ref(o)) != inverted; };
     return r;
   }
-  static const char* type_name_bool() { return "true or false"; }
 
   // A choice stored as an enum: `parse` (text, context) -> enum, `name` enum -> text.
   template <typename Ref, typename Parse, typename Name>

@@ -152,7 +152,6 @@ OptionValue parse_option_text(const OptionRow& row, const std::string& text, con
 }
 
 std::string option_text(const OptionRow& row, const OptionValue& v) {
-  (void)row;
   if (std::holds_alternative<std::monostate>(v)) return "auto";
   if (const auto* b = std::get_if<bool>(&v)) return row.type == OptionType::on_off ? (*b ? "on" : "off") : (*b ? "true" : "false");
   if (const auto* x = std::get_if<double>(&v)) return shortest(*x);

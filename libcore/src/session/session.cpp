@@ -1,5 +1,7 @@
 #include "impinge/session/session.hpp"
 
+#include "impinge/session/option_table.hpp"
+
 #include <unistd.h>
 
 #include <cmath>
@@ -32,16 +34,19 @@ std::string point_text(const Eigen::Vector3d& p) {
 }
 }  // namespace
 
+// Both parse through the option table's rows, the one parser of --cor and --head-region.
 std::optional<Eigen::Vector3d> parse_cor(const std::string& text, const std::string& context) {
-  if (text.empty() || text == "auto") return std::nullopt;
-  const auto v = parse_number_list(text, context, 3);
-  return Eigen::Vector3d(v[0], v[1], v[2]);
+  RunOptions o;
+  const OptionRow& row = *find_option("cor");
+  row.set(o, parse_option_text(row, text, context), context);
+  return o.session.cor.given;
 }
 
 Eigen::Vector4d parse_head_region(const std::string& text, const std::string& context) {
-  const auto v = parse_number_list(text, context, 4);
-  require(v[3] > 0, context + " '" + text + "': the radius R must be > 0 mm");
-  return Eigen::Vector4d(v[0], v[1], v[2], v[3]);
+  RunOptions o;
+  const OptionRow& row = *find_option("head-region");
+  row.set(o, parse_option_text(row, text, context), context);
+  return *o.session.cor.head_region;
 }
 
 namespace {
