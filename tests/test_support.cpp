@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/subject.hpp"
 
@@ -78,6 +79,34 @@ TriangleMesh make_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
       0, 2, 3, 0, 3, 1,     //
       4, 5, 7, 4, 7, 6;
   return m;
+}
+
+const Session& generated_session(const std::string& frame) {
+  auto make = [](FrameConvention f) {
+    HipModelOptions g;
+    g.target_triangles = 2000;
+    g.cam_height_mm = 2;
+    const HipModel h = make_hip_model(g);
+    const Eigen::Matrix3d M = to_working_frame(f);  // RAS -> f (its own inverse)
+    SessionOptions o;
+    o.input.ball_mesh = h.ball;
+    o.input.socket_mesh = h.socket;
+    transform_vertices(o.input.ball_mesh->V, M);
+    transform_vertices(o.input.socket_mesh->V, M);
+    o.input.frame = f == FrameConvention::LPS ? "LPS" : "RAS";
+    o.cor.given = M * h.cor;
+    o.frames.neutral = "scan";
+    o.maps.precision = 1;
+    o.maps.distances = true;
+    o.maps.distance_reach_mm = 6;
+    return Session(o);
+  };
+  if (frame == "LPS") {
+    static const Session lps = make(FrameConvention::LPS);
+    return lps;
+  }
+  static const Session ras = make(FrameConvention::RAS);
+  return ras;
 }
 
 }  // namespace impinge::test

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "impinge/core/mesh.hpp"
+#include "impinge/session/session.hpp"
 
 namespace impinge::test {
 
@@ -28,6 +29,9 @@ std::optional<RealJoint> load_real_joint(const std::string& name);
 TriangleMesh concatenated(const TriangleMesh& a, const TriangleMesh& b);
 /// Closed axis-aligned box [lo, hi] (mm), 12 triangles wound outward.
 TriangleMesh make_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+/// The session of a generated hip (2,000 triangles, 2 mm cam; scan neutral, its true COR given, 1 deg maps,
+/// distances within 6 mm) with its meshes given in `frame` ("RAS" or "LPS"); built once per frame.
+const Session& generated_session(const std::string& frame);
 /// Analytic oracle: distance from origin o along unit u to the sphere (c, r), far root.
 double ray_sphere_far(const Eigen::Vector3d& o, const Eigen::Vector3d& u, const Eigen::Vector3d& c, double r);
 

@@ -15,35 +15,14 @@
 
 #include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
-#include "impinge/io/generated_models.hpp"
-#include "impinge/io/subject.hpp"
+#include "test_support.hpp"
 
 using namespace impinge;
 namespace fs = std::filesystem;
 
 namespace {
 
-const Session& session() {
-  static const Session s = [] {
-    HipModelOptions g;
-    g.target_triangles = 2000;
-    g.cam_height_mm = 2;
-    const HipModel h = make_hip_model(g);
-    SessionOptions o;
-    o.input.ball_mesh = h.ball;
-    o.input.socket_mesh = h.socket;
-    transform_vertices(o.input.ball_mesh->V, to_working_frame(FrameConvention::LPS));  // given in LPS
-    transform_vertices(o.input.socket_mesh->V, to_working_frame(FrameConvention::LPS));
-    o.input.frame = "LPS";
-    o.cor.given = to_working_frame(FrameConvention::LPS) * h.cor;
-    o.frames.neutral = "scan";
-    o.maps.precision = 1;
-    o.maps.distances = true;
-    o.maps.distance_reach_mm = 6;
-    return Session(o);
-  }();
-  return s;
-}
+const Session& session() { return test::generated_session("LPS"); }
 
 struct PlyVertex {
   float x, y, z, gap, quality, distance;

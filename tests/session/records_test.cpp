@@ -10,32 +10,14 @@
 #include <cmath>
 #include <limits>
 
-#include "impinge/io/generated_models.hpp"
-#include "impinge/io/subject.hpp"
 #include "impinge/session/runs.hpp"
+#include "test_support.hpp"
 
 using namespace impinge;
 
 namespace {
 
-const Session& session() {
-  static const Session s = [] {
-    HipModelOptions g;
-    g.target_triangles = 2000;
-    g.cam_height_mm = 2;
-    const HipModel h = make_hip_model(g);
-    SessionOptions o;
-    o.input.ball_mesh = h.ball;
-    o.input.socket_mesh = h.socket;
-    o.cor.given = h.cor;
-    o.frames.neutral = "scan";
-    o.maps.precision = 1;
-    o.maps.distances = true;
-    o.maps.distance_reach_mm = 6;
-    return Session(o);
-  }();
-  return s;
-}
+const Session& session() { return test::generated_session("RAS"); }
 
 }  // namespace
 
