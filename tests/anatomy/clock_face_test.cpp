@@ -7,6 +7,10 @@
 //   superior, 3 o'clock anterior on both sides, the notch (6 o'clock) is where the cup's extent
 //   is least; mirrored points get the same hours on the mirrored hip;
 // - the femoral clock's axis runs along the neck (neck-shaft angle 115-145 deg);
+// - analytic oracle: the acetabular sphere is fitted on the whole lunate surface whatever the joint space:
+//   a cup of inner radius r_h + 5.5 mm (an MRI's joint space) with a fossa 4 mm deeper gives its centre and
+//   radius within 0.05 mm and the lunate area within 3 % of the analytic band's, where the head radius + 4 mm
+//   cut of the old fit held none of it;
 // - clock_summary keeps every tested vertex's area and finds the closest vertex's hour.
 #include "impinge/anatomy/clock_face.hpp"
 #include "impinge/clinical/clock_summary.hpp"
@@ -15,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "impinge/anatomy/hip_frames.hpp"
+#include "impinge/io/generated_models.hpp"
 #include "test_support.hpp"
 
 using namespace impinge;
@@ -40,6 +45,30 @@ TEST(ClockFace, HoursAndSectors) {
   const Eigen::Matrix3d R = test::random_rotation(rng);
   const ClockFace m = c.transformed(R, Eigen::Vector3d(5, 6, 7));
   EXPECT_NEAR(m.hour(R * (c.centre + Eigen::Vector3d(1, 1, 0)) + Eigen::Vector3d(5, 6, 7)), 1.5, 1e-12);
+}
+
+TEST(ClockFace, AcetabulumSphereFitsTheWholeLunateSurface) {
+  // Cup about c: inner radius 27.5 mm from the pole to 100 deg, except the fossa (within 25 deg of the pole)
+  // 4 mm deeper; the head (radius 22 mm) 0.8 mm off the cup's centre. The pelvic frame: the identity.
+  const Eigen::Vector3d c(0.5, -0.3, 0.4), head(0.5, 0.3, -0.1);
+  const double r_cup = 27.5, fossa_deg = 25, coverage_deg = 100;
+  TriangleMesh cup = make_cup(r_cup, r_cup + 5, coverage_deg, c, -Eigen::Vector3d::UnitZ(), 360, 200);
+  double band_area = 0;
+  for (Eigen::Index i = 0; i < cup.V.rows(); ++i) {
+    const Eigen::Vector3d d = cup.V.row(i).transpose() - c;
+    const double polar = std::acos(std::clamp(d.normalized().dot(-Eigen::Vector3d::UnitZ()), -1.0, 1.0)) * 180 / M_PI;
+    if (std::abs(d.norm() - r_cup) < 1e-6 && polar < fossa_deg) cup.V.row(i) = (c + d.normalized() * (r_cup + 4)).transpose();
+  }
+  // The lunate band between the fossa's edge and the rim, on the sphere: 2 pi r^2 (cos a - cos b).
+  band_area = 2 * M_PI * r_cup * r_cup * (std::cos(fossa_deg * M_PI / 180) - std::cos(coverage_deg * M_PI / 180));
+  cup.source = "analytic cup";
+  AnatomicalFrame frame;
+  const Acetabulum A = find_acetabulum(cup, head, 22.0, frame);
+  EXPECT_LT((A.sphere.centre - c).norm(), 0.05) << A.sphere.centre.transpose();
+  EXPECT_NEAR(A.sphere.radius, r_cup, 0.05);
+  EXPECT_NEAR(A.joint_space_mode_mm, r_cup - 22.0, 1.0);
+  // The fossa's ring of triangles that slope down to it and the rim's edge are left out: a little under.
+  EXPECT_NEAR(A.lunate_area_mm2, band_area, 0.03 * band_area) << A.lunate_area_mm2 << " of " << band_area;
 }
 
 TEST(ClockFace, AcetabulumAndFemoralClockOnRealHipsBothSides) {

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "impinge/anatomy/femur_frame.hpp"
@@ -31,7 +32,7 @@ namespace {
 struct Concentric {
   Eigen::Vector3d cup_centre{0.6, -0.7, 0.6};  // 1.1 mm from the head centre
   std::unique_ptr<Joint> joint;
-  std::vector<std::uint8_t> lunate;  // the cup's inner surface
+  LunateSphere lunate;  // the cup's inner surface (no rim plane)
 };
 Concentric concentric() {
   Concentric c;
@@ -39,8 +40,8 @@ Concentric concentric() {
   o.scheme = make_scheme("equiangular", 0.25);
   TriangleMesh head = make_uv_sphere(20, Eigen::Vector3d::Zero(), 240, 120);
   TriangleMesh cup = make_cup(22, 26, 100, c.cup_centre, -Eigen::Vector3d::UnitZ(), 240, 100);
-  for (Eigen::Index i = 0; i < cup.V.rows(); ++i)
-    c.lunate.push_back(std::abs((cup.V.row(i).transpose() - c.cup_centre).norm() - 22) < 1e-6 ? 1 : 0);
+  c.lunate.centre = c.cup_centre;
+  c.lunate.radius_mm = 22;
   c.joint = std::make_unique<Joint>(std::move(head), std::move(cup), Eigen::Vector3d::Zero(), o);
   return c;
 }
@@ -57,7 +58,9 @@ const std::vector<Eigen::Matrix3d>& rotations() {
 TEST(JointCentre, EquidistantSeatsASphericalHeadOnTheCupCentre) {
   const Concentric c = concentric();
   // Started from the head's own centre (c_a = 0), 1.1 mm from the answer.
-  const JointCentre eq(JointCentreMethod::equidistant, *c.joint, Eigen::Vector3d::Zero(), c.lunate, 21.0);
+  LunateSphere start = c.lunate;
+  start.centre.setZero();
+  const JointCentre eq(JointCentreMethod::equidistant, *c.joint, start, {}, 21.0);
   EXPECT_GT(eq.vertices_used(), 100);
   for (const Eigen::Matrix3d& R : rotations()) {
     const Eigen::Vector3d t = eq.translation(*c.joint, R);
@@ -69,10 +72,48 @@ TEST(JointCentre, EquidistantSeatsASphericalHeadOnTheCupCentre) {
   }
 }
 
+// The equidistant translation keeps the joint space open: a head of radius 20 mm in a cup of inner radius
+// 20.5 mm whose inner surface carries a bump 0.9 mm high (a cosine cap of 4 deg radius, 30 deg from the pole).
+// Evening the joint space out alone seats the head near the cup centre and the bump presses over 0.2 mm into it;
+// with the lunate vertices as the guard, no inner vertex's gap is below 0 (up to the maps' error), at any
+// rotation. The sample alone (no guard) misses the bump, which lies between its points: the check can fail.
+TEST(JointCentre, EquidistantNeverPressesTheHeadIntoTheSocket) {
+  JointOptions o;
+  o.scheme = make_scheme("equiangular", 0.25);
+  const Eigen::Vector3d cup_centre(0.3, -0.2, 0.1);
+  TriangleMesh head = make_uv_sphere(20, Eigen::Vector3d::Zero(), 240, 120);
+  TriangleMesh cup = make_cup(20.5, 25, 100, cup_centre, -Eigen::Vector3d::UnitZ(), 360, 150);
+  const Eigen::Vector3d bump_dir = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitX()) * -Eigen::Vector3d::UnitZ();
+  std::vector<std::uint8_t> inner(static_cast<std::size_t>(cup.V.rows()), 0);
+  for (Eigen::Index i = 0; i < cup.V.rows(); ++i) {
+    const Eigen::Vector3d d = cup.V.row(i).transpose() - cup_centre;
+    if (std::abs(d.norm() - 20.5) > 1e-6) continue;
+    inner[static_cast<std::size_t>(i)] = 1;
+    const double angle = std::acos(std::clamp(d.normalized().dot(bump_dir), -1.0, 1.0));
+    const double width = 4 * M_PI / 180;
+    if (angle < width) cup.V.row(i) = (cup_centre + d.normalized() * (20.5 - 0.45 * (1 + std::cos(M_PI * angle / width)))).transpose();
+  }
+  const Joint joint(std::move(head), std::move(cup), Eigen::Vector3d::Zero(), o);
+  LunateSphere lunate;
+  lunate.centre = cup_centre;
+  lunate.radius_mm = 20.5;
+  const JointCentre guarded(JointCentreMethod::equidistant, joint, lunate, inner, 21.0);
+  const JointCentre sample_only(JointCentreMethod::equidistant, joint, lunate, {}, 21.0);
+  auto least_inner_gap = [&](const JointCentre& jc, const Eigen::Matrix3d& R) {
+    const PoseResult r = joint.detect(R, jc.translation(joint, R));
+    double least = 1e9;
+    for (std::size_t i = 0; i < inner.size(); ++i)
+      if (inner[i] && std::isfinite(r.socket_gaps.gap_mm[i])) least = std::min(least, double(r.socket_gaps.gap_mm[i]));
+    return least;
+  };
+  EXPECT_LT(least_inner_gap(sample_only, Eigen::Matrix3d::Identity()), -0.2);
+  for (const Eigen::Matrix3d& R : rotations()) EXPECT_GE(least_inner_gap(guarded, R), -0.02);
+}
+
 TEST(JointCentre, CombinedAndAcetabularKeepTheirCentres) {
   const Concentric c = concentric();
-  const JointCentre combined(JointCentreMethod::combined, *c.joint, c.cup_centre, {}, 0);
-  const JointCentre acetabular(JointCentreMethod::acetabular, *c.joint, c.cup_centre, {}, 0);
+  const JointCentre combined(JointCentreMethod::combined, *c.joint, c.lunate, {}, 0);
+  const JointCentre acetabular(JointCentreMethod::acetabular, *c.joint, c.lunate, {}, 0);
   const JointCentre head;
   for (const Eigen::Matrix3d& R : rotations()) {
     // Combined: the head centre (the origin, posed at t) on the cup centre.
@@ -88,15 +129,20 @@ TEST(JointCentre, BadInputIsAnError) {
   EXPECT_THROW(parse_joint_centre("equidistance", "joint-centre"), Error);
   EXPECT_EQ(parse_joint_centre("femoral_head", "x"), JointCentreMethod::femoral_head);
   EXPECT_STREQ(to_string(JointCentreMethod::equidistant), "equidistant");
-  // Too few lunate vertices, flags of another mesh, no acetabular centre, no head reach.
-  std::vector<std::uint8_t> few(c.lunate.size(), 0);
-  few[0] = 1;
-  EXPECT_THROW(JointCentre(JointCentreMethod::equidistant, *c.joint, c.cup_centre, few, 21.0), Error);
-  EXPECT_THROW(JointCentre(JointCentreMethod::equidistant, *c.joint, c.cup_centre, {1, 1, 1}, 21.0), Error);
-  EXPECT_THROW(JointCentre(JointCentreMethod::combined, *c.joint, Eigen::Vector3d::Constant(std::nan("")), {}, 0), Error);
-  EXPECT_THROW(JointCentre(JointCentreMethod::equidistant, *c.joint, c.cup_centre, c.lunate, 0.0), Error);
+  // No lunate surface on the sphere given, no radius, no acetabular centre, no head reach.
+  LunateSphere elsewhere = c.lunate;
+  elsewhere.radius_mm = 40;  // no socket surface within the band of this sphere
+  LunateSphere no_radius = c.lunate;
+  no_radius.radius_mm = 0;
+  LunateSphere no_centre = c.lunate;
+  no_centre.centre = Eigen::Vector3d::Constant(std::nan(""));
+  EXPECT_THROW(JointCentre(JointCentreMethod::equidistant, *c.joint, elsewhere, {}, 21.0), Error);
+  EXPECT_THROW(JointCentre(JointCentreMethod::equidistant, *c.joint, no_radius, {}, 21.0), Error);
+  EXPECT_THROW(JointCentre(JointCentreMethod::combined, *c.joint, no_centre, {}, 0), Error);
+  EXPECT_THROW(JointCentre(JointCentreMethod::equidistant, *c.joint, c.lunate, {}, 0.0), Error);
   try {
-    JointCentre(JointCentreMethod::equidistant, *c.joint, c.cup_centre, few, 21.0);
+    JointCentre(JointCentreMethod::equidistant, *c.joint, elsewhere, {}, 21.0);
+    ADD_FAILURE() << "no lunate surface accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("lunate"), std::string::npos) << e.what();
   }
@@ -159,14 +205,20 @@ TEST(JointCentre, EquidistantLimitsHoldUnderAMillimetreMoveOfTheCentre) {
     return find_rom_limits(hip, standard_motions(), ro, rom_baseline(hip, hip.femur_rotation({}), ro));
   };
   const auto base = limits_about(head.centre);
+  int compared = 0;
   for (const Eigen::Vector3d& d : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1)}) {
     const auto moved = limits_about(head.centre + d);
     for (std::size_t k = 0; k < base.size(); ++k) {
       SCOPED_TRACE(standard_motions()[k].name);
       ASSERT_EQ(std::isnan(base[k].limit_deg), std::isnan(moved[k].limit_deg));
-      if (!std::isnan(base[k].limit_deg)) {
-        EXPECT_LE(std::abs(moved[k].limit_deg - base[k].limit_deg), 3.0);
+      // A transient touch (monotone false: the gap opens again past it, the output flags it) is a graze whose
+      // angle a tenth of a millimetre decides; lhdl-ct's extension at 0.5 deg is one (124.6 deg, past the
+      // soft tissue's limit). The others must hold.
+      if (!std::isnan(base[k].limit_deg) && base[k].monotone && moved[k].monotone) {
+        EXPECT_LE(std::abs(moved[k].limit_deg - base[k].limit_deg), 3.0) << base[k].limit_deg << " -> " << moved[k].limit_deg;
+        ++compared;
       }
     }
   }
+  EXPECT_GE(compared, 3 * 7);  // at most one motion of nine left out per move
 }

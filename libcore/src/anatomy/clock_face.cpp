@@ -34,36 +34,109 @@ namespace {
 Eigen::Vector3d in_plane(const Eigen::Vector3d& v, const Eigen::Vector3d& n) { return (v - v.dot(n) * n).normalized(); }
 }  // namespace
 
+namespace {
+/// One triangle of the pelvis as the lunate fit sees it: centroid, area, unit outward normal.
+struct Facet {
+  Eigen::Vector3d centroid, normal;
+  double area;
+};
+
+std::vector<Facet> facets(const TriangleMesh& mesh) {
+  std::vector<Facet> out(static_cast<std::size_t>(mesh.F.rows()));
+  double volume6 = 0;  // six times the signed volume: > 0 when the normals point out
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose(), b = mesh.V.row(mesh.F(f, 1)).transpose(),
+                          c = mesh.V.row(mesh.F(f, 2)).transpose();
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    const double len = n.norm();
+    out[static_cast<std::size_t>(f)] = {(a + b + c) / 3, len > 0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero(),
+                                        len / 2};
+    volume6 += a.dot(b.cross(c));
+  }
+  if (volume6 < 0)
+    for (Facet& t : out) t.normal = -t.normal;
+  return out;
+}
+
+// The facets on the sphere (c, r) within `band` mm whose outward normal faces its centre.
+std::vector<std::size_t> on_sphere(const std::vector<Facet>& T, const Eigen::Vector3d& c, double r, double band) {
+  std::vector<std::size_t> sel;
+  for (std::size_t f = 0; f < T.size(); ++f) {
+    const Eigen::Vector3d d = T[f].centroid - c;
+    const double n = d.norm();
+    if (T[f].area > 0 && n > 0 && std::abs(n - r) <= band && T[f].normal.dot(d) <= -kLunateFacing * n)
+      sel.push_back(f);
+  }
+  return sel;
+}
+}  // namespace
+
 Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c, double r, const AnatomicalFrame& P,
                            double margin) {
   const std::string ctx = pelvis.source + ": acetabulum";
   require(c.allFinite() && std::isfinite(r) && r > 0, ctx + ": head centre and radius must be finite");
   const Vertices& V = pelvis.V;
   Acetabulum A;
-  // Each vertex stands for a third of its triangles' area: the pole and the sphere are the surface's, not
-  // its vertices' (a file that splits or duplicates them gives the same acetabulum).
+  // The lunate surface and its sphere, from the triangles (their centroids and areas: the surface's, not its
+  // vertices', so a file that splits, duplicates or renumbers them gives the same sphere).
+  const std::vector<Facet> T = facets(pelvis);
+  // 1. The joint space at the scan pose: the mode (area-weighted, 0.25 mm bins smoothed over +-1 mm) of the
+  //    distance from the head sphere of the triangles facing the head within [-3, 12] mm of it.
+  constexpr double kBin = 0.25, kLow = -3, kHigh = 12;
+  std::vector<double> hist(static_cast<std::size_t>((kHigh - kLow) / kBin), 0.0);
+  for (const Facet& t : T) {
+    const Eigen::Vector3d d = t.centroid - c;
+    const double n = d.norm(), s = n - r;
+    if (n > 0 && s >= kLow && s < kHigh && t.normal.dot(d) <= -kLunateFacing * n)
+      hist[std::min(hist.size() - 1, static_cast<std::size_t>((s - kLow) / kBin))] += t.area;
+  }
+  std::size_t mode = 0;
+  double best = -1;
+  for (std::size_t b = 0; b < hist.size(); ++b) {
+    double sum = 0;
+    for (int k = -4; k <= 4; ++k)
+      if (b + k < hist.size()) sum += hist[b + k];  // (size_t wraps below 0: out of range)
+    if (sum > best) best = sum, mode = b;
+  }
+  require(best > 0, ctx + ": no pelvis surface faces the femoral head within 12 mm of its sphere (is the head in "
+                          "the acetabulum?)");
+  A.joint_space_mode_mm = kLow + (static_cast<double>(mode) + 0.5) * kBin;
+  // 2. The lunate sphere: from the head-centred sphere at that joint space, refit (area-weighted, geometric) on
+  //    the facing triangles within kLunateBandMm of the last sphere until the selection no longer changes (the
+  //    deeper fossa and the rim's flare stay out; the whole lunate surface is in, however wide the joint space).
+  Eigen::Vector3d centre = c;
+  double radius = r + A.joint_space_mode_mm;
+  std::vector<std::size_t> sel, previous;
+  for (int it = 0; it < 50; ++it) {
+    sel = on_sphere(T, centre, radius, kLunateBandMm);
+    require(sel.size() >= 20, ctx + ": fewer than 20 triangles on the acetabular sphere (" +
+                                  std::to_string(sel.size()) + " within " + std::to_string(kLunateBandMm) +
+                                  " mm of it, facing the head)");
+    if (sel == previous) break;
+    Eigen::Matrix<double, Eigen::Dynamic, 3> pts(static_cast<Eigen::Index>(sel.size()), 3);
+    std::vector<double> w(sel.size());
+    for (std::size_t k = 0; k < sel.size(); ++k)
+      pts.row(static_cast<Eigen::Index>(k)) = T[sel[k]].centroid.transpose(), w[k] = T[sel[k]].area;
+    A.sphere = fit_sphere_geometric(pts, w);
+    A.sphere.iterations = it + 1;
+    centre = A.sphere.centre, radius = A.sphere.radius;
+    previous.swap(sel);
+  }
+  A.lunate_area_mm2 = 0;
+  for (std::size_t f : previous) A.lunate_area_mm2 += T[f].area;
+  A.lunate_triangles = static_cast<std::int64_t>(previous.size());
+  // 3. The cup: pelvis vertices within the acetabular radius + margin of its centre.
   const Eigen::VectorXd area = vertex_areas(pelvis);
   std::vector<Eigen::Index> cup;
   Eigen::Vector3d mean_dir = Eigen::Vector3d::Zero();
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
-    const Eigen::Vector3d d = V.row(i).transpose() - c;
+    const Eigen::Vector3d d = V.row(i).transpose() - centre;
     const double n = d.norm();
-    if (n > 0 && n < r + margin) cup.push_back(i), mean_dir += area[i] * d / n;
+    if (n > 0 && n < radius + margin) cup.push_back(i), mean_dir += area[i] * d / n;
   }
   A.cup_vertices = static_cast<std::int64_t>(cup.size());
   require(cup.size() >= 50, ctx + ": only " + std::to_string(cup.size()) + " pelvis vertices within " +
-                                std::to_string(r + margin) + " mm of the head centre (is the head in the acetabulum?)");
-  // The sphere of the lunate zone: cup vertices within 4 mm of the head sphere (the rim's flare and
-  // the deep fossa would inflate it).
-  std::vector<Eigen::Index> lunate;
-  for (Eigen::Index i : cup)
-    if ((V.row(i).transpose() - c).norm() < r + 4) lunate.push_back(i);
-  require(lunate.size() >= 20, ctx + ": fewer than 20 pelvis vertices within 4 mm of the head sphere");
-  Eigen::Matrix<double, Eigen::Dynamic, 3> pts(static_cast<Eigen::Index>(lunate.size()), 3);
-  std::vector<double> w(lunate.size());
-  for (std::size_t k = 0; k < lunate.size(); ++k)
-    pts.row(static_cast<Eigen::Index>(k)) = V.row(lunate[k]), w[k] = area[lunate[k]];
-  A.sphere = fit_sphere_geometric(pts, w);
+                                std::to_string(radius + margin) + " mm of the acetabular centre");
   // The cup's pole (its deepest direction) and axis out of the cup.
   const Eigen::Vector3d pole = mean_dir.normalized();
   const Eigen::Vector3d axis = -pole;
@@ -74,7 +147,7 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
   std::vector<double> cover(kBins, -1);
   std::vector<Eigen::Vector3d> rim(kBins);
   for (Eigen::Index i : cup) {
-    const Eigen::Vector3d d = V.row(i).transpose() - c;
+    const Eigen::Vector3d d = V.row(i).transpose() - centre;
     const double theta = std::acos(std::clamp(d.normalized().dot(pole), -1.0, 1.0));
     double psi = std::atan2(d.dot(e2), d.dot(e1));
     if (psi < 0) psi += 2 * M_PI;
@@ -103,7 +176,7 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
   // Notch: least extent (smoothed over +-22.5 deg; empty bins count as no extent) in the inferior half.
   std::vector<double> cov(kBins);
   for (int b = 0; b < kBins; ++b) cov[static_cast<std::size_t>(b)] = std::max(0.0, cover[static_cast<std::size_t>(b)]);
-  int best = -1;
+  int notch = -1;
   double best_v = 1e300;
   std::vector<double> sorted;
   for (int b = 0; b < kBins; ++b) {
@@ -112,13 +185,13 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
     s /= 9;
     const double psi = (b + 0.5) * 2 * M_PI / kBins;
     const Eigen::Vector3d dir = std::cos(psi) * e1 + std::sin(psi) * e2;
-    if (dir.dot(P.axes.col(1)) < 0 && s < best_v) best_v = s, best = b;
+    if (dir.dot(P.axes.col(1)) < 0 && s < best_v) best_v = s, notch = b;
     sorted.push_back(cov[static_cast<std::size_t>(b)]);
   }
   std::nth_element(sorted.begin(), sorted.begin() + kBins / 2, sorted.end());
   A.median_coverage_deg = sorted[kBins / 2] * 180 / M_PI;
   A.notch_coverage_deg = best_v * 180 / M_PI;
-  const double psi = (best + 0.5) * 2 * M_PI / kBins;
+  const double psi = (notch + 0.5) * 2 * M_PI / kBins;
   const Eigen::Vector3d six = in_plane(std::cos(psi) * e1 + std::sin(psi) * e2, n);
   A.clock.centre = m;
   A.clock.axis = n;

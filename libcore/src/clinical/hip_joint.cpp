@@ -44,8 +44,13 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   if (method != JointCentreMethod::femoral_head) {
     EquidistantOptions equidistant = options.equidistant;
     equidistant.mirror_x = side_ == Side::left;  // the joint frame's x is medio-lateral: mirrored hips alike
-    centre_ = JointCentre(method, *joint_, joint_to_working_.transpose() * (acetabulum_->sphere.centre - cor_),
-                          articular_->pelvis, articular_->head_sphere_reach_mm, equidistant);
+    const Eigen::Matrix3d to_joint = joint_to_working_.transpose();
+    LunateSphere lunate;
+    lunate.centre = to_joint * (acetabulum_->sphere.centre - cor_);
+    lunate.radius_mm = acetabulum_->sphere.radius;
+    lunate.band_mm = kLunateBandMm;
+    lunate.scan_head_centre = -(to_joint * seat_);
+    centre_ = JointCentre(method, *joint_, lunate, articular_->pelvis, articular_->head_sphere_reach_mm, equidistant);
   }
   if (socket_clock_) {
     ball_hours_ = clock_hours(joint_->ball().relative, *ball_clock_);

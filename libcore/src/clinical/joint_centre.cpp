@@ -33,63 +33,56 @@ const char* to_string(JointCentreMethod m) {
   return "femoral-head";
 }
 
-ScanSet lunate_sample(PointsRef P, const std::vector<std::uint8_t>& lunate, const Eigen::Vector3d& c_a,
-                      int max_vertices, bool mirror_x) {
+ScanSet lunate_sample(const RadialDistanceMap& socket_map, const LunateSphere& L, int max_vertices, bool mirror_x) {
   const Eigen::Vector3d flip(mirror_x ? -1.0 : 1.0, 1.0, 1.0);  // lattice frame <-> joint frame (its own inverse)
-  std::vector<std::int32_t> flagged;
-  for (std::size_t i = 0; i < lunate.size(); ++i)
-    if (lunate[i]) flagged.push_back(static_cast<std::int32_t>(i));
-  std::vector<Eigen::Vector3d> u(flagged.size());  // directions from c_a
-  for (std::size_t k = 0; k < flagged.size(); ++k) u[k] = (P.row(flagged[k]).transpose() - c_a).normalized();
-  // Cells of a Fibonacci lattice about c_a, coarse enough (8 max_vertices nodes over the sphere: 4.5 deg apart
-  // for 256) that every cell over the lunate surface holds a vertex however finely it is tessellated.
   const double nodes = 8.0 * std::max(16, max_vertices);
   const FibonacciScheme lattice(nodes);
-  std::vector<std::int64_t> cell(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k)
-    cell[k] = u[k].allFinite() ? lattice.node(Eigen::Vector3d(flip.cwiseProduct(u[k]))) : -1;
-  // In each cell the vertex nearest its node's direction; ties (duplicated vertices) by position.
-  std::vector<std::size_t> order(flagged.size());
-  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  auto key = [&](std::size_t k) {
-    const Eigen::Vector3d p = P.row(flagged[k]).transpose();
-    return std::make_tuple(cell[k], -u[k].dot(flip.cwiseProduct(lattice.node_direction(std::max<std::int64_t>(cell[k], 0)))),
-                           flip.x() * p.x(), p.y(), p.z());
-  };
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+  const auto n = static_cast<std::int64_t>(lattice.num_nodes());
+  // Each node's direction from c_a, at the sphere: where the socket's surface lies in that direction from the COR.
+  std::vector<double> x(static_cast<std::size_t>(n)), y(x.size()), z(x.size()), rho(x.size());
+  for (std::int64_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d v = L.centre + L.radius_mm * flip.cwiseProduct(lattice.node_direction(k));
+    x[static_cast<std::size_t>(k)] = v.x(), y[static_cast<std::size_t>(k)] = v.y(), z[static_cast<std::size_t>(k)] = v.z();
+  }
+  socket_map.lookup_many_soa_marked(x.data(), y.data(), z.data(), n, rho.data());
   ScanSet set;
-  set.vertices = P.rows();
-  for (std::size_t j = 0; j < order.size(); ++j) {
-    const std::size_t k = order[j];
-    if (cell[k] < 0 || (j > 0 && cell[order[j - 1]] == cell[k])) continue;  // one per cell
-    const Eigen::Vector3d p = P.row(flagged[k]).transpose();
-    set.index.push_back(flagged[k]);
+  set.vertices = n;
+  for (std::int64_t k = 0; k < n; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    if (!std::isfinite(rho[i])) continue;  // no surface, or a depth discontinuity in the stencil
+    const Eigen::Vector3d v(x[i], y[i], z[i]);
+    const Eigen::Vector3d p = rho[i] * v.normalized();
+    if (std::abs((p - L.centre).norm() - L.radius_mm) > L.band_mm) continue;                  // off the lunate sphere
+    set.index.push_back(static_cast<std::int32_t>(k));
     set.x.push_back(p.x()), set.y.push_back(p.y()), set.z.push_back(p.z());
   }
   return set;
 }
 
-JointCentre::JointCentre(JointCentreMethod method, const Joint& joint, const Eigen::Vector3d& c_a,
-                         const std::vector<std::uint8_t>& lunate, double head_sphere_reach_mm,
+JointCentre::JointCentre(JointCentreMethod method, const Joint& joint, const LunateSphere& lunate,
+                         const std::vector<std::uint8_t>& guard, double head_sphere_reach_mm,
                          const EquidistantOptions& o)
-    : method_(method), c_a_(c_a), reach_mm_(head_sphere_reach_mm), options_(o) {
+    : method_(method), c_a_(lunate.centre), start_(lunate.scan_head_centre.allFinite() ? lunate.scan_head_centre : lunate.centre),
+      reach_mm_(head_sphere_reach_mm), options_(o) {
   if (method == JointCentreMethod::femoral_head) return;
-  require(c_a.allFinite(), std::string("joint centre ") + to_string(method) +
-                               ": needs the acetabular centre (anatomical neutral), and it is not finite");
+  require(lunate.centre.allFinite(), std::string("joint centre ") + to_string(method) +
+                                         ": needs the acetabular centre (anatomical neutral), and it is not finite");
   if (method != JointCentreMethod::equidistant) return;
   require(o.max_vertices >= 16 && o.max_iterations >= 1 && o.tolerance_mm > 0,
           "joint centre equidistant: need max_vertices >= 16, max_iterations >= 1 and tolerance > 0 mm");
   require(std::isfinite(head_sphere_reach_mm) && head_sphere_reach_mm > 0,
           "joint centre equidistant: the head sphere's reach must be > 0 mm");
+  require(std::isfinite(lunate.radius_mm) && lunate.radius_mm > 0 && std::isfinite(lunate.band_mm) && lunate.band_mm > 0,
+          "joint centre equidistant: the lunate sphere's radius and band must be > 0 mm");
+  lunate_ = lunate_sample(joint.socket().map, lunate, o.max_vertices, o.mirror_x);
+  require(lunate_.size() >= 16, joint.socket().mesh.source + ": " + std::to_string(lunate_.size()) +
+                                    " points of the lunate surface sampled, fewer than 16: the equidistant joint centre "
+                                    "needs the acetabulum's joint surface (use --joint-centre femoral-head)");
   const Vertices& P = joint.socket().relative;
-  require(lunate.size() == static_cast<std::size_t>(P.rows()),
-          "joint centre equidistant: the lunate flags have " + std::to_string(lunate.size()) + " entries for " +
+  require(guard.empty() || guard.size() == static_cast<std::size_t>(P.rows()),
+          "joint centre equidistant: the lunate flags have " + std::to_string(guard.size()) + " entries for " +
               std::to_string(P.rows()) + " pelvis vertices");
-  const auto flagged = static_cast<std::int64_t>(std::count(lunate.begin(), lunate.end(), std::uint8_t(1)));
-  require(flagged >= 16, joint.socket().mesh.source + ": " + std::to_string(flagged) +
-                             " vertices on the lunate surface, fewer than 16: the equidistant joint centre needs "
-                             "the acetabulum's joint surface (use --joint-centre femoral-head)");
-  lunate_ = lunate_sample(P, lunate, c_a, o.max_vertices, o.mirror_x);
+  if (!guard.empty()) guard_ = make_scan_set(P, guard);
 }
 
 void JointCentre::gaps(const Joint& joint, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float* out) const {
@@ -164,6 +157,72 @@ void normal_sums(const double* __restrict X, const double* __restrict Y, const d
 }
 }  // namespace
 
+Eigen::Vector3d JointCentre::constrained_step(const Eigen::Matrix4d& H, const Eigen::Vector4d& b, const Eigen::Vector3d& t,
+                                              const OpenPoints& open, std::vector<std::size_t>& active) {
+  // Least squares of gap_j - w_j . d - m (normal equations H x = b, x = (d, m)) subject to the joint space
+  // staying open at every point of `open`: c_k . x <= e_k with c_k = (w_k, 0), e_k = gap_k (w_k: the unit
+  // direction from the head centre t to the point). An active set of these constraints: add the most
+  // violated, solve the equality-constrained problem, drop a constraint whose multiplier turns negative. With
+  // the active rows C, x = H^-1 (b - C^T l) and (C H^-1 C^T) l = C H^-1 b - e: a system as small as the
+  // active set, which holds at most 3 independent rows (the constraints bind d alone).
+  const Eigen::LDLT<Eigen::Matrix4d> ldlt(H);
+  const Eigen::Vector4d x0 = ldlt.solve(b);
+  Eigen::Vector4d x = x0;
+  const std::size_t n = open.g.size();
+  thread_local std::vector<double> wx, wy, wz, v;
+  wx.resize(n), wy.resize(n), wz.resize(n), v.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {  // vectorises
+    const double dx = open.x[k] - t.x(), dy = open.y[k] - t.y(), dz = open.z[k] - t.z();
+    const double inv = 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
+    wx[k] = dx * inv, wy[k] = dy * inv, wz[k] = dz * inv;
+  }
+  auto w = [&](std::size_t k) { return Eigen::Vector3d(wx[k], wy[k], wz[k]); };
+  constexpr int kMaxActive = 6;
+  constexpr double kSlack = 1e-6;  // mm: a constraint violated by less is met
+  // The equality-constrained solution with the active set (dropping a constraint that pulls the wrong way).
+  auto solve_active = [&]() {
+    while (!active.empty()) {
+      const auto m = static_cast<Eigen::Index>(active.size());
+      Eigen::Matrix<double, 4, Eigen::Dynamic, 0, 4, kMaxActive> Ct(4, m);  // C^T
+      Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxActive, 1> e(m);
+      for (Eigen::Index a = 0; a < m; ++a) {
+        const std::size_t k = active[static_cast<std::size_t>(a)];
+        Ct.col(a) << w(k), 0.0;
+        e(a) = open.g[k];
+      }
+      const Eigen::Matrix<double, 4, Eigen::Dynamic, 0, 4, kMaxActive> HiCt = ldlt.solve(Ct);
+      const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxActive, kMaxActive> S = Ct.transpose() * HiCt;
+      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxActive, 1> rhs = Ct.transpose() * x0 - e;
+      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxActive, 1> l = S.completeOrthogonalDecomposition().solve(rhs);
+      x = x0 - HiCt * l;
+      Eigen::Index drop = -1;
+      double least = -1e-12;
+      for (Eigen::Index a = 0; a < m; ++a)
+        if (l(a) < least) least = l(a), drop = a;
+      if (drop < 0) break;
+      active.erase(active.begin() + drop);
+      if (active.empty()) x = x0;
+    }
+  };
+  // The active set starts from the last step's (the same points, in the same order: warm) and grows.
+  active.erase(std::remove_if(active.begin(), active.end(), [&](std::size_t k) { return k >= n; }), active.end());
+  if (active.size() > static_cast<std::size_t>(kMaxActive)) active.resize(kMaxActive);
+  if (!active.empty()) solve_active();
+  for (int round = 0; round < 32; ++round) {
+    const double dx = x(0), dy = x(1), dz = x(2);
+    for (std::size_t k = 0; k < n; ++k) v[k] = wx[k] * dx + wy[k] * dy + wz[k] * dz - open.g[k];  // vectorises
+    for (std::size_t k : active) v[k] = -1;
+    std::size_t worst = n;
+    double most = kSlack;
+    for (std::size_t k = 0; k < n; ++k)
+      if (v[k] > most) most = v[k], worst = k;
+    if (worst == n || static_cast<int>(active.size()) == kMaxActive) break;
+    active.push_back(worst);
+    solve_active();
+  }
+  return x.head<3>();
+}
+
 Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix3d& R) const {
   switch (method_) {
     case JointCentreMethod::femoral_head: return Eigen::Vector3d::Zero();
@@ -180,18 +239,35 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
   // acetabular centre (the combined method's t), so that t is a function of R alone (not of where
   // the iteration starts). The femur's surface in q's direction lies |y| - gap from the head centre.
   const Eigen::Matrix3d Rt = R.transpose();
-  gaps(joint, R, c_a_, g.data());
+  gaps(joint, R, start_, g.data());
   std::int64_t used = 0;
   for (std::int64_t j = 0; j < n; ++j) {
     const auto k = static_cast<std::size_t>(j);
-    const double r = (Rt * (Eigen::Vector3d(lunate_.x[j], lunate_.y[j], lunate_.z[j]) - c_a_)).norm();
+    const double r = (Rt * (Eigen::Vector3d(lunate_.x[j], lunate_.y[j], lunate_.z[j]) - start_)).norm();
     on_head[k] = std::isfinite(g[k]) && r - g[k] <= reach_mm_;
     used += on_head[k];
   }
   require(used >= 16, "joint centre equidistant: fewer than 16 lunate vertices face the femoral head's joint surface "
                       "at this pose");
-  Eigen::Vector3d t = c_a_;
-  for (int it = 0; it < options_.max_iterations; ++it) {
+  // The guard: every lunate vertex's joint space must stay open. Those found closed at a converged t are
+  // constrained from then on (watched), and the iteration goes on; most poses close none.
+  const std::int64_t ng = guard_.size();
+  thread_local std::vector<float> guard_gap, watched_gap;
+  thread_local ScanSet watched;
+  thread_local OpenPoints open;
+  thread_local std::vector<std::size_t> active;  // the constraints binding at the last step (indices into open)
+  active.clear();
+  thread_local std::vector<std::uint8_t> is_watched;
+  guard_gap.resize(static_cast<std::size_t>(ng));
+  is_watched.assign(static_cast<std::size_t>(ng), 0);
+  watched.index.clear(), watched.x.clear(), watched.y.clear(), watched.z.clear();
+  watched.vertices = guard_.vertices;
+  auto scan = [&](const ScanSet& set, const Eigen::Vector3d& at, float* out) {
+    scan_gaps_compact(set, Rt, Eigen::Vector3d(-(Rt * at)), joint.ball().map, ScanSide::outside, out);
+  };
+  Eigen::Vector3d t = start_, previous = Eigen::Vector3d::Zero();
+  const int max_iterations = 4 * options_.max_iterations;
+  for (int it = 0, steps = 0; it < max_iterations; ++it) {
     if (it > 0) gaps(joint, R, t, g.data());  // the first step uses the selection's gaps
     // gap_j(t + d) ~ gap_j(t) - w_j . d (w_j: unit direction from the head centre t to q_j; exact
     // for a spherical head). Least squares of gap_j - w_j . d - m over d and the mean joint space m:
@@ -202,10 +278,40 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
     for (int i = 0, k = 0; i < 4; ++i)
       for (int c = 0; c <= i; ++c, ++k) A(i, c) = A(c, i) = sums[k];
     const Eigen::Vector4d b(sums[10], sums[11], sums[12], sums[13]);
-    const Eigen::Vector3d d = A.ldlt().solve(b).head<3>();
+    open.clear();
+    for (std::int64_t j = 0; j < n; ++j)
+      if (on_head[static_cast<std::size_t>(j)]) open.add(lunate_.x[j], lunate_.y[j], lunate_.z[j], g[static_cast<std::size_t>(j)]);
+    if (watched.size() > 0) {
+      watched_gap.resize(static_cast<std::size_t>(watched.size()));
+      scan(watched, t, watched_gap.data());
+      for (std::int64_t k = 0; k < watched.size(); ++k)
+        if (std::isfinite(watched_gap[static_cast<std::size_t>(k)]))
+          open.add(watched.x[k], watched.y[k], watched.z[k], watched_gap[static_cast<std::size_t>(k)]);
+    }
+    Eigen::Vector3d d = constrained_step(A, b, t, open, active);
+    if (d.dot(previous) < 0) d *= 0.5;  // a zig-zag between two active sets: halve the step
+    previous = d;
     t += d;
     if (!t.allFinite()) throw Error("joint centre equidistant: the iteration diverged (no joint space to even out)");
-    if (d.norm() < options_.tolerance_mm) break;
+    if (d.norm() >= options_.tolerance_mm && ++steps < options_.max_iterations) continue;
+    // Converged (or out of steps): is the joint space open over every lunate vertex facing the head?
+    scan(guard_, t, guard_gap.data());
+    bool closed = false;
+    for (std::int64_t k = 0; k < ng && !closed; ++k)
+      closed = !is_watched[static_cast<std::size_t>(k)] && guard_gap[static_cast<std::size_t>(k)] < -options_.tolerance_mm;
+    if (!closed) break;
+    // Closed by whatever of the femur (the head, or a bump past its sphere): watch it, and its neighbours in
+    // closing (within kNearMm), so that the next round does not close them in turn.
+    constexpr float kNearMm = 0.25f;
+    for (std::int64_t k = 0; k < ng; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      if (is_watched[i] || !(guard_gap[i] < kNearMm)) continue;
+      is_watched[i] = 1;
+      watched.index.push_back(guard_.index[i]);
+      watched.x.push_back(guard_.x[k]), watched.y.push_back(guard_.y[k]), watched.z.push_back(guard_.z[k]);
+    }
+    if (!closed) break;
+    steps = 0;
   }
   return t;
 }

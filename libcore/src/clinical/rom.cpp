@@ -94,6 +94,9 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
     b.contacts = o.contacts;
     if (keep_articular) b.lunate = z->pelvis;
   }
+  if (const auto& z = hip.articular())
+    for (std::size_t i = 0; i < z->pelvis.size(); ++i)
+      if (z->pelvis[i] && std::isfinite(socket_values[i])) b.joint_space_min_mm = std::fmin(b.joint_space_min_mm, socket_values[i]);
   b.min_gap_mm = by_distance ? std::fmin(r.ball.min_distance_mm, r.socket.min_distance_mm)
                              : std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);
   if (o.use_bounds && screened_or_radial(o))

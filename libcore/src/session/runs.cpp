@@ -259,6 +259,7 @@ nlohmann::json rom_record(const RomRun& run) {
   j["metric"] = to_string(o.metric);
   j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
   j["neutral_min_gap_mm"] = number_or_null(run.baseline.min_gap_mm);
+  j["neutral_joint_space_min_mm"] = number_or_null(run.baseline.joint_space_min_mm);
   j["excluded_vertices"] = run.baseline.excluded_vertices;
   j["contacts_counted"] = run.baseline.articular_vertices == 0 && o.contacts != RomContacts::all
                               ? "all (no articular zones: scan neutral)"

@@ -36,7 +36,11 @@ struct ClockFace {
 
 /// The acetabulum of a pelvis: its sphere, rim and clock face.
 struct Acetabulum {
-  SphereFitResult sphere;                 ///< geometric sphere fit of the cup surface (lunate surface and fossa), mm
+  SphereFitResult sphere;                 ///< area-weighted geometric sphere fit of the lunate surface, mm
+                                          ///< (iterations: refits until the lunate triangles no longer changed)
+  double joint_space_mode_mm = 0;         ///< the commonest distance of the socket from the head sphere at the scan pose
+  double lunate_area_mm2 = 0;             ///< area of the lunate surface the sphere is fitted on
+  std::int64_t lunate_triangles = 0;      ///< its triangles
   Eigen::Vector3d rim_centre;             ///< centroid of the rim points, mm
   Eigen::Vector3d opening;                ///< unit normal of the rim plane, out of the acetabulum
   double rim_radius_mm = 0;               ///< mean distance of the rim points from the rim centre
@@ -44,24 +48,39 @@ struct Acetabulum {
   std::vector<Eigen::Vector3d> rim;       ///< rim points, one per azimuth bin with cup vertices
   double notch_coverage_deg = 0;          ///< the cup's extent from its pole at the notch
   double median_coverage_deg = 0;         ///< and its median over the rim
-  std::int64_t cup_vertices = 0;          ///< pelvis vertices taken as the cup
+  std::int64_t cup_vertices = 0;          ///< pelvis vertices taken as the cup (within the sphere's radius + margin)
   ClockFace clock;                        ///< 12 superior, 3 anterior, 6 at the notch
 };
+
+/// A triangle belongs to the lunate surface when its outward normal faces the acetabular centre within
+/// acos(kLunateFacing) = 45.6 deg and its centroid lies within kLunateBandMm of the acetabular sphere.
+inline constexpr double kLunateFacing = 0.7;
+/// Half-width of the band about the acetabular sphere that holds the lunate surface, mm: wider than an MRI
+/// socket's roughness about its sphere (0.5-0.9 mm rms on the shared hips), narrower than the fossa's depth
+/// below it (3-5 mm).
+inline constexpr double kLunateBandMm = 1.5;
 
 /// Find the acetabulum of `pelvis` (working frame, mm) around the femoral head (centre
 /// `head_centre`, radius `head_radius_mm`) of a hip on `side`, with the pelvic frame `pelvis_frame`
 /// (for superior and anterior):
-/// 1. cup: pelvis vertices within head radius + `cup_margin_mm` of the head centre;
-/// 2. sphere: geometric fit of the lunate zone (cup vertices within 4 mm of the head sphere): the
-///    acetabular centre onto which Puls et al. 2010's equidistant method seats the head;
-/// 3. rim: in each 5-degree azimuth bin about the cup's axis, the cup vertex farthest from the
+/// 1. joint space: the mode of the head-facing triangles' distance from the head sphere (area-weighted,
+///    within [-3, 12] mm; 2-6 mm on the shared hips' CT and MRI);
+/// 2. sphere: from the head-centred sphere at that distance, an area-weighted geometric fit of the
+///    triangles on the sphere (kLunateBandMm, facing its centre, kLunateFacing), refitted until they no
+///    longer change: the lunate surface whole, whatever the joint space, without the deeper fossa or the
+///    rim's flare; the acetabular centre onto which Puls et al. 2010's equidistant method seats the head.
+///    (Until 2026-11 the fit took the vertices within the head radius + 4 mm, which left out 40-97 % of
+///    an MRI socket whose joint space is 3.5-6 mm.) Triangles, not vertices: a file that renumbers,
+///    duplicates or splits them gives the same sphere;
+/// 3. cup: pelvis vertices within the sphere's radius + `cup_margin_mm` of its centre;
+/// 4. rim: in each 5-degree azimuth bin about the cup's axis, the cup vertex farthest from the
 ///    cup's pole (the edge where the bone leaves the head); the rim plane by least squares;
-/// 4. notch: the azimuth, in the inferior half, where the cup's extent (smoothed over 45 deg) is least:
+/// 5. notch: the azimuth, in the inferior half, where the cup's extent (smoothed over 45 deg) is least:
 ///    6 o'clock; 12 opposite; 3 anterior.
-/// Throws impinge::Error naming the mesh when fewer than 50 cup vertices or 36 rim points are
-/// found (is the head in the acetabulum?).
+/// Throws impinge::Error naming the mesh when no surface faces the head, fewer than 20 triangles lie on
+/// the sphere, fewer than 50 cup vertices or 36 rim points are found (is the head in the acetabulum?).
 Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& head_centre, double head_radius_mm,
-                           const AnatomicalFrame& pelvis_frame, double cup_margin_mm = 8.0);
+                           const AnatomicalFrame& pelvis_frame, double cup_margin_mm = 6.0);
 
 /// Radiographic orientation of the acetabulum (Murray 1993, J Bone Joint Surg Br 75:228): the
 /// angles of its opening (the rim plane's normal, out of the acetabulum), degrees.

@@ -20,8 +20,12 @@
 ///   the femur's surface (the ball map's look-up, thesis Algorithm 2), counted where that surface is
 ///   the head's joint surface (within the head sphere's reach r_h + t_h, ArticularZones; not where
 ///   the ray from the head centre through q leaves through the head-neck junction or the fovea's
-///   rim); t is found by Gauss-Newton from the combined method's t (the exact Jacobian for a
-///   spherical head), to within EquidistantOptions::tolerance_mm.
+///   rim); t is found by Gauss-Newton from the head centre's scan position (LunateSphere::scan_head_centre;
+///   the exact Jacobian for a spherical head), to within EquidistantOptions::tolerance_mm, each step constrained so that the joint
+///   space stays open (>= 0 mm, up to the tolerance) at every point sampled and at every lunate vertex facing
+///   the head's joint surface (those found closed at a converged t join the constraints and the iteration goes
+///   on): the head is never pressed into the socket to even the joint space out (an MRI socket whose sphere is
+///   barely larger than the head's, tlem2-mri's, had it pressed 1-2.5 mm in and its abduction ended at 8 deg).
 ///
 /// Puls et al. define the methods in words (the hip centre fixed in the head, fixed in the
 /// acetabulum, both, or recomputed per pose to keep the joint space equidistant); the formulas
@@ -31,6 +35,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -50,40 +55,53 @@ const char* to_string(JointCentreMethod method);
 
 /// Options of the equidistant method.
 struct EquidistantOptions {
-  /// Sets the lunate sample's lattice (lunate_sample: 8 max_vertices cells over the sphere, the lunate
+  /// Sets the lunate sample's lattice (lunate_sample: 8 max_vertices nodes over the sphere, the lunate
   /// surface covering some of them); more: slower, no better.
   int max_vertices = 256;
   int max_iterations = 6;      ///< Gauss-Newton steps, at most
   /// Bin the lunate directions with x negated (lunate_sample): a left hip in the joint frame, whose x is
   /// medio-lateral, so that a mirrored hip is sampled at the mirrored points (HipJoint sets it by side).
   bool mirror_x = false;
-  double tolerance_mm = 5e-3;  ///< stop when a step moves t by less than this, mm
+  double tolerance_mm = 0.02;  ///< stop when a step moves t by less than this, mm (the maps' own error: 0.05 mm at 0.1 deg)
 };
 
-/// The lunate vertices the equidistant method measures the joint space at, chosen by position so that the
-/// choice depends on the surface, not on how its file numbers, duplicates or splits the vertices: their
-/// directions from the acetabular centre `c_a` (joint frame, mm) binned on a Fibonacci lattice of
-/// 8 max_vertices nodes (4.5 deg apart for 256: coarser than any bone mesh's vertices), and
-/// in each cell the vertex whose direction is nearest the cell's node (ties, such as duplicated vertices,
-/// by position); in cell order. `P`: the pelvis vertices (n x 3, joint frame, mm); `lunate`: n flags.
-/// Renumbered or duplicated vertices give the same sample; split triangles add vertices that may be nearer a
-/// cell's node. (Sampling each cell at the surface's exact hit in its node direction instead, tessellation-free,
-/// made the equidistant translations of the MRI hips swing by millimetres: the node directions reach past the
-/// lunate surface's border.) `mirror_x`: bin with x negated (EquidistantOptions::mirror_x).
-ScanSet lunate_sample(PointsRef P, const std::vector<std::uint8_t>& lunate, const Eigen::Vector3d& c_a,
-                      int max_vertices, bool mirror_x = false);
+/// The acetabulum's lunate surface as the joint-centre methods see it, joint frame (relative to the COR), mm.
+struct LunateSphere {
+  Eigen::Vector3d centre = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());  ///< c_a
+  double radius_mm = 0;          ///< the acetabular sphere's radius (find_acetabulum)
+  double band_mm = 1.5;          ///< the lunate surface lies within this of the sphere (kLunateBandMm)
+  /// Where the head centre sat in the scan (the femur's translation that puts it back there), mm: the
+  /// equidistant iteration starts there (the joint space open, as the bones were imaged); NaN: from `centre`.
+  Eigen::Vector3d scan_head_centre = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+};
+
+/// The points of the lunate surface at which the equidistant method measures the joint space, chosen by the
+/// surface alone, so that they do not depend on how its file numbers, duplicates or splits the vertices: the
+/// nodes of a Fibonacci lattice of 8 max_vertices directions about c_a (4.5 deg apart for 256; x negated
+/// with `mirror_x`, EquidistantOptions::mirror_x), each taken to the sphere (c_a, r_a), and there the
+/// socket's surface in that direction from the COR (`socket_map`'s look-up: the first surface, interpolated
+/// between exact node values, so the same for any tessellation of one surface). A node is kept when the
+/// surface point lies within band_mm of the sphere (not the fossa, not past the rim's edge, where the bone
+/// turns away from the sphere) and its look-up has no depth discontinuity in its stencil. The rim plane is
+/// not used: it is found from vertices (the farthest per azimuth, find_acetabulum) and moves when a file
+/// splits its triangles. In lattice order; `index` holds the lattice node, `vertices` the lattice size.
+/// (Until 2026-11 the sample was the lunate vertex nearest each node, which moved when a file split its
+/// triangles: 0.44 deg on lhdl-ct's limits, 0.02 mm of the equidistant translation.) Never throws.
+ScanSet lunate_sample(const RadialDistanceMap& socket_map, const LunateSphere& lunate, int max_vertices,
+                      bool mirror_x = false);
 
 /// The translation of the femur at each pose by one method.
 class JointCentre {
  public:
-  /// femoral_head needs nothing else. acetabular and combined need `acetabular_centre_mm` (joint
-  /// frame, mm); equidistant also needs `lunate` (one flag per socket vertex of `joint`: the lunate
-  /// surface, ArticularZones::pelvis) with at least 16 flagged vertices, and the head sphere's reach
-  /// (mm: r_h + t_h, ArticularZones::head_sphere_reach_mm). Throws impinge::Error when what the
-  /// method needs is missing or not finite.
-  JointCentre(JointCentreMethod method, const Joint& joint, const Eigen::Vector3d& acetabular_centre_mm,
-              const std::vector<std::uint8_t>& lunate, double head_sphere_reach_mm,
-              const EquidistantOptions& options = {});
+  /// femoral_head needs nothing else. acetabular and combined need the acetabular centre (`lunate.centre`,
+  /// joint frame, mm); equidistant also needs the rest of `lunate` (lunate_sample must find at least 16
+  /// points on it in `joint`'s socket map), the head sphere's reach (mm: r_h + t_h,
+  /// ArticularZones::head_sphere_reach_mm) and `guard`: one flag per socket vertex of `joint`, 1 on the
+  /// lunate surface (ArticularZones::pelvis), where the joint space must stay open (empty: the sample's points
+  /// only). Throws impinge::Error when what the method needs is missing, not finite or not positive, or
+  /// `guard` has another size.
+  JointCentre(JointCentreMethod method, const Joint& joint, const LunateSphere& lunate,
+              const std::vector<std::uint8_t>& guard, double head_sphere_reach_mm, const EquidistantOptions& options = {});
   /// The femoral head method (t = 0 at every pose).
   JointCentre() = default;
 
@@ -91,7 +109,7 @@ class JointCentre {
 
   /// t (mm, joint frame) at the femur rotation R (3 x 3, joint frame) of `joint` (the one given to
   /// the constructor: its ball map measures the joint space); a function of R alone (the equidistant
-  /// iteration always starts from the combined method's t). Thread-safe. Throws impinge::Error when
+  /// iteration always starts from the head centre's scan position). Thread-safe. Throws impinge::Error when
   /// fewer than 16 lunate vertices face the head's joint surface or the iteration diverges.
   Eigen::Vector3d translation(const Joint& joint, const Eigen::Matrix3d& R) const;
 
@@ -99,17 +117,30 @@ class JointCentre {
   /// the equidistant method minimises (NaN without them).
   double joint_space_sd_mm(const Joint& joint, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const;
 
-  /// Lunate vertices the equidistant method uses (0 for the other methods).
+  /// Lunate points the equidistant method samples (0 for the other methods).
   std::int64_t vertices_used() const { return lunate_.size(); }
 
  private:
   // Joint-space gaps of the lunate subset at (R, t) into `out` (one per vertex; NaN where none, or
   // where the femur's surface there lies beyond the head sphere's reach).
   void gaps(const Joint& joint, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float* out) const;
+  // Points of the lunate surface (joint frame, mm) whose joint space must stay open, and their gaps at t (mm).
+  struct OpenPoints {
+    std::vector<double> x, y, z, g;
+    void clear() { x.clear(), y.clear(), z.clear(), g.clear(); }
+    void add(double px, double py, double pz, double gap) { x.push_back(px), y.push_back(py), z.push_back(pz), g.push_back(gap); }
+  };
+  // One Gauss-Newton step d (mm) of the equidistant least squares (normal equations H, b at the head
+  // centre t), constrained so that the joint space stays open at every point of `open`: g_k - w_k . d >= 0.
+  // `active`: the constraints that bound at the last step (indices into `open`), in and out.
+  static Eigen::Vector3d constrained_step(const Eigen::Matrix4d& H, const Eigen::Vector4d& b, const Eigen::Vector3d& t,
+                                          const OpenPoints& open, std::vector<std::size_t>& active);
   JointCentreMethod method_ = JointCentreMethod::femoral_head;
   Eigen::Vector3d c_a_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d start_ = Eigen::Vector3d::Zero();  // where the equidistant iteration starts
   double reach_mm_ = 0;
-  ScanSet lunate_;  // the lunate subset, joint frame (relative to the COR)
+  ScanSet lunate_;  // the lunate sample, joint frame (relative to the COR)
+  ScanSet guard_;   // the lunate vertices whose joint space must stay open
   EquidistantOptions options_;
 };
 

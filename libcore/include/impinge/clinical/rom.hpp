@@ -159,6 +159,10 @@ struct RomBaseline {
   Eigen::Vector3d head_centre = Eigen::Vector3d::Zero();  ///< HipJoint::head_centre_joint()
   std::vector<std::uint8_t> lunate;         ///< per pelvis vertex, 1 on the lunate surface (RomContacts::articular)
   double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< least gap of all vertices at the baseline
+  /// The joint space at the baseline: the least gap (the metric's) of the lunate surface's vertices to the femur,
+  /// mm; NaN without articular zones (scan neutral) or when every lunate vertex is beyond the distance's reach.
+  /// Negative: the joint-centre method presses the head into the socket.
+  double joint_space_min_mm = std::numeric_limits<double>::quiet_NaN();
   /// The bounds of the cluster search (RomOptions::use_bounds), built once by rom_baseline (about
   /// 10 ms for 0.1 deg maps) and shared by every search given this baseline with the same joint and
   /// threshold; a search with another threshold builds its own.
