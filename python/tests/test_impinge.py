@@ -247,3 +247,10 @@ def test_real_subject_anatomical_frames():
                j.detect_pose(90, 0, fl - 0.5)["summary"]["ball"]["min_gap_mm"]) > 0
     grid = j.rom_map([0, 90], [0, 10], contact_depth_mm=0)
     assert grid.shape == (2, 2) and grid[1, 0] == pytest.approx(fl)
+    # Each limit says what it is, the published normal range beside it, whether the soft tissue usually ends the
+    # motion first (the bony limit past that range), and the pelvic frame the angles are measured in.
+    row = lim["internal_rotation_90_flexion"]
+    assert row["status"] == "limited" and row["pelvic_frame"] == "isb" and row["normal_deg"] == pytest.approx(37.9)
+    assert bool(row["soft_tissue_first"]) == (fl > 37.9)
+    app = impinge.Joint(ball, socket, resolution=0.5, pelvis_frame="app")
+    assert app.rom_limits(contact_depth_mm=0)["flexion"]["pelvic_frame"] == "app"

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <optional>
 
@@ -49,6 +50,16 @@ const char* to_string(RomMapStatus status) {
   return "free";
 }
 
+const char* to_string(RomLimitStatus status) {
+  switch (status) {
+    case RomLimitStatus::limited: return "limited";
+    case RomLimitStatus::contact_at_start: return "contact_at_start";
+    case RomLimitStatus::not_reachable: return "not_reachable";
+    case RomLimitStatus::free: break;
+  }
+  return "free";
+}
+
 std::vector<StandardMotion> standard_motions() {
   return {
       {"flexion", [](double t) { return PoseAngles{t, 0, 0}; }},
@@ -57,9 +68,9 @@ std::vector<StandardMotion> standard_motions() {
       {"adduction", [](double t) { return PoseAngles{0, t, 0}; }},
       {"internal_rotation", [](double t) { return PoseAngles{0, 0, t}; }},
       {"external_rotation", [](double t) { return PoseAngles{0, 0, -t}; }},
-      {"internal_rotation_90_flexion", [](double t) { return PoseAngles{90, 0, t}; }},
-      {"external_rotation_90_flexion", [](double t) { return PoseAngles{90, 0, -t}; }},
-      {"fadir", [](double t) { return PoseAngles{90, 10, t}; }},
+      {"internal_rotation_90_flexion", [](double t) { return PoseAngles{90, 0, t}; }, PoseAngles{90, 0, 0}},
+      {"external_rotation_90_flexion", [](double t) { return PoseAngles{90, 0, -t}; }, PoseAngles{90, 0, 0}},
+      {"fadir", [](double t) { return PoseAngles{90, 10, t}; }, PoseAngles{90, 10, 0}},
   };
 }
 
@@ -135,6 +146,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
   if (!limit_only) out.min_gap_at_start_mm = std::isinf(start_gap) ? std::numeric_limits<double>::quiet_NaN() : start_gap;
   bool found = start_gap <= cut;
   out.contact_at_start = found;
+  out.status = found ? RomLimitStatus::contact_at_start : RomLimitStatus::free;
   for (int k = 1; !found; ++k) {
     const double t = std::min(o.max_deg, k * o.step_deg);
     const double g = gap_at(t).gap;
@@ -149,6 +161,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
     const double mid = 0.5 * (lo + hi);
     (gap_at(mid).gap <= cut ? hi : lo) = mid;
   }
+  if (!out.contact_at_start) out.status = RomLimitStatus::limited;
   if (limit_only) {
     out.vertices_looked_up = scan.vertices_looked_up();
     out.vertices_skipped = scan.vertices_skipped();
@@ -210,7 +223,38 @@ std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<Sta
   for (std::int64_t k = 0; k < n; ++k) {
     try {
       const auto& m = motions[static_cast<std::size_t>(k)];
-      out[static_cast<std::size_t>(k)] = search(
+      RomLimit& limit = out[static_cast<std::size_t>(k)];
+      // The way to a start other than neutral: the straight path, parameterised by its largest angle.
+      const double way = std::max({std::abs(m.start.flexion_deg), std::abs(m.start.adduction_deg),
+                                   std::abs(m.start.internal_rotation_deg)});
+      if (way > 0) {
+        RomOptions lead = o;
+        lead.max_deg = way;
+        const PoseAngles s = m.start;
+        const RomLimit on_the_way = search(
+            hip, std::function<Eigen::Matrix3d(double)>([&](double t) {
+              const double f = t / way;
+              return hip.femur_rotation({f * s.flexion_deg, f * s.adduction_deg, f * s.internal_rotation_deg});
+            }),
+            lead, base, bounds.get(), true);
+        if (on_the_way.status != RomLimitStatus::free) {
+          const double f = on_the_way.limit_deg / way;
+          char text[200];
+          std::snprintf(text, sizeof text,
+                        "the start (flexion %g, adduction %g deg) is not reached: the bones meet at flexion %.1f, "
+                        "adduction %.1f deg on the way from neutral",
+                        s.flexion_deg, s.adduction_deg, f * s.flexion_deg, f * s.adduction_deg);
+          limit = RomLimit{};
+          limit.status = RomLimitStatus::not_reachable;
+          limit.note = text;
+          limit.excluded_vertices = on_the_way.excluded_vertices;
+          limit.evaluations = on_the_way.evaluations;
+          limit.vertices_looked_up = on_the_way.vertices_looked_up;
+          limit.vertices_skipped = on_the_way.vertices_skipped;
+          continue;
+        }
+      }
+      limit = search(
           hip, std::function<Eigen::Matrix3d(double)>([&](double t) { return hip.femur_rotation(m.angles(t)); }), o,
           base, bounds.get());
     } catch (const std::exception& e) {

@@ -177,6 +177,11 @@ nlohmann::json acetabulum_record(const Acetabulum& A, const AnatomicalFrame& pel
                          "inclination and anteversion radiographic (Murray 1993) in the pelvic frame"}};
 }
 
+std::string pelvic_frame_name(const Session& s) {
+  if (s.hip().neutral() != Neutral::anatomical) return "scan";
+  return s.options().frames.pelvis_frame == "app" ? "app" : "isb";
+}
+
 nlohmann::json setup_record(const Session& s) {
   const Eigen::Matrix3d to_input = s.to_input();
   const JointOptions& opt = s.joint_options();
@@ -213,6 +218,7 @@ nlohmann::json setup_record(const Session& s) {
   if (opt.distances) j["distance_reach_mm"] = opt.reach_mm();
   j["nodes_marked"] = {{"ball", s.joint().ball().nodes_marked}, {"socket", s.joint().socket().nodes_marked}};
   j["neutral"] = hip.neutral() == Neutral::anatomical ? "anatomical" : "scan";
+  j["pelvic_frame"] = pelvic_frame_name(s);
   j["warnings"] = s.warnings();
   j["scan_pose_min_gap_mm"] = number_or_null(s.scan_pose_min_gap_mm());
   j["overlap_at_scan_pose"] = s.scan_pose_min_gap_mm() < 0;

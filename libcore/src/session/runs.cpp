@@ -9,8 +9,10 @@
 
 #include <omp.h>
 
+#include "impinge/clinical/published_rom.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/timing.hpp"
+#include "impinge/session/records.hpp"
 
 namespace impinge {
 
@@ -199,18 +201,23 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
 
 Table rom_limits_table(const Session& s, const RomRun& run) {
   Table t;
-  t.columns = {"motion",      "limit_deg",        "limited_by",   "contact_class", "socket_clock_h", "femur_clock_h",
-               "min_gap_at_limit_mm", "monotone", "contact_at_start", "contact_x_mm", "contact_y_mm",
+  t.columns = {"motion",      "limit_deg",        "status",       "limited_by",     "contact_class", "socket_clock_h",
+               "femur_clock_h", "min_gap_at_limit_mm", "monotone", "contact_at_start", "contact_x_mm", "contact_y_mm",
                "contact_z_mm", "joint_translation_x_mm", "joint_translation_y_mm", "joint_translation_z_mm",
-               "evaluations"};
+               "evaluations", "normal_deg", "soft_tissue_first", "pelvic_frame", "note"};
+  const std::string frame = pelvic_frame_name(s);
   for (std::size_t k = 0; k < run.motions.size(); ++k) {
     const RomLimit& l = run.limits[k];
+    const std::string& name = run.motions[k].name;
     const Eigen::Vector3d c = s.to_input(l.contact_mm), tr = s.to_input(l.joint_translation_mm);
-    t.add({run.motions[k].name, number_or_null(l.limit_deg), to_string(l.limited_by), to_string(l.contact_class),
+    const bool judged = l.status == RomLimitStatus::limited || l.status == RomLimitStatus::free;
+    t.add({name, number_or_null(l.limit_deg), to_string(l.status), to_string(l.limited_by), to_string(l.contact_class),
            number_or_null(l.socket_clock_h),
            number_or_null(l.femur_clock_h), number_or_null(l.min_gap_at_limit_mm), l.monotone, l.contact_at_start,
            number_or_null(c.x()), number_or_null(c.y()), number_or_null(c.z()), number_or_null(tr.x()),
-           number_or_null(tr.y()), number_or_null(tr.z()), l.evaluations});
+           number_or_null(tr.y()), number_or_null(tr.z()), l.evaluations,
+           number_or_null(published_normal_range(name).normal_deg), judged && soft_tissue_first(name, l.limit_deg),
+           frame, l.note});
   }
   return t;
 }
@@ -270,10 +277,18 @@ nlohmann::json rom_record(const RomRun& run) {
   nlohmann::json limits = nlohmann::json::array();
   for (std::size_t k = 0; k < run.motions.size(); ++k) {
     const RomLimit& l = run.limits[k];
-    limits.push_back({{"motion", run.motions[k].name},
+    const std::string& name = run.motions[k].name;
+    const bool judged = l.status == RomLimitStatus::limited || l.status == RomLimitStatus::free;
+    const PublishedRange normal = published_normal_range(name);
+    limits.push_back({{"motion", name},
                       {"limit_deg", number_or_null(l.limit_deg)},
+                      {"status", to_string(l.status)},
                       {"limited_by", to_string(l.limited_by)},
-                      {"monotone", l.monotone}});
+                      {"monotone", l.monotone},
+                      {"normal_deg", number_or_null(normal.normal_deg)},
+                      {"normal_source", normal.source},
+                      {"soft_tissue_first", judged && soft_tissue_first(name, l.limit_deg)},
+                      {"note", l.note}});
   }
   j["limits"] = limits;
   if (run.envelope) {

@@ -89,10 +89,13 @@ struct RomOptions {
   double intra_articular_margin_mm = kIntraArticularMarginMm;
 };
 
-/// A standard motion: angles(theta) for theta >= 0 from its start (degrees).
+/// A standard motion: angles(theta) for theta >= 0 from its start (degrees), angles(0) = start.
 struct StandardMotion {
   std::string name;
   std::function<PoseAngles(double)> angles;
+  /// Where the motion starts (deg). Not neutral (90 deg flexion, say): the start must be reached first, along
+  /// the straight path from neutral (each angle in proportion), or the motion is RomLimitStatus::not_reachable.
+  PoseAngles start{};
 };
 
 /// The standard motions of clinical ROM tests: flexion, extension, abduction, adduction,
@@ -100,6 +103,16 @@ struct StandardMotion {
 /// external_rotation_90_flexion (from 90 deg flexion) and fadir (internal rotation at 90 deg
 /// flexion and 10 deg adduction).
 std::vector<StandardMotion> standard_motions();
+
+/// What a ROM limit is.
+enum class RomLimitStatus {
+  limited,           ///< the bones meet at limit_deg
+  free,              ///< they do not meet within RomOptions::max_deg (limit NaN)
+  contact_at_start,  ///< they meet already at the motion's start (limit 0)
+  not_reachable,     ///< the motion's start cannot be reached from neutral: the bones meet on the way (limit NaN)
+};
+/// "limited", "free", "contact_at_start", "not_reachable" (the CSV and JSON spelling).
+const char* to_string(RomLimitStatus status);
 
 /// Where a ROM limit's contact lies: intra-articular (within the rim radius plus
 /// RomOptions::intra_articular_margin_mm of the COR) or extra-articular (farther); none without a limit.
@@ -137,6 +150,9 @@ struct RomLimit {
   std::int64_t excluded_vertices = 0;  ///< vertices within the threshold at the baseline pose (pre-existing
                                        ///< overlap, e.g. of the segmentation): not counted
   bool contact_at_start = false;       ///< the counted gap is already within the threshold at theta = 0 (limit 0)
+  RomLimitStatus status = RomLimitStatus::free;  ///< what the limit is (find_rom_limits sets not_reachable)
+  /// Why the limit is not a number (not_reachable: where the way to the start is blocked), else empty.
+  std::string note;
   int evaluations = 0;                 ///< poses evaluated
   std::int64_t vertices_looked_up = 0;  ///< map look-ups made over the search
   std::int64_t vertices_skipped = 0;    ///< first-surface vertices skipped by the cluster bounds
@@ -197,7 +213,11 @@ RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(doub
 RomLimit find_rom_limit(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation,
                         const RomOptions& options, const RomBaseline& baseline);
 
-/// Every motion of `motions`, on all cores (OpenMP), sharing one set of bounds.
+/// Every motion of `motions`, on all cores (OpenMP), sharing one set of bounds. A motion whose start is not
+/// neutral is searched only when its start is reached first: the straight path from neutral to the start
+/// (searched as a motion of its own, its largest angle as the parameter) must be free of contact, else the
+/// motion is RomLimitStatus::not_reachable with limit NaN and a note naming the angle at which the bones met
+/// on the way (a hip whose flexion stops at 83 deg has no internal rotation at 90 deg flexion, not a 0 deg one).
 std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
                                       const RomOptions& options, const RomBaseline& baseline);
 

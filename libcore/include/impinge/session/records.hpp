@@ -60,6 +60,11 @@ nlohmann::json acetabulum_record(const Acetabulum& acetabulum, const AnatomicalF
 /// the scan-pose overlap, and with anatomical neutral the frames, the scan pose and the acetabulum.
 nlohmann::json setup_record(const Session& session);
 
+/// The pelvic frame the clinical angles are measured in: "isb" (Wu et al. 2002: ASIS and PSIS), "app" (the
+/// anterior pelvic plane of clinical ROM tools: ASIS and pubic tubercles) or "scan" (scan neutral: the input
+/// files' axes). rom_limits.csv and summary.json state it.
+std::string pelvic_frame_name(const Session& session);
+
 /// Where one scan comes closest to the other bone.
 struct ClosestPoint {
   std::int64_t vertex = -1;  ///< the tested vertex with the least gap; -1 when none was tested
