@@ -25,6 +25,7 @@
 #include "impinge/io/vtk_output.hpp"
 #include "impinge/maps/map_image.hpp"
 #include "impinge/session/option_table.hpp"
+#include "impinge/session/morphology_run.hpp"
 #include "impinge/session/outputs.hpp"
 #include "impinge/session/records.hpp"
 #include "impinge/session/runs.hpp"
@@ -237,6 +238,28 @@ int run_rom(const RunOptions& o) {
   return 0;
 }
 
+int run_morphology(const RunOptions& o) {
+  const std::string& out = o.command.out;
+  SessionOptions so = o.session;
+  cli::read_vtk_inputs(so.input);
+  const MorphologyRun run = run_morphology(so);
+  for (const std::string& w : run.warnings) std::cerr << "impinge: warning: " << w << "\n";
+  begin_output_folder(out, "morphology");
+  write_morphology_ply(in_dir(out, "femur_sphericity.ply"), run);
+  nlohmann::json j = morphology_record(run);
+  j["impinge_version"] = IMPINGE_VERSION;
+  write_json(in_dir(out, "morphology.json"), j);
+  write_json(in_dir(out, "summary.json"), {{"impinge_version", IMPINGE_VERSION}, {"command", "morphology"}, {"ms", run.ms}});
+  end_output_folder(out);
+  const Morphology& m = run.morphology;
+  std::cout << std::fixed << std::setprecision(1) << "morphology: head radius " << m.head_radius_mm
+            << " mm, alpha max " << m.alpha_max_deg << " deg at " << std::setprecision(0) << m.alpha_max_hour
+            << " o'clock, femoral version " << std::setprecision(1) << m.version_posterior_condylar_deg
+            << " deg, acetabular version " << m.orientation_app.anteversion_deg << " deg, LCE "
+            << m.lateral_centre_edge_deg << " deg; written to " << out << "\n";
+  return 0;
+}
+
 int run_generate(const RunOptions& run) {
   const HipModelOptions& o = run.generate;
   const std::string& out = run.command.out;
@@ -283,6 +306,11 @@ int main(int argc, char** argv) {
                           "Range-of-motion limits from neutral for the standard motions (rom_limits.csv) and the ROM "
                           "map: the largest internal rotation over flexion x adduction (rom_map.csv)"),
        use_rom, run_rom},
+      {app.add_subcommand("morphology",
+                          "The hip's shape as clinicians measure it (morphology.json): femoral head radius and "
+                          "sphericity, neck-shaft angle, femoral version, alpha angle per clock hour, head-neck "
+                          "offset; acetabular sphere, version, inclination, centre-edge angles, coverage. No maps"),
+       use_morphology, run_morphology},
       {app.add_subcommand("generate", "Write a generated hip model (femur_r.ply, pelvis.ply, subject.json)"),
        use_generate, run_generate},
   };

@@ -8,6 +8,7 @@
 #include "bindings.hpp"
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/session/morphology_run.hpp"
 #include "impinge/session/runs.hpp"
 
 namespace impinge::python {
@@ -211,6 +212,21 @@ void add_joint_queries(py::class_<PyJoint>& c) {
            "ROM map: the largest internal rotation (deg) before contact for every flexion x adduction (deg; default "
            "`impinge rom`'s grid) -> float64 (len(flexion), len(adduction)); NaN where in contact already without "
            "rotation or free up to 150 deg. The same search as `impinge rom`'s rom_map.csv (run_rom).")
+      .def(
+          "morphology",
+          [](const PyJoint& j) {
+            MorphologyRun run;
+            {
+              py::gil_scoped_release release;
+              run = run_morphology(j.session->options());
+            }
+            return from_json(morphology_record(run));
+          },
+          "The hip's morphology (the CLI's morphology.json as a dict: femur and acetabulum, each measure's value, unit, "
+          "definition and source; notes): head radius and sphericity, neck-shaft angle, femoral version, alpha "
+          "angle per clock hour, head-neck offset; acetabular sphere, version and inclination (Murray 1993, "
+          "anterior pelvic plane), lateral and anterior centre-edge angles, coverage. Measured on this Joint's inputs "
+          "and frames, without its maps.")
       .def(
           "femur_rotation",
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {

@@ -142,6 +142,7 @@ class Joint:
                 metric: str = 'distance') -> npt.NDArray[np.float64]:
         """Largest internal rotation before contact, (len(flexion), len(adduction)) degrees: `impinge rom`'s
         ROM map (the same search)."""
+    def morphology(self) -> Dict[str, Any]: ...
     def femur_rotation(self, flexion: float = 0.0, adduction: float = 0.0,
                        internal_rotation: float = 0.0) -> npt.NDArray[np.float64]: ...
     def femur_pose(self, flexion: float = 0.0, adduction: float = 0.0,

@@ -12,7 +12,7 @@ namespace {
 using namespace detail;
 
 constexpr unsigned kJointCommands = use_distance | use_motion | use_rom;
-constexpr unsigned kInput = kJointCommands | use_joint;
+constexpr unsigned kInput = kJointCommands | use_joint | use_morphology;
 constexpr unsigned kSetting = kJointCommands | use_joint | use_study;
 
 std::vector<std::string> registered_schemes() {
@@ -100,11 +100,11 @@ void add_input_rows(Rows& t) {
     const Eigen::Vector3d& c = *o.session.cor.given;
     return std::vector<double>{c.x(), c.y(), c.z()};
   };
-  t.flag("allow-any-cor", "allow_any_cor", OptionType::flag, kSetting,
+  t.flag("allow-any-cor", "allow_any_cor", OptionType::flag, kSetting | use_morphology,
          "Accept a --cor outside the femoral head (research; otherwise an error naming the COR and the fitted head "
          "centre)",
          [](auto& o) -> auto& { return o.session.cor.allow_any; });
-  OptionRow& hr = t.add("head-region", "head_region", OptionType::region, "mm", kSetting,
+  OptionRow& hr = t.add("head-region", "head_region", OptionType::region, "mm", kSetting | use_morphology,
                         "X,Y,Z,R: fit the head sphere to femur vertices within R mm of (X,Y,Z), input frame");
   hr.set = [](RunOptions& o, const OptionValue& v, const std::string& as) {
     if (std::holds_alternative<std::monostate>(v)) {
@@ -217,7 +217,7 @@ void add_frame_rows(Rows& t) {
          "axes: flexion about left-right, adduction about antero-posterior, rotation about superior-inferior). "
          "Default: subject.json's \"neutral\", else anatomical",
          [](auto& o) -> auto& { return o.session.frames.neutral; });
-  t.text("pelvis-frame", "pelvis_frame", OptionType::choice, kSetting, {"isb", "app"},
+  t.text("pelvis-frame", "pelvis_frame", OptionType::choice, kSetting | use_morphology, {"isb", "app"},
          "Pelvic axes: 'isb' (Wu et al. 2002: ASIS and PSIS) or 'app' (anterior pelvic plane: ASIS and pubic "
          "tubercles, as clinical ROM tools)",
          [](auto& o) -> auto& { return o.session.frames.pelvis_frame; });
@@ -230,7 +230,7 @@ void add_frame_rows(Rows& t) {
          "pose and limit. Default: equidistant with anatomical neutral, femoral-head with --neutral scan (which "
          "allows no other)",
          [](auto& o) -> auto& { return o.session.frames.joint_centre; });
-  t.text("femur-frame", "femur_frame", OptionType::choice, kSetting, {"epicondyles", "posterior-condyles"},
+  t.text("femur-frame", "femur_frame", OptionType::choice, kSetting | use_morphology, {"epicondyles", "posterior-condyles"},
          "Femoral medio-lateral axis: 'epicondyles' (ISB) or 'posterior-condyles' (posterior condylar axis)",
          [](auto& o) -> auto& { return o.session.frames.femur_frame; });
 }

@@ -157,13 +157,9 @@ LoadedInput load_input(const SessionInput& input) {
   return in;
 }
 
-namespace {
-// The femoral head found on the femur: the end of its long axis that sits in the acetabulum when the
-// pelvis is there, else the end with the better sphere.
 SphereFitResult located_head(const LoadedInput& in) {
   return in.pelvis.V.rows() > 0 ? locate_femoral_head(in.femur, in.pelvis) : locate_femoral_head(in.femur);
 }
-}  // namespace
 
 CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) {
   const Eigen::Matrix3d& M = in.to_working;
@@ -299,11 +295,6 @@ void check_map_memory(const MapSettings& m, const SamplingScheme& scheme) {
 }
 }  // namespace
 
-namespace {
-// The side and the input frame against the bones: on a whole pelvis (over 200 mm wide) the femoral head lies
-// 60-100 mm to its own side of the pelvis' centroid (the shared hips: 82-94 mm); a head on the other side means
-// the side or the frame (LPS read as RAS mirrors left and right) is wrong, which would give a mirrored hip's
-// numbers without a word.
 void check_side_and_frame(const LoadedInput& in, const Eigen::Vector3d& head, const SessionInput& given) {
   if (in.pelvis.V.rows() == 0) return;
   const double width = in.pelvis.V.col(0).maxCoeff() - in.pelvis.V.col(0).minCoeff();
@@ -320,7 +311,6 @@ void check_side_and_frame(const LoadedInput& in, const Eigen::Vector3d& head, co
            ") is wrong";
   });
 }
-}  // namespace
 
 Session::Session(const SessionOptions& options) : options_(options) {
   // The cheap options are checked before anything is read or built.

@@ -85,7 +85,8 @@ enum OptionUse : unsigned {
   use_rom_map = 1u << 6,      ///< Python Joint.rom_map(...); a study's `envelope` task
   use_study = 1u << 7,        ///< a study's [joint] and [[task]] keys
   use_generated_hip = 1u << 8,  ///< Python generated_hip(...)
-  use_cli_commands = use_distance | use_motion | use_rom | use_generate,
+  use_morphology = 1u << 9,     ///< `impinge morphology`, Python impinge.morphology(...)
+  use_cli_commands = use_distance | use_motion | use_rom | use_generate | use_morphology,
 };
 
 /// A value given to an option: nothing ("auto": the preset's rule), a flag, a number, a text, a list

@@ -125,6 +125,16 @@ struct LoadedInput {
   std::vector<std::string> warnings;
 };
 
+/// The femoral head found on the femur of `in`: the end of its long axis that sits in the acetabulum when the
+/// pelvis is there, else the end with the better sphere (locate_femoral_head). Throws impinge::Error as that does.
+SphereFitResult located_head(const LoadedInput& in);
+
+/// Check the side and the input frame against the bones: on a whole pelvis (over 200 mm wide) the femoral head
+/// (`head`, working frame) lies 60-100 mm to its own side of the pelvis' centroid (the shared hips: 82-94 mm); a
+/// head on the other side means the side or the frame (LPS read as RAS mirrors left and right) is wrong. Throws
+/// impinge::Error naming the option (`given`'s side or frame, or the subject's) that is wrong.
+void check_side_and_frame(const LoadedInput& in, const Eigen::Vector3d& head, const SessionInput& given);
+
 /// The side of `input` without reading its meshes (subject.json's, or `side`, else right), to
 /// read a motion file for it before the joint is built. Throws impinge::Error as load_input.
 Side input_side(const SessionInput& input);

@@ -1,0 +1,193 @@
+#include "impinge/clinical/morphology.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "impinge/anatomy/pelvis_frame.hpp"
+#include "impinge/casters/exact_reference.hpp"
+#include "impinge/core/error.hpp"
+
+namespace impinge {
+
+namespace {
+constexpr double kDeg = 180.0 / M_PI;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The unit vector of v's component across unit n.
+Eigen::Vector3d across(const Eigen::Vector3d& v, const Eigen::Vector3d& n) { return (v - v.dot(n) * n).normalized(); }
+
+// The femoral version (deg): the neck axis `neck` (towards the head) against the condylar axis from `medial` to
+// `lateral`, both across the long axis `y`, positive when the neck points towards `anterior`.
+double version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& medial, const Eigen::Vector3d& lateral,
+                   const Eigen::Vector3d& y, const Eigen::Vector3d& anterior) {
+  const Eigen::Vector3d to_medial = across(medial - lateral, y);
+  const Eigen::Vector3d ant = across(across(anterior, y) - across(anterior, y).dot(to_medial) * to_medial, y);
+  const Eigen::Vector3d n = across(neck, y);
+  return std::atan2(n.dot(ant), n.dot(to_medial)) * kDeg;
+}
+
+// The angle (deg) of the rim where it crosses the plane through the origin normal to `normal`, on the side where
+// `side_axis` is positive, measured from `up` towards `towards`: rim points d (relative to the head centre) in
+// azimuth order; the crossing interpolated between consecutive points. NaN when the rim does not cross there.
+double centre_edge_deg(const std::vector<Eigen::Vector3d>& d, const Eigen::Vector3d& normal,
+                       const Eigen::Vector3d& side_axis, const Eigen::Vector3d& up, const Eigen::Vector3d& towards) {
+  double best = kNaN, best_side = -1;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const Eigen::Vector3d& a = d[i];
+    const Eigen::Vector3d& b = d[(i + 1) % d.size()];
+    const double sa = a.dot(normal), sb = b.dot(normal);
+    if ((sa > 0) == (sb > 0) || sa == sb) continue;
+    const Eigen::Vector3d p = a + (b - a) * (sa / (sa - sb));
+    const double s = p.dot(side_axis);
+    if (s <= 0 || s <= best_side) continue;  // on the wanted side; the farthest crossing there
+    best_side = s;
+    best = std::atan2(p.dot(towards), p.dot(up)) * kDeg;
+  }
+  return best;
+}
+}  // namespace
+
+Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFrames& frames, const Acetabulum& A) {
+  Morphology m;
+  const SphereFitResult& head = frames.head;
+  const Eigen::Vector3d c = head.centre;
+  const double r = head.radius;
+  require(c.allFinite() && std::isfinite(r) && r > 0, femur.source + ": morphology: the femoral head sphere is not set");
+  m.head_centre_mm = c;
+  m.head_radius_mm = r;
+  m.head_fit_rms_mm = head.rms_residual;
+  const double lateral_sign = side == Side::right ? 1.0 : -1.0;
+  const AnatomicalFrame& F = frames.femur;
+  const Eigen::Vector3d fx = F.axes.col(0), fy = F.axes.col(1);
+
+  // Neck axis (towards the head) and the head-neck clock.
+  const ClockFace clock = femoral_clock_face(femur, c, r, F);
+  const Eigen::Vector3d n = clock.axis, down_neck = -n;
+  m.neck_axis = n;
+
+  // Sphericity over the head's cap away from the neck.
+  m.head_deviation_mm.assign(static_cast<std::size_t>(femur.V.rows()), kNaN);
+  const double cap = std::cos(100.0 / kDeg);
+  double sum2 = 0;
+  for (Eigen::Index i = 0; i < femur.V.rows(); ++i) {
+    const Eigen::Vector3d d = femur.V.row(i).transpose() - c;
+    const double len = d.norm();
+    if (len == 0 || len > r + 5 || d.dot(down_neck) / len > cap) continue;
+    const double dev = len - r;
+    m.head_deviation_mm[static_cast<std::size_t>(i)] = dev;
+    sum2 += dev * dev;
+    m.sphericity_max_mm = std::max(m.sphericity_max_mm, std::abs(dev));
+    ++m.sphericity_vertices;
+  }
+  m.sphericity_rms_mm = m.sphericity_vertices > 0 ? std::sqrt(sum2 / double(m.sphericity_vertices)) : kNaN;
+
+  // Shaft axis: the principal axis of the diaphysis' surface (35-65 % of the head-to-knee length).
+  const FemurLandmarks& L = frames.femur_landmarks;
+  const Eigen::Vector3d knee = 0.5 * (L.epicondyle_lateral + L.epicondyle_medial);
+  const double length = (c - knee).dot(fy);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> shaft;
+  for (Eigen::Index i = 0; i < femur.V.rows(); ++i) {
+    const Eigen::Vector3d v = femur.V.row(i).transpose();
+    const double s = (c - v).dot(fy) / length;
+    if (s >= 0.35 && s <= 0.65) shaft.push_back(v), mean += v;
+  }
+  if (shaft.size() >= 30) {
+    mean /= double(shaft.size());
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    for (const auto& v : shaft) C += (v - mean) * (v - mean).transpose();
+    Eigen::Vector3d s = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(C).eigenvectors().col(2);
+    if (s.dot(fy) < 0) s = -s;
+    m.shaft_axis = s;
+    m.neck_shaft_angle_deg = std::acos(std::clamp(n.dot(-s), -1.0, 1.0)) * kDeg;
+  } else {
+    m.neck_shaft_angle_deg = kNaN;
+    m.notes.push_back("neck-shaft angle: fewer than 30 vertices on the diaphysis (a proximal femur only?)");
+  }
+
+  // Femoral version against both condylar axes, across the long axis (ISB y).
+  m.version_posterior_condylar_deg =
+      version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, fy, fx);
+  m.version_transepicondylar_deg = version_deg(n, L.epicondyle_medial, L.epicondyle_lateral, fy, fx);
+
+  // Alpha angle per clock hour and the anterior head-neck offset, by exact rays from inside the femur.
+  const ExactReference ref(femur);
+  const double tol = std::max(0.5, std::isfinite(head.rms_residual) ? 2 * head.rms_residual : 0.0);
+  // Swept from the neck (5 deg from its axis, where the ray leaves through the neck far from the centre) towards
+  // the head: the first direction in which the surface lies within the head's radius + tol is where the contour
+  // crosses the circle (Noetzli's point, seen from the neck side: the fovea and any bump on the head beyond it
+  // are never reached).
+  constexpr double kStep = 0.5, kFrom = 5, kTo = 150;
+  m.alpha_max_deg = -1;
+  for (int h = 1; h <= 12; ++h) {
+    const double psi = h * 30.0 / kDeg;
+    const Eigen::Vector3d e = std::cos(psi) * clock.twelve + std::sin(psi) * clock.three;
+    double alpha = kNaN, previous_excess = kNaN;
+    for (double phi = kFrom; phi <= kTo; phi += kStep) {
+      const Eigen::Vector3d u = std::cos(phi / kDeg) * down_neck + std::sin(phi / kDeg) * e;
+      const std::optional<double> rho = ref.first_hit(c, u);
+      const double excess = rho ? *rho - r - tol : std::numeric_limits<double>::infinity();
+      if (excess <= 0) {
+        // Between the last step past the head's reach and this one, where the surface crosses r + tol.
+        alpha = std::isfinite(previous_excess) ? phi - kStep * excess / (excess - previous_excess) : phi;
+        break;
+      }
+      previous_excess = excess;
+    }
+    m.alpha_deg[static_cast<std::size_t>(h - 1)] = alpha;
+    if (std::isfinite(alpha) && alpha > m.alpha_max_deg) m.alpha_max_deg = alpha, m.alpha_max_hour = h;
+  }
+  if (m.alpha_max_deg < 0) m.alpha_max_deg = m.alpha_max_hour = kNaN;
+  double waist = std::numeric_limits<double>::infinity();
+  for (double s = 0.5 * r; s <= 1.3 * r; s += 0.25) {
+    const std::optional<double> w = ref.first_hit(c + s * down_neck, clock.three);
+    if (w) waist = std::min(waist, *w);
+  }
+  if (std::isfinite(waist)) {
+    m.head_neck_offset_mm = r - waist;
+    m.head_neck_offset_ratio = m.head_neck_offset_mm / (2 * r);
+  } else {
+    m.head_neck_offset_mm = m.head_neck_offset_ratio = kNaN;
+    m.notes.push_back("head-neck offset: no anterior neck surface found along the neck axis");
+  }
+
+  // The acetabulum.
+  m.acetabular_centre_mm = A.sphere.centre;
+  m.acetabular_radius_mm = A.sphere.radius;
+  m.acetabular_fit_rms_mm = A.sphere.rms_residual;
+  m.lunate_area_mm2 = A.lunate_area_mm2;
+  const AnatomicalFrame app = pelvis_frame(frames.pelvis_landmarks, c, PelvisFrameKind::anterior_pelvic_plane);
+  m.orientation_app = radiographic_orientation(A, app, side);
+  m.orientation_isb = radiographic_orientation(A, frames.pelvis, side);
+  const Eigen::Vector3d X = app.axes.col(0), Y = app.axes.col(1), lateral = lateral_sign * app.axes.col(2);
+  std::vector<Eigen::Vector3d> d;
+  for (const Eigen::Vector3d& p : A.rim) d.push_back(p - c);
+  // Lateral: the coronal plane (normal X), the rim's crossing that lies most lateral; anterior: the sagittal
+  // plane (normal lateral), the crossing that lies most anterior.
+  m.lateral_centre_edge_deg = centre_edge_deg(d, X, lateral, Y, lateral);
+  m.anterior_centre_edge_deg = centre_edge_deg(d, lateral, X, Y, X);
+  if (std::isnan(m.lateral_centre_edge_deg)) m.notes.push_back("lateral centre-edge angle: the rim does not cross the coronal plane");
+  if (std::isnan(m.anterior_centre_edge_deg)) m.notes.push_back("anterior centre-edge angle: the rim does not cross the sagittal plane");
+  // Coverage: the cap inside the rim, seen from the head centre (the pole: into the acetabulum).
+  const Eigen::Vector3d pole = -A.opening;
+  std::array<double, 12> sum{};
+  std::array<int, 12> count{};
+  double covered = 0;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const double theta = std::acos(std::clamp(d[i].normalized().dot(pole), -1.0, 1.0));
+    covered += (1 - std::cos(theta)) / 2;
+    const double hour = A.clock.hour(A.rim[i]);
+    if (std::isfinite(hour)) {
+      const auto k = static_cast<std::size_t>(ClockFace::sector(hour));
+      sum[k] += theta * kDeg, ++count[k];
+    }
+  }
+  m.head_coverage = d.empty() ? kNaN : covered / double(d.size());
+  for (std::size_t k = 0; k < 12; ++k) m.coverage_deg[k] = count[k] > 0 ? sum[k] / count[k] : kNaN;
+  return m;
+}
+
+}  // namespace impinge

@@ -1,0 +1,155 @@
+"""impinge morphology (clinical/morphology.hpp) on the shared hips, against independent measures:
+- the head radius within 0.3 mm of an independent sphere fit (numpy least squares on the head's cap) on the CT
+  hip; within 1.5 mm on the MRI hips, whose heads are not spheres;
+- a mirrored hip (x negated, the other side) gives the same morphology, and a rigidly moved hip the same;
+- Joint.morphology() is the CLI's morphology.json;
+- the femur PLY carries the head's deviation from its sphere."""
+import json
+import os
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+import impinge
+
+DATA = os.environ.get("IMPINGE_SHARED_DATA", "../shared/data/hips")
+CLI = os.environ.get("IMPINGE_CLI", "build/impinge")
+HIPS = ["lhdl-ct", "mc22", "mc22-left", "tlem2-mri"]
+
+needs_data = pytest.mark.skipif(not os.path.exists(os.path.join(DATA, "lhdl-ct", "subject.json")),
+                                reason="shared data absent")
+
+
+def morphology(subject_or_args, out):
+    args = ["--subject", subject_or_args] if isinstance(subject_or_args, str) else subject_or_args
+    subprocess.run([CLI, "morphology", *args, "--out", out], check=True, capture_output=True, text=True)
+    with open(os.path.join(out, "morphology.json")) as f:
+        return json.load(f)
+
+
+def values(m):
+    """Every scalar and per-hour measure of a morphology.json, flattened: name -> float."""
+    out = {}
+    for part in ("femur", "acetabulum"):
+        for k, v in m[part].items():
+            if not isinstance(v, dict) or "value" not in v:
+                continue
+            x = v["value"]
+            if isinstance(x, dict):
+                for h, y in x.items():
+                    out[f"{part}.{k}.{h}"] = np.nan if y is None else float(y)
+            elif not isinstance(x, list):
+                out[f"{part}.{k}"] = np.nan if x is None else float(x)
+    return out
+
+
+def sphere_fit(P):
+    """Algebraic least-squares sphere (|p|^2 = 2 c.p + d), then Gauss-Newton on the geometric distance."""
+    A = np.c_[2 * P, np.ones(len(P))]
+    x = np.linalg.lstsq(A, (P ** 2).sum(1), rcond=None)[0]
+    c, r = x[:3], np.sqrt(x[3] + x[:3] @ x[:3])
+    for _ in range(20):
+        d = P - c
+        n = np.linalg.norm(d, axis=1)
+        J = np.c_[-d / n[:, None], -np.ones(len(P))]
+        step = np.linalg.lstsq(J, -(n - r), rcond=None)[0]
+        c, r = c + step[:3], r + step[3]
+    return c, r
+
+
+@needs_data
+@pytest.mark.parametrize("hip", HIPS)
+def test_head_radius_matches_an_independent_sphere_fit(hip, tmp_path):
+    m = morphology(os.path.join(DATA, hip, "subject.json"), str(tmp_path))
+    subject = json.load(open(os.path.join(DATA, hip, "subject.json")))
+    V, _ = impinge.load_mesh(os.path.join(DATA, hip, subject["femur"]))
+    c = np.array(m["femur"]["head_centre_mm"]["value"])
+    n = np.array(m["femur"]["neck_axis"]["value"])
+    r = m["femur"]["head_radius_mm"]["value"]
+    # The head's cap: vertices within 6 mm of the reported sphere, more than 100 deg from the neck direction.
+    d = V - c
+    dist = np.linalg.norm(d, axis=1)
+    cap = (np.abs(dist - r) < 6) & ((d @ -n) / dist < np.cos(np.radians(100)))
+    assert cap.sum() > 200
+    # Own robust fit: refit on the points within 2.5 rms (at least 1 mm) of the last sphere, five times.
+    P = V[cap]
+    for _ in range(5):
+        c_own, r_own = sphere_fit(P)
+        res = np.linalg.norm(V[cap] - c_own, axis=1) - r_own
+        keep = np.abs(res) < max(1.0, 2.5 * np.sqrt(np.mean(res ** 2)))
+        P = V[cap][keep]
+    assert len(P) > 200
+    # The CT head is a sphere to 0.39 mm rms: both fits agree within 0.3 mm. The MRI heads are not (sphericity up to
+    # 4.7 mm): a fit of their whole cap and impinge's fit of their most spherical part (RANSAC, then the fixed
+    # point of its inliers) differ by 0.4-1.3 mm, and a cap fit's radius moves by up to 5 mm with the cap's extent.
+    assert abs(r_own - r) <= (0.3 if hip == "lhdl-ct" else 1.5), (hip, r_own, r)
+    # The values a reader checks first lie in anatomical ranges.
+    f, a = m["femur"], m["acetabulum"]
+    assert 100 < f["neck_shaft_angle_deg"]["value"] < 150
+    assert -30 < f["version_posterior_condylar_deg"]["value"] < 50
+    assert all(15 < v < 90 for v in f["alpha_deg_by_hour"]["value"].values() if v is not None)
+    assert 30 < a["inclination_deg"]["value"] < 70 and -10 < a["version_deg"]["value"] < 45
+    assert 0.2 < a["head_coverage"]["value"] < 0.7
+
+
+def write_ply(path, V, F):
+    with open(path, "wb") as f:
+        f.write(f"ply\nformat binary_little_endian 1.0\nelement vertex {len(V)}\nproperty double x\nproperty double y\n"
+                f"property double z\nelement face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n".encode())
+        f.write(np.ascontiguousarray(V, dtype="<f8").tobytes())
+        rec = np.zeros(len(F), dtype=[("n", "u1"), ("i", "<i4", (3,))])
+        rec["n"] = 3
+        rec["i"] = F
+        f.write(rec.tobytes())
+
+
+def moved_copy(hip, out, transform, flip_side):
+    """The hip with every vertex moved by transform (x -> R x + t, LPS), side flipped when mirrored; triangles
+    re-wound when the transform reverses orientation."""
+    subject = json.load(open(os.path.join(DATA, hip, "subject.json")))
+    R, t = transform
+    for key in ("femur", "pelvis"):
+        V, F = impinge.load_mesh(os.path.join(DATA, hip, subject[key]))
+        if np.linalg.det(R) < 0:
+            F = F[:, ::-1]
+        write_ply(os.path.join(out, key + ".ply"), V @ R.T + t, F)
+    s = dict(subject, femur="femur.ply", pelvis="pelvis.ply")
+    if flip_side:
+        s["side"] = "left" if subject["side"] == "right" else "right"
+    s.pop("landmarks", None)
+    json.dump(s, open(os.path.join(out, "subject.json"), "w"))
+    return os.path.join(out, "subject.json")
+
+
+@needs_data
+def test_a_mirrored_or_moved_hip_has_the_same_morphology(tmp_path):
+    base = values(morphology(os.path.join(DATA, "lhdl-ct", "subject.json"), str(tmp_path / "base")))
+    mirror = (np.diag([-1.0, 1.0, 1.0]), np.zeros(3))
+    a = np.radians(25)
+    R = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]]) @ \
+        np.array([[1, 0, 0], [0, np.cos(0.4), -np.sin(0.4)], [0, np.sin(0.4), np.cos(0.4)]])
+    moved = (R, np.array([40.0, -120.0, 300.0]))
+    for name, transform, flip in (("mirrored", mirror, True), ("moved", moved, False)):
+        d = tmp_path / name
+        d.mkdir()
+        got = values(morphology(moved_copy("lhdl-ct", str(d), transform, flip), str(d / "out")))
+        for k, v in base.items():
+            unit_mm = k.endswith("_mm") or "_mm." in k
+            tol = 0.05 if unit_mm else 0.02 if ("coverage" in k and "deg" not in k) or "ratio" in k else 0.5
+            assert np.isnan(v) == np.isnan(got[k]), (name, k, v, got[k])
+            if not np.isnan(v):
+                assert abs(got[k] - v) <= tol, (name, k, v, got[k])
+
+
+@needs_data
+def test_joint_morphology_is_the_clis_and_the_ply_shows_the_deviation(tmp_path):
+    subject = os.path.join(DATA, "tlem2-mri", "subject.json")
+    cli = morphology(subject, str(tmp_path))
+    j = impinge.Joint(subject=subject, resolution=2.0)
+    py = j.morphology()
+    assert values(py) == pytest.approx(values(cli), nan_ok=True)
+    ply = open(tmp_path / "femur_sphericity.ply", "rb").read(400).decode("latin-1")
+    assert "property float gap_mm" in ply  # the deviation, in the gap's slot (ParaView colours it)
+    assert cli["femur"]["sphericity_max_mm"]["value"] >= cli["femur"]["sphericity_rms_mm"]["value"] > 0
