@@ -29,24 +29,21 @@ double version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& medial, c
   return std::atan2(n.dot(ant), n.dot(to_medial)) * kDeg;
 }
 
-// The angle (deg) of the rim where it crosses the plane through the origin normal to `normal`, on the side where
-// `side_axis` is positive, measured from `up` towards `towards`: rim points d (relative to the head centre) in
-// azimuth order; the crossing interpolated between consecutive points. NaN when the rim does not cross there.
+// The angle (deg) of the rim in the plane through the head centre (the origin) normal to `normal`, on the side where
+// `side_axis` is positive, measured from `up` towards `towards`: the median over the rim points d (relative to the
+// head centre) within kBandMm of the plane (an MRI rim has notches a single crossing would fall into: mc22-left's
+// lateral centre-edge angle read 5 deg at one crossing, 15 deg as this median); NaN when no rim point lies there.
 double centre_edge_deg(const std::vector<Eigen::Vector3d>& d, const Eigen::Vector3d& normal,
                        const Eigen::Vector3d& side_axis, const Eigen::Vector3d& up, const Eigen::Vector3d& towards) {
-  double best = kNaN, best_side = -1;
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    const Eigen::Vector3d& a = d[i];
-    const Eigen::Vector3d& b = d[(i + 1) % d.size()];
-    const double sa = a.dot(normal), sb = b.dot(normal);
-    if ((sa > 0) == (sb > 0) || sa == sb) continue;
-    const Eigen::Vector3d p = a + (b - a) * (sa / (sa - sb));
-    const double s = p.dot(side_axis);
-    if (s <= 0 || s <= best_side) continue;  // on the wanted side; the farthest crossing there
-    best_side = s;
-    best = std::atan2(p.dot(towards), p.dot(up)) * kDeg;
-  }
-  return best;
+  constexpr double kBandMm = 5;
+  std::vector<double> angles;
+  for (const Eigen::Vector3d& p : d)
+    if (std::abs(p.dot(normal)) <= kBandMm && p.dot(side_axis) > 0)
+      angles.push_back(std::atan2(p.dot(towards), p.dot(up)) * kDeg);
+  if (angles.empty()) return kNaN;
+  std::sort(angles.begin(), angles.end());
+  const std::size_t k = angles.size() / 2;
+  return angles.size() % 2 == 1 ? angles[k] : 0.5 * (angles[k - 1] + angles[k]);
 }
 }  // namespace
 
@@ -165,12 +162,12 @@ Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFra
   const Eigen::Vector3d X = app.axes.col(0), Y = app.axes.col(1), lateral = lateral_sign * app.axes.col(2);
   std::vector<Eigen::Vector3d> d;
   for (const Eigen::Vector3d& p : A.rim) d.push_back(p - c);
-  // Lateral: the coronal plane (normal X), the rim's crossing that lies most lateral; anterior: the sagittal
-  // plane (normal lateral), the crossing that lies most anterior.
-  m.lateral_centre_edge_deg = centre_edge_deg(d, X, lateral, Y, lateral);
+  // Lateral: the rim in the coronal plane (normal X) above the head centre; anterior: in the sagittal plane
+  // (normal: lateral), in front of it.
+  m.lateral_centre_edge_deg = centre_edge_deg(d, X, Y, Y, lateral);
   m.anterior_centre_edge_deg = centre_edge_deg(d, lateral, X, Y, X);
-  if (std::isnan(m.lateral_centre_edge_deg)) m.notes.push_back("lateral centre-edge angle: the rim does not cross the coronal plane");
-  if (std::isnan(m.anterior_centre_edge_deg)) m.notes.push_back("anterior centre-edge angle: the rim does not cross the sagittal plane");
+  if (std::isnan(m.lateral_centre_edge_deg)) m.notes.push_back("lateral centre-edge angle: no rim point within 5 mm of the coronal plane above the head");
+  if (std::isnan(m.anterior_centre_edge_deg)) m.notes.push_back("anterior centre-edge angle: no rim point within 5 mm of the sagittal plane in front of the head");
   // Coverage: the cap inside the rim, seen from the head centre (the pole: into the acetabulum).
   const Eigen::Vector3d pole = -A.opening;
   std::array<double, 12> sum{};

@@ -138,6 +138,10 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
                                       "the rim's angle from the acetabular pole per acetabular clock hour (12 "
                                       "superior, 3 anterior, 6 at the notch)",
                                       "Blankenbaker et al. 2007 (clock)");
+  nlohmann::json rim = nlohmann::json::array();
+  for (const Eigen::Vector3d& p : run.acetabulum.rim) rim.push_back(vec(T * p));
+  a["rim_mm"] = measure(rim, "mm", "the acetabular rim: per 5 deg of azimuth about the cup's axis, the cup's point "
+                                   "farthest from its pole", "impinge (find_acetabulum)");
   a["pelvic_frame"] = frame_record(run.frames.pelvis, T, "app_out_of_plane_mm");
   j["notes"] = m.notes;
   j["warnings"] = run.warnings;

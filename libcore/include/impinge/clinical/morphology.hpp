@@ -32,10 +32,11 @@
 ///   (Murray 1993, J Bone Joint Surg Br 75:228) of the rim plane's normal in the anterior pelvic plane (supine
 ///   radiographs; the ISB frame's values beside them); normal inclination 40-50, version 10-25 deg;
 /// - lateral centre-edge angle (Wiberg 1939): in the coronal plane of the anterior pelvic plane frame through the
-///   head centre, between the superior axis and the line from the head centre to the rim where it crosses that
-///   plane, positive lateral (normal 25-39 deg; under 20 dysplasia, over 39-40 over-coverage); anterior
-///   centre-edge angle (Lequesne and de Seze 1961): the same in the sagittal plane, towards anterior (normal over
-///   20-25 deg);
+///   head centre, between the superior axis and the line from the head centre to the rim above it, positive
+///   lateral: the median over the rim points within 5 mm of that plane (an MRI rim has notches) (normal 25-39 deg;
+///   under 20 dysplasia, over 39-40 over-coverage); anterior centre-edge angle (Lequesne and de Seze 1961): the
+///   same in the sagittal plane, in front of the head, towards anterior (normal over 20-25 deg). Both from the
+///   bony rim in 3D, not the sourcil on a radiograph;
 /// - coverage: the share of the head sphere's surface that the acetabulum covers seen from the head centre (the
 ///   cap inside the rim: 0.5 is a hemisphere), and the rim's angle from the acetabular pole per acetabular clock
 ///   hour (deg).

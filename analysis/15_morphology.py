@@ -1,0 +1,126 @@
+"""15_morphology: each shared hip's morphology beside the published normal ranges, and its ROM limits beside the
+morphology (issue 49).
+
+Reads RESULTS/15_morphology/{morphology,limits,published}.csv; writes table_morphology.tex, alpha_by_hour.pdf/png,
+ir90_vs_morphology.pdf/png, macros.tex. With no hips (no shared data) it writes the macros as "--" and no figures."""
+import matplotlib.pyplot as plt
+import numpy as np
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+
+d = experiment_dir("15_morphology")
+mo = read_csv(d, "morphology.csv")
+lim = read_csv(d, "limits.csv")
+pub = read_csv(d, "published.csv")
+hips = list(mo.subject)
+
+
+def f(x, n=1):
+    return "--" if x is None or (isinstance(x, float) and np.isnan(x)) else f"{x:.{n}f}"
+
+
+def normal_text(p):
+    lo, hi = p.low, p.high
+    if np.isnan(lo):
+        return f"$\\le {hi:g}$"
+    if np.isnan(hi):
+        return f"$\\ge {lo:g}$"
+    return f"{lo:g}--{hi:g}"
+
+
+def outside(p, v):
+    return (not np.isnan(p.low) and v < p.low) or (not np.isnan(p.high) and v > p.high)
+
+
+# The table: every published quantity for every hip, marked (*) where it lies outside the normal range.
+rows = []
+names = {"alpha_max_deg": "alpha angle, largest (deg)", "head_neck_offset_ratio": "head-neck offset ratio",
+         "neck_shaft_angle_deg": "neck-shaft angle (deg)",
+         "version_posterior_condylar_deg": "femoral version, post. condylar (deg)",
+         "inclination_deg": "acetabular inclination (deg)", "version_deg": "acetabular version (deg)",
+         "lateral_centre_edge_deg": "lateral centre-edge angle (deg)",
+         "anterior_centre_edge_deg": "anterior centre-edge angle (deg)"}
+for p in pub.itertuples():
+    digits = 2 if "ratio" in p.quantity else 1
+    cells = []
+    for h in hips:
+        v = float(mo[mo.subject == h][p.quantity].iloc[0])
+        cells.append(f(v, digits) + ("*" if outside(p, v) else ""))
+    rows.append([names.get(p.quantity, p.quantity)] + cells + [normal_text(p), p.source.split(",")[0]])
+for key, label, digits in (("head_radius_mm", "head radius (mm)", 1), ("sphericity_max_mm", "head asphericity, max (mm)", 1),
+                           ("acetabular_radius_mm", "acetabular radius (mm)", 1), ("head_coverage", "head coverage (share)", 2)):
+    rows.append([label] + [f(float(mo[mo.subject == h][key].iloc[0]), digits) for h in hips] + ["", ""])
+write_table(d, "table_morphology", ["measure"] + hips + ["normal", "source"], rows, align="l" + "r" * len(hips) + "ll")
+
+macros = {}
+def count_outside(quantity, side):
+    p = next(q for q in pub.itertuples() if q.quantity == quantity)
+    bound = p.high if side == "high" else p.low
+    vals = mo[quantity].astype(float)
+    return int((vals > bound).sum() if side == "high" else (vals < bound).sum())
+
+
+macros["MOhips"] = str(len(hips))
+if hips:
+    macros["MOcamHips"] = str(count_outside("alpha_max_deg", "high"))
+    macros["MOlowOffsetHips"] = str(count_outside("head_neck_offset_ratio", "low"))
+    macros["MOpincerHips"] = str(count_outside("lateral_centre_edge_deg", "high"))
+    macros["MOdysplasticHips"] = str(count_outside("lateral_centre_edge_deg", "low"))
+    macros["MOalphaMaxLow"], macros["MOalphaMaxHigh"] = f(mo.alpha_max_deg.min()), f(mo.alpha_max_deg.max())
+    macros["MOlceLow"], macros["MOlceHigh"] = f(mo.lateral_centre_edge_deg.min()), f(mo.lateral_centre_edge_deg.max())
+    macros["MOasphericityHigh"] = f(mo.sphericity_max_mm.max())
+    if {"mc22", "mc22-left"} <= set(hips):
+        r, l = mo[mo.subject == "mc22"].iloc[0], mo[mo.subject == "mc22-left"].iloc[0]
+        macros["MOversionLR"] = f(l.version_posterior_condylar_deg - r.version_posterior_condylar_deg)
+        macros["MOversionTeLR"] = f(l.version_transepicondylar_deg - r.version_transepicondylar_deg)
+        macros["MOlceLR"] = f(l.lateral_centre_edge_deg - r.lateral_centre_edge_deg)
+        macros["MOacetVersionLR"] = f(l.version_deg - r.version_deg)
+    app = lim[(lim.pelvic_frame == "app") & (lim.motion == "internal_rotation_90_flexion")]
+    reached = app[app.status == "limited"]
+    macros["MOirNinetyReached"] = str(len(reached))
+    macros["MOirNinetyLow"] = f(reached.limit_deg.min()) if len(reached) else "--"
+    macros["MOirNinetyHigh"] = f(reached.limit_deg.max()) if len(reached) else "--"
+    macros["MOsoftTissueFirst"] = str(int(lim[lim.pelvic_frame == "app"].soft_tissue_first.sum()))
+    macros["MOlimitsApp"] = str(int((lim.pelvic_frame == "app").sum()))
+    macros["MOnotReachable"] = str(int((lim.status == "not_reachable").sum()))
+else:
+    for k in ("MOcamHips", "MOlowOffsetHips", "MOpincerHips", "MOdysplasticHips", "MOalphaMaxLow", "MOalphaMaxHigh",
+              "MOlceLow", "MOlceHigh", "MOasphericityHigh", "MOirNinetyReached", "MOirNinetyLow", "MOirNinetyHigh",
+              "MOsoftTissueFirst", "MOlimitsApp", "MOnotReachable"):
+        macros[k] = "--"
+for k in ("MOversionLR", "MOversionTeLR", "MOlceLR", "MOacetVersionLR"):
+    macros.setdefault(k, "--")
+write_macros(d, "macros", macros)
+
+if hips:
+    # The alpha angle around the head-neck junction, every hip.
+    fig, ax = plt.subplots(figsize=(6, 3.2))
+    hours = np.arange(1, 13)
+    for i, h in enumerate(hips):
+        r = mo[mo.subject == h].iloc[0]
+        ax.plot(hours, [r[f"alpha_{k}h_deg"] for k in hours], "o-", color=f"C{i}", label=h, ms=4)
+    cam = next(q for q in pub.itertuples() if q.quantity == "alpha_max_deg").high
+    ax.axhline(cam, color="black", lw=1, ls="--", label=f"cam above {cam:g} deg (Noetzli 2002)")
+    ax.set_xticks(hours)
+    ax.set_xlabel("head-neck clock hour (12 superior, 3 anterior)")
+    ax.set_ylabel("alpha angle (deg)")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    save(fig, d, "alpha_by_hour")
+
+    # Internal rotation at 90 deg flexion (anterior pelvic plane) against the alpha angle and the femoral version.
+    fig, axes = plt.subplots(1, 2, figsize=(7.5, 3.2), sharey=True)
+    for ax, key, label in ((axes[0], "alpha_max_deg", "largest alpha angle (deg)"),
+                           (axes[1], "version_posterior_condylar_deg", "femoral version (deg)")):
+        for i, h in enumerate(hips):
+            row = lim[(lim.subject == h) & (lim.pelvic_frame == "app") & (lim.motion == "internal_rotation_90_flexion")]
+            x = float(mo[mo.subject == h][key].iloc[0])
+            if row.status.iloc[0] == "limited":
+                ax.plot(x, row.limit_deg.iloc[0], "o", color=f"C{i}", label=h)
+            else:
+                ax.plot(x, 0, "x", color=f"C{i}", label=f"{h} (start not reached)")
+        ax.set_xlabel(label)
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("internal rotation at 90 deg flexion (deg, APP)")
+    axes[1].legend(fontsize=7)
+    save(fig, d, "ir90_vs_morphology")
