@@ -326,3 +326,26 @@ def test_motion_files_read_as_the_cli_reads_them():
     assert m["angles"][:, 0].max() == pytest.approx(110.0, abs=0.01) and m["time_s"][-1] == 4.0
     with pytest.raises(impinge.Error, match="deep_squat.mot.*hip_flexion_x|side"):
         impinge.load_motion(os.path.join(MOTIONS, "deep_squat.mot"), "middle")
+
+
+@pytest.mark.skipif(not os.path.exists(os.path.join(os.environ.get("IMPINGE_SHARED_DATA", "../shared/data/hips"),
+                                                    "lhdl-ct", "subject.json")), reason="shared data absent")
+def test_a_morphology_task_records_the_joints_morphology(tmp_path):
+    data = os.environ.get("IMPINGE_SHARED_DATA", "../shared/data/hips")
+    subject = os.path.abspath(os.path.join(data, "lhdl-ct", "subject.json"))
+    path = write_study(str(tmp_path), f"""name = "shape"
+subjects = ["{subject}"]
+[joint]
+resolution = 2.0
+[[task]]
+kind = "morphology"
+""")
+    out = str(tmp_path / "out")
+    study.run(path, out, workers=0, progress=False, log=lambda _: None)
+    rows = read(out)
+    assert len(rows) == 1 and rows[0]["status"] == "ok", rows
+    expected = impinge.Joint(subject=subject, resolution=2.0).morphology()
+    assert float(rows[0]["alpha_max_deg"]) == pytest.approx(expected["femur"]["alpha_max_deg"]["value"])
+    assert float(rows[0]["lateral_centre_edge_deg"]) == pytest.approx(
+        expected["acetabulum"]["lateral_centre_edge_deg"]["value"])
+    assert os.path.exists(os.path.join(out, "tasks", rows[0]["task_id"], "morphology.json"))

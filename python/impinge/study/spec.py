@@ -17,7 +17,7 @@ import numpy as np
 
 import impinge
 
-KINDS = ("rom", "envelope", "motion", "distance")
+KINDS = ("rom", "envelope", "motion", "distance", "morphology")
 
 # Every key below comes from the option table (the session layer's, impinge.options()): a study cannot expose an
 # option, a default or a type that the CLI and Python do not share.
@@ -39,6 +39,7 @@ KIND_KEYS = {
     "envelope": {o["key"]: o["default"] for o in _table("rom_map")},
     "motion": {"motion": None},
     "distance": {"poses": None},
+    "morphology": {},
 }
 KIND_TYPES = dict({o["key"]: _PY_TYPES[o["type"]] for o in _table("rom_limits") + _table("rom_map")},
                   motion=str, poses=list)

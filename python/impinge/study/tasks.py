@@ -175,7 +175,22 @@ def _run_distance(joint, task, folder):
     return out
 
 
-RUNNERS = {"rom": _run_rom, "envelope": _run_envelope, "motion": _run_motion, "distance": _run_distance}
+def _run_morphology(joint, task, folder):
+    m = joint.morphology()
+    with open(os.path.join(folder, "morphology.json"), "w") as f:
+        json.dump(m, f, indent=1)
+    out = {}
+    for part in ("femur", "acetabulum"):
+        for k, v in m[part].items():
+            if isinstance(v, dict) and isinstance(v.get("value"), (int, float)) and not isinstance(v["value"], bool):
+                out[k] = float(v["value"])
+            elif isinstance(v, dict) and v.get("value") is None and "unit" in v:
+                out[k] = float("nan")
+    return out
+
+
+RUNNERS = {"rom": _run_rom, "envelope": _run_envelope, "motion": _run_motion, "distance": _run_distance,
+           "morphology": _run_morphology}
 
 
 def task_record(task):
