@@ -1,8 +1,12 @@
 """Results that depend on the geometry, not on how a file writes it (issue 48, item 1). Invariants: a shared hip
 whose pelvis or femur has its vertices and faces renumbered (and each face's corners rotated), or whose pelvis has
 every vertex duplicated (each face its own three), gives the original's ROM limits within 0.05 deg and least
-distances within 0.01 mm. An OBJ file's vertices come back in the file's order. (A pelvis whose triangles are split
-moves the acetabulum's vertex-cut fit: not asserted here; issue 49 refits it.)"""
+distances within 0.01 mm. A pelvis whose every triangle is split in four (the same surface, more vertices) gives the
+same acetabulum (0.005 mm), the same equidistant translation (0.005 mm) and least distances (0.01 mm), and the same
+limits within 0.1 deg where both runs call them monotone, but for one graze (a contact barely past the contact depth
+is decided by the vertices the split adds: lhdl-ct's extension moves 1.6 deg at 0.5 deg maps, its abduction 1 deg
+at 0.1 deg). An OBJ file's vertices come back in the
+file's order."""
 import csv
 import json
 import os
@@ -72,6 +76,21 @@ def duplicated(V, F):
     return V[F.reshape(-1)], np.arange(3 * len(F)).reshape(-1, 3)
 
 
+def split4(V, F):
+    edges, W, out = {}, list(V), []
+
+    def mid(a, b):
+        k = (min(a, b), max(a, b))
+        if k not in edges:
+            edges[k] = len(W)
+            W.append((V[a] + V[b]) / 2)
+        return edges[k]
+    for a, b, c in F:
+        ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+        out += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca)]
+    return np.array(W), np.array(out)
+
+
 def outcome(subject, out):
     r = run(["rom", "--subject", subject, "--precision", "0.5", "--no-map", "--out", out / "rom"])
     assert r.returncode == 0, r.stderr
@@ -111,3 +130,27 @@ def test_an_obj_keeps_its_vertex_order(tmp_path):
     W, _ = impinge.load_mesh(str(tmp_path / "m.obj"))
     assert W.shape == (5, 3)
     np.testing.assert_array_equal(W, V[order])
+
+
+def monotone_limits(out):
+    return {x["motion"]: float(x["limit_deg"]) for x in csv.DictReader(open(out / "rom" / "rom_limits.csv"))
+            if x["monotone"] in ("1", "true") and x["status"] == "limited"}
+
+
+@pytest.mark.skipif(not os.path.exists(SUBJECT), reason="shared data absent")
+def test_a_pelvis_split_in_four_gives_the_same_acetabulum_translation_and_distances(tmp_path):
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    _, ref_dist = outcome(SUBJECT, tmp_path / "a")
+    _, dist = outcome(variant(tmp_path, "v", split4, "pelvis"), tmp_path / "b")
+    assert np.allclose(dist, ref_dist, atol=0.01, rtol=0), (ref_dist, dist)
+    a, b = (json.load(open(tmp_path / x / "d" / "summary.json")) for x in ("a", "b"))
+    assert np.allclose(a["acetabular_centre_mm"], b["acetabular_centre_mm"], atol=0.005, rtol=0)
+    assert np.allclose(a["joint_translation_mm"], b["joint_translation_mm"], atol=0.005, rtol=0)
+    la, lb = monotone_limits(tmp_path / "a"), monotone_limits(tmp_path / "b")
+    both = set(la) & set(lb)
+    assert len(both) >= 6, (la, lb)
+    # All but one within 0.1 deg; the one left is lhdl-ct's extension near 138 deg at 0.5 deg maps (1.6 deg apart,
+    # 108 deg past the normal range: a graze along the posterior rim that the added vertices meet first).
+    off = {k: (la[k], lb[k]) for k in both if abs(la[k] - lb[k]) > 0.1}
+    assert len(off) <= 1 and all(abs(a - b) <= 2 for a, b in off.values()), off
