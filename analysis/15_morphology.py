@@ -9,9 +9,11 @@ import numpy as np
 from common import experiment_dir, read_csv, save, write_macros, write_table
 
 d = experiment_dir("15_morphology")
-mo = read_csv(d, "morphology.csv")
+mo_all = read_csv(d, "morphology.csv")
 lim = read_csv(d, "limits.csv")
 pub = read_csv(d, "published.csv")
+generated = mo_all[mo_all.subject.str.startswith("generated")]
+mo = mo_all[~mo_all.subject.str.startswith("generated")]
 hips = list(mo.subject)
 
 
@@ -90,6 +92,24 @@ else:
         macros[k] = "--"
 for k in ("MOversionLR", "MOversionTeLR", "MOlceLR", "MOacetVersionLR"):
     macros.setdefault(k, "--")
+# The generated cams: the alpha angle and the internal rotation the cam leaves (ROM map at 0 and 20 deg flexion).
+def gen_ir(subject, flexion):
+    r = lim[(lim.subject == subject) & (lim.motion == f"internal_rotation_map_{flexion}_flexion")]
+    return float(r.limit_deg.iloc[0]) if len(r) else float("nan")
+
+
+cams = sorted(generated.subject, key=lambda x: float(x.replace("generated-cam", "")))
+if cams:
+    lo, hi = cams[0], cams[-1]
+    macros["MOgenCamLow"], macros["MOgenCamHigh"] = lo.replace("generated-cam", ""), hi.replace("generated-cam", "")
+    macros["MOgenAlphaLow"] = f(float(generated[generated.subject == lo].alpha_max_deg.iloc[0]))
+    macros["MOgenAlphaHigh"] = f(float(generated[generated.subject == hi].alpha_max_deg.iloc[0]))
+    macros["MOgenIrZeroLow"], macros["MOgenIrZeroHigh"] = f(gen_ir(lo, 0)), f(gen_ir(hi, 0))
+    macros["MOgenIrTwentyLow"], macros["MOgenIrTwentyHigh"] = f(gen_ir(lo, 20)), f(gen_ir(hi, 20))
+else:
+    for k in ("MOgenCamLow", "MOgenCamHigh", "MOgenAlphaLow", "MOgenAlphaHigh", "MOgenIrZeroLow", "MOgenIrZeroHigh",
+              "MOgenIrTwentyLow", "MOgenIrTwentyHigh"):
+        macros[k] = "--"
 write_macros(d, "macros", macros)
 
 if hips:
@@ -108,8 +128,9 @@ if hips:
     ax.grid(alpha=0.3)
     save(fig, d, "alpha_by_hour")
 
-    # Internal rotation at 90 deg flexion (anterior pelvic plane) against the alpha angle and the femoral version.
-    fig, axes = plt.subplots(1, 2, figsize=(7.5, 3.2), sharey=True)
+    # Internal rotation at 90 deg flexion (anterior pelvic plane) against the alpha angle and the femoral version;
+    # and the generated cams' internal rotation (ROM map) against their alpha angle.
+    fig, axes = plt.subplots(1, 3, figsize=(10, 3.2))
     for ax, key, label in ((axes[0], "alpha_max_deg", "largest alpha angle (deg)"),
                            (axes[1], "version_posterior_condylar_deg", "femoral version (deg)")):
         for i, h in enumerate(hips):
@@ -121,6 +142,15 @@ if hips:
                 ax.plot(x, 0, "x", color=f"C{i}", label=f"{h} (start not reached)")
         ax.set_xlabel(label)
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel("internal rotation at 90 deg flexion (deg, APP)")
-    axes[1].legend(fontsize=7)
+    axes[0].set_ylabel("IR at 90 deg flexion, APP (deg)")
+    axes[1].legend(fontsize=6)
+    ax = axes[2]
+    for flexion, marker in ((0, "o-"), (20, "s-")):
+        xs = [float(generated[generated.subject == c].alpha_max_deg.iloc[0]) for c in cams]
+        ys = [gen_ir(c, flexion) for c in cams]
+        ax.plot(xs, ys, marker, label=f"generated cams, {flexion} deg flexion")
+    ax.set_xlabel("largest alpha angle (deg)")
+    ax.set_ylabel("internal rotation (deg, ROM map)")
+    ax.legend(fontsize=6)
+    ax.grid(alpha=0.3)
     save(fig, d, "ir90_vs_morphology")

@@ -153,3 +153,27 @@ def test_joint_morphology_is_the_clis_and_the_ply_shows_the_deviation(tmp_path):
     ply = open(tmp_path / "femur_sphericity.ply", "rb").read(400).decode("latin-1")
     assert "property float gap_mm" in ply  # the deviation, in the gap's slot (ParaView colours it)
     assert cli["femur"]["sphericity_max_mm"]["value"] >= cli["femur"]["sphericity_rms_mm"]["value"] > 0
+
+
+def test_a_generated_hip_has_its_analytic_alpha_angle_and_offset_and_a_cam_raises_it(tmp_path):
+    """A generated hip (head radius 22 mm, cylindrical neck of radius 15 mm along the clock's axis): the contour leaves
+    the head's radius + 0.5 mm (the tolerance at a 0 rms fit) where 15 / sin(alpha) = 22.5, at every hour; the
+    anterior offset ratio is (22 - 15) / 44. A 2 mm cam at the antero-superior junction raises the alpha angle there
+    past 55 deg and leaves the postero-inferior hours within 3 deg."""
+    out = {}
+    for cam in (0, 2):
+        g = str(tmp_path / f"gen{cam}")
+        subprocess.run([CLI, "generate", "--triangles", "12000", "--cam", str(cam), "--out", g], check=True,
+                       capture_output=True)
+        out[cam] = morphology(os.path.join(g, "subject.json"), str(tmp_path / f"m{cam}"))
+    f0, f2 = out[0]["femur"], out[2]["femur"]
+    assert f0["head_radius_mm"]["value"] == pytest.approx(22.0, abs=0.05)
+    alpha = np.degrees(np.arcsin(15 / 22.5))
+    a0 = f0["alpha_deg_by_hour"]["value"]
+    assert all(abs(a0[str(h)] - alpha) <= 0.5 for h in range(1, 13)), (alpha, a0)
+    assert f0["head_neck_offset_ratio"]["value"] == pytest.approx(7 / 44, abs=0.005)
+    assert f0["version_posterior_condylar_deg"]["value"] is None  # no knee: no version, said in the notes
+    assert any("no femoral landmarks" in n for n in out[0]["notes"])
+    a2 = f2["alpha_deg_by_hour"]["value"]
+    assert max(a2[str(h)] for h in (12, 1, 2)) > 55
+    assert all(abs(a2[str(h)] - a0[str(h)]) <= 3 for h in (6, 7, 8)), (a0, a2)

@@ -81,13 +81,20 @@ Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFra
   }
   m.sphericity_rms_mm = m.sphericity_vertices > 0 ? std::sqrt(sum2 / double(m.sphericity_vertices)) : kNaN;
 
-  // Shaft axis: the principal axis of the diaphysis' surface (35-65 % of the head-to-knee length).
+  // Without femoral landmarks (scan neutral: a generated hip, a proximal femur) there is no knee: no shaft, no version.
   const FemurLandmarks& L = frames.femur_landmarks;
+  const bool landmarks = !L.source.empty();
+  if (!landmarks) {
+    m.neck_shaft_angle_deg = m.version_posterior_condylar_deg = m.version_transepicondylar_deg = kNaN;
+    m.notes.push_back("no femoral landmarks (scan neutral): no neck-shaft angle or femoral version; the input frame's "
+                      "axes stand for the femoral and pelvic frames");
+  }
+  // Shaft axis: the principal axis of the diaphysis' surface (35-65 % of the head-to-knee length).
   const Eigen::Vector3d knee = 0.5 * (L.epicondyle_lateral + L.epicondyle_medial);
   const double length = (c - knee).dot(fy);
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> shaft;
-  for (Eigen::Index i = 0; i < femur.V.rows(); ++i) {
+  for (Eigen::Index i = 0; landmarks && i < femur.V.rows(); ++i) {
     const Eigen::Vector3d v = femur.V.row(i).transpose();
     const double s = (c - v).dot(fy) / length;
     if (s >= 0.35 && s <= 0.65) shaft.push_back(v), mean += v;
@@ -100,15 +107,17 @@ Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFra
     if (s.dot(fy) < 0) s = -s;
     m.shaft_axis = s;
     m.neck_shaft_angle_deg = std::acos(std::clamp(n.dot(-s), -1.0, 1.0)) * kDeg;
-  } else {
+  } else if (landmarks) {
     m.neck_shaft_angle_deg = kNaN;
     m.notes.push_back("neck-shaft angle: fewer than 30 vertices on the diaphysis (a proximal femur only?)");
   }
 
   // Femoral version against both condylar axes, across the long axis (ISB y).
-  m.version_posterior_condylar_deg =
-      version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, fy, fx);
-  m.version_transepicondylar_deg = version_deg(n, L.epicondyle_medial, L.epicondyle_lateral, fy, fx);
+  if (landmarks) {
+    m.version_posterior_condylar_deg =
+        version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, fy, fx);
+    m.version_transepicondylar_deg = version_deg(n, L.epicondyle_medial, L.epicondyle_lateral, fy, fx);
+  }
 
   // Alpha angle per clock hour and the anterior head-neck offset, by exact rays from inside the femur.
   const ExactReference ref(femur);
@@ -156,7 +165,9 @@ Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFra
   m.acetabular_radius_mm = A.sphere.radius;
   m.acetabular_fit_rms_mm = A.sphere.rms_residual;
   m.lunate_area_mm2 = A.lunate_area_mm2;
-  const AnatomicalFrame app = pelvis_frame(frames.pelvis_landmarks, c, PelvisFrameKind::anterior_pelvic_plane);
+  const AnatomicalFrame app = frames.pelvis_landmarks.source.empty()
+                                  ? frames.pelvis
+                                  : pelvis_frame(frames.pelvis_landmarks, c, PelvisFrameKind::anterior_pelvic_plane);
   m.orientation_app = radiographic_orientation(A, app, side);
   m.orientation_isb = radiographic_orientation(A, frames.pelvis, side);
   const Eigen::Vector3d X = app.axes.col(0), Y = app.axes.col(1), lateral = lateral_sign * app.axes.col(2);

@@ -18,11 +18,21 @@ MorphologyRun run_morphology(const SessionOptions& options) {
   // The head the femur shows (a given COR moves neither the head nor what is measured about it).
   SphereFitResult head = cor.head;
   if (!std::isfinite(head.radius)) head = cor.fitted_head ? *cor.fitted_head : located_head(in);
-  const HipFrameOptions frame_options = hip_joint_options(options.maps, options.frames).frames;
-  Landmarks given = in.landmarks;
-  given["hip_centre"] = head.centre;
+  const HipJointOptions hip_options = hip_joint_options(options.maps, options.frames, in.neutral);
   MorphologyRun run;
-  run.frames = find_hip_frames(in.femur, in.pelvis, in.side, given, frame_options);
+  if (hip_options.neutral == Neutral::anatomical) {
+    Landmarks given = in.landmarks;
+    given["hip_centre"] = head.centre;
+    run.frames = find_hip_frames(in.femur, in.pelvis, in.side, given, hip_options.frames);
+  } else {
+    // Scan neutral (a generated hip, a proximal femur in a cup): the input frame's axes stand for both frames,
+    // and there are no landmarks (no version, neck-shaft angle or anterior pelvic plane).
+    for (AnatomicalFrame* f : {&run.frames.pelvis, &run.frames.femur}) {
+      f->origin = head.centre;
+      f->axes = scan_axes();
+      f->definition = "scan neutral: the input frame's axes (X anterior, Y superior, Z right)";
+    }
+  }
   run.frames.head = head;
   run.acetabulum = find_acetabulum(in.pelvis, head.centre, head.radius, run.frames.pelvis);
   run.morphology = measure_morphology(in.femur, in.side, run.frames, run.acetabulum);

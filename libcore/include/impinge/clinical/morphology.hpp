@@ -40,6 +40,8 @@
 /// - coverage: the share of the head sphere's surface that the acetabulum covers seen from the head centre (the
 ///   cap inside the rim: 0.5 is a hemisphere), and the rim's angle from the acetabular pole per acetabular clock
 ///   hour (deg).
+/// Without landmarks (`frames` from scan neutral: a generated hip, a proximal femur in a cup) the frames' axes stand
+/// for the anatomical ones and the neck-shaft angle and femoral version are NaN, with a note.
 /// Every direction is taken from the bone's own axes and its side (lateral is right for a right hip, left for a
 /// left one), so a mirrored hip gives the same values and a rigidly moved hip the same values.
 
