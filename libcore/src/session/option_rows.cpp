@@ -211,7 +211,7 @@ void add_map_rows(Rows& t) {
 }
 
 void add_frame_rows(Rows& t) {
-  t.text("neutral", "neutral", OptionType::choice, kSetting, {"anatomical", "scan"},
+  t.text("neutral", "neutral", OptionType::choice, kSetting | use_morphology, {"anatomical", "scan"},
          "Zero pose: 'anatomical' (the femoral ISB frame parallel to the pelvic one, both found from the bones or "
          "given as landmarks in subject.json) or 'scan' (the pose in the scanner; angles about the input frame's "
          "axes: flexion about left-right, adduction about antero-posterior, rotation about superior-inferior). "
