@@ -91,6 +91,25 @@ def read_vtk_mesh(path):
 
 
 
+def polydata(V, F):
+    """V (n, 3, mm) and F (m, 3, vertex indices) as vtkPolyData (double points, triangles), for VTK's writers: the
+    inverse of read_vtk_mesh."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+
+    poly = vtkPolyData()
+    pts = vtkPoints()
+    pts.SetData(numpy_to_vtk(np.ascontiguousarray(V, dtype=np.float64), deep=True))
+    poly.SetPoints(pts)
+    cells = vtkCellArray()
+    conn = np.hstack([np.full((len(F), 1), 3), F]).astype(np.int64).ravel()
+    cells.SetCells(len(F), numpy_to_vtkIdTypeArray(conn, deep=True))
+    poly.SetPolys(cells)
+    return poly
+
+
 def write_ply(path, V, F):
     """V (n, 3) and F (m, 3) as a binary little-endian PLY (double vertices, int faces)."""
     import numpy as np

@@ -21,6 +21,7 @@ import pytest
 import impinge
 from impinge import study
 from impinge.study import runner, spec
+from impinge.vtk_meshes import polydata as vtk_polydata
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
@@ -265,22 +266,6 @@ def test_the_slurm_script_runs_a_study_on_loopback(serial, tmp_path):
     rows = read(out)
     assert len({x["worker"] for x in rows}) == 2  # both of the script's workers ran tasks
     assert runner.nan_equal_rows(read(ref), rows)
-
-
-def vtk_polydata(V, F):
-    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
-    from vtkmodules.vtkCommonCore import vtkPoints
-    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
-
-    pd = vtkPolyData()
-    pts = vtkPoints()
-    pts.SetData(numpy_to_vtk(np.ascontiguousarray(V, dtype=np.float64), deep=True))
-    pd.SetPoints(pts)
-    cells = vtkCellArray()
-    conn = np.hstack([np.full((len(F), 1), 3), F]).astype(np.int64).ravel()
-    cells.SetCells(len(F), numpy_to_vtkIdTypeArray(conn, deep=True))
-    pd.SetPolys(cells)
-    return pd
 
 
 def test_vtk_meshes_give_the_ply_gaps(tmp_path):

@@ -13,19 +13,9 @@ vtk = pytest.importorskip("vtkmodules.vtkIOXML")
 
 
 def write_vtp(path, V, F):
-    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
-    from vtkmodules.vtkCommonCore import vtkPoints
-    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
-    import numpy as np
+    from impinge.vtk_meshes import polydata
 
-    poly = vtkPolyData()
-    pts = vtkPoints()
-    pts.SetData(numpy_to_vtk(np.ascontiguousarray(V, dtype=np.float64), deep=True))
-    poly.SetPoints(pts)
-    cells = vtkCellArray()
-    conn = np.hstack([np.full((len(F), 1), 3), F]).astype(np.int64).ravel()
-    cells.SetCells(len(F), numpy_to_vtkIdTypeArray(conn, deep=True))
-    poly.SetPolys(cells)
+    poly = polydata(V, F)
     w = vtk.vtkXMLPolyDataWriter()
     w.SetFileName(str(path))
     w.SetInputData(poly)

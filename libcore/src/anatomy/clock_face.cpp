@@ -58,14 +58,17 @@ std::vector<Facet> facets(const TriangleMesh& mesh) {
   return out;
 }
 
+// Whether facet t faces the point c (its outward normal within acos(kLunateFacing) of the direction to c); `n`: |d|
+// for d = t.centroid - c.
+bool faces(const Facet& t, const Eigen::Vector3d& d, double n) { return n > 0 && t.normal.dot(d) <= -kLunateFacing * n; }
+
 // The facets on the sphere (c, r) within `band` mm whose outward normal faces its centre.
 std::vector<std::size_t> on_sphere(const std::vector<Facet>& T, const Eigen::Vector3d& c, double r, double band) {
   std::vector<std::size_t> sel;
   for (std::size_t f = 0; f < T.size(); ++f) {
     const Eigen::Vector3d d = T[f].centroid - c;
     const double n = d.norm();
-    if (T[f].area > 0 && n > 0 && std::abs(n - r) <= band && T[f].normal.dot(d) <= -kLunateFacing * n)
-      sel.push_back(f);
+    if (T[f].area > 0 && std::abs(n - r) <= band && faces(T[f], d, n)) sel.push_back(f);
   }
   return sel;
 }
@@ -87,7 +90,7 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
   for (const Facet& t : T) {
     const Eigen::Vector3d d = t.centroid - c;
     const double n = d.norm(), s = n - r;
-    if (n > 0 && s >= kLow && s < kHigh && t.normal.dot(d) <= -kLunateFacing * n)
+    if (s >= kLow && s < kHigh && faces(t, d, n))
       hist[std::min(hist.size() - 1, static_cast<std::size_t>((s - kLow) / kBin))] += t.area;
   }
   std::size_t mode = 0;

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <tuple>
 
 #include "impinge/core/error.hpp"
 #include "impinge/schemes/fibonacci_scheme.hpp"
@@ -235,9 +234,9 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
   thread_local std::vector<std::uint8_t> on_head;
   g.resize(static_cast<std::size_t>(n));
   on_head.resize(static_cast<std::size_t>(n));
-  // Which lunate vertices face the head's joint surface: decided once per pose, with the head on the
-  // acetabular centre (the combined method's t), so that t is a function of R alone (not of where
-  // the iteration starts). The femur's surface in q's direction lies |y| - gap from the head centre.
+  // Which lunate points face the head's joint surface: decided once per pose, with the head at the iteration's
+  // start (its scan position), so that t is a function of R alone (not of where the iteration goes). The femur's
+  // surface in q's direction lies |y| - gap from the head centre.
   const Eigen::Matrix3d Rt = R.transpose();
   gaps(joint, R, start_, g.data());
   std::int64_t used = 0;
@@ -294,7 +293,7 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
     t += d;
     if (!t.allFinite()) throw Error("joint centre equidistant: the iteration diverged (no joint space to even out)");
     if (d.norm() >= options_.tolerance_mm && ++steps < options_.max_iterations) continue;
-    // Converged (or out of steps): is the joint space open over every lunate vertex facing the head?
+    // Converged (or out of steps): is the joint space open at every guard vertex not yet watched?
     scan(guard_, t, guard_gap.data());
     bool closed = false;
     for (std::int64_t k = 0; k < ng && !closed; ++k)
@@ -310,7 +309,6 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
       watched.index.push_back(guard_.index[i]);
       watched.x.push_back(guard_.x[k]), watched.y.push_back(guard_.y[k]), watched.z.push_back(guard_.z[k]);
     }
-    if (!closed) break;
     steps = 0;
   }
   return t;

@@ -52,7 +52,8 @@ Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFra
   const SphereFitResult& head = frames.head;
   const Eigen::Vector3d c = head.centre;
   const double r = head.radius;
-  require(c.allFinite() && std::isfinite(r) && r > 0, femur.source + ": morphology: the femoral head sphere is not set");
+  require(c.allFinite() && std::isfinite(r) && r > 0,
+          femur.source + ": morphology: the femoral head sphere is not set");
   m.head_centre_mm = c;
   m.head_radius_mm = r;
   m.head_fit_rms_mm = head.rms_residual;
@@ -86,8 +87,9 @@ Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFra
   const bool landmarks = !L.source.empty();
   if (!landmarks) {
     m.neck_shaft_angle_deg = m.version_posterior_condylar_deg = m.version_transepicondylar_deg = kNaN;
-    m.notes.push_back("no femoral landmarks (scan neutral): no neck-shaft angle or femoral version; the input frame's "
-                      "axes stand for the femoral and pelvic frames");
+    m.notes.push_back(
+        "no femoral landmarks (scan neutral): no neck-shaft angle or femoral version; the input frame's "
+        "axes stand for the femoral and pelvic frames");
   }
   // Shaft axis: the principal axis of the diaphysis' surface (35-65 % of the head-to-knee length).
   const Eigen::Vector3d knee = 0.5 * (L.epicondyle_lateral + L.epicondyle_medial);
@@ -114,8 +116,7 @@ Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFra
 
   // Femoral version against both condylar axes, across the long axis (ISB y).
   if (landmarks) {
-    m.version_posterior_condylar_deg =
-        version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, fy, fx);
+    m.version_posterior_condylar_deg = version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, fy, fx);
     m.version_transepicondylar_deg = version_deg(n, L.epicondyle_medial, L.epicondyle_lateral, fy, fx);
   }
 
@@ -177,8 +178,11 @@ Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFra
   // (normal: lateral), in front of it.
   m.lateral_centre_edge_deg = centre_edge_deg(d, X, Y, Y, lateral);
   m.anterior_centre_edge_deg = centre_edge_deg(d, lateral, X, Y, X);
-  if (std::isnan(m.lateral_centre_edge_deg)) m.notes.push_back("lateral centre-edge angle: no rim point within 5 mm of the coronal plane above the head");
-  if (std::isnan(m.anterior_centre_edge_deg)) m.notes.push_back("anterior centre-edge angle: no rim point within 5 mm of the sagittal plane in front of the head");
+  if (std::isnan(m.lateral_centre_edge_deg))
+    m.notes.push_back("lateral centre-edge angle: no rim point within 5 mm of the coronal plane above the head");
+  if (std::isnan(m.anterior_centre_edge_deg))
+    m.notes.push_back(
+        "anterior centre-edge angle: no rim point within 5 mm of the sagittal plane in front of the head");
   // Coverage: the cap inside the rim, seen from the head centre (the pole: into the acetabulum).
   const Eigen::Vector3d pole = -A.opening;
   std::array<double, 12> sum{};

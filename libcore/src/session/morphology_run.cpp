@@ -49,15 +49,17 @@ MorphologyRun run_morphology(const SessionOptions& options) {
 }
 
 namespace {
-nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-nlohmann::json vec(const Eigen::Vector3d& v) { return {number(v.x()), number(v.y()), number(v.z())}; }
+// A point or axis; NaN entries (a measure not taken) as null.
+nlohmann::json vec(const Eigen::Vector3d& v) {
+  return {number_or_null(v.x()), number_or_null(v.y()), number_or_null(v.z())};
+}
 // One measure: value, unit, definition, source.
 nlohmann::json measure(nlohmann::json value, const char* unit, const char* definition, const char* source) {
   return {{"value", std::move(value)}, {"unit", unit}, {"definition", definition}, {"source", source}};
 }
 nlohmann::json per_hour(const std::array<double, 12>& v) {
   nlohmann::json j = nlohmann::json::object();
-  for (int h = 1; h <= 12; ++h) j[std::to_string(h)] = number(v[static_cast<std::size_t>(h - 1)]);
+  for (int h = 1; h <= 12; ++h) j[std::to_string(h)] = number_or_null(v[static_cast<std::size_t>(h - 1)]);
   return j;
 }
 }  // namespace
@@ -70,34 +72,37 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
   j["pelvis_file"] = run.pelvis_source;
   j["side"] = run.side == Side::right ? "right" : "left";
   j["input_frame"] = run.input_frame == FrameConvention::LPS ? "LPS" : "RAS";
-  j["axes_note"] = "points and axes in the input files' frame, mm; angles in degrees; left hips measured mirrored, "
-                   "so that both sides read alike";
+  j["axes_note"] =
+      "points and axes in the input files' frame, mm; angles in degrees; left hips measured mirrored, "
+      "so that both sides read alike";
   nlohmann::json& f = j["femur"];
   f["head_centre_mm"] = measure(vec(T * m.head_centre_mm), "mm", "centre of the sphere fitted to the femoral head",
                                 "geometric sphere fit, thesis sec. 3.4");
-  f["head_radius_mm"] = measure(number(m.head_radius_mm), "mm", "radius of that sphere", "thesis sec. 3.4");
-  f["head_fit_rms_mm"] = measure(number(m.head_fit_rms_mm), "mm", "rms distance of the fitted vertices from it", "");
+  f["head_radius_mm"] = measure(number_or_null(m.head_radius_mm), "mm", "radius of that sphere", "thesis sec. 3.4");
+  f["head_fit_rms_mm"] =
+      measure(number_or_null(m.head_fit_rms_mm), "mm", "rms distance of the fitted vertices from it", "");
   f["sphericity_rms_mm"] =
-      measure(number(m.sphericity_rms_mm), "mm",
+      measure(number_or_null(m.sphericity_rms_mm), "mm",
               "rms of |distance from the head centre - radius| over the head's cap (over 100 deg from the neck axis)",
               "impinge");
-  f["sphericity_max_mm"] = measure(number(m.sphericity_max_mm), "mm", "largest of the same", "impinge");
-  f["neck_axis"] = measure(vec(T * m.neck_axis), "unit vector",
-                           "from the centroid of the femur's surface 4-12 mm outside the head sphere to the head centre",
-                           "impinge (femoral_clock_face)");
-  f["shaft_axis"] = measure(vec(T * m.shaft_axis), "unit vector",
-                            "principal axis of the diaphysis' surface (35-65 % of the head-to-knee length), proximal",
-                            "impinge");
-  f["neck_shaft_angle_deg"] = measure(number(m.neck_shaft_angle_deg), "deg",
-                                      "between the neck axis and the shaft axis pointing distal (normal 125-135)",
-                                      "impinge (3D)");
+  f["sphericity_max_mm"] = measure(number_or_null(m.sphericity_max_mm), "mm", "largest of the same", "impinge");
+  f["neck_axis"] =
+      measure(vec(T * m.neck_axis), "unit vector",
+              "from the centroid of the femur's surface 4-12 mm outside the head sphere to the head centre",
+              "impinge (femoral_clock_face)");
+  f["shaft_axis"] =
+      measure(vec(T * m.shaft_axis), "unit vector",
+              "principal axis of the diaphysis' surface (35-65 % of the head-to-knee length), proximal", "impinge");
+  f["neck_shaft_angle_deg"] =
+      measure(number_or_null(m.neck_shaft_angle_deg), "deg",
+              "between the neck axis and the shaft axis pointing distal (normal 125-135)", "impinge (3D)");
   f["version_posterior_condylar_deg"] =
-      measure(number(m.version_posterior_condylar_deg), "deg",
+      measure(number_or_null(m.version_posterior_condylar_deg), "deg",
               "neck axis against the posterior condylar axis across the femur's long axis (knee centre to head "
               "centre); + anteversion (normal 10-20)",
               "Murphy et al. 1987, J Bone Joint Surg Am 69:1169");
   f["version_transepicondylar_deg"] =
-      measure(number(m.version_transepicondylar_deg), "deg", "the same against the transepicondylar axis",
+      measure(number_or_null(m.version_transepicondylar_deg), "deg", "the same against the transepicondylar axis",
               "Reikeras et al. 1983, Acta Orthop Scand 54:18");
   f["alpha_deg_by_hour"] = measure(
       per_hour(m.alpha_deg), "deg",
@@ -105,42 +110,43 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
       "between the neck axis and where the surface first lies past the head radius + max(0.5 mm, 2 x the fit's "
       "rms), coming from the head (normal under 50-55; a cam above)",
       "Noetzli et al. 2002, J Bone Joint Surg Br 84:556, measured radially");
-  f["alpha_max_deg"] = measure(number(m.alpha_max_deg), "deg", "largest alpha angle over the hours", "");
-  f["alpha_max_hour"] = measure(number(m.alpha_max_hour), "h", "the hour of the largest alpha angle", "");
+  f["alpha_max_deg"] = measure(number_or_null(m.alpha_max_deg), "deg", "largest alpha angle over the hours", "");
+  f["alpha_max_hour"] = measure(number_or_null(m.alpha_max_hour), "h", "the hour of the largest alpha angle", "");
   f["head_neck_offset_mm"] =
-      measure(number(m.head_neck_offset_mm), "mm",
+      measure(number_or_null(m.head_neck_offset_mm), "mm",
               "at 3 o'clock (anterior): the head radius less the least distance of the neck surface from the neck axis",
               "Eijer et al. 2001, Hip Int 11:37");
-  f["head_neck_offset_ratio"] = measure(number(m.head_neck_offset_ratio), "",
-                                        "offset / head diameter (normal over 0.15-0.17; a cam under)",
-                                        "Eijer et al. 2001");
+  f["head_neck_offset_ratio"] =
+      measure(number_or_null(m.head_neck_offset_ratio), "",
+              "offset / head diameter (normal over 0.15-0.17; a cam under)", "Eijer et al. 2001");
   f["frame"] = frame_record(run.frames.femur, T, "head_fit_rms_mm");
   nlohmann::json& a = j["acetabulum"];
   a["centre_mm"] = measure(vec(T * m.acetabular_centre_mm), "mm",
                            "centre of the sphere fitted to the whole lunate surface", "impinge (find_acetabulum)");
-  a["radius_mm"] = measure(number(m.acetabular_radius_mm), "mm", "its radius", "impinge");
-  a["fit_rms_mm"] = measure(number(m.acetabular_fit_rms_mm), "mm", "area-weighted rms of the lunate surface about it", "");
-  a["lunate_area_mm2"] = measure(number(m.lunate_area_mm2), "mm^2", "area the sphere is fitted on", "");
-  a["inclination_deg"] = measure(number(m.orientation_app.inclination_deg), "deg",
+  a["radius_mm"] = measure(number_or_null(m.acetabular_radius_mm), "mm", "its radius", "impinge");
+  a["fit_rms_mm"] =
+      measure(number_or_null(m.acetabular_fit_rms_mm), "mm", "area-weighted rms of the lunate surface about it", "");
+  a["lunate_area_mm2"] = measure(number_or_null(m.lunate_area_mm2), "mm^2", "area the sphere is fitted on", "");
+  a["inclination_deg"] = measure(number_or_null(m.orientation_app.inclination_deg), "deg",
                                  "radiographic inclination of the rim plane's normal in the anterior pelvic plane "
                                  "(normal 40-50)",
                                  "Murray 1993, J Bone Joint Surg Br 75:228");
-  a["version_deg"] = measure(number(m.orientation_app.anteversion_deg), "deg",
-                             "radiographic version (anteversion) of the same (normal 10-25; retroversion under 0)",
-                             "Murray 1993");
-  a["inclination_isb_deg"] = measure(number(m.orientation_isb.inclination_deg), "deg", "the same in the ISB pelvic frame",
-                                     "Murray 1993; Wu et al. 2002");
-  a["version_isb_deg"] = measure(number(m.orientation_isb.anteversion_deg), "deg", "the same in the ISB pelvic frame",
-                                 "Murray 1993; Wu et al. 2002");
+  a["version_deg"] =
+      measure(number_or_null(m.orientation_app.anteversion_deg), "deg",
+              "radiographic version (anteversion) of the same (normal 10-25; retroversion under 0)", "Murray 1993");
+  a["inclination_isb_deg"] = measure(number_or_null(m.orientation_isb.inclination_deg), "deg",
+                                     "the same in the ISB pelvic frame", "Murray 1993; Wu et al. 2002");
+  a["version_isb_deg"] = measure(number_or_null(m.orientation_isb.anteversion_deg), "deg",
+                                 "the same in the ISB pelvic frame", "Murray 1993; Wu et al. 2002");
   a["lateral_centre_edge_deg"] =
-      measure(number(m.lateral_centre_edge_deg), "deg",
+      measure(number_or_null(m.lateral_centre_edge_deg), "deg",
               "in the coronal plane (anterior pelvic plane frame) through the head centre, from the superior axis to "
               "the rim, + lateral (normal 25-39; dysplasia under 20)",
               "Wiberg 1939");
-  a["anterior_centre_edge_deg"] = measure(number(m.anterior_centre_edge_deg), "deg",
-                                          "the same in the sagittal plane, + anterior (normal over 20-25)",
-                                          "Lequesne and de Seze 1961");
-  a["head_coverage"] = measure(number(m.head_coverage), "share",
+  a["anterior_centre_edge_deg"] =
+      measure(number_or_null(m.anterior_centre_edge_deg), "deg",
+              "the same in the sagittal plane, + anterior (normal over 20-25)", "Lequesne and de Seze 1961");
+  a["head_coverage"] = measure(number_or_null(m.head_coverage), "share",
                                "share of the head sphere's surface inside the rim, seen from the head centre "
                                "(0.5: a hemisphere)",
                                "impinge");
@@ -150,8 +156,10 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
                                       "Blankenbaker et al. 2007 (clock)");
   nlohmann::json rim = nlohmann::json::array();
   for (const Eigen::Vector3d& p : run.acetabulum.rim) rim.push_back(vec(T * p));
-  a["rim_mm"] = measure(rim, "mm", "the acetabular rim: per 5 deg of azimuth about the cup's axis, the cup's point "
-                                   "farthest from its pole", "impinge (find_acetabulum)");
+  a["rim_mm"] = measure(rim, "mm",
+                        "the acetabular rim: per 5 deg of azimuth about the cup's axis, the cup's point "
+                        "farthest from its pole",
+                        "impinge (find_acetabulum)");
   a["pelvic_frame"] = frame_record(run.frames.pelvis, T, "app_out_of_plane_mm");
   j["notes"] = m.notes;
   j["warnings"] = run.warnings;

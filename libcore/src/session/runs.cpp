@@ -199,6 +199,15 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
   return run;
 }
 
+namespace {
+// Whether soft tissue usually ends `motion` before the bones meet at its limit `l`: judged for a limit or a free
+// motion; a motion not reached, or in contact at its start, has no bony limit to judge.
+bool soft_tissue_ends_first(const std::string& motion, const RomLimit& l) {
+  const bool judged = l.status == RomLimitStatus::limited || l.status == RomLimitStatus::free;
+  return judged && soft_tissue_first(motion, l.limit_deg);
+}
+}  // namespace
+
 Table rom_limits_table(const Session& s, const RomRun& run) {
   Table t;
   t.columns = {"motion",      "limit_deg",        "status",       "limited_by",     "contact_class", "socket_clock_h",
@@ -210,13 +219,12 @@ Table rom_limits_table(const Session& s, const RomRun& run) {
     const RomLimit& l = run.limits[k];
     const std::string& name = run.motions[k].name;
     const Eigen::Vector3d c = s.to_input(l.contact_mm), tr = s.to_input(l.joint_translation_mm);
-    const bool judged = l.status == RomLimitStatus::limited || l.status == RomLimitStatus::free;
     t.add({name, number_or_null(l.limit_deg), to_string(l.status), to_string(l.limited_by), to_string(l.contact_class),
            number_or_null(l.socket_clock_h),
            number_or_null(l.femur_clock_h), number_or_null(l.min_gap_at_limit_mm), l.monotone, l.contact_at_start,
            number_or_null(c.x()), number_or_null(c.y()), number_or_null(c.z()), number_or_null(tr.x()),
            number_or_null(tr.y()), number_or_null(tr.z()), l.evaluations,
-           number_or_null(published_normal_range(name).normal_deg), judged && soft_tissue_first(name, l.limit_deg),
+           number_or_null(published_normal_range(name).normal_deg), soft_tissue_ends_first(name, l),
            frame, l.note});
   }
   return t;
@@ -278,7 +286,6 @@ nlohmann::json rom_record(const RomRun& run) {
   for (std::size_t k = 0; k < run.motions.size(); ++k) {
     const RomLimit& l = run.limits[k];
     const std::string& name = run.motions[k].name;
-    const bool judged = l.status == RomLimitStatus::limited || l.status == RomLimitStatus::free;
     const PublishedRange normal = published_normal_range(name);
     limits.push_back({{"motion", name},
                       {"limit_deg", number_or_null(l.limit_deg)},
@@ -287,7 +294,7 @@ nlohmann::json rom_record(const RomRun& run) {
                       {"monotone", l.monotone},
                       {"normal_deg", number_or_null(normal.normal_deg)},
                       {"normal_source", normal.source},
-                      {"soft_tissue_first", judged && soft_tissue_first(name, l.limit_deg)},
+                      {"soft_tissue_first", soft_tissue_ends_first(name, l)},
                       {"note", l.note}});
   }
   j["limits"] = limits;

@@ -81,16 +81,17 @@ struct Morphology {
   double acetabular_radius_mm = 0, acetabular_fit_rms_mm = 0, lunate_area_mm2 = 0;
   AcetabularOrientation orientation_app, orientation_isb;  ///< radiographic (Murray 1993)
   double lateral_centre_edge_deg = 0, anterior_centre_edge_deg = 0;
-  double head_coverage = 0;                ///< share of the head sphere covered (0.5: a hemisphere)
+  double head_coverage = 0;               ///< share of the head sphere covered (0.5: a hemisphere)
   std::array<double, 12> coverage_deg{};  ///< rim angle from the acetabular pole per acetabular clock hour
-  std::vector<std::string> notes;          ///< what could not be measured, and why
+  std::vector<std::string> notes;         ///< what could not be measured, and why
 };
 
 /// Measure the morphology of a hip from its whole femur (working frame, mm) on `side`, its frames
 /// (find_hip_frames: head sphere, landmarks, ISB frames) and its acetabulum (find_acetabulum on the pelvis). The
-/// anterior pelvic plane frame is built from the same landmarks. Costs about a thousand exact ray casts on the femur (CGAL AABB
-/// tree; ExactReference). Throws impinge::Error naming the femur mesh when no neck is found (femoral_clock_face)
-/// or CGAL is missing from this build.
-Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFrames& frames, const Acetabulum& acetabulum);
+/// anterior pelvic plane frame is built from the same landmarks. Costs about a thousand exact ray casts on the femur
+/// (CGAL AABB tree; ExactReference). Throws impinge::Error naming the femur mesh when no neck is found
+/// (femoral_clock_face) or CGAL is missing from this build.
+Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFrames& frames,
+                              const Acetabulum& acetabulum);
 
 }  // namespace impinge

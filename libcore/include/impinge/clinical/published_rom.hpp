@@ -21,7 +21,7 @@ namespace impinge {
 
 /// The published normal range of one standard motion (rom.hpp's names).
 struct PublishedRange {
-  double normal_deg = 0;  ///< the normal passive range in living subjects, deg (NaN: none published, e.g. FADIR)
+  double normal_deg = 0;    ///< the normal passive range in living subjects, deg (NaN: none published, e.g. FADIR)
   const char* source = "";  ///< the citation
 };
 

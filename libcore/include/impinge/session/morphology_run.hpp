@@ -17,9 +17,9 @@ namespace impinge {
 /// A morphology run: the measures and what they were measured on.
 struct MorphologyRun {
   Morphology morphology;
-  HipFrames frames;        ///< working frame (the head: the sphere the femur shows)
-  Acetabulum acetabulum;   ///< working frame
-  TriangleMesh femur;      ///< working frame
+  HipFrames frames;       ///< working frame (the head: the sphere the femur shows)
+  Acetabulum acetabulum;  ///< working frame
+  TriangleMesh femur;     ///< working frame
   Side side = Side::right;
   Eigen::Matrix3d to_input = Eigen::Matrix3d::Identity();  ///< working -> input frame
   FrameConvention input_frame = FrameConvention::RAS;
