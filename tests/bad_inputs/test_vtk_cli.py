@@ -1,6 +1,7 @@
 """VTK meshes wherever the CLI reads a mesh (issue 47, item 4). Invariants: a femur and pelvis written as VTK XML
 PolyData give the PLY files' gaps bit for bit, given with --ball/--socket or named by a subject.json; a file VTK
 cannot read is a one-line error naming it."""
+import importlib.util
 import json
 import os
 
@@ -12,10 +13,18 @@ from test_geometry_only import read_ply
 vtk = pytest.importorskip("vtkmodules.vtkIOXML")
 
 
-def write_vtp(path, V, F):
-    from impinge.vtk_meshes import polydata
+def vtk_meshes():
+    """python/impinge/vtk_meshes.py from the source tree, loaded on its own: it needs no compiled extension, so this
+    CLI test also runs where the Python module is not built (./test --sanitize builds none)."""
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "python", "impinge", "vtk_meshes.py")
+    spec = importlib.util.spec_from_file_location("vtk_meshes_standalone", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
-    poly = polydata(V, F)
+
+def write_vtp(path, V, F):
+    poly = vtk_meshes().polydata(V, F)
     w = vtk.vtkXMLPolyDataWriter()
     w.SetFileName(str(path))
     w.SetInputData(poly)
