@@ -26,6 +26,7 @@
 #include "impinge/maps/map_image.hpp"
 #include "impinge/session/option_table.hpp"
 #include "impinge/session/morphology_run.hpp"
+#include "impinge/session/plan_run.hpp"
 #include "impinge/session/outputs.hpp"
 #include "impinge/session/records.hpp"
 #include "impinge/session/runs.hpp"
@@ -112,10 +113,11 @@ Session open_session(SessionOptions options) {
 
 std::string in_dir(const std::string& dir, const std::string& name) { return (fs::path(dir) / name).string(); }
 
-// Shaded renders of an output folder by analysis/render_hip.py (matplotlib; Debian's python3-matplotlib).
-void render(const std::string& out_dir) {
+// Figures of an output folder by an analysis/ script (matplotlib; Debian's python3-matplotlib): render_hip.py
+// (distance) or render_plan.py (plan).
+void render(const std::string& out_dir, const char* name = "render_hip.py") {
   const char* env = std::getenv("IMPINGE_ANALYSIS_DIR");
-  const std::string script = std::string(env != nullptr ? env : IMPINGE_ANALYSIS_DIR) + "/render_hip.py";
+  const std::string script = std::string(env != nullptr ? env : IMPINGE_ANALYSIS_DIR) + "/" + name;
   require(fs::exists(script), script + ": render script not found (set IMPINGE_ANALYSIS_DIR to impinge's analysis/ folder)");
   const int rc = std::system(("/usr/bin/python3 " + cli::shell_quote(script) + " " + cli::shell_quote(out_dir)).c_str());
   require(rc == 0, out_dir + ": --render failed (needs /usr/bin/python3 with numpy and matplotlib; "
@@ -260,6 +262,45 @@ int run_morphology(const RunOptions& o) {
   return 0;
 }
 
+int run_plan(const RunOptions& o) {
+  const std::string& out = o.command.out;
+  SessionOptions so = o.session;
+  cli::read_vtk_inputs(so.input);
+  const PlanRun run = run_plan(so, o.rom, o.plan);
+  for (const std::string& w : run.warnings) std::cerr << "impinge: warning: " << w << "\n";
+  begin_output_folder(out, "plan");
+  write_plan_meshes(out, run);
+  nlohmann::json j = plan_record(run);
+  j["impinge_version"] = IMPINGE_VERSION;
+  write_json(in_dir(out, "plan.json"), j);
+  write_json(in_dir(out, "summary.json"),
+             {{"impinge_version", IMPINGE_VERSION}, {"command", "plan"}, {"ms", run.total_ms}, {"all_targets_met", run.all_met}});
+  if (o.command.render) render(out, "render_plan.py");
+  end_output_folder(out);
+  const BoneResection& f = run.plan.femur;
+  const BoneResection& p = run.plan.pelvis;
+  std::cout << std::fixed << std::setprecision(1) << "plan: ";
+  if (f.allowed) std::cout << "femur " << f.volume_mm3 << " mm^3 (max depth " << f.max_depth_mm << " mm)";
+  if (f.allowed && p.allowed) std::cout << ", ";
+  if (p.allowed) std::cout << "pelvis " << p.volume_mm3 << " mm^3 (max depth " << p.max_depth_mm << " mm)";
+  std::cout << "; targets:";
+  for (const PlanTargetCheck& c : run.targets) {
+    std::cout << " " << c.name;
+    if (!std::isnan(c.target_deg))
+      std::cout << " " << (std::isnan(c.before.limit_deg) ? std::string(to_string(c.before.status)) : std::to_string(std::lround(c.before.limit_deg * 10) / 10.0).substr(0, 5))
+                << "->" << (std::isnan(c.after.limit_deg) ? std::string(to_string(c.after.status)) : std::to_string(std::lround(c.after.limit_deg * 10) / 10.0).substr(0, 5))
+                << "/" << c.target_deg;
+    std::cout << (c.met ? " met" : " MISSED") << ";";
+  }
+  std::cout << " " << std::setprecision(0) << run.total_ms << " ms; written to " << out << "\n";
+  if (!run.all_met && !o.plan.allow_partial) {
+    std::cerr << "impinge: error: the plan misses a target (plan.json says which and why); --allow-partial accepts "
+                 "that\n";
+    return 3;
+  }
+  return 0;
+}
+
 int run_generate(const RunOptions& run) {
   const HipModelOptions& o = run.generate;
   const std::string& out = run.command.out;
@@ -311,6 +352,11 @@ int main(int argc, char** argv) {
                           "sphericity, neck-shaft angle, femoral version, alpha angle per clock hour, head-neck "
                           "offset; acetabular sphere, version, inclination, centre-edge angles, coverage. No maps"),
        use_morphology, run_morphology},
+      {app.add_subcommand("plan",
+                          "Resection plan: the least bone to remove (the cam, a rim) so that target motions run free "
+                          "of impingement, checked by the ROM search on the resected bones. Writes plan.json, "
+                          "femur_resected.ply/.vtp (per-vertex resection_mm) and summary.json"),
+       use_plan, run_plan},
       {app.add_subcommand("generate", "Write a generated hip model (femur_r.ply, pelvis.ply, subject.json)"),
        use_generate, run_generate},
   };

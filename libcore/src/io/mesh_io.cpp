@@ -151,14 +151,23 @@ void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const E
   write_file_atomically(path, os.str());
 }
 
-void write_ply(const std::string& path, const TriangleMesh& mesh) {
+void write_ply(const std::string& path, const TriangleMesh& mesh) { write_ply(path, mesh, {}); }
+
+void write_ply(const std::string& path, const TriangleMesh& mesh, const std::vector<PointArray>& arrays) {
   validate_mesh(mesh);
+  for (const PointArray& a : arrays)
+    require(a.f32.size() == static_cast<std::size_t>(mesh.V.rows()) && !a.name.empty(),
+            path + ": per-vertex property '" + a.name + "' has " + std::to_string(a.f32.size()) +
+                " values for " + std::to_string(mesh.V.rows()) + " vertices");
   std::ostringstream os(std::ios::binary);
   os << "ply\nformat binary_little_endian 1.0\nelement vertex " << mesh.V.rows() << "\n"
-     << "property float x\nproperty float y\nproperty float z\n"
-     << "element face " << mesh.F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
-  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
+     << "property float x\nproperty float y\nproperty float z\n";
+  for (const PointArray& a : arrays) os << "property float " << a.name << "\n";
+  os << "element face " << mesh.F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
     for (int k = 0; k < 3; ++k) put<float>(os, static_cast<float>(mesh.V(i, k)));
+    for (const PointArray& a : arrays) put<float>(os, a.f32[static_cast<std::size_t>(i)]);
+  }
   write_faces(os, mesh.F);
   write_file_atomically(path, os.str());
 }

@@ -11,7 +11,7 @@ namespace {
 
 using namespace detail;
 
-constexpr unsigned kJointCommands = use_distance | use_motion | use_rom;
+constexpr unsigned kJointCommands = use_distance | use_motion | use_rom | use_plan;
 constexpr unsigned kInput = kJointCommands | use_joint | use_morphology;
 constexpr unsigned kSetting = kJointCommands | use_joint | use_study;
 
@@ -236,7 +236,7 @@ void add_frame_rows(Rows& t) {
 }
 
 void add_rom_rows(Rows& t) {
-  const unsigned both = use_rom | use_rom_limits | use_rom_map;
+  const unsigned both = use_rom | use_rom_limits | use_rom_map | use_plan;
   t.number("threshold", "threshold_mm", "mm", both, -100, 100,
            "The bones meet when the least gap (--metric) is <= this less --contact-depth (0: bone contact; a "
            "cartilage offset > 0)",
@@ -252,16 +252,16 @@ void add_rom_rows(Rows& t) {
            "Joint built with distances=False uses the radial gap unless metric is given",
            [](auto& o) -> auto& { return o.rom.search.metric; }, parse_rom_metric,
            [](RomMetric m) { return to_string(m); });
-  t.choice("contacts", "contacts", use_rom | use_rom_limits, {"impingement", "articular", "all"},
+  t.choice("contacts", "contacts", use_rom | use_rom_limits | use_plan, {"impingement", "articular", "all"},
            "Which contacts end a search: 'impingement' (the head-neck junction, neck or trochanters against the rim "
            "or the pelvis beyond it; the head's joint surface meeting the lunate surface, the joint space closing, "
            "is left out), 'articular' (only that: where the joint space closes) or 'all' (every vertex, the thesis' "
            "criterion). Anatomical neutral only (the zones need the acetabulum)",
            [](auto& o) -> auto& { return o.rom.search.contacts; }, parse_rom_contacts,
            [](RomContacts c) { return to_string(c); });
-  t.number("step", "step_deg", "deg", use_rom | use_rom_limits, 0.01, 90,
+  t.number("step", "step_deg", "deg", use_rom | use_rom_limits | use_plan, 0.01, 90,
            "Coarse search step (then bisection to 0.1 deg)", [](auto& o) -> auto& { return o.rom.search.step_deg; });
-  t.number("max", "max_deg", "deg", use_rom | use_rom_limits, 0.1, 360, "Search no farther than this from the start",
+  t.number("max", "max_deg", "deg", use_rom | use_rom_limits | use_plan, 0.1, 360, "Search no farther than this from the start",
            [](auto& o) -> auto& { return o.rom.search.max_deg; });
   t.numbers("map-flexion", "flexion", "deg", use_rom | use_rom_map, "The ROM map's flexion angles",
             [](auto& o) -> auto& { return o.rom.map_flexion_deg; });
@@ -290,9 +290,9 @@ void add_command_rows(Rows& t) {
          "negative = abduction), internal rotation about the femoral long axis (+ = front of the thigh turns "
          "inwards); mirrored for the left side so the signs mean the same. Zero is set by --neutral",
          [](auto& o) -> auto& { return o.command.pose; });
-  t.flag("render", "render", OptionType::flag, use_distance,
-         "Also write shaded renders (render.png: anterior, lateral and the socket's medial view with the acetabular "
-         "clock face) with matplotlib",
+  t.flag("render", "render", OptionType::flag, use_distance | use_plan,
+         "Also write shaded renders with matplotlib (distance: render.png, anterior, lateral and the socket's medial "
+         "view with the acetabular clock face; plan: plan.png, the resection's depth on the head-neck clock face)",
          [](auto& o) -> auto& { return o.command.render; });
   OptionRow& motion = t.text("motion", "motion", OptionType::path, use_motion, {}, "Motion file: .csv, .mot or .sto",
                              [](auto& o) -> auto& { return o.command.motion; });
@@ -312,6 +312,45 @@ void add_command_rows(Rows& t) {
            [](auto& o) -> auto& { return o.generate.cup_coverage_deg; });
 }
 
+void add_plan_rows(Rows& t) {
+  const unsigned plan = use_plan | use_study;
+  t.text("target", "target", OptionType::text, plan, {},
+         "Targets of a resection plan: MOTION=DEG,... (standard motions: flexion, extension, abduction, adduction, "
+         "internal_rotation, external_rotation, internal_rotation_90_flexion, external_rotation_90_flexion, fadir) "
+         "and/or 'normal' (each motion's published normal range: AAOS 1965, Kouyoumdjian et al. 2012); a named "
+         "angle replaces normal's",
+         [](auto& o) -> auto& { return o.plan.target; });
+  t.text("target-motion", "target_motion", OptionType::path, plan, {},
+         "A motion file (.csv, .mot, .sto) whose every frame the plan must free of impingement",
+         [](auto& o) -> auto& { return o.plan.target_motion; });
+  t.choice("resect", "resect", plan, {"femur", "pelvis", "both"},
+           "Which bone the plan may resect: femur (the cam: osteochondroplasty of the head-neck junction), pelvis "
+           "(a rim trim) or both (each contact shared); never the head's articular surface or the lunate surface",
+           [](auto& o) -> auto& { return o.plan.resection.bones; }, parse_resect_bones,
+           [](ResectBones b) { return to_string(b); });
+  t.number("clearance-mm", "clearance_mm", "mm", plan, 0, 5,
+           "The least distance the bones keep at every target pose after the resection",
+           [](auto& o) -> auto& { return o.plan.resection.clearance_mm; });
+  t.number("max-depth-fraction", "max_depth_fraction", "", plan, 0.01, 1,
+           "Safety depth as a fraction of the femoral neck's least diameter (Mardones et al. 2005: deeper than "
+           "about 30 % weakens the neck); a target that needs more is planned up to where it can be reached",
+           [](auto& o) -> auto& { return o.plan.max_depth_fraction; });
+  t.number("max-depth-mm", "max_depth_mm", "mm", plan, 0, 100,
+           "Safety depth in mm instead of the fraction (0: the fraction of the neck's diameter)",
+           [](auto& o) -> auto& { return o.plan.max_depth_mm; });
+  t.number("burr-radius-mm", "burr_radius_mm", "mm", plan, 0, 10,
+           "Radius of the spherical burr the removal is shaped for (arthroscopic burrs: 4-5.5 mm diameter; 0: no "
+           "shaping, the least removal per vertex)",
+           [](auto& o) -> auto& { return o.plan.resection.burr_radius_mm; });
+  t.number("plan-step", "plan_step_deg", "deg", plan, 0.05, 5,
+           "Poses along each target motion every this many degrees (with the clearance, a step small enough that "
+           "no contact deeper than --contact-depth fits between two poses)",
+           [](auto& o) -> auto& { return o.plan.step_deg; });
+  t.flag("allow-partial", "allow_partial", OptionType::flag, plan,
+         "A target the checked plan misses is reported, not an error (exit 0)",
+         [](auto& o) -> auto& { return o.plan.allow_partial; });
+}
+
 }  // namespace
 
 const std::vector<OptionRow>& option_table() {
@@ -321,6 +360,7 @@ const std::vector<OptionRow>& option_table() {
     add_map_rows(t);
     add_frame_rows(t);
     add_rom_rows(t);
+    add_plan_rows(t);
     add_command_rows(t);
     return std::move(t.rows);
   }();

@@ -4,8 +4,10 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "impinge/core/mesh.hpp"
+#include "impinge/io/vtk_output.hpp"
 
 namespace impinge {
 
@@ -41,5 +43,8 @@ void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const E
 
 /// Write a plain mesh (x y z float, faces) as binary little-endian PLY. Throws on I/O error.
 void write_ply(const std::string& path, const TriangleMesh& mesh);
+/// The same with per-vertex float properties after x y z, named as `arrays` name them (each f32 with n values, e.g.
+/// resection_mm). Throws impinge::Error naming the file on I/O errors or an array of another length.
+void write_ply(const std::string& path, const TriangleMesh& mesh, const std::vector<PointArray>& arrays);
 
 }  // namespace impinge

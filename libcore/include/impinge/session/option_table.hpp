@@ -18,6 +18,7 @@
 #include "impinge/anatomy/anatomical_frame.hpp"
 #include "impinge/core/mesh.hpp"
 #include "impinge/io/generated_models.hpp"
+#include "impinge/session/plan_run.hpp"
 #include "impinge/session/runs.hpp"
 #include "impinge/session/session.hpp"
 
@@ -42,6 +43,7 @@ struct RunOptions {
   SessionOptions session;
   RomRequest rom;
   HipModelOptions generate;
+  PlanRequest plan;  ///< `impinge plan`, Joint.plan, a study's `plan` task
   CommandArguments command;
   /// The front ends' defaults (CLI, Python, studies): layered maps (4 crossings) for hidden vertices,
   /// Euclidean distances beside the gaps, the ROM metric the distance, the ROM map on its 0..120 x
@@ -86,7 +88,8 @@ enum OptionUse : unsigned {
   use_study = 1u << 7,        ///< a study's [joint] and [[task]] keys
   use_generated_hip = 1u << 8,  ///< Python generated_hip(...)
   use_morphology = 1u << 9,     ///< `impinge morphology`, Python impinge.morphology(...)
-  use_cli_commands = use_distance | use_motion | use_rom | use_generate | use_morphology,
+  use_plan = 1u << 10,          ///< `impinge plan`, Python Joint.plan(...), a study's `plan` task
+  use_cli_commands = use_distance | use_motion | use_rom | use_generate | use_morphology | use_plan,
 };
 
 /// A value given to an option: nothing ("auto": the preset's rule), a flag, a number, a text, a list

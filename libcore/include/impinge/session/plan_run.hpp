@@ -1,0 +1,89 @@
+#pragma once
+/// @file plan_run.hpp
+/// `impinge plan` (and Python's Joint.plan): a resection plan (clinical/resection.hpp) from the session's inputs
+/// and targets, checked by the ROM search on the resected bones, with its record (plan.json) and meshes
+/// (femur_resected.ply, pelvis_resected.ply, and VTP for ParaView).
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "impinge/clinical/morphology.hpp"
+#include "impinge/clinical/resection.hpp"
+#include "impinge/session/runs.hpp"
+#include "impinge/session/session.hpp"
+
+namespace impinge {
+
+/// What a plan asks for (the option table's plan rows).
+struct PlanRequest {
+  /// Targets: "MOTION=DEG,..." (standard motions: rom.hpp's names), "normal" (every standard motion's published
+  /// normal range, published_rom.hpp), or both ("normal,flexion=130": a named angle replaces normal's). Empty:
+  /// none (then `target_motion` must be given).
+  std::string target;
+  std::string target_motion;  ///< a motion file (.csv, .mot, .sto) whose every frame must be free; empty: none
+  ResectionOptions resection;  ///< bones, clearance, burr (max_depth_mm: set from the two below)
+  double max_depth_fraction = 0.3;  ///< safety depth as a fraction of the neck's least diameter (Mardones 2005)
+  double max_depth_mm = 0;          ///< safety depth, mm; 0: max_depth_fraction x the neck's diameter
+  bool allow_partial = false;       ///< a target missed after the check is not an error (exit 0)
+  double step_deg = 0.5;            ///< poses along each target motion, deg
+};
+
+/// One target before and after.
+struct PlanTargetCheck {
+  std::string name;
+  double target_deg = std::numeric_limits<double>::quiet_NaN();  ///< NaN for a motion file
+  RomLimit before, after;  ///< the ROM search's limit on the input and on the resected bones (standard motions)
+  bool met = false;        ///< after: limited at or beyond the target (within 0.1 deg, the search's tolerance),
+                           ///< or free; a motion file: no frame in contact after
+  double shortfall_deg = 0;  ///< target less the limit after, when not met
+  /// Motion files: frames in contact before and after (the ROM search's criterion), else 0.
+  std::int64_t frames_in_contact_before = 0, frames_in_contact_after = 0;
+};
+
+/// A plan run: the plan, its check and what they were computed on.
+struct PlanRun {
+  ResectionPlan plan;
+  std::vector<PlanTargetCheck> targets;
+  bool all_met = false;
+  RomOptions search;                        ///< the ROM search's options (the check's)
+  double neck_diameter_mm = std::numeric_limits<double>::quiet_NaN();
+  double max_depth_mm = 0;                  ///< the safety depth used
+  std::optional<Morphology> before, after;  ///< morphology of the input and of the resected femur
+  std::vector<std::string> notes;           ///< what could not be measured or checked
+  TriangleMesh femur_resected, pelvis_resected;  ///< input frame, mm (the input's faces and vertex order)
+  std::vector<double> femur_hours, pelvis_hours;  ///< per vertex: head-neck and acetabular clock hours (empty
+                                                  ///< with scan neutral)
+  double clock_from_h[2] = {NAN, NAN}, clock_to_h[2] = {NAN, NAN};  ///< femur, pelvis: the resection's extent
+  std::string subject, femur_source, pelvis_source;
+  FrameConvention input_frame = FrameConvention::RAS;
+  double setup_ms = 0, before_ms = 0, plan_ms = 0, check_ms = 0, total_ms = 0;
+  std::vector<std::string> warnings;
+};
+
+/// The targets of `request` for `session`'s hip (PlanRequest::target, target_motion) with the limits `before`
+/// (run_rom's): each standard motion's poses from 2 deg short of its limit to the target, every
+/// `step_deg` (from the start when in contact there; after the straight way from neutral to the start when
+/// that is blocked); a target already met has no poses. Throws impinge::Error naming the target text, motion
+/// or file.
+std::vector<ResectionTarget> plan_targets(const Session& session, const PlanRequest& request, const RomRun& before);
+
+/// Plan and check: the session (rom_session_options of `rom.search`, distances on with a reach of at least the
+/// clearance + 1 mm), the ROM limits before, the plan (plan_resection), the resected meshes, and the ROM limits
+/// of a new session on them (the check: the same options, as `impinge rom` on the written meshes), the
+/// morphology before and after where it can be measured. Throws impinge::Error naming the option, target or
+/// file; a target missed is not an error here (the CLI's exit status follows PlanRequest::allow_partial).
+PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const PlanRequest& request);
+
+/// plan.json: per bone the volume (mm^3), area (mm^2), largest and mean depth (mm), vertices, clock extent (from-
+/// to hours), alpha angles before and after; per target the limit before, after, met, shortfall; the safety
+/// depth and neck diameter; method and options; notes. Never throws.
+nlohmann::json plan_record(const PlanRun& run);
+
+/// Write femur_resected.ply / .vtp (and pelvis_resected.* when the pelvis was resected) into `dir`: input frame,
+/// the input's faces, per-vertex resection_mm (and clock_hour). Atomic; throws impinge::Error naming the file.
+void write_plan_meshes(const std::string& dir, const PlanRun& run);
+
+}  // namespace impinge

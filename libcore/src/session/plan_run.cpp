@@ -1,0 +1,400 @@
+#include "impinge/session/plan_run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+#include "impinge/clinical/clock_summary.hpp"
+#include "impinge/clinical/published_rom.hpp"
+#include "impinge/core/error.hpp"
+#include "impinge/core/parse.hpp"
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/io/motion.hpp"
+#include "impinge/io/vtk_output.hpp"
+#include "impinge/session/morphology_run.hpp"
+#include "impinge/session/records.hpp"
+
+namespace impinge {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+/// "name=deg,name=deg" and "normal" into motion -> angle (a named angle replaces normal's).
+std::map<std::string, double> parse_targets(const std::string& text, const std::vector<StandardMotion>& motions) {
+  std::map<std::string, double> out;
+  std::string names;
+  for (const StandardMotion& m : motions) names += (names.empty() ? "" : ", ") + m.name;
+  std::stringstream ss(text);
+  std::string item;
+  std::map<std::string, double> named;
+  bool normal = false;
+  while (std::getline(ss, item, ',')) {
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
+    if (item.empty()) continue;
+    if (item == "normal") {
+      normal = true;
+      continue;
+    }
+    const auto eq = item.find('=');
+    require(eq != std::string::npos, "--target: '" + item + "' is not MOTION=DEG or 'normal'; motions: " + names);
+    const std::string name = item.substr(0, eq);
+    require(std::any_of(motions.begin(), motions.end(), [&](const StandardMotion& m) { return m.name == name; }),
+            "--target: '" + name + "' is not a standard motion; valid: " + names + ", or 'normal'");
+    const double deg = parse_number_list(item.substr(eq + 1), "--target " + name, 1)[0];
+    require(std::isfinite(deg) && deg > 0 && deg <= 150,
+            "--target " + name + "=" + item.substr(eq + 1) + ": the angle must lie in (0, 150] deg");
+    named[name] = deg;
+  }
+  if (normal)
+    for (const StandardMotion& m : motions) {
+      const PublishedRange r = published_normal_range(m.name);
+      if (std::isfinite(r.normal_deg)) out[m.name] = r.normal_deg;
+    }
+  for (const auto& [k, v] : named) out[k] = v;
+  return out;
+}
+
+/// The least counted gap at a pose (the ROM search's criterion: distance with the distance metric, else the
+/// radial gap), over the vertices the baseline counts; +inf when none is near.
+double counted_min_gap(const Session& s, const RomBaseline& base, const RomOptions& search, const FemurPose& P,
+                       PoseResult& res) {
+  s.joint().detect(P.R, P.t, res);
+  double m = std::numeric_limits<double>::infinity();
+  const Vertices& socket = s.joint().socket().relative;
+  for (int b = 0; b < 2; ++b) {
+    const ScanGaps& g = b == 0 ? res.ball_gaps : res.socket_gaps;
+    const std::vector<std::uint8_t>& skip = b == 0 ? base.skip_ball : base.skip_socket;
+    for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
+      if (!skip.empty() && skip[i]) continue;
+      double v = search.metric == RomMetric::distance && !g.distance_mm.empty() ? g.distance_mm[i] : g.gap_mm[i];
+      if (std::isnan(v) && search.metric == RomMetric::distance && g.gap_mm[i] < 0) v = g.gap_mm[i];
+      if (!(v < m)) continue;
+      if (b == 1 && std::isfinite(base.head_sphere_reach_mm)) {
+        const Eigen::Vector3d u = socket.row(static_cast<Eigen::Index>(i)).transpose();
+        if ((P.R.transpose() * (u - P.t) - base.head_centre).norm() <= base.head_sphere_reach_mm) continue;
+      }
+      m = v;
+    }
+  }
+  return m;
+}
+
+std::int64_t frames_in_contact(const Session& s, const RomBaseline& base, const RomOptions& search,
+                               const std::vector<PoseAngles>& frames) {
+  std::int64_t n = 0;
+  const double cut = search.threshold_mm - search.contact_depth_mm;
+#pragma omp parallel reduction(+ : n)
+  {
+    PoseResult res;
+#pragma omp for schedule(dynamic, 4)
+    for (std::size_t k = 0; k < frames.size(); ++k)
+      if (counted_min_gap(s, base, search, s.hip().femur_pose(frames[k]), res) <= cut) ++n;
+  }
+  return n;
+}
+
+/// The extent (from, to hours) of the smallest clock arc holding every resected vertex.
+void clock_extent(const std::vector<double>& hours, const std::vector<double>& depth, double& from, double& to) {
+  std::vector<double> h;
+  for (std::size_t i = 0; i < hours.size() && i < depth.size(); ++i)
+    if (depth[i] > 0.01 && std::isfinite(hours[i])) h.push_back(std::fmod(hours[i], 12.0));
+  if (h.empty()) return;
+  std::sort(h.begin(), h.end());
+  double gap = h.front() + 12 - h.back();
+  std::size_t after = 0;
+  for (std::size_t i = 1; i < h.size(); ++i)
+    if (h[i] - h[i - 1] > gap) gap = h[i] - h[i - 1], after = i;
+  auto hour = [](double x) { return x <= 0 ? x + 12 : x; };
+  from = hour(h[after]);
+  to = hour(h[(after + h.size() - 1) % h.size()]);
+}
+
+std::optional<Morphology> try_morphology(const SessionOptions& so, std::vector<std::string>& notes,
+                                         const char* what) {
+  try {
+    return run_morphology(so).morphology;
+  } catch (const std::exception& e) {
+    notes.push_back(std::string("morphology ") + what + " not measured: " + e.what());
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
+std::vector<ResectionTarget> plan_targets(const Session& s, const PlanRequest& request, const RomRun& before) {
+  std::vector<ResectionTarget> out;
+  const double step = request.step_deg;
+  require(step > 0 && step <= 5, "plan: the pose step " + std::to_string(step) + " deg must lie in (0, 5]");
+  const std::map<std::string, double> wanted = parse_targets(request.target, before.motions);
+  for (std::size_t m = 0; m < before.motions.size(); ++m) {
+    const StandardMotion& motion = before.motions[m];
+    const auto it = wanted.find(motion.name);
+    if (it == wanted.end()) continue;
+    const RomLimit& limit = before.limits[m];
+    ResectionTarget t;
+    t.name = motion.name;
+    t.angle_deg = it->second;
+    double from = 0;
+    if (limit.status == RomLimitStatus::limited) {
+      if (limit.limit_deg >= t.angle_deg) {
+        out.push_back(t);  // met already: no poses
+        continue;
+      }
+      from = std::max(0.0, limit.limit_deg - 2);
+    } else if (limit.status == RomLimitStatus::free) {
+      out.push_back(t);
+      continue;
+    } else if (limit.status == RomLimitStatus::not_reachable) {
+      // The straight way from neutral to the start, parameterised by its largest angle (as find_rom_limits).
+      const PoseAngles& a = motion.start;
+      const double way = std::max({std::abs(a.flexion_deg), std::abs(a.adduction_deg), std::abs(a.internal_rotation_deg)});
+      for (double x = 0; x < way; x += step) {
+        const double f = x / way;
+        t.poses.push_back({f * a.flexion_deg, f * a.adduction_deg, f * a.internal_rotation_deg});
+        t.theta_deg.push_back(std::nan(""));
+      }
+    }
+    for (double th = from;; th += step) {
+      const double x = std::min(th, t.angle_deg);
+      t.poses.push_back(motion.angles(x));
+      t.theta_deg.push_back(x);
+      if (x >= t.angle_deg) break;
+    }
+    out.push_back(t);
+  }
+  if (!request.target_motion.empty()) {
+    const Motion motion = load_motion(request.target_motion, s.side());
+    ResectionTarget t;
+    t.name = request.target_motion;
+    t.poses = motion.angles;
+    for (std::size_t k = 0; k < motion.angles.size(); ++k) t.theta_deg.push_back(static_cast<double>(k));
+    out.push_back(t);
+  }
+  require(!out.empty(), "plan: no target: give --target (MOTION=DEG,... or normal) or --target-motion");
+  return out;
+}
+
+PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const PlanRequest& request) {
+  const auto t_start = Clock::now();
+  PlanRun run;
+  require(std::isfinite(request.max_depth_fraction) && request.max_depth_fraction > 0 && request.max_depth_fraction <= 1,
+          "--max-depth-fraction " + std::to_string(request.max_depth_fraction) + ": valid (0, 1]");
+  RomRequest limits_only = rom;
+  limits_only.map = false;
+  limits_only.envelope = false;
+  limits_only.limits = true;
+  run.search = rom.search;
+  SessionOptions so = rom_session_options(options, rom.search);
+  so.maps.distances = true;
+  so.maps.distance_reach_mm =
+      std::max(so.maps.distance_reach_mm, request.resection.clearance_mm + request.resection.candidate_margin_mm);
+  const Session s(so);
+  run.setup_ms = ms_since(t_start);
+  run.warnings = s.warnings();
+  run.subject = s.subject_name();
+  run.femur_source = s.ball_source();
+  run.pelvis_source = s.socket_source();
+  run.input_frame = s.input_frame();
+
+  auto t = Clock::now();
+  const RomRun before = run_rom(s, limits_only);
+  run.before_ms = ms_since(t);
+  const std::vector<ResectionTarget> targets = plan_targets(s, request, before);
+
+  // The safety depth: given, or a fraction of the neck's least diameter (Mardones et al. 2005).
+  run.before = try_morphology(options, run.notes, "before");
+  const HipJoint& hip = s.hip();
+  if (run.before) {
+    const Eigen::Matrix3d to_joint = hip.joint_to_working().transpose();
+    const Eigen::Vector3d neck = to_joint * run.before->neck_axis;
+    run.neck_diameter_mm = neck_diameter_mm(s.joint().ball().relative, s.joint().ball().mesh.F, hip.head_centre_joint(),
+                                           hip.head_radius_mm(), neck);
+  }
+  if (request.max_depth_mm > 0) {
+    run.max_depth_mm = request.max_depth_mm;
+  } else {
+    require(std::isfinite(run.neck_diameter_mm),
+            "plan: the neck's diameter could not be measured (" +
+                (run.notes.empty() ? std::string("no neck found") : run.notes.back()) +
+                "), so the safety depth is unknown: give --max-depth-mm");
+    run.max_depth_mm = request.max_depth_fraction * run.neck_diameter_mm;
+  }
+  ResectionOptions ro = request.resection;
+  ro.max_depth_mm = run.max_depth_mm;
+  t = Clock::now();
+  run.plan = plan_resection(hip, targets, before.baseline, ro);
+  run.plan_ms = ms_since(t);
+
+  // The resected meshes in the input frame: the scan-pose vertices moved by the plan's (joint-frame) displacement.
+  const Eigen::Matrix3d joint_to_input = s.to_input() * hip.joint_to_working();
+  auto resected = [&](const BoneResection& b, Vertices V, const TriangleMesh& like, const char* name) {
+    TriangleMesh m;
+    const Vertices& orig = (&b == &run.plan.femur ? s.joint().ball() : s.joint().socket()).relative;
+    m.V = V + (b.resected - orig) * joint_to_input.transpose();
+    m.F = like.F;
+    m.source = name;
+    return m;
+  };
+  run.femur_resected = resected(run.plan.femur, s.femur_input(hip.scan_pose()), s.joint().ball().mesh, "femur_resected");
+  run.pelvis_resected = resected(run.plan.pelvis, s.pelvis_input(), s.joint().socket().mesh, "pelvis_resected");
+  if (hip.ball_clock()) {
+    run.femur_hours = clock_hours(s.joint().ball().relative, *hip.ball_clock());
+    clock_extent(run.femur_hours, run.plan.femur.depth_mm, run.clock_from_h[0], run.clock_to_h[0]);
+  }
+  if (hip.socket_clock()) {
+    run.pelvis_hours = clock_hours(s.joint().socket().relative, *hip.socket_clock());
+    clock_extent(run.pelvis_hours, run.plan.pelvis.depth_mm, run.clock_from_h[1], run.clock_to_h[1]);
+  }
+
+  // The check: a new session on the resected meshes, as `impinge rom` on the written files.
+  t = Clock::now();
+  SessionOptions after_options = options;
+  if (run.plan.femur.allowed) after_options.input.ball_mesh = run.femur_resected, after_options.input.ball.clear();
+  if (run.plan.pelvis.allowed)
+    after_options.input.socket_mesh = run.pelvis_resected, after_options.input.socket.clear();
+  const Session s_after(rom_session_options(after_options, rom.search));
+  const RomRun after = run_rom(s_after, limits_only);
+  run.all_met = true;
+  for (const ResectionTarget& target : targets) {
+    PlanTargetCheck c;
+    c.name = target.name;
+    c.target_deg = target.angle_deg;
+    if (!std::isnan(target.angle_deg)) {
+      for (std::size_t m = 0; m < before.motions.size(); ++m)
+        if (before.motions[m].name == target.name) c.before = before.limits[m], c.after = after.limits[m];
+      c.met = c.after.status == RomLimitStatus::free ||
+              (c.after.status == RomLimitStatus::limited && c.after.limit_deg >= target.angle_deg - 0.1);
+      if (!c.met)
+        c.shortfall_deg = c.after.status == RomLimitStatus::limited ? target.angle_deg - c.after.limit_deg
+                                                                    : target.angle_deg;
+    } else {
+      c.frames_in_contact_before = frames_in_contact(s, before.baseline, rom.search, target.poses);
+      c.frames_in_contact_after = frames_in_contact(s_after, after.baseline, rom.search, target.poses);
+      c.met = c.frames_in_contact_after == 0;
+    }
+    run.all_met = run.all_met && c.met;
+    run.targets.push_back(c);
+  }
+  run.check_ms = ms_since(t);
+  if (run.plan.femur.allowed && run.before) {
+    SessionOptions mo = options;
+    mo.input.ball_mesh = run.femur_resected;
+    mo.input.ball.clear();
+    run.after = try_morphology(mo, run.notes, "after");
+  }
+  run.total_ms = ms_since(t_start);
+  return run;
+}
+
+nlohmann::json plan_record(const PlanRun& run) {
+  nlohmann::json j;
+  const ResectionOptions& o = run.plan.options;
+  j["subject"] = run.subject;
+  j["femur"] = run.femur_source;
+  j["pelvis"] = run.pelvis_source;
+  j["input_frame"] = run.input_frame == FrameConvention::LPS ? "LPS" : "RAS";
+  j["method"] =
+      "least removal: per vertex, the depth that keeps every target pose's counted contacts at least the clearance "
+      "apart (exact signed distances, iterated on the resected bones), widened to what a spherical burr cuts, "
+      "capped at the safety depth, never on the articular surfaces (impinge, clinical/resection.hpp)";
+  j["options"] = {{"resect", to_string(o.bones)},
+                  {"clearance_mm", o.clearance_mm},
+                  {"burr_radius_mm", o.burr_radius_mm},
+                  {"max_depth_mm", run.max_depth_mm},
+                  {"tolerance_mm", o.tolerance_mm}};
+  j["neck_diameter_mm"] = number_or_null(run.neck_diameter_mm);
+  j["safety_depth"] = {{"value_mm", run.max_depth_mm},
+                       {"source", "Mardones et al. 2005, J Bone Joint Surg Am 87:273 (30 % of the neck's diameter)"}};
+  auto bone = [&](const BoneResection& b, int k) {
+    nlohmann::json r = {{"resected", b.allowed},
+                        {"volume_mm3", b.volume_mm3},
+                        {"area_mm2", b.area_mm2},
+                        {"max_depth_mm", b.max_depth_mm},
+                        {"mean_depth_mm", b.mean_depth_mm},
+                        {"vertices", b.vertices},
+                        {"vertices_at_safety_depth", b.capped_vertices},
+                        {"clock_from_h", number_or_null(run.clock_from_h[k])},
+                        {"clock_to_h", number_or_null(run.clock_to_h[k])}};
+    return r;
+  };
+  j["femur_resection"] = bone(run.plan.femur, 0);
+  j["pelvis_resection"] = bone(run.plan.pelvis, 1);
+  if (run.before) {
+    nlohmann::json a = nlohmann::json::object();
+    a["before_deg"] = nlohmann::json::array();
+    a["after_deg"] = nlohmann::json::array();
+    for (int h = 0; h < 12; ++h) {
+      a["before_deg"].push_back(number_or_null(run.before->alpha_deg[static_cast<std::size_t>(h)]));
+      a["after_deg"].push_back(run.after ? number_or_null(run.after->alpha_deg[static_cast<std::size_t>(h)]) : nullptr);
+    }
+    a["max_before_deg"] = number_or_null(run.before->alpha_max_deg);
+    a["max_after_deg"] = run.after ? number_or_null(run.after->alpha_max_deg) : nullptr;
+    a["definition"] = "alpha angle per head-neck clock hour 1..12 (Notzli et al. 2002; impinge morphology)";
+    j["femur_resection"]["alpha"] = a;
+  }
+  nlohmann::json targets = nlohmann::json::array();
+  for (std::size_t k = 0; k < run.targets.size(); ++k) {
+    const PlanTargetCheck& c = run.targets[k];
+    const ResectionTargetResult& r = run.plan.targets[k];
+    nlohmann::json t = {{"target", c.name},
+                        {"target_deg", number_or_null(c.target_deg)},
+                        {"met", c.met},
+                        {"planned_reachable", r.reachable},
+                        {"planned_reachable_deg", number_or_null(r.reachable_deg)},
+                        {"poses", r.poses},
+                        {"poses_cleared", r.poses_cleared},
+                        {"note", r.note}};
+    if (!std::isnan(c.target_deg)) {
+      t["limit_before_deg"] = number_or_null(c.before.limit_deg);
+      t["status_before"] = to_string(c.before.status);
+      t["limit_after_deg"] = number_or_null(c.after.limit_deg);
+      t["status_after"] = to_string(c.after.status);
+      t["shortfall_deg"] = c.shortfall_deg;
+    } else {
+      t["frames_in_contact_before"] = c.frames_in_contact_before;
+      t["frames_in_contact_after"] = c.frames_in_contact_after;
+    }
+    targets.push_back(t);
+  }
+  j["targets"] = targets;
+  j["all_targets_met"] = run.all_met;
+  j["plan"] = {{"iterations", run.plan.iterations},
+               {"rounds", run.plan.rounds},
+               {"residual_mm", run.plan.residual_mm},
+               {"poses", run.plan.poses},
+               {"contacts", run.plan.contacts}};
+  j["timings_ms"] = {{"setup", run.setup_ms},
+                     {"limits_before", run.before_ms},
+                     {"plan", run.plan_ms},
+                     {"check", run.check_ms},
+                     {"total", run.total_ms}};
+  j["notes"] = run.notes;
+  j["warnings"] = run.warnings;
+  return j;
+}
+
+void write_plan_meshes(const std::string& dir, const PlanRun& run) {
+  auto one = [&](const TriangleMesh& m, const BoneResection& b, const std::vector<double>& hours, const char* stem) {
+    std::vector<PointArray> arrays(1);
+    arrays[0].name = "resection_mm";
+    for (double d : b.depth_mm) arrays[0].f32.push_back(static_cast<float>(d));
+    if (!hours.empty()) {
+      PointArray h;
+      h.name = "clock_hour";
+      for (double x : hours) h.f32.push_back(static_cast<float>(x));
+      arrays.push_back(h);
+    }
+    write_ply(dir + "/" + stem + ".ply", m, arrays);
+    write_vtp(dir + "/" + stem + ".vtp", m.V, m.F, arrays);
+  };
+  if (run.plan.femur.allowed) one(run.femur_resected, run.plan.femur, run.femur_hours, "femur_resected");
+  if (run.plan.pelvis.allowed) one(run.pelvis_resected, run.plan.pelvis, run.pelvis_hours, "pelvis_resected");
+}
+
+}  // namespace impinge
