@@ -9,6 +9,7 @@
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/session/morphology_run.hpp"
+#include "impinge/session/plan_run.hpp"
 #include "impinge/session/runs.hpp"
 
 namespace impinge::python {
@@ -133,6 +134,54 @@ py::dict rom_limits(const PyJoint& j, const py::object& threshold_mm, const py::
   return d;
 }
 
+// Joint.plan: a resection plan on this Joint's inputs and settings (run_plan), its check, its record as a dict with
+// the resected meshes (input frame) and each vertex's depth.
+py::dict plan(const PyJoint& j, const py::object& target, const py::object& target_motion, const py::object& resect, const py::object& clearance_mm, const py::object& max_depth_fraction, const py::object& max_depth_mm, const py::object& burr_radius_mm, const py::object& plan_step_deg, const py::object& allow_partial, const py::object& threshold_mm, const py::object& contact_depth_mm, const py::object& metric, const py::object& contacts, const py::object& step_deg, const py::object& max_deg) {
+  py::dict given;
+  given["target"] = target;
+  given["target_motion"] = target_motion;
+  given["resect"] = resect;
+  given["clearance_mm"] = clearance_mm;
+  given["max_depth_fraction"] = max_depth_fraction;
+  given["max_depth_mm"] = max_depth_mm;
+  given["burr_radius_mm"] = burr_radius_mm;
+  given["plan_step_deg"] = plan_step_deg;
+  given["allow_partial"] = allow_partial;
+  given["threshold_mm"] = threshold_mm;
+  given["contact_depth_mm"] = contact_depth_mm;
+  given["metric"] = metric;
+  given["contacts"] = contacts;
+  given["step_deg"] = step_deg;
+  given["max_deg"] = max_deg;
+
+  RunOptions run = RunOptions::clinical();
+  set_options(run, given, use_joint_plan, "plan");
+  PlanRun p;
+  {
+    py::gil_scoped_release release;
+    p = run_plan(j.session->options(), run.rom, run.plan);
+  }
+  require(p.all_met || run.plan.allow_partial,
+          "plan: a target is missed (give allow_partial=True to get the plan anyway): " + [&] {
+            std::string s;
+            for (std::size_t k = 0; k < p.targets.size(); ++k)
+              if (!p.targets[k].met)
+                s += (s.empty() ? "" : "; ") + p.targets[k].name +
+                     (p.plan.targets[k].note.empty() ? std::string() : ": " + p.plan.targets[k].note);
+            return s;
+          }());
+  py::dict d = py::reinterpret_borrow<py::dict>(from_json(plan_record(p)));
+  if (p.plan.femur.allowed) {
+    d["femur_resected"] = py::make_tuple(p.femur_resected.V, p.femur_resected.F);
+    d["femur_resection_mm"] = Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(p.plan.femur.depth_mm.data(), static_cast<Eigen::Index>(p.plan.femur.depth_mm.size())));
+  }
+  if (p.plan.pelvis.allowed) {
+    d["pelvis_resected"] = py::make_tuple(p.pelvis_resected.V, p.pelvis_resected.F);
+    d["pelvis_resection_mm"] = Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(p.plan.pelvis.depth_mm.data(), static_cast<Eigen::Index>(p.plan.pelvis.depth_mm.size())));
+  }
+  return d;
+}
+
 py::array_t<double> rom_map(const PyJoint& j, const py::object& flexion, const py::object& adduction,
                             const py::object& threshold_mm, const py::object& contact_depth_mm, const py::object& metric) {
   py::dict given;
@@ -206,6 +255,14 @@ void add_joint_queries(py::class_<PyJoint>& c) {
            "excluded_vertices (in contact at neutral, not counted). The keywords are the option table's "
            "(impinge.options(): `impinge rom`'s --threshold, --contact-depth, --metric, --contacts, --step, --max), "
            "with its defaults. metric 'distance' needs the Joint's distances (the default).")
+      .def("plan", &plan, py::arg("target") = default_of("target"), py::arg("target_motion") = default_of("target_motion"), py::arg("resect") = default_of("resect"), py::arg("clearance_mm") = default_of("clearance_mm"), py::arg("max_depth_fraction") = default_of("max_depth_fraction"), py::arg("max_depth_mm") = default_of("max_depth_mm"), py::arg("burr_radius_mm") = default_of("burr_radius_mm"), py::arg("plan_step_deg") = default_of("plan_step_deg"), py::arg("allow_partial") = default_of("allow_partial"), py::arg("threshold_mm") = default_of("threshold_mm"), py::arg("contact_depth_mm") = default_of("contact_depth_mm"), py::arg("metric") = default_of("metric"), py::arg("contacts") = default_of("contacts"), py::arg("step_deg") = default_of("step_deg"), py::arg("max_deg") = default_of("max_deg"),
+           "Resection plan (the CLI's `impinge plan`, plan.json as a dict): the least bone to remove so that the "
+           "targets run free of impingement (target: 'MOTION=DEG,...' and/or 'normal'; target_motion: a motion "
+           "file), shaped for a spherical burr, within the safety depth, never the head inside the labrum line or "
+           "the lunate surface; checked by the ROM search on the resected bones. Adds femur_resected (V, F: input "
+           "frame, the input's faces) and femur_resection_mm (per vertex), and the pelvis' with resect 'pelvis' or "
+           "'both'. Raises impinge.Error when a target is missed, unless allow_partial. Keywords and defaults: the "
+           "option table's (impinge.options()).")
       .def("rom_map", &rom_map, py::arg("flexion") = default_of("flexion"),
            py::arg("adduction") = default_of("adduction"), py::arg("threshold_mm") = default_of("threshold_mm"),
            py::arg("contact_depth_mm") = default_of("contact_depth_mm"), py::arg("metric") = default_of("metric"),

@@ -37,6 +37,9 @@ const char* use_name(unsigned bit) {
     case use_rom_map: return "rom_map";
     case use_study: return "study";
     case use_generated_hip: return "generated_hip";
+    case use_morphology: return "morphology";
+    case use_plan: return "plan";
+    case use_joint_plan: return "joint_plan";
     default: return "?";
   }
 }
@@ -155,7 +158,7 @@ void bind_options(py::module_& m) {
           d["thesis_default"] = to_python(r, r.get(thesis));
           d["help"] = r.help;
           py::list uses;
-          for (unsigned bit = 1; bit <= use_generated_hip; bit <<= 1)
+          for (unsigned bit = 1; bit <= use_joint_plan; bit <<= 1)
             if (r.uses & bit) uses.append(use_name(bit));
           d["uses"] = uses;
           rows.append(d);

@@ -133,6 +133,18 @@ class Joint:
         table). contacts: 'impingement' (the joint surfaces meeting is left out), 'articular' (only that: the
         joint space closing) or 'all'. contact_depth_mm: how far past the threshold a contact must reach to end a
         search (0: the first touch). metric: 'distance' (needs the Joint's distances) or 'radial'."""
+    def plan(self, target: Optional[str] = None, target_motion: Optional[str] = None, resect: str = 'femur',
+             clearance_mm: float = 0.3, max_depth_fraction: float = 0.3, max_depth_mm: float = 0.0,
+             burr_radius_mm: float = 2.5, plan_step_deg: float = 0.5, allow_partial: bool = False,
+             threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
+             contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0) -> Dict[str, Any]:
+        """Resection plan (`impinge plan`'s plan.json as a dict): the least bone to remove so that the targets
+        ('MOTION=DEG,...' and/or 'normal'; target_motion: a motion file) run free of impingement, shaped for a
+        spherical burr (burr_radius_mm), within the safety depth (max_depth_fraction of the neck's least diameter,
+        or max_depth_mm), never the head inside the labrum line or the lunate surface; checked by the ROM search on
+        the resected bones. Adds femur_resected (V, F: input frame, mm) and femur_resection_mm (per vertex, mm),
+        and the pelvis' with resect 'pelvis' or 'both'. Raises impinge.Error when a target is missed unless
+        allow_partial."""
     def rom_map(self, flexion: Sequence[float] = [0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0,
                                                   55.0, 60.0, 65.0, 70.0, 75.0, 80.0, 85.0, 90.0, 95.0, 100.0,
                                                   105.0, 110.0, 115.0, 120.0],

@@ -53,7 +53,7 @@ def cli_help(command):
             if m.group(1) != "help"}
 
 
-@pytest.mark.parametrize("command", ["distance", "motion", "rom", "generate"])
+@pytest.mark.parametrize("command", ["distance", "motion", "rom", "generate", "morphology", "plan"])
 def test_cli_options_are_the_tables(command):
     shown = cli_help(command)
     table = {o["name"]: o for o in rows(command)}
@@ -124,7 +124,7 @@ def test_joint_keywords_are_the_tables_in_the_stub_with_its_defaults():
     assert {x.strip() for x in listed.split(",")} == set(table)
 
 
-@pytest.mark.parametrize("method,use", [("rom_limits", "rom_limits"), ("rom_map", "rom_map")])
+@pytest.mark.parametrize("method,use", [("rom_limits", "rom_limits"), ("rom_map", "rom_map"), ("plan", "joint_plan")])
 def test_rom_keywords_are_the_tables_in_module_and_stub(method, use):
     table = {o["key"]: o["default"] for o in rows(use)}
     runtime = dict(module_parameters(getattr(impinge._impinge.Joint, method)))
@@ -164,8 +164,10 @@ def test_study_keys_are_the_tables_and_documented():
     assert spec.JOINT_KEYS == {o["key"]: types[o["type"]] for o in rows("study")}
     assert spec.KIND_KEYS["rom"] == {o["key"]: o["default"] for o in rows("rom_limits")}
     assert spec.KIND_KEYS["envelope"] == {o["key"]: o["default"] for o in rows("rom_map")}
+    assert spec.KIND_KEYS["plan"] == {o["key"]: o["default"] for o in rows("joint_plan")}
     doc = open(STUDIES_DOC).read()
     missing = [k for k in list(spec.JOINT_KEYS) + list(spec.KIND_KEYS["rom"]) + list(spec.KIND_KEYS["envelope"])
+               + list(spec.KIND_KEYS["plan"])
                if f"`{k}`" not in doc]
     assert not missing, f"docs/studies.md does not name {missing}"
 

@@ -236,7 +236,7 @@ void add_frame_rows(Rows& t) {
 }
 
 void add_rom_rows(Rows& t) {
-  const unsigned both = use_rom | use_rom_limits | use_rom_map | use_plan;
+  const unsigned both = use_rom | use_rom_limits | use_rom_map | use_plan | use_joint_plan;
   t.number("threshold", "threshold_mm", "mm", both, -100, 100,
            "The bones meet when the least gap (--metric) is <= this less --contact-depth (0: bone contact; a "
            "cartilage offset > 0)",
@@ -252,16 +252,16 @@ void add_rom_rows(Rows& t) {
            "Joint built with distances=False uses the radial gap unless metric is given",
            [](auto& o) -> auto& { return o.rom.search.metric; }, parse_rom_metric,
            [](RomMetric m) { return to_string(m); });
-  t.choice("contacts", "contacts", use_rom | use_rom_limits | use_plan, {"impingement", "articular", "all"},
+  t.choice("contacts", "contacts", use_rom | use_rom_limits | use_plan | use_joint_plan, {"impingement", "articular", "all"},
            "Which contacts end a search: 'impingement' (the head-neck junction, neck or trochanters against the rim "
            "or the pelvis beyond it; the head's joint surface meeting the lunate surface, the joint space closing, "
            "is left out), 'articular' (only that: where the joint space closes) or 'all' (every vertex, the thesis' "
            "criterion). Anatomical neutral only (the zones need the acetabulum)",
            [](auto& o) -> auto& { return o.rom.search.contacts; }, parse_rom_contacts,
            [](RomContacts c) { return to_string(c); });
-  t.number("step", "step_deg", "deg", use_rom | use_rom_limits | use_plan, 0.01, 90,
+  t.number("step", "step_deg", "deg", use_rom | use_rom_limits | use_plan | use_joint_plan, 0.01, 90,
            "Coarse search step (then bisection to 0.1 deg)", [](auto& o) -> auto& { return o.rom.search.step_deg; });
-  t.number("max", "max_deg", "deg", use_rom | use_rom_limits | use_plan, 0.1, 360, "Search no farther than this from the start",
+  t.number("max", "max_deg", "deg", use_rom | use_rom_limits | use_plan | use_joint_plan, 0.1, 360, "Search no farther than this from the start",
            [](auto& o) -> auto& { return o.rom.search.max_deg; });
   t.numbers("map-flexion", "flexion", "deg", use_rom | use_rom_map, "The ROM map's flexion angles",
             [](auto& o) -> auto& { return o.rom.map_flexion_deg; });
@@ -313,7 +313,7 @@ void add_command_rows(Rows& t) {
 }
 
 void add_plan_rows(Rows& t) {
-  const unsigned plan = use_plan | use_study;
+  const unsigned plan = use_plan | use_joint_plan;
   t.text("target", "target", OptionType::text, plan, {},
          "Targets of a resection plan: MOTION=DEG,... (standard motions: flexion, extension, abduction, adduction, "
          "internal_rotation, external_rotation, internal_rotation_90_flexion, external_rotation_90_flexion, fadir) "

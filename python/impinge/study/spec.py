@@ -17,7 +17,7 @@ import numpy as np
 
 import impinge
 
-KINDS = ("rom", "envelope", "motion", "distance", "morphology")
+KINDS = ("rom", "envelope", "motion", "distance", "morphology", "plan")
 
 # Every key below comes from the option table (the session layer's, impinge.options()): a study cannot expose an
 # option, a default or a type that the CLI and Python do not share.
@@ -40,8 +40,9 @@ KIND_KEYS = {
     "motion": {"motion": None},
     "distance": {"poses": None},
     "morphology": {},
+    "plan": {o["key"]: o["default"] for o in _table("joint_plan")},
 }
-KIND_TYPES = dict({o["key"]: _PY_TYPES[o["type"]] for o in _table("rom_limits") + _table("rom_map")},
+KIND_TYPES = dict({o["key"]: _PY_TYPES[o["type"]] for o in _table("rom_limits") + _table("rom_map") + _table("joint_plan")},
                   motion=str, poses=list)
 # Keys whose value is itself a list: a list of such lists sweeps them (not a plain list).
 LIST_VALUED = {o["key"] for o in impinge.options() if o["type"] in ("numbers", "region", "point")}

@@ -189,8 +189,31 @@ def _run_morphology(joint, task, folder):
     return out
 
 
+def _run_plan(joint, task, folder):
+    o = dict(task["options"])
+    o["allow_partial"] = True  # a missed target is a result of the study, recorded in plan.json and its figures
+    d = joint.plan(**o)
+    meshes = {k: d.pop(k) for k in list(d) if k.endswith("_resected") or k.endswith("_resection_mm")}
+    with open(os.path.join(folder, "plan.json"), "w") as f:
+        json.dump(d, f, indent=1)
+    np.savez_compressed(os.path.join(folder, "resection.npz"),
+                        **{k: np.asarray(v) for k, v in meshes.items() if k.endswith("_resection_mm")})
+    out = {"all_targets_met": bool(d["all_targets_met"]), "plan_ms": float(d["timings_ms"]["total"])}
+    for bone in ("femur", "pelvis"):
+        r = d[f"{bone}_resection"]
+        if r["resected"]:
+            for k in ("volume_mm3", "area_mm2", "max_depth_mm", "mean_depth_mm"):
+                out[f"{bone}_{k}"] = float(r[k])
+    for t in d["targets"]:
+        if "limit_after_deg" in t:
+            out[f"limit_after_{t['target']}_deg"] = float("nan") if t["limit_after_deg"] is None else float(
+                t["limit_after_deg"])
+            out[f"met_{t['target']}"] = bool(t["met"])
+    return out
+
+
 RUNNERS = {"rom": _run_rom, "envelope": _run_envelope, "motion": _run_motion, "distance": _run_distance,
-           "morphology": _run_morphology}
+           "morphology": _run_morphology, "plan": _run_plan}
 
 
 def task_record(task):

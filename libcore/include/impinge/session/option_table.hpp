@@ -88,7 +88,8 @@ enum OptionUse : unsigned {
   use_study = 1u << 7,        ///< a study's [joint] and [[task]] keys
   use_generated_hip = 1u << 8,  ///< Python generated_hip(...)
   use_morphology = 1u << 9,     ///< `impinge morphology`, Python impinge.morphology(...)
-  use_plan = 1u << 10,          ///< `impinge plan`, Python Joint.plan(...), a study's `plan` task
+  use_plan = 1u << 10,          ///< `impinge plan`
+  use_joint_plan = 1u << 11,    ///< Python Joint.plan(...); a study's `plan` task
   use_cli_commands = use_distance | use_motion | use_rom | use_generate | use_morphology | use_plan,
 };
 
