@@ -201,6 +201,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   run.femur_source = s.ball_source();
   run.pelvis_source = s.socket_source();
   run.input_frame = s.input_frame();
+  run.head_centre_mm = s.head_centre_input();
 
   auto t = Clock::now();
   const RomRun before = run_rom(s, limits_only);
@@ -298,6 +299,7 @@ nlohmann::json plan_record(const PlanRun& run) {
   j["subject"] = run.subject;
   j["femur"] = run.femur_source;
   j["pelvis"] = run.pelvis_source;
+  j["head_centre_mm"] = {run.head_centre_mm.x(), run.head_centre_mm.y(), run.head_centre_mm.z()};
   j["input_frame"] = run.input_frame == FrameConvention::LPS ? "LPS" : "RAS";
   j["method"] =
       "least removal: per vertex, the depth that keeps every target pose's counted contacts at least the clearance "

@@ -58,6 +58,7 @@ struct PlanRun {
                                                   ///< with scan neutral)
   double clock_from_h[2] = {NAN, NAN}, clock_to_h[2] = {NAN, NAN};  ///< femur, pelvis: the resection's extent
   std::string subject, femur_source, pelvis_source;
+  Eigen::Vector3d head_centre_mm = Eigen::Vector3d::Zero();  ///< the femoral head centre at the scan pose, input frame
   FrameConvention input_frame = FrameConvention::RAS;
   double setup_ms = 0, before_ms = 0, plan_ms = 0, check_ms = 0, total_ms = 0;
   std::vector<std::string> warnings;
