@@ -4,8 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 
+#include "impinge/casters/exact_reference.hpp"
 #include "impinge/casters/signed_distance.hpp"
 #include "impinge/core/error.hpp"
 
@@ -80,12 +82,25 @@ struct BoneState {
   std::vector<std::uint8_t> protect;
   std::vector<double> required, depth;  // the contacts' depth (before the burr), the planned depth
   Vertices resected;
+  std::vector<double> limit;  // per vertex: the deepest it may go (the safety depth, less where the bone is thin)
+  std::vector<std::uint8_t> thin;  // 1: held by the bone's thickness, not the safety depth
   std::unique_ptr<VertexGrid> grid;
+  std::vector<std::uint8_t> thickness_known;
   std::unique_ptr<SignedDistanceQuery> query;
+  std::unique_ptr<ExactReference> original;
   bool changed = true;
 
-  bool can_take(std::int64_t i, double cap) const {
-    return allowed && !protect[static_cast<std::size_t>(i)] && depth[static_cast<std::size_t>(i)] < cap - 1e-9;
+  bool can_take(std::int64_t i, double) const {
+    const auto k = static_cast<std::size_t>(i);
+    return allowed && !protect[k] && depth[k] < limit[k] - 1e-9;
+  }
+  /// The bone's thickness under vertex i: the first hit of the ray from it along -n_i (from 0.05 mm inside, past
+  /// its own faces) with the input's surface, mm; infinity when the ray meets nothing.
+  double thickness(std::size_t i) const {
+    const Eigen::Vector3d n = normals.row(static_cast<Eigen::Index>(i)).transpose();
+    const Eigen::Vector3d from = V->row(static_cast<Eigen::Index>(i)).transpose() - 0.05 * n;
+    const std::optional<double> t = original->first_hit(from, -n);
+    return t ? *t + 0.05 : kInf;
   }
   void rebuild_query(const std::string& name) {
     if (!changed && query) return;
@@ -116,7 +131,14 @@ struct BoneState {
       }
     }
     for (std::size_t i = 0; i < n; ++i) {
-      const double v = protect[i] ? 0.0 : std::min(std::max(d[i], 0.0), cap);
+      double v = protect[i] ? 0.0 : std::min(std::max(d[i], 0.0), limit[i]);
+      if (v > 0 && !thickness_known[i]) {
+        // At most half the bone's thickness here: a thin rim or trochanter is not cut through.
+        thickness_known[i] = 1;
+        const double half = 0.5 * thickness(i);
+        if (half < limit[i]) limit[i] = half, thin[i] = 1;
+        v = std::min(v, limit[i]);
+      }
       if (v != depth[i]) changed = true;
       depth[i] = v;
     }
@@ -237,6 +259,16 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
     s.required.assign(n, 0.0);
     s.depth.assign(n, 0.0);
     s.resected = body.relative;
+    s.limit.assign(n, cap);
+    s.thin.assign(n, 0);
+    s.thickness_known.assign(n, 0);
+    if (s.allowed) {
+      TriangleMesh m;
+      m.V = body.relative;
+      m.F = body.mesh.F;
+      m.source = body.mesh.source;
+      s.original = std::make_unique<ExactReference>(m);
+    }
   }
   // The protected surfaces.
   const auto& art = hip.articular();
@@ -265,6 +297,9 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
       bone[1].protect[k] = u.norm() <= rh + 3 && bone[1].normals.row(i).dot(-u.normalized()) > 0.7;
     }
   }
+  for (BoneState& s : bone)
+    for (std::size_t i = 0; i < s.limit.size(); ++i)
+      if (s.protect[i]) s.limit[i] = 0;
   for (BoneState& s : bone)
     if (s.allowed) {
       std::vector<std::uint8_t> use(s.protect.size());
@@ -430,7 +465,7 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
       const char* what = pose_blocked[p] == Blocked::head     ? "the femoral head's articular surface"
                          : pose_blocked[p] == Blocked::lunate ? "the acetabulum's lunate surface"
                          : pose_blocked[p] == Blocked::depth
-                             ? "more than the safety depth"
+                             ? "more than the safety depth or the bone's thickness"
                              : "a bone the plan may not resect (--resect)";
       const double theta = targets[static_cast<std::size_t>(t)].theta_deg[poses[p].index];
       r.note = "the bones meet at " + (std::isnan(theta) ? std::string("the way to the motion's start")
@@ -466,6 +501,7 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
     double weighted = 0;
     for (std::size_t i = 0; i < s.depth.size(); ++i) {
       if (s.depth[i] >= cap - 1e-9 && s.depth[i] > 0) ++out.capped_vertices;
+      if (s.thin[i] && s.depth[i] > 0) ++out.thin_vertices;
       if (s.depth[i] <= kResectedMm) continue;
       ++out.vertices;
       out.area_mm2 += area[i];

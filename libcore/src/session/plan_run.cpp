@@ -321,6 +321,7 @@ nlohmann::json plan_record(const PlanRun& run) {
                         {"mean_depth_mm", b.mean_depth_mm},
                         {"vertices", b.vertices},
                         {"vertices_at_safety_depth", b.capped_vertices},
+                        {"vertices_held_by_thickness", b.thin_vertices},
                         {"clock_from_h", number_or_null(run.clock_from_h[k])},
                         {"clock_to_h", number_or_null(run.clock_to_h[k])}};
     return r;

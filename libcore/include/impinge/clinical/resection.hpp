@@ -21,7 +21,9 @@
 /// 3. the burr: the required depth field r is widened into what a spherical burr of radius b cuts when its tip
 ///    reaches r_j below the surface at each vertex j: d_i = max_j (r_j - (b - sqrt(b^2 - |x_i - x_j|^2))) over
 ///    |x_i - x_j| < b, the least burr-cut surface that contains the required one on a surface flat at the
-///    burr's scale; then d_i is capped at the safety depth, and 0 on the protected surfaces: the femoral head's
+///    burr's scale; then d_i is capped at the safety depth and at half the bone's thickness under the vertex (the
+///    first hit of the inward ray along -n_i with the input's surface: a thin rim or trochanter is not cut
+///    through), and 0 on the protected surfaces: the femoral head's
 ///    articular surface inside the labrum line (ArticularZones' head surface on the inner side of the acetabular
 ///    rim's plane with the femur at neutral; the head-neck junction outside it, where an osteochondroplasty
 ///    restores the offset, may go) and the lunate surface; with scan neutral, the head sphere's surface within
@@ -93,6 +95,7 @@ struct BoneResection {
   double max_depth_mm = 0, mean_depth_mm = 0;  ///< mean: area-weighted over that surface
   std::int64_t vertices = 0;           ///< vertices with depth > 0.01 mm
   std::int64_t capped_vertices = 0;    ///< vertices held at the safety depth
+  std::int64_t thin_vertices = 0;      ///< vertices held at half the bone's thickness under them
 };
 
 /// Per target: whether the plan clears it.

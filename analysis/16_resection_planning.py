@@ -1,0 +1,129 @@
+"""16_resection_planning: how much bone `impinge plan` removes against cams of known size, where, what it restores,
+and how long it takes (issue 50).
+
+Reads RESULTS/16_resection_planning/{generated,added_cam,ir90,published}.csv; writes table_plans.tex,
+volume_vs_cam.pdf/png, limits_restored.pdf/png, macros.tex. Without shared hips (no data) the added-cam and ir90
+parts are empty and their macros "--"."""
+import matplotlib.pyplot as plt
+import numpy as np
+
+from common import experiment_dir, read_csv, save, write_macros, write_table
+
+d = experiment_dir("16_resection_planning")
+gen = read_csv(d, "generated.csv")
+cam = read_csv(d, "added_cam.csv")
+ir = read_csv(d, "ir90.csv")
+pub = read_csv(d, "published.csv")
+
+
+def f(x, n=1):
+    return "--" if x is None or (isinstance(x, float) and np.isnan(x)) else f"{x:.{n}f}"
+
+
+def per_plan(frame, key):
+    """One row per plan (a plan's bone figures repeat on each of its targets' rows)."""
+    return frame.drop_duplicates(subset=key)
+
+
+macros = {}
+# Generated cams: the cams that limit a motion, and their plans.
+planned = gen[gen.volume_mm3 > 0]
+plans = per_plan(planned, ["cam_mm"])
+macros["RPgenCams"] = ", ".join(f"{c:g}" for c in sorted(gen.cam_mm.unique()))
+macros["RPgenLimitingCams"] = ", ".join(f"{c:g}" for c in plans.cam_mm) if len(plans) else "none"
+macros["RPgenNonLimitingCams"] = ", ".join(f"{c:g}" for c in sorted(set(gen.cam_mm) - set(plans.cam_mm))) or "none"
+ratio = plans.volume_mm3 / plans.cam_volume_mm3
+macros["RPgenRatioLow"], macros["RPgenRatioHigh"] = f(ratio.min(), 2), f(ratio.max(), 2)
+macros["RPgenShareLow"], macros["RPgenShareHigh"] = f(100 * plans.on_cam_share.min(), 0), f(100 * plans.on_cam_share.max(), 0)
+macros["RPgenTargets"], macros["RPgenMet"] = str(len(planned)), str(int(planned.met.sum()))
+over = planned.limit_after_deg - planned.limit_free_deg
+macros["RPgenOverLow"], macros["RPgenOverHigh"] = f(over.min()), f(over.max())
+macros["RPgenMsHigh"] = f(plans.plan_ms.max(), 0)
+
+# Real femurs with an added cam.
+cam_plans = cam[cam.motion != "none"]
+hips_cam = sorted(cam.subject.unique())
+macros["RPcamHips"] = str(len(hips_cam))
+macros["RPcamHeight"] = f(float(cam.cam_mm.iloc[0]), 0) if len(cam) else "--"
+macros["RPcamNoEffect"] = str(int((cam.motion == "none").sum()))
+if len(cam_plans):
+    p = per_plan(cam_plans, ["subject"])
+    r = p.volume_mm3 / p.cam_volume_mm3
+    macros["RPcamTargets"], macros["RPcamMet"] = str(len(cam_plans)), str(int(cam_plans.met.sum()))
+    macros["RPcamRatioLow"], macros["RPcamRatioHigh"] = f(r.min(), 2), f(r.max(), 2)
+    macros["RPcamShareLow"], macros["RPcamShareHigh"] = f(100 * p.on_cam_share.min(), 0), f(100 * p.on_cam_share.max(), 0)
+    macros["RPcamCheckedSame"] = str(int((np.abs(cam_plans.limit_after_deg - cam_plans.limit_checked_deg) < 1e-9).sum()))
+    restored = cam_plans[cam_plans.met == 1]
+    macros["RPcamRestoredHips"] = str(restored.subject.nunique())
+    macros["RPcamVolumeLow"], macros["RPcamVolumeHigh"] = f(p.cam_volume_mm3.min(), 0), f(p.cam_volume_mm3.max(), 0)
+else:
+    for k in ("RPcamTargets", "RPcamMet", "RPcamRatioLow", "RPcamRatioHigh", "RPcamShareLow", "RPcamShareHigh",
+              "RPcamCheckedSame", "RPcamRestoredHips", "RPcamVolumeLow", "RPcamVolumeHigh"):
+        macros[k] = "--"
+
+# Internal rotation at 90 deg flexion + 10 deg.
+macros["RPirHips"] = str(ir.subject.nunique())
+for resect in ("femur", "both"):
+    rows = ir[ir.resect == resect]
+    key = "Femur" if resect == "femur" else "Both"
+    macros[f"RPir{key}Met"] = str(int(rows.met.sum())) if len(rows) else "--"
+    vol = rows.femur_volume_mm3 + rows.pelvis_volume_mm3
+    macros[f"RPir{key}VolumeLow"] = f(vol.min(), 0) if len(rows) else "--"
+    macros[f"RPir{key}VolumeHigh"] = f(vol.max(), 0) if len(rows) else "--"
+macros["RPirHeadBlocked"] = str(int(ir.note.fillna("").str.contains("articular surface").sum()))
+macros["RPirDepthBlocked"] = str(int(ir.note.fillna("").str.contains("safety depth").sum()))
+macros["RPirMsHigh"] = f(ir.plan_ms.max(), 0) if len(ir) else "--"
+lhdl = ir[(ir.subject == "lhdl-ct")]
+macros["RPlhdlMs"] = f(lhdl.plan_ms.max() / 1000, 1) if len(lhdl) else "--"
+vol = pub[pub.quantity == "arthroscopic_resection_volume_mm3"].iloc[0]
+macros["RPpubVolumeLow"], macros["RPpubVolumeHigh"] = f(vol.low, 0), f(vol.high, 0)
+write_macros(d, "macros", macros)
+
+# The table: every plan on a real hip.
+rows = []
+for r in cam_plans.itertuples():
+    rows.append([r.subject, "added cam", r.motion.replace("_", " "), f(r.limit_free_deg), f(r.limit_cam_deg),
+                 f(r.limit_after_deg), "yes" if r.met else "no", f(r.volume_mm3, 0), f(r.max_depth_mm),
+                 f(100 * r.on_cam_share, 0)])
+for r in ir.itertuples():
+    rows.append([r.subject, f"IR90 +10, {r.resect}", "IR at 90 flexion", f(r.limit_before_deg), f(r.target_deg),
+                 f(r.limit_after_deg), "yes" if r.met else "no", f(r.femur_volume_mm3 + r.pelvis_volume_mm3, 0),
+                 f(max(r.femur_max_depth_mm, r.pelvis_max_depth_mm)), ""])
+write_table(d, "table_plans", ["hip", "plan", "motion", "limit before", "target", "after", "met", "volume (mm$^3$)",
+                               "max depth (mm)", "on cam (\\%)"], rows, align="lllrrrlrrr")
+
+# Planned volume against the cam's.
+fig, ax = plt.subplots(figsize=(5, 3.6))
+if len(plans):
+    ax.plot(plans.cam_volume_mm3, plans.volume_mm3, "o", label="generated cams")
+if len(cam_plans):
+    p = per_plan(cam_plans, ["subject"])
+    ax.plot(p.cam_volume_mm3, p.volume_mm3, "s", label="real femurs, added cam")
+top = max([1.0] + list(gen.cam_volume_mm3) + list(cam.cam_volume_mm3.dropna()))
+x = np.array([0, top * 1.1])
+ax.plot(x, x, "k-", lw=1, label="the cam's volume")
+ax.plot(x, 1.2 * x, "k--", lw=1, label="1.2 x the cam's volume")
+ax.set_xlabel("cam volume (mm$^3$)")
+ax.set_ylabel("planned resection (mm$^3$)")
+ax.legend(fontsize=7)
+ax.grid(alpha=0.3)
+save(fig, d, "volume_vs_cam")
+
+# Limits: without the cam, with it, after the plan.
+cases = [(f"gen {r.cam_mm:g} mm, {r.motion.replace('_', ' ')}", r.limit_free_deg, r.limit_cam_deg, r.limit_after_deg)
+         for r in planned.itertuples()]
+cases += [(f"{r.subject}, {r.motion.replace('_', ' ')}", r.limit_free_deg, r.limit_cam_deg, r.limit_after_deg)
+          for r in cam_plans.itertuples()]
+fig, ax = plt.subplots(figsize=(8, 3.6))
+if cases:
+    y = np.arange(len(cases))
+    ax.barh(y - 0.27, [c[1] for c in cases], 0.27, label="without the cam", color="0.7")
+    ax.barh(y, [c[2] for c in cases], 0.27, label="with the cam", color="tab:red")
+    ax.barh(y + 0.27, [c[3] for c in cases], 0.27, label="after the plan (checked)", color="tab:blue")
+    ax.set_yticks(y)
+    ax.set_yticklabels([c[0] for c in cases], fontsize=7)
+    ax.invert_yaxis()
+ax.set_xlabel("ROM limit (deg)")
+ax.legend(fontsize=7)
+ax.grid(alpha=0.3, axis="x")
+save(fig, d, "limits_restored")
