@@ -17,6 +17,7 @@ import pytest
 
 import impinge
 from test_impinge import CLI, DATA
+from test_morphology import write_ply
 
 TARGETS = ("flexion", "abduction", "internal_rotation")
 
@@ -184,3 +185,52 @@ def test_internal_rotation_in_flexion_ten_degrees_more_on_a_real_hip(tmp_path):
              tmp_path / "both" / "pelvis_resected.ply", "--out", tmp_path / "after", "--no-map", "--precision", 0.5])
     assert r.returncode == 0, r.stderr
     assert limits(tmp_path / "after")["internal_rotation_90_flexion"] >= target - 0.5
+
+
+@pytest.mark.skipif(not os.path.isdir(os.path.join(DATA, "tlem2-mri")), reason="shared data absent")
+def test_a_cam_added_to_a_real_femur_is_planned_away(tmp_path):
+    """tlem2-mri's femur with a 3 mm bump at its antero-superior head-neck junction (the input frame's femur axes from
+    impinge morphology): targets = the limits without the bump that it lowers; `impinge rom` on the written
+    femur_resected.ply restores each within 0.5 deg, the plan removing at most 1.2 times the bump's volume, most of
+    it on the bump (issue 50's first done-when item; experiment 16 does every shared hip)."""
+    subject = os.path.join(DATA, "tlem2-mri", "subject.json")
+    meshes = impinge.subject_meshes(subject)
+    m = impinge.Joint(subject=subject, precision=0.5).morphology()["femur"]
+    V, F = impinge.load_mesh(meshes["femur"])
+    c, r = np.asarray(m["head_centre_mm"]["value"]), m["head_radius_mm"]["value"]
+    a = np.asarray(m["neck_axis"]["value"])
+    s = np.asarray(m["frame"]["x_axis"]) + np.asarray(m["frame"]["y_axis"])  # anterior + superior: 1:30 o'clock
+    u = s - s.dot(a) * a
+    u /= np.linalg.norm(u)
+    d = np.cos(np.radians(62)) * (-a) + np.sin(np.radians(62)) * u
+    p = V - c
+    dist = np.linalg.norm(p, axis=1)
+    g = np.degrees(np.arccos(np.clip(p @ d / dist, -1, 1))) / 12
+    bump = np.where((dist > r - 6) & (dist < r + 12), 3.0 * np.exp(-g * g), 0.0)
+    Vc = V + p / dist[:, None] * bump[:, None]
+    write_ply(tmp_path / "femur_cam.ply", Vc, F)
+    cam_volume = volume(Vc, F) - volume(V, F)
+    common = ["--subject", subject, "--precision", 0.5]
+    r = run(["rom", "--out", tmp_path / "free", "--no-map"] + common)
+    assert r.returncode == 0, r.stderr
+    r = run(["rom", "--ball", tmp_path / "femur_cam.ply", "--out", tmp_path / "cam", "--no-map"] + common)
+    assert r.returncode == 0, r.stderr
+    free, cam = limits(tmp_path / "free"), limits(tmp_path / "cam")
+    lowered = [k for k in free if free[k] == free[k] and cam[k] == cam[k] and cam[k] < free[k] - 1]
+    assert "internal_rotation_90_flexion" in lowered, (free, cam)
+    r = run(["plan", "--ball", tmp_path / "femur_cam.ply", "--out", tmp_path / "plan", "--target",
+             ",".join(f"{k}={free[k]:.3f}" for k in lowered)] + common)
+    assert r.returncode == 0, r.stderr + r.stdout
+    r = run(["rom", "--ball", tmp_path / "plan" / "femur_resected.ply", "--out", tmp_path / "after", "--no-map"]
+            + common)
+    assert r.returncode == 0, r.stderr
+    after = limits(tmp_path / "after")
+    for k in lowered:
+        assert after[k] >= free[k] - 0.5, (k, after[k], free[k])
+    props, Fr = read_ply_properties(tmp_path / "plan" / "femur_resected.ply")
+    Vr = np.column_stack([props["x"], props["y"], props["z"]])
+    assert np.array_equal(Fr, F)
+    removed = volume(Vc, F) - volume(Vr, F)
+    assert 0 < removed <= 1.2 * cam_volume, (removed, cam_volume)
+    w = props["resection_mm"] * np.bincount(F.ravel(), minlength=len(V))  # depth x (a proxy of) area
+    assert w[bump > 0.05].sum() > 0.5 * w.sum()

@@ -334,3 +334,26 @@ kind = "morphology"
     assert float(rows[0]["lateral_centre_edge_deg"]) == pytest.approx(
         expected["acetabulum"]["lateral_centre_edge_deg"]["value"])
     assert os.path.exists(os.path.join(out, "tasks", rows[0]["task_id"], "morphology.json"))
+
+
+def test_a_plan_task_records_the_joints_plan(tmp_path):
+    """A study's plan task gives Joint.plan's figures (generated hip with a 3 mm cam: flexion back to 50 deg)."""
+    path = write_study(str(tmp_path), """name = "plans"
+subjects = [{name = "cam3", generated = {cam_mm = 3.0, triangles = 6000}}]
+[joint]
+precision = 1.0
+neutral = "scan"
+[[task]]
+kind = "plan"
+target = "flexion=50"
+""")
+    out = str(tmp_path / "out")
+    study.run(path, out, workers=0, progress=False, log=lambda _: None)
+    rows = read(out)
+    assert len(rows) == 1 and rows[0]["status"] == "ok", rows
+    h = impinge.generated_hip(triangles=6000, cam_mm=3.0)
+    expected = impinge.Joint(h["ball"], h["socket"], precision=1.0, neutral="scan").plan(target="flexion=50")
+    assert float(rows[0]["femur_volume_mm3"]) == pytest.approx(expected["femur_resection"]["volume_mm3"])
+    assert rows[0]["met_flexion"] == "true" and float(rows[0]["limit_after_flexion_deg"]) >= 50 - 0.1
+    folder = os.path.join(out, "tasks", rows[0]["task_id"])
+    assert os.path.exists(os.path.join(folder, "plan.json")) and os.path.exists(os.path.join(folder, "resection.npz"))

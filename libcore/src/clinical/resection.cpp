@@ -57,8 +57,7 @@ struct VertexGrid {
   std::int64_t coord(double v) const { return static_cast<std::int64_t>(std::floor(v / cell)); }
   VertexGrid(const Vertices& V, const std::vector<std::uint8_t>& use, double cell_mm) : cell(cell_mm) {
     for (Eigen::Index i = 0; i < V.rows(); ++i)
-      if (use[static_cast<std::size_t>(i)])
-        cells[key(coord(V(i, 0)), coord(V(i, 1)), coord(V(i, 2)))].push_back(i);
+      if (use[static_cast<std::size_t>(i)]) cells[key(coord(V(i, 0)), coord(V(i, 1)), coord(V(i, 2)))].push_back(i);
   }
   template <class F>
   void near(const Eigen::Vector3d& p, F&& f) const {
@@ -82,7 +81,7 @@ struct BoneState {
   std::vector<std::uint8_t> protect;
   std::vector<double> required, depth;  // the contacts' depth (before the burr), the planned depth
   Vertices resected;
-  std::vector<double> limit;  // per vertex: the deepest it may go (the safety depth, less where the bone is thin)
+  std::vector<double> limit;       // per vertex: the deepest it may go (the safety depth, less where the bone is thin)
   std::vector<std::uint8_t> thin;  // 1: held by the bone's thickness, not the safety depth
   std::unique_ptr<VertexGrid> grid;
   std::vector<std::uint8_t> thickness_known;
@@ -164,9 +163,12 @@ enum class Blocked : std::uint8_t { no = 0, head = 1, lunate = 2, depth = 3, bon
 
 const char* to_string(ResectBones bones) {
   switch (bones) {
-    case ResectBones::femur: return "femur";
-    case ResectBones::pelvis: return "pelvis";
-    case ResectBones::both: return "both";
+    case ResectBones::femur:
+      return "femur";
+    case ResectBones::pelvis:
+      return "pelvis";
+    case ResectBones::both:
+      return "both";
   }
   return "femur";
 }
@@ -195,7 +197,8 @@ double neck_diameter_mm(const Vertices& femur, const Faces& faces, const Eigen::
   std::vector<std::vector<double>> radius(static_cast<std::size_t>(slabs));
   std::vector<unsigned> sectors(static_cast<std::size_t>(slabs), 0u);
   // Any unit vector normal to the axis, for the azimuth.
-  const Eigen::Vector3d e1 = (std::abs(a.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY()).cross(a).normalized();
+  const Eigen::Vector3d e1 =
+      (std::abs(a.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY()).cross(a).normalized();
   const Eigen::Vector3d e2 = a.cross(e1);
   for (Eigen::Index i = 0; i < femur.rows(); ++i) {
     const Eigen::Vector3d p = femur.row(i).transpose() - head_centre;
@@ -393,7 +396,8 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
         const BoneState& own = bone[ct.ball ? 0 : 1];
         const BoneState& other = bone[ct.ball ? 1 : 0];
         const Eigen::Vector3d x = own.resected.row(static_cast<Eigen::Index>(ct.vertex)).transpose();
-        const Eigen::Vector3d q = ct.ball ? Eigen::Vector3d(P.R * x + P.t) : Eigen::Vector3d(P.R.transpose() * (x - P.t));
+        const Eigen::Vector3d q =
+            ct.ball ? Eigen::Vector3d(P.R * x + P.t) : Eigen::Vector3d(P.R.transpose() * (x - P.t));
         ClosestSurfacePoint cp;
         if (other.query->signed_distance(q, kInf, 0, cp, ct.seed)) {
           ct.seed = cp.triangle;
@@ -434,8 +438,8 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
         }
         residual = std::max(residual, ct.deficit);
         const double share = own_can && other_can ? 0.5 * ct.deficit : ct.deficit;
-        if (own_can) need[a][static_cast<std::size_t>(ct.vertex)] =
-                         std::max(need[a][static_cast<std::size_t>(ct.vertex)], share);
+        if (own_can)
+          need[a][static_cast<std::size_t>(ct.vertex)] = std::max(need[a][static_cast<std::size_t>(ct.vertex)], share);
         if (other_can)
           for (int m = 0; m < 3; ++m)
             if (bone[b].can_take(tri[m], cap))
@@ -464,12 +468,12 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
       r.reachable = false;
       const char* what = pose_blocked[p] == Blocked::head     ? "the femoral head's articular surface"
                          : pose_blocked[p] == Blocked::lunate ? "the acetabulum's lunate surface"
-                         : pose_blocked[p] == Blocked::depth
-                             ? "more than the safety depth or the bone's thickness"
-                             : "a bone the plan may not resect (--resect)";
+                         : pose_blocked[p] == Blocked::depth  ? "more than the safety depth or the bone's thickness"
+                                                              : "a bone the plan may not resect (--resect)";
       const double theta = targets[static_cast<std::size_t>(t)].theta_deg[poses[p].index];
-      r.note = "the bones meet at " + (std::isnan(theta) ? std::string("the way to the motion's start")
-                                                         : std::to_string(theta).substr(0, 6) + " deg") +
+      r.note = "the bones meet at " +
+               (std::isnan(theta) ? std::string("the way to the motion's start")
+                                  : std::to_string(theta).substr(0, 6) + " deg") +
                " where clearing them would take " + what;
       for (std::size_t q = p; q < poses.size() && poses[q].target == t; ++q) pose_kept[q] = 0;
       dropped = true;

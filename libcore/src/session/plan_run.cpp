@@ -115,8 +115,7 @@ void clock_extent(const std::vector<double>& hours, const std::vector<double>& d
   to = hour(h[(after + h.size() - 1) % h.size()]);
 }
 
-std::optional<Morphology> try_morphology(const SessionOptions& so, std::vector<std::string>& notes,
-                                         const char* what) {
+std::optional<Morphology> try_morphology(const SessionOptions& so, std::vector<std::string>& notes, const char* what) {
   try {
     return run_morphology(so).morphology;
   } catch (const std::exception& e) {
@@ -153,7 +152,8 @@ std::vector<ResectionTarget> plan_targets(const Session& s, const PlanRequest& r
     } else if (limit.status == RomLimitStatus::not_reachable) {
       // The straight way from neutral to the start, parameterised by its largest angle (as find_rom_limits).
       const PoseAngles& a = motion.start;
-      const double way = std::max({std::abs(a.flexion_deg), std::abs(a.adduction_deg), std::abs(a.internal_rotation_deg)});
+      const double way =
+          std::max({std::abs(a.flexion_deg), std::abs(a.adduction_deg), std::abs(a.internal_rotation_deg)});
       for (double x = 0; x < way; x += step) {
         const double f = x / way;
         t.poses.push_back({f * a.flexion_deg, f * a.adduction_deg, f * a.internal_rotation_deg});
@@ -183,8 +183,9 @@ std::vector<ResectionTarget> plan_targets(const Session& s, const PlanRequest& r
 PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const PlanRequest& request) {
   const auto t_start = Clock::now();
   PlanRun run;
-  require(std::isfinite(request.max_depth_fraction) && request.max_depth_fraction > 0 && request.max_depth_fraction <= 1,
-          "--max-depth-fraction " + std::to_string(request.max_depth_fraction) + ": valid (0, 1]");
+  require(
+      std::isfinite(request.max_depth_fraction) && request.max_depth_fraction > 0 && request.max_depth_fraction <= 1,
+      "--max-depth-fraction " + std::to_string(request.max_depth_fraction) + ": valid (0, 1]");
   RomRequest limits_only = rom;
   limits_only.map = false;
   limits_only.envelope = false;
@@ -215,7 +216,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
     const Eigen::Matrix3d to_joint = hip.joint_to_working().transpose();
     const Eigen::Vector3d neck = to_joint * run.before->neck_axis;
     run.neck_diameter_mm = neck_diameter_mm(s.joint().ball().relative, s.joint().ball().mesh.F, hip.head_centre_joint(),
-                                           hip.head_radius_mm(), neck);
+                                            hip.head_radius_mm(), neck);
   }
   if (request.max_depth_mm > 0) {
     run.max_depth_mm = request.max_depth_mm;
@@ -242,7 +243,8 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
     m.source = name;
     return m;
   };
-  run.femur_resected = resected(run.plan.femur, s.femur_input(hip.scan_pose()), s.joint().ball().mesh, "femur_resected");
+  run.femur_resected =
+      resected(run.plan.femur, s.femur_input(hip.scan_pose()), s.joint().ball().mesh, "femur_resected");
   run.pelvis_resected = resected(run.plan.pelvis, s.pelvis_input(), s.joint().socket().mesh, "pelvis_resected");
   if (hip.ball_clock()) {
     run.femur_hours = clock_hours(s.joint().ball().relative, *hip.ball_clock());
@@ -272,8 +274,8 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
       c.met = c.after.status == RomLimitStatus::free ||
               (c.after.status == RomLimitStatus::limited && c.after.limit_deg >= target.angle_deg - 0.1);
       if (!c.met)
-        c.shortfall_deg = c.after.status == RomLimitStatus::limited ? target.angle_deg - c.after.limit_deg
-                                                                    : target.angle_deg;
+        c.shortfall_deg =
+            c.after.status == RomLimitStatus::limited ? target.angle_deg - c.after.limit_deg : target.angle_deg;
     } else {
       c.frames_in_contact_before = frames_in_contact(s, before.baseline, rom.search, target.poses);
       c.frames_in_contact_after = frames_in_contact(s_after, after.baseline, rom.search, target.poses);

@@ -66,36 +66,36 @@ ResectBones parse_resect_bones(const std::string& text, const std::string& conte
 
 /// The poses one target asks to be free of impingement, in order along its motion.
 struct ResectionTarget {
-  std::string name;                                            ///< a standard motion's name, or a motion file
+  std::string name;                                             ///< a standard motion's name, or a motion file
   double angle_deg = std::numeric_limits<double>::quiet_NaN();  ///< the angle to reach (NaN for a motion file)
-  std::vector<PoseAngles> poses;                               ///< degrees, ISB
+  std::vector<PoseAngles> poses;                                ///< degrees, ISB
   std::vector<double> theta_deg;  ///< per pose: the motion's angle (NaN on a lead-in to the start), or the frame
 };
 
 /// Options of plan_resection.
 struct ResectionOptions {
   ResectBones bones = ResectBones::femur;
-  double clearance_mm = 0.3;      ///< c: the least distance the bones keep at every target pose, mm
+  double clearance_mm = 0.3;  ///< c: the least distance the bones keep at every target pose, mm
   double max_depth_mm = std::numeric_limits<double>::infinity();  ///< the safety depth, mm (the caller's)
-  double burr_radius_mm = 2.5;    ///< b: the spherical burr's radius, mm (0: no widening)
-  double tolerance_mm = 0.02;     ///< a contact asking for less than this more is met, mm
-  int max_iterations = 16;        ///< rounds of step 4
+  double burr_radius_mm = 2.5;     ///< b: the spherical burr's radius, mm (0: no widening)
+  double tolerance_mm = 0.02;      ///< a contact asking for less than this more is met, mm
+  int max_iterations = 16;         ///< rounds of step 4
   double candidate_margin_mm = 1;  ///< contacts: vertices within c + this of the other bone, mm
 };
 
 /// What is removed from one bone.
 struct BoneResection {
-  bool allowed = false;                ///< the options let this bone be resected
-  std::vector<double> depth_mm;        ///< per vertex, >= 0 (input vertex order)
+  bool allowed = false;                        ///< the options let this bone be resected
+  std::vector<double> depth_mm;                ///< per vertex, >= 0 (input vertex order)
   std::vector<std::uint8_t> protected_vertex;  ///< 1: never resected (articular surface)
-  Vertices resected;                   ///< n x 3, joint frame, mm (the input's faces)
-  Vertices normals;                    ///< n x 3 unit outward vertex normals (area-weighted), joint frame
-  double volume_mm3 = 0;               ///< the input's enclosed volume less the resected one's
-  double area_mm2 = 0;                 ///< surface whose depth exceeds 0.01 mm (vertex areas)
+  Vertices resected;                           ///< n x 3, joint frame, mm (the input's faces)
+  Vertices normals;                            ///< n x 3 unit outward vertex normals (area-weighted), joint frame
+  double volume_mm3 = 0;                       ///< the input's enclosed volume less the resected one's
+  double area_mm2 = 0;                         ///< surface whose depth exceeds 0.01 mm (vertex areas)
   double max_depth_mm = 0, mean_depth_mm = 0;  ///< mean: area-weighted over that surface
-  std::int64_t vertices = 0;           ///< vertices with depth > 0.01 mm
-  std::int64_t capped_vertices = 0;    ///< vertices held at the safety depth
-  std::int64_t thin_vertices = 0;      ///< vertices held at half the bone's thickness under them
+  std::int64_t vertices = 0;                   ///< vertices with depth > 0.01 mm
+  std::int64_t capped_vertices = 0;            ///< vertices held at the safety depth
+  std::int64_t thin_vertices = 0;              ///< vertices held at half the bone's thickness under them
 };
 
 /// Per target: whether the plan clears it.
@@ -115,11 +115,11 @@ struct ResectionPlan {
   ResectionOptions options;
   BoneResection femur, pelvis;  ///< pelvis.allowed false: no pelvis resection (depth all 0)
   std::vector<ResectionTargetResult> targets;
-  int iterations = 0;                ///< rounds of step 4 in the last plan
-  int rounds = 0;                    ///< plans made (1 + one per round of dropping unreachable poses)
-  double residual_mm = 0;            ///< the largest depth a kept contact still asks for, mm
+  int iterations = 0;                    ///< rounds of step 4 in the last plan
+  int rounds = 0;                        ///< plans made (1 + one per round of dropping unreachable poses)
+  double residual_mm = 0;                ///< the largest depth a kept contact still asks for, mm
   std::int64_t poses = 0, contacts = 0;  ///< poses scanned; (pose, vertex) contacts followed
-  double ms = 0;                     ///< wall time, ms
+  double ms = 0;                         ///< wall time, ms
 };
 
 /// Plan the least resection (the file comment's method) of `hip`'s bones that frees every pose of `targets`:

@@ -23,8 +23,8 @@ struct PlanRequest {
   /// normal range, published_rom.hpp), or both ("normal,flexion=130": a named angle replaces normal's). Empty:
   /// none (then `target_motion` must be given).
   std::string target;
-  std::string target_motion;  ///< a motion file (.csv, .mot, .sto) whose every frame must be free; empty: none
-  ResectionOptions resection;  ///< bones, clearance, burr (max_depth_mm: set from the two below)
+  std::string target_motion;        ///< a motion file (.csv, .mot, .sto) whose every frame must be free; empty: none
+  ResectionOptions resection;       ///< bones, clearance, burr (max_depth_mm: set from the two below)
   double max_depth_fraction = 0.3;  ///< safety depth as a fraction of the neck's least diameter (Mardones 2005)
   double max_depth_mm = 0;          ///< safety depth, mm; 0: max_depth_fraction x the neck's diameter
   bool allow_partial = false;       ///< a target missed after the check is not an error (exit 0)
@@ -35,9 +35,9 @@ struct PlanRequest {
 struct PlanTargetCheck {
   std::string name;
   double target_deg = std::numeric_limits<double>::quiet_NaN();  ///< NaN for a motion file
-  RomLimit before, after;  ///< the ROM search's limit on the input and on the resected bones (standard motions)
-  bool met = false;        ///< after: limited at or beyond the target (within 0.1 deg, the search's tolerance),
-                           ///< or free; a motion file: no frame in contact after
+  RomLimit before, after;    ///< the ROM search's limit on the input and on the resected bones (standard motions)
+  bool met = false;          ///< after: limited at or beyond the target (within 0.1 deg, the search's tolerance),
+                             ///< or free; a motion file: no frame in contact after
   double shortfall_deg = 0;  ///< target less the limit after, when not met
   /// Motion files: frames in contact before and after (the ROM search's criterion), else 0.
   std::int64_t frames_in_contact_before = 0, frames_in_contact_after = 0;
@@ -48,12 +48,12 @@ struct PlanRun {
   ResectionPlan plan;
   std::vector<PlanTargetCheck> targets;
   bool all_met = false;
-  RomOptions search;                        ///< the ROM search's options (the check's)
+  RomOptions search;  ///< the ROM search's options (the check's)
   double neck_diameter_mm = std::numeric_limits<double>::quiet_NaN();
-  double max_depth_mm = 0;                  ///< the safety depth used
-  std::optional<Morphology> before, after;  ///< morphology of the input and of the resected femur
-  std::vector<std::string> notes;           ///< what could not be measured or checked
-  TriangleMesh femur_resected, pelvis_resected;  ///< input frame, mm (the input's faces and vertex order)
+  double max_depth_mm = 0;                        ///< the safety depth used
+  std::optional<Morphology> before, after;        ///< morphology of the input and of the resected femur
+  std::vector<std::string> notes;                 ///< what could not be measured or checked
+  TriangleMesh femur_resected, pelvis_resected;   ///< input frame, mm (the input's faces and vertex order)
   std::vector<double> femur_hours, pelvis_hours;  ///< per vertex: head-neck and acetabular clock hours (empty
                                                   ///< with scan neutral)
   double clock_from_h[2] = {NAN, NAN}, clock_to_h[2] = {NAN, NAN};  ///< femur, pelvis: the resection's extent
