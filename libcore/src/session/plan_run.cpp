@@ -186,6 +186,11 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   require(
       std::isfinite(request.max_depth_fraction) && request.max_depth_fraction > 0 && request.max_depth_fraction <= 1,
       "--max-depth-fraction " + std::to_string(request.max_depth_fraction) + ": valid (0, 1]");
+  // The targets and the motion file are checked before anything is built (a bad one is an error in milliseconds).
+  parse_targets(request.target, standard_motions());
+  if (!request.target_motion.empty()) load_motion(request.target_motion, input_side(options.input));
+  require(!request.target.empty() || !request.target_motion.empty(),
+          "plan: no target: give --target (MOTION=DEG,... or normal) or --target-motion");
   RomRequest limits_only = rom;
   limits_only.map = false;
   limits_only.envelope = false;
