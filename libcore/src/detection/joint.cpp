@@ -1,5 +1,7 @@
 #include "impinge/detection/joint.hpp"
 
+#include <omp.h>
+
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -19,11 +21,12 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
   require(o.occlusion_tolerance_mm >= 0, "joint: occlusion tolerance must be >= 0 mm");
   require(o.max_radius_mm > 0, "joint: region radius must be > 0 mm");
   require(o.sparse_region_mm > 0, "joint: sparse region must be > 0 mm");
-  require(!o.exact_at_discontinuities || (std::isfinite(o.discontinuity_tolerance_mm) && o.discontinuity_tolerance_mm > 0),
-          "joint: the depth-discontinuity tolerance must be > 0 mm and finite");
-  require(o.layers >= 0 && o.layers <= LayeredMap::kMaxLayers,
-          "joint: layers must be 0 (off) to " + std::to_string(LayeredMap::kMaxLayers) + ", not " +
-              std::to_string(o.layers));
+  require(
+      !o.exact_at_discontinuities || (std::isfinite(o.discontinuity_tolerance_mm) && o.discontinuity_tolerance_mm > 0),
+      "joint: the depth-discontinuity tolerance must be > 0 mm and finite");
+  require(o.layers >= 0 && o.layers <= LayeredMap::kMaxLayers, "joint: layers must be 0 (off) to " +
+                                                                   std::to_string(LayeredMap::kMaxLayers) + ", not " +
+                                                                   std::to_string(o.layers));
   require(o.layers == 0 || FirstHitCaster::available(),
           "joint: layered maps need a ray caster (Embree or CGAL), and this build has neither");
   require(o.extra_articular_radius_mm > 0, "joint: the extra-articular radius must be > 0 mm");
@@ -34,8 +37,7 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
           "joint: distances need a closest-point engine (Embree or CGAL), and this build has neither");
   require(std::isfinite(o.distance_reach_mm) && o.distance_reach_mm >= 0,
           "joint: the distances' reach must be 0 (the largest level threshold) or > 0 mm");
-  require(o.levels_on == LevelQuantity::radial_gap || o.distances,
-          "joint: levels on the distance need distances on");
+  require(o.levels_on == LevelQuantity::radial_gap || o.distances, "joint: levels on the distance need distances on");
   require(o.levels_on == LevelQuantity::radial_gap || o.reach_mm() >= o.levels.thresholds_mm.front(),
           "joint: levels on the distance need a distance reach of at least the largest level threshold (" +
               std::to_string(o.levels.thresholds_mm.front()) + " mm)");
@@ -48,8 +50,9 @@ Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor,
 
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options,
              RadialDistanceMap ball_map, RadialDistanceMap socket_map)
-    : Joint(cor, options,
-            build_bodies(cor, options, std::move(ball), std::move(socket), std::move(ball_map), std::move(socket_map))) {}
+    : Joint(
+          cor, options,
+          build_bodies(cor, options, std::move(ball), std::move(socket), std::move(ball_map), std::move(socket_map))) {}
 
 Joint::Joint(const Eigen::Vector3d& cor, const JointOptions& options, std::pair<JointBody, JointBody> bodies)
     : cor_(cor), options_(options), ball_(std::move(bodies.first)), socket_(std::move(bodies.second)) {}
@@ -62,9 +65,8 @@ std::pair<JointBody, JointBody> Joint::build_bodies(const Eigen::Vector3d& cor, 
   // The two bodies are independent: the socket's is built on a second thread while this one builds the
   // ball's (much of a build is serial: hierarchies, marks, masks, page faults of the maps). A failure
   // on either is rethrown here, after both have finished.
-  auto socket_future = std::async(std::launch::async, [&] {
-    return build(cor, options, std::move(socket), std::move(socket_map));
-  });
+  auto socket_future =
+      std::async(std::launch::async, [&] { return build(cor, options, std::move(socket), std::move(socket_map)); });
   std::optional<JointBody> b;
   std::exception_ptr ball_error;
   try {
@@ -86,14 +88,15 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
   // serial). Joined before b is returned or the build fails (the future's destructor waits).
   std::future<std::shared_ptr<const SignedDistanceQuery>> query;
   if (options.distances || options.layers > 0)
-    query = std::async(std::launch::async, [&mesh = b.mesh] { return std::make_shared<const SignedDistanceQuery>(mesh); });
+    query =
+        std::async(std::launch::async, [&mesh = b.mesh] { return std::make_shared<const SignedDistanceQuery>(mesh); });
   b.relative = b.mesh.V.rowwise() - cor.transpose();
   if (given) {
     const SamplingScheme& want = *options.scheme;
     const SamplingScheme& have = given->scheme();
-    require(want.conformable(have),
-            b.mesh.source + ": the given map is " + have.name() + " at " + std::to_string(have.resolution()) +
-                ", the joint's scheme is " + want.name() + " at " + std::to_string(want.resolution()));
+    require(want.conformable(have), b.mesh.source + ": the given map is " + have.name() + " at " +
+                                        std::to_string(have.resolution()) + ", the joint's scheme is " + want.name() +
+                                        " at " + std::to_string(want.resolution()));
     b.map = std::move(*given);
     b.sampling.nodes_covered = b.map.nodes_covered();
   } else {
@@ -157,58 +160,86 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
 }
 
 void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& res, DetectionMemory* memory) const {
-  std::vector<float>& gaps = res.compact_gaps;
-  gaps.resize(static_cast<std::size_t>(std::max(ball_.scan_set.size(), socket_.scan_set.size())));
-  auto t0 = std::chrono::steady_clock::now();
-  const std::int64_t ball_refined =
-      scan_gaps_compact(ball_.scan_set, R, t, socket_.map, ScanSide::inside, gaps.data(), socket_.exact.get());
-  res.ball_detection_ms = ms_since(t0);
-  expand_scan(ball_.scan_set, gaps.data(), res.ball_gaps);
-  res.ball_gaps.refined = ball_refined;
-  if (socket_.layered) {
-    gaps.resize(std::max(gaps.size(), static_cast<std::size_t>(ball_.hidden_set.size())));
-    res.ball_gaps.refined += scan_layered_near(ball_.hidden_set, ball_.hidden_clusters, R, t, *socket_.layered, cor_,
-                                               *socket_.distance_query, options_.reach_mm(), gaps.data(),
-                                               socket_.caster.get())
-                                 .refined;
-    expand_layered_scan(ball_.hidden_set, gaps.data(), res.ball_gaps);
+  // The ball's scans (its vertices against the socket's maps and surface) and the socket's (in the ball's frame:
+  // R^T (p - t)) share nothing but the pose: on their own threads when this call is not already on one of
+  // several (a motion's or a ROM search's frames are), each with its own scratch. Same results either way.
+  const Eigen::Matrix3d Rt = R.transpose();
+  const Eigen::Vector3d tt = -(Rt * t);
+  auto ball_scans = [&] {
+    std::vector<float>& gaps = res.compact_gaps;
+    gaps.resize(static_cast<std::size_t>(std::max(ball_.scan_set.size(), ball_.hidden_set.size())));
+    auto t0 = std::chrono::steady_clock::now();
+    const std::int64_t refined =
+        scan_gaps_compact(ball_.scan_set, R, t, socket_.map, ScanSide::inside, gaps.data(), socket_.exact.get());
+    expand_scan(ball_.scan_set, gaps.data(), res.ball_gaps);  // resets the scan's counts
+    res.ball_gaps.refined = refined;
+    if (socket_.layered) {
+      res.ball_gaps.refined +=
+          scan_layered_near(ball_.hidden_set, ball_.hidden_clusters, R, t, *socket_.layered, cor_,
+                            *socket_.distance_query, options_.reach_mm(), gaps.data(), socket_.caster.get())
+              .refined;
+      expand_layered_scan(ball_.hidden_set, gaps.data(), res.ball_gaps);
+    }
     res.ball_detection_ms = ms_since(t0);
-  }
-  // Socket vertices in the ball's frame: R^T (p - t).
-  t0 = std::chrono::steady_clock::now();
-  const std::int64_t socket_refined =
-      scan_gaps_compact(socket_.scan_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), ball_.map,
-                        ScanSide::outside, gaps.data(), ball_.exact.get());
-  res.socket_detection_ms = ms_since(t0);
-  expand_scan(socket_.scan_set, gaps.data(), res.socket_gaps);
-  res.socket_gaps.refined = socket_refined;
-  if (ball_.layered) {
-    gaps.resize(std::max(gaps.size(), static_cast<std::size_t>(socket_.hidden_set.size())));
-    res.socket_gaps.refined +=
-        scan_layered_near(socket_.hidden_set, socket_.hidden_clusters, R.transpose(),
-                          Eigen::Vector3d(-(R.transpose() * t)), *ball_.layered, cor_, *ball_.distance_query,
-                          options_.reach_mm(), gaps.data(), ball_.caster.get())
-            .refined;
-    expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
+    if (options_.distances) {
+      t0 = std::chrono::steady_clock::now();
+      res.ball_gaps.distance_winding =
+          scan_distances(ball_.distance_set, R, t, cor_, *socket_.distance_query, options_.reach_mm(),
+                         res.ball_gaps.gap_mm, res.ball_gaps.distance_mm, memory != nullptr ? &memory->ball : nullptr)
+              .winding;
+      res.ball_distance_ms = ms_since(t0);
+    } else {
+      res.ball_gaps.distance_mm.clear();
+      res.ball_gaps.distance_winding = 0;
+    }
+  };
+  auto socket_scans = [&] {
+    std::vector<float>& gaps = res.compact_gaps_socket;
+    gaps.resize(static_cast<std::size_t>(std::max(socket_.scan_set.size(), socket_.hidden_set.size())));
+    auto t0 = std::chrono::steady_clock::now();
+    const std::int64_t refined =
+        scan_gaps_compact(socket_.scan_set, Rt, tt, ball_.map, ScanSide::outside, gaps.data(), ball_.exact.get());
+    expand_scan(socket_.scan_set, gaps.data(), res.socket_gaps);  // resets the scan's counts
+    res.socket_gaps.refined = refined;
+    if (ball_.layered) {
+      res.socket_gaps.refined +=
+          scan_layered_near(socket_.hidden_set, socket_.hidden_clusters, Rt, tt, *ball_.layered, cor_,
+                            *ball_.distance_query, options_.reach_mm(), gaps.data(), ball_.caster.get())
+              .refined;
+      expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
+    }
     res.socket_detection_ms = ms_since(t0);
-  }
-  if (options_.distances) {
-    t0 = std::chrono::steady_clock::now();
-    res.ball_gaps.distance_winding = scan_distances(ball_.distance_set, R, t, cor_, *socket_.distance_query,
-                                                    options_.reach_mm(), res.ball_gaps.gap_mm, res.ball_gaps.distance_mm,
-                                                    memory != nullptr ? &memory->ball : nullptr)
-                                         .winding;
-    res.ball_distance_ms = ms_since(t0);
-    t0 = std::chrono::steady_clock::now();
-    res.socket_gaps.distance_winding =
-        scan_distances(socket_.distance_set, R.transpose(), Eigen::Vector3d(-(R.transpose() * t)), cor_,
-                       *ball_.distance_query, options_.reach_mm(), res.socket_gaps.gap_mm, res.socket_gaps.distance_mm,
-                       memory != nullptr ? &memory->socket : nullptr)
-            .winding;
-    res.socket_distance_ms = ms_since(t0);
+    if (options_.distances) {
+      t0 = std::chrono::steady_clock::now();
+      res.socket_gaps.distance_winding =
+          scan_distances(socket_.distance_set, Rt, tt, cor_, *ball_.distance_query, options_.reach_mm(),
+                         res.socket_gaps.gap_mm, res.socket_gaps.distance_mm,
+                         memory != nullptr ? &memory->socket : nullptr)
+              .winding;
+      res.socket_distance_ms = ms_since(t0);
+    } else {
+      res.socket_gaps.distance_mm.clear();
+      res.socket_gaps.distance_winding = 0;
+    }
+  };
+  const bool two_threads = !omp_in_parallel() && omp_get_max_threads() > 1;
+  if (two_threads) {
+    std::exception_ptr error[2];
+#pragma omp parallel num_threads(2)
+    {
+      const int k = omp_get_thread_num();
+      try {
+        if (k == 0) ball_scans();
+        if (k == 1 || omp_get_num_threads() == 1) socket_scans();
+      } catch (...) {
+        error[k] = std::current_exception();
+      }
+    }
+    for (const std::exception_ptr& e : error)
+      if (e) std::rethrow_exception(e);
   } else {
-    res.ball_gaps.distance_mm.clear(), res.socket_gaps.distance_mm.clear();
-    res.ball_gaps.distance_winding = res.socket_gaps.distance_winding = 0;
+    ball_scans();
+    socket_scans();
   }
   summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels, res.ball, options_.levels_on);
   summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels, res.socket, options_.levels_on);

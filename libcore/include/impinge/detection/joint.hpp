@@ -124,7 +124,8 @@ struct PoseResult {
   ScanSummary ball, socket;
   double ball_detection_ms = 0, socket_detection_ms = 0;  ///< both include the layered scans when on
   double ball_distance_ms = 0, socket_distance_ms = 0;    ///< the distance scans (JointOptions::distances)
-  std::vector<float> compact_gaps;  ///< scratch of detect (the compact scans), kept to reuse its storage
+  std::vector<float> compact_gaps;         ///< scratch of detect (the ball's compact scans), kept to reuse its storage
+  std::vector<float> compact_gaps_socket;  ///< and the socket's (the two scans may run on two threads)
 };
 
 /// What a sequence of Joint::detect calls learns for the next (a motion's frames, one thread's): each
