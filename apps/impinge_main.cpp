@@ -136,7 +136,9 @@ void progress_bar(std::size_t done, std::size_t n) {
 int run_distance(const RunOptions& o) {
   const std::string& out = o.command.out;
   const PoseAngles pose = parse_pose(o.command.pose);
-  const Session s = open_session(o.session);
+  SessionOptions so = o.session;
+  if (so.maps.setup == "auto") so.maps.setup = "direct";  // one pose: the layered maps would not pay back
+  const Session s = open_session(so);
   const FemurPose femur = s.hip().femur_pose(pose);
   const PoseResult res = s.joint().detect(femur.R, femur.t);
   begin_output_folder(out, "distance");

@@ -58,9 +58,19 @@ def test_gaps_equal_the_cli_on_a_generated_hip(generated):
     with open(d + "/cli/summary.json") as f:
         cor = json.load(f)["head_centre_mm"]
     ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
-    j = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0)
+    # The CLI's distance sets up for its one pose (setup auto: direct, no layered maps); the Joint, the same.
+    j = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0, setup="direct")
     r = j.detect_pose(30, -10, 5)
     assert r["ball_gap_mm"].dtype == np.float32 and r["ball_gap_mm"].shape == (len(ball[0]),)
+    # With the layered maps (the Joint's default, for many poses): the same distances and first-surface gaps; the
+    # hidden vertices' gaps the maps' interpolation of the exact ones, within 0.1 mm here.
+    m = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0).detect_pose(30, -10, 5)
+    for part in ("ball", "socket"):
+        np.testing.assert_array_equal(m[f"{part}_distance_mm"], r[f"{part}_distance_mm"])
+        first = m[f"{part}_status"] == 0
+        np.testing.assert_array_equal(m[f"{part}_gap_mm"][first], r[f"{part}_gap_mm"][first])
+        np.testing.assert_array_equal(m[f"{part}_status"], r[f"{part}_status"])
+        np.testing.assert_allclose(m[f"{part}_gap_mm"], r[f"{part}_gap_mm"], atol=0.1)
     np.testing.assert_array_equal(r["ball_gap_mm"], cli_ball)
     np.testing.assert_array_equal(r["socket_gap_mm"], cli_socket)
     # The Euclidean distances beside them (issue 26): the CLI's, and never larger in size than a gap.
@@ -254,3 +264,14 @@ def test_real_subject_anatomical_frames():
     assert bool(row["soft_tissue_first"]) == (fl > 37.9)
     app = impinge.Joint(ball, socket, resolution=0.5, pelvis_frame="app")
     assert app.rom_limits(contact_depth_mm=0)["flexion"]["pelvic_frame"] == "app"
+
+
+def test_a_joint_set_up_without_layered_maps_refuses_rom_searches(generated):
+    """setup='direct' leaves the layered maps out (a few poses); a ROM search needs them and says so."""
+    d = generated
+    ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
+    j = impinge.Joint(ball, socket, neutral="scan", resolution=2.0, setup="direct")
+    assert j.setup["setup"] == "direct"
+    with pytest.raises(impinge.Error, match="without its layered maps.*setup 'maps'"):
+        j.rom_limits()
+    assert impinge.Joint(ball, socket, neutral="scan", resolution=2.0).setup["setup"] == "maps"

@@ -122,9 +122,11 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
   b.vertex_area = vertex_areas(b.mesh);
   if (options.layers > 0) {
     b.caster = b.exact != nullptr ? b.exact : std::make_shared<const FirstHitCaster>(b.mesh, cor);
-    auto layered = std::make_shared<LayeredMap>(layered_scheme(options), options.layers);
-    b.layered_sampling = sample_layered_map(*layered, *b.caster);
-    b.layered = std::move(layered);
+    if (options.layered_maps) {
+      auto layered = std::make_shared<LayeredMap>(layered_scheme(options), options.layers);
+      b.layered_sampling = sample_layered_map(*layered, *b.caster);
+      b.layered = std::move(layered);
+    }
     std::vector<std::uint8_t> hidden(b.mask.size(), 0);
     for (std::size_t i = 0; i < hidden.size(); ++i) {
       const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
@@ -179,6 +181,11 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
                             *socket_.distance_query, options_.reach_mm(), gaps.data(), socket_.caster.get())
               .refined;
       expand_layered_scan(ball_.hidden_set, gaps.data(), res.ball_gaps);
+    } else if (options_.layers > 0 && socket_.caster) {  // no layered maps: exact casts (layered_maps off)
+      res.ball_gaps.refined += scan_layered_near_exact(ball_.hidden_set, ball_.hidden_clusters, R, t, *socket_.caster,
+                                                       cor_, *socket_.distance_query, options_.reach_mm(), gaps.data())
+                                   .refined;
+      expand_layered_scan(ball_.hidden_set, gaps.data(), res.ball_gaps);
     }
     res.ball_detection_ms = ms_since(t0);
     if (options_.distances) {
@@ -206,6 +213,12 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
           scan_layered_near(socket_.hidden_set, socket_.hidden_clusters, Rt, tt, *ball_.layered, cor_,
                             *ball_.distance_query, options_.reach_mm(), gaps.data(), ball_.caster.get())
               .refined;
+      expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
+    } else if (options_.layers > 0 && ball_.caster) {
+      res.socket_gaps.refined += scan_layered_near_exact(socket_.hidden_set, socket_.hidden_clusters, Rt, tt,
+                                                         *ball_.caster, cor_, *ball_.distance_query,
+                                                         options_.reach_mm(), gaps.data())
+                                     .refined;
       expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
     }
     res.socket_detection_ms = ms_since(t0);

@@ -166,6 +166,12 @@ void add_map_rows(Rows& t) {
             "bone's nearer surface (trochanters, shaft, ilium) are tested too: extra-articular impingement (0 = off, "
             "the thesis' single-layer maps)",
             [](auto& o) -> auto& { return o.session.maps.layers; });
+  t.text("setup", "setup", OptionType::choice, kSetting, {"auto", "maps", "direct"},
+         "What to build for the work: maps (both maps and the layered maps, for many poses), direct (no layered "
+         "maps: the hidden vertices by exact ray casts; a few poses; no ROM searches), auto (distance, one pose: "
+         "direct; every other command: maps). The distances and the first-surface gaps are the same either way; the "
+         "hidden vertices' gaps are exact with direct, the maps' interpolation with maps",
+         [](auto& o) -> auto& { return o.session.maps.setup; });
   t.number("layered-spacing", "layered_spacing", "deg", kSetting, 0, 180,
            "The layered maps' largest node spacing (the scheme at the coarsest resolution reaching it, never finer "
            "than the maps'; 0: the maps' own); their edges are exact ray casts",

@@ -213,6 +213,8 @@ nlohmann::json setup_record(const Session& s) {
   j["exact_at_discontinuities"] = opt.exact_at_discontinuities && s.joint().ball().exact != nullptr;
   j["discontinuity_tolerance_mm"] = opt.discontinuity_tolerance_mm;
   j["layers"] = opt.layers;
+  // What was built for the work (MapSettings::setup): the layered maps, or exact casts for the hidden vertices.
+  j["setup"] = opt.layers > 0 && !opt.layered_maps ? "direct" : "maps";
   j["distances"] = opt.distances;
   j["levels_on"] = to_string(opt.levels_on);
   if (opt.distances) j["distance_reach_mm"] = opt.reach_mm();

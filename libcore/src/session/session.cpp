@@ -256,6 +256,9 @@ HipJointOptions hip_joint_options(const MapSettings& m, const FrameSettings& f, 
   require(std::isfinite(m.extra_articular_radius_mm) && m.extra_articular_radius_mm > 0,
           "extra-articular-radius must be > 0 mm");
   jo.layers = m.layers;
+  require(m.setup == "auto" || m.setup == "maps" || m.setup == "direct",
+          "setup '" + m.setup + "': must be maps, direct or auto");
+  jo.layered_maps = m.setup != "direct";  // auto: the library builds the maps; the CLI's distance chooses direct
   jo.extra_articular_radius_mm = m.extra_articular_radius_mm;
   require(std::isfinite(m.layered_spacing_deg) && m.layered_spacing_deg >= 0 && m.layered_spacing_deg <= 90,
           "layered-spacing " + num(m.layered_spacing_deg) + ": must be 0 (the maps' own) to 90 deg");

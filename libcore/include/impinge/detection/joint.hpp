@@ -60,6 +60,12 @@ struct JointOptions {
   /// Needs a ray caster (Embree or CGAL). Memory per map: nodes * (4 N + 1) bytes.
   int layers = 0;
   double extra_articular_radius_mm = 150;  ///< hidden vertices farther from the COR are not tested, mm (> 0)
+  /// With layers > 0: build the layered maps (true), or leave them out (false: a set-up for a few poses, which
+  /// filling them, about 0.12 s for lhdl-ct at 0.5 deg, would not repay): the hidden vertices near the other bone
+  /// are then tested by exact ray casts over their rays' crossings (scan_layered_near_exact), the value the
+  /// maps' look-ups approximate. The ROM searches need the maps (find_rom_limit refuses a joint without them).
+  /// Source: impinge (issue 52: a set-up chosen by the work).
+  bool layered_maps = true;
   /// The layered maps' largest node spacing, deg: `scheme` at the coarsest resolution reaching it, or
   /// `scheme` itself when that is coarser already (0: `scheme` itself). The hidden vertices lie far
   /// from the COR (the trochanters, ischium and ilium), where a node spacing of 0.5 deg is 0.5 mm at

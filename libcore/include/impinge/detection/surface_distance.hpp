@@ -144,6 +144,11 @@ ScanClusters cluster_scan_set(const ScanSet& set, int cluster_size = 32);
 /// above reach_mm too. Shared by scan_layered_near and the ROM searches' hidden scan.
 bool cluster_apart(const Eigen::Vector3d& centre, double radius_mm, const LayeredMap& map, const Eigen::Vector3d& cor,
                    const SignedDistanceQuery& other, double reach_mm);
+/// The same without a layered map (JointOptions::layered_maps off): the centre placed outside by the exact
+/// signed radial distance over its ray's crossings (signed_radial_distance_exact on `caster`, the other bone
+/// about the COR).
+bool cluster_apart(const Eigen::Vector3d& centre, double radius_mm, const FirstHitCaster& caster,
+                   const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm);
 
 /// Counts of one scan_layered_near.
 struct LayeredNearStats {
@@ -163,5 +168,14 @@ LayeredNearStats scan_layered_near(const ScanSet& set, const ScanClusters& clust
                                    const Eigen::Vector3d& t, const LayeredMap& map, const Eigen::Vector3d& cor,
                                    const SignedDistanceQuery& other, double reach_mm, float* gap_mm,
                                    const FirstHitCaster* exact);
+/// scan_layered_near without a layered map (JointOptions::layered_maps off, a set-up for a few poses): the same
+/// clusters pruned (cluster_apart's exact form), each remaining vertex's gap the exact signed radial distance over
+/// the crossings of its ray (signed_radial_distance_exact on `exact`, the other bone about the COR), which the
+/// map's look-up approximates (they agree where the map resolves its stencil exactly). `refined` counts every
+/// vertex so cast. Throws as scan_layered_near.
+LayeredNearStats scan_layered_near_exact(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
+                                         const Eigen::Vector3d& t, const FirstHitCaster& exact,
+                                         const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
+                                         float* gap_mm);
 
 }  // namespace impinge

@@ -74,6 +74,10 @@ struct MapSettings {
   double discontinuity_tolerance_mm = 0.05;
   bool maps_only = false;               ///< no exact look-ups at depth discontinuities (the thesis' algorithm)
   int layers = 0;                       ///< layered maps of this many crossings per node (0: off)
+  /// What to build for the work: "maps" (both maps and, with layers, the layered maps), "direct" (no layered
+  /// maps: the hidden vertices by exact ray casts, JointOptions::layered_maps off; for a few poses; no ROM
+  /// searches), "auto" (the front end's choice: `impinge distance`, one pose, takes direct; everything else maps).
+  std::string setup = "auto";
   double extra_articular_radius_mm = 150;
   double layered_spacing_deg = 0.5;     ///< the layered maps' largest node spacing (JointOptions), deg
   bool distances = false;               ///< Euclidean distances beside the gaps (JointOptions::distances)
