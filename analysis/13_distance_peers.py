@@ -69,3 +69,38 @@ write_macros(d, "macros", {
     "PEERopenVersion": versions["open3d"],
     "PEERvtkVersion": versions["vtk"],
 })
+
+# Whole processes and single poses beside Open3D (benchmarks/whole_process.py, issue 52): a table and macros.
+wp_path = os.path.join(d, "whole_process.csv")
+wp = read_csv(d, "whole_process.csv") if os.path.exists(wp_path) else None
+wp_macros = {}
+if wp is not None and len(wp):
+    rows = []
+    for (job, mesh, poses, threads), g in wp.groupby(["job", "mesh", "poses", "threads"], sort=False):
+        a, b = g[g.tool == "impinge"].iloc[0], g[g.tool == "open3d"].iloc[0]
+        scale, unit = (1e3, "ms") if job == "pose" else (1.0, "s")
+        what = f"{poses} pose{'s' if poses > 1 else ''}, whole process" if job == "process" else \
+            f"per pose, {threads} thread{'s' if threads > 1 else ''}"
+
+        def span(r):
+            return f"{scale * r.median_s:.3g} ({scale * r.q1_s:.3g}--{scale * r.q3_s:.3g}) {unit}"
+        rows.append([mesh.replace("_", " "), what, span(a), span(b), f"{b.median_s / a.median_s:.1f}"])
+    write_table(d, "table_whole_process", ["mesh", "job", "impinge, median (quartiles)", "Open3D", "Open3D / impinge"],
+                rows, align="lllll")
+    one = wp[(wp.job == "process") & (wp.poses == 1) & (wp.mesh == "native")]
+    ten = wp[(wp.job == "process") & (wp.poses == 10) & (wp.mesh == "native")]
+    pose1 = wp[(wp.job == "pose") & (wp.threads == 1) & (wp.mesh == "native")]
+    pose2 = wp[(wp.job == "pose") & (wp.threads == 2) & (wp.mesh == "native")]
+
+    def ratio(g):
+        return f"{g[g.tool == 'open3d'].median_s.iloc[0] / g[g.tool == 'impinge'].median_s.iloc[0]:.1f}"
+    wp_macros = {"WPonePose": ratio(one), "WPtenPoses": ratio(ten), "WPperPoseOne": ratio(pose1),
+                 "WPperPoseTwo": ratio(pose2),
+                 "WPonePoseSeconds": f"{one[one.tool == 'impinge'].median_s.iloc[0]:.2f}",
+                 "WPonePoseOpenSeconds": f"{one[one.tool == 'open3d'].median_s.iloc[0]:.2f}"}
+else:
+    wp_macros = {k: "--" for k in ("WPonePose", "WPtenPoses", "WPperPoseOne", "WPperPoseTwo", "WPonePoseSeconds",
+                                   "WPonePoseOpenSeconds")}
+with open(os.path.join(d, "macros.tex"), "a") as f:
+    for k, v in wp_macros.items():
+        f.write("\\newcommand{\\%s}{%s}\n" % (k, v))

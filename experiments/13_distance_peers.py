@@ -12,6 +12,8 @@ the vertices whose sign differs from impinge's (its sign: the angle-weighted pse
 number where that cannot be trusted; casters/signed_distance.hpp).
 
 Outputs (OUT/13_distance_peers/):
+  whole_process.csv   whole processes (1, 10, 100, 1,000 poses; --quick 1 and 10) and single poses at 1 and 2
+                      threads, impinge beside Open3D, medians and quartiles (benchmarks/whole_process.py, issue 52)
   distance_peers.csv  subject x pose: vertices, impinge's radial and distance scan times (ms, medians of the
                       repetitions), Open3D's and VTK's on the same vertices, their largest difference from
                       impinge's distances (mm) and their sign disagreements
@@ -31,6 +33,8 @@ import numpy as np
 from experiment_support import experiment_args, write_meta
 
 import impinge
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def o3d_scene(V, F):
@@ -153,6 +157,22 @@ def main():
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
+    # Whole processes and single poses at 1 and 2 threads beside Open3D (benchmarks/whole_process.py): lhdl-ct, or
+    # without the shared data a generated hip of 100,000 triangles.
+    import subprocess
+    import sys
+    import tempfile
+    sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
+    import whole_process
+    subject = os.path.join(data, "lhdl-ct", "subject.json") if data else ""
+    if not os.path.exists(subject):
+        g = tempfile.mkdtemp(prefix="impinge-exp13-")
+        subprocess.run([whole_process.CLI, "generate", "--triangles", "100000", "--cam", "2", "--out", g],
+                       check=True, capture_output=True)
+        subject = os.path.join(g, "subject.json")
+    print(f"[13_distance_peers] whole processes beside Open3D: {subject}", flush=True)
+    whole_process.run(d, subject, 3 if quick else 5, quick)
+    assert os.path.exists(os.path.join(d, "whole_process.csv"))  # written by whole_process.run
     import vtk
     write_meta(d, "13_distance_peers", {
         "data_folder": data if data and os.path.isdir(data) else None,
@@ -162,6 +182,11 @@ def main():
         "parameters": {"resolution_deg": resolution, "scheme": "equiangular", "distance_reach_mm": "6 (the largest "
                        "--levels threshold)", "poses_deg": poses},
         "versions": {"open3d": __import__("open3d").__version__, "vtk": vtk.vtkVersion.GetVTKVersion()},
+        "whole_process": {"subject": subject, "repetitions": 3 if quick else 5,
+                          "impinge": "impinge distance (1 pose) / impinge motion (N poses), CLI defaults, --neutral scan "
+                                     "--joint-centre femoral-head; per pose: Joint.detect_pose at OMP_NUM_THREADS 1, 2",
+                          "open3d": "a Python process: import, load both meshes, build both RaycastingScenes, "
+                                    "compute_signed_distance of every vertex at every pose, write"},
     })
 
 
