@@ -167,73 +167,48 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
   // several (a motion's or a ROM search's frames are), each with its own scratch. Same results either way.
   const Eigen::Matrix3d Rt = R.transpose();
   const Eigen::Vector3d tt = -(Rt * t);
-  auto ball_scans = [&] {
-    std::vector<float>& gaps = res.compact_gaps;
-    gaps.resize(static_cast<std::size_t>(std::max(ball_.scan_set.size(), ball_.hidden_set.size())));
+  // One body's scans: its first-surface vertices against the other's map, its hidden ones against the other's
+  // layered map (or exact casts without one), then its distances to the other's surface. The pose (Rq, tq) takes
+  // this body's vertices into the other's frame.
+  auto scans = [&](const JointBody& own, const JointBody& other, const Eigen::Matrix3d& Rq, const Eigen::Vector3d& tq,
+                   ScanSide side, ScanGaps& out, std::vector<float>& gaps, DistanceScanMemory* mem,
+                   double& detection_ms, double& distance_ms) {
+    gaps.resize(static_cast<std::size_t>(std::max(own.scan_set.size(), own.hidden_set.size())));
     auto t0 = std::chrono::steady_clock::now();
     const std::int64_t refined =
-        scan_gaps_compact(ball_.scan_set, R, t, socket_.map, ScanSide::inside, gaps.data(), socket_.exact.get());
-    expand_scan(ball_.scan_set, gaps.data(), res.ball_gaps);  // resets the scan's counts
-    res.ball_gaps.refined = refined;
-    if (socket_.layered) {
-      res.ball_gaps.refined +=
-          scan_layered_near(ball_.hidden_set, ball_.hidden_clusters, R, t, *socket_.layered, cor_,
-                            *socket_.distance_query, options_.reach_mm(), gaps.data(), socket_.caster.get())
-              .refined;
-      expand_layered_scan(ball_.hidden_set, gaps.data(), res.ball_gaps);
-    } else if (options_.layers > 0 && socket_.caster) {  // no layered maps: exact casts (layered_maps off)
-      res.ball_gaps.refined += scan_layered_near_exact(ball_.hidden_set, ball_.hidden_clusters, R, t, *socket_.caster,
-                                                       cor_, *socket_.distance_query, options_.reach_mm(), gaps.data())
-                                   .refined;
-      expand_layered_scan(ball_.hidden_set, gaps.data(), res.ball_gaps);
+        scan_gaps_compact(own.scan_set, Rq, tq, other.map, side, gaps.data(), other.exact.get());
+    expand_scan(own.scan_set, gaps.data(), out);  // resets the scan's counts
+    out.refined = refined;
+    if (other.layered) {
+      out.refined += scan_layered_near(own.hidden_set, own.hidden_clusters, Rq, tq, *other.layered, cor_,
+                                       *other.distance_query, options_.reach_mm(), gaps.data(), other.caster.get())
+                         .refined;
+      expand_layered_scan(own.hidden_set, gaps.data(), out);
+    } else if (options_.layers > 0 && other.caster) {  // no layered maps: exact casts (layered_maps off)
+      out.refined += scan_layered_near_exact(own.hidden_set, own.hidden_clusters, Rq, tq, *other.caster, cor_,
+                                             *other.distance_query, options_.reach_mm(), gaps.data())
+                         .refined;
+      expand_layered_scan(own.hidden_set, gaps.data(), out);
     }
-    res.ball_detection_ms = ms_since(t0);
+    detection_ms = ms_since(t0);
     if (options_.distances) {
       t0 = std::chrono::steady_clock::now();
-      res.ball_gaps.distance_winding =
-          scan_distances(ball_.distance_set, R, t, cor_, *socket_.distance_query, options_.reach_mm(),
-                         res.ball_gaps.gap_mm, res.ball_gaps.distance_mm, memory != nullptr ? &memory->ball : nullptr)
-              .winding;
-      res.ball_distance_ms = ms_since(t0);
+      out.distance_winding = scan_distances(own.distance_set, Rq, tq, cor_, *other.distance_query, options_.reach_mm(),
+                                            out.gap_mm, out.distance_mm, mem)
+                                 .winding;
+      distance_ms = ms_since(t0);
     } else {
-      res.ball_gaps.distance_mm.clear();
-      res.ball_gaps.distance_winding = 0;
+      out.distance_mm.clear();
+      out.distance_winding = 0;
     }
   };
+  auto ball_scans = [&] {
+    scans(ball_, socket_, R, t, ScanSide::inside, res.ball_gaps, res.compact_gaps,
+          memory != nullptr ? &memory->ball : nullptr, res.ball_detection_ms, res.ball_distance_ms);
+  };
   auto socket_scans = [&] {
-    std::vector<float>& gaps = res.compact_gaps_socket;
-    gaps.resize(static_cast<std::size_t>(std::max(socket_.scan_set.size(), socket_.hidden_set.size())));
-    auto t0 = std::chrono::steady_clock::now();
-    const std::int64_t refined =
-        scan_gaps_compact(socket_.scan_set, Rt, tt, ball_.map, ScanSide::outside, gaps.data(), ball_.exact.get());
-    expand_scan(socket_.scan_set, gaps.data(), res.socket_gaps);  // resets the scan's counts
-    res.socket_gaps.refined = refined;
-    if (ball_.layered) {
-      res.socket_gaps.refined +=
-          scan_layered_near(socket_.hidden_set, socket_.hidden_clusters, Rt, tt, *ball_.layered, cor_,
-                            *ball_.distance_query, options_.reach_mm(), gaps.data(), ball_.caster.get())
-              .refined;
-      expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
-    } else if (options_.layers > 0 && ball_.caster) {
-      res.socket_gaps.refined += scan_layered_near_exact(socket_.hidden_set, socket_.hidden_clusters, Rt, tt,
-                                                         *ball_.caster, cor_, *ball_.distance_query,
-                                                         options_.reach_mm(), gaps.data())
-                                     .refined;
-      expand_layered_scan(socket_.hidden_set, gaps.data(), res.socket_gaps);
-    }
-    res.socket_detection_ms = ms_since(t0);
-    if (options_.distances) {
-      t0 = std::chrono::steady_clock::now();
-      res.socket_gaps.distance_winding =
-          scan_distances(socket_.distance_set, Rt, tt, cor_, *ball_.distance_query, options_.reach_mm(),
-                         res.socket_gaps.gap_mm, res.socket_gaps.distance_mm,
-                         memory != nullptr ? &memory->socket : nullptr)
-              .winding;
-      res.socket_distance_ms = ms_since(t0);
-    } else {
-      res.socket_gaps.distance_mm.clear();
-      res.socket_gaps.distance_winding = 0;
-    }
+    scans(socket_, ball_, Rt, tt, ScanSide::outside, res.socket_gaps, res.compact_gaps_socket,
+          memory != nullptr ? &memory->socket : nullptr, res.socket_detection_ms, res.socket_distance_ms);
   };
   const bool two_threads = !omp_in_parallel() && omp_get_max_threads() > 1;
   if (two_threads) {

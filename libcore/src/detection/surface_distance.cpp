@@ -270,56 +270,63 @@ bool cluster_apart(const Eigen::Vector3d& centre, double radius_mm, const FirstH
   return signed_radial_distance_exact(caster, centre) > 0;  // outside (+inf: the bone is nowhere along the ray)
 }
 
-LayeredNearStats scan_layered_near_exact(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
-                                         const Eigen::Vector3d& t, const FirstHitCaster& exact,
-                                         const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
-                                         float* gap_mm) {
+namespace {
+
+// The clusters' loop shared by both layered scans: `apart(centre, radius)` proves a posed cluster beyond the reach
+// (its members get +inf), `scan(first, count)` fills the others' gaps and returns the exact casts it made.
+template <class Apart, class Scan>
+LayeredNearStats layered_near(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
+                              const Eigen::Vector3d& t, double reach_mm, float* gap_mm, Apart&& apart, Scan&& scan) {
   require(reach_mm > 0 && std::isfinite(reach_mm), "layered scan: the reach must be > 0 mm and finite");
   require(!clusters.cluster_begin.empty() && clusters.cluster_begin.back() == set.size(),
           "layered scan: the clusters are not the set's (" + std::to_string(set.size()) + " vertices)");
   LayeredNearStats st;
   for (std::int64_t c = 0; c < clusters.clusters(); ++c) {
-    const std::int64_t first = clusters.cluster_begin[static_cast<std::size_t>(c)];
-    const std::int64_t count = clusters.cluster_begin[static_cast<std::size_t>(c) + 1] - first;
-    if (cluster_apart(R * clusters.centre[static_cast<std::size_t>(c)] + t, clusters.radius[static_cast<std::size_t>(c)],
-                      exact, cor, other, reach_mm)) {
+    const auto k = static_cast<std::size_t>(c);
+    const std::int64_t first = clusters.cluster_begin[k];
+    const std::int64_t count = clusters.cluster_begin[k + 1] - first;
+    if (apart(Eigen::Vector3d(R * clusters.centre[k] + t), clusters.radius[k])) {
       std::fill(gap_mm + first, gap_mm + first + count, std::numeric_limits<float>::infinity());
       ++st.clusters_skipped;
       continue;
     }
-    for (std::int64_t j = first; j < first + count; ++j) {
-      const Eigen::Vector3d p(set.x[static_cast<std::size_t>(j)], set.y[static_cast<std::size_t>(j)],
-                              set.z[static_cast<std::size_t>(j)]);
-      const double g = signed_radial_distance_exact(exact, R * p + t);
-      gap_mm[j] = std::isfinite(g) ? static_cast<float>(g) : std::numeric_limits<float>::quiet_NaN();
-    }
-    st.refined += count;
+    st.refined += scan(first, count);
     st.vertices_scanned += count;
   }
   return st;
+}
+
+}  // namespace
+
+LayeredNearStats scan_layered_near_exact(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
+                                         const Eigen::Vector3d& t, const FirstHitCaster& exact,
+                                         const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
+                                         float* gap_mm) {
+  return layered_near(
+      set, clusters, R, t, reach_mm, gap_mm,
+      [&](const Eigen::Vector3d& centre, double radius) {
+        return cluster_apart(centre, radius, exact, cor, other, reach_mm);
+      },
+      [&](std::int64_t first, std::int64_t count) {
+        for (std::int64_t j = first; j < first + count; ++j) {
+          const auto k = static_cast<std::size_t>(j);
+          const double g = signed_radial_distance_exact(exact, R * Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) + t);
+          gap_mm[j] = std::isfinite(g) ? static_cast<float>(g) : std::numeric_limits<float>::quiet_NaN();
+        }
+        return count;
+      });
 }
 
 LayeredNearStats scan_layered_near(const ScanSet& set, const ScanClusters& clusters, const Eigen::Matrix3d& R,
                                    const Eigen::Vector3d& t, const LayeredMap& map, const Eigen::Vector3d& cor,
                                    const SignedDistanceQuery& other, double reach_mm, float* gap_mm,
                                    const FirstHitCaster* exact) {
-  require(reach_mm > 0 && std::isfinite(reach_mm), "layered scan: the reach must be > 0 mm and finite");
-  require(!clusters.cluster_begin.empty() && clusters.cluster_begin.back() == set.size(),
-          "layered scan: the clusters are not the set's (" + std::to_string(set.size()) + " vertices)");
-  LayeredNearStats st;
-  for (std::int64_t c = 0; c < clusters.clusters(); ++c) {
-    const std::int64_t first = clusters.cluster_begin[static_cast<std::size_t>(c)];
-    const std::int64_t count = clusters.cluster_begin[static_cast<std::size_t>(c) + 1] - first;
-    if (cluster_apart(R * clusters.centre[static_cast<std::size_t>(c)] + t, clusters.radius[static_cast<std::size_t>(c)],
-                      map, cor, other, reach_mm)) {
-      std::fill(gap_mm + first, gap_mm + first + count, std::numeric_limits<float>::infinity());
-      ++st.clusters_skipped;
-      continue;
-    }
-    st.refined += scan_layered(set, first, count, R, t, map, gap_mm, exact);
-    st.vertices_scanned += count;
-  }
-  return st;
+  return layered_near(
+      set, clusters, R, t, reach_mm, gap_mm,
+      [&](const Eigen::Vector3d& centre, double radius) {
+        return cluster_apart(centre, radius, map, cor, other, reach_mm);
+      },
+      [&](std::int64_t first, std::int64_t count) { return scan_layered(set, first, count, R, t, map, gap_mm, exact); });
 }
 
 }  // namespace impinge
