@@ -83,8 +83,11 @@ if wp is not None and len(wp):
             f"per pose, {threads} thread{'s' if threads > 1 else ''}"
 
         def span(r):
+            if r.runs == 0:
+                return "left out (over 300 s)"
             return f"{scale * r.median_s:.3g} ({scale * r.q1_s:.3g}--{scale * r.q3_s:.3g}) {unit}"
-        rows.append([mesh.replace("_", " "), what, span(a), span(b), f"{b.median_s / a.median_s:.1f}"])
+        rows.append([mesh.replace("_", " "), what, span(a), span(b),
+                     f"{b.median_s / a.median_s:.1f}" if b.runs > 0 else "--"])
     write_table(d, "table_whole_process", ["mesh", "job", "impinge, median (quartiles)", "Open3D", "Open3D / impinge"],
                 rows, align="lllll")
     one = wp[(wp.job == "process") & (wp.poses == 1) & (wp.mesh == "native")]

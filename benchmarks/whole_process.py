@@ -12,7 +12,8 @@ each pose of a motion. Measured as a new user runs it:
 Medians and quartiles over --repeats runs, on the native meshes and on the same meshes subdivided 4x (Open3D's
 midpoint subdivision); --quick: 1 and 10 poses, native meshes only. Experiment 13 runs it (run()).
 
-Writes OUT/whole_process.csv (job, mesh, poses, threads, tool, median_s, q1_s, q3_s, runs) and OUT/meta.json.
+Writes OUT/whole_process.csv (job, mesh, poses, threads, tool, median_s, q1_s, q3_s, runs) and OUT/meta.json. A job
+longer than 30 s is run once; an Open3D job expected to take over 300 s is left out (runs 0, times NaN).
 usage: PYTHONPATH=build/python /usr/bin/python3 benchmarks/whole_process.py --out DIR [--data DIR] [--subject NAME]
        [--repeats 5] [--quick]"""
 import csv
@@ -28,6 +29,8 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CLI = os.environ.get("IMPINGE_CLI", os.path.join(ROOT, "build", "impinge"))
 PY = "/usr/bin/python3"
+LONG_S = 30.0   # a whole-process job longer than this is run once
+SKIP_S = 300.0  # an Open3D job expected to take longer than this is left out
 
 OPEN3D_JOB = r'''
 import sys, numpy as np, open3d as o3d
@@ -100,6 +103,7 @@ def run(out, subject, repeats, quick):
         frame = json.load(open(subject)).get("frame", "RAS")
         common = ["--ball", femur, "--socket", pelvis, "--side", side, "--frame", frame, "--neutral", "scan",
                   "--joint-centre", "femoral-head"]
+        o3d_per_pose = None  # Open3D's time per pose at the last job, s
         for k in ((1, 10) if quick else (1, 10, 100, 1000)):
             rng = np.random.default_rng(k)
             angles = np.column_stack([rng.uniform(0, 60, k), rng.uniform(-10, 10, k), rng.uniform(-20, 20, k)])
@@ -119,14 +123,23 @@ def run(out, subject, repeats, quick):
             np.save(npy, np.asarray(poses))
             ours = (["distance", "--pose", "0,0,0"] if k == 1 else ["motion", "--motion", csv_path, "--quiet",
                                                                     "--vtp-every", str(10 ** 9)])
+            # Alternated runs; a job that takes longer than LONG_S is run once, and an Open3D job expected (from its
+            # time per pose at fewer poses) to take longer than SKIP_S is left out (NaN, 0 runs): 1,000 poses on the
+            # subdivided meshes would take Open3D about 17 min a run.
             t_imp, t_o3d = [], []
+            run_o3d = o3d_per_pose is None or k * o3d_per_pose <= SKIP_S
             for _ in range(repeats):
                 t_imp.append(timed([CLI] + ours + common + ["--out", os.path.join(tmp, "o")]))
-                t_o3d.append(timed([PY, "-c", OPEN3D_JOB, femur, pelvis, npy, os.path.join(tmp, "o3d.npy")]))
+                if run_o3d:
+                    t_o3d.append(timed([PY, "-c", OPEN3D_JOB, femur, pelvis, npy, os.path.join(tmp, "o3d.npy")]))
+                if max(t_imp + t_o3d) > LONG_S:
+                    break
+            if t_o3d:
+                o3d_per_pose = float(np.median(t_o3d)) / k
             for tool, ts in (("impinge", t_imp), ("open3d", t_o3d)):
-                rows.append(["process", mesh, k, 2, tool, *stats(ts), repeats])
+                rows.append(["process", mesh, k, 2, tool, *(stats(ts) if ts else (np.nan,) * 3), len(ts)])
             print(f"[whole_process] {mesh} {k} poses: impinge {np.median(t_imp):.3f} s, Open3D "
-                  f"{np.median(t_o3d):.3f} s", flush=True)
+                  + (f"{np.median(t_o3d):.3f} s" if t_o3d else "left out (too long)"), flush=True)
         # Per pose, in one process, at 1 and 2 threads.
         for threads in (1, 2):
             env = dict(os.environ, OMP_NUM_THREADS=str(threads), PYTHONPATH=os.path.join(ROOT, "build", "python"))
