@@ -72,7 +72,10 @@ def main():
     ax.legend(fontsize=8)
     ax.set_title("checked by the ROM search on the resected bones", fontsize=9)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
-    fig.savefig(os.path.join(folder, "plan.png"), dpi=130)
+    # Atomically: a temporary file renamed over plan.png once it is whole.
+    tmp = os.path.join(folder, ".plan.png.tmp")
+    fig.savefig(tmp, dpi=130, format="png")
+    os.replace(tmp, os.path.join(folder, "plan.png"))
 
 
 if __name__ == "__main__":

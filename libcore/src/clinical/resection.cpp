@@ -16,7 +16,6 @@ namespace impinge {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kResectedMm = 0.01;  // a vertex deeper than this counts as resected
 
 /// Area-weighted outward vertex normals (unit; zero where a vertex has no face).
 Vertices vertex_normals(const Vertices& V, const Faces& F) {
@@ -34,17 +33,6 @@ Vertices vertex_normals(const Vertices& V, const Faces& F) {
     if (len > 0) N.row(i) *= sign / len;
   }
   return N;
-}
-
-/// Per-vertex areas (a third of each face's area).
-std::vector<double> areas_of(const Vertices& V, const Faces& F) {
-  std::vector<double> a(static_cast<std::size_t>(V.rows()), 0.0);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d p = V.row(F(f, 0)), q = V.row(F(f, 1)), r = V.row(F(f, 2));
-    const double third = (q - p).cross(r - p).norm() / 6;
-    for (int k = 0; k < 3; ++k) a[static_cast<std::size_t>(F(f, k))] += third;
-  }
-  return a;
 }
 
 /// A uniform grid over vertices (cell = `cell` mm) for the burr's neighbourhoods.
@@ -77,6 +65,7 @@ struct BoneState {
   bool allowed = false;
   const Vertices* V = nullptr;  // joint frame, unposed (relative to the COR)
   const Faces* F = nullptr;
+  const Eigen::VectorXd* area = nullptr;  // per vertex, mm^2 (the joint's: JointBody::vertex_area)
   Vertices normals;
   std::vector<std::uint8_t> protect;
   std::vector<double> required, depth;  // the contacts' depth (before the burr), the planned depth
@@ -89,7 +78,7 @@ struct BoneState {
   std::unique_ptr<ExactReference> original;
   bool changed = true;
 
-  bool can_take(std::int64_t i, double) const {
+  bool can_take(std::int64_t i) const {
     const auto k = static_cast<std::size_t>(i);
     return allowed && !protect[k] && depth[k] < limit[k] - 1e-9;
   }
@@ -110,8 +99,9 @@ struct BoneState {
     query = std::make_unique<SignedDistanceQuery>(m);
     changed = false;
   }
-  /// The burr's widening of `required` (file comment, step 3), capped and zero on the protected surface.
-  void apply_burr(double b, double cap) {
+  /// The burr's widening of `required` (file comment, step 3), held at each vertex's limit (the safety depth, half
+  /// the bone's thickness; zero on the protected surface).
+  void apply_burr(double b) {
     const std::size_t n = required.size();
     std::vector<double> d(n, 0.0);
     for (std::size_t i = 0; i < n; ++i) d[i] = required[i];
@@ -256,6 +246,7 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
     s.allowed = b == 0 ? o.bones != ResectBones::pelvis : o.bones != ResectBones::femur;
     s.V = &body.relative;
     s.F = &body.mesh.F;
+    s.area = &body.vertex_area;
     s.normals = vertex_normals(body.relative, body.mesh.F);
     const auto n = static_cast<std::size_t>(body.relative.rows());
     s.protect.assign(n, 0);
@@ -414,13 +405,13 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
       for (const Contact& ct : contacts) {
         if (ct.deficit <= o.tolerance_mm) continue;
         const int a = ct.ball ? 0 : 1, b = 1 - a;
-        const bool own_can = bone[a].can_take(ct.vertex, cap);
+        const bool own_can = bone[a].can_take(ct.vertex);
         std::int64_t tri[3] = {-1, -1, -1};
         bool other_can = false;
         if (bone[b].allowed && ct.triangle >= 0)
           for (int m = 0; m < 3; ++m) {
             tri[m] = (*bone[b].F)(ct.triangle, m);
-            other_can = other_can || bone[b].can_take(tri[m], cap);
+            other_can = other_can || bone[b].can_take(tri[m]);
           }
         if (!own_can && !other_can) {
           Blocked why = Blocked::bone;
@@ -442,7 +433,7 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
           need[a][static_cast<std::size_t>(ct.vertex)] = std::max(need[a][static_cast<std::size_t>(ct.vertex)], share);
         if (other_can)
           for (int m = 0; m < 3; ++m)
-            if (bone[b].can_take(tri[m], cap))
+            if (bone[b].can_take(tri[m]))
               need[b][static_cast<std::size_t>(tri[m])] = std::max(need[b][static_cast<std::size_t>(tri[m])], share);
       }
       plan.residual_mm = residual;
@@ -451,7 +442,7 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
       for (int b = 0; b < 2; ++b) {
         if (!bone[b].allowed) continue;
         for (std::size_t i = 0; i < need[b].size(); ++i) bone[b].required[i] += need[b][i];
-        bone[b].apply_burr(o.burr_radius_mm, cap);
+        bone[b].apply_burr(o.burr_radius_mm);
       }
     }
     // Poses still asking for more after the last round are not cleared either.
@@ -501,15 +492,15 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
     out.resected = s.resected;
     out.normals = s.normals;
     out.volume_mm3 = enclosed_volume(*s.V, *s.F) - enclosed_volume(s.resected, *s.F);
-    const std::vector<double> area = areas_of(*s.V, *s.F);
+    const Eigen::VectorXd& area = *s.area;
     double weighted = 0;
     for (std::size_t i = 0; i < s.depth.size(); ++i) {
       if (s.depth[i] >= cap - 1e-9 && s.depth[i] > 0) ++out.capped_vertices;
       if (s.thin[i] && s.depth[i] > 0) ++out.thin_vertices;
-      if (s.depth[i] <= kResectedMm) continue;
+      if (s.depth[i] <= kResectedDepthMm) continue;
       ++out.vertices;
-      out.area_mm2 += area[i];
-      weighted += area[i] * s.depth[i];
+      out.area_mm2 += area[static_cast<Eigen::Index>(i)];
+      weighted += area[static_cast<Eigen::Index>(i)] * s.depth[i];
       out.max_depth_mm = std::max(out.max_depth_mm, s.depth[i]);
     }
     out.mean_depth_mm = out.area_mm2 > 0 ? weighted / out.area_mm2 : 0;

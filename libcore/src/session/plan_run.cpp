@@ -103,7 +103,7 @@ std::int64_t frames_in_contact(const Session& s, const RomBaseline& base, const 
 void clock_extent(const std::vector<double>& hours, const std::vector<double>& depth, double& from, double& to) {
   std::vector<double> h;
   for (std::size_t i = 0; i < hours.size() && i < depth.size(); ++i)
-    if (depth[i] > 0.01 && std::isfinite(hours[i])) h.push_back(std::fmod(hours[i], 12.0));
+    if (depth[i] > kResectedDepthMm && std::isfinite(hours[i])) h.push_back(std::fmod(hours[i], 12.0));
   if (h.empty()) return;
   std::sort(h.begin(), h.end());
   double gap = h.front() + 12 - h.back();
@@ -240,17 +240,15 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
 
   // The resected meshes in the input frame: the scan-pose vertices moved by the plan's (joint-frame) displacement.
   const Eigen::Matrix3d joint_to_input = s.to_input() * hip.joint_to_working();
-  auto resected = [&](const BoneResection& b, Vertices V, const TriangleMesh& like, const char* name) {
+  auto resected = [&](const BoneResection& b, const JointBody& body, const Vertices& scan_pose, const char* name) {
     TriangleMesh m;
-    const Vertices& orig = (&b == &run.plan.femur ? s.joint().ball() : s.joint().socket()).relative;
-    m.V = V + (b.resected - orig) * joint_to_input.transpose();
-    m.F = like.F;
+    m.V = scan_pose + (b.resected - body.relative) * joint_to_input.transpose();
+    m.F = body.mesh.F;
     m.source = name;
     return m;
   };
-  run.femur_resected =
-      resected(run.plan.femur, s.femur_input(hip.scan_pose()), s.joint().ball().mesh, "femur_resected");
-  run.pelvis_resected = resected(run.plan.pelvis, s.pelvis_input(), s.joint().socket().mesh, "pelvis_resected");
+  run.femur_resected = resected(run.plan.femur, s.joint().ball(), s.femur_input(hip.scan_pose()), "femur_resected");
+  run.pelvis_resected = resected(run.plan.pelvis, s.joint().socket(), s.pelvis_input(), "pelvis_resected");
   if (hip.ball_clock()) {
     run.femur_hours = clock_hours(s.joint().ball().relative, *hip.ball_clock());
     clock_extent(run.femur_hours, run.plan.femur.depth_mm, run.clock_from_h[0], run.clock_to_h[0]);

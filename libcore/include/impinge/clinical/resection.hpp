@@ -53,6 +53,9 @@
 
 namespace impinge {
 
+/// A vertex moved deeper than this counts as resected (area, vertices, mean depth, clock extent), mm.
+inline constexpr double kResectedDepthMm = 0.01;
+
 /// Which bone a plan may resect.
 enum class ResectBones {
   femur,   ///< the cam: femoral osteochondroplasty (the default)
@@ -91,9 +94,9 @@ struct BoneResection {
   Vertices resected;                           ///< n x 3, joint frame, mm (the input's faces)
   Vertices normals;                            ///< n x 3 unit outward vertex normals (area-weighted), joint frame
   double volume_mm3 = 0;                       ///< the input's enclosed volume less the resected one's
-  double area_mm2 = 0;                         ///< surface whose depth exceeds 0.01 mm (vertex areas)
+  double area_mm2 = 0;                         ///< surface whose depth exceeds kResectedDepthMm (vertex areas)
   double max_depth_mm = 0, mean_depth_mm = 0;  ///< mean: area-weighted over that surface
-  std::int64_t vertices = 0;                   ///< vertices with depth > 0.01 mm
+  std::int64_t vertices = 0;                   ///< vertices with depth > kResectedDepthMm
   std::int64_t capped_vertices = 0;            ///< vertices held at the safety depth
   std::int64_t thin_vertices = 0;              ///< vertices held at half the bone's thickness under them
 };
