@@ -1,7 +1,7 @@
 """16_resection_planning: how much bone `impinge plan` removes against cams of known size, where, what it restores,
 and how long it takes (issue 50).
 
-Reads RESULTS/16_resection_planning/{generated,added_cam,ir90,published}.csv; writes table_plans.tex,
+Reads RESULTS/16_resection_planning/{generated,added_cam,ir90,plan_times,published}.csv; writes table_plans.tex,
 volume_vs_cam.pdf/png, limits_restored.pdf/png, macros.tex. Without shared hips (no data) the added-cam and ir90
 parts are empty and their macros "--"."""
 import matplotlib.pyplot as plt
@@ -14,6 +14,7 @@ gen = read_csv(d, "generated.csv")
 cam = read_csv(d, "added_cam.csv")
 ir = read_csv(d, "ir90.csv")
 pub = read_csv(d, "published.csv")
+times = read_csv(d, "plan_times.csv")
 
 
 def f(x, n=1):
@@ -38,7 +39,19 @@ macros["RPgenShareLow"], macros["RPgenShareHigh"] = f(100 * plans.on_cam_share.m
 macros["RPgenTargets"], macros["RPgenMet"] = str(len(planned)), str(int(planned.met.sum()))
 over = planned.limit_after_deg - planned.limit_free_deg
 macros["RPgenOverLow"], macros["RPgenOverHigh"] = f(over.min()), f(over.max())
-macros["RPgenMsHigh"] = f(plans.plan_ms.max(), 0)
+
+
+def timed(kind, scale=1.0, n=0):
+    """(median, lower quartile, upper quartile, repetitions, plan) of a timed plan (plan_times.csv), "--" when absent."""
+    t = times[times.kind == kind].plan_ms / scale
+    if not len(t):
+        return "--", "--", "--", "0", "--"
+    return (f(t.median(), n), f(t.quantile(0.25), n), f(t.quantile(0.75), n), str(len(t)),
+            times[times.kind == kind].plan.iloc[0])
+
+
+(macros["RPgenMs"], macros["RPgenMsQlow"], macros["RPgenMsQhigh"], macros["RPtimingReps"],
+ macros["RPgenTimedPlan"]) = timed("generated")
 
 # Real femurs with an added cam.
 cam_plans = cam[cam.motion != "none"]
@@ -73,8 +86,7 @@ for resect in ("femur", "both"):
 macros["RPirHeadBlocked"] = str(int(ir.note.fillna("").str.contains("articular surface").sum()))
 macros["RPirDepthBlocked"] = str(int(ir.note.fillna("").str.contains("safety depth").sum()))
 macros["RPirMsHigh"] = f(ir.plan_ms.max(), 0) if len(ir) else "--"
-lhdl = ir[(ir.subject == "lhdl-ct")]
-macros["RPlhdlMs"] = f(lhdl.plan_ms.max() / 1000, 1) if len(lhdl) else "--"
+macros["RPlhdlMs"], macros["RPlhdlMsQlow"], macros["RPlhdlMsQhigh"], _, _ = timed("shared", 1000, 2)
 vol = pub[pub.quantity == "arthroscopic_resection_volume_mm3"].iloc[0]
 macros["RPpubVolumeLow"], macros["RPpubVolumeHigh"] = f(vol.low, 0), f(vol.high, 0)
 write_macros(d, "macros", macros)

@@ -413,7 +413,7 @@ with open(os.path.join(tex_dir, "table_claims.tex"), "w") as f:
 counts = {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS}
 
 # The run's provenance for the front matter, from the drivers' meta.json files: the commit (or every commit,
-# where the run is mixed), the CPU, compiler and cores of the C++ drivers, and the dates.
+# where the run is mixed), the machine, compiler and cores (the same in every driver), and the dates.
 metas = []
 for name in sorted(os.listdir(ROOT)):
     path = os.path.join(ROOT, name, "meta.json")
@@ -422,18 +422,39 @@ for name in sorted(os.listdir(ROOT)):
             metas.append(json.load(f))
 commits = sorted({m.get("git_commit", "") for m in metas})
 dates = sorted(m["date"] for m in metas if m.get("date"))
-cpp = [m for m in metas if m.get("cpu_model")]
 
 
 def first(key):
-    return next((str(m[key]) for m in cpp if m.get(key)), "unknown")
+    return next((str(m[key]) for m in metas if m.get(key)), "unknown")
+
+
+def machine_text():
+    """The CPU as the machine exposes it: model, family/model number, the clock the kernel reports, caches, memory
+    and whether it is a virtual machine (every meta.json's machine block, provenance.hpp)."""
+    m = next((m["machine"] for m in metas if isinstance(m.get("machine"), dict)), None)
+    if m is None:
+        return "unknown"
+    parts = [m.get("cpu_model", "unknown")]
+    if m.get("cpu_family", "unknown") != "unknown":
+        parts[0] += f" (family {m['cpu_family']}, model {m.get('cpu_model_number', '?')})"
+    try:
+        parts.append(f"{float(m['cpu_mhz']) / 1000:.1f} GHz")
+    except (KeyError, ValueError):
+        pass
+    if m.get("l3_cache", "unknown") != "unknown":
+        parts.append(f"{m['l3_cache'].replace('K', ' KiB')} L3")
+    if m.get("memory_gib", "unknown") != "unknown":
+        parts.append(f"{m['memory_gib']} GiB")
+    if m.get("hypervisor") == "yes":
+        parts.append("a virtual machine")
+    return ", ".join(parts)
 
 
 write_macros(tex_dir, "macros", {
     "ClaimsTotal": str(len(rows)), "ClaimsHolds": str(counts["holds"]), "ClaimsPartly": str(counts["partly"]),
     "ClaimsNot": str(counts["does_not_hold"]), "ClaimsUntestable": str(counts["not_testable"]),
     "RunCommit": latex_escape(", ".join(c[:7] + ("-dirty" if c.endswith("-dirty") else "") for c in commits) or "unknown"),
-    "RunCommits": str(len(commits)), "RunCpu": latex_escape(first("cpu_model")), "RunCompiler": latex_escape(first("compiler")),
+    "RunCommits": str(len(commits)), "RunCpu": latex_escape(machine_text()), "RunCompiler": latex_escape(first("compiler")),
     "RunCores": latex_escape(first("cores")), "RunDates": latex_escape(dates[0][:10] if dates and dates[0][:10] == dates[-1][:10]
                                                      else f"{dates[0][:10]} to {dates[-1][:10]}" if dates else "unknown"),
 })

@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <memory>
 
@@ -19,6 +18,7 @@
 #include "impinge/casters/exact_reference.hpp"
 #include "impinge/casters/fcl_collision.hpp"
 #include "impinge/casters/pairwise.hpp"
+#include "impinge/core/provenance.hpp"
 #include "impinge/detection/detection.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
@@ -364,18 +364,11 @@ void BM_PairwiseSample(benchmark::State& st) {
 }
 BENCHMARK(BM_PairwiseSample)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown";
-}
 }  // namespace
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  benchmark::AddCustomContext("cpu_model", cpu_model());
+  for (const auto& [key, value] : impinge::machine_description()) benchmark::AddCustomContext(key, value);
   benchmark::AddCustomContext("subject", scene().name);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -174,20 +174,20 @@ def main():
     whole_process.run(d, subject, 3 if quick else 5, quick)
     assert os.path.exists(os.path.join(d, "whole_process.csv"))  # written by whole_process.run
     import vtk
-    write_meta(d, "13_distance_peers", {
-        "data_folder": data if data and os.path.isdir(data) else None,
-        "quick": quick,
-        "repetitions": reps,
-        "timing": "median wall time after one warm-up run, one thread each (impinge's scans, Open3D nthreads=1, VTK)",
-        "parameters": {"resolution_deg": resolution, "scheme": "equiangular", "distance_reach_mm": "6 (the largest "
-                       "--levels threshold)", "poses_deg": poses},
-        "versions": {"open3d": __import__("open3d").__version__, "vtk": vtk.vtkVersion.GetVTKVersion()},
-        "whole_process": {"subject": subject, "repetitions": 3 if quick else 5,
-                          "impinge": "impinge distance (1 pose) / impinge motion (N poses), CLI defaults, --neutral scan "
-                                     "--joint-centre femoral-head; per pose: Joint.detect_pose at OMP_NUM_THREADS 1, 2",
-                          "open3d": "a Python process: import, load both meshes, build both RaycastingScenes, "
-                                    "compute_signed_distance of every vertex at every pose, write"},
-    })
+    write_meta(d, "13_distance_peers", quick=quick, data_folder=data if data and os.path.isdir(data) else None,
+               repetitions=reps,
+               timing="median wall time after one warm-up run, one thread each (impinge's scans, Open3D nthreads=1, "
+                      "VTK); whole processes: median and quartiles of alternated runs",
+               parameters={"resolution_deg": resolution, "scheme": "equiangular",
+                           "distance_reach_mm": "6 (the largest --levels threshold)", "poses_deg": poses,
+                           "whole_process": {
+                               "subject": subject, "repetitions": 3 if quick else 5,
+                               "impinge": "impinge distance (1 pose) / impinge motion (N poses), CLI defaults, "
+                                          "--neutral scan --joint-centre femoral-head; per pose: Joint.detect_pose at "
+                                          "OMP_NUM_THREADS 1, 2",
+                               "open3d": "a Python process: import, load both meshes, build both RaycastingScenes, "
+                                         "compute_signed_distance of every vertex at every pose, write"}},
+               versions={"open3d": __import__("open3d").__version__, "vtk": vtk.vtkVersion.GetVTKVersion()})
 
 
 if __name__ == "__main__":

@@ -156,17 +156,14 @@ def main():
         shutil.rmtree(work, ignore_errors=True)
 
     import distributed
-    write_meta(d, "14_studies", {
-        "data_folder": data if real else None,
-        "quick": quick,
-        "timing": "wall time of the task phase (cluster started), one OpenMP thread per task; task times measured "
-                  "inside the tasks (their Joint's build included where it was built)",
-        "parameters": {"cohort_study": os.path.relpath(EXAMPLE, ROOT), "cohort_perturbations": samples,
-                       "scaling_perturbations": scaling_samples, "scaling_resolution_deg": 0.5,
-                       "subjects": [os.path.basename(os.path.dirname(s)) if isinstance(s, str) else s["name"]
-                                    for s in subjects]},
-        "versions": {"impinge": impinge.__version__, "distributed": distributed.__version__},
-    })
+    write_meta(d, "14_studies", quick=quick, data_folder=data if real else None,
+               timing="wall time of the task phase (cluster started), one OpenMP thread per task; task times measured "
+                      "inside the tasks (their Joint's build included where it was built)",
+               parameters={"cohort_study": os.path.relpath(EXAMPLE, ROOT), "cohort_perturbations": samples,
+                           "scaling_perturbations": scaling_samples, "scaling_resolution_deg": 0.5,
+                           "subjects": [os.path.basename(os.path.dirname(s)) if isinstance(s, str) else s["name"]
+                                        for s in subjects]},
+               versions={"distributed": distributed.__version__})
 
 
 if __name__ == "__main__":

@@ -91,9 +91,11 @@ def main():
                         continue
                     wl.writerow([hip, r["pelvic_frame"], motion, r["limit_deg"], r["status"], r["normal_deg"],
                                  int(bool(r["soft_tissue_first"]))])
-    write_meta(d, "15_morphology", {"resolution_deg": resolution, "subjects": hips, "quick": quick,
-                                    "generated_cams_mm": list(CAMS_MM), "generated_triangles": 12000,
-                                    "rom": "CLI defaults (equidistant, distance metric, contact depth 0.25 mm)"})
+    write_meta(d, "15_morphology", quick=quick, data_folder=data if hips else None,
+               timing="not timed (the morphology_ms column: one run each, not quoted)",
+               parameters={"resolution_deg": resolution, "subjects": hips, "generated_cams_mm": list(CAMS_MM),
+                           "generated_triangles": 12000,
+                           "rom": "CLI defaults (equidistant, distance metric, contact depth 0.25 mm)"})
 
 
 if __name__ == "__main__":

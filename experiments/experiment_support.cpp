@@ -11,6 +11,7 @@
 
 #include "impinge/core/error.hpp"
 #include "impinge/core/kernels.hpp"
+#include "impinge/core/provenance.hpp"
 #include "impinge/core/timing.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/subject.hpp"
@@ -170,20 +171,24 @@ const std::string& source_commit() {
 
 void write_meta(const std::string& dir, const Args& args, nlohmann::json params) {
   nlohmann::json m;
-  m["parameters"] = std::move(params);
-  m["quick"] = args.quick;
-  m["repetitions"] = args.repetitions;
-  m["timing"] = "median wall time after one warm-up run, single thread";
-  m["data_folder"] = args.data;
+  m["experiment"] = fs::path(dir).filename().string();
   m["git_commit"] = source_commit();
-  m["compiler"] = IMPINGE_COMPILER;
-  m["cpu_model"] = command_output("grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'");
-  m["kernels"] = kernel_description();  // which dispatched kernels ran (IMPINGE_KERNELS)
-  m["cores"] = command_output("nproc");
   const std::time_t now = std::time(nullptr);
   char buf[64];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   m["date"] = buf;
+  m["quick"] = args.quick;
+  m["repetitions"] = args.repetitions;
+  m["timing"] = "median wall time after one warm-up run, single thread";
+  m["data_folder"] = args.data.empty() || !fs::is_directory(args.data) ? nlohmann::json(nullptr) : nlohmann::json(args.data);
+  m["parameters"] = std::move(params);
+  m["versions"] = {{"impinge", IMPINGE_VERSION}};
+  m["compiler"] = compiler_description();
+  m["kernels"] = kernel_description();  // which dispatched kernels ran (IMPINGE_KERNELS)
+  m["cores"] = command_output("nproc");
+  nlohmann::json machine = nlohmann::json::object();
+  for (const auto& [key, value] : machine_description()) machine[key] = value;
+  m["machine"] = std::move(machine);
   write_file_atomically((fs::path(dir) / "meta.json").string(), m.dump(2) + "\n");
 }
 

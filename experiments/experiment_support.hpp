@@ -77,7 +77,11 @@ double median_ms(const std::function<void()>& fn, int reps);
 /// OUT/NN_name, created.
 std::string experiment_dir(const Args& args, const std::string& name);
 
-/// Write meta.json: the parameters plus git commit, compiler, CPU model, date, repetitions.
+/// Write DIR/meta.json with the fields every driver's meta.json has (the Python drivers' write_meta in
+/// experiment_support.py writes the same; tools/check-report checks it): experiment (DIR's name),
+/// git_commit (with "-dirty" when tracked files outside results/ differ), date (UTC), quick,
+/// repetitions, timing, data_folder, parameters (`params`), versions, compiler, kernels, cores and
+/// machine (machine_description(): CPU model, family, clock, caches, memory, hypervisor, kernel).
 void write_meta(const std::string& dir, const Args& args, nlohmann::json params);
 
 /// Minimal CSV writer: header once, then rows of already-formatted cells.

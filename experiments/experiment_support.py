@@ -3,7 +3,6 @@
 import datetime
 import json
 import os
-import platform
 import subprocess
 import sys
 
@@ -26,16 +25,27 @@ def experiment_args(name, usage):
     return d, arg("--data"), "--quick" in sys.argv
 
 
-def write_meta(d, experiment, fields):
-    """d/meta.json: experiment, git_commit (with -dirty when tracked files outside results/ differ from it), date
-    (UTC), cores, machine, then `fields`."""
+def write_meta(d, experiment, *, quick, data_folder, parameters, timing, repetitions=None, versions=None):
+    """d/meta.json with the fields every driver's meta.json has, in the C++ drivers' order (write_meta in
+    experiment_support.cpp; tools/check-report checks they agree): experiment, git_commit (with -dirty when
+    tracked files outside results/ differ from it), date (UTC), quick, repetitions (None: not repeated), timing
+    (how times were taken), data_folder, parameters, versions (impinge's and the peers'), compiler and kernels
+    (impinge.build_info()), cores (CPUs this process may run on) and machine (impinge.machine_info()). Written
+    atomically."""
+    import impinge
     commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
     # The results folder left out, as the C++ drivers' source_commit(): a reproduction rewrites it as it goes.
     dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no", "--", ".",
                             ":(exclude)results"], capture_output=True, text=True).stdout.strip() != ""
-    meta = {"experiment": experiment, "git_commit": commit + ("-dirty" if dirty else ""),
+    build = impinge.build_info()
+    meta = {"experiment": experiment, "git_commit": (commit or "unknown") + ("-dirty" if dirty and commit else ""),
             "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-            "cores": str(os.cpu_count()), "machine": platform.processor() or platform.machine()}
-    meta.update(fields)
-    with open(os.path.join(d, "meta.json"), "w") as f:
+            "quick": bool(quick), "repetitions": repetitions, "timing": timing, "data_folder": data_folder,
+            "parameters": parameters, "versions": {"impinge": build["version"], **(versions or {})},
+            "compiler": build["compiler"], "kernels": build["kernels"],
+            "cores": str(len(os.sched_getaffinity(0))), "machine": impinge.machine_info()}
+    tmp = os.path.join(d, f".meta.json.{os.getpid()}.tmp")
+    with open(tmp, "w") as f:
         json.dump(meta, f, indent=2)
+        f.write("\n")
+    os.replace(tmp, os.path.join(d, "meta.json"))

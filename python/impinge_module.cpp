@@ -8,6 +8,8 @@
 
 #include "bindings.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/kernels.hpp"
+#include "impinge/core/provenance.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/motion.hpp"
@@ -45,6 +47,27 @@ void bind_functions(py::module_& m) {
       "core (or OMP_NUM_THREADS). Studies give each task one thread (impinge.study).");
   m.def("get_threads", []() { return omp_get_max_threads(); },
         "Threads (OpenMP) the calling thread's next parallel call would use.");
+  m.def(
+      "build_info",
+      []() {
+        py::dict d;
+        d["version"] = IMPINGE_VERSION;
+        d["compiler"] = compiler_description();
+        d["kernels"] = kernel_description();
+        return d;
+      },
+      "The build's provenance -> dict(version, compiler (e.g. 'GNU 12.2.0'), kernels (the dispatched kernels "
+      "in use, IMPINGE_KERNELS)); what every experiment's meta.json records.");
+  m.def(
+      "machine_info",
+      []() {
+        py::dict d;
+        for (const auto& [key, value] : machine_description()) d[py::str(key)] = value;
+        return d;
+      },
+      "What this machine exposes about itself -> dict of str: cpu_model, cpu_family, cpu_model_number, "
+      "cpu_stepping, cpu_mhz, l2_cache, l3_cache, logical_cpus, memory_gib, hypervisor, os_kernel ('unknown' "
+      "where the machine does not say; provenance.hpp).");
 
   m.def(
       "load_motion",

@@ -27,12 +27,23 @@ def test_thesis_items_are_read_one_by_one():
     assert check.thesis_items("(new) the Euclidean distance beside Open3D and VTK (issue 26)") == set()
 
 
-def write_run(d, commits, claims_rows, log="", leave_out=()):
-    """A run of every manifest experiment (but leave_out), the k-th from commits[k % len(commits)]."""
+def head():
+    """This checkout's HEAD commit, or None outside a git work tree."""
+    r = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True, text=True)
+    return r.stdout.strip() if r.returncode == 0 else None
+
+
+def write_run(d, commits, claims_rows, log="", leave_out=(), drop_field=None):
+    """A run of every manifest experiment (but leave_out), the k-th from commits[k % len(commits)] ("abc" stands for
+    HEAD: a run of the code as it is), every meta.json with every field but drop_field."""
+    here = head() or "abc"
     for k, name in enumerate(n for n in check.manifest_items() if n not in leave_out):
         os.makedirs(os.path.join(d, name), exist_ok=True)
+        meta = {field: "x" for field in check.META_FIELDS}
+        meta["git_commit"] = commits[k % len(commits)].replace("abc", here)
+        meta.pop(drop_field, None)
         with open(os.path.join(d, name, "meta.json"), "w") as f:
-            json.dump({"git_commit": commits[k % len(commits)]}, f)
+            json.dump(meta, f)
     with open(os.path.join(d, "claims.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=["thesis_item", "claim", "thesis_value", "our_value", "verdict", "reason",
                                           "section"])
@@ -69,6 +80,49 @@ def test_mixed_and_dirty_commits_are_found():
         write_run(d, ["abc-dirty"], every_item_row())
         assert run(d).returncode == 1
         assert run(d, "--allow-dirty").returncode == 0
+
+
+def test_a_meta_json_without_every_field_is_found():
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc"], every_item_row(), drop_field="machine")
+        r = run(d)
+        assert r.returncode == 1 and "lacks machine" in r.stdout, r.stdout
+
+
+def git(repo, *args):
+    subprocess.run(["git", "-C", repo, "-c", "user.name=t", "-c", "user.email=t@t", *args], check=True,
+                   capture_output=True)
+    return subprocess.run(["git", "-C", repo, "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
+
+
+def test_a_run_older_than_a_change_to_what_shapes_the_results_is_found():
+    # A repository whose first commit holds a driver and a README: a run of it is current until a later commit
+    # touches the driver (a README change does not count).
+    with tempfile.TemporaryDirectory() as repo, tempfile.TemporaryDirectory() as d:
+        os.makedirs(os.path.join(repo, "experiments"))
+        for path, text in (("experiments/01.py", "a = 1\n"), ("README.md", "r\n")):
+            with open(os.path.join(repo, path), "w") as f:
+                f.write(text)
+        git(repo, "init", "-q")
+        git(repo, "add", "-A")
+        first = git(repo, "commit", "-q", "-m", "one")
+        os.makedirs(os.path.join(d, "01"))
+        with open(os.path.join(d, "01", "meta.json"), "w") as f:
+            json.dump({"git_commit": first}, f)
+        assert check.check_current(d, repo) == []
+        with open(os.path.join(repo, "README.md"), "a") as f:
+            f.write("more\n")
+        git(repo, "commit", "-q", "-am", "docs")
+        assert check.check_current(d, repo) == []
+        with open(os.path.join(repo, "experiments", "01.py"), "a") as f:
+            f.write("b = 2\n")
+        git(repo, "commit", "-q", "-am", "driver")
+        found = check.check_current(d, repo)
+        assert len(found) == 1 and "experiments/01.py" in found[0] and "README" not in found[0], found
+        # A commit the repository does not hold cannot be vouched for.
+        with open(os.path.join(d, "01", "meta.json"), "w") as f:
+            json.dump({"git_commit": "0" * 40}, f)
+        assert "not in this repository's history" in check.check_current(d, repo)[0]
 
 
 def test_an_experiment_missing_from_the_run_is_found():
@@ -109,6 +163,18 @@ def experiments_at(commit):
     return {line.split("\t")[0] for line in r.stdout.splitlines()[1:] if line and not line.startswith("#")}
 
 
+def run_predates_same_fields(commit):
+    """True when the run's commit is older than the commit that gave every meta.json the same fields (META_FIELDS
+    in tools/check-report): such a run cannot have them."""
+    r = subprocess.run(["git", "-C", ROOT, "log", "--format=%H", "-S", "META_FIELDS", "--", "tools/check-report"],
+                       capture_output=True, text=True)
+    introduced = r.stdout.split()[-1] if r.returncode == 0 and r.stdout.split() else None
+    if introduced is None:
+        return False
+    return subprocess.run(["git", "-C", ROOT, "merge-base", "--is-ancestor", commit.removesuffix("-dirty"),
+                           introduced], capture_output=True).returncode == 0 and commit != introduced
+
+
 def test_the_committed_run_is_one_clean_commit_of_every_experiment_and_its_claims_cover_the_manifest():
     results = os.path.join(ROOT, "results")
     # Every experiment the manifest held at the run's commit is in the run, from that one clean commit. An
@@ -120,5 +186,9 @@ def test_the_committed_run_is_one_clean_commit_of_every_experiment_and_its_claim
     if then is not None:
         findings = [x for x in findings if not any(f"provenance: {name} (experiments/manifest.tsv) has no meta.json"
                                                    in x for name in set(check.manifest_items()) - then)]
+    if run_predates_same_fields(commit):
+        findings = [x for x in findings if " lacks " not in x]
+    # Not asserted here: check_current (a code commit lands before its reference run; tools/check-report on
+    # results/ says so, and the reference run is redone last, issue 51).
     assert findings == []
     assert check.check_claims(results) == []

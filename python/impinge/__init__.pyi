@@ -30,6 +30,13 @@ def set_threads(n: int) -> None:
 def get_threads() -> int:
     """OpenMP threads the calling thread's next parallel call would use."""
 
+def build_info() -> Dict[str, str]:
+    """The build's provenance -> dict(version, compiler, kernels): what every experiment's meta.json records."""
+
+def machine_info() -> Dict[str, str]:
+    """What this machine exposes -> dict(cpu_model, cpu_family, cpu_model_number, cpu_stepping, cpu_mhz, l2_cache,
+    l3_cache, logical_cpus, memory_gib, hypervisor, os_kernel); 'unknown' where it does not say."""
+
 def load_motion(path: str, side: str = "right") -> Dict[str, Any]:
     """A motion file as impinge motion reads it (CSV or OpenSim .mot/.sto) -> dict(time_s (k,) s,
     angles (k, 3) degrees: flexion, adduction, internal rotation; format 'csv' or 'opensim')."""
