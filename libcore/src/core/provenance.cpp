@@ -78,9 +78,9 @@ std::vector<std::pair<std::string, std::string>> machine_description() {
   }
   m.emplace_back("memory_gib", memory);
   const std::string flags = proc_field("/proc/cpuinfo", "flags");
-  m.emplace_back("hypervisor", flags.empty() ? std::string("unknown")
+  m.emplace_back("hypervisor", flags.empty()                                                   ? std::string("unknown")
                                : (" " + flags + " ").find(" hypervisor ") != std::string::npos ? "yes"
-                                                                                              : "no");
+                                                                                               : "no");
   utsname u{};
   m.emplace_back("os_kernel", uname(&u) == 0 ? std::string(u.sysname) + " " + u.release : std::string("unknown"));
   return m;
