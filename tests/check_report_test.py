@@ -96,11 +96,12 @@ def git(repo, *args):
 
 
 def test_a_run_older_than_a_change_to_what_shapes_the_results_is_found():
-    # A repository whose first commit holds a driver and a README: a run of it is current until a later commit
-    # touches the driver (a README change does not count).
+    # A repository whose first commit holds a driver, a README and a test: a run of it is current until a later
+    # commit touches the driver (changes to the README or the tests do not count).
     with tempfile.TemporaryDirectory() as repo, tempfile.TemporaryDirectory() as d:
         os.makedirs(os.path.join(repo, "experiments"))
-        for path, text in (("experiments/01.py", "a = 1\n"), ("README.md", "r\n")):
+        os.makedirs(os.path.join(repo, "python", "tests"))
+        for path, text in (("experiments/01.py", "a = 1\n"), ("README.md", "r\n"), ("python/tests/t.py", "t\n")):
             with open(os.path.join(repo, path), "w") as f:
                 f.write(text)
         git(repo, "init", "-q")
@@ -110,9 +111,10 @@ def test_a_run_older_than_a_change_to_what_shapes_the_results_is_found():
         with open(os.path.join(d, "01", "meta.json"), "w") as f:
             json.dump({"git_commit": first}, f)
         assert check.check_current(d, repo) == []
-        with open(os.path.join(repo, "README.md"), "a") as f:
-            f.write("more\n")
-        git(repo, "commit", "-q", "-am", "docs")
+        for path in ("README.md", "python/tests/t.py"):
+            with open(os.path.join(repo, path), "a") as f:
+                f.write("more\n")
+        git(repo, "commit", "-q", "-am", "docs and tests")
         assert check.check_current(d, repo) == []
         with open(os.path.join(repo, "experiments", "01.py"), "a") as f:
             f.write("b = 2\n")
