@@ -129,7 +129,8 @@ write_table(d, "table_sensitivity", ["subject", "method", "perturbation", "media
 # limit under a 1 mm move of the initial COR (6 directions).
 # Without the shared hips (no methods.csv, no mc22 pair) the prose's numbers read "--".
 method_macros = {k: "--" for k in ["ROMeqSensMax", "ROMeqSensWorstSubject", "ROMeqSensWithinThree", "ROMmethodSubjects",
-                                   "ROMfhSensMax", "ROMfhSensVanish", "ROMeqSensMedian"]}
+                                   "ROMfhSensMax", "ROMfhSensVanish", "ROMeqSensMedian", "ROMeqSensOverThree",
+                                   "ROMeqSensLimits", "ROMeqSensOverThreeList"]}
 if meth is not None:
     order = ["femoral-head", "acetabular", "combined", "equidistant"]
     msubjects = list(dict.fromkeys(meth.subject))
@@ -157,6 +158,15 @@ if meth is not None:
         "ROMfhSensMax": f(changes(fh)[np.isfinite(changes(fh))].max()),
         "ROMfhSensVanish": str(int(np.isinf(changes(fh)).sum())),
         "ROMeqSensMedian": f(changes(eq).median(), 2),
+    })
+    # The limits a 1 mm move changes by more than 3 deg, by subject (the prose names them).
+    worst = eq.assign(change=changes(eq)).groupby(["subject", "motion"], sort=False).change.max()
+    over = worst[worst > 3]
+    method_macros.update({
+        "ROMeqSensOverThree": str(len(over)), "ROMeqSensLimits": str(len(worst)),
+        "ROMeqSensOverThreeList": "; ".join(
+            f"\\texttt{{{s}}}: " + ", ".join(m.replace("_", " ") for m in over[s].index)
+            for s in dict.fromkeys(over.index.get_level_values(0))) or "none",
     })
 
 # The thesis' ROM observation (sec. 5.2, Tables 12-13), with a verdict: red zones at 1-2 o'clock for
