@@ -45,8 +45,7 @@ def write_run(d, commits, claims_rows, log="", leave_out=(), drop_field=None):
         with open(os.path.join(d, name, "meta.json"), "w") as f:
             json.dump(meta, f)
     with open(os.path.join(d, "claims.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["thesis_item", "claim", "thesis_value", "our_value", "verdict", "reason",
-                                          "section"])
+        w = csv.DictWriter(f, fieldnames=list(check.CLAIM_COLUMNS))
         w.writeheader()
         w.writerows(claims_rows)
     os.makedirs(os.path.join(d, "paper"), exist_ok=True)
@@ -56,8 +55,9 @@ def write_run(d, commits, claims_rows, log="", leave_out=(), drop_field=None):
 
 def every_item_row(verdict="holds"):
     items = sorted(set().union(*check.manifest_items().values()))
-    return [{"thesis_item": "; ".join(items), "claim": "c", "thesis_value": "t", "our_value": "o", "verdict": verdict,
-             "reason": "r", "section": "s"}]
+    return [{"thesis_item": "; ".join(items), "claim": "c", "kind": "measured", "thesis_value": "t", "our_value": "o",
+             "tolerance": "1 %", "conditions": "rest pose", "same_subjects": "yes", "verdict": verdict, "reason": "r",
+             "section": "s"}]
 
 
 def run(d, *extra):
@@ -145,6 +145,19 @@ def test_a_thesis_item_without_a_claim_and_a_bad_verdict_are_found():
         write_run(d, ["abc"], every_item_row("probably"))
         r = run(d)
         assert r.returncode == 1 and "verdict 'probably'" in r.stdout, r.stdout
+
+
+def test_a_claims_table_without_kind_tolerance_and_conditions_is_found():
+    with tempfile.TemporaryDirectory() as d:
+        rows = every_item_row()
+        write_run(d, ["abc"], rows)
+        with open(os.path.join(d, "claims.csv"), "w", newline="") as f:
+            old = ["thesis_item", "claim", "thesis_value", "our_value", "verdict", "reason", "section"]
+            w = csv.DictWriter(f, fieldnames=old, extrasaction="ignore")
+            w.writeheader()
+            w.writerows(rows)
+        r = run(d)
+        assert r.returncode == 1 and "lacks the columns kind, tolerance, conditions, same_subjects" in r.stdout, r.stdout
 
 
 def test_a_page_that_runs_over_is_found():
