@@ -1,6 +1,7 @@
 """03_detection_time: thesis Tables 4 and 9 beside ours, peers on the same vertices, throughput.
 
-Reads RESULTS/03_detection_time/detection.csv and throughput.csv; writes table4_9.tex (generated
+Reads RESULTS/03_detection_time/detection.csv, detection_runs.csv and throughput.csv (every time a median over
+alternated rounds, with its quartiles; ratios paired round by round); writes table4_9.tex (generated
 models at the thesis' triangle levels), table_real.tex (every real subject, pushed pose),
 table_throughput.tex, table_schemes.tex (every registered scheme), detection_time.pdf/png, macros.tex."""
 import numpy as np
@@ -11,6 +12,7 @@ from common import experiment_dir, read_csv, save, write_macros, write_table
 d = experiment_dir("03_detection_time")
 t = read_csv(d, "detection.csv")
 thr = read_csv(d, "throughput.csv")
+runs = read_csv(d, "detection_runs.csv")
 labels = {"rsid": "RSID", "usid": "USID", "embree_radial": "Embree rtcIntersect1",
           "embree_radial_packet8": "Embree rtcIntersect8", "cgal_radial": "CGAL first hit",
           "fcl_collide": "FCL collide", "fcl_distance": "FCL distance", "pairwise": "pair-wise"}
@@ -22,6 +24,25 @@ def fmt(ms):
     if ms >= 100:
         return f"{ms:,.0f}"
     return f"{ms:.1f}" if ms >= 10 else (f"{ms:.2f}" if ms >= 1 else f"{ms:.3f}")
+
+
+def spread(g, method, res=None):
+    """A time cell with its spread: 'median (lower quartile-upper quartile)' ms over the alternated rounds."""
+    med, lo, hi = (get(g, method, res, c) for c in ("time_ms", "time_q25_ms", "time_q75_ms"))
+    if not np.isfinite(med):
+        return "--"
+    return fmt(med) if not np.isfinite(lo) or lo == hi else f"{fmt(med)} ({fmt(lo)}-{fmt(hi)})"
+
+
+def paired(subject, pose, num, den, num_res=None, den_res=None):
+    """(median, lower quartile, upper quartile) of num's time over den's, round by round (detection_runs.csv)."""
+    def rounds(method, res):
+        r = runs[(runs.subject == subject) & (runs.pose == pose) & (runs.method == method)]
+        if res is not None:
+            r = r[np.isclose(r.resolution, res)]
+        return r.set_index("round").time_ms
+    ratio = (rounds(num, num_res) / rounds(den, den_res)).dropna()
+    return (ratio.median(), ratio.quantile(0.25), ratio.quantile(0.75)) if len(ratio) else (np.nan,) * 3
 
 
 def get(g, method, res=None, col="time_ms"):
@@ -42,10 +63,10 @@ for s in ["generated-300", "generated-1k", "generated-3k", "generated-12k"]:
         continue
     rows.append([s.replace("generated-", ""), f"{int(g.femur_triangles.iloc[0]):,}",
                  fmt(get(g, "pairwise", col="thesis_ms")), fmt(get(g, "pairwise")),
-                 fmt(get(g, "fcl_collide", col="thesis_ms")), fmt(get(g, "fcl_collide")),
-                 fmt(get(g, "rsid", col="thesis_ms")), fmt(get(g, "rsid", p_table)),
-                 fmt(get(g, "usid", col="thesis_ms")), fmt(get(g, "usid", k_table)),
-                 fmt(get(g, "embree_radial")), fmt(get(g, "cgal_radial"))])
+                 fmt(get(g, "fcl_collide", col="thesis_ms")), spread(g, "fcl_collide"),
+                 fmt(get(g, "rsid", col="thesis_ms")), spread(g, "rsid", p_table),
+                 fmt(get(g, "usid", col="thesis_ms")), spread(g, "usid", k_table),
+                 spread(g, "embree_radial"), spread(g, "cgal_radial")])
 write_table(d, "table4_9", ["level", "triangles", "pair-wise thesis", "pair-wise ours", "RAPID thesis", "FCL ours",
                             "RSID thesis", "RSID ours", "USID thesis", "USID ours", "Embree", "CGAL"], rows,
             align="lrrrrrrrrrrr")
@@ -54,19 +75,22 @@ write_table(d, "table4_9", ["level", "triangles", "pair-wise thesis", "pair-wise
 rows = []
 for (s, pose), g in t[~t.generated.astype(bool)].groupby(["subject", "pose"], sort=False):
     nv = int(get(g, "rsid", 0.1, "vertices"))
-    rows.append([s, pose.replace("_", " "), f"{nv:,}", fmt(get(g, "rsid", 0.5)), fmt(get(g, "rsid", 0.1)),
-                 fmt(get(g, "usid", k_table)), fmt(get(g, "embree_radial")), fmt(get(g, "embree_radial_packet8")),
-                 fmt(get(g, "cgal_radial")), fmt(get(g, "fcl_collide")), f"{get(g, 'fcl_collide', col='result'):.0f}",
-                 fmt(get(g, "fcl_distance")), fmt(get(g, "pairwise")), f"{get(g, 'rsid', 0.1, 'result'):.2f}"])
+    rows.append([s, pose.replace("_", " "), f"{nv:,}", spread(g, "rsid", 0.5), spread(g, "rsid", 0.1),
+                 spread(g, "usid", k_table), spread(g, "embree_radial"), spread(g, "embree_radial_packet8"),
+                 spread(g, "cgal_radial"), spread(g, "fcl_collide"), f"{get(g, 'fcl_collide', col='result'):.0f}",
+                 spread(g, "fcl_distance"), fmt(get(g, "pairwise")), f"{get(g, 'rsid', 0.1, 'result'):.2f}"])
 write_table(d, "table_real", ["subject", "pose", "vertices", "RSID 0.5", "RSID 0.1", "USID", "Embree", "Embree x8",
                               "CGAL", "FCL collide", "contacts", "FCL distance", "pair-wise", "RSID min gap (mm)"], rows,
             align="llrrrrrrrrrrrr")
 
 rows = []
 for (s, m, r), g in thr[thr.method.isin(["rsid", "usid"])].groupby(["subject", "method", "resolution"], sort=False):
-    one = g[g.threads == 1].poses_per_s.iloc[0]
-    two = g[g.threads == 2].poses_per_s.iloc[0]
-    rows.append([s, labels.get(m, m), f"{r:g}", f"{one:,.0f}", f"{two:,.0f}", f"{two / one:.2f}"])
+    a, b = g[g.threads == 1].iloc[0], g[g.threads == 2].iloc[0]
+
+    def rate(x):  # poses/s at the median, with the quartiles of the time turned into rates
+        n = x.poses * 1000.0
+        return f"{n / x.time_ms:,.0f} ({n / x.time_q75_ms:,.0f}-{n / x.time_q25_ms:,.0f})"
+    rows.append([s, labels.get(m, m), f"{r:g}", rate(a), rate(b), f"{b.poses_per_s / a.poses_per_s:.2f}"])
 write_table(d, "table_throughput", ["subject", "method", "resolution", "poses/s, 1 thread", "poses/s, 2 threads",
                                     "speed-up"], rows, align="llrrrr")
 
@@ -101,8 +125,10 @@ for m, res in [("rsid", p_table), ("rsid", 0.1), ("usid", k_table), ("embree_rad
         g = g[np.isclose(g.resolution, res)]
     g = g.sort_values("femur_triangles")
     if len(g):
-        ax.loglog(g.femur_triangles, g.time_ms, marker="o", markersize=3,
-                  label=labels[m] + (f" {res:g}" if res is not None else ""))
+        ax.errorbar(g.femur_triangles, g.time_ms, yerr=[g.time_ms - g.time_q25_ms, g.time_q75_ms - g.time_ms],
+                    marker="o", markersize=3, capsize=2, label=labels[m] + (f" {res:g}" if res is not None else ""))
+        ax.set_xscale("log")
+        ax.set_yscale("log")
 for col, mk, name in [("rsid", "s", "thesis RSID"), ("fcl_collide", "^", "thesis RAPID"), ("pairwise", "x", "thesis pair-wise")]:
     g = gen[(gen.method == col)].drop_duplicates("subject").sort_values("femur_triangles")
     ax.loglog(g.femur_triangles, g.thesis_ms, mk, color="k", markersize=5, label=name)
@@ -133,10 +159,17 @@ if len(real):
                    "DetEmbreeNs": f"{get(g, 'embree_radial', col='ns_per_vertex'):.0f}",
                    "DetCgalNs": f"{get(g, 'cgal_radial', col='ns_per_vertex'):,.0f}",
                    "DetFclMs": fmt(fcl), "DetFclContacts": f"{get(g, 'fcl_collide', col='result'):.0f}",
-                   "DetFclOverRsid": f"{fcl / rs:.0f}", "DetEmbreeOverRsid": f"{emb / rs:.1f}",
-                   "DetCgalOverRsid": f"{cg / rs:.0f}", "DetUsidMs": fmt(get(g, "usid", k_table)),
+                   "DetUsidMs": fmt(get(g, "usid", k_table)),
+                   "DetRsidMsQlow": fmt(get(g, "rsid", 0.1, "time_q25_ms")),
+                   "DetRsidMsQhigh": fmt(get(g, "rsid", 0.1, "time_q75_ms")),
+                   "DetRuns": f"{int(get(g, 'rsid', 0.1, 'runs'))}",
                    "DetFclDistance": f"{get(g0, 'fcl_distance', col='result'):.3f}",
                    "DetRsidMinGapRest": f"{get(g0, 'rsid', 0.1, 'result'):.3f}"})
+    # Ratios to RSID paired round by round (the methods of a pose ran alternately), with their quartiles.
+    for name, method, digits in (("Fcl", "fcl_collide", 0), ("Embree", "embree_radial", 1), ("Cgal", "cgal_radial", 0)):
+        med, lo, hi = paired(s, "pushed_3mm", method, "rsid", None, 0.1)
+        macros.update({f"Det{name}OverRsid": f"{med:.{digits}f}", f"Det{name}OverRsidQlow": f"{lo:.{digits}f}",
+                       f"Det{name}OverRsidQhigh": f"{hi:.{digits}f}"})
 # Against the thesis (generated levels, pushed pose): RSID at the table's precision, USID over RSID.
 gen_p = t[t.generated.astype(bool) & (t.pose == "pushed_3mm")]
 rsid_vs_thesis, usid_over_rsid = [], []

@@ -13,15 +13,21 @@
 //             fcl_collide (FCL OBBRSS trees, every contact), fcl_distance (FCL minimum distance),
 //             pairwise (the thesis' exhaustive triangle-pair test over the hip-region triangles)
 //     vertices: the scanned vertices of both bodies (first surface, within 45 mm of the COR);
-//     time_ms: both scans (or the whole query) of one pose; ball_ms, socket_ms: per scan;
+//     time_ms, time_q25_ms, time_q75_ms, runs: median and quartiles of both scans (or the whole query) of one pose
+//       over `runs` rounds, every method of a pose timed alternately (one run of each per round; pair-wise: once);
+//       ball_ms, socket_ms: per scan (medians);
 //     ns_per_vertex = time / vertices; result: min gap (mm) for the radial methods, contacts,
 //     distance (mm) or intersecting pairs for the others; thesis_ms: Table 4 / 9; spacing_deg: the
 //     equiangular precision a scheme's resolution is matched to (empty for the peers)
+//   detection_runs.csv  every round's time of every method (subject, pose, method, resolution, round, time_ms):
+//                   ratios paired round by round
 //   throughput.csv  poses per second for every scheme's maps over 256 random poses (rotations up to
-//                   20 deg about the COR), with 1 and 2 threads (each thread its own poses)
+//                   20 deg about the COR), with 1 and 2 threads (each thread its own poses), alternated; the
+//                   median and quartiles of the 256 poses' time
 //   meta.json
 // Command: build/experiments/exp_03_detection_time --out results --data ../shared/data/hips [--quick]
 // Quick mode: fewer repetitions; the pairwise test only where it has <= 20 million pairs.
+#include <memory>
 #include <random>
 #include <thread>
 
@@ -145,74 +151,106 @@ struct SubjectRun {
   Peers peers;
 };
 
-// One row of detection.csv.
+// One row of detection.csv: `t` the spread of the pose's time (both scans), ball_ms and socket_ms their medians.
 void row(CsvWriter& csv, const SubjectRun& r, const std::string& pose, const std::string& method, double res,
-         std::int64_t vertices, double ms, double ball_ms, double socket_ms, double result, const std::string& kind,
-         double spacing = std::nan("")) {
+         std::int64_t vertices, const Timing& t, double ball_ms, double socket_ms, double result,
+         const std::string& kind, double spacing = std::nan("")) {
   const Subject& s = r.s;
+  const double ms = t.median_ms;
   csv.row(s.name, int(s.generated), static_cast<std::int64_t>(s.femur.F.rows()),
-          static_cast<std::int64_t>(s.pelvis.F.rows()), pose, method, res, vertices, ms, ball_ms, socket_ms,
-          vertices > 0 ? ms * 1e6 / double(vertices) : std::nan(""), result, kind, thesis_ms(s.name, method), spacing);
+          static_cast<std::int64_t>(s.pelvis.F.rows()), pose, method, res, vertices, ms, t.q25_ms, t.q75_ms, t.runs,
+          ball_ms, socket_ms, vertices > 0 ? ms * 1e6 / double(vertices) : std::nan(""), result, kind,
+          thesis_ms(s.name, method), spacing);
 }
 
-// Both scans of every scheme's maps at one pose (ball against the pelvis map, pelvis against the femur map).
-void time_maps(const SubjectRun& r, const std::string& pname, const Eigen::Vector3d& t, int reps, CsvWriter& csv) {
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  for (std::size_t k = 0; k < r.schemes.size(); ++k) {
-    const Body &fb = r.built[k].first, &pb = r.built[k].second;
-    std::vector<float> g1(std::size_t(fb.set.size())), g2(std::size_t(pb.set.size()));
-    const double tb = median_ms([&] { scan_gaps_compact(fb.set, I, t, pb.map, ScanSide::inside, g1.data()); }, reps);
-    const double ts = median_ms(
-        [&] { scan_gaps_compact(pb.set, I, Eigen::Vector3d(-t), fb.map, ScanSide::outside, g2.data()); }, reps);
-    row(csv, r, pname, r.schemes[k].method, r.schemes[k].res, fb.set.size() + pb.set.size(), tb + ts, tb, ts,
-        min_of(g1, g2), "min_gap_mm", r.schemes[k].spacing);
-  }
-}
-
-// The peers at one pose: Embree (single rays, packets of 8) and CGAL radial scans on the same vertices,
-// FCL collide and distance, pairwise triangle intersection.
-void time_peers(const SubjectRun& r, const std::string& pname, const Eigen::Vector3d& t, int reps, bool quick,
-                CsvWriter& csv) {
+// Every method at one pose, timed alternately (run_alternated: one warm-up each, then `reps` rounds in which each
+// runs once), so that their ratios are paired round by round: both scans of every scheme's maps (ball against the
+// pelvis map, pelvis against the femur map), Embree (single rays, packets of 8) and CGAL radial scans on the same
+// vertices, FCL collide and distance. The raw rounds go to detection_runs.csv. Pair-wise triangle intersection
+// (seconds) runs once, apart.
+void time_pose(const SubjectRun& r, const std::string& pname, const Eigen::Vector3d& t, int reps, bool quick,
+               CsvWriter& csv, CsvWriter& runs_csv) {
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   const ScanSet &fset = r.fset(), &pset = r.pset();
   const std::int64_t nv = fset.size() + pset.size();
   const Peers& P = r.peers;
   const double nan = std::nan("");
-  std::vector<float> g1(std::size_t(fset.size())), g2(std::size_t(pset.size()));
+  struct Job {
+    std::string method;
+    double res, spacing;
+    std::int64_t vertices;
+    std::vector<std::size_t> fns;  // indices into `fns`: the ball's and the socket's scan, or one call
+    std::function<double()> result;
+    std::string kind;
+  };
+  std::vector<std::function<void()>> fns;
+  std::vector<Job> jobs;
+  // Every job's outputs live as long as the timing (the lambdas write into them).
+  std::vector<std::unique_ptr<std::vector<float>>> outs;
+  auto buffer = [&](std::int64_t n) {
+    outs.push_back(std::make_unique<std::vector<float>>(std::size_t(n)));
+    return outs.back().get();
+  };
+  for (std::size_t k = 0; k < r.schemes.size(); ++k) {
+    const Body &fb = r.built[k].first, &pb = r.built[k].second;
+    std::vector<float>* g1 = buffer(fb.set.size());
+    std::vector<float>* g2 = buffer(pb.set.size());
+    fns.push_back([&fb, &pb, &I, t, g1] { scan_gaps_compact(fb.set, I, t, pb.map, ScanSide::inside, g1->data()); });
+    fns.push_back([&fb, &pb, &I, t, g2] {
+      scan_gaps_compact(pb.set, I, Eigen::Vector3d(-t), fb.map, ScanSide::outside, g2->data());
+    });
+    jobs.push_back({r.schemes[k].method, r.schemes[k].res, r.schemes[k].spacing, fb.set.size() + pb.set.size(),
+                    {fns.size() - 2, fns.size() - 1}, [g1, g2] { return min_of(*g1, *g2); }, "min_gap_mm"});
+  }
   if (P.emb_f)
     for (int packet = 0; packet < 2; ++packet) {
-      const double tb = median_ms([&] { scan_gaps_embree(*P.emb_p, fset, I, t, ScanSide::inside, g1.data(), packet); }, reps);
-      const double ts = median_ms(
-          [&] { scan_gaps_embree(*P.emb_f, pset, I, Eigen::Vector3d(-t), ScanSide::outside, g2.data(), packet); }, reps);
-      row(csv, r, pname, packet ? "embree_radial_packet8" : "embree_radial", 0, nv, tb + ts, tb, ts, min_of(g1, g2),
-          "min_gap_mm");
+      std::vector<float>* g1 = buffer(fset.size());
+      std::vector<float>* g2 = buffer(pset.size());
+      fns.push_back([&, g1, packet] { scan_gaps_embree(*P.emb_p, fset, I, t, ScanSide::inside, g1->data(), packet); });
+      fns.push_back([&, g2, packet] {
+        scan_gaps_embree(*P.emb_f, pset, I, Eigen::Vector3d(-t), ScanSide::outside, g2->data(), packet);
+      });
+      jobs.push_back({packet ? "embree_radial_packet8" : "embree_radial", 0, nan, nv, {fns.size() - 2, fns.size() - 1},
+                      [g1, g2] { return min_of(*g1, *g2); }, "min_gap_mm"});
     }
   if (P.cg_f) {
-    auto cgal_scan = [&](const ScanSet& set, const ExactReference& other, const Eigen::Vector3d& tt, double side,
-                         std::vector<float>& out) {
+    auto cgal_scan = [&r](const ScanSet& set, const ExactReference& other, const Eigen::Vector3d& tt, double side,
+                          std::vector<float>& out) {
       for (std::int64_t j = 0; j < set.size(); ++j) {
         const Eigen::Vector3d q = Eigen::Vector3d(set.x[j], set.y[j], set.z[j]) + tt;
         const auto h = other.first_hit(r.cor, q.normalized());
         out[std::size_t(j)] = h ? float(side * (*h - q.norm())) : std::numeric_limits<float>::quiet_NaN();
       }
     };
-    const int n = std::max(1, reps / 2);
-    const double tb = median_ms([&] { cgal_scan(fset, *P.cg_p, t, 1, g1); }, n);
-    const double ts = median_ms([&] { cgal_scan(pset, *P.cg_f, Eigen::Vector3d(-t), -1, g2); }, n);
-    row(csv, r, pname, "cgal_radial", 0, nv, tb + ts, tb, ts, min_of(g1, g2), "min_gap_mm");
+    std::vector<float>* g1 = buffer(fset.size());
+    std::vector<float>* g2 = buffer(pset.size());
+    fns.push_back([&, g1, cgal_scan] { cgal_scan(fset, *P.cg_p, t, 1, *g1); });
+    fns.push_back([&, g2, cgal_scan] { cgal_scan(pset, *P.cg_f, Eigen::Vector3d(-t), -1, *g2); });
+    jobs.push_back({"cgal_radial", 0, nan, nv, {fns.size() - 2, fns.size() - 1},
+                    [g1, g2] { return min_of(*g1, *g2); }, "min_gap_mm"});
   }
+  auto contacts = std::make_shared<FclContacts>();
+  auto distance = std::make_shared<double>(0);
   if (P.fcl) {
-    FclContacts c;
-    const double tc = median_ms([&] { c = P.fcl->collide(I, t); }, reps);
-    row(csv, r, pname, "fcl_collide", 0, 0, tc, nan, nan, double(c.contacts), "contacts");
-    double d = 0;
-    const double td = median_ms([&] { d = P.fcl->distance(I, t); }, reps);
-    row(csv, r, pname, "fcl_distance", 0, 0, td, nan, nan, d, "distance_mm");
+    fns.push_back([&, contacts] { *contacts = P.fcl->collide(I, t); });
+    jobs.push_back({"fcl_collide", 0, nan, 0, {fns.size() - 1}, [contacts] { return double(contacts->contacts); },
+                    "contacts"});
+    fns.push_back([&, distance] { *distance = P.fcl->distance(I, t); });
+    jobs.push_back({"fcl_distance", 0, nan, 0, {fns.size() - 1}, [distance] { return *distance; }, "distance_mm"});
+  }
+  const std::vector<std::vector<double>> runs = run_alternated(fns, reps);
+  for (const Job& j : jobs) {
+    const std::vector<double> total = round_sums(runs, j.fns);
+    const bool two = j.fns.size() == 2;
+    row(csv, r, pname, j.method, j.res, j.vertices, summarize(total),
+        two ? summarize(runs[j.fns[0]]).median_ms : nan, two ? summarize(runs[j.fns[1]]).median_ms : nan,
+        j.result(), j.kind, j.spacing);
+    for (std::size_t k = 0; k < total.size(); ++k) runs_csv.row(r.s.name, pname, j.method, j.res, int(k), total[k]);
   }
   if (P.pairwise &&
       (!quick || double(P.pairwise->ball_triangles()) * double(P.pairwise->socket_triangles()) <= 2e7)) {
     PairwiseResult pr;
-    const double tp = median_ms([&] { pr = P.pairwise->intersect(I, t); }, 1);
+    const Timing tp = summarize(run_alternated({[&] { pr = P.pairwise->intersect(I, t); }}, 1)[0]);
     row(csv, r, pname, "pairwise", 0, 0, tp, nan, nan, double(pr.intersecting_pairs), "intersecting_pairs");
   }
 }
@@ -233,17 +271,19 @@ void throughput(const SubjectRun& r, int reps, CsvWriter& thr) {
                           ScanSide::outside, b.data());
       }
     };
+    // One thread and two, alternated (run_alternated), so that their ratio is paired round by round.
+    const std::vector<std::vector<double>> runs = run_alternated(
+        {[&] { run(0, poses.size()); },
+         [&] {
+           std::thread other([&] { run(poses.size() / 2, poses.size()); });
+           run(0, poses.size() / 2);
+           other.join();
+         }},
+        reps);
     for (int threads : {1, 2}) {
-      const double ms = median_ms(
-          [&] {
-            if (threads == 1) return run(0, poses.size());
-            std::thread other([&] { run(poses.size() / 2, poses.size()); });
-            run(0, poses.size() / 2);
-            other.join();
-          },
-          reps);
-      thr.row(r.s.name, r.schemes[k].method, r.schemes[k].res, threads, static_cast<int>(poses.size()), ms,
-              1000.0 * double(poses.size()) / ms, r.schemes[k].spacing);
+      const Timing tt = summarize(runs[std::size_t(threads - 1)]);
+      thr.row(r.s.name, r.schemes[k].method, r.schemes[k].res, threads, static_cast<int>(poses.size()), tt.median_ms,
+              tt.q25_ms, tt.q75_ms, tt.runs, 1000.0 * double(poses.size()) / tt.median_ms, r.schemes[k].spacing);
     }
   }
 }
@@ -261,10 +301,11 @@ int main(int argc, char** argv) {
 
   CsvWriter csv(dir + "/detection.csv",
                 {"subject", "generated", "femur_triangles", "pelvis_triangles", "pose", "method", "resolution",
-                 "vertices", "time_ms", "ball_ms", "socket_ms", "ns_per_vertex", "result", "result_kind", "thesis_ms",
-                 "spacing_deg"});
-  CsvWriter thr(dir + "/throughput.csv",
-                {"subject", "method", "resolution", "threads", "poses", "time_ms", "poses_per_s", "spacing_deg"});
+                 "vertices", "time_ms", "time_q25_ms", "time_q75_ms", "runs", "ball_ms", "socket_ms", "ns_per_vertex",
+                 "result", "result_kind", "thesis_ms", "spacing_deg"});
+  CsvWriter runs_csv(dir + "/detection_runs.csv", {"subject", "pose", "method", "resolution", "round", "time_ms"});
+  CsvWriter thr(dir + "/throughput.csv", {"subject", "method", "resolution", "threads", "poses", "time_ms",
+                                          "time_q25_ms", "time_q75_ms", "runs", "poses_per_s", "spacing_deg"});
   int done = 0;
   for (const Subject& s : subjects) {
     progress("03_detection_time", ++done, static_cast<int>(subjects.size()), s.name);
@@ -272,8 +313,7 @@ int main(int argc, char** argv) {
     for (int pose = 0; pose < 2; ++pose) {
       const std::string pname = pose == 0 ? "rest" : "pushed_3mm";
       const Eigen::Vector3d t = pose == 0 ? Eigen::Vector3d::Zero() : r.push;
-      time_maps(r, pname, t, reps, csv);
-      time_peers(r, pname, t, reps, args.quick, csv);
+      time_pose(r, pname, t, reps, args.quick, csv, runs_csv);
     }
     throughput(r, reps, thr);
   }

@@ -135,6 +135,39 @@ double median_ms(const std::function<void()>& fn, int reps) {
   return t.size() % 2 ? t[t.size() / 2] : 0.5 * (t[t.size() / 2 - 1] + t[t.size() / 2]);
 }
 
+Timing summarize(std::vector<double> ms) {
+  Timing t;
+  t.runs = static_cast<int>(ms.size());
+  if (ms.empty()) return t;
+  std::sort(ms.begin(), ms.end());
+  auto quantile = [&](double q) {
+    const double pos = q * double(ms.size() - 1);
+    const auto i = static_cast<std::size_t>(pos);
+    return i + 1 < ms.size() ? ms[i] + (pos - double(i)) * (ms[i + 1] - ms[i]) : ms[i];
+  };
+  t.median_ms = quantile(0.5), t.q25_ms = quantile(0.25), t.q75_ms = quantile(0.75);
+  return t;
+}
+
+std::vector<std::vector<double>> run_alternated(const std::vector<std::function<void()>>& fns, int reps) {
+  for (const auto& fn : fns) fn();  // warm-up: caches, page faults, lazy set-up
+  std::vector<std::vector<double>> runs(fns.size());
+  for (int r = 0; r < std::max(1, reps); ++r)
+    for (std::size_t k = 0; k < fns.size(); ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      fns[k]();
+      runs[k].push_back(ms_since(t0));
+    }
+  return runs;
+}
+
+std::vector<double> round_sums(const std::vector<std::vector<double>>& runs, const std::vector<std::size_t>& which) {
+  std::vector<double> sum(which.empty() ? 0 : runs.at(which[0]).size(), 0.0);
+  for (std::size_t k : which)
+    for (std::size_t r = 0; r < sum.size(); ++r) sum[r] += runs.at(k).at(r);
+  return sum;
+}
+
 std::string experiment_dir(const Args& args, const std::string& name) {
   const fs::path d = fs::path(args.out) / name;
   fs::create_directories(d);

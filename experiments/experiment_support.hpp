@@ -74,6 +74,24 @@ Eigen::Vector3d push_direction(const TriangleMesh& pelvis, const Eigen::Vector3d
 /// Median wall time in ms of `fn` over `reps` runs after one warm-up run.
 double median_ms(const std::function<void()>& fn, int reps);
 
+/// A timing's spread (issue 51: every timing with its spread): median and quartiles (ms; linear interpolation
+/// between order statistics, numpy's default) of `runs` wall times.
+struct Timing {
+  double median_ms = std::nan(""), q25_ms = std::nan(""), q75_ms = std::nan("");
+  int runs = 0;
+};
+
+/// The median and quartiles of `ms` (wall times, ms); NaNs when `ms` is empty.
+Timing summarize(std::vector<double> ms);
+
+/// Wall times (ms) of several configurations timed alternately: one warm-up run of each, then `reps` rounds in which
+/// each runs once, in order, so that a drift of the machine (another process, the clock) falls on all of them alike
+/// and their ratios can be taken round by round (paired). Returns runs[k][r]: the k-th function's time in round r.
+std::vector<std::vector<double>> run_alternated(const std::vector<std::function<void()>>& fns, int reps);
+
+/// Round-by-round sums of runs (ms): the time of configurations that make one job (a pose's two scans).
+std::vector<double> round_sums(const std::vector<std::vector<double>>& runs, const std::vector<std::size_t>& which);
+
 /// OUT/NN_name, created.
 std::string experiment_dir(const Args& args, const std::string& name);
 
