@@ -38,7 +38,8 @@ write_table(d, "table", ["$k$", "nodes", "exact $L$", "Eq. 10 $L$", "max index e
             [[f"{int(r.turns)}", f"{int(r.nodes):,}", f"{r.total_length_exact:.6f}", f"{r.total_length_eq10:.1f}",
               f"{r.max_abs_index_error_steps:.3f}", f"{100 * r.fraction_differing:.2f}%",
               f"{100 * r.fraction_nearest_differing:.2f}%", f"{int(r.max_node_index_difference)}",
-              f"{r.exact_ns_per_locate:.0f}", f"{r.eq10_ns_per_locate:.0f}"] for r in idx.itertuples()])
+              f"{r.exact_ns_per_locate:.0f} ({r.exact_ns_q25:.0f}-{r.exact_ns_q75:.0f})",
+              f"{r.eq10_ns_per_locate:.0f} ({r.eq10_ns_q25:.0f}-{r.eq10_ns_q75:.0f})"] for r in idx.itertuples()])
 big = idx.iloc[-1]
 write_macros(d, "macros", {
     "HAkBig": f"{int(big.turns)}", "HAstepsBig": f"{big.max_abs_index_error_steps:.2f}",

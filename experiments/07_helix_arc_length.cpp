@@ -5,7 +5,9 @@
 //   arc_length.csv    per k and phi (0.1-deg steps): exact s, Eq. 10's T, their absolute and
 //                     relative difference, and the difference in node steps used for locating
 //   index_errors.csv  per k: how often locating with Eq. 10 picks other stencil nodes than the
-//                     exact arc length, over random directions, and by how many nodes at most
+//                     exact arc length, over random directions, and by how many nodes at most; the cost of
+//                     one locate-and-interpolate (ns) of each locator, median and quartiles over `runs`
+//                     alternated rounds
 //   meta.json
 // Command: build/experiments/exp_07_helix_arc_length --out results [--quick]
 #include <iostream>
@@ -29,7 +31,8 @@ int main(int argc, char** argv) {
       dir + "/index_errors.csv",
       {"turns", "nodes", "node_spacing_deg", "total_length_exact", "total_length_eq10", "directions",
        "stencils_differing", "fraction_differing", "nearest_node_differing", "fraction_nearest_differing",
-       "max_node_index_difference", "max_abs_index_error_steps", "exact_ns_per_locate", "eq10_ns_per_locate"});
+       "max_node_index_difference", "max_abs_index_error_steps", "exact_ns_per_locate", "exact_ns_q25", "exact_ns_q75",
+       "eq10_ns_per_locate", "eq10_ns_q25", "eq10_ns_q75", "runs"});
   int step = 0;
   for (double k : turns) {
     progress("07_helix_arc_length", ++step, int(turns.size()), "k=" + std::to_string(int(k)));
@@ -64,12 +67,16 @@ int main(int argc, char** argv) {
         sink += st.weights[0] + double(st.nodes[3]);
       }
     };
-    const double t_exact = median_ms([&] { locate_all(exact); }, args.repetitions);
-    const double t_fit = median_ms([&] { locate_all(fitted); }, args.repetitions);
+    // Both locators timed alternately (one run of each per round): medians and quartiles per locate.
+    const std::vector<std::vector<double>> runs =
+        run_alternated({[&] { locate_all(exact); }, [&] { locate_all(fitted); }}, args.repetitions);
+    const Timing t_exact = summarize(runs[0]), t_fit = summarize(runs[1]);
+    const double per = 1e6 / directions;
     if (!(sink > 0)) std::cerr << "07_helix_arc_length: empty stencils\n";
     idx.row(k, exact.num_nodes(), exact.node_spacing() * kRadToDeg, s.total(), traveled_distance_eq10(k, -1.0),
             directions, differ, double(differ) / directions, nearest_differ, double(nearest_differ) / directions,
-            max_diff, max_steps, t_exact * 1e6 / directions, t_fit * 1e6 / directions);
+            max_diff, max_steps, t_exact.median_ms * per, t_exact.q25_ms * per, t_exact.q75_ms * per,
+            t_fit.median_ms * per, t_fit.q25_ms * per, t_fit.q75_ms * per, t_exact.runs);
   }
   write_meta(dir, args,
              {{"turns", turns},
