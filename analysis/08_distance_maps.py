@@ -38,6 +38,17 @@ write_table(d, "table_finest", ["subject", "scan", "tested", "no surface", "beyo
                                 "pen. vertices", "pen. area (mm$^2$)", "head $r$ (mm)", "fit RMS (mm)"], rows,
             align="llrrrrrrrr")
 
+def ms_spread(r, what):
+    """'median (lower quartile-upper quartile)' ms of a row's sampling or detection (alternated rounds)."""
+    return f"{r[what + '_ms']:.1f} ({r[what + '_q25_ms']:.1f}-{r[what + '_q75_ms']:.1f})"
+
+
+def ns_spread(r):
+    """ns per look-up: median (quartiles) of the row's detection over its look-ups."""
+    per = r.detection_ns_per_lookup / r.detection_ms if r.detection_ms > 0 else np.nan
+    return f"{r.detection_ns_per_lookup:.0f} ({r.detection_q25_ms * per:.0f}-{r.detection_q75_ms * per:.0f})"
+
+
 # Table: min gap and penetration against precision and mode (ball scan).
 rows = []
 for s in subjects:
@@ -46,7 +57,7 @@ for s in subjects:
         sock = st[(st.subject == s) & (st.scan == "socket") & (st.precision_deg == p) & (st["mode"] == mode)].iloc[0]
         lin = "" if np.isnan(r.linear_vs_exact_p95_abs_mm) else f"{r.linear_vs_exact_p95_abs_mm:.4f}"
         rows.append([s, f"{p:g}", mode, f"{r.min_gap_mm:.3f}", f"{sock.min_gap_mm:.3f}", f"{int(r.vertices_penetrating)}",
-                     f"{r.sampling_ms:.1f}", f"{sock.sampling_ms:.1f}", f"{r.detection_ns_per_lookup:.0f}", lin])
+                     ms_spread(r, "sampling"), ms_spread(sock, "sampling"), ns_spread(r), lin])
 write_table(d, "table_convergence", ["subject", "$p$", "mode", "ball min gap", "socket min gap", "ball pen.",
                                      "femur map ms", "pelvis map ms", "ns/lookup", "lin-exact p95"], rows,
             align="lrlrrrrrrr")
@@ -211,7 +222,8 @@ rows = []
 def versus(eb, es, ob, os_):
     """Columns comparing another scheme's ball and socket rows (ob, os_) with the equiangular grid's
     (eb, es): both min gaps, the ball gaps' p95 and max difference, sampling ms of both bones, ns per
-    look-up, and the bytes ratio of both maps."""
+    look-up (medians of alternated rounds; their quartiles in gap_statistics.csv and table_convergence), and the
+    bytes ratio of both maps."""
     return [f"{eb.min_gap_mm:.3f}", f"{ob.min_gap_mm:.3f}", f"{ob.vs_equiangular_p95_abs_mm:.4f}",
             f"{ob.vs_equiangular_max_abs_mm:.2f}", f"{(eb.sampling_ms + es.sampling_ms):.0f}",
             f"{(ob.sampling_ms + os_.sampling_ms):.0f}", f"{eb.detection_ns_per_lookup:.0f}",

@@ -5,7 +5,9 @@
 // Outputs: OUT/08_distance_maps/
 //   gap_statistics.csv  one row per subject x precision x mode x scan (ball / socket); the scan's
 //                       vertices are tested against the other body's map, while map_* and
-//                       sampling_ms describe the scanned body's own map; COR in the RAS frame
+//                       sampling_ms describe the scanned body's own map; COR in the RAS frame; sampling_ms and
+//                       detection_ms are medians, *_q25_ms and *_q75_ms their quartiles, over timing_runs rounds
+//                       (both bodies' samplings alternated, both scans alternated)
 //   vertex_gaps.csv     per-vertex gaps within 45 mm of the COR at the finest precision, exact mode
 //   map_<subject>_<body>.png  the maps at 0.5 deg (theta across, phi down); *_helix.png at k = 458,
 //                       *_<scheme>.png for the other registered schemes (drawn in their own way)
@@ -65,7 +67,8 @@ struct Outputs {
                "vertices_tested", "vertices_no_surface", "vertices_beyond_reach", "min_gap_mm",
                "vertices_penetrating", "area_penetrating_mm2", "level_none", "level_yellow", "level_orange",
                "level_red", "level_purple", "map_nodes", "map_nodes_covered", "map_bytes", "sampling_ms",
-               "detection_ms", "detection_ns_per_lookup", "linear_vs_exact_p95_abs_mm", "vs_equiangular_p95_abs_mm",
+               "sampling_q25_ms", "sampling_q75_ms", "detection_ms", "detection_q25_ms", "detection_q75_ms",
+               "timing_runs", "detection_ns_per_lookup", "linear_vs_exact_p95_abs_mm", "vs_equiangular_p95_abs_mm",
                "vs_equiangular_max_abs_mm", "vs_equiangular_compared"}),
         map_images(dir + "/map_images.csv",
                    {"subject", "body", "scheme", "resolution", "file", "nearest_mm", "farthest_mm"}),
@@ -126,29 +129,31 @@ void measure(const Subject& s, const SphereFitResult& fit, double cor_error, dou
   const Joint joint(s.femur, s.pelvis, fit.centre, o);
   const PoseResult res = joint.detect(Eigen::Matrix3d::Identity());
   const int reps = p <= 0.05 ? std::max(1, args.repetitions / 2) : args.repetitions;
-  double sample_ms[2], detect_ms[2];
+  // Both bodies' sampling, then both scans, each pair timed alternately (run_alternated): medians and quartiles.
+  Timing sample_ms[2], detect_ms[2];
   const JointBody* bodies[2] = {&joint.ball(), &joint.socket()};
-  for (int b = 0; b < 2; ++b) {
-    RadialDistanceMap scratch{scheme};
+  {
+    RadialDistanceMap scratch[2] = {RadialDistanceMap{scheme}, RadialDistanceMap{scheme}};
     SamplingOptions so;
     so.mode = mode;
-    sample_ms[b] = median_ms(
-        [&] {
-          std::fill(scratch.data(), scratch.data() + scratch.num_nodes(), RadialDistanceMap::no_surface());
-          sample_surface(bodies[b]->mesh, fit.centre, so, scratch);
-        },
-        reps);
+    auto sample = [&](int b) {
+      return [&, b] {
+        std::fill(scratch[b].data(), scratch[b].data() + scratch[b].num_nodes(), RadialDistanceMap::no_surface());
+        sample_surface(bodies[b]->mesh, fit.centre, so, scratch[b]);
+      };
+    };
+    const auto runs = run_alternated({sample(0), sample(1)}, reps);
+    for (int b = 0; b < 2; ++b) sample_ms[b] = summarize(runs[std::size_t(b)]);
   }
   ScanGaps scratch_gaps;
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  detect_ms[0] = median_ms(
-      [&] { scan_gaps(joint.ball().relative, I, joint.ball().mask, joint.socket().map, ScanSide::inside, scratch_gaps); },
+  const auto scans = run_alternated(
+      {[&] { scan_gaps(joint.ball().relative, I, joint.ball().mask, joint.socket().map, ScanSide::inside, scratch_gaps); },
+       [&] {
+         scan_gaps(joint.socket().relative, I, joint.socket().mask, joint.ball().map, ScanSide::outside, scratch_gaps);
+       }},
       args.repetitions);
-  detect_ms[1] = median_ms(
-      [&] {
-        scan_gaps(joint.socket().relative, I, joint.socket().mask, joint.ball().map, ScanSide::outside, scratch_gaps);
-      },
-      args.repetitions);
+  for (int b = 0; b < 2; ++b) detect_ms[b] = summarize(scans[std::size_t(b)]);
   double p95 = std::nan(""), vs_p95 = std::nan(""), vs_max = std::nan("");
   std::int64_t vs_n = 0;
   if (mode == DistanceMode::exact)
@@ -169,14 +174,16 @@ void measure(const Subject& s, const SphereFitResult& fit, double cor_error, dou
     const JointBody& body = *bodies[b];
     // per map look-up (tested + no surface); masked vertices cost one byte test each
     const std::int64_t lookups = sm.vertices_tested + sm.vertices_no_surface;
-    const double ns = lookups > 0 ? detect_ms[b] * 1e6 / double(lookups) : std::nan("");
+    const double ns = lookups > 0 ? detect_ms[b].median_ms * 1e6 / double(lookups) : std::nan("");
     out.stats.row(s.name, int(s.generated), scheme->name(), scheme->resolution(), p, to_string(mode),
                   b == 0 ? "ball" : "socket", fit.centre.x(), fit.centre.y(), fit.centre.z(), fit.radius,
                   fit.rms_residual, cor_error, sm.vertices, sm.vertices_tested, sm.vertices_no_surface,
                   sm.vertices_beyond_reach, sm.min_gap_mm, sm.vertices_penetrating, sm.area_penetrating_mm2,
                   sm.level_vertices[0], sm.level_vertices[1], sm.level_vertices[2], sm.level_vertices[3],
                   sm.level_vertices[4], body.map.num_nodes(), body.sampling.nodes_covered,
-                  std::int64_t(body.map.bytes()), sample_ms[b], detect_ms[b], ns, b == 0 ? p95 : std::nan(""),
+                  std::int64_t(body.map.bytes()), sample_ms[b].median_ms, sample_ms[b].q25_ms, sample_ms[b].q75_ms,
+                  detect_ms[b].median_ms, detect_ms[b].q25_ms, detect_ms[b].q75_ms, detect_ms[b].runs, ns,
+                  b == 0 ? p95 : std::nan(""),
                   b == 0 ? vs_p95 : std::nan(""), b == 0 ? vs_max : std::nan(""), b == 0 ? vs_n : std::int64_t(0));
   }
   if (p == 0.5 && mode == DistanceMode::exact) {
