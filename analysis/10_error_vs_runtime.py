@@ -39,17 +39,24 @@ def e(x):
     return "--" if np.isnan(x) else (f"{x:.2g}" if x < 0.01 else f"{x:.3f}")
 
 
+def ns_spread(r, digits=0):
+    """'median (lower quartile-upper quartile)' ns per vertex of a row's query over its repetitions."""
+    return (f"{r.query_ns_per_vertex:,.{digits}f} ({r.query_ns_q25:,.{digits}f}-{r.query_ns_q75:,.{digits}f})"
+            if np.isfinite(r.query_ns_q25) else f"{r.query_ns_per_vertex:,.{digits}f}")
+
+
 # Table: first subject, rest pose, every scheme x mode x resolution.
 rows = []
 g0 = maps[(maps.subject == subj) & (maps.pose == "rest")]
 for _, r in g0.sort_values(["scheme", "mode", "precision_deg"], ascending=[True, True, False]).iterrows():
     rows.append([r.scheme, r["mode"], f"{r.resolution:g}", e(r.max_abs_mm), e(r.p99_abs_mm), e(r.p95_abs_mm),
-                 e(r.median_abs_mm), f"{int(r.mismatched)}", f"{r.query_ns_per_vertex:.1f}", f"{r.sampling_ms:.1f}",
+                 e(r.median_abs_mm), f"{int(r.mismatched)}", ns_spread(r, 1), f"{r.sampling_ms:.1f}",
                  f"{r.bytes / 2**20:.1f}"])
 write_table(d, "table_main", ["scheme", "mode", "res.", "max", "p99", "p95", "median", "mism.", "ns/vertex",
                               "sampling ms", "MiB"], rows, align="llrrrrrrrrr",
             caption=r"Every configuration of experiment 10 on \ErrSubject, scan pose: |gap error| (mm) statistics "
-                    r"against CGAL, vertices where one side finds no surface (mism.), query ns per vertex, sampling ms "
+                    r"against CGAL, vertices where one side finds no surface (mism.), query ns per vertex (median and quartiles "
+                    r"of the repetitions), sampling ms "
                     r"and MiB of both maps.", label="tab:error-main")
 
 # Peers and the headline configuration (equiangular 0.1 exact) per subject and pose.
@@ -64,7 +71,8 @@ for (s, pose), g in t.groupby(["subject", "pose"], sort=False):
     en = emb.query_ns_per_vertex.iloc[0] if len(emb) else np.nan
     cn = cg.query_ns_per_vertex.iloc[0] if len(cg) else np.nan
     rows.append([s, pose.replace("_", " "), f"{int(r.vertices):,}", e(r.p95_abs_mm), e(r.max_abs_mm),
-                 f"{r.query_ns_per_vertex:.1f}", f"{en:.0f}", f"{cn:,.0f}", f"{en / r.query_ns_per_vertex:.1f}",
+                 ns_spread(r, 1), ns_spread(emb.iloc[0]) if len(emb) else "--", ns_spread(cg.iloc[0]) if len(cg) else "--",
+                 f"{en / r.query_ns_per_vertex:.1f}",
                  f"{cn / r.query_ns_per_vertex:.0f}",
                  e(emb.p95_abs_mm.iloc[0]) if len(emb) else "--"])
 write_table(d, "table_peers", ["subject", "pose", "vertices", "p95 (mm)", "max (mm)", "ns/vertex", "Embree ns",
@@ -131,13 +139,19 @@ if len(h):
     emb = t[(t.subject == subj) & (t.pose == "rest") & (t.scheme == "embree_radial")]
     cg = t[(t.subject == subj) & (t.pose == "rest") & (t.scheme == "cgal_radial")]
     macros.update({"ErrPninetyFive": e(h.p95_abs_mm), "ErrMax": e(h.max_abs_mm), "ErrNs": f"{h.query_ns_per_vertex:.1f}",
+                   "ErrNsQlow": f"{h.query_ns_q25:.1f}", "ErrNsQhigh": f"{h.query_ns_q75:.1f}",
+                   "ErrRuns": f"{int(h.timing_runs)}",
                    "ErrVertices": f"{int(h.vertices):,}", "ErrCompared": f"{int(h.compared):,}",
                    "ErrLarge": f"{int(h.large_errors)}", "ErrAtJump": f"{int(h.at_discontinuity)}"})
     if len(emb):
         macros["ErrEmbreeNs"] = f"{emb.query_ns_per_vertex.iloc[0]:.0f}"
+        macros["ErrEmbreeNsQlow"] = f"{emb.query_ns_q25.iloc[0]:.0f}"
+        macros["ErrEmbreeNsQhigh"] = f"{emb.query_ns_q75.iloc[0]:.0f}"
         macros["ErrEmbreeRatio"] = f"{emb.query_ns_per_vertex.iloc[0] / h.query_ns_per_vertex:.1f}"
     if len(cg):
         macros["ErrCgalNs"] = f"{cg.query_ns_per_vertex.iloc[0]:,.0f}"
+        macros["ErrCgalNsQlow"] = f"{cg.query_ns_q25.iloc[0]:,.0f}"
+        macros["ErrCgalNsQhigh"] = f"{cg.query_ns_q75.iloc[0]:,.0f}"
         macros["ErrCgalRatio"] = f"{cg.query_ns_per_vertex.iloc[0] / h.query_ns_per_vertex:.0f}"
 lin = g0[(g0.scheme == "equiangular") & (g0["mode"] == "linear")]
 if len(lin):

@@ -10,7 +10,8 @@
 //       every row; compared: those where both the method and CGAL find a surface; mismatched:
 //       one does, the other does not;
 //     max / p99 / p95 / median |gap - exact gap| (mm) over the compared vertices;
-//     query_ns_per_vertex: both scans, median over the repetitions, per vertex;
+//     query_ns_per_vertex, query_ns_q25, query_ns_q75, timing_runs: both scans, median and quartiles over the
+//       repetitions (timing_runs), per vertex (CGAL too: every repetition, no longer half);
 //     sampling_ms: filling both maps (sample_surface, exact mode with face culling), median (one
 //       run for a ray-cast fill at p <= 0.1 deg: seconds each);
 //     bytes: both maps; large_errors: vertices with |error| > 0.05 mm, of which
@@ -87,7 +88,8 @@ struct Outputs {
       : csv(dir + "/error_runtime.csv",
             {"subject",     "generated",     "pose",         "scheme",           "mode",
              "resolution",  "precision_deg", "vertices",     "compared",         "mismatched",
-             "max_abs_mm",  "p99_abs_mm",    "p95_abs_mm",   "median_abs_mm",    "query_ns_per_vertex",
+             "max_abs_mm",  "p99_abs_mm",    "p95_abs_mm",   "median_abs_mm",    "query_ns_per_vertex", "query_ns_q25",
+             "query_ns_q75", "timing_runs",
              "sampling_ms", "bytes",         "large_errors", "at_discontinuity", "near_pole",
              "near_seam",   "resample_precision_deg", "storage"}),
         vcsv(dir + "/vertex_errors.csv",
@@ -121,12 +123,12 @@ struct SubjectData {
   Eigen::Vector3d translation(int pose) const { return pose == 0 ? Eigen::Vector3d::Zero() : push; }
   static const char* pose_name(int pose) { return pose == 0 ? "rest" : "pushed_3mm"; }
   // Gaps of both scans (ball against the pelvis map, pelvis against the femur map) at `pose`, and the
-  // median time of `reps` scans (ms).
+  // median and quartiles of `reps` scans' times (ms).
   using Scan = std::function<void(const Eigen::Vector3d& t, std::vector<float> (&g)[2])>;
-  double scan(int pose, const Scan& fn, std::vector<float> (&g)[2], int reps) const {
+  Timing scan(int pose, const Scan& fn, std::vector<float> (&g)[2], int reps) const {
     g[0].assign(std::size_t(fset.size()), 0.f);
     g[1].assign(std::size_t(pset.size()), 0.f);
-    return median_ms([&] { fn(translation(pose), g); }, reps);
+    return summarize(run_alternated({[&] { fn(translation(pose), g); }}, reps)[0]);
   }
 
   const Subject& s;
@@ -189,10 +191,17 @@ struct Row {
   std::string scheme, mode;
   double resolution = 0, precision = 0, ns = 0, sampling_ms = 0, bytes = 0, resample_p = 0;
   const char* storage = "dense";
+  double ns_q25 = std::nan(""), ns_q75 = std::nan("");  // the query time's quartiles, per vertex
+  int runs = 0;
+  // The query time per vertex (ns) of a scan's Timing (ms for all vertices).
+  void query(const Timing& t, double per_vertex) {
+    ns = t.median_ms * per_vertex, ns_q25 = t.q25_ms * per_vertex, ns_q75 = t.q75_ms * per_vertex, runs = t.runs;
+  }
 };
 void put(Outputs& out, const SubjectData& d, int pose, const Row& r, const Errors& e) {
   out.csv.row(d.s.name, int(d.s.generated), SubjectData::pose_name(pose), r.scheme, r.mode, r.resolution, r.precision,
-              d.nv, e.compared, e.mismatched, e.max, e.p99, e.p95, e.median, r.ns, r.sampling_ms, r.bytes, e.large,
+              d.nv, e.compared, e.mismatched, e.max, e.p99, e.p95, e.median, r.ns, r.ns_q25, r.ns_q75, r.runs,
+              r.sampling_ms, r.bytes, e.large,
               e.discontinuity, e.pole, e.seam, r.resample_p, r.storage);
 }
 
@@ -241,7 +250,7 @@ void measure_maps(const SubjectData& d, const Maps& m, Row row, DistanceMode mod
     };
   };
   for (int pose = 0; pose < 2; ++pose) {
-    row.ns = d.scan(pose, lookups(m.fm, m.pm, nullptr, nullptr), g, reps) * per_vertex;
+    row.query(d.scan(pose, lookups(m.fm, m.pm, nullptr, nullptr), g, reps), per_vertex);
     const bool dump = pose == 0 && row.scheme == "equiangular" && mode == DistanceMode::exact && row.precision == 0.1;
     put(out, d, pose, row, evaluate(d, pose, g, &m.fm, &m.pm, dump ? &out.vcsv : nullptr));
   }
@@ -257,7 +266,7 @@ void measure_maps(const SubjectData& d, const Maps& m, Row row, DistanceMode mod
   Row sparse = row;
   sparse.sampling_ms += tsp, sparse.bytes = double(fms.bytes() + pms.bytes()), sparse.storage = "sparse";
   for (int pose = 0; pose < 2; ++pose) {
-    sparse.ns = d.scan(pose, lookups(fms, pms, nullptr, nullptr), g, reps) * per_vertex;
+    sparse.query(d.scan(pose, lookups(fms, pms, nullptr, nullptr), g, reps), per_vertex);
     std::vector<float> dense[2];
     d.scan(pose, lookups(m.fm, m.pm, nullptr, nullptr), dense, 1);
     for (int k = 0; k < 2; ++k)
@@ -276,7 +285,7 @@ void measure_maps(const SubjectData& d, const Maps& m, Row row, DistanceMode mod
   Row refined = row;
   refined.mode = "exact_refined", refined.sampling_ms += tm, refined.bytes = double(fmr.bytes() + pmr.bytes());
   for (int pose = 0; pose < 2; ++pose) {
-    refined.ns = d.scan(pose, lookups(fmr, pmr, &d.casters->first, &d.casters->second), g, reps) * per_vertex;
+    refined.query(d.scan(pose, lookups(fmr, pmr, &d.casters->first, &d.casters->second), g, reps), per_vertex);
     put(out, d, pose, refined, evaluate(d, pose, g, &fmr, &pmr, nullptr));
   }
 }
@@ -310,18 +319,19 @@ void measure_peers(const SubjectData& d, int reps, Outputs& out) {
     if (have_embree()) {
       const EmbreeRayCaster ef(d.s.femur, d.cor), ep(d.s.pelvis, d.cor);
       for (int packet = 0; packet < 2; ++packet) {
-        const double tq = d.scan(
+        const Timing tq = d.scan(
             pose,
             [&](const Eigen::Vector3d& t, std::vector<float> (&gg)[2]) {
               scan_gaps_embree(ep, d.fset, I, t, ScanSide::inside, gg[0].data(), packet);
               scan_gaps_embree(ef, d.pset, I, Eigen::Vector3d(-t), ScanSide::outside, gg[1].data(), packet);
             },
             g, reps);
-        put(out, d, pose, {packet ? "embree_radial_packet8" : "embree_radial", "exact", 0, 0, tq * per_vertex, nan, nan, 0},
-            evaluate(d, pose, g, nullptr, nullptr, nullptr));
+        Row peer{packet ? "embree_radial_packet8" : "embree_radial", "exact", 0, 0, 0, nan, nan, 0};
+        peer.query(tq, per_vertex);
+        put(out, d, pose, peer, evaluate(d, pose, g, nullptr, nullptr, nullptr));
       }
     }
-    const double tq = d.scan(
+    const Timing tq = d.scan(
         pose,
         [&](const Eigen::Vector3d& t, std::vector<float> (&gg)[2]) {
           for (int scan = 0; scan < 2; ++scan) {
@@ -335,9 +345,10 @@ void measure_peers(const SubjectData& d, int reps, Outputs& out) {
             }
           }
         },
-        g, std::max(1, reps / 2));
-    put(out, d, pose, {"cgal_radial", "exact", 0, 0, tq * per_vertex, nan, nan, 0},
-        evaluate(d, pose, g, nullptr, nullptr, nullptr));
+        g, reps);
+    Row cgal{"cgal_radial", "exact", 0, 0, 0, nan, nan, 0};
+    cgal.query(tq, per_vertex);
+    put(out, d, pose, cgal, evaluate(d, pose, g, nullptr, nullptr, nullptr));
   }
 }
 }  // namespace
