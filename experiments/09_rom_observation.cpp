@@ -20,7 +20,9 @@
 //                     contact depth), the method first
 //   methods_map.csv   subject x method x flexion x adduction: the ROM map under each method
 //   timing.csv        subject: sampling, limits, map, evaluations, poses per second, share of vertices
-//                     skipped by the bounds, FCL collide per pose and its extrapolated search time
+//                     skipped by the bounds, FCL collide per pose and its extrapolated search time; limits, map
+//                     and search (both) are medians of --repetitions searches, search_q25_ms and search_q75_ms
+//                     the search's quartiles, search_runs their number
 //   extra_articular.csv  subject x motion x counted vertices (all, hidden): with layered maps (4 crossings
 //                     per node), the limit, where limited, and the exact check 0.5 deg either side (CGAL
 //                     all-intersection rays for the hidden vertices, first hits for the others)
@@ -169,6 +171,7 @@ struct Settings {
   ImpingementLevels observation_levels;    // thesis sec. 5.2: blue > 6 mm, red < 2 mm
   std::vector<Table11Row> table11;
   int threads = 1;
+  int reps = 5;  // the search's timing runs (--repetitions)
 };
 
 // The experiment's outputs, one writer or table each (see the file comment).
@@ -194,7 +197,8 @@ struct Outputs {
              "brute_force_poses_valid", "poses_differ"}),
         sens(dir + "/sensitivity.csv", {"subject", "method", "variant", "motion", "limit_deg", "delta_deg"}),
         tim(dir + "/timing.csv",
-            {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "evaluations",
+            {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "search_q25_ms",
+             "search_q75_ms", "search_runs", "evaluations",
              "poses_per_second", "share_skipped", "fcl_collide_ms_per_pose", "fcl_poses_timed",
              "fcl_search_ms_extrapolated", "fcl_over_ours", "excluded_vertices", "neutral_min_gap_mm"}),
         bony(dir + "/bony.csv",
@@ -393,10 +397,19 @@ void timing(const SubjectRun& r, const Settings& st, Outputs& out) {
   }
   const RomRun& run = r.run;
   const std::int64_t all_evals = run.limit_evaluations + run.map_evaluations;
-  const double search_ms = run.limits_ms + run.map_ms;
+  // The search (limits and map) again, `reps` times: the medians and quartiles of its times (the limits and the map
+  // of each run as run_rom reports them).
+  std::vector<double> limits, map, search;
+  for (int k = 0; k < std::max(1, st.reps); ++k) {
+    const RomRun again = run_rom(r.session, SubjectRun::request(st));
+    limits.push_back(again.limits_ms), map.push_back(again.map_ms), search.push_back(again.limits_ms + again.map_ms);
+  }
+  const Timing tl = summarize(limits), tm = summarize(map), ts = summarize(search);
+  const double search_ms = ts.median_ms;
   const double fcl_total = fcl_ms * double(all_evals);
   out.tim.row(r.subject.name, st.resolution, st.threads, joint.ball().sampling_ms + joint.socket().sampling_ms,
-              run.limits_ms, run.map_ms, search_ms, all_evals, double(all_evals) / (search_ms / 1000),
+              tl.median_ms, tm.median_ms, search_ms, ts.q25_ms, ts.q75_ms, ts.runs, all_evals,
+              double(all_evals) / (search_ms / 1000),
               double(run.vertices_skipped) / double(run.vertices_looked_up + run.vertices_skipped), fcl_ms, fcl_poses,
               fcl_total, fcl_total / search_ms, run.baseline.excluded_vertices, run.baseline.min_gap_mm);
 }
@@ -581,6 +594,7 @@ int main(int argc, char** argv) {
   st.observation_levels.thresholds_mm = kReportLevelsMm;
   st.ro.contact_depth_mm = 0;  // the thesis' criterion: the first touch (methods() uses the CLI's defaults)
   st.threads = omp_get_max_threads();
+  st.reps = args.repetitions;
 
   Outputs out(st.dir);
   int done = 0;
