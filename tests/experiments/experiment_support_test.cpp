@@ -1,12 +1,12 @@
 // The experiments' timing helpers (experiments/experiment_support.hpp): summarize's median and quartiles against
 // numpy's linear interpolation worked by hand, run_alternated's order (a warm-up of each, then rounds in which each
 // runs once) and round_sums.
+#include "experiment_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
-
-#include "experiment_support.hpp"
 
 using namespace impinge::experiment;
 
