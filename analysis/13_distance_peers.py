@@ -15,7 +15,8 @@ d = experiment_dir("13_distance_peers")
 t = read_csv(d, "distance_peers.csv")
 subjects = list(dict.fromkeys(t.subject))
 t["both_ms"] = t.impinge_radial_ms + t.impinge_distance_ms
-t["open3d_over_distance"] = t.open3d_ms / t.impinge_distance_ms
+# Open3D over impinge's distance scans, paired round by round (the two ran alternately), each pose's median.
+t["open3d_over_distance"] = t.open3d_over_distance_paired
 t["vtk_over_distance"] = t.vtk_ms / t.impinge_distance_ms
 
 
@@ -27,8 +28,12 @@ rows = []
 for s in subjects:
     g = t[t.subject == s]
     rows.append([s, str(len(g)), f"{g.vertices.median():.0f}", f(g.impinge_radial_ms.median()),
-                 f(g.impinge_distance_ms.median()), f(g.open3d_ms.median()), f(g.vtk_ms.median(), 1),
-                 f(g.open3d_over_distance.median(), 1), f"{g.vtk_max_diff_mm.max():.0e}",
+                 f"{f(g.impinge_distance_ms.median())} ({f(g.impinge_distance_q25_ms.median())}-"
+                 f"{f(g.impinge_distance_q75_ms.median())})",
+                 f"{f(g.open3d_ms.median())} ({f(g.open3d_q25_ms.median())}-{f(g.open3d_q75_ms.median())})",
+                 f(g.vtk_ms.median(), 1),
+                 f"{f(g.open3d_over_distance.median(), 1)} ({f(g.open3d_over_distance_q25.median(), 1)}-"
+                 f"{f(g.open3d_over_distance_q75.median(), 1)})", f"{g.vtk_max_diff_mm.max():.0e}",
                  f"{g.open3d_max_diff_mm.max():.2g}", str(int(g.open3d_sign_disagreements.sum())),
                  str(int(g.vtk_sign_disagreements.sum()))])
 write_table(d, "table_peers", ["subject", "poses", "vertices", "radial ms", "distance ms", "Open3D ms", "VTK ms",

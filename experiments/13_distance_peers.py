@@ -15,8 +15,10 @@ Outputs (OUT/13_distance_peers/):
   whole_process.csv   whole processes (1, 10, 100, 1,000 poses; --quick 1 and 10) and single poses at 1 and 2
                       threads, impinge beside Open3D, medians and quartiles (benchmarks/whole_process.py, issue 52)
   distance_peers.csv  subject x pose: vertices, impinge's radial and distance scan times (ms, medians of the
-                      repetitions), Open3D's and VTK's on the same vertices, their largest difference from
-                      impinge's distances (mm) and their sign disagreements
+                      repetitions; the distance scans' quartiles), Open3D's (median, quartiles; impinge and Open3D
+                      alternated, one run of each per round, and Open3D's time over impinge's distance scans
+                      paired round by round: median and quartiles) and VTK's on the same vertices, their largest
+                      difference from impinge's distances (mm) and their sign disagreements
   meta.json
 Every shared hip with a subject.json under --data, or (without it) the generated hip with a 2 mm cam.
 Poses: rest and 10 poses up to 110 deg flexion (issue 26's); --quick: rest and 2 poses at 0.5 deg maps.
@@ -119,13 +121,7 @@ def main():
         import open3d as o3d
         for pose in poses:
             R, t = j.femur_pose(*pose)
-            radial, distance = [], []
-            j.detect_pose(*pose)  # warm-up
-            for _ in range(reps):
-                r = j.detect_pose(*pose)
-                s = r["summary"]
-                radial.append(s["ball_detection_ms"] + s["socket_detection_ms"])
-                distance.append(s["ball_distance_ms"] + s["socket_distance_ms"])
+            r = j.detect_pose(*pose)  # warm-up, and the vertices within reach that the peers are given
             bd, sd = r["ball_distance_mm"], r["socket_distance_mm"]
             bi, si = np.flatnonzero(np.isfinite(bd)), np.flatnonzero(np.isfinite(sd))
             # Femur vertices posed into the pelvis' frame; pelvis vertices into the femur's (its scene stays put).
@@ -136,7 +132,17 @@ def main():
             def run_open3d():
                 return pelvis_scene.compute_signed_distance(tb).numpy(), femur_scene.compute_signed_distance(ts).numpy()
             run_open3d()
-            o3d_ms = median_ms(run_open3d, reps)
+            # impinge and Open3D alternated, one run of each per round, so that their ratio is paired round by round.
+            radial, distance, o3d_runs = [], [], []
+            for _ in range(reps):
+                s = j.detect_pose(*pose)["summary"]
+                radial.append(s["ball_detection_ms"] + s["socket_detection_ms"])
+                distance.append(s["ball_distance_ms"] + s["socket_distance_ms"])
+                t0 = time.perf_counter()
+                run_open3d()
+                o3d_runs.append((time.perf_counter() - t0) * 1e3)
+            o3d_ms = statistics.median(o3d_runs)
+            paired = np.asarray(o3d_runs) / np.asarray(distance)
             ob, os_ = run_open3d()
             vtk_ms = median_ms(lambda: (pelvis_vtk(qb), femur_vtk(qs)), 1 if quick else 3)
             vb, vs = pelvis_vtk(qb), femur_vtk(qs)
@@ -146,7 +152,14 @@ def main():
                 "vertices": len(bi) + len(si),
                 "impinge_radial_ms": statistics.median(radial),
                 "impinge_distance_ms": statistics.median(distance),
+                "impinge_distance_q25_ms": float(np.quantile(distance, 0.25)),
+                "impinge_distance_q75_ms": float(np.quantile(distance, 0.75)),
                 "open3d_ms": o3d_ms,
+                "open3d_q25_ms": float(np.quantile(o3d_runs, 0.25)),
+                "open3d_q75_ms": float(np.quantile(o3d_runs, 0.75)),
+                "open3d_over_distance_paired": float(np.median(paired)),
+                "open3d_over_distance_q25": float(np.quantile(paired, 0.25)),
+                "open3d_over_distance_q75": float(np.quantile(paired, 0.75)),
                 "vtk_ms": vtk_ms,
                 "open3d_max_diff_mm": max(diff(ob, bd[bi]), diff(os_, sd[si])),
                 "vtk_max_diff_mm": max(diff(vb, bd[bi]), diff(vs, sd[si])),
