@@ -108,7 +108,13 @@ void discontinuities(const Subject& s, const std::string& name, double res, doub
       const Joint& jm = hips[m]->joint();
       ns[m].push_back(dt / double(flexions.size()) / double(jm.ball().scan_set.size() + jm.socket().scan_set.size()));
     }
+  // Each joint's ns per vertex: quartiles over the rounds; the refined joint's over the maps', paired round by round
+  // (Timing's fields hold ns and ratios here, not ms).
+  const Timing q[2] = {summarize(ns[0]), summarize(ns[1])};
+  std::vector<double> ratio;
+  for (std::size_t k = 0; k < ns[0].size(); ++k) ratio.push_back(ns[1][k] / ns[0][k]);
   for (int m = 0; m < 2; ++m) {
+    const Timing paired = m == 1 ? summarize(ratio) : summarize({1.0});
     const HipJoint& hip = *hips[m];
     const Joint& jm = hip.joint();
     std::int64_t skipped = 0, added = 0, over = 0, mismatched = 0, refined = 0;
@@ -149,7 +155,8 @@ void discontinuities(const Subject& s, const std::string& name, double res, doub
     csv.row(s.name, int(s.generated), name, res, p, m == 0 ? "maps" : "refined", flexions.size(),
             std::int64_t(errors.size()), mx, p99, over, skipped, added, mismatched,
             double(refined) / double(flexions.size()), jm.ball().nodes_marked + jm.socket().nodes_marked,
-            jm.ball().marking_ms + jm.socket().marking_ms, median(ns[m]));
+            jm.ball().marking_ms + jm.socket().marking_ms, median(ns[m]), q[m].q25_ms, q[m].q75_ms, paired.median_ms,
+            paired.q25_ms, paired.q75_ms);
   }
 }
 
@@ -237,7 +244,8 @@ int main(int argc, char** argv) {
   CsvWriter csv(dir + "/discontinuities.csv",
                 {"subject", "generated", "scheme", "resolution", "precision_deg", "method", "poses", "compared",
                  "max_abs_mm", "p99_abs_mm", "over_tolerance", "mask_skipped", "mask_added", "surface_mismatched",
-                 "refined_per_pose", "nodes_marked", "marking_ms", "query_ns_per_vertex"});
+                 "refined_per_pose", "nodes_marked", "marking_ms", "query_ns_per_vertex", "query_ns_q25",
+                 "query_ns_q75", "over_maps_paired", "over_maps_q25", "over_maps_q75"});
   int done = 0;
   const int total = static_cast<int>(subjects.size() * schemes.size());
   for (const Subject& s : subjects)
