@@ -3,7 +3,7 @@
 // poses to 110 deg flexion, every scheme at its 0.1 deg equivalent, exact mode, the maps alone and
 // with exact look-ups at depth discontinuities: the largest |gap error| against CGAL, the first-
 // surface vertices skipped or added against the exact mask, and the query time of both, timed
-// interleaved (alternating runs, medians).
+// interleaved (alternating runs: medians and quartiles, the ratio of the two paired round by round).
 // Cases 2-6 (the catalogue, 11_extreme_cases_catalogue.hpp): closed spheres about the COR stressed
 // one way each (poles, seam, slivers, duplicates, scales, placement, float input, size), touching and
 // penetrating bones, and the stiff numerics (sphere fits on small caps, helix arc length, conchoid
