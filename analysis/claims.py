@@ -436,6 +436,22 @@ if cam is not None and len(cam):
 else:
     missing("Fig. 60; Fig. 61", "the cam region is where the hip impinges", "red circles on the cam", "cam.csv", S09,
       kind="measured", tolerance="--", conditions="--", same_subjects=False)
+# The single-layer LUT's reach (issue 51, item 2): with layered maps, the limits counting every vertex and where the
+# bones meet first (extra_articular.csv); a single-layer map has no place for the vertices behind each bone's first
+# surface, so an extra-articular first contact is one it cannot see.
+xa = csv_of("09_rom_observation", "extra_articular.csv")
+if xa is not None and len(xa):
+    every = xa[(xa.counted == "all") & (xa.validated != "no_limit")]
+    outside = every[every.limited_by == "extra_articular"]
+    claim("Ch. 6", "one radial distance per direction (a single-layer LUT) detects the joint's impingement",
+          "the LUT detects impingement", f"{len(outside)} of {len(every)} limits (counting every vertex, layered maps) "
+          f"end where the bones meet outside the joint first, on {outside.subject.nunique()} hips",
+          "holds" if len(outside) == 0 else "partly",
+          "a single-layer map keeps each bone's first surface seen from the centre: the trochanters, the ischium and "
+          "the ilium behind it have no place in it (the thesis' ch. 6 names multiple layers as future work); layered "
+          "maps add them", S09, kind="measured", tolerance="no limit ending outside the joint",
+          conditions="the standard motions and two with external rotation, layered maps of 4 crossings, 0.1 deg, our "
+          "hips", same_subjects=True)
 claim("Fig. 62; Fig. 63", "the scene: femur rotated about the head centre, socket seen from the medial side",
       "images", "medial views with the clock face (section 09)", "holds", "same set-up, our hips", S09,
       kind="qualitative", tolerance="--", conditions="our hips, medial view", same_subjects=False)
