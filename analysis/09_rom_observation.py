@@ -184,6 +184,9 @@ for patient, zones in THESIS_ROM_ZONES.items():
     hits = sum(in_clock_zones(h, zones) for h in g.socket_closest_clock_h if np.isfinite(h))
     posterior = sum(7.5 <= h <= 11.5 for h in g.socket_closest_clock_h if np.isfinite(h))
     obs_macros[f"ROMobs{patient}InZone"] = str(hits)
+    # The thesis shows its clock faces "horizontally reversed": read that way, our hour h is its 12 - h.
+    obs_macros[f"ROMobs{patient}InZoneReversed"] = str(sum(in_clock_zones((12 - h) % 12, zones)
+                                                          for h in g.socket_closest_clock_h if np.isfinite(h)))
     obs_macros[f"ROMobs{patient}Poses"] = str(len(g))
     obs_macros[f"ROMobs{patient}Posterior"] = str(posterior)
     obs_macros[f"ROMobs{patient}Verdict"] = verdict(hits / max(len(g), 1))

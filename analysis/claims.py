@@ -418,12 +418,15 @@ if obs is not None and len(obs):
         g = obs[obs.patient == patient]
         hours = [h for h in g.socket_closest_clock_h if np.isfinite(h)]
         hits = sum(in_clock_zones(h, THESIS_ROM_ZONES[patient]) for h in hours)
+        # The thesis shows its clock faces "horizontally reversed": read that way, an hour h is 12 - h of ours.
+        reversed_hits = sum(in_clock_zones((12 - h) % 12, THESIS_ROM_ZONES[patient]) for h in hours)
         share = hits / max(len(g), 1)
         verdict = "holds" if share >= 0.75 else "partly" if share >= 0.25 else "does_not_hold"
         claim(f"{item}; Sec. 5.2", f"at patient {patient}'s extremities the red zones (within 2 mm) lie at {zones_text}",
-              zones_text, f"{hits} of {len(g)} extremities over {g.subject.nunique()} hips",
-              verdict, "the socket's closest point within half an hour of the thesis' zones; ours are mostly "
-              "posterosuperior, where our hips' joint space is thinnest (no cam or pincer)", S09,
+              zones_text, f"{hits} of {len(g)} extremities over {g.subject.nunique()} hips ({reversed_hits} of "
+              f"{len(g)} on the horizontally reversed clock)",
+              verdict, "the socket's closest point within half an hour of the thesis' zones, on our clock (3 o'clock "
+              "anterior on both sides); ours are mostly posterosuperior, where our hips' joint space is thinnest", S09,
       kind="measured", tolerance="three quarters of the extremities within half an hour of the zones", conditions="the thesis' extremities as clinical angles from anatomical neutral, our hips", same_subjects=False)
     red = obs.socket_area_0to2_mm2 + obs.socket_area_penetrating_mm2
     claim("Sec. 5.2", "the extremities bring the socket within 2 mm of the femur (red zones appear)", "red zones",
