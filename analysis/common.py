@@ -29,8 +29,22 @@ def read_csv(d, file):
 
 def save(fig, d, stem, rect=None):
     """Save as PDF (for the paper) and PNG (for viewing). rect: the part of the figure (left, bottom, right,
-    top, 0-1) the axes fill, leaving the rest to a figure legend."""
+    top, 0-1) the axes fill, leaving the rest to a figure legend. Records the figure's width (inches) and the smallest
+    font size of its visible text (points) in d/figures.json, so that tools/check-report can tell the text's size at
+    the width the paper prints it (issue 51: no figure text below 8 pt)."""
+    import json
+    import matplotlib.text
     fig.tight_layout(rect=rect)
+    sizes = [t.get_fontsize() for t in fig.findobj(matplotlib.text.Text) if t.get_visible() and t.get_text().strip()]
+    path = os.path.join(d, "figures.json")
+    record = {}
+    if os.path.exists(path):
+        with open(path) as f:
+            record = json.load(f)
+    record[stem] = {"width_in": float(fig.get_size_inches()[0]), "min_font_pt": float(min(sizes)) if sizes else None}
+    with open(path + ".tmp", "w") as f:
+        json.dump(record, f, indent=1, sort_keys=True)
+    os.replace(path + ".tmp", path)
     fig.savefig(os.path.join(d, stem + ".pdf"))
     fig.savefig(os.path.join(d, stem + ".png"), dpi=130)
     plt.close(fig)

@@ -160,6 +160,23 @@ def test_a_claims_table_without_kind_tolerance_and_conditions_is_found():
         assert r.returncode == 1 and "lacks the columns kind, tolerance, conditions, same_subjects" in r.stdout, r.stdout
 
 
+def test_figure_text_under_eight_points_at_its_printed_width_is_found():
+    # A figure 6.5 in wide printed at half the text width shrinks its 8 pt text to about 4 pt; drawn at the printed
+    # width (half the text width, in inches) it keeps 8 pt.
+    with tempfile.TemporaryDirectory() as results, tempfile.TemporaryDirectory() as paper:
+        os.makedirs(os.path.join(paper, "sections"))
+        with open(os.path.join(paper, "sections", "01.tex"), "w") as f:
+            f.write("\\includegraphics[width=0.5\\textwidth]{01_x/fig.pdf}\n")
+        os.makedirs(os.path.join(results, "01_x"))
+        for width, found in ((6.5, 1), (0.5 * check.TEXT_WIDTH_IN, 0)):
+            with open(os.path.join(results, "01_x", "figures.json"), "w") as f:
+                json.dump({"fig": {"width_in": width, "min_font_pt": 8}}, f)
+            findings = check.check_figure_text(results, paper)
+            assert len(findings) == found, findings
+            if found:
+                assert "01_x/fig prints its smallest text at 4.0 pt" in findings[0], findings
+
+
 def test_a_page_that_runs_over_is_found():
     with tempfile.TemporaryDirectory() as d:
         write_run(d, ["abc"], every_item_row(), "Overfull \\vbox (250.3pt too high) has occurred while \\output")
