@@ -112,11 +112,11 @@ def main():
                                + [0.0] * 4 + ["nan", "nan", "nan", m, free[m]["limit_deg"], before[m]["limit_deg"],
                                              before[m]["limit_deg"], 1, 0.0])
                 continue
+            plan = lambda j=j, target=target: j.plan(target=target, allow_partial=True)  # noqa: E731
             t0 = time.perf_counter()
-            p = j.plan(target=target, allow_partial=True)
+            p = plan()
             ms = (time.perf_counter() - t0) * 1e3
-            timed["generated"] = (f"generated hip with the {cam:g} mm cam",
-                                  lambda j=j, target=target: j.plan(target=target, allow_partial=True))
+            timed["generated"] = (f"generated hip with the {cam:g} mm cam", plan)
             r = p["femur_resection"]
             cam_volume = volume(h["ball"][0], h["ball"][1]) - volume(free_hip["ball"][0], free_hip["ball"][1])
             share = on_cam_share(np.asarray(h["ball"][0]), np.asarray(free_hip["ball"][0]), np.asarray(h["ball"][1]),
@@ -146,15 +146,13 @@ def main():
             ir = free["internal_rotation_90_flexion"]
             if ir["status"] == "limited":
                 for resect in ("femur", "both"):
+                    plan = lambda j=j, resect=resect, limit=ir["limit_deg"]: j.plan(  # noqa: E731
+                        target=f"internal_rotation_90_flexion={limit + 10:.3f}", resect=resect, allow_partial=True)
                     t0 = time.perf_counter()
-                    p = j.plan(target=f"internal_rotation_90_flexion={ir['limit_deg'] + 10:.3f}", resect=resect,
-                               allow_partial=True)
+                    p = plan()
                     ms = (time.perf_counter() - t0) * 1e3
                     if resect == "femur" and hip == TIMED_HIP:
-                        kw = dict(target=f"internal_rotation_90_flexion={ir['limit_deg'] + 10:.3f}", resect=resect,
-                                  allow_partial=True)
-                        timed["shared"] = (f"{hip} internal rotation at 90 deg flexion + 10 deg, femur",
-                                           lambda j=j, kw=kw: j.plan(**kw))
+                        timed["shared"] = (f"{hip} internal rotation at 90 deg flexion + 10 deg, femur", plan)
                     t = p["targets"][0]
                     fr, pr = p["femur_resection"], p["pelvis_resection"]
                     wi.writerow([hip, resect, ir["limit_deg"], t["target_deg"], t["limit_after_deg"], int(t["met"]),

@@ -5,7 +5,7 @@
 
 #include <cstdio>
 #include <fstream>
-#include <sstream>
+#include <map>
 
 #ifndef IMPINGE_COMPILER
 #define IMPINGE_COMPILER "unknown"
@@ -14,22 +14,26 @@
 namespace impinge {
 namespace {
 
-// The text after "key<tabs>: " on the first line of `path` that starts with `key` followed by
-// whitespace or ':', or "" when there is none.
-std::string proc_field(const char* path, const std::string& key) {
+// The "key<tabs>: value" fields of `path` up to its first blank line (for /proc/cpuinfo: the first CPU), each key's
+// first value, surrounding blanks removed.
+std::map<std::string, std::string> proc_fields(const char* path) {
+  std::map<std::string, std::string> fields;
   std::ifstream in(path);
   std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind(key, 0) != 0 || line.size() == key.size()) continue;
-    const char next = line[key.size()];
-    if (next != ' ' && next != '\t' && next != ':') continue;
+  auto trim = [](const std::string& t) {
+    const auto b = t.find_first_not_of(" \t"), e = t.find_last_not_of(" \t");
+    return b == std::string::npos ? std::string() : t.substr(b, e - b + 1);
+  };
+  while (std::getline(in, line) && !trim(line).empty()) {
     const auto colon = line.find(':');
-    if (colon == std::string::npos) continue;
-    std::string v = line.substr(colon + 1);
-    const auto b = v.find_first_not_of(" \t");
-    return b == std::string::npos ? std::string() : v.substr(b);
+    if (colon != std::string::npos) fields.emplace(trim(line.substr(0, colon)), trim(line.substr(colon + 1)));
   }
-  return {};
+  return fields;
+}
+
+std::string field(const std::map<std::string, std::string>& fields, const std::string& key) {
+  const auto it = fields.find(key);
+  return it == fields.end() || it->second.empty() ? std::string("unknown") : it->second;
 }
 
 std::string first_line(const std::string& path) {
@@ -59,17 +63,18 @@ std::string compiler_description() { return IMPINGE_COMPILER; }
 
 std::vector<std::pair<std::string, std::string>> machine_description() {
   std::vector<std::pair<std::string, std::string>> m;
-  m.emplace_back("cpu_model", or_unknown(proc_field("/proc/cpuinfo", "model name")));
-  m.emplace_back("cpu_family", or_unknown(proc_field("/proc/cpuinfo", "cpu family")));
-  m.emplace_back("cpu_model_number", or_unknown(proc_field("/proc/cpuinfo", "model")));
-  m.emplace_back("cpu_stepping", or_unknown(proc_field("/proc/cpuinfo", "stepping")));
-  m.emplace_back("cpu_mhz", or_unknown(proc_field("/proc/cpuinfo", "cpu MHz")));
+  const auto cpu = proc_fields("/proc/cpuinfo");
+  m.emplace_back("cpu_model", field(cpu, "model name"));
+  m.emplace_back("cpu_family", field(cpu, "cpu family"));
+  m.emplace_back("cpu_model_number", field(cpu, "model"));
+  m.emplace_back("cpu_stepping", field(cpu, "stepping"));
+  m.emplace_back("cpu_mhz", field(cpu, "cpu MHz"));
   m.emplace_back("l2_cache", or_unknown(cache_size(2)));
   m.emplace_back("l3_cache", or_unknown(cache_size(3)));
   const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
   m.emplace_back("logical_cpus", cpus > 0 ? std::to_string(cpus) : std::string("unknown"));
   std::string memory = "unknown";
-  const std::string kb = proc_field("/proc/meminfo", "MemTotal");  // "24684100 kB"
+  const std::string kb = field(proc_fields("/proc/meminfo"), "MemTotal");  // "24684100 kB"
   double kib = 0;
   if (std::sscanf(kb.c_str(), "%lf", &kib) == 1 && kib > 0) {
     char buf[32];
@@ -77,10 +82,10 @@ std::vector<std::pair<std::string, std::string>> machine_description() {
     memory = buf;
   }
   m.emplace_back("memory_gib", memory);
-  const std::string flags = proc_field("/proc/cpuinfo", "flags");
-  m.emplace_back("hypervisor", flags.empty()                                                   ? std::string("unknown")
-                               : (" " + flags + " ").find(" hypervisor ") != std::string::npos ? "yes"
-                                                                                               : "no");
+  const auto flags = cpu.find("flags");
+  m.emplace_back("hypervisor", flags == cpu.end() ? std::string("unknown")
+                               : (" " + flags->second + " ").find(" hypervisor ") != std::string::npos ? "yes"
+                                                                                                       : "no");
   utsname u{};
   m.emplace_back("os_kernel", uname(&u) == 0 ? std::string(u.sysname) + " " + u.release : std::string("unknown"));
   return m;
