@@ -76,7 +76,7 @@ write_table(d, "table_real", ["subject", "body", "$p$"] + [labels[m].replace("O(
 # Figure: time against precision for each body of the first real subject (or the generated one).
 real = maps[~maps.generated.astype(bool)]
 subj = real.subject.iloc[0] if len(real) else "generated-3k"
-fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
+fig, axes = plt.subplots(1, 2, figsize=(7.5, 4.4), sharey=True)
 for ax, body in zip(axes, ("femur", "pelvis")):
     g0 = maps[(maps.subject == subj) & (maps.body == body)]
     for m in methods:
@@ -88,11 +88,11 @@ for ax, body in zip(axes, ("femur", "pelvis")):
             ax.set_yscale("log")
     ax.invert_xaxis()
     ax.set_xlabel("precision p (deg)")
-    ax.set_ylabel("time (ms)")
     ax.set_title(f"{subj} {body}")
     ax.grid(True, which="both", lw=0.3)
-axes[1].legend(fontsize=7)
-save(fig, d, "sampling_time")
+axes[0].set_ylabel("time (ms)")
+fig.legend(*axes[1].get_legend_handles_labels(), loc="lower center", ncol=4, frameon=False)
+save(fig, d, "sampling_time", rect=(0, 0.17, 1, 1))
 
 # Numbers quoted in the text: pelvis of the first real subject at the finest precision.
 macros = {}

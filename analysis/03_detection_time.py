@@ -135,14 +135,13 @@ for col, mk, name in [("rsid", "s", "thesis RSID"), ("fcl_collide", "^", "thesis
 ax.set_xlabel("triangles per model")
 ax.set_ylabel("ms per pose (both scans)")
 ax.grid(True, which="both", lw=0.3)
-# Two legends (at most 8 entries each): ours beside the axes, the thesis' markers inside.
+# Two legends (at most 8 entries each) right of the axes: ours above, the thesis' markers below.
 handles, names = ax.get_legend_handles_labels()
 ours = [(h, n) for h, n in zip(handles, names) if not n.startswith("thesis")]
 thesis = [(h, n) for h, n in zip(handles, names) if n.startswith("thesis")]
-first = ax.legend(*zip(*ours), fontsize=6, title="ours", title_fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1))
-ax.add_artist(first)
-ax.legend(*zip(*thesis), fontsize=6, title="thesis", title_fontsize=6, loc="lower left", bbox_to_anchor=(1.01, 0))
-save(fig, d, "detection_time")
+fig.legend(*zip(*ours), title="ours", loc="upper right", bbox_to_anchor=(1.0, 1.0), frameon=False)
+fig.legend(*zip(*thesis), title="thesis", loc="lower right", bbox_to_anchor=(1.0, 0.0), frameon=False)
+save(fig, d, "detection_time", rect=(0, 0, 0.7, 1))
 
 # Numbers for the text: the first real subject, pushed pose; without real subjects, the largest generated model.
 real = t[~t.generated.astype(bool)]

@@ -66,19 +66,19 @@ styles = {("equiangular", "exact"): ("-", "o"), ("equiangular", "linear"): (":",
 FLOOR = 1e-8  # mm; errors below it (rounding only) are drawn at it
 
 
-def legends(ax, configs, loc_shapes, loc_configs):
+def legends(fig, configs):
+    """Two figure legends below the panels: the colours (shapes) and the line styles (scheme and mode)."""
     from matplotlib.lines import Line2D
     h1 = [Line2D([], [], color=colour[sh], lw=2) for sh in shapes]
-    l1 = ax.legend(h1, [sh.replace("_", " ") for sh in shapes], fontsize=6, loc=loc_shapes, title="shape",
-                   title_fontsize=6)
-    ax.add_artist(l1)
+    fig.legend(h1, [sh.replace("_", " ") for sh in shapes], loc="lower center", bbox_to_anchor=(0.5, 0.15), ncol=4,
+               title="shape", frameon=False)
     h2 = [Line2D([], [], color="0.3", ls=styles[c][0], marker=styles[c][1], markersize=3) for c in configs]
     h2.append(Line2D([], [], color="k", lw=2.5, alpha=0.6))  # the bound, named here rather than over the data
-    ax.legend(h2, [f"{a} {b}" for a, b in configs] + ["Eq. 7 (r = 22 mm)"], fontsize=6, loc=loc_configs,
-              title="scheme, mode", title_fontsize=6)
+    fig.legend(h2, [f"{a} {b}" for a, b in configs] + ["Eq. 7 (r = 22 mm)"], loc="lower center",
+               bbox_to_anchor=(0.5, 0.0), ncol=2, title="scheme, mode", frameon=False)
 
 
-fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
+fig, axes = plt.subplots(1, 2, figsize=(6.5, 5.2), sharey=True)
 for ax, stat in zip(axes, ("max_mm", "p95_mm")):
     for shape in shapes:
         for cfg, (ls, mk) in styles.items():
@@ -89,34 +89,31 @@ for ax, stat in zip(axes, ("max_mm", "p95_mm")):
     g = rad[(rad["shape"] == shapes[0]) & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]
     ax.loglog(g.precision_deg, g.eq7_mm, "k-", lw=2.5, alpha=0.6)
     ax.set_xlabel("precision p (deg; helix matched)")
-    ax.set_title({"max_mm": "max", "p95_mm": "95th percentile"}[stat] + " |interpolated - exact| radial distance",
-                 fontsize=8)
+    ax.set_title({"max_mm": "max", "p95_mm": "95th percentile"}[stat] + " radial error")
     ax.invert_xaxis()
     ax.set_ylim(FLOOR / 2, None)
     ax.grid(True, which="major", alpha=0.3)
-axes[0].set_ylabel(f"mm (below {FLOOR:g} drawn at {FLOOR:g})")
-legends(axes[1], list(styles), "lower left", "lower right")
-save(fig, d, "radial")
+axes[0].set_ylabel(f"|interpolated - exact| (mm; floor {FLOOR:g})")
+legends(fig, list(styles))
+save(fig, d, "radial", rect=(0, 0.36, 1, 1))
 
-fig, ax = plt.subplots(figsize=(5.8, 3.6))
+fig, ax = plt.subplots(figsize=(6.5, 3.2))
 for (shape, scheme), g in cov.groupby(["shape", "scheme"], sort=False):
     m = g.groupby("precision_deg").apply(lambda x: (x.max_nearest_mm / x.eq7_mm).max())
     ls, mk = styles[(scheme, "exact")]
     ax.semilogx(m.index, m.values, ls=ls, marker=mk, color=colour[shape], markersize=4)
 ax.axhline(1, color="k", lw=1)
 ax.set_xlabel("precision p (deg; helix matched)")
-ax.set_ylabel("max nearest-sample distance / Eq. 7")
+ax.set_ylabel("max nearest sample / Eq. 7")
 ax.invert_xaxis()
 ax.grid(True, alpha=0.3)
 from matplotlib.lines import Line2D
 h1 = [Line2D([], [], color=colour[sh], lw=2) for sh in shapes]
-l1 = ax.legend(h1, [sh.replace("_", " ") for sh in shapes], fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.65),
-               title="shape", title_fontsize=6)
-ax.add_artist(l1)
-ax.legend([Line2D([], [], color="0.3", ls=styles[(sc, "exact")][0], marker=styles[(sc, "exact")][1]) for sc in ("equiangular", "helix")],
-          ["equiangular", "helix"], fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.15), title="scheme",
-          title_fontsize=6)
-save(fig, d, "covering")
+fig.legend(h1, [sh.replace("_", " ") for sh in shapes], loc="upper right", bbox_to_anchor=(1.0, 1.0),
+           title="shape", frameon=False)
+fig.legend([Line2D([], [], color="0.3", ls=styles[(sc, "exact")][0], marker=styles[(sc, "exact")][1]) for sc in ("equiangular", "helix")],
+          ["equiangular", "helix"], loc="lower right", bbox_to_anchor=(1.0, 0.0), title="scheme", frameon=False)
+save(fig, d, "covering", rect=(0, 0, 0.7, 1))
 
 sph = rad[(rad["shape"] == "sphere") & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]
 heads = rad[rad["shape"].str.startswith("head_") & (rad.scheme == "equiangular")]

@@ -25,7 +25,7 @@ for t, g in ny.groupby("slice_mm"):
     rows.append([f"{t:g}"] + [f"{v:.2f}" for v in g.sort_values("radius_mm").nyquist_precision_deg])
 write_table(d, "nyquist", ["slice (mm)"] + [f"$r$ = {r:g}" for r in sorted(ny.radius_mm.unique())], rows)
 
-fig, ax = plt.subplots(figsize=(5.5, 3.4))
+fig, ax = plt.subplots(figsize=(5.5, 4.6))
 ax.loglog(st.precision_deg, st.vs_sphere_rms_mm, "o-", label="map vs smooth sphere (RMS)")
 ax.loglog(st.precision_deg, st.vs_staircase_rms_mm, "s-", label="map vs staircase (RMS)")
 ax.loglog(st.precision_deg, st.gap_vs_smooth_rms_mm, "^-", label="socket-scan gap vs smooth truth (RMS)")
@@ -35,8 +35,8 @@ ax.set_xlabel("precision p (deg)")
 ax.set_ylabel("mm")
 ax.invert_xaxis()
 ax.grid(True, which="both", alpha=0.3)
-ax.legend(fontsize=6)
-save(fig, d, "staircase")
+fig.legend(*ax.get_legend_handles_labels(), loc="lower center", ncol=1, frameon=False)
+save(fig, d, "staircase", rect=(0, 0.36, 1, 1))
 
 write_table(d, "table_staircase", ["$p$ (deg)", "vs sphere RMS", "vs sphere max", "vs staircase RMS",
                                    "vs staircase max", "gap error RMS", "gap error max"],

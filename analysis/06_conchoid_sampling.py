@@ -21,18 +21,18 @@ write_table(d, "table10", ["$i$", "original", "thesis", "Eq. 16", "exact", "Eq. 
               f"{r.exact_deg:.2f}", f"{r.eq16_adjustment_deg:+.2f}", f"{r.exact_adjustment_deg:+.2f}"]
              for r in t10.itertuples()])
 
-fig, axes = plt.subplots(1, 2, figsize=(8.5, 3.2))
+fig, axes = plt.subplots(1, 2, figsize=(5.2, 2.9))
 axes[0].plot(an.original_deg, an.original_deg, label="original (equiangular)")
 axes[0].plot(an.original_deg, an.eq16_deg, label="Eq. 16")
 axes[0].plot(an.original_deg, an.exact_deg, "--", label="exact inversion")
 axes[0].set_xlabel("original phi (deg)")
 axes[0].set_ylabel("ray angle (deg)")
-axes[0].legend(fontsize=7)
+axes[0].legend(handlelength=1.5, loc="lower right")
 axes[1].plot(an.original_deg, an.eq16_adjustment_deg, label="Eq. 16")
 axes[1].plot(an.original_deg, an.exact_adjustment_deg, "--", label="exact inversion")
 axes[1].set_xlabel("original phi (deg)")
 axes[1].set_ylabel("adjustment (deg)")
-axes[1].legend(fontsize=7)
+
 for ax in axes:
     ax.grid(True, alpha=0.3)
 save(fig, d, "angles")
@@ -40,13 +40,13 @@ save(fig, d, "angles")
 write_table(d, "table_equal", ["scheme", "res.", "nodes", "hip-region nodes", "max (mm)", "p95 (mm)", "RMS (mm)"],
             [[r.scheme, f"{r.resolution:g}", f"{int(r.nodes):,}", f"{int(r.hip_region_nodes):,}", f"{r.max_mm:.2e}",
               f"{r.p95_mm:.2e}", f"{r.rms_mm:.2e}"] for r in eq.itertuples()], align="llrrrrr")
-fig, ax = plt.subplots(figsize=(5.5, 3.2))
+fig, ax = plt.subplots(figsize=(3.3, 2.9))
 for scheme, g in eq.groupby("scheme", sort=False):
-    ax.loglog(g.nodes, g.max_mm, "o-", label=f"{scheme} (max)")
+    ax.loglog(g.nodes, g.max_mm, "o-", label=scheme)
 ax.set_xlabel("nodes")
-ax.set_ylabel("radial error over phi <= 90 deg (mm)")
+ax.set_ylabel("max radial error (mm)")
 ax.grid(True, which="both", alpha=0.3)
-ax.legend(fontsize=7)
+ax.legend(handlelength=1.5)
 save(fig, d, "equal")
 
 def span(v):
@@ -61,7 +61,7 @@ seg = read_csv(d, "segments.csv")
 seg = seg[seg.ray_to_deg - seg.ray_from_deg > 0.999]  # whole 1-deg segments (the last one is cut short)
 names = {"conchoid_origin": "conchoid's origin (thesis Fig. 53 b)", "object_centroid": "area centroid (Fig. 53 a)",
          "object_extent_middle": "middle of the extent (Fig. 53 a)"}
-fig, ax = plt.subplots(figsize=(5.5, 3.0))
+fig, ax = plt.subplots(figsize=(5.5, 3.2))
 longer = {}
 for origin, g in seg.groupby("origin", sort=False):
     rel = g.length_mm / g.length_mm.min()
@@ -70,7 +70,7 @@ for origin, g in seg.groupby("origin", sort=False):
 ax.set_xlabel("position on the hip curve: conchoid angle phi (deg)")
 ax.set_ylabel("segment length / shortest")
 ax.grid(True, alpha=0.3)
-ax.legend(fontsize=7)
+ax.legend()
 save(fig, d, "segments")
 exact_len = ln.iloc[0]
 write_macros(d, "macros", {

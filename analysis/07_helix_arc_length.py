@@ -11,25 +11,25 @@ d = experiment_dir("07_helix_arc_length")
 arc = read_csv(d, "arc_length.csv")
 idx = read_csv(d, "index_errors.csv")
 
-fig, axes = plt.subplots(1, 2, figsize=(8.5, 3.2))
+fig, axes = plt.subplots(1, 2, figsize=(5.2, 3.1))
 for k, g in arc.groupby("turns"):
     axes[0].plot(g.phi_deg, g.abs_error, label=f"k={int(k)}")
     axes[1].semilogy(g.phi_deg, np.abs(g.rel_error), label=f"k={int(k)}")
-axes[0].set_ylabel("Eq. 10 T - exact s (unit-sphere length)")
+axes[0].set_ylabel("Eq. 10 T - exact s (unit sphere)")
 axes[1].set_ylabel("|relative error|")
 for ax in axes:
     ax.set_xlabel("polar angle phi (deg)")
     ax.grid(True, alpha=0.3)
-axes[1].legend(fontsize=7)
-save(fig, d, "error")
+fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=6, frameon=False, handlelength=1,
+           columnspacing=0.8)
+save(fig, d, "error", rect=(0, 0.1, 1, 1))
 
-fig, ax = plt.subplots(figsize=(5.5, 3.2))
+fig, ax = plt.subplots(figsize=(3.3, 3.1))
 for k, g in arc.groupby("turns"):
     ax.plot(g.phi_deg, g.index_error_steps, label=f"k={int(k)}")
 ax.set_xlabel("polar angle phi (deg)")
-ax.set_ylabel("located index error (node steps)")
+ax.set_ylabel("index error (node steps)")
 ax.grid(True, alpha=0.3)
-ax.legend(fontsize=7)
 save(fig, d, "steps")
 
 write_table(d, "table", ["$k$", "nodes", "exact $L$", "Eq. 10 $L$", "max index error (steps)",

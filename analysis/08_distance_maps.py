@@ -245,17 +245,18 @@ write_table(d, "table_usid", ["subject", "$p$ / $k$", "mode", "RSID min", "USID 
                               "max $|\\Delta|$", "RSID ms", "USID ms", "RSID ns", "USID ns", "bytes ratio"], rows,
             align="llrrrrrrrrrr")
 
-fig, ax = plt.subplots(figsize=(5.5, 3.2))
+fig, ax = plt.subplots(figsize=(5.5, 3.4))
 for s_ in subjects:
     g = hx[(hx.subject == s_) & (hx.scan == "ball") & (hx["mode"] == "exact")].sort_values("precision_deg")
     ax.loglog(g.precision_deg, g.vs_equiangular_p95_abs_mm, marker="o", label=s_)
 ax.set_xlabel("precision p (deg; helix at matched k)")
 precision_axis(ax, allst.precision_deg)
-ax.set_ylabel("p95 |USID - RSID| ball gap (mm)")
+ax.set_ylabel("p95 |USID - RSID| (mm)")
+ax.set_title("ball gap, exact mode")
 ax.invert_xaxis()
 ax.grid(True, which="both", alpha=0.3)
-ax.legend(fontsize=7)
-save(fig, d, "usid_vs_rsid")
+fig.legend(*ax.get_legend_handles_labels(), loc="center right", frameon=False)
+save(fig, d, "usid_vs_rsid", rect=(0, 0, 0.68, 1))
 
 # Table: every other registered scheme beside the equiangular grid at the same node spacing, exact
 # mode, at the finest spacing it was run at (issue 12: the driver loops over the registry).
@@ -289,10 +290,12 @@ write_table(d, "table_radial_vs_distance",
             ["subject", "pose", "scan", "both", "$>1$ mm", "art./intra/extra", "max (mm)", "no gap", "inside",
              "missed", "min gap", "min dist.", "pen. area gap", "pen. area dist."], rows, align="lllrrrrrrrrrrr")
 rv_subjects = list(dict.fromkeys(rvv.subject))
-fig, axes = plt.subplots(1, max(1, len(rv_subjects)), figsize=(2.4 * max(1, len(rv_subjects)), 2.6), sharey=True,
-                         squeeze=False)
+n_panels = max(1, len(rv_subjects))
+n_cols = min(3, n_panels)
+n_rows = -(-n_panels // n_cols)
+fig, axes = plt.subplots(n_rows, n_cols, figsize=(6.5, 2.3 * n_rows + 0.6), sharex=True, sharey=True, squeeze=False)
 pose_colour = {"scan": "#1f77b4", "flexion90": "#ff7f0e", "extension20": "#2ca02c"}
-for ax, s_ in zip(axes[0], rv_subjects):
+for ax, s_ in zip(axes.flat, rv_subjects):
     for pose, c in pose_colour.items():
         g = rvv[(rvv.subject == s_) & (rvv.pose == pose) & np.isfinite(rvv.gap_mm)]
         ax.scatter(np.clip(g.gap_mm, -10, 10), g.distance_mm, s=1, color=c, alpha=0.4, label=pose, rasterized=True)
@@ -301,12 +304,14 @@ for ax, s_ in zip(axes[0], rv_subjects):
     ax.axvline(0, color="k", lw=0.3)
     ax.set_xlim(-10.5, 10.5)
     ax.set_ylim(-4, 6.5)
-    ax.set_title(s_, fontsize=8)
-    ax.set_xlabel("radial gap (mm; clipped at $\pm$10)", fontsize=7)
-    ax.tick_params(labelsize=7)
-axes[0][0].set_ylabel("Euclidean distance (mm)", fontsize=7)
-axes[0][-1].legend(fontsize=6, markerscale=6, loc="lower right")
-fig.tight_layout()
+    ax.set_title(s_)
+for ax in axes.flat[len(rv_subjects):]:
+    ax.set_visible(False)
+fig.supxlabel("radial gap (mm; clipped at $\\pm$10)")
+fig.supylabel("Euclidean distance (mm)")
+handles, labels = axes[0][0].get_legend_handles_labels()
+fig.legend(handles, labels, markerscale=8, loc="lower right", bbox_to_anchor=(0.98, 0.12) if n_rows * n_cols > n_panels
+           else (0.98, 0.0), title="pose")
 save(fig, d, "radial_vs_distance")
 both = rv.vertices_both.sum()
 

@@ -7,15 +7,17 @@ table_layered.tex, table_envelope.tex, table_methods.tex, table_method_sensitivi
 rom_map.pdf, limits_vs_normal.pdf (every limit beside the published normal range), medial_<subject>_<patient>.pdf
 (Tables 12-13's panels), macros.tex."""
 import os
+import warnings
 
 import numpy as np
+
 import matplotlib
 import matplotlib.colors
 import matplotlib.patches
 import matplotlib.pyplot as plt
 
 from common import THESIS_ROM_ZONES, experiment_dir, in_clock_zones, read_csv, save, write_macros, write_table
-from render import draw, level_key, level_rgb, read_gap_ply
+from render import draw, level_key, level_rgb, plot_coordinates, read_gap_ply
 
 d = experiment_dir("09_rom_observation")
 obs = read_csv(d, "observation.csv")
@@ -235,8 +237,10 @@ if meth is not None and {"mc22", "mc22-left"} <= set(meth.subject):
         })
 
 # ROM maps.
-fig, axes = plt.subplots(1, len(subjects), figsize=(4 * len(subjects), 3.4), squeeze=False)
-for ax, s in zip(axes[0], subjects):
+n_cols = min(2, len(subjects))
+n_rows = -(-len(subjects) // n_cols)
+fig, axes = plt.subplots(n_rows, n_cols, figsize=(6.5, 2.6 * n_rows + 0.9), sharex=True, sharey=True, squeeze=False)
+for ax, s in zip(axes.flat, subjects):
     g = rmap[rmap.subject == s]
     fl, ad = sorted(g.flexion_deg.unique()), sorted(g.adduction_deg.unique())
     Z = np.full((len(ad), len(fl)), np.nan)
@@ -250,15 +254,19 @@ for ax, s in zip(axes[0], subjects):
     # The cells without a limit get their own colours, so that neither reads as a value or as the other.
     ax.imshow(state, origin="lower", aspect="auto", extent=extent, vmin=0, vmax=1,
               cmap=matplotlib.colors.ListedColormap(["#d9d9d9", "#8b0000"]))
-    if s == subjects[0]:
-        ax.legend(handles=[matplotlib.patches.Patch(color="#d9d9d9", label="free to the search's end"),
-                           matplotlib.patches.Patch(color="#8b0000", label="in contact at zero rotation")],
-                  fontsize=6, loc="upper right")
-    ax.set_title(f"{s}: largest internal rotation (deg)", fontsize=8)
-    ax.set_xlabel("flexion (deg)")
-    ax.set_ylabel("adduction (deg)")
-    fig.colorbar(im, ax=ax, shrink=0.8)
-save(fig, d, "rom_map")
+    ax.set_title(s)
+for ax in axes.flat[len(subjects):]:
+    ax.set_visible(False)
+fig.supxlabel("flexion (deg)", y=0.065)
+fig.supylabel("adduction (deg)")
+fig.legend(handles=[matplotlib.patches.Patch(color="#d9d9d9", label="free to the search's end"),
+                    matplotlib.patches.Patch(color="#8b0000", label="in contact at zero rotation")],
+           loc="lower center", ncol=2, frameon=False)
+fig.tight_layout(rect=(0, 0.08, 0.86, 1))
+# The colour bar's own axes sit right of the panels; tight_layout (in save) leaves them where they are.
+fig.colorbar(im, cax=fig.add_axes([0.88, 0.2, 0.025, 0.7]), label="largest internal rotation (deg)")
+warnings.filterwarnings("ignore", message="This figure includes Axes that are not compatible with tight_layout")
+save(fig, d, "rom_map", rect=(0, 0.08, 0.86, 1))
 
 # Tables 12-13's panels: the cup from the medial side at each extremity, with the clock face.
 clk = read_csv(d, "clock_faces.csv")
@@ -271,16 +279,26 @@ for s in clk.subject:
         files = [os.path.join(d, f"observation_{s}_{patient}_{m}.ply") for m in t11[t11.patient == patient].motion]
         if not all(os.path.exists(p) for p in files):
             continue
-        fig = plt.figure(figsize=(9, 6))
+        fig = plt.figure(figsize=(8, 6.4))
         order = ["abduction", "internal_rotation", "extension", "adduction", "external_rotation", "flexion"]
         for k, m in enumerate(order):
             V, F, _, gap = read_gap_ply(os.path.join(d, f"observation_{s}_{patient}_{m}.ply"))
             rgb = level_rgb(gap, False)
             ang = t11[(t11.patient == patient) & (t11.motion == m)].angle_deg.iloc[0]
             ax = fig.add_subplot(2, 3, k + 1, projection="3d")
+            # The panels differ little (the head turns about the socket's centre, so the joint space keeps its
+            # width); the socket's closest point, marked, and the least gap in the title are what changes.
+            finite = np.where(np.isfinite(gap))[0]
+            closest = finite[np.argmin(gap[finite])] if len(finite) else None
             draw(ax, [(V, F, rgb)], "socket_medial", row.side, clock, radius=row.rim_radius_mm + 3,
-                 title=f"{m.replace('_', ' ')} {ang:g} deg")
-        fig.suptitle(f"{s} at patient {patient}'s extremities (thesis Table {12 if patient == 'A' else 13})", fontsize=9)
+                 title=f"{m.replace('_', ' ')} {ang:g} deg" +
+                 (f"\nleast gap {gap[closest]:.2f} mm" if closest is not None else ""))
+            if closest is not None:
+                p = plot_coordinates(V[closest][None])[0]
+                ax.computed_zorder = False  # the star above the surface, not sorted behind it
+                ax.scatter([p[0]], [p[1]], [p[2]], marker="*", s=140, color="k", edgecolors="w", linewidths=0.6,
+                           zorder=12, depthshade=False)
+        fig.suptitle(f"{s} at patient {patient}'s extremities (thesis Table {12 if patient == 'A' else 13}); star: the closest point")
         level_key(fig, skip=("apart, femur",))
         save(fig, d, f"medial_{s}_{patient}")
 

@@ -2,8 +2,8 @@
 and memory, for every scheme, mode and resolution; Pareto figures; where the errors concentrate.
 
 Reads RESULTS/10_error_vs_runtime/error_runtime.csv and vertex_errors.csv; writes table_main.tex
-(first real subject, rest pose, every configuration), table_peers.tex, pareto_time.pdf,
-pareto_memory.pdf, pareto_sampling.pdf, error_map.pdf (per-vertex errors over the sphere),
+(first real subject, rest pose, every configuration), table_peers.tex, pareto_time_memory.pdf,
+pareto_sampling.pdf, error_map.pdf (per-vertex errors over the sphere),
 equal_error.csv with table_equal_error.tex (every scheme at equal error, issue 12), macros.tex.
 
 equal_error.csv: for every real subject, scheme, storage, mode (exact: the maps alone;
@@ -82,20 +82,22 @@ write_table(d, "table_peers", ["subject", "pose", "vertices", "p95 (mm)", "max (
 # Pareto figures: p95 error against query time and against memory, rest pose, first subject.
 markers = {"equiangular": "o", "helix": "s", "helix-eq10": "v", "conchoid": "^", "octahedral": "D",
            "healpix": "h", "fibonacci": "*"}
-for xcol, stem, xlabel in [("query_ns_per_vertex", "pareto_time", "query time (ns per vertex)"),
-                           ("bytes", "pareto_memory", "memory of both maps (bytes)"),
-                           ("sampling_ms", "pareto_sampling", "sampling both maps (ms)")]:
-    # A colour and marker per scheme, a line style per mode, and a legend for each (at most 8 entries apiece).
-    from matplotlib.lines import Line2D
-    schemes = list(dict.fromkeys(g0.scheme))
-    colour = {s: f"C{k}" for k, s in enumerate(schemes)}
-    style = {"exact": "-", "exact_refined": ":", "linear": "--"}
-    fig, ax = plt.subplots(figsize=(6, 3.8))
+# The Pareto fronts: error against query time and memory (one figure, two panels sharing the error axis) and
+# against sampling time. A colour and marker per scheme, a line style per mode; the legends below the panels.
+from matplotlib.lines import Line2D
+schemes = list(dict.fromkeys(g0.scheme))
+colour = {s: f"C{k}" for k, s in enumerate(schemes)}
+style = {"exact": "-", "exact_refined": ":", "linear": "--"}
+
+
+def pareto_panel(ax, xcol, xlabel):
+    """One Pareto panel; returns the (handle, name) pairs of its modes and peers."""
     for (scheme, mode), g in g0.groupby(["scheme", "mode"]):
         g = g.sort_values("precision_deg")
         ax.loglog(g[xcol], g.p95_abs_mm.clip(lower=1e-7), marker=markers.get(scheme, "o"), color=colour[scheme],
                   ls=style.get(mode, "--"), markersize=4)
-    second = [(Line2D([], [], color="0.3", ls=ls), mode) for mode, ls in style.items() if (g0["mode"] == mode).any()]
+    second = [(Line2D([], [], color="0.3", ls=ls), mode.replace("_", " ")) for mode, ls in style.items()
+              if (g0["mode"] == mode).any()]
     if xcol == "query_ns_per_vertex":
         for pname, mk in (("embree_radial", "P"), ("cgal_radial", "X")):
             g = t[(t.subject == subj) & (t.pose == "rest") & (t.scheme == pname)]
@@ -104,15 +106,30 @@ for xcol, stem, xlabel in [("query_ns_per_vertex", "pareto_time", "query time (n
                 second.append((Line2D([], [], color="k", marker=mk, ls="", markersize=6), pname.replace("_", " ")))
     ax.axhline(0.05, color="r", lw=0.6, ls=":")
     ax.set_xlabel(xlabel)
-    ax.set_ylabel("p95 |gap error| (mm)")
-    ax.set_title(f"{subj}, rest pose (error floor clipped at 1e-7 mm)", fontsize=8)
     ax.grid(True, which="both", lw=0.3)
-    first = ax.legend([Line2D([], [], color=colour[s], marker=markers.get(s, "o"), markersize=4) for s in schemes],
-                      schemes, fontsize=6, title="scheme", title_fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1))
-    ax.add_artist(first)
-    ax.legend([h for h, _ in second], [n for _, n in second], fontsize=6, title="mode, peers", title_fontsize=6,
-              loc="lower left", bbox_to_anchor=(1.01, 0))
-    save(fig, d, stem)
+    return second
+
+
+def pareto_legends(fig, second):
+    fig.legend([Line2D([], [], color=colour[s], marker=markers.get(s, "o"), markersize=4) for s in schemes],
+               schemes, title="scheme", loc="lower center", bbox_to_anchor=(0.5, 0.17), ncol=4, frameon=False)
+    fig.legend([h for h, _ in second], [n for _, n in second], title="mode, peers", loc="lower center",
+               bbox_to_anchor=(0.5, 0.0), ncol=min(len(second), 3), frameon=False)
+
+
+fig, axes = plt.subplots(1, 2, figsize=(6.5, 4.6), sharey=True)
+second = pareto_panel(axes[0], "query_ns_per_vertex", "query time (ns per vertex)")
+pareto_panel(axes[1], "bytes", "memory of both maps (bytes)")
+axes[0].set_ylabel("p95 |gap error| (mm)")
+fig.suptitle(f"{subj}, rest pose (error floor clipped at 1e-7 mm)")
+pareto_legends(fig, second)
+save(fig, d, "pareto_time_memory", rect=(0, 0.37, 1, 1))
+fig, ax = plt.subplots(figsize=(6.5, 4.4))
+second = pareto_panel(ax, "sampling_ms", "sampling both maps (ms)")
+ax.set_ylabel("p95 |gap error| (mm)")
+ax.set_title(f"{subj}, rest pose")
+pareto_legends(fig, second)
+save(fig, d, "pareto_sampling", rect=(0, 0.38, 1, 1))
 
 # Where the errors are: per-vertex errors of equiangular 0.1 exact over (theta, phi).
 fig, ax = plt.subplots(figsize=(7, 3.4))

@@ -13,16 +13,16 @@ syn = read_csv(d, "synthetic.csv")
 real = read_csv(d, "real.csv")
 res = read_csv(d, "residuals.csv")
 
-fig, axes = plt.subplots(1, 3, figsize=(10, 3.2), sharey=True)
+fig, axes = plt.subplots(1, 3, figsize=(7.5, 3.2), sharey=True)
 for ax, cam in zip(axes, sorted(syn.cam_mm.unique())):
     for method, g in syn[(syn.cam_mm == cam) & (syn.noise_mm == 0.3)].groupby("method"):
         m = g.groupby("coverage_deg").centre_error_mm.max()
         ax.semilogy(m.index, m.values, "o-", label=method)
-    ax.set_title(f"cam {cam:g} mm, noise 0.3 mm", fontsize=8)
-    ax.set_xlabel("head coverage half-angle (deg)")
+    ax.set_title(f"cam {cam:g} mm, noise 0.3 mm")
     ax.grid(True, which="both", alpha=0.3)
 axes[0].set_ylabel("max centre error (mm)")
-axes[-1].legend(fontsize=7)
+fig.supxlabel("head coverage half-angle (deg)")
+axes[0].legend(loc="upper right")
 save(fig, d, "synthetic")
 
 rows = []

@@ -49,8 +49,8 @@ for k, (col, label) in enumerate([("impinge_radial_ms", "impinge radial"), ("imp
 ax.set_xticks(x, subjects)
 ax.set_yscale("log")
 ax.set_ylabel("ms per pose (both bones, one thread)")
-ax.legend(fontsize=7)
-save(fig, d, "peers_time")
+fig.legend(*ax.get_legend_handles_labels(), loc="center right", frameon=False)
+save(fig, d, "peers_time", rect=(0, 0, 0.75, 1))
 
 wrong = t.groupby("subject").open3d_sign_disagreements.sum()
 with open(os.path.join(d, "meta.json")) as fm:

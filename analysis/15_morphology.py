@@ -114,7 +114,7 @@ write_macros(d, "macros", macros)
 
 if hips:
     # The alpha angle around the head-neck junction, every hip.
-    fig, ax = plt.subplots(figsize=(6, 3.2))
+    fig, ax = plt.subplots(figsize=(6, 4.2))
     hours = np.arange(1, 13)
     for i, h in enumerate(hips):
         r = mo[mo.subject == h].iloc[0]
@@ -124,13 +124,13 @@ if hips:
     ax.set_xticks(hours)
     ax.set_xlabel("head-neck clock hour (12 superior, 3 anterior)")
     ax.set_ylabel("alpha angle (deg)")
-    ax.legend(fontsize=7)
+    fig.legend(*ax.get_legend_handles_labels(), loc="lower center", ncol=2, frameon=False)
     ax.grid(alpha=0.3)
-    save(fig, d, "alpha_by_hour")
+    save(fig, d, "alpha_by_hour", rect=(0, 0.2, 1, 1))
 
     # Internal rotation at 90 deg flexion (anterior pelvic plane) against the alpha angle and the femoral version;
     # and the generated cams' internal rotation (ROM map) against their alpha angle.
-    fig, axes = plt.subplots(1, 3, figsize=(10, 3.2))
+    fig, axes = plt.subplots(1, 3, figsize=(8, 3.6))
     for ax, key, label in ((axes[0], "alpha_max_deg", "largest alpha angle (deg)"),
                            (axes[1], "version_posterior_condylar_deg", "femoral version (deg)")):
         for i, h in enumerate(hips):
@@ -143,14 +143,15 @@ if hips:
         ax.set_xlabel(label)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("IR at 90 deg flexion, APP (deg)")
-    axes[1].legend(fontsize=6)
+    handles, labels = axes[1].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower left", bbox_to_anchor=(0.0, 0.0), ncol=2, frameon=False)
     ax = axes[2]
     for flexion, marker in ((0, "o-"), (20, "s-")):
         xs = [float(generated[generated.subject == c].alpha_max_deg.iloc[0]) for c in cams]
         ys = [gen_ir(c, flexion) for c in cams]
-        ax.plot(xs, ys, marker, label=f"generated cams, {flexion} deg flexion")
+        ax.plot(xs, ys, marker, color=f"C{4 + flexion // 20}", label=f"generated cams, {flexion} deg flexion")
     ax.set_xlabel("largest alpha angle (deg)")
     ax.set_ylabel("internal rotation (deg, ROM map)")
-    ax.legend(fontsize=6)
+    fig.legend(*ax.get_legend_handles_labels(), loc="lower right", bbox_to_anchor=(1.0, 0.0), frameon=False)
     ax.grid(alpha=0.3)
-    save(fig, d, "ir90_vs_morphology")
+    save(fig, d, "ir90_vs_morphology", rect=(0, 0.2, 1, 1))

@@ -105,7 +105,7 @@ write_table(d, "table_plans", ["hip", "plan", "motion", "limit before", "target"
                                "max depth (mm)", "on cam (\\%)"], rows, align="lllrrrlrrr")
 
 # Planned volume against the cam's.
-fig, ax = plt.subplots(figsize=(5, 3.6))
+fig, ax = plt.subplots(figsize=(3.6, 3.4))
 if len(plans):
     ax.plot(plans.cam_volume_mm3, plans.volume_mm3, "o", label="generated cams")
 if len(cam_plans):
@@ -117,7 +117,7 @@ ax.plot(x, x, "k-", lw=1, label="the cam's volume")
 ax.plot(x, 1.2 * x, "k--", lw=1, label="1.2 x the cam's volume")
 ax.set_xlabel("cam volume (mm$^3$)")
 ax.set_ylabel("planned resection (mm$^3$)")
-ax.legend(fontsize=7)
+ax.legend(loc="upper left", handlelength=1.5)
 ax.grid(alpha=0.3)
 save(fig, d, "volume_vs_cam")
 
@@ -126,16 +126,16 @@ cases = [(f"gen {r.cam_mm:g} mm, {r.motion.replace('_', ' ')}", r.limit_free_deg
          for r in planned.itertuples()]
 cases += [(f"{r.subject}, {r.motion.replace('_', ' ')}", r.limit_free_deg, r.limit_cam_deg, r.limit_after_deg)
           for r in cam_plans.itertuples()]
-fig, ax = plt.subplots(figsize=(8, 3.6))
+fig, ax = plt.subplots(figsize=(6.5, 1.2 + 0.32 * max(1, len(cases))))
 if cases:
     y = np.arange(len(cases))
     ax.barh(y - 0.27, [c[1] for c in cases], 0.27, label="without the cam", color="0.7")
     ax.barh(y, [c[2] for c in cases], 0.27, label="with the cam", color="tab:red")
-    ax.barh(y + 0.27, [c[3] for c in cases], 0.27, label="after the plan (checked)", color="tab:blue")
+    ax.barh(y + 0.27, [c[3] for c in cases], 0.27, label="after the plan", color="tab:blue")
     ax.set_yticks(y)
-    ax.set_yticklabels([c[0] for c in cases], fontsize=7)
+    ax.set_yticklabels([c[0] for c in cases])
     ax.invert_yaxis()
 ax.set_xlabel("ROM limit (deg)")
-ax.legend(fontsize=7)
+fig.legend(*ax.get_legend_handles_labels(), loc="upper center", ncol=3, frameon=False)
 ax.grid(alpha=0.3, axis="x")
-save(fig, d, "limits_restored")
+save(fig, d, "limits_restored", rect=(0, 0, 1, 1 - 0.45 / fig.get_size_inches()[1]))

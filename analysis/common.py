@@ -27,15 +27,60 @@ def read_csv(d, file):
     return pd.read_csv(path)
 
 
+# The paper's printed text width (paper/impinge.tex: A4, 2.2 cm margins) and the smallest text a figure may print
+# (issue 51). tools/check-report checks the same two numbers against figures.json.
+TEXT_WIDTH_IN = (210 - 2 * 22) / 25.4
+MIN_FIGURE_FONT_PT = 8
+PAPER_SECTIONS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "paper", "sections")
+
+
+def printed_width_in(folder, stem, sections=None):
+    """The width (inches) at which the paper prints RESULTS/folder/stem: the fraction of the text width given by
+    its \\includegraphics[width=F\\textwidth]{folder/stem} in paper/sections/*.tex, times TEXT_WIDTH_IN; None
+    when the paper does not include the figure (the smallest of several widths when it is included more than
+    once)."""
+    import glob
+    import re
+    sections = sections or PAPER_SECTIONS
+    widths = []
+    pattern = re.compile(r"\\includegraphics\[width=([\d.]*)\\textwidth\]\{" + re.escape(folder + "/" + stem) +
+                         r"(\.pdf|\.png)?\}")
+    for tex in sorted(glob.glob(os.path.join(sections, "*.tex"))):
+        with open(tex) as f:
+            for m in pattern.finditer(f.read()):
+                widths.append(float(m.group(1) or 1) * TEXT_WIDTH_IN)
+    return min(widths) if widths else None
+
+
+def _visible_texts(fig):
+    import matplotlib.text
+    return [t for t in fig.findobj(matplotlib.text.Text) if t.get_visible() and t.get_text().strip()]
+
+
 def save(fig, d, stem, rect=None):
     """Save as PDF (for the paper) and PNG (for viewing). rect: the part of the figure (left, bottom, right,
-    top, 0-1) the axes fill, leaving the rest to a figure legend. Records the figure's width (inches) and the smallest
-    font size of its visible text (points) in d/figures.json, so that tools/check-report can tell the text's size at
-    the width the paper prints it (issue 51: no figure text below 8 pt)."""
+    top, 0-1) the axes fill, leaving the rest to a figure legend.
+
+    Text at its printed size (issue 51): when the paper includes the figure (printed_width_in), every text smaller
+    than MIN_FIGURE_FONT_PT at that width (font size x printed width / figure width) is enlarged to it before the
+    layout is made, so a figure drawn wider than the page still prints legible ticks, labels and legends. Records the
+    figure's width (inches) and the smallest font size of its visible text (points) in d/figures.json, which
+    tools/check-report reads to check the text's printed size."""
     import json
-    import matplotlib.text
+    fig.canvas.draw()  # creates the tick labels, so that they are scaled too
+    printed = printed_width_in(os.path.basename(os.path.normpath(d)), stem)
+    if printed:
+        floor = MIN_FIGURE_FONT_PT * fig.get_size_inches()[0] / printed
+        for t in _visible_texts(fig):
+            if t.get_fontsize() < floor:
+                t.set_fontsize(floor)
+        for ax in fig.axes:
+            for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+                ticks = axis.get_major_ticks() + axis.get_minor_ticks()
+                if any(t.label1.get_fontsize() < floor for t in ticks):
+                    ax.tick_params(axis=name, which="both", labelsize=floor)
     fig.tight_layout(rect=rect)
-    sizes = [t.get_fontsize() for t in fig.findobj(matplotlib.text.Text) if t.get_visible() and t.get_text().strip()]
+    sizes = [t.get_fontsize() for t in _visible_texts(fig)]
     path = os.path.join(d, "figures.json")
     record = {}
     if os.path.exists(path):

@@ -79,8 +79,9 @@ def to_frame(V, origin, axes):
     return (V - origin) @ axes
 
 
-# Plot coordinates: (Z right, X anterior, Y superior), so that matplotlib's vertical axis is superior.
-def _plot(P):
+def plot_coordinates(P):
+    """Points P (n x 3, pelvic frame: X anterior, Y superior, Z right; mm) in the 3-D axes' coordinates
+    (Z right, X anterior, Y superior), so that matplotlib's vertical axis is superior."""
     return P[:, [2, 0, 1]]
 
 
@@ -117,7 +118,7 @@ def draw(ax, bodies, view, side="right", clock=None, radius=60.0, extent=None, t
         F = _crop(V, F, np.zeros(3), radius)
         if len(F) == 0:
             continue
-        tri = _plot(V)[F]
+        tri = plot_coordinates(V)[F]
         nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
         nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
         lam = 0.3 + 0.7 * np.abs(nrm @ light)  # two-sided Lambert
@@ -132,11 +133,11 @@ def draw(ax, bodies, view, side="right", clock=None, radius=60.0, extent=None, t
         c, u, v, r = (np.asarray(clock[k], float) for k in ("centre", "twelve", "three", "radius_mm"))
         t = np.linspace(0, 2 * np.pi, 121)
         ring = c + r * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))
-        ring = _plot(ring)
+        ring = plot_coordinates(ring)
         ax.add_collection3d(Line3DCollection([ring], colors="k", linewidths=0.8, zorder=10))
         for h in (12, 3, 6, 9):
             ang = np.radians(30 * h)
-            p = _plot((c + 1.18 * r * (np.cos(ang) * u + np.sin(ang) * v))[None])[0]
+            p = plot_coordinates((c + 1.18 * r * (np.cos(ang) * u + np.sin(ang) * v))[None])[0]
             ax.text(p[0], p[1], p[2], str(h), fontsize=7, ha="center", va="center", zorder=11,
                     color="k", fontweight="bold")
     lim = extent if extent is not None else min(radius, 60.0) * 0.85

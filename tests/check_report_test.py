@@ -177,6 +177,38 @@ def test_figure_text_under_eight_points_at_its_printed_width_is_found():
                 assert "01_x/fig prints its smallest text at 4.0 pt" in findings[0], findings
 
 
+def test_the_analysis_draws_figure_text_at_eight_points_where_the_paper_prints_it():
+    # analysis/common.py's save() enlarges text drawn at 6 pt on a 6.5 in figure that the paper prints at half the
+    # text width, so that check_figure_text, reading the figures.json it writes, finds nothing; the two share the
+    # text width and the 8 pt floor.
+    sys.path.insert(0, os.path.join(ROOT, "analysis"))
+    import common
+    assert common.TEXT_WIDTH_IN == check.TEXT_WIDTH_IN and common.MIN_FIGURE_FONT_PT == check.MIN_FIGURE_FONT_PT
+    with tempfile.TemporaryDirectory() as results, tempfile.TemporaryDirectory() as paper:
+        os.makedirs(os.path.join(paper, "sections"))
+        with open(os.path.join(paper, "sections", "01.tex"), "w") as f:
+            f.write("\\includegraphics[width=0.5\\textwidth]{01_x/fig.pdf}\n")
+        d = os.path.join(results, "01_x")
+        os.makedirs(d)
+        assert common.printed_width_in("01_x", "fig", os.path.join(paper, "sections")) == 0.5 * check.TEXT_WIDTH_IN
+        assert common.printed_width_in("01_x", "other", os.path.join(paper, "sections")) is None
+        old = common.PAPER_SECTIONS
+        common.PAPER_SECTIONS = os.path.join(paper, "sections")
+        try:
+            fig, ax = common.plt.subplots(figsize=(6.5, 3))
+            ax.plot([0, 1], [0, 1], label="a line")
+            ax.legend(fontsize=6)
+            ax.set_xlabel("x", fontsize=6)
+            ax.tick_params(labelsize=6)
+            common.save(fig, d, "fig")
+        finally:
+            common.PAPER_SECTIONS = old
+        with open(os.path.join(d, "figures.json")) as f:
+            recorded = json.load(f)["fig"]
+        assert recorded["min_font_pt"] >= 8 * 6.5 / (0.5 * check.TEXT_WIDTH_IN) - 1e-9, recorded
+        assert check.check_figure_text(results, paper) == []
+
+
 def test_a_page_that_runs_over_is_found():
     with tempfile.TemporaryDirectory() as d:
         write_run(d, ["abc"], every_item_row(), "Overfull \\vbox (250.3pt too high) has occurred while \\output")
