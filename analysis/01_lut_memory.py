@@ -87,7 +87,21 @@ fem = spr[(spr.body == "femur") & (spr.spacing_deg == fin)]
 eq1 = df[(df.scheme == "equiangular") & (df.matched_precision_deg == 1)].iloc[0]
 hx1 = df[(df.scheme == "helix") & (df.matched_precision_deg == 1)].iloc[0]
 fine = match.iloc[-1]
+
+
+def uniformity(g):
+    """Share of the sphere's area (%) whose node density lies within 10 % of the mean, and the peak over the mean
+    (thesis Fig. 47's uniformity; claims.py applies the same rule)."""
+    mean = g.nodes.sum() / g.band_sr.sum()
+    within = (g.nodes_per_sr / mean - 1).abs() <= 0.1
+    return 100 * g.band_sr[within].sum() / g.band_sr.sum(), g.nodes_per_sr.max() / mean
+
+
+hx_share, hx_peak = uniformity(dens[dens.scheme == "helix"])
+eq_share, eq_peak = uniformity(dens[dens.scheme == "equiangular"])
 write_macros(d, "macros", {
+    "LMhxUniformShare": f"{hx_share:.3f}", "LMhxUniformPeak": f"{hx_peak:.1f}",
+    "LMeqUniformShare": f"{eq_share:.0f}", "LMeqUniformPeak": f"{eq_peak:,.0f}",
     "LMeqOne": f"{int(eq1.nodes):,}", "LMhxOne": f"{int(hx1.nodes):,}",
     "LMratioFine": f"{fine.node_ratio:.4f}", "LMkFine": f"{int(fine.turns):,}",
     "LMratioMin": f"{match.node_ratio.min():.2f}", "LMratioMax": f"{match.node_ratio.max():.2f}",
