@@ -598,6 +598,26 @@ for r in rows:
 lines.append(r"\end{longtable}")
 with open(os.path.join(tex_dir, "table_claims.tex"), "w") as f:
     f.write("\n".join(lines) + "\n")
+# "What holds, in one page" (issue 51, item 5): every claim by verdict, one line each (its thesis item, what it says,
+# the kind of evidence), ahead of the full table.
+headings = {"holds": "Holds", "partly": "Holds in part", "does_not_hold": "Does not hold (refuted under the thesis' "
+            "conditions)", "not_reproduced": "Not reproduced on our subjects (a claim about the thesis' patients or "
+            "models; not a refutation)", "not_testable": "Not testable here"}
+summary = [r"{\footnotesize"]
+for v in VERDICTS:
+    group = [r for r in rows if r["verdict"] == v]
+    if not group:
+        continue
+    summary.append(r"\paragraph{%s (%d).}" % (headings[v], len(group)))
+    summary.append(r"\begin{itemize}\setlength{\itemsep}{0pt}\setlength{\parskip}{0pt}")
+    for r in group:
+        summary.append(r"\item \textbf{%s} (%s): %s" % (latex_escape(r["thesis_item"]), r["kind"],
+                                                      latex_escape(r["claim"])))
+    summary.append(r"\end{itemize}")
+summary.append("}")
+with open(os.path.join(tex_dir, "summary.tex"), "w") as f:
+    f.write("\n".join(summary) + "\n")
+
 counts = {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS}
 # Counts per kind of evidence, so that the abstract does not add measured agreement, recomputed arithmetic and
 # reproduced figures into one number (issue 51).
