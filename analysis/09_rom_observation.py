@@ -316,9 +316,10 @@ write_table(d, "table_extra", ["subject", "motion", "limit", "where", "hidden", 
 rows = []
 for r in lay.itertuples():
     rows.append([r.subject, r.body, str(int(r.layers)), f"{r.layered_bytes / 2**20:.1f}", f"{r.single_bytes / 2**20:.1f}",
-                 f(r.layered_sampling_ms, 0), f(r.single_sampling_ms, 0), str(int(r.max_crossings)),
+                 f"{f(r.layered_sampling_ms, 0)} ({f(r.layered_sampling_q25_ms, 0)}--{f(r.layered_sampling_q75_ms, 0)})",
+                 f(r.single_sampling_ms, 0), str(int(r.max_crossings)),
                  f"{100 * r.nodes_truncated / r.nodes:.2f}", str(int(r.nodes_not_alternating)), str(int(r.hidden_vertices))])
-write_table(d, "table_layered", ["subject", "bone", "layers", "MiB", "single MiB", "ms", "single ms", "most crossings",
+write_table(d, "table_layered", ["subject", "bone", "layers", "MiB", "single MiB", "ms (quartiles)", "single ms", "most crossings",
                                  "truncated \\%", "not alternating", "hidden vertices"], rows, align="llrrrrrrrrr")
 hid = xa[(xa.counted == "hidden") & (xa.validated != "no_limit")]
 far = hid[hid.limited_by == "extra_articular"]
@@ -333,10 +334,12 @@ slow = lay.groupby("subject").first()
 rows = []
 for r in env.itertuples():
     rows.append([r.subject, f"{int(r.poses):,}", f(100 * r.poses_scanned / r.poses), f(100 * r.poses_valid / r.poses),
-                 f(r.envelope_ms / 1000, 2), f"{r.poses_per_core_second / 1000:.0f}k", f(r.brute_force_ms / 1000, 1),
+                 f"{f(r.envelope_ms / 1000, 2)} ({f(r.envelope_q25_ms / 1000, 2)}--{f(r.envelope_q75_ms / 1000, 2)})",
+                 f"{r.poses_per_core_second / 1000:.0f}k",
+                 f"{f(r.brute_force_ms / 1000, 1)} ({f(r.brute_force_q25_ms / 1000, 1)}--{f(r.brute_force_q75_ms / 1000, 1)})",
                  f(100 * r.poses_differ / r.poses, 2)])
-write_table(d, "table_envelope", ["subject", "poses", "scanned \\%", "valid \\%", "time s", "poses/core-s",
-                                  "every pose s", "differ \\%"], rows, align="lrrrrrrr")
+write_table(d, "table_envelope", ["subject", "poses", "scanned \\%", "valid \\%", "time s (quartiles)", "poses/core-s",
+                                  "every pose s (quartiles)", "differ \\%"], rows, align="lrrrrrrr")
 # Kawasaki et al. 2007: 360 x 360 x 180 poses with adaptive refinement in 20 s on 64 PCs.
 KAWASAKI_POSES_PER_PC_SECOND = 360 * 360 * 180 / (20 * 64)
 e0 = env.iloc[0]
@@ -415,6 +418,11 @@ write_macros(d, "macros", {
     "ROMlayeredSamplingMs": f"{lay.layered_sampling_ms.min():.0f}--{lay.layered_sampling_ms.max():.0f}",
     "ROMlayeredSlowdown": f"{(slow.limits_ms_layered / slow.limits_ms_single).min():.1f}--"
                           f"{(slow.limits_ms_layered / slow.limits_ms_single).max():.1f}",
+    "ROMlayeredLimitsSingleMs": f"{slow.limits_ms_single.min():.1f}--{slow.limits_ms_single.max():.1f}",
+    "ROMlayeredLimitsLayeredMs": f"{slow.limits_ms_layered.min():.1f}--{slow.limits_ms_layered.max():.1f}",
+    "ROMlayeredLimitsIqrMax": f"{100 * ((slow.limits_layered_q75_ms - slow.limits_layered_q25_ms) / slow.limits_ms_layered).max():.0f}",
+    "ROMlayeredRuns": str(int(lay.timing_runs.min())),
+    "ROMenvRuns": str(int(env.timing_runs.min())),
     "ROMlayeredNotAlternating": str(int(lay.nodes_not_alternating.sum())),
     "ROMlayeredTruncatedMax": f"{100 * (lay.nodes_truncated / lay.nodes).max():.1f}",
     **method_macros,

@@ -26,11 +26,13 @@
 //   extra_articular.csv  subject x motion x counted vertices (all, hidden): with layered maps (4 crossings
 //                     per node), the limit, where limited, and the exact check 0.5 deg either side (CGAL
 //                     all-intersection rays for the hidden vertices, first hits for the others)
-//   layered.csv       subject x body: layered map nodes, bytes and sampling time beside the single-layer
-//                     map's; hidden vertices; the nine limits' search time with and without layers
+//   layered.csv       subject x body: layered map nodes, bytes and sampling time (median and quartiles of
+//                     at least 5 sessions) beside the single-layer map's; hidden vertices; the nine limits' search
+//                     time with and without layers (alternated, at least 5 rounds: medians and quartiles)
 //   envelope.csv      subject: the ROM envelope (every pose of flexion -30..130 x adduction -50..40 x internal
-//                     rotation -60..60, 1 deg; quick: 2 deg) by adaptive refinement, timed, beside the brute
-//                     force that scans every pose, and the poses on which they differ
+//                     rotation -60..60, 1 deg; quick: 2 deg) by adaptive refinement beside the brute force that
+//                     scans every pose, timed alternately (at least 5 rounds: medians and quartiles), and the
+//                     poses on which they differ
 //   cam.csv           thesis Fig. 60-61: the generated 12k hip without and with a 2 mm cam at the antero-superior
 //                     head-neck junction (scan neutral, the thesis' femoral-head method, bone contact): each
 //                     motion's limit and how high the cam stands where the bones meet (the femur's vertex
@@ -189,12 +191,15 @@ struct Outputs {
                "exact_gap_before_mm", "exact_gap_after_mm", "validated"}),
         layered(dir + "/layered.csv",
                 {"subject", "body", "layers", "nodes", "layered_bytes", "single_bytes", "layered_sampling_ms",
-                 "single_sampling_ms", "nodes_covered", "nodes_truncated", "nodes_not_alternating", "max_crossings",
-                 "hidden_vertices", "limits_ms_single", "limits_ms_layered"}),
+                 "layered_sampling_q25_ms", "layered_sampling_q75_ms", "single_sampling_ms", "nodes_covered",
+                 "nodes_truncated", "nodes_not_alternating", "max_crossings", "hidden_vertices", "limits_ms_single",
+                 "limits_ms_layered", "limits_single_q25_ms", "limits_single_q75_ms", "limits_layered_q25_ms",
+                 "limits_layered_q75_ms", "timing_runs"}),
         env(dir + "/envelope.csv",
             {"subject", "resolution_deg", "step_deg", "coarse_steps", "threads", "poses", "poses_scanned",
-             "poses_valid", "envelope_ms", "poses_per_second", "poses_per_core_second", "brute_force_ms",
-             "brute_force_poses_valid", "poses_differ"}),
+             "poses_valid", "envelope_ms", "envelope_q25_ms", "envelope_q75_ms", "poses_per_second",
+             "poses_per_core_second", "brute_force_ms", "brute_force_q25_ms", "brute_force_q75_ms",
+             "brute_force_poses_valid", "poses_differ", "timing_runs"}),
         sens(dir + "/sensitivity.csv", {"subject", "method", "variant", "motion", "limit_deg", "delta_deg"}),
         tim(dir + "/timing.csv",
             {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "search_q25_ms",
@@ -310,9 +315,21 @@ void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
   const Joint& lj = lhip.joint();
   const RomBaseline lbase = rom_baseline(lhip, lhip.femur_rotation({}), st.ro);
   const std::vector<StandardMotion> xm = extra_articular_motions();
-  auto t1 = Clock::now();
-  find_rom_limits(lhip, r.run.motions, st.ro, lbase);
-  const double limits_layered_ms = ms_since(t1);
+  // The nine limits without and with the layers, timed alternately (medians and quartiles of --repetitions rounds).
+  const HipJoint& hip = r.session.hip();
+  const int reps = std::max(5, st.reps);
+  const std::vector<std::vector<double>> lim_runs =
+      run_alternated({[&] { find_rom_limits(hip, r.run.motions, st.ro, r.run.baseline); },
+                      [&] { find_rom_limits(lhip, r.run.motions, st.ro, lbase); }},
+                     reps);
+  const Timing lim_single = summarize(lim_runs[0]), lim_layered = summarize(lim_runs[1]);
+  // The layered maps' sampling, again `reps` times (each a new session of the same options): its spread.
+  std::vector<double> layered_ms[2];
+  for (int k = 0; k < reps; ++k) {
+    const Session again(lo);
+    layered_ms[0].push_back(again.hip().joint().ball().layered_sampling.sampling_ms);
+    layered_ms[1].push_back(again.hip().joint().socket().layered_sampling.sampling_ms);
+  }
   for (const RomVertices counted : {RomVertices::all, RomVertices::hidden}) {
     RomOptions xo = st.ro;
     xo.vertices = counted;
@@ -339,40 +356,41 @@ void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
                     l.min_gap_at_limit_mm, l.contact_at_start ? 1 : 0, before, after, validated);
     }
   }
-  for (const JointBody* b : {&lj.ball(), &lj.socket()})
+  for (const JointBody* b : {&lj.ball(), &lj.socket()}) {
+    const Timing ls = summarize(layered_ms[b == &lj.ball() ? 0 : 1]);
     out.layered.row(r.subject.name, b == &lj.ball() ? "femur" : "pelvis", lo.maps.layers, b->layered->num_nodes(),
-                    b->layered->bytes(), b->map.bytes(), b->layered_sampling.sampling_ms, b->sampling_ms,
+                    b->layered->bytes(), b->map.bytes(), ls.median_ms, ls.q25_ms, ls.q75_ms, b->sampling_ms,
                     b->layered_sampling.nodes_covered, b->layered_sampling.nodes_truncated,
                     b->layered_sampling.nodes_not_alternating, b->layered_sampling.max_crossings, b->hidden_set.size(),
-                    r.run.limits_ms, limits_layered_ms);
+                    lim_single.median_ms, lim_layered.median_ms, lim_single.q25_ms, lim_single.q75_ms,
+                    lim_layered.q25_ms, lim_layered.q75_ms, reps);
+  }
 }
 
-// The ROM envelope by refinement, timed (median of 3), beside the brute force over every pose.
+// The ROM envelope by refinement beside the brute force over every pose, timed alternately (medians and quartiles
+// of at least 5 rounds).
 void envelope(const SubjectRun& r, const Settings& st, Outputs& out) {
   const HipJoint& hip = r.session.hip();
   RomEnvelopeOptions eo;
   eo.step_deg = st.quick ? 2 : 1;
   eo.coarse_steps = 4;
-  std::vector<double> ts;
-  RomEnvelope fast;
-  for (int rep = 0; rep < 3; ++rep) {
-    const auto t1 = Clock::now();
-    fast = rom_envelope(hip, eo, st.ro, r.run.baseline);
-    ts.push_back(ms_since(t1));
-  }
-  std::sort(ts.begin(), ts.end());
   RomEnvelopeOptions bo = eo;
   bo.coarse_steps = 1;
-  const auto t1 = Clock::now();
-  const RomEnvelope all = rom_envelope(hip, bo, st.ro, r.run.baseline);
-  const double brute_ms = ms_since(t1);
+  RomEnvelope fast, all;
+  const int reps = std::max(5, st.reps);
+  const std::vector<std::vector<double>> runs = run_alternated(
+      {[&] { fast = rom_envelope(hip, eo, st.ro, r.run.baseline); },
+       [&] { all = rom_envelope(hip, bo, st.ro, r.run.baseline); }},
+      reps);
+  const Timing tf = summarize(runs[0]), tb = summarize(runs[1]);
   std::int64_t valid = 0, all_valid = 0, differ = 0;
   for (std::size_t p = 0; p < all.valid.size(); ++p)
     valid += fast.valid[p], all_valid += all.valid[p], differ += fast.valid[p] != all.valid[p];
-  const double ms = ts[1];
+  const double ms = tf.median_ms;
   out.env.row(r.subject.name, st.resolution, eo.step_deg, eo.coarse_steps, st.threads, fast.poses,
-              fast.poses_evaluated, valid, ms, double(fast.poses) / (ms / 1000),
-              double(fast.poses) / (ms / 1000) / st.threads, brute_ms, all_valid, differ);
+              fast.poses_evaluated, valid, ms, tf.q25_ms, tf.q75_ms, double(fast.poses) / (ms / 1000),
+              double(fast.poses) / (ms / 1000) / st.threads, tb.median_ms, tb.q25_ms, tb.q75_ms, all_valid, differ,
+              reps);
 }
 
 // The search's cost beside FCL collide on a subset of the map's poses (flexion 45, adduction 10,

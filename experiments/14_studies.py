@@ -3,9 +3,11 @@
 1. The example cohort study (examples/hip_cohort_study.toml: every shared hip, rom + motion + distance tasks,
    COR perturbations) run serially (no Dask) and on the default local cluster (one worker per core); their
    results.csv compared value for value (every column but time and worker).
-2. Scaling: a study of ROM tasks only (every shared hip, 50 COR perturbations each: >= 200 tasks) on one
-   worker and on two (the 2 cores), in one run: wall times, their ratio, and the per-task overhead
-   (scheduling, serialisation, I/O): (workers x wall - the tasks' own summed time) / the tasks' own time.
+2. Scaling: a study of ROM tasks only (every shared hip at its nominal centre and 10 COR perturbations: 44
+   tasks) on one worker, on two (the 2 cores) and, as the control, as two shards in two processes without Dask,
+   in 5 alternated rounds (each round runs the three in a rotated order): wall times, their ratio paired round
+   by round, and the per-task overhead (scheduling, serialisation, I/O): (workers x wall - the tasks' own summed
+   time) / the tasks' own time.
 3. The tasks' own times, per kind, for the analysis' estimate of a 1,000-subject x 100-perturbation x
    4-method study on one machine and on a cluster.
 Without shared data, the generated hips (no cam, 2 mm cam) stand in for the subjects.
@@ -14,12 +16,12 @@ Outputs (OUT/14_studies/):
   cohort_results.csv   the cohort study's results.csv (local cluster)
   cohort_summary.csv   its summary.csv
   equality.csv         serial against the local cluster: tasks, cells compared, cells that differ
-  scaling.csv          workers (0: the control, two shards in two processes without Dask), tasks, wall_s,
-                       task_s (summed), overhead, mean task s
+  scaling.csv          round, workers (0: the control, two shards in two processes without Dask), tasks,
+                       wall_s, task_s (summed), overhead, mean task s
   task_times.csv       every task of every run: run, kind, subject, time_s, joint_build_s, worker
   meta.json
---quick: 2 perturbations in the cohort, 2 in the scaling study (its figures then test the pipeline, not the
-1,000-subject estimate).
+--quick: 2 perturbations in the cohort, 2 in the scaling study and 2 rounds (its figures then test the pipeline,
+not the 1,000-subject estimate).
 
 usage: exp_14_studies --out DIR [--data DIR] [--quick]
 (build/experiments/exp_14_studies runs this file with the module on PYTHONPATH)"""
@@ -86,7 +88,8 @@ def main():
     # thesis') is the only joint-centre method.
     joint_centre = "equidistant" if real else "femoral-head"
     samples = 2 if quick else 20
-    scaling_samples = 2 if quick else 50
+    scaling_samples = 2 if quick else 10
+    rounds = 2 if quick else 5
     work = tempfile.mkdtemp(prefix="impinge-exp14-")
     cores = os.cpu_count() or 1
     times, scaling = [], []
@@ -123,33 +126,45 @@ def main():
                     f'joint_centre = "{joint_centre}"\n[[task]]\nkind = "rom"\nmetric = "distance"\n'
                     '[perturb]\ncor_sd_mm = 1.0\nsamples = 0\n')
         over = {"subjects": subjects, "perturb.samples": scaling_samples}
-        for workers in (1, 2):
-            print(f"[14_studies] scaling: ROM tasks on {workers} worker(s)", flush=True)
-            folder = os.path.join(work, f"rom{workers}")
+
+        def dask_run(k, workers):
+            print(f"[14_studies] scaling, round {k + 1}/{rounds}: ROM tasks on {workers} worker(s)", flush=True)
+            folder = os.path.join(work, f"rom{workers}-{k}")
             s = study.run(rom, folder, workers=workers, progress=False, log=quiet, overrides=over)
             require_ok(s, folder, f"the scaling study on {workers} worker(s)")
-            scaling.append({"workers": s["workers"], "tasks": s["tasks"], "errors": s["errors"],
+            scaling.append({"round": k, "workers": s["workers"], "tasks": s["tasks"], "errors": s["errors"],
                             "wall_s": s["wall_s"], "setup_s": s["setup_s"], "task_s": s["task_s"],
                             "mean_task_s": s["task_s"] / s["tasks"],
                             "overhead": (s["workers"] * s["wall_s"] - s["task_s"]) / s["task_s"]})
-            times += task_rows(f"rom-{workers}-workers", folder)
-        # The control: the same study as two shards in two processes at once, without Dask (what the 2 cores
-        # give two independent processes of this work).
-        print("[14_studies] scaling: the same tasks as two shards in two processes, without Dask", flush=True)
-        args = over_args(over)
-        t0 = time.perf_counter()
-        procs = [subprocess.Popen([sys.executable, "-m", "impinge.study", "run", rom, "--out",
-                                   os.path.join(work, "shards"), "--workers", "0", "--shard", f"{i}/2",
-                                   "--no-progress"] + args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-                 for i in range(2)]
-        if any(p.wait() != 0 for p in procs):
-            raise SystemExit("14_studies: a shard of the scaling study failed")
-        wall = time.perf_counter() - t0
-        records = runner.merge(os.path.join(work, "shards"), [], log=quiet)
-        task_s = float(sum(r["time_s"] for r in records))
-        scaling.append({"workers": 0, "tasks": len(records), "errors": sum(r["status"] != "ok" for r in records),
-                        "wall_s": wall, "setup_s": 0.0, "task_s": task_s, "mean_task_s": task_s / len(records),
-                        "overhead": (2 * wall - task_s) / task_s})
+            times.extend(task_rows(f"rom-{workers}-workers", folder))
+            shutil.rmtree(folder, ignore_errors=True)
+
+        def control_run(k):
+            # The control: the same study as two shards in two processes at once, without Dask (what the 2 cores
+            # give two independent processes of this work).
+            print(f"[14_studies] scaling, round {k + 1}/{rounds}: two shards in two processes, without Dask",
+                  flush=True)
+            folder = os.path.join(work, f"shards-{k}")
+            t0 = time.perf_counter()
+            procs = [subprocess.Popen([sys.executable, "-m", "impinge.study", "run", rom, "--out", folder,
+                                       "--workers", "0", "--shard", f"{i}/2", "--no-progress"] + over_args(over),
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                     for i in range(2)]
+            if any(p.wait() != 0 for p in procs):
+                raise SystemExit("14_studies: a shard of the scaling study failed")
+            wall = time.perf_counter() - t0
+            records = runner.merge(folder, [], log=quiet)
+            task_s = float(sum(r["time_s"] for r in records))
+            scaling.append({"round": k, "workers": 0, "tasks": len(records),
+                            "errors": sum(r["status"] != "ok" for r in records), "wall_s": wall, "setup_s": 0.0,
+                            "task_s": task_s, "mean_task_s": task_s / len(records), "overhead": (2 * wall - task_s) / task_s})
+            shutil.rmtree(folder, ignore_errors=True)
+
+        # Alternated rounds, the order rotated each round, so that drift of the machine spreads over all three.
+        runs = [lambda k: dask_run(k, 1), lambda k: dask_run(k, 2), control_run]
+        for k in range(rounds):
+            for j in range(len(runs)):
+                runs[(j + k) % len(runs)](k)
         write_csv(os.path.join(d, "scaling.csv"), scaling)
         write_csv(os.path.join(d, "task_times.csv"), times)
     finally:
@@ -158,9 +173,11 @@ def main():
     import distributed
     write_meta(d, "14_studies", quick=quick, data_folder=data if real else None,
                timing="wall time of the task phase (cluster started), one OpenMP thread per task; task times measured "
-                      "inside the tasks (their Joint's build included where it was built)",
+                      "inside the tasks (their Joint's build included where it was built); the scaling study in "
+                      f"{rounds} alternated rounds (1 worker, 2 workers, 2 shards without Dask, the order rotated)",
+               repetitions=rounds,
                parameters={"cohort_study": os.path.relpath(EXAMPLE, ROOT), "cohort_perturbations": samples,
-                           "scaling_perturbations": scaling_samples, "scaling_resolution_deg": 0.5,
+                           "scaling_perturbations": scaling_samples, "scaling_rounds": rounds, "scaling_resolution_deg": 0.5,
                            "subjects": [os.path.basename(os.path.dirname(s)) if isinstance(s, str) else s["name"]
                                         for s in subjects]},
                versions={"distributed": distributed.__version__})
