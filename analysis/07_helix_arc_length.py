@@ -41,7 +41,13 @@ write_table(d, "table", ["$k$", "nodes", "exact $L$", "Eq. 10 $L$", "max index e
               f"{r.exact_ns_per_locate:.0f} ({r.exact_ns_q25:.0f}-{r.exact_ns_q75:.0f})",
               f"{r.eq10_ns_per_locate:.0f} ({r.eq10_ns_q25:.0f}-{r.eq10_ns_q75:.0f})"] for r in idx.itertuples()])
 big = idx.iloc[-1]
+# The self-consistent Eq. 10 helix (nodes placed by Eq. 10 too): its node spacing against the exact helix's.
+selfc = read_csv(d, "self_consistent.csv")
+fine = selfc[selfc.turns >= 229]
 write_macros(d, "macros", {
+    "HAselfMaxRatio": f"{selfc.max_spacing_ratio.max():.2f}",
+    "HAselfShareMin": f"{100 * fine.share_within_10pct.min():.3f}",
+    "HAselfKmin": f"{int(fine.turns.min())}",
     "HAkBig": f"{int(big.turns)}", "HAstepsBig": f"{big.max_abs_index_error_steps:.2f}",
     "HAdifferBig": f"{100 * big.fraction_differing:.1f}", "HAnearestBig": f"{100 * big.fraction_nearest_differing:.1f}",
 })

@@ -8,8 +8,15 @@
 //                     exact arc length, over random directions, and by how many nodes at most; the cost of
 //                     one locate-and-interpolate (ns) of each locator, median and quartiles over `runs`
 //                     alternated rounds
+//   self_consistent.csv  per k: a helix whose nodes are placed by Eq. 10 itself (node i at T = i steps, so
+//                     phi_i = acos(1 - 2 i / (w - 1))), located by Eq. 10 without error by construction: its node
+//                     spacing along the curve against the exact helix's equal spacing (smallest and largest
+//                     ratio, where the largest lies, and the share of intervals within 10 % of it) -- the
+//                     sensitivity check of a self-consistent Eq. 10 helix (issue 51)
 //   meta.json
 // Command: build/experiments/exp_07_helix_arc_length --out results [--quick]
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <random>
 
@@ -33,6 +40,8 @@ int main(int argc, char** argv) {
        "stencils_differing", "fraction_differing", "nearest_node_differing", "fraction_nearest_differing",
        "max_node_index_difference", "max_abs_index_error_steps", "exact_ns_per_locate", "exact_ns_q25", "exact_ns_q75",
        "eq10_ns_per_locate", "eq10_ns_q25", "eq10_ns_q75", "runs"});
+  CsvWriter self(dir + "/self_consistent.csv", {"turns", "nodes", "exact_spacing_deg", "min_spacing_ratio",
+                                                 "max_spacing_ratio", "phi_of_max_deg", "share_within_10pct"});
   int step = 0;
   for (double k : turns) {
     progress("07_helix_arc_length", ++step, int(turns.size()), "k=" + std::to_string(int(k)));
@@ -46,6 +55,23 @@ int main(int argc, char** argv) {
       max_steps = std::max(max_steps, std::abs(steps_f - steps_e));
       arc.row(k, j * 0.1, se, t10, t10 - se, j > 0 ? (t10 - se) / se : std::nan(""), steps_e, steps_f,
               steps_f - steps_e);
+    }
+    {
+      // The self-consistent Eq. 10 helix: node i where Eq. 10's traveled distance is i steps. Its spacing along
+      // the curve (exact arc length between consecutive nodes) over the exact helix's equal spacing.
+      const std::int64_t w = exact.num_nodes();
+      const double dx = exact.node_spacing();
+      double lo = 1e300, hi = 0, phi_hi = 0, prev_s = 0;
+      std::int64_t within = 0;
+      for (std::int64_t i = 1; i < w; ++i) {
+        const double phi = std::acos(std::clamp(1 - 2 * double(i) / double(w - 1), -1.0, 1.0));
+        const double si = s(phi), ratio = (si - prev_s) / dx;
+        prev_s = si;
+        if (ratio < lo) lo = ratio;
+        if (ratio > hi) hi = ratio, phi_hi = phi;
+        within += std::abs(ratio - 1) <= 0.1;
+      }
+      self.row(k, w, dx * kRadToDeg, lo, hi, phi_hi * kRadToDeg, double(within) / double(w - 1));
     }
     std::mt19937_64 rng(1234);
     std::uniform_real_distribution<double> U(0, 1);
