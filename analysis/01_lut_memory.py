@@ -5,7 +5,7 @@ Reads RESULTS/01_lut_memory/{lut_memory,helix_match,density}.csv; writes table.t
 table_helix.tex, table_match.tex, memory.pdf/png, density.pdf/png, macros.tex."""
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, read_csv, resolution_text, save, write_macros, write_table
+from common import density_uniformity, experiment_dir, read_csv, resolution_text, save, write_macros, write_table
 
 d = experiment_dir("01_lut_memory")
 df = read_csv(d, "lut_memory.csv")
@@ -89,16 +89,9 @@ hx1 = df[(df.scheme == "helix") & (df.matched_precision_deg == 1)].iloc[0]
 fine = match.iloc[-1]
 
 
-def uniformity(g):
-    """Share of the sphere's area (%) whose node density lies within 10 % of the mean, and the peak over the mean
-    (thesis Fig. 47's uniformity; claims.py applies the same rule)."""
-    mean = g.nodes.sum() / g.band_sr.sum()
-    within = (g.nodes_per_sr / mean - 1).abs() <= 0.1
-    return 100 * g.band_sr[within].sum() / g.band_sr.sum(), g.nodes_per_sr.max() / mean
-
-
-hx_share, hx_peak = uniformity(dens[dens.scheme == "helix"])
-eq_share, eq_peak = uniformity(dens[dens.scheme == "equiangular"])
+hx_share, hx_peak = density_uniformity(dens[dens.scheme == "helix"])  # thesis Fig. 47; claims.py's rule too
+eq_share, eq_peak = density_uniformity(dens[dens.scheme == "equiangular"])
+hx_share, eq_share = 100 * hx_share, 100 * eq_share
 write_macros(d, "macros", {
     "LMhxUniformShare": f"{hx_share:.3f}", "LMhxUniformPeak": f"{hx_peak:.1f}",
     "LMeqUniformShare": f"{eq_share:.0f}", "LMeqUniformPeak": f"{eq_peak:,.0f}",

@@ -6,7 +6,7 @@ thesis' level), table_real.tex (real bones, every method), sampling_time.pdf/png
 import numpy as np
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, read_csv, save, session_figures, write_macros, write_table
+from common import experiment_dir, median_quartiles, read_csv, save, session_figures, write_macros, write_table
 
 d = experiment_dir("02_sampling_time")
 t = read_csv(d, "sampling_time.csv")
@@ -44,8 +44,7 @@ def spread(g, method, body):
 def paired(subject, body, p, num, den):
     """(median, lower quartile, upper quartile) of num's time over den's, round by round (sampling_runs.csv)."""
     r = runs[(runs.subject == subject) & (runs.body == body) & np.isclose(runs.precision_deg, p)]
-    ratio = (r[r.method == num].set_index("round").time_ms / r[r.method == den].set_index("round").time_ms).dropna()
-    return (ratio.median(), ratio.quantile(0.25), ratio.quantile(0.75)) if len(ratio) else (np.nan,) * 3
+    return median_quartiles(r[r.method == num].set_index("round").time_ms / r[r.method == den].set_index("round").time_ms)
 
 
 # Table 3 / 8: the generated 3k model (pelvis = the socket model), thesis beside ours.

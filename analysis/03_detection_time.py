@@ -7,7 +7,7 @@ table_throughput.tex, table_schemes.tex (every registered scheme), detection_tim
 import numpy as np
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, read_csv, save, write_macros, write_table
+from common import experiment_dir, median_quartiles, read_csv, save, write_macros, write_table
 
 d = experiment_dir("03_detection_time")
 t = read_csv(d, "detection.csv")
@@ -41,8 +41,7 @@ def paired(subject, pose, num, den, num_res=None, den_res=None):
         if res is not None:
             r = r[np.isclose(r.resolution, res)]
         return r.set_index("round").time_ms
-    ratio = (rounds(num, num_res) / rounds(den, den_res)).dropna()
-    return (ratio.median(), ratio.quantile(0.25), ratio.quantile(0.75)) if len(ratio) else (np.nan,) * 3
+    return median_quartiles(rounds(num, num_res) / rounds(den, den_res))
 
 
 def get(g, method, res=None, col="time_ms"):

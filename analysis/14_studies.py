@@ -9,7 +9,7 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
-from common import experiment_dir, read_csv, save, write_macros, write_table
+from common import experiment_dir, median_quartiles, read_csv, save, write_macros, write_table
 
 d = experiment_dir("14_studies")
 eq = read_csv(d, "equality.csv").iloc[0]
@@ -25,8 +25,7 @@ n_rounds = len(by_round)
 
 def paired(num, den):
     """Median and quartiles of num's wall time over den's, round by round."""
-    r = (by_round[num] / by_round[den]).dropna()
-    return r.median(), r.quantile(0.25), r.quantile(0.75)
+    return median_quartiles(by_round[num] / by_round[den])
 
 
 times = read_csv(d, "task_times.csv")

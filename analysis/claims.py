@@ -25,7 +25,7 @@ import sys
 import numpy as np
 import pandas as pd
 
-from common import THESIS_ROM_ZONES, in_clock_zones, latex_escape, write_macros
+from common import THESIS_ROM_ZONES, density_uniformity, in_clock_zones, latex_escape, write_macros
 
 ROOT = sys.argv[1] if len(sys.argv) > 1 else "results"
 VERDICTS = ("holds", "partly", "does_not_hold", "not_reproduced", "not_testable")
@@ -129,13 +129,8 @@ density = csv_of("01_lut_memory", "density.csv")
 if density is not None and len(density):
     # Fig. 47 / sec. 4.2: the helix's points spread uniformly over the sphere. Node density (nodes per steradian) in
     # 1 deg bands of phi against its mean, as a share of the sphere's area; the equiangular grid beside it.
-    def uniform_share(g):
-        mean = g.nodes.sum() / g.band_sr.sum()
-        within = np.abs(g.nodes_per_sr / mean - 1) <= 0.1
-        return g.band_sr[within].sum() / g.band_sr.sum(), g.nodes_per_sr.max() / mean
-
     hx, eq = density[density.scheme == "helix"], density[density.scheme == "equiangular"]
-    (hx_share, hx_peak), (eq_share, eq_peak) = uniform_share(hx), uniform_share(eq)
+    (hx_share, hx_peak), (eq_share, eq_peak) = density_uniformity(hx), density_uniformity(eq)
     claim("Fig. 47; Sec. 4.2", "the spherical helix's points sample the sphere uniformly (approximately: sec. 4.5)",
           "uniform", f"helix (k = {int(hx.resolution.iloc[0])}): density within 10 % of its mean over "
           f"{100 * hx_share:.3f} % of the sphere, at most {hx_peak:.1f}x the mean (in the band at a pole); "

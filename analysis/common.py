@@ -95,6 +95,22 @@ def save(fig, d, stem, rect=None):
     plt.close(fig)
 
 
+def median_quartiles(values):
+    """(median, lower quartile, upper quartile) of a pandas Series (NaN dropped; three NaNs when empty): the spread of a
+    timing or of a ratio taken round by round."""
+    v = values.dropna()
+    return (v.median(), v.quantile(0.25), v.quantile(0.75)) if len(v) else (float("nan"),) * 3
+
+
+def density_uniformity(g, within=0.1):
+    """Thesis Fig. 47's uniformity of a scheme's nodes, from experiment 01's density.csv rows of one scheme (nodes and
+    band_sr per band of the polar angle): the share of the sphere's area whose node density lies within `within` of
+    the mean (0-1), and the largest density over the mean."""
+    mean = g.nodes.sum() / g.band_sr.sum()
+    close = (g.nodes_per_sr / mean - 1).abs() <= within
+    return g.band_sr[close].sum() / g.band_sr.sum(), g.nodes_per_sr.max() / mean
+
+
 def latex_escape(s):
     """Escape a table cell (cells are plain text, except a cell that is one math span such as "$\\infty$";
     headers are LaTeX and are not escaped)."""

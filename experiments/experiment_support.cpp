@@ -131,8 +131,7 @@ double median_ms(const std::function<void()>& fn, int reps) {
     fn();
     t.push_back(ms_since(t0));
   }
-  std::sort(t.begin(), t.end());
-  return t.size() % 2 ? t[t.size() / 2] : 0.5 * (t[t.size() / 2 - 1] + t[t.size() / 2]);
+  return summarize(std::move(t)).median_ms;
 }
 
 Timing summarize(std::vector<double> ms) {

@@ -31,9 +31,11 @@ std::map<std::string, std::string> proc_fields(const char* path) {
   return fields;
 }
 
+std::string or_unknown(std::string s) { return s.empty() ? std::string("unknown") : s; }
+
 std::string field(const std::map<std::string, std::string>& fields, const std::string& key) {
   const auto it = fields.find(key);
-  return it == fields.end() || it->second.empty() ? std::string("unknown") : it->second;
+  return or_unknown(it == fields.end() ? std::string() : it->second);
 }
 
 std::string first_line(const std::string& path) {
@@ -54,8 +56,6 @@ std::string cache_size(int level) {
   }
   return {};
 }
-
-std::string or_unknown(std::string s) { return s.empty() ? std::string("unknown") : s; }
 
 }  // namespace
 
