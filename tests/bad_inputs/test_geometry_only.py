@@ -3,10 +3,14 @@ whose pelvis or femur has its vertices and faces renumbered (and each face's cor
 every vertex duplicated (each face its own three), gives the original's ROM limits within 0.05 deg and least
 distances within 0.01 mm. A pelvis whose every triangle is split in four (the same surface, more vertices) gives the
 same acetabulum (0.005 mm), the same equidistant translation (0.005 mm) and least distances (0.01 mm), and the same
-limits within 0.1 deg where both runs call them monotone, but for one graze (a contact barely past the contact depth
-is decided by the vertices the split adds: lhdl-ct's extension moves 1.6 deg at 0.5 deg maps, its abduction 1 deg
-at 0.1 deg). An OBJ file's vertices come back in the
-file's order."""
+limits within 0.1 deg where both runs call them monotone, but for one within 1 deg: the vertices the split adds are
+new samples of the same surface, and where the femur's neck presses into the middle of a pelvic triangle they meet it
+first (lhdl-ct's extension: 49.4 deg, 48.75 on the split pelvis; rotating about the fitted head centre instead, its
+internal rotation moves 0.56 deg the same way). A contact between vertices is what a per-vertex gap cannot see, so
+splitting triangles moves a limit by up to the angle over which the contact crosses a triangle. (Before the
+equidistant placement stopped guarding rim contacts, it levered the femur out of the socket past the first contact,
+and the split moved extension 137.9 -> 139.6 deg and abduction 54.6 -> 57.9 deg.) An OBJ file's vertices come back in
+the file's order."""
 import csv
 import json
 import os
@@ -150,7 +154,7 @@ def test_a_pelvis_split_in_four_gives_the_same_acetabulum_translation_and_distan
     la, lb = monotone_limits(tmp_path / "a"), monotone_limits(tmp_path / "b")
     both = set(la) & set(lb)
     assert len(both) >= 6, (la, lb)
-    # All but one within 0.1 deg; the one left is lhdl-ct's extension near 138 deg at 0.5 deg maps (1.6 deg apart,
-    # 108 deg past the normal range: a graze along the posterior rim that the added vertices meet first).
+    # All but one within 0.1 deg; the one left (lhdl-ct's extension, 0.6 deg apart at 0.5 deg maps) within 1 deg,
+    # the split's earlier (its added vertices meet the femur first).
     off = {k: (la[k], lb[k]) for k in both if abs(la[k] - lb[k]) > 0.1}
-    assert len(off) <= 1 and all(abs(a - b) <= 2 for a, b in off.values()), off
+    assert len(off) <= 1 and all(abs(a - b) <= 1 for a, b in off.values()), off

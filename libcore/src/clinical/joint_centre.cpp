@@ -264,6 +264,15 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
   auto scan = [&](const ScanSet& set, const Eigen::Vector3d& at, float* out) {
     scan_gaps_compact(set, Rt, Eigen::Vector3d(-(Rt * at)), joint.ball().map, ScanSide::outside, out);
   };
+  // Whether the femur's surface that set's vertex k faces, with the head centre at `at`, is the head's joint surface
+  // (within the head sphere's reach, as on_head): only there is a closed joint space the head pressed into the
+  // socket. A neck or a cam meeting the rim is an impingement, the ROM's to find, not the placement's to avoid
+  // (guarding it levered the femur out of the socket: lhdl-ct by 6 mm at 70 deg of extension, 23-60 mm beyond).
+  auto faces_head = [&](const ScanSet& set, std::int64_t k, const Eigen::Vector3d& at, float gap) {
+    if (!std::isfinite(gap)) return false;
+    const double r = (Rt * (Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) - at)).norm();
+    return r - gap <= reach_mm_;
+  };
   Eigen::Vector3d t = start_, previous = Eigen::Vector3d::Zero();
   const int max_iterations = 4 * options_.max_iterations;
   for (int it = 0, steps = 0; it < max_iterations; ++it) {
@@ -284,7 +293,7 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
       watched_gap.resize(static_cast<std::size_t>(watched.size()));
       scan(watched, t, watched_gap.data());
       for (std::int64_t k = 0; k < watched.size(); ++k)
-        if (std::isfinite(watched_gap[static_cast<std::size_t>(k)]))
+        if (faces_head(watched, k, t, watched_gap[static_cast<std::size_t>(k)]))
           open.add(watched.x[k], watched.y[k], watched.z[k], watched_gap[static_cast<std::size_t>(k)]);
     }
     Eigen::Vector3d d = constrained_step(A, b, t, open, active);
@@ -297,14 +306,15 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
     scan(guard_, t, guard_gap.data());
     bool closed = false;
     for (std::int64_t k = 0; k < ng && !closed; ++k)
-      closed = !is_watched[static_cast<std::size_t>(k)] && guard_gap[static_cast<std::size_t>(k)] < -options_.tolerance_mm;
+      closed = !is_watched[static_cast<std::size_t>(k)] && guard_gap[static_cast<std::size_t>(k)] < -options_.tolerance_mm &&
+               faces_head(guard_, k, t, guard_gap[static_cast<std::size_t>(k)]);
     if (!closed) break;
     // Closed by whatever of the femur (the head, or a bump past its sphere): watch it, and its neighbours in
     // closing (within kNearMm), so that the next round does not close them in turn.
     constexpr float kNearMm = 0.25f;
     for (std::int64_t k = 0; k < ng; ++k) {
       const auto i = static_cast<std::size_t>(k);
-      if (is_watched[i] || !(guard_gap[i] < kNearMm)) continue;
+      if (is_watched[i] || !(guard_gap[i] < kNearMm) || !faces_head(guard_, k, t, guard_gap[i])) continue;
       is_watched[i] = 1;
       watched.index.push_back(guard_.index[i]);
       watched.x.push_back(guard_.x[k]), watched.y.push_back(guard_.y[k]), watched.z.push_back(guard_.z[k]);

@@ -26,6 +26,10 @@
 ///   the head's joint surface (those found closed at a converged t join the constraints and the iteration goes
 ///   on): the head is never pressed into the socket to even the joint space out (an MRI socket whose sphere is
 ///   barely larger than the head's, tlem2-mri's, had it pressed 1-2.5 mm in and its abduction ended at 8 deg).
+///   Only a closure by the head's joint surface is guarded (the femur's surface facing the lunate vertex within
+///   the head sphere's reach): a neck or cam meeting the rim is an impingement, the ROM's to find. Guarding it
+///   too levered the femur out of the socket past the first contact (lhdl-ct: 6 mm at 70 deg of extension,
+///   23-60 mm beyond 75 deg, where the bones parted again and extension ended at 138 deg instead of 49).
 ///
 /// Puls et al. define the methods in words (the hip centre fixed in the head, fixed in the
 /// acetabulum, both, or recomputed per pose to keep the joint space equidistant); the formulas
