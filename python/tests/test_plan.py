@@ -168,6 +168,20 @@ def test_internal_rotation_in_flexion_ten_degrees_more_on_a_real_hip(tmp_path):
              tmp_path / "both" / "pelvis_resected.ply", "--out", tmp_path / "after", "--no-map", "--precision", 0.5])
     assert r.returncode == 0, r.stderr
     assert limits(tmp_path / "after")["internal_rotation_90_flexion"] >= target - 0.5
+    # Whatever the passes (a further one where the check of the first missed: the resected bones' own joint centre
+    # and rim), plan.json's volumes are the written meshes' (the enclosed volumes, computed here) and every vertex's
+    # total depth is within the safety depth.
+    plan = json.load(open(tmp_path / "both" / "plan.json"))
+    assert 1 <= plan["plan"]["passes"] <= 3
+    meshes = impinge.subject_meshes(subject)
+    for bone, key in (("femur", "femur_resection"), ("pelvis", "pelvis_resection")):
+        V, F = impinge.load_mesh(meshes[bone])
+        props, Fr = read_ply_properties(tmp_path / "both" / f"{bone}_resected.ply")
+        Vr = np.column_stack([props["x"], props["y"], props["z"]])
+        assert np.array_equal(Fr, F)
+        assert abs((volume(V, F) - volume(Vr, F)) - plan[key]["volume_mm3"]) <= 1e-3 * plan[key]["volume_mm3"] + 0.05
+        assert props["resection_mm"].max() <= plan["safety_depth"]["value_mm"] + 1e-6
+        assert abs(props["resection_mm"].max() - plan[key]["max_depth_mm"]) <= 1e-4
 
 
 @pytest.mark.skipif(not os.path.isdir(os.path.join(DATA, "tlem2-mri")), reason="shared data absent")

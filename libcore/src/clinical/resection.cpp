@@ -217,6 +217,30 @@ double neck_diameter_mm(const Vertices& femur, const Faces& faces, const Eigen::
   return best;
 }
 
+void summarize_resection(BoneResection& out, const Vertices& original, const Faces& F, const Eigen::VectorXd& vertex_area,
+                         double cap_mm) {
+  const auto n = static_cast<std::size_t>(original.rows());
+  require(out.depth_mm.size() == n && static_cast<std::size_t>(out.resected.rows()) == n &&
+              static_cast<std::size_t>(vertex_area.size()) == n,
+          "resection summary: " + std::to_string(out.depth_mm.size()) + " depths, " +
+              std::to_string(out.resected.rows()) + " resected vertices and " + std::to_string(vertex_area.size()) +
+              " areas for " + std::to_string(n) + " vertices");
+  out.volume_mm3 = enclosed_volume(original, F) - enclosed_volume(out.resected, F);
+  out.area_mm2 = out.max_depth_mm = out.mean_depth_mm = 0;
+  out.vertices = out.capped_vertices = 0;
+  double weighted = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = out.depth_mm[i];
+    if (d >= cap_mm - 1e-9 && d > 0) ++out.capped_vertices;
+    if (d <= kResectedDepthMm) continue;
+    ++out.vertices;
+    out.area_mm2 += vertex_area[static_cast<Eigen::Index>(i)];
+    weighted += vertex_area[static_cast<Eigen::Index>(i)] * d;
+    out.max_depth_mm = std::max(out.max_depth_mm, d);
+  }
+  out.mean_depth_mm = out.area_mm2 > 0 ? weighted / out.area_mm2 : 0;
+}
+
 ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTarget>& targets,
                              const RomBaseline& baseline, const ResectionOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -254,6 +278,11 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
     s.depth.assign(n, 0.0);
     s.resected = body.relative;
     s.limit.assign(n, cap);
+    const std::vector<double>& removed = b == 0 ? o.femur_removed_mm : o.pelvis_removed_mm;
+    require(removed.empty() || removed.size() == n, "resection: " + std::to_string(removed.size()) +
+                                                        " depths removed before for " + std::to_string(n) +
+                                                        " vertices of " + body.mesh.source);
+    for (std::size_t i = 0; i < removed.size(); ++i) s.limit[i] = std::max(0.0, cap - removed[i]);
     s.thin.assign(n, 0);
     s.thickness_known.assign(n, 0);
     if (s.allowed) {
@@ -491,19 +520,15 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
     out.protected_vertex = s.protect;
     out.resected = s.resected;
     out.normals = s.normals;
-    out.volume_mm3 = enclosed_volume(*s.V, *s.F) - enclosed_volume(s.resected, *s.F);
-    const Eigen::VectorXd& area = *s.area;
-    double weighted = 0;
+    summarize_resection(out, *s.V, *s.F, *s.area, cap);
+    // At the safety depth: this round's depth and an earlier round's together.
+    const std::vector<double>& removed = b == 0 ? o.femur_removed_mm : o.pelvis_removed_mm;
+    out.capped_vertices = 0;
     for (std::size_t i = 0; i < s.depth.size(); ++i) {
-      if (s.depth[i] >= cap - 1e-9 && s.depth[i] > 0) ++out.capped_vertices;
+      const double before = removed.empty() ? 0.0 : removed[i];
+      if (s.depth[i] > 0 && s.depth[i] + before >= cap - 1e-9) ++out.capped_vertices;
       if (s.thin[i] && s.depth[i] > 0) ++out.thin_vertices;
-      if (s.depth[i] <= kResectedDepthMm) continue;
-      ++out.vertices;
-      out.area_mm2 += area[static_cast<Eigen::Index>(i)];
-      weighted += area[static_cast<Eigen::Index>(i)] * s.depth[i];
-      out.max_depth_mm = std::max(out.max_depth_mm, s.depth[i]);
     }
-    out.mean_depth_mm = out.area_mm2 > 0 ? weighted / out.area_mm2 : 0;
   }
   plan.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return plan;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iomanip>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "impinge/clinical/clock_summary.hpp"
@@ -239,16 +240,96 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   run.plan_ms = ms_since(t);
 
   // The resected meshes in the input frame: the scan-pose vertices moved by the plan's (joint-frame) displacement.
-  const Eigen::Matrix3d joint_to_input = s.to_input() * hip.joint_to_working();
-  auto resected = [&](const BoneResection& b, const JointBody& body, const Vertices& scan_pose, const char* name) {
+  // `session` is the one the plan was made on; its input is the bones as they were before that plan.
+  auto resected = [](const Session& session, const BoneResection& b, const JointBody& body, const Vertices& scan_pose,
+                     const char* name) {
+    const Eigen::Matrix3d joint_to_input = session.to_input() * session.hip().joint_to_working();
     TriangleMesh m;
     m.V = scan_pose + (b.resected - body.relative) * joint_to_input.transpose();
     m.F = body.mesh.F;
     m.source = name;
     return m;
   };
-  run.femur_resected = resected(run.plan.femur, s.joint().ball(), s.femur_input(hip.scan_pose()), "femur_resected");
-  run.pelvis_resected = resected(run.plan.pelvis, s.joint().socket(), s.pelvis_input(), "pelvis_resected");
+  const Vertices femur_scan = s.femur_input(hip.scan_pose()), pelvis_scan = s.pelvis_input();
+  run.femur_resected = resected(s, run.plan.femur, s.joint().ball(), femur_scan, "femur_resected");
+  run.pelvis_resected = resected(s, run.plan.pelvis, s.joint().socket(), pelvis_scan, "pelvis_resected");
+
+  // The check: a new session on the resected meshes, as `impinge rom` on the written files. Where it misses a
+  // target, a further pass plans on those resected bones, with their own joint placement, acetabulum and joint
+  // surfaces (which the resection may have moved a little: the equidistant joint centre, the rim), within what
+  // the safety depth leaves of each vertex, and adds to the resection; at most kPlanPasses passes.
+  t = Clock::now();
+  constexpr int kPlanPasses = 3;
+  double extra_plan_ms = 0;
+  std::unique_ptr<Session> s_after;
+  RomRun after;
+  for (int pass = 1;; ++pass) {
+    SessionOptions after_options = options;
+    if (run.plan.femur.allowed) after_options.input.ball_mesh = run.femur_resected, after_options.input.ball.clear();
+    if (run.plan.pelvis.allowed)
+      after_options.input.socket_mesh = run.pelvis_resected, after_options.input.socket.clear();
+    // As the first session: the distances on, with the plan's reach (which changes no limit, only which far
+    // vertices get a distance).
+    SessionOptions check_options = rom_session_options(after_options, rom.search);
+    check_options.maps.distances = true;
+    check_options.maps.distance_reach_mm = so.maps.distance_reach_mm;
+    s_after = std::make_unique<Session>(check_options);
+    after = run_rom(*s_after, limits_only);
+    run.all_met = true;
+    run.targets.clear();
+    for (const ResectionTarget& target : targets) {
+      PlanTargetCheck c;
+      c.name = target.name;
+      c.target_deg = target.angle_deg;
+      if (!std::isnan(target.angle_deg)) {
+        for (std::size_t m = 0; m < before.motions.size(); ++m)
+          if (before.motions[m].name == target.name) c.before = before.limits[m], c.after = after.limits[m];
+        c.met = c.after.status == RomLimitStatus::free ||
+                (c.after.status == RomLimitStatus::limited && c.after.limit_deg >= target.angle_deg - 0.1);
+        if (!c.met)
+          c.shortfall_deg =
+              c.after.status == RomLimitStatus::limited ? target.angle_deg - c.after.limit_deg : target.angle_deg;
+      } else {
+        c.frames_in_contact_before = frames_in_contact(s, before.baseline, rom.search, target.poses);
+        c.frames_in_contact_after = frames_in_contact(*s_after, after.baseline, rom.search, target.poses);
+        c.met = c.frames_in_contact_after == 0;
+      }
+      run.all_met = run.all_met && c.met;
+      run.targets.push_back(c);
+    }
+    if (run.all_met || pass >= kPlanPasses) break;
+    // A further pass on the resected bones, its depths added to the earlier passes'.
+    const auto t_pass = Clock::now();
+    ResectionOptions more = ro;
+    more.femur_removed_mm = run.plan.femur.depth_mm;
+    more.pelvis_removed_mm = run.plan.pelvis.depth_mm;
+    const ResectionPlan next =
+        plan_resection(s_after->hip(), plan_targets(*s_after, request, after), after.baseline, more);
+    extra_plan_ms += ms_since(t_pass);
+    if (next.femur.max_depth_mm <= kResectedDepthMm && next.pelvis.max_depth_mm <= kResectedDepthMm) break;
+    const Eigen::Matrix3d joint_to_input = s.to_input() * hip.joint_to_working();
+    auto add = [&](BoneResection& total, const BoneResection& pass_plan, const JointBody& body_after,
+                   const JointBody& body, const Vertices& scan, TriangleMesh& mesh) {
+      if (!total.allowed) return;
+      mesh = resected(*s_after, pass_plan, body_after, mesh.V, mesh.source.c_str());
+      for (std::size_t i = 0; i < total.depth_mm.size(); ++i) total.depth_mm[i] += pass_plan.depth_mm[i];
+      // In the first session's joint frame (the frame of total.resected): the input-frame displacement, rotated.
+      total.resected = body.relative + (mesh.V - scan) * joint_to_input;
+      summarize_resection(total, body.relative, body.mesh.F, body.vertex_area, ro.max_depth_mm);
+      total.thin_vertices += pass_plan.thin_vertices;
+    };
+    add(run.plan.femur, next.femur, s_after->joint().ball(), s.joint().ball(), femur_scan, run.femur_resected);
+    add(run.plan.pelvis, next.pelvis, s_after->joint().socket(), s.joint().socket(), pelvis_scan, run.pelvis_resected);
+    run.plan.targets = next.targets;
+    run.plan.iterations = next.iterations;
+    run.plan.rounds += next.rounds;
+    run.plan.residual_mm = next.residual_mm;
+    run.plan.poses += next.poses;
+    run.plan.contacts += next.contacts;
+    run.plan.ms += next.ms;
+    run.plan.passes = pass + 1;
+  }
+  run.plan_ms += extra_plan_ms;
   if (hip.ball_clock()) {
     run.femur_hours = clock_hours(s.joint().ball().relative, *hip.ball_clock());
     clock_extent(run.femur_hours, run.plan.femur.depth_mm, run.clock_from_h[0], run.clock_to_h[0]);
@@ -257,37 +338,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
     run.pelvis_hours = clock_hours(s.joint().socket().relative, *hip.socket_clock());
     clock_extent(run.pelvis_hours, run.plan.pelvis.depth_mm, run.clock_from_h[1], run.clock_to_h[1]);
   }
-
-  // The check: a new session on the resected meshes, as `impinge rom` on the written files.
-  t = Clock::now();
-  SessionOptions after_options = options;
-  if (run.plan.femur.allowed) after_options.input.ball_mesh = run.femur_resected, after_options.input.ball.clear();
-  if (run.plan.pelvis.allowed)
-    after_options.input.socket_mesh = run.pelvis_resected, after_options.input.socket.clear();
-  const Session s_after(rom_session_options(after_options, rom.search));
-  const RomRun after = run_rom(s_after, limits_only);
-  run.all_met = true;
-  for (const ResectionTarget& target : targets) {
-    PlanTargetCheck c;
-    c.name = target.name;
-    c.target_deg = target.angle_deg;
-    if (!std::isnan(target.angle_deg)) {
-      for (std::size_t m = 0; m < before.motions.size(); ++m)
-        if (before.motions[m].name == target.name) c.before = before.limits[m], c.after = after.limits[m];
-      c.met = c.after.status == RomLimitStatus::free ||
-              (c.after.status == RomLimitStatus::limited && c.after.limit_deg >= target.angle_deg - 0.1);
-      if (!c.met)
-        c.shortfall_deg =
-            c.after.status == RomLimitStatus::limited ? target.angle_deg - c.after.limit_deg : target.angle_deg;
-    } else {
-      c.frames_in_contact_before = frames_in_contact(s, before.baseline, rom.search, target.poses);
-      c.frames_in_contact_after = frames_in_contact(s_after, after.baseline, rom.search, target.poses);
-      c.met = c.frames_in_contact_after == 0;
-    }
-    run.all_met = run.all_met && c.met;
-    run.targets.push_back(c);
-  }
-  run.check_ms = ms_since(t);
+  run.check_ms = ms_since(t) - extra_plan_ms;
   if (run.plan.femur.allowed && run.before) {
     SessionOptions mo = options;
     mo.input.ball_mesh = run.femur_resected;
@@ -374,6 +425,7 @@ nlohmann::json plan_record(const PlanRun& run) {
   j["all_targets_met"] = run.all_met;
   j["plan"] = {{"iterations", run.plan.iterations},
                {"rounds", run.plan.rounds},
+               {"passes", run.plan.passes},
                {"residual_mm", run.plan.residual_mm},
                {"poses", run.plan.poses},
                {"contacts", run.plan.contacts}};

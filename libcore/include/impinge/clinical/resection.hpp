@@ -84,6 +84,10 @@ struct ResectionOptions {
   double tolerance_mm = 0.02;      ///< a contact asking for less than this more is met, mm
   int max_iterations = 16;         ///< rounds of step 4
   double candidate_margin_mm = 1;  ///< contacts: vertices within c + this of the other bone, mm
+  /// Per vertex of the femur and of the pelvis (or empty: none), the depth an earlier plan already removed, mm
+  /// (a further round on its resected bones, run_plan): the safety depth caps the sum, this round's depth at
+  /// max_depth_mm less it.
+  std::vector<double> femur_removed_mm, pelvis_removed_mm;
 };
 
 /// What is removed from one bone.
@@ -100,6 +104,13 @@ struct BoneResection {
   std::int64_t capped_vertices = 0;            ///< vertices held at the safety depth
   std::int64_t thin_vertices = 0;              ///< vertices held at half the bone's thickness under them
 };
+
+/// Fill `out`'s summary (volume_mm3, area_mm2, max_depth_mm, mean_depth_mm, vertices, capped_vertices; not
+/// thin_vertices) from its depth_mm (n, mm) and resected (n x 3, mm): `original` (n x 3, mm, the same frame) and `F`
+/// the bone before any resection, `vertex_area` (n, mm^2) its vertex areas, `cap_mm` the safety depth. Throws
+/// impinge::Error when the sizes differ.
+void summarize_resection(BoneResection& out, const Vertices& original, const Faces& F, const Eigen::VectorXd& vertex_area,
+                         double cap_mm);
 
 /// Per target: whether the plan clears it.
 struct ResectionTargetResult {
@@ -120,6 +131,8 @@ struct ResectionPlan {
   std::vector<ResectionTargetResult> targets;
   int iterations = 0;                    ///< rounds of step 4 in the last plan
   int rounds = 0;                        ///< plans made (1 + one per round of dropping unreachable poses)
+  /// Plans on the resected bones (run_plan: 1, plus one per further round after a check that missed a target)
+  int passes = 1;
   double residual_mm = 0;                ///< the largest depth a kept contact still asks for, mm
   std::int64_t poses = 0, contacts = 0;  ///< poses scanned; (pose, vertex) contacts followed
   double ms = 0;                         ///< wall time, ms
