@@ -51,6 +51,7 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     lunate.band_mm = kLunateBandMm;
     lunate.scan_head_centre = -(to_joint * seat_);
     centre_ = JointCentre(method, *joint_, lunate, articular_->pelvis, articular_->head_sphere_reach_mm, equidistant);
+    centre_.guard_at_neutral(*joint_, femur_rotation({}));  // no head pressed into the socket at neutral
   }
   if (socket_clock_) {
     ball_hours_ = clock_hours(joint_->ball().relative, *ball_clock_);

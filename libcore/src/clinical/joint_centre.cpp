@@ -229,6 +229,25 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
     case JointCentreMethod::combined: return c_a_;
     case JointCentreMethod::equidistant: break;
   }
+  return solve(joint, R, false, nullptr);
+}
+
+void JointCentre::guard_at_neutral(const Joint& joint, const Eigen::Matrix3d& R0) {
+  if (method_ != JointCentreMethod::equidistant) return;
+  std::vector<std::uint8_t> closed(static_cast<std::size_t>(guard_.size()), 0);
+  neutral_closed_.clear();
+  solve(joint, R0, true, &closed);
+  neutral_closed_ = std::move(closed);
+}
+
+std::int64_t JointCentre::guarded_at_neutral() const {
+  std::int64_t n = 0;
+  for (std::uint8_t c : neutral_closed_) n += c;
+  return n;
+}
+
+Eigen::Vector3d JointCentre::solve(const Joint& joint, const Eigen::Matrix3d& R, bool guard_all,
+                                   std::vector<std::uint8_t>* closed_out) const {
   const std::int64_t n = lunate_.size();
   thread_local std::vector<float> g;
   thread_local std::vector<std::uint8_t> on_head;
@@ -259,6 +278,8 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
   thread_local std::vector<std::uint8_t> is_watched;
   guard_gap.resize(static_cast<std::size_t>(ng));
   is_watched.assign(static_cast<std::size_t>(ng), 0);
+  thread_local std::vector<std::int64_t> watched_k;  // each watched vertex's index into guard_
+  watched_k.clear();
   watched.index.clear(), watched.x.clear(), watched.y.clear(), watched.z.clear();
   watched.vertices = guard_.vertices;
   auto scan = [&](const ScanSet& set, const Eigen::Vector3d& at, float* out) {
@@ -272,6 +293,13 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
     if (!std::isfinite(gap)) return false;
     const double r = (Rt * (Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) - at)).norm();
     return r - gap <= reach_mm_;
+  };
+  // Whether guard vertex g's closure is guarded: any closure at neutral (guard_all) and at the vertices closed
+  // there (neutral_closed_), elsewhere the head's (guard_at_neutral).
+  auto guarded = [&](std::int64_t g, const ScanSet& set, std::int64_t k, const Eigen::Vector3d& at, float gap) {
+    if (!std::isfinite(gap)) return false;
+    return guard_all || (!neutral_closed_.empty() && neutral_closed_[static_cast<std::size_t>(g)]) ||
+           faces_head(set, k, at, gap);
   };
   Eigen::Vector3d t = start_, previous = Eigen::Vector3d::Zero();
   const int max_iterations = 4 * options_.max_iterations;
@@ -293,7 +321,7 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
       watched_gap.resize(static_cast<std::size_t>(watched.size()));
       scan(watched, t, watched_gap.data());
       for (std::int64_t k = 0; k < watched.size(); ++k)
-        if (faces_head(watched, k, t, watched_gap[static_cast<std::size_t>(k)]))
+        if (guarded(watched_k[static_cast<std::size_t>(k)], watched, k, t, watched_gap[static_cast<std::size_t>(k)]))
           open.add(watched.x[k], watched.y[k], watched.z[k], watched_gap[static_cast<std::size_t>(k)]);
     }
     Eigen::Vector3d d = constrained_step(A, b, t, open, active);
@@ -307,15 +335,17 @@ Eigen::Vector3d JointCentre::translation(const Joint& joint, const Eigen::Matrix
     bool closed = false;
     for (std::int64_t k = 0; k < ng && !closed; ++k)
       closed = !is_watched[static_cast<std::size_t>(k)] && guard_gap[static_cast<std::size_t>(k)] < -options_.tolerance_mm &&
-               faces_head(guard_, k, t, guard_gap[static_cast<std::size_t>(k)]);
+               guarded(k, guard_, k, t, guard_gap[static_cast<std::size_t>(k)]);
     if (!closed) break;
     // Closed by whatever of the femur (the head, or a bump past its sphere): watch it, and its neighbours in
     // closing (within kNearMm), so that the next round does not close them in turn.
     constexpr float kNearMm = 0.25f;
     for (std::int64_t k = 0; k < ng; ++k) {
       const auto i = static_cast<std::size_t>(k);
-      if (is_watched[i] || !(guard_gap[i] < kNearMm) || !faces_head(guard_, k, t, guard_gap[i])) continue;
+      if (is_watched[i] || !(guard_gap[i] < kNearMm) || !guarded(k, guard_, k, t, guard_gap[i])) continue;
       is_watched[i] = 1;
+      watched_k.push_back(k);
+      if (closed_out) (*closed_out)[i] = 1;
       watched.index.push_back(guard_.index[i]);
       watched.x.push_back(guard_.x[k]), watched.y.push_back(guard_.y[k]), watched.z.push_back(guard_.z[k]);
     }

@@ -27,9 +27,11 @@
 ///   on): the head is never pressed into the socket to even the joint space out (an MRI socket whose sphere is
 ///   barely larger than the head's, tlem2-mri's, had it pressed 1-2.5 mm in and its abduction ended at 8 deg).
 ///   Only a closure by the head's joint surface is guarded (the femur's surface facing the lunate vertex within
-///   the head sphere's reach): a neck or cam meeting the rim is an impingement, the ROM's to find. Guarding it
-///   too levered the femur out of the socket past the first contact (lhdl-ct: 6 mm at 70 deg of extension,
-///   23-60 mm beyond 75 deg, where the bones parted again and extension ended at 138 deg instead of 49).
+///   the head sphere's reach), and at the lunate vertices anything closes at neutral (guard_at_neutral: a head
+///   bulging past its sphere, a segmentation overlap): a neck or cam meeting the rim is an impingement, the ROM's
+///   to find. Guarding it too levered the femur out of the socket past the first contact (lhdl-ct: 6 mm at 70 deg
+///   of extension, 23-60 mm beyond 75 deg, where the bones parted again and extension ended at 138 deg instead of
+///   49; mc22's flexion reached 113 deg with the femur 3.4 mm out, 88 deg now, 1.6 mm).
 ///
 /// Puls et al. define the methods in words (the hip centre fixed in the head, fixed in the
 /// acetabulum, both, or recomputed per pose to keep the joint space equidistant); the formulas
@@ -117,6 +119,16 @@ class JointCentre {
   /// fewer than 16 lunate vertices face the head's joint surface or the iteration diverges.
   Eigen::Vector3d translation(const Joint& joint, const Eigen::Matrix3d& R) const;
 
+  /// Equidistant: the lunate vertices that whatever of the femur closes at the neutral rotation R0 (3 x 3, joint
+  /// frame) stay guarded at every pose, however far the closing surface lies from the head sphere (a head that
+  /// bulges past its sphere, or a segmentation overlap: mc22's head was pressed 0.59 mm into its socket at neutral
+  /// without it). Elsewhere only a closure by the head's joint surface is guarded. Call once, before the first
+  /// translation (HipJoint does, with the anatomical neutral). No-op for the other methods.
+  void guard_at_neutral(const Joint& joint, const Eigen::Matrix3d& R0);
+
+  /// Equidistant: the lunate vertices guarded at every pose by guard_at_neutral (0 before it).
+  std::int64_t guarded_at_neutral() const;
+
   /// The joint space's standard deviation (mm) over the lunate vertices used, at pose (R, t): what
   /// the equidistant method minimises (NaN without them).
   double joint_space_sd_mm(const Joint& joint, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const;
@@ -145,6 +157,11 @@ class JointCentre {
   double reach_mm_ = 0;
   ScanSet lunate_;  // the lunate sample, joint frame (relative to the COR)
   ScanSet guard_;   // the lunate vertices whose joint space must stay open
+  std::vector<std::uint8_t> neutral_closed_;  // per guard_ vertex: closed at neutral (guard_at_neutral), guarded always
+  // translation's iteration; guard_all: every closure guarded (not only the head's); closed_out (guard_.size(), or
+  // null): set to 1 at every guard vertex watched
+  Eigen::Vector3d solve(const Joint& joint, const Eigen::Matrix3d& R, bool guard_all,
+                        std::vector<std::uint8_t>* closed_out) const;
   EquidistantOptions options_;
 };
 
