@@ -207,16 +207,28 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
 ClockFace femoral_clock_face(const TriangleMesh& femur, const Eigen::Vector3d& c, double r,
                              const AnatomicalFrame& F) {
   require(c.allFinite() && std::isfinite(r) && r > 0, femur.source + ": femoral clock: head centre and radius must be finite");
+  // Each vertex weighted by its share of the surface (a third of its triangles' areas), so that the centroid is the
+  // surface's, not the tessellation's: a mesh refined on one side of the neck would pull a plain vertex mean towards
+  // it (issue 49: the femoral version moved by up to 5 deg with the weighting on the shared hips).
+  std::vector<double> area(static_cast<std::size_t>(femur.V.rows()), 0.0);
+  for (Eigen::Index f = 0; f < femur.F.rows(); ++f) {
+    const Eigen::Vector3d a = femur.V.row(femur.F(f, 0)).transpose(), b = femur.V.row(femur.F(f, 1)).transpose(),
+                          e = femur.V.row(femur.F(f, 2)).transpose();
+    const double third = (b - a).cross(e - a).norm() / 6;
+    for (int j = 0; j < 3; ++j) area[static_cast<std::size_t>(femur.F(f, j))] += third;
+  }
   Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  double w = 0;
   int n = 0;
   for (Eigen::Index i = 0; i < femur.V.rows(); ++i) {
     const double d = (femur.V.row(i).transpose() - c).norm();
-    if (d > r + 4 && d < r + 12) s += femur.V.row(i).transpose(), ++n;
+    const double a = area[static_cast<std::size_t>(i)];
+    if (d > r + 4 && d < r + 12 && a > 0) s += a * femur.V.row(i).transpose(), w += a, ++n;
   }
   require(n >= 10, femur.source + ": femoral clock: no neck vertices 4 to 12 mm outside the head sphere");
   ClockFace k;
   k.centre = c;
-  k.axis = (c - s / n).normalized();
+  k.axis = (c - s / w).normalized();
   k.twelve = in_plane(F.axes.col(1), k.axis);
   k.three = k.axis.cross(k.twelve);
   if (k.three.dot(F.axes.col(0)) < 0) k.three = -k.three;

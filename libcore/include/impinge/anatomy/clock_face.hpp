@@ -97,8 +97,9 @@ AcetabularOrientation radiographic_orientation(const Acetabulum& acetabulum, con
                                                Side side);
 
 /// The femoral head-neck clock face (femur frame, working coordinates, mm): centre at the head
-/// centre, axis from the neck (the centroid of the femur's vertices 4 to 12 mm outside the head
-/// sphere) to the head centre, 12 o'clock towards the femoral frame's +y (superior) and 3 towards
+/// centre, axis from the neck (the area-weighted centroid of the femur's surface 4 to 12 mm outside the head
+/// sphere: each vertex there weighted by a third of its triangles' areas, so that the tessellation does not move
+/// it) to the head centre, 12 o'clock towards the femoral frame's +y (superior) and 3 towards
 /// +x (anterior), both projected onto the plane normal to the axis. Throws impinge::Error
 /// naming the mesh when no neck vertices are found.
 ClockFace femoral_clock_face(const TriangleMesh& femur, const Eigen::Vector3d& head_centre, double head_radius_mm,
