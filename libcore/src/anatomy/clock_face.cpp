@@ -207,25 +207,21 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
 ClockFace femoral_clock_face(const TriangleMesh& femur, const Eigen::Vector3d& c, double r,
                              const AnatomicalFrame& F) {
   require(c.allFinite() && std::isfinite(r) && r > 0, femur.source + ": femoral clock: head centre and radius must be finite");
-  // Each vertex weighted by its share of the surface (a third of its triangles' areas), so that the centroid is the
-  // surface's, not the tessellation's: a mesh refined on one side of the neck would pull a plain vertex mean towards
-  // it (issue 49: the femoral version moved by up to 5 deg with the weighting on the shared hips).
-  std::vector<double> area(static_cast<std::size_t>(femur.V.rows()), 0.0);
-  for (Eigen::Index f = 0; f < femur.F.rows(); ++f) {
-    const Eigen::Vector3d a = femur.V.row(femur.F(f, 0)).transpose(), b = femur.V.row(femur.F(f, 1)).transpose(),
-                          e = femur.V.row(femur.F(f, 2)).transpose();
-    const double third = (b - a).cross(e - a).norm() / 6;
-    for (int j = 0; j < 3; ++j) area[static_cast<std::size_t>(femur.F(f, j))] += third;
-  }
+  // The area-weighted centroid of the triangles whose centroids lie in the shell, so that the centroid is the
+  // surface's, not the tessellation's: a mesh refined on one side of the neck pulls a plain vertex mean towards it
+  // (issue 49: the femoral version moved by up to 5 deg with the weighting on the shared hips), and a triangle at
+  // the shell's edge is in or out by its centroid, without bias towards either side.
   Eigen::Vector3d s = Eigen::Vector3d::Zero();
   double w = 0;
   int n = 0;
-  for (Eigen::Index i = 0; i < femur.V.rows(); ++i) {
-    const double d = (femur.V.row(i).transpose() - c).norm();
-    const double a = area[static_cast<std::size_t>(i)];
-    if (d > r + 4 && d < r + 12 && a > 0) s += a * femur.V.row(i).transpose(), w += a, ++n;
+  for (Eigen::Index f = 0; f < femur.F.rows(); ++f) {
+    const Eigen::Vector3d p = femur.V.row(femur.F(f, 0)).transpose(), q = femur.V.row(femur.F(f, 1)).transpose(),
+                          e = femur.V.row(femur.F(f, 2)).transpose();
+    const Eigen::Vector3d g = (p + q + e) / 3;
+    const double d = (g - c).norm(), area = (q - p).cross(e - p).norm() / 2;
+    if (d > r + 4 && d < r + 12 && area > 0) s += area * g, w += area, ++n;
   }
-  require(n >= 10, femur.source + ": femoral clock: no neck vertices 4 to 12 mm outside the head sphere");
+  require(n >= 10, femur.source + ": femoral clock: no neck triangles 4 to 12 mm outside the head sphere");
   ClockFace k;
   k.centre = c;
   k.axis = (c - s / w).normalized();
