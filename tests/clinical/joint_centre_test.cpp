@@ -216,7 +216,9 @@ TEST(JointCentre, EquidistantKeepsTheHeadSeatedPastTheFirstContact) {
       const PoseResult r = hip.joint().detect(pose.R, pose.t);
       const double least = std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);  // radial gaps (no distances here)
       // Once the bones press half a millimetre into each other, they stay pressed: the placement does not part them.
-      if (in_contact > 0) EXPECT_LT(least, 0.0) << a << " deg";
+      if (in_contact > 0) {
+        EXPECT_LT(least, 0.0) << a << " deg";
+      }
       in_contact += least < -0.5 || in_contact > 0;
     }
     EXPECT_GE(in_contact, 5);  // the sweep goes well past the first contact

@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdint>
 #include <string>
+#include <unordered_map>
+#include <vector>
 
 #include "impinge/core/error.hpp"
 
@@ -204,6 +207,120 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
   return A;
 }
 
+namespace {
+
+// The closed loop, nearest p0, in which the plane through p0 normal to n (unit) cuts the triangles `near` of `mesh`:
+// its centroid (by length, mm) and perimeter (mm; NaN when the plane cuts none). The loops are the cut segments
+// joined where they share a mesh edge or an end point (to 1e-6 mm: a T-junction, where a split triangle's edge
+// half meets its neighbour's whole edge).
+struct Section {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  double perimeter = std::numeric_limits<double>::quiet_NaN();
+};
+Section nearest_section(const TriangleMesh& mesh, const std::vector<Eigen::Index>& near, const Eigen::Vector3d& p0,
+                        const Eigen::Vector3d& n) {
+  std::unordered_map<std::uint64_t, int> node;  // a cut mesh edge -> its point's node
+  std::vector<int> parent;
+  auto node_of = [&](Eigen::Index a, Eigen::Index b) {
+    if (a > b) std::swap(a, b);
+    const auto [it, added] =
+        node.emplace((static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint64_t>(b), static_cast<int>(parent.size()));
+    if (added) parent.push_back(static_cast<int>(parent.size()));
+    return it->second;
+  };
+  std::unordered_map<std::uint64_t, int> at_point;  // an end point, rounded to 1e-6 mm -> its first node
+  auto point_key = [](const Eigen::Vector3d& p) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (int k = 0; k < 3; ++k) {
+      h ^= static_cast<std::uint64_t>(std::llround(p[k] * 1e6));
+      h *= 1099511628211ull;
+    }
+    return h;
+  };
+  auto root = [&](int x) {
+    while (parent[static_cast<std::size_t>(x)] != x)
+      x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+    return x;
+  };
+  struct Segment {
+    int node;
+    Eigen::Vector3d mid;
+    double length;
+  };
+  std::vector<Segment> segments;
+  for (const Eigen::Index f : near) {
+    const Eigen::Index v[3] = {mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2)};
+    double s[3];
+    for (int k = 0; k < 3; ++k) s[k] = (mesh.V.row(v[k]).transpose() - p0).dot(n);
+    int cuts = 0, nodes[2] = {0, 0};
+    Eigen::Vector3d points[2];
+    for (int k = 0; k < 3; ++k) {
+      const int l = (k + 1) % 3;
+      if ((s[k] < 0) == (s[l] < 0)) continue;
+      if (cuts < 2) {
+        const double t = s[k] / (s[k] - s[l]);
+        points[cuts] = mesh.V.row(v[k]).transpose() + t * (mesh.V.row(v[l]) - mesh.V.row(v[k])).transpose();
+        nodes[cuts] = node_of(v[k], v[l]);
+      }
+      ++cuts;
+    }
+    if (cuts != 2) continue;
+    for (int k = 0; k < 2; ++k) {  // the same point on another edge (a T-junction): one node
+      const int other = at_point.try_emplace(point_key(points[k]), nodes[k]).first->second;
+      const int a = root(nodes[k]), b = root(other);
+      if (a != b) parent[static_cast<std::size_t>(a)] = b;
+    }
+    const int a = root(nodes[0]), b = root(nodes[1]);
+    if (a != b) parent[static_cast<std::size_t>(a)] = b;
+    segments.push_back({nodes[0], 0.5 * (points[0] + points[1]), (points[0] - points[1]).norm()});
+  }
+  std::unordered_map<int, std::pair<Eigen::Vector3d, double>> loops;  // root -> (sum of length x midpoint, length)
+  for (const Segment& g : segments) {
+    auto it = loops.try_emplace(root(g.node), Eigen::Vector3d::Zero(), 0.0).first;
+    it->second.first += g.length * g.mid;
+    it->second.second += g.length;
+  }
+  Section best;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const auto& [key, loop] : loops) {
+    if (!(loop.second > 0)) continue;
+    const Eigen::Vector3d g = loop.first / loop.second;
+    if ((g - p0).norm() < nearest) nearest = (g - p0).norm(), best.centroid = g, best.perimeter = loop.second;
+  }
+  return best;
+}
+
+}  // namespace
+
+Eigen::Vector3d femoral_neck_axis(const TriangleMesh& femur, const Eigen::Vector3d& c, double r,
+                                  const Eigen::Vector3d& seed) {
+  require(c.allFinite() && std::isfinite(r) && r > 0 && seed.allFinite() && seed.norm() > 0,
+          femur.source + ": femoral neck axis: head centre, radius and seed axis must be finite");
+  // The triangles within reach of the sections (the head, the neck, the trochanters' start).
+  std::vector<Eigen::Index> near;
+  for (Eigen::Index f = 0; f < femur.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if ((femur.V.row(femur.F(f, k)).transpose() - c).norm() <= r + 30) {
+        near.push_back(f);
+        break;
+      }
+  Eigen::Vector3d a = seed.normalized();
+  for (int it = 0; it < 20; ++it) {
+    Section narrowest;
+    for (double d = r - 8; d <= r + 16 + 1e-9; d += 0.5) {
+      const Section s = nearest_section(femur, near, c - d * a, a);
+      if (std::isfinite(s.perimeter) && !(s.perimeter >= narrowest.perimeter)) narrowest = s;
+    }
+    if (!std::isfinite(narrowest.perimeter) || (c - narrowest.centroid).norm() < 1e-9) return seed.normalized();
+    const Eigen::Vector3d next = (c - narrowest.centroid).normalized();
+    const bool done = (next - a).norm() < 1e-7;
+    a = next;
+    if (done) break;
+  }
+  // Far from the seed, the sections found something other than the neck (a short or cut femur): the seed.
+  return a.dot(seed.normalized()) >= std::cos(30 * M_PI / 180) ? a : Eigen::Vector3d(seed.normalized());
+}
+
 ClockFace femoral_clock_face(const TriangleMesh& femur, const Eigen::Vector3d& c, double r,
                              const AnatomicalFrame& F) {
   require(c.allFinite() && std::isfinite(r) && r > 0, femur.source + ": femoral clock: head centre and radius must be finite");
@@ -224,7 +341,8 @@ ClockFace femoral_clock_face(const TriangleMesh& femur, const Eigen::Vector3d& c
   require(n >= 10, femur.source + ": femoral clock: no neck triangles 4 to 12 mm outside the head sphere");
   ClockFace k;
   k.centre = c;
-  k.axis = (c - s / w).normalized();
+  // The shell's centroid seeds the neck axis through the narrowest section (femoral_neck_axis).
+  k.axis = femoral_neck_axis(femur, c, r, (c - s / w).normalized());
   k.twelve = in_plane(F.axes.col(1), k.axis);
   k.three = k.axis.cross(k.twelve);
   if (k.three.dot(F.axes.col(0)) < 0) k.three = -k.three;

@@ -294,11 +294,11 @@ Eigen::Vector3d JointCentre::solve(const Joint& joint, const Eigen::Matrix3d& R,
     const double r = (Rt * (Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) - at)).norm();
     return r - gap <= reach_mm_;
   };
-  // Whether guard vertex g's closure is guarded: any closure at neutral (guard_all) and at the vertices closed
-  // there (neutral_closed_), elsewhere the head's (guard_at_neutral).
-  auto guarded = [&](std::int64_t g, const ScanSet& set, std::int64_t k, const Eigen::Vector3d& at, float gap) {
+  // Whether guard vertex `guard_k`'s closure is guarded: any closure at neutral (guard_all) and at the vertices
+  // closed there (neutral_closed_), elsewhere the head's (guard_at_neutral).
+  auto guarded = [&](std::int64_t guard_k, const ScanSet& set, std::int64_t k, const Eigen::Vector3d& at, float gap) {
     if (!std::isfinite(gap)) return false;
-    return guard_all || (!neutral_closed_.empty() && neutral_closed_[static_cast<std::size_t>(g)]) ||
+    return guard_all || (!neutral_closed_.empty() && neutral_closed_[static_cast<std::size_t>(guard_k)]) ||
            faces_head(set, k, at, gap);
   };
   Eigen::Vector3d t = start_, previous = Eigen::Vector3d::Zero();

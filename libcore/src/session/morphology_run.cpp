@@ -88,8 +88,9 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
   f["sphericity_max_mm"] = measure(number_or_null(m.sphericity_max_mm), "mm", "largest of the same", "impinge");
   f["neck_axis"] =
       measure(vec(T * m.neck_axis), "unit vector",
-              "from the centroid of the femur's surface 4-12 mm outside the head sphere to the head centre",
-              "impinge (femoral_clock_face)");
+              "through the head centre and the centre of the neck's narrowest cross-section (normal to the axis), "
+              "towards the head",
+              "Reikeras et al. 1983, Acta Orthop Scand 54:18 (femoral_neck_axis)");
   f["shaft_axis"] =
       measure(vec(T * m.shaft_axis), "unit vector",
               "principal axis of the diaphysis' surface (35-65 % of the head-to-knee length), proximal", "impinge");

@@ -96,12 +96,22 @@ struct AcetabularOrientation {
 AcetabularOrientation radiographic_orientation(const Acetabulum& acetabulum, const AnatomicalFrame& pelvis_frame,
                                                Side side);
 
+/// The femoral neck axis (unit, from the neck towards the head; same frame as `femur`, mm): the line through the head
+/// centre `c` and the centre of the neck's narrowest cross-section (Reikeras et al. 1983, Acta Orthop Scand 54:18):
+/// the femur cut by planes normal to the axis, 8 mm inside the head radius `r` to 16 mm beyond it every 0.5 mm, the
+/// closed loop nearest the axis in each, the least perimeter's loop centroid (by length) taken as the neck's centre,
+/// the axis through it, repeated until it moves less than 1e-7 (at most 20 times) from `seed` (unit, the same
+/// direction roughly). The seed back when no section is found or the result turns more than 30 deg from it (a short
+/// or cut femur). Throws impinge::Error when c, r or seed is not finite.
+Eigen::Vector3d femoral_neck_axis(const TriangleMesh& femur, const Eigen::Vector3d& c, double r,
+                                  const Eigen::Vector3d& seed);
+
 /// The femoral head-neck clock face (femur frame, working coordinates, mm): centre at the head
-/// centre, axis from the neck (the area-weighted centroid of the femur's surface 4 to 12 mm outside the head
-/// sphere: each vertex there weighted by a third of its triangles' areas, so that the tessellation does not move
-/// it) to the head centre, 12 o'clock towards the femoral frame's +y (superior) and 3 towards
-/// +x (anterior), both projected onto the plane normal to the axis. Throws impinge::Error
-/// naming the mesh when no neck vertices are found.
+/// centre, axis the femoral neck axis (femoral_neck_axis, seeded by the direction from the area-weighted centroid
+/// of the femur's surface 4 to 12 mm outside the head sphere to the head centre: triangles in the shell by their
+/// centroids, weighted by area, so that the tessellation does not move it), 12 o'clock towards the femoral frame's
+/// +y (superior) and 3 towards +x (anterior), both projected onto the plane normal to the axis. Throws
+/// impinge::Error naming the mesh when no neck triangles are found.
 ClockFace femoral_clock_face(const TriangleMesh& femur, const Eigen::Vector3d& head_centre, double head_radius_mm,
                              const AnatomicalFrame& femur_frame);
 
