@@ -6,6 +6,10 @@
   0.5 deg of an own implementation of that definition (numpy slicing, the sections normal to the axis, iterated
   from impinge's axis); the neck shell's centroid that impinge took for the neck's centre before was 0.2-8.4 deg
   off it (area-weighted) and 1.8-13.0 deg (the vertex mean);
+- the lateral centre-edge angle within 0.5 deg of an own ray sweep (numpy Moeller-Trumbore rays from the head centre
+  in the anterior pelvic plane's coronal plane, from superior towards lateral, until one meets no bone within the head
+  radius + 10 mm; the median of five planes 2 mm apart), so that the left-minus-right difference of mc22's one
+  pelvis is the sweep's, -9.0 deg (the rim points' median before read mc22-left's as 10.7 deg, not 19.8: -18.0);
 - Joint.morphology() is the CLI's morphology.json;
 - the femur PLY carries the head's deviation from its sphere."""
 import json
@@ -151,6 +155,55 @@ def test_neck_axis_agrees_with_the_narrowest_section(hip, tmp_path):
             break
     angle = np.degrees(np.arccos(np.clip(a @ impinge_axis, -1, 1)))
     assert angle <= 0.5, (hip, angle)
+
+
+def first_hits(o, d, A, B, C):
+    """Distance (mm) along the unit ray (o, d) to its first hit on the triangles (A, B, C), inf when none."""
+    e1, e2 = B - A, C - A
+    p = np.cross(d, e2)
+    det = (e1 * p).sum(1)
+    ok = np.abs(det) > 1e-12
+    inv = np.where(ok, 1 / np.where(ok, det, 1), 0)
+    s = o - A
+    u = (s * p).sum(1) * inv
+    q = np.cross(s, e1)
+    v = (q @ d) * inv
+    t = (q * e2).sum(1) * inv
+    hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
+    return t[hit].min() if hit.any() else np.inf
+
+
+@needs_data
+@pytest.mark.parametrize("hip", HIPS)
+def test_lateral_centre_edge_angle_is_where_the_roof_ends(hip, tmp_path):
+    m = morphology(os.path.join(DATA, hip, "subject.json"), str(tmp_path))
+    subject = json.load(open(os.path.join(DATA, hip, "subject.json")))
+    V, F = impinge.load_mesh(os.path.join(DATA, hip, subject["pelvis"]))
+    c = np.array(m["femur"]["head_centre_mm"]["value"])
+    r = m["femur"]["head_radius_mm"]["value"]
+    L = {k: np.array(v["position_mm"]) for k, v in m["acetabulum"]["pelvic_frame"]["landmarks"].items()}
+    # The anterior pelvic plane (both ASIS, the pubic tubercles' midpoint): medio-lateral and superior axes in it.
+    pubis = 0.5 * (L["pubic_tubercle_left"] + L["pubic_tubercle_right"])
+    right = (L["asis_right"] - L["asis_left"]) / np.linalg.norm(L["asis_right"] - L["asis_left"])
+    normal = np.cross(L["asis_right"] - pubis, L["asis_left"] - pubis)
+    normal /= np.linalg.norm(normal)
+    up = np.cross(normal, right)
+    up *= np.sign(up @ (0.5 * (L["asis_left"] + L["asis_right"]) - pubis))
+    lateral = right if subject["side"] == "right" else -right
+    near = np.linalg.norm(V[F].mean(1) - c, axis=1) < r + 20
+    A, B, C = V[F[near, 0]], V[F[near, 1]], V[F[near, 2]]
+    edges = []
+    for offset in (-4, -2, 0, 2, 4):
+        o, last = c + offset * normal, None
+        for a in np.arange(0, 90, 0.1):
+            d = np.cos(np.radians(a)) * up + np.sin(np.radians(a)) * lateral
+            if first_hits(o, d, A, B, C) > r + 10:
+                break
+            last = a
+        if last is not None:
+            edges.append(last)
+    own = float(np.median(edges))
+    assert abs(m["acetabulum"]["lateral_centre_edge_deg"]["value"] - own) <= 0.5, (hip, own)
 
 
 def write_ply(path, V, F):

@@ -29,25 +29,36 @@ double version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& medial, c
   return std::atan2(n.dot(ant), n.dot(to_medial)) * kDeg;
 }
 
-// The angle (deg) of the rim in the plane through the head centre (the origin) normal to `normal`, on the side where
-// `side_axis` is positive, measured from `up` towards `towards`: the median over the rim points d (relative to the
-// head centre) within kBandMm of the plane (an MRI rim has notches a single crossing would fall into: mc22-left's
-// lateral centre-edge angle read 5 deg at one crossing, 15 deg as this median); NaN when no rim point lies there.
-double centre_edge_deg(const std::vector<Eigen::Vector3d>& d, const Eigen::Vector3d& normal,
-                       const Eigen::Vector3d& side_axis, const Eigen::Vector3d& up, const Eigen::Vector3d& towards) {
-  constexpr double kBandMm = 5;
-  std::vector<double> angles;
-  for (const Eigen::Vector3d& p : d)
-    if (std::abs(p.dot(normal)) <= kBandMm && p.dot(side_axis) > 0)
-      angles.push_back(std::atan2(p.dot(towards), p.dot(up)) * kDeg);
-  if (angles.empty()) return kNaN;
-  std::sort(angles.begin(), angles.end());
-  const std::size_t k = angles.size() / 2;
-  return angles.size() % 2 == 1 ? angles[k] : 0.5 * (angles[k - 1] + angles[k]);
+// The centre-edge angle (deg): rays from the head centre c (mm) in the plane normal to `normal` swept from `up`
+// towards `towards` (unit vectors, orthogonal) every 0.1 deg; the edge is the last ray before the first that meets no
+// bone of the pelvis within the head radius r + kReachMm (mm; the MRI joint spaces are 3.5-6 mm); the median of the
+// edges in the planes 4, 2 and 0 mm to either side (a notch in an MRI rim lets one plane's ray out early). NaN when
+// even the ray along `up` meets nothing. The rim points' median this replaced read mc22-left's lateral centre-edge
+// angle as 10.7 deg where the roof's bone reaches 19.8 deg (Wiberg's edge: where the roof ends).
+double centre_edge_deg(const ExactReference& pelvis, const Eigen::Vector3d& c, double r, const Eigen::Vector3d& normal,
+                       const Eigen::Vector3d& up, const Eigen::Vector3d& towards) {
+  constexpr double kReachMm = 10, kStepDeg = 0.1;
+  std::vector<double> edges;
+  for (double offset = -4; offset <= 4 + 1e-9; offset += 2) {
+    const Eigen::Vector3d o = c + offset * normal;
+    double last = kNaN;
+    for (double a = 0; a < 90; a += kStepDeg) {
+      const Eigen::Vector3d u = std::cos(a / kDeg) * up + std::sin(a / kDeg) * towards;
+      const std::optional<double> hit = pelvis.first_hit(o, u);
+      if (!hit || *hit > r + kReachMm) break;
+      last = a;
+    }
+    if (!std::isnan(last)) edges.push_back(last);
+  }
+  if (edges.empty()) return kNaN;
+  std::sort(edges.begin(), edges.end());
+  const std::size_t k = edges.size() / 2;
+  return edges.size() % 2 == 1 ? edges[k] : 0.5 * (edges[k - 1] + edges[k]);
 }
 }  // namespace
 
-Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFrames& frames, const Acetabulum& A) {
+Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pelvis, Side side, const HipFrames& frames,
+                              const Acetabulum& A) {
   Morphology m;
   const SphereFitResult& head = frames.head;
   const Eigen::Vector3d c = head.centre;
@@ -174,15 +185,15 @@ Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFra
   const Eigen::Vector3d X = app.axes.col(0), Y = app.axes.col(1), lateral = lateral_sign * app.axes.col(2);
   std::vector<Eigen::Vector3d> d;
   for (const Eigen::Vector3d& p : A.rim) d.push_back(p - c);
-  // Lateral: the rim in the coronal plane (normal X) above the head centre; anterior: in the sagittal plane
-  // (normal: lateral), in front of it.
-  m.lateral_centre_edge_deg = centre_edge_deg(d, X, Y, Y, lateral);
-  m.anterior_centre_edge_deg = centre_edge_deg(d, lateral, X, Y, X);
+  // Lateral: in the coronal plane (normal X) from superior towards lateral; anterior: in the sagittal plane (normal:
+  // lateral) from superior towards anterior.
+  const ExactReference pelvis_ref(pelvis);
+  m.lateral_centre_edge_deg = centre_edge_deg(pelvis_ref, c, r, X, Y, lateral);
+  m.anterior_centre_edge_deg = centre_edge_deg(pelvis_ref, c, r, lateral, Y, X);
   if (std::isnan(m.lateral_centre_edge_deg))
-    m.notes.push_back("lateral centre-edge angle: no rim point within 5 mm of the coronal plane above the head");
+    m.notes.push_back("lateral centre-edge angle: no bone of the pelvis above the head within its radius + 10 mm");
   if (std::isnan(m.anterior_centre_edge_deg))
-    m.notes.push_back(
-        "anterior centre-edge angle: no rim point within 5 mm of the sagittal plane in front of the head");
+    m.notes.push_back("anterior centre-edge angle: no bone of the pelvis above the head within its radius + 10 mm");
   // Coverage: the cap inside the rim, seen from the head centre (the pole: into the acetabulum).
   const Eigen::Vector3d pole = -A.opening;
   std::array<double, 12> sum{};

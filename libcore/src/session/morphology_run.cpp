@@ -35,7 +35,7 @@ MorphologyRun run_morphology(const SessionOptions& options) {
   }
   run.frames.head = head;
   run.acetabulum = find_acetabulum(in.pelvis, head.centre, head.radius, run.frames.pelvis);
-  run.morphology = measure_morphology(in.femur, in.side, run.frames, run.acetabulum);
+  run.morphology = measure_morphology(in.femur, in.pelvis, in.side, run.frames, run.acetabulum);
   run.side = in.side;
   run.to_input = in.to_working.transpose();
   run.input_frame = in.frame;
@@ -142,7 +142,9 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
   a["lateral_centre_edge_deg"] =
       measure(number_or_null(m.lateral_centre_edge_deg), "deg",
               "in the coronal plane (anterior pelvic plane frame) through the head centre, from the superior axis to "
-              "the rim, + lateral (normal 25-39; dysplasia under 20)",
+              "the edge of the acetabular roof (where rays from the head centre, swept laterally, first meet no "
+              "bone within the head radius + 10 mm; the median over planes -4 to 4 mm), + lateral (normal 25-39; "
+              "dysplasia under 20)",
               "Wiberg 1939");
   a["anterior_centre_edge_deg"] =
       measure(number_or_null(m.anterior_centre_edge_deg), "deg",

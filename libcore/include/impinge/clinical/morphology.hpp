@@ -86,12 +86,13 @@ struct Morphology {
   std::vector<std::string> notes;         ///< what could not be measured, and why
 };
 
-/// Measure the morphology of a hip from its whole femur (working frame, mm) on `side`, its frames
+/// Measure the morphology of a hip from its whole femur and its pelvis (working frame, mm) on `side`, its frames
 /// (find_hip_frames: head sphere, landmarks, ISB frames) and its acetabulum (find_acetabulum on the pelvis). The
-/// anterior pelvic plane frame is built from the same landmarks. Costs about a thousand exact ray casts on the femur
-/// (CGAL AABB tree; ExactReference). Throws impinge::Error naming the femur mesh when no neck is found
-/// (femoral_clock_face) or CGAL is missing from this build.
-Morphology measure_morphology(const TriangleMesh& femur, Side side, const HipFrames& frames,
+/// anterior pelvic plane frame is built from the same landmarks. The centre-edge angles are Wiberg's edge found by
+/// rays from the head centre (where the roof's bone ends, the median of five parallel planes 2 mm apart). Costs about
+/// a thousand exact ray casts on the femur and up to 9,000 on the pelvis (CGAL AABB trees; ExactReference). Throws
+/// impinge::Error naming the femur mesh when no neck is found (femoral_clock_face) or CGAL is missing from this build.
+Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pelvis, Side side, const HipFrames& frames,
                               const Acetabulum& acetabulum);
 
 }  // namespace impinge
