@@ -126,6 +126,9 @@ else:
 ca = t[(t.method == "culling_analysis") & (t.subject == subj) & (t.body == "pelvis")]
 if len(ca):
     macros["SampCullingMs"] = fmt(ca.time_ms.iloc[0])
+    macros["SampCullingMsQlow"] = fmt(ca.time_q25_ms.iloc[0])
+    macros["SampCullingMsQhigh"] = fmt(ca.time_q75_ms.iloc[0])
+    macros["SampCullingRuns"] = str(int(ca.runs.iloc[0]))
     macros["SampKeptTriangles"] = f"{int(ca.triangles_rasterised.iloc[0]):,}"
     macros["SampTriangles"] = f"{int(ca.triangles.iloc[0]):,}"
 g3 = gen[gen.precision_deg == gen.precision_deg.min()]

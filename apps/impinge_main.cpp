@@ -289,8 +289,8 @@ int run_plan(const RunOptions& o) {
   for (const PlanTargetCheck& c : run.targets) {
     std::cout << " " << c.name;
     if (!std::isnan(c.target_deg))
-      std::cout << " " << (std::isnan(c.before.limit_deg) ? std::string(to_string(c.before.status)) : std::to_string(std::lround(c.before.limit_deg * 10) / 10.0).substr(0, 5))
-                << "->" << (std::isnan(c.after.limit_deg) ? std::string(to_string(c.after.status)) : std::to_string(std::lround(c.after.limit_deg * 10) / 10.0).substr(0, 5))
+      std::cout << " " << (std::isnan(c.before.limit_deg) ? std::string(to_string(c.before.status)) : std::to_string(static_cast<double>(std::lround(c.before.limit_deg * 10)) / 10.0).substr(0, 5))
+                << "->" << (std::isnan(c.after.limit_deg) ? std::string(to_string(c.after.status)) : std::to_string(static_cast<double>(std::lround(c.after.limit_deg * 10)) / 10.0).substr(0, 5))
                 << "/" << c.target_deg;
     std::cout << (c.met ? " met" : " MISSED") << ";";
   }

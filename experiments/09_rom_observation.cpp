@@ -22,7 +22,9 @@
 //   timing.csv        subject: sampling, limits, map, evaluations, poses per second, share of vertices
 //                     skipped by the bounds, FCL collide per pose and its extrapolated search time; limits, map
 //                     and search (both) are medians of --repetitions searches, search_q25_ms and search_q75_ms
-//                     the search's quartiles, search_runs their number
+//                     the search's quartiles, search_runs their number; sampling (both maps) the median and
+//                     quartiles of at least 5 new sessions (sampling_runs); FCL per pose the median and quartiles
+//                     over fcl_poses_timed poses
 //   extra_articular.csv  subject x motion x counted vertices (all, hidden): with layered maps (4 crossings
 //                     per node), the limit, where limited, and the exact check 0.5 deg either side (CGAL
 //                     all-intersection rays for the hidden vertices, first hits for the others)
@@ -202,9 +204,10 @@ struct Outputs {
              "brute_force_poses_valid", "poses_differ", "timing_runs"}),
         sens(dir + "/sensitivity.csv", {"subject", "method", "variant", "motion", "limit_deg", "delta_deg"}),
         tim(dir + "/timing.csv",
-            {"subject", "resolution_deg", "threads", "sampling_ms", "limits_ms", "map_ms", "search_ms", "search_q25_ms",
-             "search_q75_ms", "search_runs", "evaluations",
-             "poses_per_second", "share_skipped", "fcl_collide_ms_per_pose", "fcl_poses_timed",
+            {"subject", "resolution_deg", "threads", "sampling_ms", "sampling_q25_ms", "sampling_q75_ms",
+             "sampling_runs", "limits_ms", "map_ms", "search_ms", "search_q25_ms", "search_q75_ms", "search_runs",
+             "evaluations", "poses_per_second", "share_skipped", "fcl_collide_ms_per_pose", "fcl_collide_q25_ms",
+             "fcl_collide_q75_ms", "fcl_poses_timed",
              "fcl_search_ms_extrapolated", "fcl_over_ours", "excluded_vertices", "neutral_min_gap_mm"}),
         bony(dir + "/bony.csv",
              {"subject", "side", "head_radius_mm", "head_fit_rms_mm", "acetabular_radius_mm", "acetabular_fit_rms_mm",
@@ -398,7 +401,7 @@ void envelope(const SubjectRun& r, const Settings& st, Outputs& out) {
 void timing(const SubjectRun& r, const Settings& st, Outputs& out) {
   const HipJoint& hip = r.session.hip();
   const Joint& joint = hip.joint();
-  double fcl_ms = std::nan("");
+  Timing fcl;  // FCL collide per pose: median and quartiles over the poses
   int fcl_poses = 0;
   if (have_fcl()) {
     const FclJoint fj(joint.ball().mesh, joint.socket().mesh, Eigen::Vector3d::Zero());
@@ -409,10 +412,18 @@ void timing(const SubjectRun& r, const Settings& st, Outputs& out) {
       fj.collide(R, Eigen::Vector3d::Zero(), 1);
       ts.push_back(ms_since(t1));
     }
-    std::sort(ts.begin(), ts.end());
-    fcl_ms = ts[ts.size() / 2];
+    fcl = summarize(ts);
     fcl_poses = static_cast<int>(ts.size());
   }
+  const double fcl_ms = fcl_poses > 0 ? fcl.median_ms : std::nan("");
+  // Both maps' sampling, in new sessions of the same options (at least 5): its spread (the first session's alone was
+  // one run).
+  std::vector<double> sampling;
+  for (int k = 0; k < std::max(5, st.reps); ++k) {
+    const Session again(r.options);
+    sampling.push_back(again.hip().joint().ball().sampling_ms + again.hip().joint().socket().sampling_ms);
+  }
+  const Timing tsam = summarize(sampling);
   const RomRun& run = r.run;
   const std::int64_t all_evals = run.limit_evaluations + run.map_evaluations;
   // The search (limits and map) again, `reps` times: the medians and quartiles of its times (the limits and the map
@@ -425,10 +436,11 @@ void timing(const SubjectRun& r, const Settings& st, Outputs& out) {
   const Timing tl = summarize(limits), tm = summarize(map), ts = summarize(search);
   const double search_ms = ts.median_ms;
   const double fcl_total = fcl_ms * double(all_evals);
-  out.tim.row(r.subject.name, st.resolution, st.threads, joint.ball().sampling_ms + joint.socket().sampling_ms,
+  out.tim.row(r.subject.name, st.resolution, st.threads, tsam.median_ms, tsam.q25_ms, tsam.q75_ms, tsam.runs,
               tl.median_ms, tm.median_ms, search_ms, ts.q25_ms, ts.q75_ms, ts.runs, all_evals,
               double(all_evals) / (search_ms / 1000),
-              double(run.vertices_skipped) / double(run.vertices_looked_up + run.vertices_skipped), fcl_ms, fcl_poses,
+              double(run.vertices_skipped) / double(run.vertices_looked_up + run.vertices_skipped), fcl_ms,
+              fcl_poses > 0 ? fcl.q25_ms : std::nan(""), fcl_poses > 0 ? fcl.q75_ms : std::nan(""), fcl_poses,
               fcl_total, fcl_total / search_ms, run.baseline.excluded_vertices, run.baseline.min_gap_mm);
 }
 
