@@ -447,6 +447,22 @@ claim("Table 11", "the six extremities of two FAI patients' recorded ROM (Vicon)
       "applied as clinical angles from anatomical neutral", "not_testable",
       "data of the thesis' patients; we apply them to our hips", S09,
       kind="measured", tolerance="--", conditions="--", same_subjects=False)
+sectors = csv_of("09_rom_observation", "observation_sectors.csv")
+
+
+def red_area_in_zones(patient, reverse=False):
+    """The share of patient's extremities' red area (every hip) whose clock sector's middle lies in the thesis' zones
+    (half an hour of slack, as for the closest point), on our clock or the horizontally reversed one; None without
+    the sectors' data or red area."""
+    if sectors is None or not len(sectors):
+        return None
+    g = sectors[sectors.patient == patient]
+    mid = (g.sector + 0.5) % 12
+    inside = [in_clock_zones((12 - h) % 12 if reverse else h, THESIS_ROM_ZONES[patient]) for h in mid]
+    total = g.red_area_mm2.sum()
+    return float(g.red_area_mm2[inside].sum() / total) if total > 0 else None
+
+
 if obs is not None and len(obs):
     for item, patient, zones_text in (("Table 12", "A", "1-2 o'clock"), ("Table 13", "B", "1-3 and 7 o'clock")):
         g = obs[obs.patient == patient]
@@ -456,9 +472,15 @@ if obs is not None and len(obs):
         reversed_hits = sum(in_clock_zones((12 - h) % 12, THESIS_ROM_ZONES[patient]) for h in hours)
         share = hits / max(len(g), 1)
         verdict = "holds" if share >= 0.75 else "partly" if share >= 0.25 else "does_not_hold"
+        # Sensitivity: where the red zone lies by area rather than by its closest point.
+        by_area, by_area_reversed = red_area_in_zones(patient), red_area_in_zones(patient, True)
+        zone_share = np.mean([in_clock_zones(k + 0.5, THESIS_ROM_ZONES[patient]) for k in range(12)])
+        area_text = ("" if by_area is None else
+                     f"; by area {100 * by_area:.0f} % of the red area lies in the zones "
+                     f"({100 * by_area_reversed:.0f} % reversed; the zones are {100 * zone_share:.0f} % of the clock)")
         claim(f"{item}; Sec. 5.2", f"at patient {patient}'s extremities the red zones (within 2 mm) lie at {zones_text}",
               zones_text, f"{hits} of {len(g)} extremities over {g.subject.nunique()} hips ({reversed_hits} of "
-              f"{len(g)} on the horizontally reversed clock)",
+              f"{len(g)} on the horizontally reversed clock){area_text}",
               verdict, "the socket's closest point within half an hour of the thesis' zones, on our clock (3 o'clock "
               "anterior on both sides); ours are mostly posterosuperior, where our hips' joint space is thinnest", S09,
       kind="measured", tolerance="three quarters of the extremities within half an hour of the zones", conditions="the thesis' extremities as clinical angles from anatomical neutral, our hips", same_subjects=False)
@@ -468,18 +490,23 @@ if obs is not None and len(obs):
                        "B": ["abduction", "adduction", "internal_rotation", "flexion"]}
     for item, patient in (("Table 12", "A"), ("Table 13", "B")):
         want = THESIS_SMALLEST[patient]
-        g = obs[obs.patient == patient].assign(least=lambda x: np.fmin(x.ball_min_gap_mm, x.socket_min_gap_mm))
-        found, per_hip = 0, []
+        g = obs[obs.patient == patient].assign(least=lambda x: np.fmin(x.ball_min_gap_mm, x.socket_min_gap_mm),
+                                               red=lambda x: x.socket_area_0to2_mm2 + x.socket_area_penetrating_mm2)
+        found, found_by_area, per_hip = 0, 0, []
         for subject, h in g.groupby("subject", sort=False):
             smallest = list(h.sort_values("least").motion.iloc[:len(want)])
             found += sum(m in smallest for m in want)
+            # Sensitivity: the motions with the largest red area instead of the least gap.
+            reddest = list(h.sort_values("red", ascending=False, kind="stable").motion.iloc[:len(want)])
+            found_by_area += sum(m in reddest for m in want)
             per_hip.append(f"{subject}: {', '.join(m.replace('_', ' ') for m in smallest)}")
         total = len(want) * g.subject.nunique()
         share = found / max(total, 1)
         claim(f"{item}; Sec. 5.2", f"at patient {patient}'s extremities {', '.join(m.replace('_', ' ') for m in want)} "
               "give the smallest gap between the bones",
               ", ".join(m.replace("_", " ") for m in want),
-              f"{found} of {total} among each hip's {len(want)} smallest ({'; '.join(per_hip)})",
+              f"{found} of {total} among each hip's {len(want)} smallest ({'; '.join(per_hip)}); by the largest red "
+              f"area instead, {found_by_area} of {total}",
               "holds" if share >= 0.75 else "partly" if share > len(want) / 6 else "does_not_hold",
               f"the least gap of both scans at each extremity; by chance {len(want)} of the six motions would put "
               f"{100 * len(want) / 6:.0f} % of the thesis' among the {len(want)} smallest (partly: above chance)", S09,

@@ -9,6 +9,9 @@
 //   observation.csv   subject x patient (A, B) x motion: Table 11's extremity as a pose from anatomical
 //                     neutral; both scans' minimum gap, the socket's area per level (thresholds 6, 4,
 //                     2, 0 mm: thesis sec. 5.2's blue > 6 mm and red < 2 mm), the closest point's clock hour
+//   observation_sectors.csv  subject x patient x motion x acetabular clock sector (hours (k, k+1]): the
+//                     socket's red area there (within 2 mm or penetrating, mm^2): where the red zone lies by
+//                     area, beside the closest point's hour
 //   observation_<subject>_<patient>_<motion>.ply  (first real subject) the cup region with gaps, for the
 //                     medial views of Tables 12-13
 //   rom_limits.csv    subject x motion: limit, where limited, exact-reference check 0.5 deg either side
@@ -185,6 +188,7 @@ struct Outputs {
             {"subject", "patient", "motion", "angle_deg", "flexion_deg", "adduction_deg", "internal_rotation_deg",
              "ball_min_gap_mm", "socket_min_gap_mm", "socket_closest_clock_h", "socket_area_over6_mm2",
              "socket_area_4to6_mm2", "socket_area_2to4_mm2", "socket_area_0to2_mm2", "socket_area_penetrating_mm2"}),
+        sectors(dir + "/observation_sectors.csv", {"subject", "patient", "motion", "sector", "hours", "red_area_mm2"}),
         clocks(dir + "/clock_faces.csv", {"subject", "side", "centre_x_mm", "centre_y_mm", "centre_z_mm", "twelve_x",
                                           "twelve_y", "twelve_z", "three_x", "three_y", "three_z", "rim_radius_mm"}),
         extra(dir + "/extra_articular.csv",
@@ -213,7 +217,7 @@ struct Outputs {
              {"subject", "side", "head_radius_mm", "head_fit_rms_mm", "acetabular_radius_mm", "acetabular_fit_rms_mm",
               "inclination_deg", "anteversion_deg", "median_coverage_deg", "notch_coverage_deg", "scan_pose_min_gap_mm",
               "neutral_min_gap_mm"}) {}
-  CsvWriter obs, clocks, extra, layered, env, sens, tim;
+  CsvWriter obs, sectors, clocks, extra, layered, env, sens, tim;
   CsvWriter bony;  // each hip's bony measures beside its limits (left against right: issue 29)
   // rom_limits.csv and rom_map.csv: the CLI's tables (session layer) with the subject first; the
   // limits also with their exact check. methods.csv, methods_map.csv: the same per joint-centre method.
@@ -262,6 +266,12 @@ void observe_table11(const SubjectRun& r, const Settings& st, Outputs& out) {
     const auto& L = res.socket.level_area_mm2;
     out.obs.row(s.name, t.patient, t.motion, t.angle, a.flexion_deg, a.adduction_deg, a.internal_rotation_deg,
                 res.ball.min_gap_mm, res.socket.min_gap_mm, sc.closest_hour, L[0], L[1], L[2], L[3], L[4]);
+    // The red area (the last two levels: 0-2 mm and penetrating) per clock sector.
+    const std::size_t levels = L.size();
+    for (std::size_t k = 0; k < 12 && sc.sector_level_area_mm2.size() == 12 * levels; ++k)
+      out.sectors.row(s.name, t.patient, t.motion, static_cast<int>(k),
+                      std::to_string(k) + "-" + std::to_string(k + 1),
+                      sc.sector_level_area_mm2[k * levels + levels - 2] + sc.sector_level_area_mm2[k * levels + levels - 1]);
     if (!out.wrote_renders)  // the cup region (within the rim radius + 3 mm of the COR), pelvic frame, with gaps
       write_region_ply(st.dir + "/observation_" + s.name + "_" + t.patient + "_" + t.motion + ".ply",
                        hip.joint().socket(), scan_axes().transpose(), hip.acetabulum()->rim_radius_mm + 3,

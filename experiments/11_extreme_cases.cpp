@@ -111,7 +111,7 @@ void discontinuities(const Subject& s, const std::string& name, double res, doub
     }
   // Each joint's ns per vertex: quartiles over the rounds; the refined joint's over the maps', paired round by round
   // (Timing's fields hold ns and ratios here, not ms).
-  const Timing q[2] = {summarize(ns[0]), summarize(ns[1])};
+  const Timing ns_q[2] = {summarize(ns[0]), summarize(ns[1])};
   // The refined joint's marking (both maps' depth discontinuities marked, on copies, and both exact casters built),
   // again at least 5 times: its median and quartiles (the session's own build was one run).
   std::vector<double> marking;
@@ -175,7 +175,7 @@ void discontinuities(const Subject& s, const std::string& name, double res, doub
             std::int64_t(errors.size()), mx, p99, over, skipped, added, mismatched,
             double(refined) / double(flexions.size()), jm.ball().nodes_marked + jm.socket().nodes_marked,
             m == 1 ? mark.median_ms : 0.0, m == 1 ? mark.q25_ms : 0.0, m == 1 ? mark.q75_ms : 0.0, m == 1 ? mark.runs : 0,
-            median(ns[m]), q[m].q25_ms, q[m].q75_ms, paired.median_ms,
+            median(ns[m]), ns_q[m].q25_ms, ns_q[m].q75_ms, paired.median_ms,
             paired.q25_ms, paired.q75_ms);
   }
 }
