@@ -134,19 +134,44 @@ void progress_bar(std::size_t done, std::size_t n) {
 // ---- commands -----------------------------------------------------------------------------
 
 int run_distance(const RunOptions& o) {
+  const auto t_start = Clock::now();
   const std::string& out = o.command.out;
   const PoseAngles pose = parse_pose(o.command.pose);
   SessionOptions so = o.session;
   if (so.maps.setup == "auto") so.maps.setup = "direct";  // one pose: the layered maps would not pay back
   const Session s = open_session(so);
+  const double setup_ms = ms_since(t_start);
+  auto t = Clock::now();
   const FemurPose femur = s.hip().femur_pose(pose);
   const PoseResult res = s.joint().detect(femur.R, femur.t);
+  const double pose_ms = ms_since(t);
+  t = Clock::now();
   begin_output_folder(out, "distance");
   write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur);
   write_map_png(in_dir(out, "ball_map.png"), s.joint().ball().map);
   write_map_png(in_dir(out, "socket_map.png"), s.joint().socket().map);
   nlohmann::json j = run_record(s);
   j.update(pose_record(s, pose, femur, res));
+  // Where a one-pose run's time goes (issue 52): the set-up (reading and checking the meshes, the head fit, the
+  // frames, both maps, their marks and casters, the distance hierarchies; the bodies on two threads, so their parts
+  // overlap), the pose (the joint centre's translation and both scans) and the output.
+  const JointBody& ball = s.joint().ball();
+  const JointBody& socket = s.joint().socket();
+  j["timings_ms"] = {{"setup_total", setup_ms},
+                     {"frames", s.hip().frames_ms()},
+                     {"ball_sampling", ball.sampling_ms},
+                     {"socket_sampling", socket.sampling_ms},
+                     {"ball_marking", ball.marking_ms},
+                     {"socket_marking", socket.marking_ms},
+                     {"ball_layered_sampling", ball.layered_sampling.sampling_ms},
+                     {"socket_layered_sampling", socket.layered_sampling.sampling_ms},
+                     {"pose", pose_ms},
+                     {"ball_detection", res.ball_detection_ms},
+                     {"socket_detection", res.socket_detection_ms},
+                     {"ball_distance", res.ball_distance_ms},
+                     {"socket_distance", res.socket_distance_ms},
+                     {"output", ms_since(t)},
+                     {"total", ms_since(t_start)}};
   write_json(in_dir(out, "summary.json"), j);
   if (o.command.render) render(out);  // reads summary.json; a failure leaves the folder marked incomplete
   end_output_folder(out);

@@ -56,7 +56,16 @@ def test_gaps_equal_the_cli_on_a_generated_hip(generated):
                     "--out", d + "/cli"], check=True, capture_output=True)
     cli_ball, cli_socket = read_gaps(d + "/cli/ball_gaps.ply"), read_gaps(d + "/cli/socket_gaps.ply")
     with open(d + "/cli/summary.json") as f:
-        cor = json.load(f)["head_centre_mm"]
+        summary = json.load(f)
+    cor = summary["head_centre_mm"]
+    # Where the one pose's time went: the parts within the whole (set-up, pose and output in order; each body's
+    # sampling and marking within the set-up, both scans within the pose), no layered maps with the direct set-up.
+    t = summary["timings_ms"]
+    assert summary["setup"] == "direct" and t["ball_layered_sampling"] == t["socket_layered_sampling"] == 0
+    assert 0 < t["setup_total"] + t["pose"] + t["output"] <= t["total"]
+    for part in ("ball", "socket"):
+        assert 0 < t[f"{part}_sampling"] + t[f"{part}_marking"] <= t["setup_total"]
+        assert t[f"{part}_detection"] + t[f"{part}_distance"] <= t["pose"]
     ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
     # The CLI's distance sets up for its one pose (setup auto: direct, no layered maps); the Joint, the same.
     j = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0, setup="direct")
