@@ -337,8 +337,8 @@ Eigen::Vector3d JointCentre::solve(const Joint& joint, const Eigen::Matrix3d& R,
       closed = !is_watched[static_cast<std::size_t>(k)] && guard_gap[static_cast<std::size_t>(k)] < -options_.tolerance_mm &&
                guarded(k, guard_, k, t, guard_gap[static_cast<std::size_t>(k)]);
     if (!closed) break;
-    // Closed by whatever of the femur (the head, or a bump past its sphere): watch it, and its neighbours in
-    // closing (within kNearMm), so that the next round does not close them in turn.
+    // Closed by the head's joint surface (or, at neutral, by anything of the femur): watch it, and its guarded
+    // neighbours in closing (within kNearMm), so that the next round does not close them in turn.
     constexpr float kNearMm = 0.25f;
     for (std::int64_t k = 0; k < ng; ++k) {
       const auto i = static_cast<std::size_t>(k);

@@ -201,6 +201,10 @@ nlohmann::json setup_record(const Session& s) {
   j["cor_method"] = s.cor_method();
   j["head_radius_mm"] = number_or_null(s.head().radius);
   j["joint_centre"] = to_string(hip.joint_centre().method());
+  // The lunate vertices the equidistant placement keeps open at every pose because something of the femur closed
+  // them at neutral (a head past its sphere, a segmentation overlap): 0 on a clean hip.
+  if (hip.joint_centre().method() == JointCentreMethod::equidistant)
+    j["equidistant_guarded_at_neutral"] = hip.joint_centre().guarded_at_neutral();
   j["sphere_fit_rms_mm"] = number_or_null(s.head().rms_residual);
   j["sphere_fit_points"] = s.head().points_used;
   j["scheme"] = opt.scheme->name();
