@@ -102,6 +102,14 @@ def test_head_radius_matches_an_independent_sphere_fit(hip, tmp_path):
     assert 0.2 < a["head_coverage"]["value"] < 0.7
 
 
+def measured_bone(hip, bone, tmp_path):
+    """impinge morphology of a shared hip, its subject.json, the `bone` mesh (V, F) and the head's centre and radius."""
+    m = morphology(os.path.join(DATA, hip, "subject.json"), str(tmp_path))
+    subject = json.load(open(os.path.join(DATA, hip, "subject.json")))
+    V, F = impinge.load_mesh(os.path.join(DATA, hip, subject[bone]))
+    return m, subject, V, F, np.array(m["femur"]["head_centre_mm"]["value"]), m["femur"]["head_radius_mm"]["value"]
+
+
 def section(V, F, p0, n):
     """Centroid (by length) and perimeter (mm) of the closed loop, nearest p0, of the plane (p0, n) through the mesh."""
     s = (V - p0) @ n
@@ -140,11 +148,7 @@ def section(V, F, p0, n):
 @needs_data
 @pytest.mark.parametrize("hip", HIPS)
 def test_neck_axis_agrees_with_the_narrowest_section(hip, tmp_path):
-    m = morphology(os.path.join(DATA, hip, "subject.json"), str(tmp_path))
-    subject = json.load(open(os.path.join(DATA, hip, "subject.json")))
-    V, F = impinge.load_mesh(os.path.join(DATA, hip, subject["femur"]))
-    c = np.array(m["femur"]["head_centre_mm"]["value"])
-    r = m["femur"]["head_radius_mm"]["value"]
+    m, _, V, F, c, r = measured_bone(hip, "femur", tmp_path)
     a = impinge_axis = np.array(m["femur"]["neck_axis"]["value"])
     for _ in range(30):  # the narrowest section normal to the axis, 8 mm inside the head radius to 16 mm beyond
         g = min((section(V, F, c - d * a, a) for d in np.arange(r - 8, r + 16, 0.5)), key=lambda x: x[1])[0]
@@ -176,11 +180,7 @@ def first_hits(o, d, A, B, C):
 @needs_data
 @pytest.mark.parametrize("hip", HIPS)
 def test_lateral_centre_edge_angle_is_where_the_roof_ends(hip, tmp_path):
-    m = morphology(os.path.join(DATA, hip, "subject.json"), str(tmp_path))
-    subject = json.load(open(os.path.join(DATA, hip, "subject.json")))
-    V, F = impinge.load_mesh(os.path.join(DATA, hip, subject["pelvis"]))
-    c = np.array(m["femur"]["head_centre_mm"]["value"])
-    r = m["femur"]["head_radius_mm"]["value"]
+    m, subject, V, F, c, r = measured_bone(hip, "pelvis", tmp_path)
     L = {k: np.array(v["position_mm"]) for k, v in m["acetabulum"]["pelvic_frame"]["landmarks"].items()}
     # The anterior pelvic plane (both ASIS, the pubic tubercles' midpoint): medio-lateral and superior axes in it.
     pubis = 0.5 * (L["pubic_tubercle_left"] + L["pubic_tubercle_right"])
