@@ -183,8 +183,6 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
   m.orientation_app = radiographic_orientation(A, app, side);
   m.orientation_isb = radiographic_orientation(A, frames.pelvis, side);
   const Eigen::Vector3d X = app.axes.col(0), Y = app.axes.col(1), lateral = lateral_sign * app.axes.col(2);
-  std::vector<Eigen::Vector3d> d;
-  for (const Eigen::Vector3d& p : A.rim) d.push_back(p - c);
   // Lateral: in the coronal plane (normal X) from superior towards lateral; anterior: in the sagittal plane (normal:
   // lateral) from superior towards anterior.
   const ExactReference pelvis_ref(pelvis);
@@ -195,6 +193,8 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
   if (std::isnan(m.anterior_centre_edge_deg))
     m.notes.push_back("anterior centre-edge angle: no bone of the pelvis above the head within its radius + 10 mm");
   // Coverage: the cap inside the rim, seen from the head centre (the pole: into the acetabulum).
+  std::vector<Eigen::Vector3d> d;  // the rim points relative to the head centre
+  for (const Eigen::Vector3d& p : A.rim) d.push_back(p - c);
   const Eigen::Vector3d pole = -A.opening;
   std::array<double, 12> sum{};
   std::array<int, 12> count{};

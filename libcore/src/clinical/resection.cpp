@@ -520,15 +520,9 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
     out.protected_vertex = s.protect;
     out.resected = s.resected;
     out.normals = s.normals;
-    summarize_resection(out, *s.V, *s.F, *s.area, cap);
-    // At the safety depth: this round's depth and an earlier round's together.
-    const std::vector<double>& removed = b == 0 ? o.femur_removed_mm : o.pelvis_removed_mm;
-    out.capped_vertices = 0;
-    for (std::size_t i = 0; i < s.depth.size(); ++i) {
-      const double before = removed.empty() ? 0.0 : removed[i];
-      if (s.depth[i] > 0 && s.depth[i] + before >= cap - 1e-9) ++out.capped_vertices;
+    summarize_resection(out, *s.V, *s.F, *s.area, cap);  // a further pass's sums are run_plan's, over every pass
+    for (std::size_t i = 0; i < s.depth.size(); ++i)
       if (s.thin[i] && s.depth[i] > 0) ++out.thin_vertices;
-    }
   }
   plan.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return plan;

@@ -260,6 +260,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   // the safety depth leaves of each vertex, and adds to the resection; at most kPlanPasses passes.
   t = Clock::now();
   constexpr int kPlanPasses = 3;
+  const Eigen::Matrix3d joint_to_input = s.to_input() * hip.joint_to_working();  // the first session's
   double extra_plan_ms = 0;
   std::unique_ptr<Session> s_after;
   RomRun after;
@@ -307,7 +308,6 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
         plan_resection(s_after->hip(), plan_targets(*s_after, request, after), after.baseline, more);
     extra_plan_ms += ms_since(t_pass);
     if (next.femur.max_depth_mm <= kResectedDepthMm && next.pelvis.max_depth_mm <= kResectedDepthMm) break;
-    const Eigen::Matrix3d joint_to_input = s.to_input() * hip.joint_to_working();
     auto add = [&](BoneResection& total, const BoneResection& pass_plan, const JointBody& body_after,
                    const JointBody& body, const Vertices& scan, TriangleMesh& mesh) {
       if (!total.allowed) return;
