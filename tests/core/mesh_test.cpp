@@ -11,6 +11,7 @@
 #include "impinge/casters/exact_reference.hpp"
 #include "impinge/casters/fcl_collision.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/spherical_frame.hpp"
 #include "impinge/detection/joint.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
@@ -46,6 +47,43 @@ TEST(Mesh, SubmeshKeepsTrianglesWhoseCornersAreAllKept) {
   EXPECT_EQ(b.F.rows(), expect);
   EXPECT_NO_THROW(validate_mesh(b));
   EXPECT_GT(b.V.col(2).minCoeff(), h.cor.z());
+}
+
+// orient_consistently: a closed, consistently wound mesh is left as it is (its fast path); with some triangles
+// flipped it flips exactly those back (the general path), and a non-orientable strip reports conflicts. The
+// oracle is the mesh before the flips.
+TEST(Mesh, OrientConsistentlyRestoresTheWindingAndLeavesAConsistentMeshAlone) {
+  const TriangleMesh sphere = make_uv_sphere(10, Eigen::Vector3d(1, 2, 3), 40, 20);
+  TriangleMesh m = sphere;
+  std::int64_t conflicts = -1;
+  EXPECT_EQ(orient_consistently(m, &conflicts), 0);
+  EXPECT_EQ(conflicts, 0);
+  EXPECT_EQ(m.F, sphere.F);
+  for (Eigen::Index f = 0; f < m.F.rows(); f += 7) std::swap(m.F(f, 1), m.F(f, 2));
+  const Eigen::Index flipped = (m.F.rows() + 6) / 7;
+  EXPECT_EQ(orient_consistently(m, &conflicts), flipped);
+  EXPECT_EQ(conflicts, 0);
+  EXPECT_EQ(m.F, sphere.F);
+  // A Moebius strip of 8 quads: one shared edge no winding can agree across.
+  TriangleMesh strip;
+  const int n = 8;
+  strip.V.resize(2 * n, 3);
+  for (int k = 0; k < n; ++k) {
+    const double a = 2 * kPi * k / n, w = kPi * k / n;
+    const Eigen::Vector3d c(20 * std::cos(a), 20 * std::sin(a), 0), r(std::cos(a), std::sin(a), 0);
+    const Eigen::Vector3d d = std::cos(w) * r + std::sin(w) * Eigen::Vector3d::UnitZ();
+    strip.V.row(2 * k) = (c - 3 * d).transpose();
+    strip.V.row(2 * k + 1) = (c + 3 * d).transpose();
+  }
+  strip.F.resize(2 * n, 3);
+  for (int k = 0; k < n; ++k) {
+    const int a = 2 * k, b = 2 * k + 1;
+    const int c = k + 1 < n ? 2 * (k + 1) : 1, d = k + 1 < n ? 2 * (k + 1) + 1 : 0;  // the half twist
+    strip.F.row(2 * k) << a, c, b;
+    strip.F.row(2 * k + 1) << b, c, d;
+  }
+  orient_consistently(strip, &conflicts);
+  EXPECT_GT(conflicts, 0);
 }
 
 TEST(Mesh, EveryEntryPointThatIndexesFacesRefusesABadIndex) {

@@ -44,3 +44,29 @@ TEST(NaiveSampling, NearestOfTwoShellsAndMisses) {
   EXPECT_TRUE(map.has_surface(0));                     // north pole row
   EXPECT_FALSE(map.has_surface(map.num_nodes() - 1));  // south pole row: no cup there
 }
+
+// cast_rays_naive (several rays in one pass, used by the rasterisation plan) against cast_ray_naive ray by ray:
+// the same nearest triangle and the same distance to the bit, hits and misses alike (rays from inside a cup).
+TEST(NaiveSampling, RaysInOnePassEqualOneByOne) {
+  const TriangleMesh cup = make_cup(20, 25, 60, Eigen::Vector3d(1, -2, 3), Eigen::Vector3d(0.2, 0.1, 1).normalized(), 48,
+                                    12);
+  const Eigen::Vector3d o(1.5, -2.5, 3.2);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> U(0, 1);
+  std::vector<Eigen::Vector3d> dirs;
+  for (int k = 0; k < 64; ++k) dirs.push_back(direction(std::acos(2 * U(rng) - 1), 2 * kPi * U(rng)));
+  const auto all = cast_rays_naive(cup, o, dirs);
+  ASSERT_EQ(all.size(), dirs.size());
+  int hits = 0;
+  for (std::size_t k = 0; k < dirs.size(); ++k) {
+    const auto one = cast_ray_naive(cup, o, dirs[k]);
+    ASSERT_EQ(all[k].has_value(), one.has_value()) << k;
+    if (!one) continue;
+    ++hits;
+    EXPECT_EQ(all[k]->first, one->first) << k;
+    EXPECT_EQ(all[k]->second, one->second) << k;
+  }
+  EXPECT_GT(hits, 10);
+  EXPECT_LT(hits, 64);  // both hits and misses were compared
+  EXPECT_TRUE(cast_rays_naive(cup, o, {}).empty());
+}

@@ -98,8 +98,44 @@ TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>& 
   return out;
 }
 
+namespace {
+
+/// Whether every directed edge (a, b) of `mesh` occurs once and its reverse (b, a) once: a closed surface wound
+/// consistently, which orient_consistently leaves as it is (each shared edge then joins two triangles that run it
+/// opposite ways: no flip, no conflict). Outgoing edges per vertex in compressed rows; O(m) for bounded valence.
+bool wound_consistently(const TriangleMesh& mesh) {
+  const Eigen::Index n = mesh.V.rows(), m = mesh.F.rows();
+  for (Eigen::Index f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k)
+      if (mesh.F(f, k) < 0 || mesh.F(f, k) >= n) return false;  // left to the general path (and validate_mesh)
+  std::vector<std::int32_t> start(static_cast<std::size_t>(n) + 1, 0), to(static_cast<std::size_t>(3 * m));
+  for (Eigen::Index f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k) ++start[static_cast<std::size_t>(mesh.F(f, k)) + 1];
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) start[i + 1] += start[i];
+  std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
+  for (Eigen::Index f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k)
+      to[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.F(f, k))]++)] = mesh.F(f, (k + 1) % 3);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i)
+    for (std::int32_t e = start[i]; e < start[i + 1]; ++e) {
+      const auto j = static_cast<std::size_t>(to[static_cast<std::size_t>(e)]);
+      int reverse = 0, same = 0;
+      for (std::int32_t g = start[j]; g < start[j + 1]; ++g) reverse += to[static_cast<std::size_t>(g)] == std::int32_t(i);
+      for (std::int32_t g = start[i]; g < start[i + 1]; ++g) same += to[static_cast<std::size_t>(g)] == std::int32_t(j);
+      if (reverse != 1 || same != 1) return false;
+    }
+  return true;
+}
+
+}  // namespace
+
 std::int64_t orient_consistently(TriangleMesh& mesh, std::int64_t* conflicts) {
   const Eigen::Index m = mesh.F.rows();
+  // A closed, consistently wound mesh (every scan's surface) needs no sort: nothing to flip, no conflict.
+  if (wound_consistently(mesh)) {
+    if (conflicts != nullptr) *conflicts = 0;
+    return 0;
+  }
   // Every directed edge (a, b) of every triangle under its undirected key, sorted so that the triangles
   // sharing an edge stand together.
   struct HalfEdge {

@@ -42,6 +42,45 @@ std::optional<std::pair<double, std::int64_t>> cast_ray_naive(const TriangleMesh
   return std::make_pair(best, best_f);
 }
 
+std::vector<std::optional<std::pair<double, std::int64_t>>> cast_rays_naive(const TriangleMesh& mesh,
+                                                                            const Eigen::Vector3d& cor,
+                                                                            const std::vector<Eigen::Vector3d>& u) {
+  const std::size_t k = u.size();
+  std::vector<double> best(k, std::numeric_limits<double>::infinity());
+  std::vector<std::int64_t> best_f(k, -1);
+  const Eigen::Index n = mesh.V.rows();
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c)
+      if (mesh.F(f, c) < 0 || mesh.F(f, c) >= n)
+        throw Error(mesh.source + ": face " + std::to_string(f) + " has vertex index " + std::to_string(mesh.F(f, c)) +
+                    " outside [0, " + std::to_string(n) + ")");
+    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)).transpose() - cor;
+    const Eigen::Vector3d e1 = mesh.V.row(mesh.F(f, 1)).transpose() - cor - p0;
+    const Eigen::Vector3d e2 = mesh.V.row(mesh.F(f, 2)).transpose() - cor - p0;
+    const Eigen::Vector3d tv = -p0;
+    const Eigen::Vector3d qv = tv.cross(e1);
+    for (std::size_t r = 0; r < k; ++r) {  // cast_ray_naive's steps, ray by ray
+      const Eigen::Vector3d pv = u[r].cross(e2);
+      const double det = e1.dot(pv);
+      if (std::abs(det) < 1e-300) continue;
+      const double inv = 1.0 / det;
+      const double bu = tv.dot(pv) * inv;
+      if (bu < 0 || bu > 1) continue;
+      const double bv = u[r].dot(qv) * inv;
+      if (bv < 0 || bu + bv > 1) continue;
+      const double t = e2.dot(qv) * inv;
+      if (t > 0 && t < best[r]) {
+        best[r] = t;
+        best_f[r] = f;
+      }
+    }
+  }
+  std::vector<std::optional<std::pair<double, std::int64_t>>> out(k);
+  for (std::size_t r = 0; r < k; ++r)
+    if (best_f[r] >= 0) out[r] = std::make_pair(best[r], best_f[r]);
+  return out;
+}
+
 template <typename Scalar>
 void sample_naive(const TriangleMesh& mesh, const Eigen::Vector3d& cor, RadialDistanceMapT<Scalar>& map,
                   std::vector<std::int64_t>* triangle_of_node) {

@@ -89,15 +89,18 @@ RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& c
     order_triangles(mesh, cor, fc);
     return fc;
   }
-  // Orientation of the nearest hit along rays towards triangle centroids spread over the mesh.
+  // Orientation of the nearest hit along rays towards triangle centroids spread over the mesh (all rays in one
+  // pass over the triangles).
+  std::vector<Eigen::Vector3d> dirs;
   for (int k = 0; k < rays; ++k) {
     const Eigen::Index f = (mesh.F.rows() - 1) * k / std::max(1, rays - 1);
     const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose() - cor,
                           b = mesh.V.row(mesh.F(f, 1)).transpose() - cor,
                           c = mesh.V.row(mesh.F(f, 2)).transpose() - cor;
     const Eigen::Vector3d u = (a + b + c).normalized();
-    if (!u.allFinite()) continue;
-    const auto hit = cast_ray_naive(mesh, cor, u);
+    if (u.allFinite()) dirs.push_back(u);
+  }
+  for (const auto& hit : cast_rays_naive(mesh, cor, dirs)) {
     if (!hit) continue;
     const Eigen::Index h = hit->second;
     const Eigen::Vector3d p = mesh.V.row(mesh.F(h, 0)).transpose() - cor,

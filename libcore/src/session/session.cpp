@@ -7,6 +7,7 @@
 #include <cmath>
 #include <exception>
 #include <future>
+#include <tuple>
 #include <limits>
 #include <sstream>
 
@@ -129,9 +130,15 @@ LoadedInput load_input(const SessionInput& input) {
   }
   // Winding: triangles that face against their neighbours would flip the sign of the distances around them
   // (a femur 1.15 mm from the pelvis read as 123 mm inside it): flipped to agree, and said.
-  for (const auto& [mesh, source] : {std::pair{&in.femur, &in.femur_source}, std::pair{&in.pelvis, &in.pelvis_source}}) {
-    std::int64_t conflicts = 0;
-    const std::int64_t flipped = orient_consistently(*mesh, &conflicts);
+  // The pelvis on a second thread.
+  std::int64_t pelvis_conflicts = 0;
+  auto pelvis_flipped = std::async(std::launch::async, [&] { return orient_consistently(in.pelvis, &pelvis_conflicts); });
+  std::int64_t femur_conflicts = 0;
+  const std::int64_t femur_flipped = orient_consistently(in.femur, &femur_conflicts);
+  const std::int64_t pelvis_flips = pelvis_flipped.get();
+  for (const auto& [mesh, source, flipped, conflicts] :
+       {std::tuple{&in.femur, &in.femur_source, femur_flipped, femur_conflicts},
+        std::tuple{&in.pelvis, &in.pelvis_source, pelvis_flips, pelvis_conflicts}}) {
     if (flipped > 0)
       in.warnings.push_back(*source + ": " + std::to_string(flipped) + " of " + std::to_string(mesh->F.rows()) +
                             " triangles were wound against their neighbours; flipped to agree with them");

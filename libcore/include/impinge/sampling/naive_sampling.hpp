@@ -19,6 +19,13 @@ namespace impinge {
 std::optional<std::pair<double, std::int64_t>> cast_ray_naive(const TriangleMesh& mesh, const Eigen::Vector3d& cor,
                                                               const Eigen::Vector3d& u);
 
+/// cast_ray_naive for several rays from one `cor` in one pass over the triangles (each triangle's corners read
+/// once for every ray): `u[k]` unit directions, result k the same value cast_ray_naive(mesh, cor, u[k]) gives
+/// (the same arithmetic, triangles in the same order). O(rays x m). Throws as cast_ray_naive.
+std::vector<std::optional<std::pair<double, std::int64_t>>> cast_rays_naive(const TriangleMesh& mesh,
+                                                                            const Eigen::Vector3d& cor,
+                                                                            const std::vector<Eigen::Vector3d>& u);
+
 /// Fill `map` node by node with the nearest hit of the node's ray on every triangle (thesis
 /// sec. 3.2 "naive O(m*n)" and sec. 4.2.1). Exact distances; the test oracle for
 /// `rasterize` on small meshes. If `triangle_of_node` is given it receives, per node, the
