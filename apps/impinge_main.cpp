@@ -9,6 +9,8 @@
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <exception>
+#include <future>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -147,9 +149,22 @@ int run_distance(const RunOptions& o) {
   const double pose_ms = ms_since(t);
   t = Clock::now();
   begin_output_folder(out, "distance");
-  write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur);
-  write_map_png(in_dir(out, "ball_map.png"), s.joint().ball().map);
-  write_map_png(in_dir(out, "socket_map.png"), s.joint().socket().map);
+  {
+    // The map images beside the gap files (both on their own threads); the gap files' error first.
+    auto images = std::async(std::launch::async, [&] {
+      write_map_png(in_dir(out, "ball_map.png"), s.joint().ball().map);
+      write_map_png(in_dir(out, "socket_map.png"), s.joint().socket().map);
+    });
+    std::exception_ptr gaps_error;
+    try {
+      write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur);
+    } catch (...) {
+      gaps_error = std::current_exception();
+    }
+    images.wait();
+    if (gaps_error) std::rethrow_exception(gaps_error);
+    images.get();
+  }
   nlohmann::json j = run_record(s);
   j.update(pose_record(s, pose, femur, res));
   // Where a one-pose run's time goes (issue 52): the set-up (reading and checking the meshes, the head fit, the

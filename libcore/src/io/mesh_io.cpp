@@ -111,15 +111,16 @@ TriangleMesh load_mesh(const std::string& path) {
 }
 
 namespace {
+// A binary PLY's bytes, appended in place (one string grown by reserve, no stream call per value).
 template <typename T>
-void put(std::ostream& os, T value) {
-  os.write(reinterpret_cast<const char*>(&value), sizeof(T));
+void put(std::string& out, T value) {
+  out.append(reinterpret_cast<const char*>(&value), sizeof(T));
 }
 
-void write_faces(std::ostream& os, const Faces& F) {
+void write_faces(std::string& out, const Faces& F) {
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    put<std::uint8_t>(os, 3);
-    for (int k = 0; k < 3; ++k) put<std::int32_t>(os, F(f, k));
+    put<std::uint8_t>(out, 3);
+    for (int k = 0; k < 3; ++k) put<std::int32_t>(out, F(f, k));
   }
 }
 }  // namespace
@@ -131,24 +132,27 @@ void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const E
   require(gap_mm.size() == V.rows() && level.size() == V.rows() && rgb.rows() == V.rows() &&
               (distance_mm == nullptr || distance_mm->size() == V.rows()),
           path + ": per-vertex arrays do not match the vertex count");
-  std::ostringstream os(std::ios::binary);
-  os << "ply\nformat binary_little_endian 1.0\ncomment impinge per-vertex gap (mm)\n"
-     << "element vertex " << V.rows() << "\n"
-     << "property float x\nproperty float y\nproperty float z\n"
-     << "property float gap_mm\nproperty float quality\n"
-     << (distance_mm != nullptr ? "property float distance_mm\n" : "") << "property uchar level\n"
-     << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-     << "element face " << F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::ostringstream header;
+  header << "ply\nformat binary_little_endian 1.0\ncomment impinge per-vertex gap (mm)\n"
+         << "element vertex " << V.rows() << "\n"
+         << "property float x\nproperty float y\nproperty float z\n"
+         << "property float gap_mm\nproperty float quality\n"
+         << (distance_mm != nullptr ? "property float distance_mm\n" : "") << "property uchar level\n"
+         << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+         << "element face " << F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string out = header.str();
+  out.reserve(out.size() + static_cast<std::size_t>(V.rows()) * (distance_mm != nullptr ? 28 : 24) +
+              static_cast<std::size_t>(F.rows()) * 13);
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
-    for (int k = 0; k < 3; ++k) put<float>(os, static_cast<float>(V(i, k)));
-    put<float>(os, gap_mm[i]);
-    put<float>(os, gap_mm[i]);
-    if (distance_mm != nullptr) put<float>(os, (*distance_mm)[i]);
-    put<std::uint8_t>(os, level[i]);
-    for (int k = 0; k < 3; ++k) put<std::uint8_t>(os, rgb(i, k));
+    for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>(V(i, k)));
+    put<float>(out, gap_mm[i]);
+    put<float>(out, gap_mm[i]);
+    if (distance_mm != nullptr) put<float>(out, (*distance_mm)[i]);
+    put<std::uint8_t>(out, level[i]);
+    for (int k = 0; k < 3; ++k) put<std::uint8_t>(out, rgb(i, k));
   }
-  write_faces(os, F);
-  write_file_atomically(path, os.str());
+  write_faces(out, F);
+  write_file_atomically(path, out);
 }
 
 void write_ply(const std::string& path, const TriangleMesh& mesh) { write_ply(path, mesh, {}); }
@@ -159,17 +163,20 @@ void write_ply(const std::string& path, const TriangleMesh& mesh, const std::vec
     require(a.f32.size() == static_cast<std::size_t>(mesh.V.rows()) && !a.name.empty(),
             path + ": per-vertex property '" + a.name + "' has " + std::to_string(a.f32.size()) +
                 " values for " + std::to_string(mesh.V.rows()) + " vertices");
-  std::ostringstream os(std::ios::binary);
-  os << "ply\nformat binary_little_endian 1.0\nelement vertex " << mesh.V.rows() << "\n"
-     << "property float x\nproperty float y\nproperty float z\n";
-  for (const PointArray& a : arrays) os << "property float " << a.name << "\n";
-  os << "element face " << mesh.F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::ostringstream header;
+  header << "ply\nformat binary_little_endian 1.0\nelement vertex " << mesh.V.rows() << "\n"
+         << "property float x\nproperty float y\nproperty float z\n";
+  for (const PointArray& a : arrays) header << "property float " << a.name << "\n";
+  header << "element face " << mesh.F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string out = header.str();
+  out.reserve(out.size() + static_cast<std::size_t>(mesh.V.rows()) * 4 * (3 + arrays.size()) +
+              static_cast<std::size_t>(mesh.F.rows()) * 13);
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-    for (int k = 0; k < 3; ++k) put<float>(os, static_cast<float>(mesh.V(i, k)));
-    for (const PointArray& a : arrays) put<float>(os, a.f32[static_cast<std::size_t>(i)]);
+    for (int k = 0; k < 3; ++k) put<float>(out, static_cast<float>(mesh.V(i, k)));
+    for (const PointArray& a : arrays) put<float>(out, a.f32[static_cast<std::size_t>(i)]);
   }
-  write_faces(os, mesh.F);
-  write_file_atomically(path, os.str());
+  write_faces(out, mesh.F);
+  write_file_atomically(path, out);
 }
 
 }  // namespace impinge

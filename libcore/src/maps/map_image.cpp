@@ -28,6 +28,9 @@ void write_grey_png(const std::string& file, const std::string& path, const unsi
     throw Error(path + ": PNG write failed");
   }
   png_init_io(png, fp);
+  // zlib's fastest level: a map image is written on every run and read rarely; the pixels are the same, the file
+  // some 50 % larger (20 against 14 KB at 0.5 deg) than at zlib's default level, and written several times faster.
+  png_set_compression_level(png, 1);
   png_set_IHDR(png, info, static_cast<png_uint_32>(w), static_cast<png_uint_32>(h), 8, PNG_COLOR_TYPE_GRAY,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
