@@ -140,7 +140,7 @@ int run_distance(const RunOptions& o) {
   const std::string& out = o.command.out;
   const PoseAngles pose = parse_pose(o.command.pose);
   SessionOptions so = o.session;
-  if (so.maps.setup == "auto") so.maps.setup = "direct";  // one pose: the layered maps would not pay back
+  so.maps.setup = setup_for_poses(so.maps.setup, 1);  // auto: one pose, direct (the layered maps would not pay back)
   const Session s = open_session(so);
   const double setup_ms = ms_since(t_start);
   auto t = Clock::now();
@@ -203,7 +203,9 @@ int run_motion(const RunOptions& o) {
   const std::string& out = mo.out;
   // The motion file is read (and fully checked) before anything is built or written.
   const Motion motion = load_motion(mo.motion, input_side(o.session.input));
-  const Session s = open_session(o.session);
+  SessionOptions so = o.session;
+  so.maps.setup = setup_for_poses(so.maps.setup, motion.frames());  // auto: by the number of frames
+  const Session s = open_session(so);
   const double setup_ms = ms_since(t_start);
 
   begin_output_folder(out, "motion", {"gaps"});

@@ -2,6 +2,7 @@
 CLI's on a generated hip, bit for bit; maps are numpy views with the documented shapes; bad
 arrays (wrong shape, NaN, bad indices, wrong dtype) raise impinge.Error naming the array;
 motion() equals detect_pose() frame by frame."""
+import csv
 import json
 import os
 import struct
@@ -118,6 +119,39 @@ def test_motion_equals_detect_pose_and_maps_are_views(generated):
     u = mp.node_directions()
     np.testing.assert_allclose(np.linalg.norm(u, axis=1), 1.0, atol=1e-12)
     assert j.frames is None
+
+
+def test_motion_set_up_chosen_by_its_frames(generated):
+    """impinge motion with --setup auto: a short motion builds no layered maps (direct), one of 400 frames or more
+    builds them (maps), as summary.json says; forcing either gives the same distances, first-surface gaps and
+    levels frame by frame (only the hidden vertices' radial gaps may differ: exact against interpolated)."""
+    d = generated
+
+    def motion(frames, name, *extra):
+        mot = f"{d}/{name}.mot"
+        with open(mot, "w") as f:
+            f.write(f"m\nversion=1\nnRows={frames}\nnColumns=4\ninDegrees=yes\nendheader\n"
+                    "time\thip_flexion_r\thip_adduction_r\thip_rotation_r\n")
+            for i in range(frames):
+                f.write(f"{i * 0.01:.2f}\t{40 * i / frames:.4f}\t{5 * i / frames:.4f}\t{-10 * i / frames:.4f}\n")
+        out = f"{d}/{name}"
+        subprocess.run([CLI, "motion", "--subject", d + "/s/subject.json", "--motion", mot, "--precision", "2",
+                        "--quiet", "--vtp-every", "1000000", "--out", out, *extra], check=True, capture_output=True)
+        with open(out + "/summary.json") as f:
+            setup = json.load(f)["setup"]
+        with open(out + "/frames.csv") as f:
+            rows = list(csv.DictReader(f))
+        return setup, rows
+
+    short, rows = motion(5, "m5")
+    forced, rows_maps = motion(5, "m5maps", "--setup", "maps")
+    assert (short, forced) == ("direct", "maps")
+    for a, b in zip(rows, rows_maps):
+        for col in ("ball_min_distance_mm", "socket_min_distance_mm", "socket_level0_area_mm2",
+                    "socket_level2_area_mm2"):
+            assert a[col] == b[col], col
+    assert motion(400, "m400")[0] == "maps"
+    assert motion(399, "m399")[0] == "direct"
 
 
 def test_maps_saved_and_loaded_give_the_same_gaps(generated):

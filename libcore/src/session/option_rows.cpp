@@ -3,6 +3,7 @@
 
 #include "impinge/detection/impingement_levels.hpp"
 #include "impinge/schemes/sampling_scheme.hpp"
+#include "impinge/session/session.hpp"
 #include "option_builders.hpp"
 
 namespace impinge {
@@ -168,9 +169,11 @@ void add_map_rows(Rows& t) {
             [](auto& o) -> auto& { return o.session.maps.layers; });
   t.text("setup", "setup", OptionType::choice, kSetting, {"auto", "maps", "direct"},
          "What to build for the work: maps (both maps and the layered maps, for many poses), direct (no layered "
-         "maps: the hidden vertices by exact ray casts; a few poses; no ROM searches), auto (distance, one pose: "
-         "direct; every other command: maps). The distances and the first-surface gaps are the same either way; the "
-         "hidden vertices' gaps are exact with direct, the maps' interpolation with maps",
+         "maps: the hidden vertices by exact ray casts; a few poses; no ROM searches), auto (by the number of poses: "
+         "distance and motions of fewer than " + std::to_string(kDirectSetupMaxPoses) +
+             " frames direct; ROM searches, plans and longer motions maps). The "
+         "distances and the first-surface gaps are the same either way; the hidden vertices' gaps are exact with "
+         "direct, the maps' interpolation with maps",
          [](auto& o) -> auto& { return o.session.maps.setup; });
   t.number("layered-spacing", "layered_spacing", "deg", kSetting, 0, 180,
            "The layered maps' largest node spacing (the scheme at the coarsest resolution reaching it, never finer "

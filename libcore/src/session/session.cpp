@@ -164,6 +164,13 @@ LoadedInput load_input(const SessionInput& input) {
   return in;
 }
 
+std::string setup_for_poses(const std::string& setup, std::size_t poses) {
+  require(setup == "auto" || setup == "maps" || setup == "direct",
+          "setup '" + setup + "': must be maps, direct or auto");
+  if (setup != "auto") return setup;
+  return poses < kDirectSetupMaxPoses ? "direct" : "maps";
+}
+
 SphereFitResult located_head(const LoadedInput& in) {
   return in.pelvis.V.rows() > 0 ? locate_femoral_head(in.femur, in.pelvis) : locate_femoral_head(in.femur);
 }

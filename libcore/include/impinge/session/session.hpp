@@ -76,7 +76,8 @@ struct MapSettings {
   int layers = 0;                       ///< layered maps of this many crossings per node (0: off)
   /// What to build for the work: "maps" (both maps and, with layers, the layered maps), "direct" (no layered
   /// maps: the hidden vertices by exact ray casts, JointOptions::layered_maps off; for a few poses; no ROM
-  /// searches), "auto" (the front end's choice: `impinge distance`, one pose, takes direct; everything else maps).
+  /// searches), "auto" (the front end's choice by the number of poses, setup_for_poses: `impinge distance` and
+  /// motions of fewer than kDirectSetupMaxPoses frames take direct; ROM searches, plans and longer motions maps).
   std::string setup = "auto";
   double extra_articular_radius_mm = 150;
   double layered_spacing_deg = 0.5;     ///< the layered maps' largest node spacing (JointOptions), deg
@@ -94,6 +95,16 @@ struct MapSettings {
 /// About how many bytes the two maps of `scheme` take (float node values, their marks and bound pyramids:
 /// 5 bytes a node, doubled for the two bones; the layered maps, at most 0.5 deg by default, come on top).
 double map_memory_bytes(const SamplingScheme& scheme);
+
+/// Below this many poses MapSettings::setup "auto" takes "direct" (no layered maps), from this many "maps": on
+/// lhdl-ct (0.5 deg, defaults, 2 cores) the layered maps cost some 80 ms more to set up and save some 0.2 ms per
+/// pose, so they pay back from about 400 poses (impinge motion, 10 / 100 / 1,000 frames: direct 0.32 / 0.45 / 1.66 s,
+/// maps 0.33 / 0.51 / 1.56 s, medians of 5 alternated runs; issue 52).
+inline constexpr std::size_t kDirectSetupMaxPoses = 400;
+
+/// The set-up a run of `poses` poses takes: `setup` itself when it is "maps" or "direct"; for "auto", "direct"
+/// below kDirectSetupMaxPoses poses, else "maps". Throws impinge::Error for any other value.
+std::string setup_for_poses(const std::string& setup, std::size_t poses);
 
 /// Frames and neutral (HipJointOptions).
 struct FrameSettings {
