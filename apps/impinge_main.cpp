@@ -10,7 +10,6 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <exception>
-#include <future>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -19,6 +18,7 @@
 #include <map>
 #include <sstream>
 
+#include "impinge/core/concurrent.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/timing.hpp"
 #include "impinge/io/generated_models.hpp"
@@ -149,22 +149,12 @@ int run_distance(const RunOptions& o) {
   const double pose_ms = ms_since(t);
   t = Clock::now();
   begin_output_folder(out, "distance");
-  {
-    // The map images beside the gap files (both on their own threads); the gap files' error first.
-    auto images = std::async(std::launch::async, [&] {
-      write_map_png(in_dir(out, "ball_map.png"), s.joint().ball().map);
-      write_map_png(in_dir(out, "socket_map.png"), s.joint().socket().map);
-    });
-    std::exception_ptr gaps_error;
-    try {
-      write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur);
-    } catch (...) {
-      gaps_error = std::current_exception();
-    }
-    images.wait();
-    if (gaps_error) std::rethrow_exception(gaps_error);
-    images.get();
-  }
+  // The map images beside the gap files (both on their own threads); the gap files' error first.
+  run_both([&] { write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur); },
+           [&] {
+             write_map_png(in_dir(out, "ball_map.png"), s.joint().ball().map);
+             write_map_png(in_dir(out, "socket_map.png"), s.joint().socket().map);
+           });
   nlohmann::json j = run_record(s);
   j.update(pose_record(s, pose, femur, res));
   // Where a one-pose run's time goes (issue 52): the set-up (reading and checking the meshes, the head fit, the

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <map>
 
 #include "impinge/anatomy/femur_frame.hpp"
 #include "impinge/casters/embree_ray_caster.hpp"
@@ -84,6 +85,47 @@ TEST(Mesh, OrientConsistentlyRestoresTheWindingAndLeavesAConsistentMeshAlone) {
   }
   orient_consistently(strip, &conflicts);
   EXPECT_GT(conflicts, 0);
+}
+
+// count_unpaired_directed_edges against a brute-force count over a map of directed edges: 0 on a closed sphere,
+// and the same count as the map's after a triangle is removed (a hole) or flipped (against its neighbours).
+TEST(Mesh, UnpairedDirectedEdgesMatchABruteForceCount) {
+  auto brute = [](const TriangleMesh& m) {
+    std::map<std::pair<int, int>, int> count;
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) ++count[{m.F(f, k), m.F(f, (k + 1) % 3)}];
+    std::int64_t unpaired = 0;
+    for (const auto& [e, c] : count) {
+      const auto r = count.find({e.second, e.first});
+      if (c != 1 || r == count.end() || r->second != 1) unpaired += c;  // each occurrence of the edge counts
+    }
+    return unpaired;
+  };
+  const TriangleMesh sphere = make_uv_sphere(10, Eigen::Vector3d(1, 2, 3), 24, 12);
+  EXPECT_EQ(count_unpaired_directed_edges(sphere), 0);
+  TriangleMesh holed = sphere;
+  holed.F.conservativeResize(holed.F.rows() - 1, 3);
+  const std::int64_t hole = count_unpaired_directed_edges(holed);
+  EXPECT_EQ(hole, brute(holed));
+  EXPECT_GE(hole, 2);  // the removed triangle's neighbours' edges (2 at a pole's fan, 3 elsewhere)
+  TriangleMesh flipped = sphere;
+  std::swap(flipped.F(40, 1), flipped.F(40, 2));
+  EXPECT_EQ(count_unpaired_directed_edges(flipped), brute(flipped));
+  EXPECT_GT(count_unpaired_directed_edges(flipped), 0);
+  EXPECT_EQ(count_unpaired_directed_edges(flipped, 1), 1);  // stops at the first
+  TriangleMesh bad = sphere;
+  bad.source = "bad-index";
+  bad.F(3, 2) = -1;
+  EXPECT_THROW(
+      {
+        try {
+          count_unpaired_directed_edges(bad);
+        } catch (const Error& e) {
+          EXPECT_NE(std::string(e.what()).find("bad-index: triangle 3"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      Error);
 }
 
 TEST(Mesh, EveryEntryPointThatIndexesFacesRefusesABadIndex) {

@@ -98,16 +98,15 @@ TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>& 
   return out;
 }
 
-namespace {
-
-/// Whether every directed edge (a, b) of `mesh` occurs once and its reverse (b, a) once: a closed surface wound
-/// consistently, which orient_consistently leaves as it is (each shared edge then joins two triangles that run it
-/// opposite ways: no flip, no conflict). Outgoing edges per vertex in compressed rows; O(m) for bounded valence.
-bool wound_consistently(const TriangleMesh& mesh) {
+std::int64_t count_unpaired_directed_edges(const TriangleMesh& mesh, std::int64_t stop_after) {
   const Eigen::Index n = mesh.V.rows(), m = mesh.F.rows();
   for (Eigen::Index f = 0; f < m; ++f)
     for (int k = 0; k < 3; ++k)
-      if (mesh.F(f, k) < 0 || mesh.F(f, k) >= n) return false;  // left to the general path (and validate_mesh)
+      require(mesh.F(f, k) >= 0 && mesh.F(f, k) < n, [&] {
+        return mesh.source + ": triangle " + std::to_string(f) + " has corner index " + std::to_string(mesh.F(f, k)) +
+               "; valid are 0 to " + std::to_string(n - 1);
+      });
+  std::int64_t unpaired = 0;
   std::vector<std::int32_t> start(static_cast<std::size_t>(n) + 1, 0), to(static_cast<std::size_t>(3 * m));
   for (Eigen::Index f = 0; f < m; ++f)
     for (int k = 0; k < 3; ++k) ++start[static_cast<std::size_t>(mesh.F(f, k)) + 1];
@@ -122,9 +121,23 @@ bool wound_consistently(const TriangleMesh& mesh) {
       int reverse = 0, same = 0;
       for (std::int32_t g = start[j]; g < start[j + 1]; ++g) reverse += to[static_cast<std::size_t>(g)] == std::int32_t(i);
       for (std::int32_t g = start[i]; g < start[i + 1]; ++g) same += to[static_cast<std::size_t>(g)] == std::int32_t(j);
-      if (reverse != 1 || same != 1) return false;
+      if ((reverse != 1 || same != 1) && ++unpaired >= stop_after) return unpaired;
     }
-  return true;
+  return unpaired;
+}
+
+namespace {
+
+/// Whether every directed edge (a, b) of `mesh` occurs once and its reverse (b, a) once: a closed surface wound
+/// consistently, which orient_consistently leaves as it is (each shared edge then joins two triangles that run it
+/// opposite ways: no flip, no conflict). A corner index out of range is left to the general path (and
+/// validate_mesh).
+bool wound_consistently(const TriangleMesh& mesh) {
+  const Eigen::Index n = mesh.V.rows();
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (mesh.F(f, k) < 0 || mesh.F(f, k) >= n) return false;
+  return count_unpaired_directed_edges(mesh, 1) == 0;
 }
 
 }  // namespace

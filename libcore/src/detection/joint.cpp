@@ -1,4 +1,5 @@
 #include "impinge/detection/joint.hpp"
+#include "impinge/core/concurrent.hpp"
 
 #include <omp.h>
 
@@ -65,18 +66,10 @@ std::pair<JointBody, JointBody> Joint::build_bodies(const Eigen::Vector3d& cor, 
   // The two bodies are independent: the socket's is built on a second thread while this one builds the
   // ball's (much of a build is serial: hierarchies, marks, masks, page faults of the maps). A failure
   // on either is rethrown here, after both have finished.
-  auto socket_future =
-      std::async(std::launch::async, [&] { return build(cor, options, std::move(socket), std::move(socket_map)); });
-  std::optional<JointBody> b;
-  std::exception_ptr ball_error;
-  try {
-    b.emplace(build(cor, options, std::move(ball), std::move(ball_map)));
-  } catch (...) {
-    ball_error = std::current_exception();
-  }
-  JointBody s = socket_future.get();  // rethrows the socket's error
-  if (ball_error) std::rethrow_exception(ball_error);
-  return {std::move(*b), std::move(s)};
+  std::optional<JointBody> b, s;
+  run_both([&] { b.emplace(build(cor, options, std::move(ball), std::move(ball_map))); },
+           [&] { s.emplace(build(cor, options, std::move(socket), std::move(socket_map))); });
+  return {std::move(*b), std::move(*s)};
 }
 
 JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh mesh,

@@ -63,25 +63,7 @@ RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& c
   require(rays >= 1, "face culling: at least one ray is needed");
   RasterPlan fc;
   // Closed and consistently oriented: every directed edge (i, j) has exactly one (j, i).
-  // Outgoing edges per vertex in compressed rows.
-  const auto n = static_cast<std::size_t>(mesh.V.rows());
-  std::vector<std::int32_t> start(n + 1, 0), to(static_cast<std::size_t>(3 * mesh.F.rows()));
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) ++start[static_cast<std::size_t>(mesh.F(f, k)) + 1];
-  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
-  std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k)
-      to[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.F(f, k))]++)] = mesh.F(f, (k + 1) % 3);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::int32_t e = start[i]; e < start[i + 1]; ++e) {
-      const auto j = static_cast<std::size_t>(to[static_cast<std::size_t>(e)]);
-      int reverse = 0, same = 0;
-      for (std::int32_t g = start[j]; g < start[j + 1]; ++g)
-        reverse += to[static_cast<std::size_t>(g)] == std::int32_t(i);
-      for (std::int32_t g = start[i]; g < start[i + 1]; ++g) same += to[static_cast<std::size_t>(g)] == std::int32_t(j);
-      if (reverse != 1 || same != 1) ++fc.boundary_edges;
-    }
+  fc.boundary_edges = count_unpaired_directed_edges(mesh);
   if (fc.boundary_edges > 0) {
     fc.reason = std::to_string(fc.boundary_edges) +
                 " directed edges without exactly one reverse (open or inconsistently "

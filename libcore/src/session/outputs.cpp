@@ -1,10 +1,10 @@
 #include "impinge/session/outputs.hpp"
+#include "impinge/core/concurrent.hpp"
 
 #include <cmath>
 #include <ctime>
 #include <exception>
 #include <filesystem>
-#include <future>
 
 #include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
@@ -79,18 +79,8 @@ void write_pose_plys(const std::string& ball_path, const std::string& socket_pat
   const ImpingementLevels& levels = s.joint_options().levels;
   const LevelQuantity on = s.joint_options().levels_on;
   // The socket's file on a second thread; the ball's error first if both fail.
-  auto socket = std::async(std::launch::async, [&] {
-    write_body_ply(socket_path, levels, on, s.joint().socket(), res.socket_gaps, s.pelvis_input(), false);
-  });
-  std::exception_ptr ball_error;
-  try {
-    write_body_ply(ball_path, levels, on, s.joint().ball(), res.ball_gaps, s.femur_input(pose), true);
-  } catch (...) {
-    ball_error = std::current_exception();
-  }
-  socket.wait();
-  if (ball_error) std::rethrow_exception(ball_error);
-  socket.get();
+  run_both([&] { write_body_ply(ball_path, levels, on, s.joint().ball(), res.ball_gaps, s.femur_input(pose), true); },
+           [&] { write_body_ply(socket_path, levels, on, s.joint().socket(), res.socket_gaps, s.pelvis_input(), false); });
 }
 
 void write_pose_vtp(const std::string& path, const Session& s, const PoseResult& res, const FemurPose& pose) {

@@ -1,4 +1,5 @@
 #include "impinge/session/session.hpp"
+#include "impinge/core/concurrent.hpp"
 
 #include "impinge/session/option_table.hpp"
 
@@ -6,7 +7,6 @@
 
 #include <cmath>
 #include <exception>
-#include <future>
 #include <tuple>
 #include <limits>
 #include <sstream>
@@ -106,16 +106,8 @@ LoadedInput load_input(const SessionInput& input) {
     source = !mesh ? path : out.source.empty() ? std::string(name) + " (in memory)" : out.source;
   };
   // The two files are read at once (the pelvis on a second thread); the femur's error first, as before.
-  auto pelvis = std::async(std::launch::async, [&] { take(input.socket_mesh, socket, "socket", in.pelvis, in.pelvis_source); });
-  std::exception_ptr femur_error;
-  try {
-    take(input.ball_mesh, ball, "ball", in.femur, in.femur_source);
-  } catch (...) {
-    femur_error = std::current_exception();
-  }
-  pelvis.wait();
-  if (femur_error) std::rethrow_exception(femur_error);
-  pelvis.get();
+  run_both([&] { take(input.ball_mesh, ball, "ball", in.femur, in.femur_source); },
+           [&] { take(input.socket_mesh, socket, "socket", in.pelvis, in.pelvis_source); });
   require(!(in.femur.V.rows() == in.pelvis.V.rows() && in.femur.F.rows() == in.pelvis.F.rows() &&
             in.femur.V.isApprox(in.pelvis.V, 1e-12)),
           in.femur_source + " and " + in.pelvis_source + ": the femur and the pelvis are the same mesh");
@@ -131,11 +123,9 @@ LoadedInput load_input(const SessionInput& input) {
   // Winding: triangles that face against their neighbours would flip the sign of the distances around them
   // (a femur 1.15 mm from the pelvis read as 123 mm inside it): flipped to agree, and said.
   // The pelvis on a second thread.
-  std::int64_t pelvis_conflicts = 0;
-  auto pelvis_flipped = std::async(std::launch::async, [&] { return orient_consistently(in.pelvis, &pelvis_conflicts); });
-  std::int64_t femur_conflicts = 0;
-  const std::int64_t femur_flipped = orient_consistently(in.femur, &femur_conflicts);
-  const std::int64_t pelvis_flips = pelvis_flipped.get();
+  std::int64_t femur_conflicts = 0, pelvis_conflicts = 0, femur_flipped = 0, pelvis_flips = 0;
+  run_both([&] { femur_flipped = orient_consistently(in.femur, &femur_conflicts); },
+           [&] { pelvis_flips = orient_consistently(in.pelvis, &pelvis_conflicts); });
   for (const auto& [mesh, source, flipped, conflicts] :
        {std::tuple{&in.femur, &in.femur_source, femur_flipped, femur_conflicts},
         std::tuple{&in.pelvis, &in.pelvis_source, pelvis_flips, pelvis_conflicts}}) {
@@ -270,9 +260,9 @@ HipJointOptions hip_joint_options(const MapSettings& m, const FrameSettings& f, 
   require(std::isfinite(m.extra_articular_radius_mm) && m.extra_articular_radius_mm > 0,
           "extra-articular-radius must be > 0 mm");
   jo.layers = m.layers;
-  require(m.setup == "auto" || m.setup == "maps" || m.setup == "direct",
-          "setup '" + m.setup + "': must be maps, direct or auto");
-  jo.layered_maps = m.setup != "direct";  // auto: the library builds the maps; the CLI's distance chooses direct
+  // setup_for_poses checks the value; "auto" reaching here (a library caller that did not resolve it by its
+  // number of poses) builds the maps, which serve any number of poses.
+  jo.layered_maps = setup_for_poses(m.setup, kDirectSetupMaxPoses) != "direct";
   jo.extra_articular_radius_mm = m.extra_articular_radius_mm;
   require(std::isfinite(m.layered_spacing_deg) && m.layered_spacing_deg >= 0 && m.layered_spacing_deg <= 90,
           "layered-spacing " + num(m.layered_spacing_deg) + ": must be 0 (the maps' own) to 90 deg");
