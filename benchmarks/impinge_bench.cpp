@@ -17,6 +17,8 @@
 #include "impinge/casters/embree_ray_caster.hpp"
 #include "impinge/casters/exact_reference.hpp"
 #include "impinge/casters/fcl_collision.hpp"
+#include "impinge/casters/first_hit_caster.hpp"
+#include "impinge/casters/signed_distance.hpp"
 #include "impinge/casters/pairwise.hpp"
 #include "impinge/core/provenance.hpp"
 #include "impinge/detection/detection.hpp"
@@ -251,6 +253,26 @@ void BM_EmbreeQuery(benchmark::State& st) {
   st.SetLabel(s.name + (st.range(1) ? " rtcIntersect8" : " rtcIntersect1"));
 }
 BENCHMARK(BM_EmbreeQuery)->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+// The set-up's two hierarchies per bone (args: body, 0 femur / 1 pelvis; issue 52, a one-pose run's set-up): the
+// closest-point query's (SignedDistanceQuery: kept triangles, edge twins, groups in boxes, Embree's tree) and the
+// first-hit caster's (Embree's triangle BVH).
+void BM_SignedDistanceBuild(benchmark::State& st) {
+  const TriangleMesh& m = st.range(0) == 0 ? scene().femur : scene().pelvis;
+  for (auto _ : st) benchmark::DoNotOptimize(SignedDistanceQuery(m).orientation());
+  st.counters["triangles"] = double(m.F.rows());
+}
+BENCHMARK(BM_SignedDistanceBuild)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_FirstHitCasterBuild(benchmark::State& st) {
+  const TriangleMesh& m = st.range(0) == 0 ? scene().femur : scene().pelvis;
+  for (auto _ : st) {
+    FirstHitCaster c(m, scene().cor);
+    benchmark::DoNotOptimize(&c);
+  }
+  st.counters["triangles"] = double(m.F.rows());
+}
+BENCHMARK(BM_FirstHitCasterBuild)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // CGAL AABB tree first intersection on the same vertices (args: body).
 void BM_CgalQuery(benchmark::State& st) {

@@ -17,8 +17,17 @@ namespace impinge::detail {
 /// of the one before, the first >= 1 (the callers check). O(n log n).
 template <typename Coordinate>
 std::vector<std::int32_t> box_order(std::size_t n, const std::vector<std::int64_t>& run_sizes, Coordinate coordinate) {
-  std::vector<std::int32_t> order(n);
-  for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::int32_t>(k);
+  // The points' coordinates beside their indices, moved together (the splits read them in place, not through
+  // the order); the same comparisons on the same values as through indices, so the same order.
+  struct Point {
+    double x[3];
+    std::int32_t index;
+  };
+  std::vector<Point> p(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto i = static_cast<std::int32_t>(k);
+    p[k] = Point{{coordinate(i, 0), coordinate(i, 1), coordinate(i, 2)}, i};
+  }
   const auto leaf = static_cast<std::size_t>(run_sizes.front());
   std::vector<std::pair<std::size_t, std::size_t>> todo{{0, n}};  // [begin, end) still to split
   while (!todo.empty()) {
@@ -32,16 +41,17 @@ std::vector<std::int32_t> box_order(std::size_t n, const std::vector<std::int64_
     const std::size_t half = std::clamp((count / 2 + unit / 2) / unit * unit, unit, (count - 1) / unit * unit);
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (std::size_t k = begin; k < end; ++k)
-      for (int a = 0; a < 3; ++a)
-        lo[a] = std::min(lo[a], coordinate(order[k], a)), hi[a] = std::max(hi[a], coordinate(order[k], a));
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[k].x[a]), hi[a] = std::max(hi[a], p[k].x[a]);
     int axis = 0;
     (hi - lo).maxCoeff(&axis);
-    const auto first = order.begin() + static_cast<std::ptrdiff_t>(begin);
-    std::nth_element(first, first + static_cast<std::ptrdiff_t>(half), order.begin() + static_cast<std::ptrdiff_t>(end),
-                     [&](std::int32_t u, std::int32_t v) { return coordinate(u, axis) < coordinate(v, axis); });
+    const auto first = p.begin() + static_cast<std::ptrdiff_t>(begin);
+    std::nth_element(first, first + static_cast<std::ptrdiff_t>(half), p.begin() + static_cast<std::ptrdiff_t>(end),
+                     [axis](const Point& u, const Point& v) { return u.x[axis] < v.x[axis]; });
     todo.emplace_back(begin, begin + half);
     todo.emplace_back(begin + half, end);
   }
+  std::vector<std::int32_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = p[k].index;
   return order;
 }
 
