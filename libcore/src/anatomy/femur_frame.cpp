@@ -4,12 +4,12 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <optional>
 #include <sstream>
 #include <vector>
 
+#include "impinge/core/concurrent.hpp"
 #include "impinge/core/error.hpp"
 
 namespace impinge {
@@ -43,10 +43,9 @@ std::array<std::optional<SphereFitResult>, 2> head_candidates(const TriangleMesh
   const Eigen::Vector3d L = femur_long_axis(femur.V, Eigen::Vector3d::Constant(std::nan("")));
   std::array<std::optional<SphereFitResult>, 2> out;
   std::array<std::string, 2> error;  // each end's, joined in order below
-  std::array<std::exception_ptr, 2> failure;
-  // The two ends are independent fits (each with its own seeded RANSAC): one thread each.
-#pragma omp parallel for schedule(static, 1) num_threads(2)
-  for (int k = 0; k < 2; ++k) {
+  // The two ends are independent fits (each with its own seeded RANSAC): one thread each. A fit's own
+  // error (impinge::Error) is kept for the message below; any other failure is rethrown by run_both.
+  const auto fit_end = [&](int k) {
     const double s = k == 0 ? 1.0 : -1.0;
     // Rotate so that s L becomes +z, fit there, rotate the centre back.
     const Eigen::Matrix3d Q = Eigen::Quaterniond::FromTwoVectors(s * L, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -60,12 +59,9 @@ std::array<std::optional<SphereFitResult>, 2> head_candidates(const TriangleMesh
       out[static_cast<std::size_t>(k)] = r;
     } catch (const Error& e) {
       error[static_cast<std::size_t>(k)] = e.what();
-    } catch (...) {
-      failure[static_cast<std::size_t>(k)] = std::current_exception();  // not a fit's error: rethrown
     }
-  }
-  for (const std::exception_ptr& f : failure)
-    if (f) std::rethrow_exception(f);
+  };
+  run_both([&] { fit_end(0); }, [&] { fit_end(1); });
   for (const std::string& e : error)
     if (!e.empty()) errors += std::string(errors.empty() ? "" : "; ") + e;
   return out;

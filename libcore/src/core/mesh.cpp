@@ -98,18 +98,29 @@ TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>& 
   return out;
 }
 
-std::int64_t count_unpaired_directed_edges(const TriangleMesh& mesh, std::int64_t stop_after) {
+namespace {
+
+/// count_unpaired_directed_edges' count, or, when a corner index is outside 0..n-1, the first such corner
+/// (bad_face >= 0) and no count: one pass over the faces serves the check and the count.
+struct UnpairedEdges {
+  std::int64_t count = 0;
+  Eigen::Index bad_face = -1;
+  int bad_corner = 0;
+};
+
+UnpairedEdges unpaired_directed_edges(const TriangleMesh& mesh, std::int64_t stop_after) {
   const Eigen::Index n = mesh.V.rows(), m = mesh.F.rows();
-  for (Eigen::Index f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k)
-      require(mesh.F(f, k) >= 0 && mesh.F(f, k) < n, [&] {
-        return mesh.source + ": triangle " + std::to_string(f) + " has corner index " + std::to_string(mesh.F(f, k)) +
-               "; valid are 0 to " + std::to_string(n - 1);
-      });
-  std::int64_t unpaired = 0;
+  UnpairedEdges out;
   std::vector<std::int32_t> start(static_cast<std::size_t>(n) + 1, 0), to(static_cast<std::size_t>(3 * m));
   for (Eigen::Index f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) ++start[static_cast<std::size_t>(mesh.F(f, k)) + 1];
+    for (int k = 0; k < 3; ++k) {
+      if (mesh.F(f, k) < 0 || mesh.F(f, k) >= n) {
+        out.bad_face = f;
+        out.bad_corner = k;
+        return out;
+      }
+      ++start[static_cast<std::size_t>(mesh.F(f, k)) + 1];
+    }
   for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) start[i + 1] += start[i];
   std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
   for (Eigen::Index f = 0; f < m; ++f)
@@ -121,26 +132,30 @@ std::int64_t count_unpaired_directed_edges(const TriangleMesh& mesh, std::int64_
       int reverse = 0, same = 0;
       for (std::int32_t g = start[j]; g < start[j + 1]; ++g) reverse += to[static_cast<std::size_t>(g)] == std::int32_t(i);
       for (std::int32_t g = start[i]; g < start[i + 1]; ++g) same += to[static_cast<std::size_t>(g)] == std::int32_t(j);
-      if ((reverse != 1 || same != 1) && ++unpaired >= stop_after) return unpaired;
+      if ((reverse != 1 || same != 1) && ++out.count >= stop_after) return out;
     }
-  return unpaired;
+  return out;
 }
-
-namespace {
 
 /// Whether every directed edge (a, b) of `mesh` occurs once and its reverse (b, a) once: a closed surface wound
 /// consistently, which orient_consistently leaves as it is (each shared edge then joins two triangles that run it
 /// opposite ways: no flip, no conflict). A corner index out of range is left to the general path (and
-/// validate_mesh).
+/// validate_mesh, whose message names it).
 bool wound_consistently(const TriangleMesh& mesh) {
-  const Eigen::Index n = mesh.V.rows();
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k)
-      if (mesh.F(f, k) < 0 || mesh.F(f, k) >= n) return false;
-  return count_unpaired_directed_edges(mesh, 1) == 0;
+  const UnpairedEdges u = unpaired_directed_edges(mesh, 1);
+  return u.bad_face < 0 && u.count == 0;
 }
 
 }  // namespace
+
+std::int64_t count_unpaired_directed_edges(const TriangleMesh& mesh, std::int64_t stop_after) {
+  const UnpairedEdges u = unpaired_directed_edges(mesh, stop_after);
+  require(u.bad_face < 0, [&] {
+    return mesh.source + ": triangle " + std::to_string(u.bad_face) + " has corner index " +
+           std::to_string(mesh.F(u.bad_face, u.bad_corner)) + "; valid are 0 to " + std::to_string(mesh.V.rows() - 1);
+  });
+  return u.count;
+}
 
 std::int64_t orient_consistently(TriangleMesh& mesh, std::int64_t* conflicts) {
   const Eigen::Index m = mesh.F.rows();
