@@ -141,6 +141,7 @@ int run_distance(const RunOptions& o) {
   const PoseAngles pose = parse_pose(o.command.pose);
   SessionOptions so = o.session;
   so.maps.setup = setup_for_poses(so.maps.setup, 1);  // auto: one pose, direct (the layered maps would not pay back)
+  so.only_poses = {pose};  // direct: the distance hierarchies cropped to it
   const Session s = open_session(so);
   const double setup_ms = ms_since(t_start);
   auto t = Clock::now();

@@ -8,6 +8,10 @@
 //   inside the other is inside: the winding number (2 in the overlap, 1 in either sphere) says so when
 //   the caller's hint disagrees with the pseudo-normal of the buried sheet;
 // - the triangles kept near an earlier query point (NearbyTriangles) change no answer, bit for bit;
+// - a query cropped to a region (balls) answers every query as the whole mesh's query, bit for bit (the closest
+//   triangle, distance, point, sign and rule; any_within; winding numbers), within the region from its own few
+//   triangles and elsewhere from the whole mesh's (counted), on a sphere, an open sphere (its rim irregular)
+//   and the shared hips; and refuses a ball that is not finite or has a negative radius;
 // - irregular edges counted by hand on small meshes: a border edge, an edge whose two triangles run
 //   it the same way (inconsistent winding) and an edge of three triangles (a fin) are each one.
 #include "impinge/casters/signed_distance.hpp"
@@ -331,5 +335,109 @@ TEST(SignedDistance, HierarchicalWindingNumberMatchesTheExactSum) {
       ASSERT_EQ(q.inside_by_winding_number(p), exact >= 0.5) << m.source << " " << p.transpose();
     }
     std::cout << m.source << ": worst |hierarchical - exact| " << worst << "\n";
+  }
+}
+
+// A query cropped to a region against the whole mesh's query (itself against CGAL above) and CGAL: every answer the
+// same bit for bit, wherever the query point lies; those within the region's balls (radius at most the ball's)
+// answered without the whole mesh's hierarchy, which the others build and count.
+TEST(SignedDistance, CroppedQueryAnswersAsTheWholeMesh) {
+  if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
+  std::vector<TriangleMesh> meshes{make_uv_sphere(20, {3, -2, 40}, 96, 48)};
+  {  // the sphere with a cap cut off: its rim is irregular, the winding number decides there
+    const TriangleMesh sphere = make_uv_sphere(10, Eigen::Vector3d::Zero(), 90, 45);
+    std::vector<std::uint8_t> keep(static_cast<std::size_t>(sphere.V.rows()));
+    for (Eigen::Index i = 0; i < sphere.V.rows(); ++i) keep[static_cast<std::size_t>(i)] = sphere.V(i, 2) < 8;
+    meshes.push_back(submesh(sphere, keep));
+  }
+  if (const auto real = test::load_real_joint("lhdl-ct")) meshes.push_back(real->pelvis), meshes.push_back(real->femur);
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> U(0, 1);
+  for (const TriangleMesh& m : meshes) {
+    const SignedDistanceQuery whole(m);
+    const ExactReference ref(m);
+    // The region: 40 balls of 2-5 mm about points up to 3 mm off the surface, and one of 12 mm.
+    std::vector<Eigen::Vector4d> region;
+    auto off_surface = [&](double spread) {
+      const Eigen::Index v = static_cast<Eigen::Index>(rng() % static_cast<std::uint64_t>(m.V.rows()));
+      return Eigen::Vector3d(m.V.row(v).transpose() +
+                             spread * Eigen::Vector3d(U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5));
+    };
+    for (int k = 0; k < 40; ++k) {
+      const Eigen::Vector3d c = off_surface(6);
+      region.emplace_back(c.x(), c.y(), c.z(), 2 + 3 * U(rng));
+    }
+    const Eigen::Vector3d big = off_surface(0);
+    region.emplace_back(big.x(), big.y(), big.z(), 12);
+    const SignedDistanceQuery crop(m, region);
+    ASSERT_TRUE(crop.cropped());
+    EXPECT_FALSE(whole.cropped());
+    EXPECT_LT(crop.triangles(), whole.triangles()) << m.source;
+    EXPECT_GT(crop.triangles(), 0) << m.source;
+    EXPECT_EQ(crop.orientation(), whole.orientation());
+    auto same = [&](const Eigen::Vector3d& q, double radius, int hint, const std::string& what) {
+      ClosestSurfacePoint a, b;
+      const bool found = whole.signed_distance(q, radius, hint, a);
+      ASSERT_EQ(crop.signed_distance(q, radius, hint, b), found) << what;
+      if (found) {
+        ASSERT_EQ(b.distance_mm, a.distance_mm) << what;
+        ASSERT_EQ(b.triangle, a.triangle) << what;
+        ASSERT_EQ(b.point, a.point) << what;
+        ASSERT_EQ(b.sign, a.sign) << what;
+        ASSERT_EQ(b.rule, a.rule) << what;
+        ASSERT_NEAR(b.distance_mm, ref.closest_distance(q), 1e-9) << what;
+      }
+      ClosestSurfacePoint c, d;
+      ASSERT_EQ(crop.closest(q, radius, d), whole.closest(q, radius, c)) << what;
+      if (found) ASSERT_EQ(d.triangle, c.triangle) << what;
+      ASSERT_EQ(crop.any_within(q, radius), whole.any_within(q, radius)) << what;
+    };
+    // Within the balls, at most their radius: the crop's own triangles answer (without a hint, on a closed mesh,
+    // where the pseudo-normal decides the signs: a winding number is always the whole mesh's).
+    auto within = [&](int k) {
+      const Eigen::Vector4d& ball = region[static_cast<std::size_t>(k) % region.size()];
+      const Eigen::Vector3d u(U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5);
+      const double r = std::max(ball[3] * U(rng), 1e-3);
+      return std::pair{Eigen::Vector3d(ball.head<3>() + U(rng) * (ball[3] - r) * u.normalized()), r};
+    };
+    for (int k = 0; k < 400; ++k) {
+      const auto [q, r] = within(k);
+      same(q, r, 0, m.source + " within ball " + std::to_string(k));
+    }
+    if (whole.irregular_edges() == 0) EXPECT_EQ(crop.cropped_fallbacks(), 0) << m.source;
+    for (int k = 0; k < 200; ++k) {  // with hints, which the winding number checks
+      const auto [q, r] = within(k);
+      same(q, r, static_cast<int>(rng() % 3) - 1, m.source + " within ball, hinted " + std::to_string(k));
+    }
+    // Anywhere, at any radius: the whole mesh answers what the crop cannot.
+    for (int k = 0; k < 200; ++k) {
+      const Eigen::Vector3d q = off_surface(30);
+      const double radius = k % 4 == 0 ? std::numeric_limits<double>::infinity() : 1 + 10 * U(rng);
+      same(q, radius, static_cast<int>(rng() % 3) - 1, m.source + " anywhere " + std::to_string(k));
+      if (k % 20 == 0) ASSERT_EQ(crop.winding_number(q), whole.winding_number(q)) << m.source;
+    }
+    EXPECT_GT(crop.cropped_fallbacks(), 0) << m.source;
+  }
+  // No region: every query goes to the whole mesh, with the same answers.
+  const TriangleMesh box = test::make_box({0, 0, 0}, {10, 10, 10});
+  const SignedDistanceQuery none(box, {}), whole(box);
+  EXPECT_EQ(none.triangles(), 0);
+  ClosestSurfacePoint a, b;
+  ASSERT_TRUE(none.signed_distance({5, 5, 11}, 4, 0, a));
+  ASSERT_TRUE(whole.signed_distance({5, 5, 11}, 4, 0, b));
+  EXPECT_EQ(a.distance_mm, b.distance_mm);
+  EXPECT_EQ(a.triangle, b.triangle);
+  EXPECT_EQ(none.cropped_fallbacks(), 1);
+  EXPECT_FALSE(none.any_within({5, 5, 30}, 4));  // off the box: no triangle there, nothing built
+  EXPECT_EQ(none.cropped_fallbacks(), 1);
+  // Bad balls: named.
+  for (const Eigen::Vector4d& bad : {Eigen::Vector4d(0, std::nan(""), 0, 1), Eigen::Vector4d(0, 0, 0, -1),
+                                     Eigen::Vector4d(0, 0, 0, std::numeric_limits<double>::infinity())}) {
+    try {
+      SignedDistanceQuery q(box, {Eigen::Vector4d(1, 1, 1, 1), bad});
+      FAIL() << "expected an error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("region ball 1"), std::string::npos) << e.what();
+    }
   }
 }

@@ -72,6 +72,23 @@ std::int64_t SignedDistanceQuery::triangles() const { return static_cast<std::in
 
 std::uint64_t SignedDistanceQuery::id() const { return impl_->serial; }
 
+bool SignedDistanceQuery::cropped() const { return impl_->crop != nullptr; }
+
+std::int64_t SignedDistanceQuery::cropped_fallbacks() const { return impl_->crop ? impl_->crop->fallbacks.load() : 0; }
+
+const SignedDistanceQuery* SignedDistanceQuery::Impl::whole_query() {
+  if (!crop) return nullptr;
+  Crop& g = *crop;
+  std::call_once(g.whole_built, [&g] { g.whole = std::make_unique<SignedDistanceQuery>(g.whole_mesh); });
+  g.fallbacks.fetch_add(1, std::memory_order_relaxed);
+  return g.whole.get();
+}
+
+const SignedDistanceQuery* SignedDistanceQuery::Impl::fallback(const Eigen::Vector3d& q, double radius) {
+  if (!crop || crop->covers(q, radius)) return nullptr;
+  return whole_query();
+}
+
 namespace {
 struct Search {
   const SignedDistanceQuery::Impl* m;
@@ -206,6 +223,7 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
     }
   }
 #elif defined(IMPINGE_HAVE_CGAL)
+  if (m.triangles.empty()) return false;  // a crop that kept no triangle
   using K = SignedDistanceQuery::Impl::K;
   const auto hit = m.tree.closest_point_and_primitive(K::Point_3(s.q.x(), s.q.y(), s.q.z()));
   const auto t = static_cast<std::size_t>(hit.second - m.triangles.begin());
@@ -219,6 +237,7 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
 }  // namespace
 
 bool SignedDistanceQuery::closest(const Eigen::Vector3d& q, double radius_mm, ClosestSurfacePoint& out) const {
+  if (const SignedDistanceQuery* whole = impl_->fallback(q, radius_mm)) return whole->closest(q, radius_mm, out);
   Search s{impl_.get(), q, 0, -1, {}, 0, false};
   if (!run(*impl_, s, radius_mm)) return false;
   out.distance_mm = s.best;
@@ -230,12 +249,15 @@ bool SignedDistanceQuery::closest(const Eigen::Vector3d& q, double radius_mm, Cl
 }
 
 bool SignedDistanceQuery::any_within(const Eigen::Vector3d& q, double radius_mm) const {
+  if (const SignedDistanceQuery* whole = impl_->fallback(q, radius_mm)) return whole->any_within(q, radius_mm);
   Search s{impl_.get(), q, 0, -1, {}, 0, true};
   return run(*impl_, s, radius_mm);
 }
 
 bool SignedDistanceQuery::signed_distance(const Eigen::Vector3d& q, double radius_mm, int hint,
                                           ClosestSurfacePoint& out, std::int64_t seed, NearbyTriangles* nearby) const {
+  if (const SignedDistanceQuery* whole = impl_->fallback(q, radius_mm))
+    return whole->signed_distance(q, radius_mm, hint, out, seed, nearby);
   Search s{impl_.get(), q, 0, -1, {}, 0, false};
   if (!run(*impl_, s, radius_mm, seed, nearby)) return false;
   const Impl& m = *impl_;

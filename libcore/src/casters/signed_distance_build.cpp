@@ -35,11 +35,119 @@ void no_ray_queries(const RTCOccludedFunctionNArguments*) {}
 
 SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
   validate_mesh(mesh);
+  build(mesh, nullptr);
+}
+
+namespace {
+// The cell of coordinate x on axis `axis` (clamped to the grid); monotone in x, so a point inside a box
+// lies in a cell of the box's range.
+int cell_of(const SignedDistanceQuery::Impl::Crop& g, double x, int axis) {
+  const double u = std::floor((x - g.origin[axis]) / g.cell);
+  return static_cast<int>(std::clamp(u, 0.0, static_cast<double>(g.dims[static_cast<std::size_t>(axis)] - 1)));
+}
+// A query ball's box is widened by this (mm, and relative to the coordinates) against rounding; the region's
+// balls are marked widened by more, so that a query about a region ball's own centre and radius is covered.
+double check_slack(const Eigen::Vector3d& q, double radius) { return 1e-9 * (1 + q.cwiseAbs().maxCoeff() + radius); }
+}  // namespace
+
+void SignedDistanceQuery::Impl::Crop::range(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                            std::array<int, 3>& first, std::array<int, 3>& last) const {
+  for (int d = 0; d < 3; ++d)
+    first[static_cast<std::size_t>(d)] = cell_of(*this, lo[d], d), last[static_cast<std::size_t>(d)] = cell_of(*this, hi[d], d);
+}
+
+bool SignedDistanceQuery::Impl::Crop::any_marked(const std::array<int, 3>& first, const std::array<int, 3>& last) const {
+  for (int z = first[2]; z <= last[2]; ++z)
+    for (int y = first[1]; y <= last[1]; ++y)
+      for (int x = first[0]; x <= last[0]; ++x)
+        if (marked[(static_cast<std::size_t>(z) * static_cast<std::size_t>(dims[1]) + static_cast<std::size_t>(y)) *
+                       static_cast<std::size_t>(dims[0]) + static_cast<std::size_t>(x)])
+          return true;
+  return false;
+}
+
+bool SignedDistanceQuery::Impl::Crop::all_marked(const std::array<int, 3>& first, const std::array<int, 3>& last) const {
+  for (int z = first[2]; z <= last[2]; ++z)
+    for (int y = first[1]; y <= last[1]; ++y)
+      for (int x = first[0]; x <= last[0]; ++x)
+        if (!marked[(static_cast<std::size_t>(z) * static_cast<std::size_t>(dims[1]) + static_cast<std::size_t>(y)) *
+                        static_cast<std::size_t>(dims[0]) + static_cast<std::size_t>(x)])
+          return false;
+  return true;
+}
+
+bool SignedDistanceQuery::Impl::Crop::covers(const Eigen::Vector3d& q, double radius) const {
+  // Outside the grid (the mesh's box) there is no triangle: clamping to it loses nothing, and a ball off it
+  // holds none.
+  if (!(radius < std::numeric_limits<double>::infinity()) || !q.allFinite()) return false;
+  const double r = radius + check_slack(q, radius);
+  if ((q.array() + r < origin.array()).any() || (q.array() - r > upper.array()).any()) return true;
+  std::array<int, 3> first{}, last{};
+  range(q.array() - r, q.array() + r, first, last);
+  return all_marked(first, last);
+}
+
+SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh, const std::vector<Eigen::Vector4d>& region)
+    : impl_(std::make_unique<Impl>()) {
+  validate_mesh(mesh);
+  require(available(), "signed distance: needs Embree or CGAL, and this build has neither (" + mesh.source + ")");
+  auto crop = std::make_unique<Impl::Crop>();
+  Impl::Crop& g = *crop;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < region.size(); ++i) {
+    const Eigen::Vector4d& ball = region[i];
+    require(ball.allFinite() && ball[3] >= 0, [&] {
+      return "signed distance (cropped, " + mesh.source + "): region ball " + std::to_string(i) + " (" +
+             std::to_string(ball[0]) + ", " + std::to_string(ball[1]) + ", " + std::to_string(ball[2]) + "; radius " +
+             std::to_string(ball[3]) + " mm) must be finite with radius >= 0";
+    });
+    if (ball[3] > 0) smallest = std::min(smallest, ball[3]);
+  }
+  // The grid over the mesh's box: cells about as wide as the smallest ball, at most 128 per axis.
+  const Eigen::Vector3d lo = mesh.V.colwise().minCoeff().transpose(), hi = mesh.V.colwise().maxCoeff().transpose();
+  const double extent = (hi - lo).maxCoeff();
+  g.cell = std::max({std::isfinite(smallest) ? smallest : extent, extent / 128, 1e-6});
+  g.origin = lo, g.upper = hi;
+  for (int d = 0; d < 3; ++d)
+    g.dims[static_cast<std::size_t>(d)] = std::clamp(static_cast<int>(std::floor((hi[d] - lo[d]) / g.cell)) + 1, 1, 129);
+  g.marked.assign(static_cast<std::size_t>(g.dims[0]) * static_cast<std::size_t>(g.dims[1]) *
+                      static_cast<std::size_t>(g.dims[2]), 0);
+  for (const Eigen::Vector4d& ball : region) {
+    const Eigen::Vector3d c = ball.head<3>();
+    const double r = ball[3] + 1e-3 * g.cell + 1e3 * check_slack(c, ball[3]);  // more than covers() widens by
+    if ((c.array() + r < lo.array()).any() || (c.array() - r > hi.array()).any()) continue;  // off the mesh's box
+    std::array<int, 3> first{}, last{};
+    g.range(c.array() - r, c.array() + r, first, last);
+    for (int z = first[2]; z <= last[2]; ++z)
+      for (int y = first[1]; y <= last[1]; ++y)
+        for (int x = first[0]; x <= last[0]; ++x)
+          g.marked[(static_cast<std::size_t>(z) * static_cast<std::size_t>(g.dims[1]) + static_cast<std::size_t>(y)) *
+                       static_cast<std::size_t>(g.dims[0]) + static_cast<std::size_t>(x)] = 1;
+  }
+  // A triangle is kept when its box meets a marked cell: every point of a covered query's ball lies in one.
+  std::vector<std::uint8_t> keep(static_cast<std::size_t>(mesh.F.rows()), 0);
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    Eigen::Vector3d flo = mesh.V.row(mesh.F(f, 0)).transpose(), fhi = flo;
+    for (int k = 1; k < 3; ++k) {
+      const Eigen::Vector3d p = mesh.V.row(mesh.F(f, k)).transpose();
+      flo = flo.cwiseMin(p), fhi = fhi.cwiseMax(p);
+    }
+    std::array<int, 3> first{}, last{};
+    g.range(flo, fhi, first, last);
+    keep[static_cast<std::size_t>(f)] = g.any_marked(first, last);
+  }
+  g.whole_mesh = mesh;
+  impl_->crop = std::move(crop);
+  build(mesh, &keep);
+}
+
+void SignedDistanceQuery::build(const TriangleMesh& mesh, const std::vector<std::uint8_t>* keep) {
   require(available(), "signed distance: needs Embree or CGAL, and this build has neither (" + mesh.source + ")");
   Impl& m = *impl_;
   static std::atomic<std::uint64_t> built{0};
   m.serial = ++built;
-  double volume = 0;
+  double volume = 0;  // of every triangle, kept or not
+  bool any_area = false;
   const auto faces = static_cast<std::size_t>(mesh.F.rows());
   m.a.reserve(faces), m.b.reserve(faces), m.c.reserve(faces), m.face.reserve(faces), m.corner.reserve(faces);
   m.face_normal.reserve(faces);
@@ -48,13 +156,15 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
                           c = mesh.V.row(mesh.F(f, 2)).transpose();
     const Eigen::Vector3d n = (b - a).cross(c - a);
     if (!(n.norm() > 0)) continue;
+    volume += a.dot(b.cross(c)) / 6;
+    any_area = true;
+    if (keep != nullptr && !(*keep)[static_cast<std::size_t>(f)]) continue;
     m.a.push_back(a), m.b.push_back(b), m.c.push_back(c), m.face.push_back(f);
     m.corner.push_back({static_cast<std::int32_t>(mesh.F(f, 0)), static_cast<std::int32_t>(mesh.F(f, 1)),
                         static_cast<std::int32_t>(mesh.F(f, 2))});
     m.face_normal.push_back(n.normalized());
-    volume += a.dot(b.cross(c)) / 6;
   }
-  require(!m.a.empty(), "signed distance: " + mesh.source + " has no triangle of nonzero area");
+  require(any_area, "signed distance: " + mesh.source + " has no triangle of nonzero area");
   m.kept.assign(static_cast<std::size_t>(mesh.F.rows()), -1);
   for (std::size_t t = 0; t < m.face.size(); ++t) m.kept[static_cast<std::size_t>(m.face[t])] = static_cast<std::int64_t>(t);
   orientation_ = m.orientation = volume >= 0 ? 1 : -1;
@@ -122,7 +232,7 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh) : impl_(std::
 
 #ifdef IMPINGE_HAVE_EMBREE
   for (std::size_t t = 0; t < k; ++t) m.shift += (m.a[t] + m.b[t] + m.c[t]) / 3.0;
-  m.shift /= static_cast<double>(k);
+  if (k > 0) m.shift /= static_cast<double>(k);  // a crop may keep no triangle (an empty hierarchy)
   m.device = rtcNewDevice(nullptr);  // the build on every core; each query runs on its caller's thread
   require(m.device != nullptr, "signed distance: rtcNewDevice failed (" + mesh.source + ")");
   m.scene = rtcNewScene(m.device);

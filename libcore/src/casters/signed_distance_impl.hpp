@@ -3,7 +3,9 @@
 // signed_distance_build.cpp (the constructor: triangles, normals, Embree's or CGAL's hierarchy) and
 // signed_distance_winding.cpp (the winding number and its hierarchy). Private to the casters layer.
 #include <array>
+#include <atomic>
 #include <cstring>
+#include <memory>
 #include <mutex>
 #include <vector>
 
@@ -72,6 +74,31 @@ struct SignedDistanceQuery::Impl {
   std::vector<Eigen::Vector3d> vertex_normal;
   std::vector<std::uint8_t> vertex_irregular;
   int orientation = 1;
+  // A cropped query (the region constructor): the grid of cells that decides which triangles are kept and
+  // which queries they answer, and the whole mesh for the others (its query built at the first of them).
+  struct Crop {
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // the grid's lower corner (the mesh's box's), mm
+    Eigen::Vector3d upper = Eigen::Vector3d::Zero();   // the mesh's box's upper corner, mm
+    double cell = 1;                                   // mm
+    std::array<int, 3> dims{1, 1, 1};
+    std::vector<std::uint8_t> marked;                  // x fastest
+    // The cells of box [lo, hi] (clamped to the grid), per axis first and last.
+    void range(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, std::array<int, 3>& first,
+               std::array<int, 3>& last) const;
+    bool any_marked(const std::array<int, 3>& first, const std::array<int, 3>& last) const;
+    bool all_marked(const std::array<int, 3>& first, const std::array<int, 3>& last) const;
+    // Whether a query ball's box (a little widened against rounding) meets only marked cells.
+    bool covers(const Eigen::Vector3d& q, double radius) const;
+    TriangleMesh whole_mesh;
+    std::once_flag whole_built;
+    std::unique_ptr<SignedDistanceQuery> whole;
+    std::atomic<std::int64_t> fallbacks{0};
+  };
+  std::unique_ptr<Crop> crop;
+  // Cropped, and the query (q, radius) not covered: the whole mesh's query (built at its first use); else null.
+  const SignedDistanceQuery* fallback(const Eigen::Vector3d& q, double radius);
+  // Cropped: the whole mesh's query (counted as a fallback); else null.
+  const SignedDistanceQuery* whole_query();
   // The winding number's hierarchy (Barill et al. 2018): nodes over `order` (kept triangles), each with
   // its area vector (sum of (b - a) x (c - a) / 2 in the triangles' own winding), area-weighted centroid
   // and the radius of a ball about it holding its triangles. Built at its first use (winding_number_fast):

@@ -90,6 +90,7 @@ constexpr double kFastMargin = 0.1;   // the hierarchical sum decides when this 
 }  // namespace
 
 double SignedDistanceQuery::winding_number(const Eigen::Vector3d& q) const {
+  if (const SignedDistanceQuery* whole = impl_->whole_query()) return whole->winding_number(q);  // cropped
   const Impl& m = *impl_;
   double sum = 0;
   for (std::size_t t = 0; t < m.a.size(); ++t) sum += half_solid_angle(q, m.a[t], m.b[t], m.c[t]);
@@ -97,6 +98,7 @@ double SignedDistanceQuery::winding_number(const Eigen::Vector3d& q) const {
 }
 
 double SignedDistanceQuery::winding_number_fast(const Eigen::Vector3d& q) const {
+  if (const SignedDistanceQuery* whole = impl_->whole_query()) return whole->winding_number_fast(q);  // cropped
   std::call_once(impl_->hierarchy_built, [this] { impl_->build_hierarchy(); });
   const Impl& m = *impl_;
   double sum = 0;
@@ -127,6 +129,7 @@ double SignedDistanceQuery::winding_number_fast(const Eigen::Vector3d& q) const 
 }
 
 bool SignedDistanceQuery::inside_by_winding_number(const Eigen::Vector3d& q) const {
+  if (const SignedDistanceQuery* whole = impl_->whole_query()) return whole->inside_by_winding_number(q);  // cropped
   const double fast = winding_number_fast(q);
   if (std::abs(fast - 0.5) > kFastMargin) return fast > 0.5;
   return winding_number(q) >= 0.5;

@@ -198,6 +198,12 @@ void HipJoint::detect(const PoseAngles& angles, PoseResult& out) const {
   joint_->detect(p.R, p.t, out);
 }
 
+void HipJoint::crop_distance_queries(const std::vector<FemurPose>& poses) {
+  std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>> joint_poses;
+  for (const FemurPose& p : poses) joint_poses.emplace_back(p.R, p.t);
+  joint_->crop_distance_queries(joint_poses);
+}
+
 PoseResult HipJoint::detect(const PoseAngles& angles) const {
   PoseResult r;
   detect(angles, r);

@@ -80,7 +80,7 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
   // it fills the core the other body's build leaves idle when it ends first (the query's hierarchy is
   // serial). Joined before b is returned or the build fails (the future's destructor waits).
   std::future<std::shared_ptr<const SignedDistanceQuery>> query;
-  if (options.distances || options.layers > 0)
+  if ((options.distances || options.layers > 0) && !options.cropped_distance_queries)
     query =
         std::async(std::launch::async, [&mesh = b.mesh] { return std::make_shared<const SignedDistanceQuery>(mesh); });
   b.relative = b.mesh.V.rowwise() - cor.transpose();
@@ -144,6 +144,34 @@ std::shared_ptr<const SamplingScheme> Joint::layered_scheme(const JointOptions& 
   return make_scheme(s->name(), resolution_for_spacing(s->name(), want));
 }
 
+void Joint::crop_distance_queries(const std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>>& poses) {
+  if (!options_.distances && options_.layers == 0) return;  // no distance hierarchy to build
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    require(poses[i].first.allFinite() && poses[i].second.allFinite(),
+            "crop distance queries: pose " + std::to_string(i) + " is not finite");
+  const double reach = options_.reach_mm();
+  // The balls `own`'s searches reach at pose (Rq, tq), in the other body's frame: those of scan_distances (its
+  // vertices within the reach; its clusters grown by the reach) and of the layered scans' pruning (cluster_apart).
+  auto region = [&](const JointBody& own, const Eigen::Matrix3d& Rq, const Eigen::Vector3d& tq,
+                    std::vector<Eigen::Vector4d>& out) {
+    const Eigen::Vector3d shift = cor_ + tq;
+    auto add = [&](const Eigen::Vector3d& c, double r) { out.emplace_back(c.x(), c.y(), c.z(), r); };
+    const DistanceScanSet& d = own.distance_set;
+    for (const Eigen::Vector3d& p : d.position) add(Rq * p + shift, reach);
+    for (std::size_t c = 0; c < d.centre.size(); ++c) add(Rq * d.centre[c] + shift, d.radius[c] + reach);
+    const ScanClusters& h = own.hidden_clusters;
+    for (std::size_t c = 0; c < h.centre.size(); ++c) add(Rq * h.centre[c] + shift, h.radius[c] + reach);
+  };
+  std::vector<Eigen::Vector4d> near_socket, near_ball;  // the ball's searches reach the socket, and back
+  for (const auto& [R, t] : poses) {
+    region(ball_, R, t, near_socket);
+    const Eigen::Matrix3d Rt = R.transpose();
+    region(socket_, Rt, -(Rt * t), near_ball);
+  }
+  run_both([&] { ball_.distance_query = std::make_shared<const SignedDistanceQuery>(ball_.mesh, near_ball); },
+           [&] { socket_.distance_query = std::make_shared<const SignedDistanceQuery>(socket_.mesh, near_socket); });
+}
+
 PoseResult Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const {
   PoseResult res;
   detect(R, t, res);
@@ -155,6 +183,8 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
 }
 
 void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& res, DetectionMemory* memory) const {
+  require(!(options_.distances || options_.layers > 0) || (ball_.distance_query && socket_.distance_query),
+          "joint: cropped_distance_queries is on and crop_distance_queries was not called before detect");
   // The ball's scans (its vertices against the socket's maps and surface) and the socket's (in the ball's frame:
   // R^T (p - t)) share nothing but the pose: on their own threads when this call is not already on one of
   // several (a motion's or a ROM search's frames are), each with its own scratch. Same results either way.

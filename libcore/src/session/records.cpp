@@ -8,6 +8,7 @@
 #include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/clinical/rom.hpp"
+#include "impinge/casters/signed_distance.hpp"
 #include "impinge/core/spherical_frame.hpp"
 #include "impinge/sampling/sampling.hpp"
 #include "impinge/schemes/sampling_scheme.hpp"
@@ -219,6 +220,15 @@ nlohmann::json setup_record(const Session& s) {
   j["layers"] = opt.layers;
   // What was built for the work (MapSettings::setup): the layered maps, or exact casts for the hidden vertices.
   j["setup"] = opt.layers > 0 && !opt.layered_maps ? "direct" : "maps";
+  // The distance hierarchies: over the whole meshes, or cropped to the session's poses (SessionOptions::only_poses),
+  // with the searches a whole-mesh hierarchy answered (built at the first of them).
+  auto hierarchy = [](const JointBody& b) {
+    const SignedDistanceQuery& q = *b.distance_query;
+    return nlohmann::json{{"cropped", q.cropped()}, {"triangles", q.triangles()}, {"of", b.mesh.F.rows()},
+                          {"whole_mesh_searches", q.cropped_fallbacks()}};
+  };
+  if (s.joint().ball().distance_query && s.joint().socket().distance_query)
+    j["distance_hierarchies"] = {{"ball", hierarchy(s.joint().ball())}, {"socket", hierarchy(s.joint().socket())}};
   j["distances"] = opt.distances;
   j["levels_on"] = to_string(opt.levels_on);
   if (opt.distances) j["distance_reach_mm"] = opt.reach_mm();

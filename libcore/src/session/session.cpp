@@ -360,9 +360,17 @@ Session::Session(const SessionOptions& options) : options_(options) {
       // No head to fit (e.g. a proximal stump): the COR's sphere, as before.
     }
   }
+  // One pose's work (SessionOptions::only_poses): the distance hierarchies cropped to it and the scan pose.
+  hip_options_.joint.cropped_distance_queries = !options.only_poses.empty() && options.maps.setup == "direct";
   try {
-    hip_ = std::make_shared<const HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
-                                            hip_options_);
+    auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
+                                          hip_options_);
+    if (hip_options_.joint.cropped_distance_queries) {
+      std::vector<FemurPose> poses{hip->scan_pose()};
+      for (const PoseAngles& a : options.only_poses) poses.push_back(hip->femur_pose(a));
+      hip->crop_distance_queries(poses);
+    }
+    hip_ = std::move(hip);
   } catch (const Error& e) {
     if (hip_options_.neutral != Neutral::anatomical) throw;
     throw Error(std::string(e.what()) +

@@ -89,6 +89,17 @@ class SignedDistanceQuery {
   /// Throws impinge::Error when no engine is in this build or the mesh is invalid (validate_mesh, naming
   /// mesh.source).
   explicit SignedDistanceQuery(const TriangleMesh& mesh);
+  /// A query cropped to a region (one pose's work, issue 52): its hierarchy holds only the triangles of
+  /// `mesh` that may lie within `region`'s balls (x, y, z, radius; mm, mesh frame; radius >= 0), found on a
+  /// grid of cells about as wide as the smallest radius (at most 128 per axis): a triangle is kept when its
+  /// box meets a cell that meets a ball's box. A query whose ball (q, radius) meets only such cells is
+  /// answered from them, and the answer is the whole mesh's: every triangle within the radius is kept (the
+  /// same closest triangle, ties by the lower index, distance, feature and sign). Any other query, and every
+  /// winding number, goes to a query over the whole mesh, built at its first use (cropped_fallbacks counts
+  /// them). So the answers never depend on the region; only the cost does. The orientation is the whole
+  /// mesh's. Throws as the constructor above, and impinge::Error on a ball that is not finite or has a
+  /// negative radius (naming it).
+  SignedDistanceQuery(const TriangleMesh& mesh, const std::vector<Eigen::Vector4d>& region);
   ~SignedDistanceQuery();
   SignedDistanceQuery(SignedDistanceQuery&&) noexcept;
   SignedDistanceQuery& operator=(SignedDistanceQuery&&) noexcept;
@@ -120,12 +131,17 @@ class SignedDistanceQuery {
   /// hierarchical lies within 0.1 of 1/2.
   bool inside_by_winding_number(const Eigen::Vector3d& q) const;
 
-  /// Edges with other than two faces, or whose two faces are wound against each other.
+  /// Edges with other than two faces, or whose two faces are wound against each other (cropped: among the
+  /// kept triangles, so the crop's own border counts too).
   std::int64_t irregular_edges() const { return irregular_edges_; }
   /// +1 when the mesh is wound outward (signed volume >= 0), -1 otherwise.
   int orientation() const { return orientation_; }
-  /// Triangles in the hierarchy (degenerate ones left out).
+  /// Triangles in the hierarchy (degenerate ones left out; cropped: the kept ones).
   std::int64_t triangles() const;
+  /// Whether this query was cropped to a region (the second constructor).
+  bool cropped() const;
+  /// Cropped: the queries (and winding numbers) the whole mesh's query answered so far; 0 otherwise.
+  std::int64_t cropped_fallbacks() const;
   /// A number no other query built in this process has (from 1): facts learnt about this query's surface
   /// (DistanceScanMemory) are tied to it, so that they are never applied to another surface, even one built
   /// at the same address after this one is gone.
@@ -134,6 +150,9 @@ class SignedDistanceQuery {
   struct Impl;  ///< the hierarchy and the pseudo-normals (implementation detail)
 
  private:
+  // Both constructors: the triangles of `mesh` (those with keep[f] != 0 when given), their normals, edges and
+  // hierarchy; the orientation from every triangle.
+  void build(const TriangleMesh& mesh, const std::vector<std::uint8_t>* keep);
   std::unique_ptr<Impl> impl_;
   std::int64_t irregular_edges_ = 0;
   int orientation_ = 1;

@@ -120,6 +120,9 @@ class HipJoint {
   Vertices pelvis_vertices() const;
 
   const Joint& joint() const { return *joint_; }
+  /// Crop the joint's distance hierarchies to these poses (femur_pose's, scan_pose's):
+  /// Joint::crop_distance_queries, for options.joint.cropped_distance_queries. Throws as that does.
+  void crop_distance_queries(const std::vector<FemurPose>& poses);
   /// The anatomical frames in the working frame (empty with scan neutral).
   const std::optional<HipFrames>& frames() const { return frames_; }
   /// The acetabulum (working frame; empty with scan neutral).

@@ -85,6 +85,12 @@ struct JointOptions {
   /// radial gap (the thesis) or, with distances on, the Euclidean distance (then distance_reach_mm must be
   /// 0 or at least the largest level threshold).
   LevelQuantity levels_on = LevelQuantity::radial_gap;
+  /// Leave the distance hierarchies (JointBody::distance_query) to Joint::crop_distance_queries, for the poses
+  /// the caller will ask (one `impinge distance`), instead of building them over the whole meshes: each then
+  /// holds only the triangles those poses' searches can reach (3-7 % of a shared hip's), and answers every
+  /// other search from a whole-mesh hierarchy built at its first use, so every result is the same either way.
+  /// Source: impinge (issue 52: a set-up chosen by the work).
+  bool cropped_distance_queries = false;
   /// distance_reach_mm resolved (the largest level threshold when 0), mm.
   double reach_mm() const { return distance_reach_mm > 0 ? distance_reach_mm : std::max(levels.thresholds_mm.front(), 1e-3); }
 };
@@ -170,6 +176,15 @@ class Joint {
   /// same result at less cost when the poses follow each other closely, as a motion's frames do. One
   /// memory per thread.
   void detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& out, DetectionMemory* memory) const;
+
+  /// With JointOptions::cropped_distance_queries (required before the first detect that needs a distance
+  /// hierarchy, with distances or layers on): build both bodies' distance hierarchies cropped to the balls their
+  /// searches at these poses (R: 3 x 3, t: mm, as detect's) can reach: the other body's distance-scan vertices
+  /// grown by the reach, its clusters grown by their radius and the reach, and its hidden clusters alike
+  /// (SignedDistanceQuery's region constructor). A detect at any other pose gives the same answers, at the cost of
+  /// the whole hierarchies, built at their first use. Replaces hierarchies built before. Throws impinge::Error on
+  /// a pose that is not finite.
+  void crop_distance_queries(const std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>>& poses);
 
   const JointBody& ball() const { return ball_; }
   const JointBody& socket() const { return socket_; }

@@ -124,6 +124,11 @@ struct SessionOptions {
   CorOptions cor;
   MapSettings maps;
   FrameSettings frames;
+  /// The poses the session will be asked for, when the front end knows them (`impinge distance`'s --pose; not
+  /// an option of its own). With maps.setup "direct" and distances or layers on, the distance hierarchies are
+  /// cropped to them and the scan pose (JointOptions::cropped_distance_queries): the same results, less set-up.
+  /// Empty: built over the whole meshes.
+  std::vector<PoseAngles> only_poses;
 };
 
 /// The meshes of a SessionInput in the working frame (RAS, mm), with what the input said.
