@@ -103,10 +103,10 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh, const std::ve
     });
     if (ball[3] > 0) smallest = std::min(smallest, ball[3]);
   }
-  // The grid over the mesh's box: cells about as wide as the smallest ball, at most 128 per axis.
+  // The grid over the mesh's box: cells about half as wide as the smallest ball, at most 128 per axis.
   const Eigen::Vector3d lo = mesh.V.colwise().minCoeff().transpose(), hi = mesh.V.colwise().maxCoeff().transpose();
   const double extent = (hi - lo).maxCoeff();
-  g.cell = std::max({std::isfinite(smallest) ? smallest : extent, extent / 128, 1e-6});
+  g.cell = std::max({std::isfinite(smallest) ? smallest / 2 : extent, extent / 128, 1e-6});
   g.origin = lo, g.upper = hi;
   for (int d = 0; d < 3; ++d)
     g.dims[static_cast<std::size_t>(d)] = std::clamp(static_cast<int>(std::floor((hi[d] - lo[d]) / g.cell)) + 1, 1, 129);
@@ -124,16 +124,19 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh, const std::ve
           g.marked[(static_cast<std::size_t>(z) * static_cast<std::size_t>(g.dims[1]) + static_cast<std::size_t>(y)) *
                        static_cast<std::size_t>(g.dims[0]) + static_cast<std::size_t>(x)] = 1;
   }
-  // A triangle is kept when its box meets a marked cell: every point of a covered query's ball lies in one.
+  // A triangle is kept when its box meets a marked cell: every point of a covered query's ball lies in one. Its
+  // box's cells run from the least to the greatest of its corners' cells (cell_of is monotone).
+  std::vector<std::array<int, 3>> vertex_cell(static_cast<std::size_t>(mesh.V.rows()));
+  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
+    for (int d = 0; d < 3; ++d)
+      vertex_cell[static_cast<std::size_t>(i)][static_cast<std::size_t>(d)] = cell_of(g, mesh.V(i, d), d);
   std::vector<std::uint8_t> keep(static_cast<std::size_t>(mesh.F.rows()), 0);
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-    Eigen::Vector3d flo = mesh.V.row(mesh.F(f, 0)).transpose(), fhi = flo;
-    for (int k = 1; k < 3; ++k) {
-      const Eigen::Vector3d p = mesh.V.row(mesh.F(f, k)).transpose();
-      flo = flo.cwiseMin(p), fhi = fhi.cwiseMax(p);
-    }
+    const auto& a = vertex_cell[static_cast<std::size_t>(mesh.F(f, 0))];
+    const auto& b = vertex_cell[static_cast<std::size_t>(mesh.F(f, 1))];
+    const auto& c = vertex_cell[static_cast<std::size_t>(mesh.F(f, 2))];
     std::array<int, 3> first{}, last{};
-    g.range(flo, fhi, first, last);
+    for (std::size_t d = 0; d < 3; ++d) first[d] = std::min({a[d], b[d], c[d]}), last[d] = std::max({a[d], b[d], c[d]});
     keep[static_cast<std::size_t>(f)] = g.any_marked(first, last);
   }
   g.whole_mesh = mesh;

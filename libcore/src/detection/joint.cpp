@@ -151,13 +151,13 @@ void Joint::crop_distance_queries(const std::vector<std::pair<Eigen::Matrix3d, E
             "crop distance queries: pose " + std::to_string(i) + " is not finite");
   const double reach = options_.reach_mm();
   // The balls `own`'s searches reach at pose (Rq, tq), in the other body's frame: those of scan_distances (its
-  // vertices within the reach; its clusters grown by the reach) and of the layered scans' pruning (cluster_apart).
+  // clusters grown by the reach, which hold its vertices' balls of the reach) and of the layered scans' pruning
+  // (cluster_apart).
   auto region = [&](const JointBody& own, const Eigen::Matrix3d& Rq, const Eigen::Vector3d& tq,
                     std::vector<Eigen::Vector4d>& out) {
     const Eigen::Vector3d shift = cor_ + tq;
     auto add = [&](const Eigen::Vector3d& c, double r) { out.emplace_back(c.x(), c.y(), c.z(), r); };
     const DistanceScanSet& d = own.distance_set;
-    for (const Eigen::Vector3d& p : d.position) add(Rq * p + shift, reach);
     for (std::size_t c = 0; c < d.centre.size(); ++c) add(Rq * d.centre[c] + shift, d.radius[c] + reach);
     const ScanClusters& h = own.hidden_clusters;
     for (std::size_t c = 0; c < h.centre.size(); ++c) add(Rq * h.centre[c] + shift, h.radius[c] + reach);

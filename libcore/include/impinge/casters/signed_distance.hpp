@@ -91,7 +91,7 @@ class SignedDistanceQuery {
   explicit SignedDistanceQuery(const TriangleMesh& mesh);
   /// A query cropped to a region (one pose's work, issue 52): its hierarchy holds only the triangles of
   /// `mesh` that may lie within `region`'s balls (x, y, z, radius; mm, mesh frame; radius >= 0), found on a
-  /// grid of cells about as wide as the smallest radius (at most 128 per axis): a triangle is kept when its
+  /// grid of cells about half as wide as the smallest radius (at most 128 per axis): a triangle is kept when its
   /// box meets a cell that meets a ball's box. A query whose ball (q, radius) meets only such cells is
   /// answered from them, and the answer is the whole mesh's: every triangle within the radius is kept (the
   /// same closest triangle, ties by the lower index, distance, feature and sign). Any other query, and every

@@ -179,8 +179,8 @@ class Joint {
 
   /// With JointOptions::cropped_distance_queries (required before the first detect that needs a distance
   /// hierarchy, with distances or layers on): build both bodies' distance hierarchies cropped to the balls their
-  /// searches at these poses (R: 3 x 3, t: mm, as detect's) can reach: the other body's distance-scan vertices
-  /// grown by the reach, its clusters grown by their radius and the reach, and its hidden clusters alike
+  /// searches at these poses (R: 3 x 3, t: mm, as detect's) can reach: the other body's distance-scan clusters
+  /// grown by the reach (which hold its vertices' balls of the reach), and its hidden clusters alike
   /// (SignedDistanceQuery's region constructor). A detect at any other pose gives the same answers, at the cost of
   /// the whole hierarchies, built at their first use. Replaces hierarchies built before. Throws impinge::Error on
   /// a pose that is not finite.
