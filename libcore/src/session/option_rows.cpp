@@ -169,7 +169,8 @@ void add_map_rows(Rows& t) {
             [](auto& o) -> auto& { return o.session.maps.layers; });
   t.text("setup", "setup", OptionType::choice, kSetting, {"auto", "maps", "direct"},
          "What to build for the work: maps (both maps and the layered maps, for many poses), direct (no layered "
-         "maps: the hidden vertices by exact ray casts; a few poses; no ROM searches), auto (by the number of poses: "
+         "maps: the hidden vertices by exact ray casts; distance's distance hierarchies only over the triangles its "
+         "pose can reach; a few poses; no ROM searches), auto (by the number of poses: "
          "distance and motions of fewer than " + std::to_string(kDirectSetupMaxPoses) +
              " frames direct; ROM searches, plans and longer motions maps). The "
          "distances and the first-surface gaps are the same either way; the hidden vertices' gaps are exact with "
