@@ -389,7 +389,9 @@ TEST(SignedDistance, CroppedQueryAnswersAsTheWholeMesh) {
       }
       ClosestSurfacePoint c, d;
       ASSERT_EQ(crop.closest(q, radius, d), whole.closest(q, radius, c)) << what;
-      if (found) ASSERT_EQ(d.triangle, c.triangle) << what;
+      if (found) {
+        ASSERT_EQ(d.triangle, c.triangle) << what;
+      }
       ASSERT_EQ(crop.any_within(q, radius), whole.any_within(q, radius)) << what;
     };
     // Within the balls, at most their radius: the crop's own triangles answer (without a hint, on a closed mesh,
@@ -404,7 +406,9 @@ TEST(SignedDistance, CroppedQueryAnswersAsTheWholeMesh) {
       const auto [q, r] = within(k);
       same(q, r, 0, m.source + " within ball " + std::to_string(k));
     }
-    if (whole.irregular_edges() == 0) EXPECT_EQ(crop.cropped_fallbacks(), 0) << m.source;
+    if (whole.irregular_edges() == 0) {
+      EXPECT_EQ(crop.cropped_fallbacks(), 0) << m.source;
+    }
     for (int k = 0; k < 200; ++k) {  // with hints, which the winding number checks
       const auto [q, r] = within(k);
       same(q, r, static_cast<int>(rng() % 3) - 1, m.source + " within ball, hinted " + std::to_string(k));
@@ -414,7 +418,9 @@ TEST(SignedDistance, CroppedQueryAnswersAsTheWholeMesh) {
       const Eigen::Vector3d q = off_surface(30);
       const double radius = k % 4 == 0 ? std::numeric_limits<double>::infinity() : 1 + 10 * U(rng);
       same(q, radius, static_cast<int>(rng() % 3) - 1, m.source + " anywhere " + std::to_string(k));
-      if (k % 20 == 0) ASSERT_EQ(crop.winding_number(q), whole.winding_number(q)) << m.source;
+      if (k % 20 == 0) {
+        ASSERT_EQ(crop.winding_number(q), whole.winding_number(q)) << m.source;
+      }
     }
     EXPECT_GT(crop.cropped_fallbacks(), 0) << m.source;
   }

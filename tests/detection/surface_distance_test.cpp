@@ -459,7 +459,9 @@ TEST(SurfaceDistance, CroppedHierarchiesChangeNoResult) {
   auto same = [](const std::vector<float>& a, const std::vector<float>& b, const std::string& what) {
     ASSERT_EQ(a.size(), b.size()) << what;
     for (std::size_t i = 0; i < a.size(); ++i)
-      if (!(std::isnan(a[i]) && std::isnan(b[i]))) ASSERT_EQ(a[i], b[i]) << what << " vertex " << i;
+      if (!(std::isnan(a[i]) && std::isnan(b[i]))) {
+        ASSERT_EQ(a[i], b[i]) << what << " vertex " << i;
+      }
   };
   for (const Case& c : cases)
     for (const bool layered_maps : {false, true}) {
@@ -476,8 +478,9 @@ TEST(SurfaceDistance, CroppedHierarchiesChangeNoResult) {
       crop.crop_distance_queries(cropped_for);
       ASSERT_TRUE(crop.ball().distance_query->cropped());
       // The generated cup lies wholly within reach of the head's clusters; a real pelvis mostly does not.
-      if (c.name != "generated")
+      if (c.name != "generated") {
         EXPECT_LT(crop.socket().distance_query->triangles(), whole.socket().distance_query->triangles() / 2) << c.name;
+      }
       std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>> poses = cropped_for;
       poses.push_back(other_pose);
       for (std::size_t k = 0; k < poses.size(); ++k) {
@@ -489,8 +492,9 @@ TEST(SurfaceDistance, CroppedHierarchiesChangeNoResult) {
           same(x->distance_mm, y->distance_mm, what + " distances");
           ASSERT_EQ(x->status, y->status) << what;
         }
-        if (k == 0 && c.name == "generated")  // at rest nothing lies deeper than the reach: the crop answers alone
+        if (k == 0 && c.name == "generated") {  // at rest nothing lies deeper than the reach: the crop answers alone
           EXPECT_EQ(crop.ball().distance_query->cropped_fallbacks() + crop.socket().distance_query->cropped_fallbacks(), 0);
+        }
       }
       // The pose it was not cropped for went to the whole hierarchies.
       EXPECT_GT(crop.ball().distance_query->cropped_fallbacks() + crop.socket().distance_query->cropped_fallbacks(), 0)

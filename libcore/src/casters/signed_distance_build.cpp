@@ -56,24 +56,27 @@ void SignedDistanceQuery::Impl::Crop::range(const Eigen::Vector3d& lo, const Eig
     first[static_cast<std::size_t>(d)] = cell_of(*this, lo[d], d), last[static_cast<std::size_t>(d)] = cell_of(*this, hi[d], d);
 }
 
-bool SignedDistanceQuery::Impl::Crop::any_marked(const std::array<int, 3>& first, const std::array<int, 3>& last) const {
+namespace {
+// Calls f(index) for every cell of the range [first, last] (per axis) until f returns false; whether none did.
+template <class F>
+bool every_cell(const SignedDistanceQuery::Impl::Crop& g, const std::array<int, 3>& first,
+                const std::array<int, 3>& last, F&& f) {
+  const auto nx = static_cast<std::size_t>(g.dims[0]), ny = static_cast<std::size_t>(g.dims[1]);
   for (int z = first[2]; z <= last[2]; ++z)
     for (int y = first[1]; y <= last[1]; ++y)
       for (int x = first[0]; x <= last[0]; ++x)
-        if (marked[(static_cast<std::size_t>(z) * static_cast<std::size_t>(dims[1]) + static_cast<std::size_t>(y)) *
-                       static_cast<std::size_t>(dims[0]) + static_cast<std::size_t>(x)])
-          return true;
-  return false;
+        if (!f((static_cast<std::size_t>(z) * ny + static_cast<std::size_t>(y)) * nx + static_cast<std::size_t>(x)))
+          return false;
+  return true;
+}
+}  // namespace
+
+bool SignedDistanceQuery::Impl::Crop::any_marked(const std::array<int, 3>& first, const std::array<int, 3>& last) const {
+  return !every_cell(*this, first, last, [&](std::size_t i) { return !marked[i]; });
 }
 
 bool SignedDistanceQuery::Impl::Crop::all_marked(const std::array<int, 3>& first, const std::array<int, 3>& last) const {
-  for (int z = first[2]; z <= last[2]; ++z)
-    for (int y = first[1]; y <= last[1]; ++y)
-      for (int x = first[0]; x <= last[0]; ++x)
-        if (!marked[(static_cast<std::size_t>(z) * static_cast<std::size_t>(dims[1]) + static_cast<std::size_t>(y)) *
-                        static_cast<std::size_t>(dims[0]) + static_cast<std::size_t>(x)])
-          return false;
-  return true;
+  return every_cell(*this, first, last, [&](std::size_t i) { return marked[i] != 0; });
 }
 
 bool SignedDistanceQuery::Impl::Crop::covers(const Eigen::Vector3d& q, double radius) const {
@@ -118,11 +121,7 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh, const std::ve
     if ((c.array() + r < lo.array()).any() || (c.array() - r > hi.array()).any()) continue;  // off the mesh's box
     std::array<int, 3> first{}, last{};
     g.range(c.array() - r, c.array() + r, first, last);
-    for (int z = first[2]; z <= last[2]; ++z)
-      for (int y = first[1]; y <= last[1]; ++y)
-        for (int x = first[0]; x <= last[0]; ++x)
-          g.marked[(static_cast<std::size_t>(z) * static_cast<std::size_t>(g.dims[1]) + static_cast<std::size_t>(y)) *
-                       static_cast<std::size_t>(g.dims[0]) + static_cast<std::size_t>(x)] = 1;
+    every_cell(g, first, last, [&](std::size_t i) { return g.marked[i] = 1; });
   }
   // A triangle is kept when its box meets a marked cell: every point of a covered query's ball lies in one. Its
   // box's cells run from the least to the greatest of its corners' cells (cell_of is monotone).

@@ -87,7 +87,7 @@ struct JointOptions {
   LevelQuantity levels_on = LevelQuantity::radial_gap;
   /// Leave the distance hierarchies (JointBody::distance_query) to Joint::crop_distance_queries, for the poses
   /// the caller will ask (one `impinge distance`), instead of building them over the whole meshes: each then
-  /// holds only the triangles those poses' searches can reach (3-7 % of a shared hip's), and answers every
+  /// holds only the triangles those poses' searches can reach (5-13 % of a shared hip's at rest), and answers every
   /// other search from a whole-mesh hierarchy built at its first use, so every result is the same either way.
   /// Source: impinge (issue 52: a set-up chosen by the work).
   bool cropped_distance_queries = false;
