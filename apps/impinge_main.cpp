@@ -146,7 +146,7 @@ int run_distance(const RunOptions& o) {
   const double setup_ms = ms_since(t_start);
   auto t = Clock::now();
   const FemurPose femur = s.hip().femur_pose(pose);
-  const PoseResult res = s.joint().detect(femur.R, femur.t);
+  const PoseResult res = s.detect(femur);  // at the scan pose, the set-up's own scan of it
   const double pose_ms = ms_since(t);
   t = Clock::now();
   begin_output_folder(out, "distance");

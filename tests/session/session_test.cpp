@@ -7,6 +7,8 @@
 // - bad options are refused before any file is read, naming the option;
 // - the runs equal the library calls they wrap: run_motion's rows are Joint::detect's least gaps
 //   at each pose, run_rom's limits find_rom_limits's;
+// - a one-pose session (only_poses, cropped hierarchies) detects as a whole session, at the scan pose (its
+//   kept scan) and at its poses;
 // - tables refuse ragged rows and write RFC 4180 CSV.
 #include "impinge/session/session.hpp"
 
@@ -16,6 +18,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <cstring>
 #include <functional>
 #include <iostream>
 #include <sstream>
@@ -197,6 +200,44 @@ TEST(Session, SideOrFrameContradictingTheSubjectIsAnError) {
   in.ball_mesh = model().ball;
   in.ball = "femur.ply";
   EXPECT_NE(error_of([&] { load_input(in); }).find("not both"), std::string::npos);
+}
+
+// The same gaps, statuses and distances bit for bit (NaN included).
+testing::AssertionResult same_scan(const ScanGaps& a, const ScanGaps& b) {
+  auto bits = [](const std::vector<float>& x, const std::vector<float>& y) {
+    return x.size() == y.size() && (x.empty() || std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0);
+  };
+  if (!bits(a.gap_mm, b.gap_mm)) return testing::AssertionFailure() << "the gaps differ";
+  if (!bits(a.distance_mm, b.distance_mm)) return testing::AssertionFailure() << "the distances differ";
+  if (a.status != b.status) return testing::AssertionFailure() << "the statuses differ";
+  return testing::AssertionSuccess();
+}
+
+// A one-pose session (only_poses, direct set-up: cropped distance hierarchies) keeps its set-up's scan of the
+// scan pose and hands it out for that pose: its detect equals a whole session's Joint::detect there, and at a
+// pose it was set up for, bit for bit; distances on, so that the crop is exercised too.
+TEST(Session, OnePoseSessionDetectsAsAWholeSession) {
+  SessionOptions whole_options = generated_options("LPS");
+  whole_options.maps.setup = "maps";
+  whole_options.maps.distances = true;
+  SessionOptions one_options = whole_options;
+  one_options.maps.setup = "direct";
+  one_options.only_poses = {{0, 0, 0}, {40, 10, -5}};
+  const Session whole(whole_options), one(one_options);
+  ASSERT_TRUE(one.joint_options().distances);
+  for (const PoseAngles& a : one_options.only_poses) {
+    const FemurPose pose = one.hip().femur_pose(a);
+    const PoseResult got = one.detect(pose);
+    const PoseResult want = whole.joint().detect(pose.R, pose.t);
+    EXPECT_TRUE(same_scan(got.ball_gaps, want.ball_gaps)) << a.flexion_deg;
+    EXPECT_TRUE(same_scan(got.socket_gaps, want.socket_gaps)) << a.flexion_deg;
+    EXPECT_EQ(got.ball.min_gap_mm, want.ball.min_gap_mm);
+    EXPECT_EQ(got.socket.vertices_penetrating, want.socket.vertices_penetrating);
+  }
+  // The scan pose itself, and a whole session's detect (which keeps nothing) at it.
+  const FemurPose scan = one.hip().scan_pose();
+  EXPECT_TRUE(same_scan(one.detect(scan).ball_gaps, whole.detect(scan).ball_gaps));
+  EXPECT_TRUE(same_scan(one.detect(scan).socket_gaps, whole.joint().detect(scan.R, scan.t).socket_gaps));
 }
 
 TEST(Session, MotionRunEqualsDetectAtEachPose) {

@@ -194,8 +194,8 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
   // layered map (or exact casts without one), then its distances to the other's surface. The pose (Rq, tq) takes
   // this body's vertices into the other's frame.
   auto scans = [&](const JointBody& own, const JointBody& other, const Eigen::Matrix3d& Rq, const Eigen::Vector3d& tq,
-                   ScanSide side, ScanGaps& out, std::vector<float>& gaps, DistanceScanMemory* mem,
-                   double& detection_ms, double& distance_ms) {
+                   ScanSide side, ScanGaps& out, ScanSummary& summary, std::vector<float>& gaps,
+                   DistanceScanMemory* mem, double& detection_ms, double& distance_ms) {
     gaps.resize(static_cast<std::size_t>(std::max(own.scan_set.size(), own.hidden_set.size())));
     auto t0 = std::chrono::steady_clock::now();
     const std::int64_t refined =
@@ -224,13 +224,15 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
       out.distance_mm.clear();
       out.distance_winding = 0;
     }
+    // On the body's own thread too: a pass over all its vertices (some 0.07 ms per body on lhdl-ct).
+    summarize_scan(out, own.vertex_area, options_.levels, summary, options_.levels_on);
   };
   auto ball_scans = [&] {
-    scans(ball_, socket_, R, t, ScanSide::inside, res.ball_gaps, res.compact_gaps,
+    scans(ball_, socket_, R, t, ScanSide::inside, res.ball_gaps, res.ball, res.compact_gaps,
           memory != nullptr ? &memory->ball : nullptr, res.ball_detection_ms, res.ball_distance_ms);
   };
   auto socket_scans = [&] {
-    scans(socket_, ball_, Rt, tt, ScanSide::outside, res.socket_gaps, res.compact_gaps_socket,
+    scans(socket_, ball_, Rt, tt, ScanSide::outside, res.socket_gaps, res.socket, res.compact_gaps_socket,
           memory != nullptr ? &memory->socket : nullptr, res.socket_detection_ms, res.socket_distance_ms);
   };
   const bool two_threads = !omp_in_parallel() && omp_get_max_threads() > 1;
@@ -252,8 +254,6 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
     ball_scans();
     socket_scans();
   }
-  summarize_scan(res.ball_gaps, ball_.vertex_area, options_.levels, res.ball, options_.levels_on);
-  summarize_scan(res.socket_gaps, socket_.vertex_area, options_.levels, res.socket, options_.levels_on);
 }
 
 }  // namespace impinge

@@ -381,14 +381,24 @@ Session::Session(const SessionOptions& options) : options_(options) {
   for (const std::string& w : hip_->warnings()) warnings_.push_back(w);
   // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).
   const FemurPose scan_pose = hip_->scan_pose();
-  const PoseResult scan = joint().detect(scan_pose.R, scan_pose.t);
+  auto scan_result = std::make_shared<const PoseResult>(joint().detect(scan_pose.R, scan_pose.t));
+  const PoseResult& scan = *scan_result;
   scan_pose_min_gap_mm_ = std::fmin(scan.ball.min_gap_mm, scan.socket.min_gap_mm);
+  if (!options.only_poses.empty()) scan_result_ = std::move(scan_result);  // a one-pose run at the scan pose
   if (scan_pose_min_gap_mm_ < 0)
     warnings_.push_back("the bones overlap by " + num(-scan_pose_min_gap_mm_) +
                         " mm at the scan pose (a segmentation overlap, not an impingement)" +
                         (hip_->joint_centre().method() == JointCentreMethod::femoral_head
                              ? std::string("; the equidistant joint centre seats the head in the acetabulum")
                              : std::string()));
+}
+
+PoseResult Session::detect(const FemurPose& pose) const {
+  if (scan_result_) {
+    const FemurPose scan = hip_->scan_pose();
+    if (pose.R == scan.R && pose.t == scan.t) return *scan_result_;
+  }
+  return joint().detect(pose.R, pose.t);
 }
 
 Vertices Session::femur_input(const FemurPose& pose) const {

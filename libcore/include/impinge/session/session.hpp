@@ -215,6 +215,10 @@ class Session {
   const std::string& cor_method() const { return cor_.method; }
   /// Least gap of both scans at the scan pose (after any re-seating), mm; < 0: the bones overlap.
   double scan_pose_min_gap_mm() const { return scan_pose_min_gap_mm_; }
+  /// Both scans at `pose` (joint frame; Joint::detect). With SessionOptions::only_poses set, the set-up's own scan
+  /// of the scan pose is kept, and a `pose` equal to the scan pose (R and t bit for bit) returns a copy of it
+  /// instead of scanning again: the same result, since detect is a function of the pose. Throws as Joint::detect.
+  PoseResult detect(const FemurPose& pose) const;
   /// HipJoint's warnings and the session's (overlap at the scan pose), one line each.
   const std::vector<std::string>& warnings() const { return warnings_; }
 
@@ -261,6 +265,7 @@ class Session {
   CorResult cor_;
   std::shared_ptr<const HipJoint> hip_;
   double scan_pose_min_gap_mm_ = 0;
+  std::shared_ptr<const PoseResult> scan_result_;  ///< the scan pose's scans, kept when only_poses is set
   std::vector<std::string> warnings_;
 };
 
