@@ -80,7 +80,7 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
   // it fills the core the other body's build leaves idle when it ends first (the query's hierarchy is
   // serial). Joined before b is returned or the build fails (the future's destructor waits).
   std::future<std::shared_ptr<const SignedDistanceQuery>> query;
-  if ((options.distances || options.layers > 0) && !options.cropped_distance_queries)
+  if (options.needs_distance_queries() && !options.cropped_distance_queries)
     query =
         std::async(std::launch::async, [&mesh = b.mesh] { return std::make_shared<const SignedDistanceQuery>(mesh); });
   b.relative = b.mesh.V.rowwise() - cor.transpose();
@@ -145,7 +145,7 @@ std::shared_ptr<const SamplingScheme> Joint::layered_scheme(const JointOptions& 
 }
 
 void Joint::crop_distance_queries(const std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>>& poses) {
-  if (!options_.distances && options_.layers == 0) return;  // no distance hierarchy to build
+  if (!options_.needs_distance_queries()) return;  // no distance hierarchy to build
   for (std::size_t i = 0; i < poses.size(); ++i)
     require(poses[i].first.allFinite() && poses[i].second.allFinite(),
             "crop distance queries: pose " + std::to_string(i) + " is not finite");
@@ -183,7 +183,7 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
 }
 
 void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& res, DetectionMemory* memory) const {
-  require(!(options_.distances || options_.layers > 0) || (ball_.distance_query && socket_.distance_query),
+  require(!options_.needs_distance_queries() || (ball_.distance_query && socket_.distance_query),
           "joint: cropped_distance_queries is on and crop_distance_queries was not called before detect");
   // The ball's scans (its vertices against the socket's maps and surface) and the socket's (in the ball's frame:
   // R^T (p - t)) share nothing but the pose: on their own threads when this call is not already on one of

@@ -91,6 +91,9 @@ struct JointOptions {
   /// other search from a whole-mesh hierarchy built at its first use, so every result is the same either way.
   /// Source: impinge (issue 52: a set-up chosen by the work).
   bool cropped_distance_queries = false;
+  /// Whether the bodies need closest-point hierarchies (SignedDistanceQuery): for the distances, and for the
+  /// layered scans' pruning of hidden vertices far from the other body (layers > 0).
+  bool needs_distance_queries() const { return distances || layers > 0; }
   /// distance_reach_mm resolved (the largest level threshold when 0), mm.
   double reach_mm() const { return distance_reach_mm > 0 ? distance_reach_mm : std::max(levels.thresholds_mm.front(), 1e-3); }
 };
