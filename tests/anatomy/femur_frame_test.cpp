@@ -92,6 +92,26 @@ TEST(FemoralHead, FoundOnEveryFemurBothSidesWholeOrProximalAnyPlacement) {
   EXPECT_EQ(subjects, 4);
 }
 
+// Beside the pelvis, an end far from the acetabulum is not refined to its fixed point (the distal end); the head
+// still is: the same sphere, bit for bit, as the search without the pelvis, which refines both ends to their fixed
+// points and takes the one with more inliers (the head, on every shared whole femur).
+TEST(FemoralHead, BesideThePelvisTheHeadIsRefinedAsWithoutIt) {
+  int subjects = 0;
+  for (const HandChecked& h : kCentres) {
+    const auto bones = load(h.name);
+    if (!bones) continue;
+    ++subjects;
+    SCOPED_TRACE(h.name);
+    const SphereFitResult alone = locate_femoral_head(bones->first);
+    const SphereFitResult beside = locate_femoral_head(bones->first, bones->second);
+    EXPECT_LT((alone.centre - h.centre_lps).norm(), 2.0);  // the head, not a condyle
+    EXPECT_EQ(beside.centre, alone.centre);
+    EXPECT_EQ(beside.radius, alone.radius);
+    EXPECT_EQ(beside.points_used, alone.points_used);
+  }
+  if (subjects == 0) GTEST_SKIP() << "shared data absent";
+}
+
 TEST(FemoralHead, NeitherEndInTheAcetabulumIsAnErrorThatSaysSo) {
   const auto bones = load("mc22-left");
   if (!bones) GTEST_SKIP() << "shared data absent";

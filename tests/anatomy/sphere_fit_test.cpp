@@ -66,6 +66,32 @@ TEST(SphereFit, AutomaticHeadFitOnGeneratedFemur) {
   }
 }
 
+TEST(SphereFit, HeadFitStopsBeforeItsFixedPointOnlyWhenAsked) {
+  HipModelOptions o;
+  o.target_triangles = 12000;
+  o.cam_height_mm = 3;
+  const HipModel h = make_hip_model(o);
+  const SphereFitResult whole = fit_femoral_head(h.ball);
+  // Asked to go on: the same sphere as without the question, bit for bit.
+  int asked = 0;
+  const SphereFitResult on = fit_femoral_head(h.ball, {}, [&](const SphereFitResult&) { return ++asked > 0; });
+  EXPECT_EQ(asked, 1);
+  EXPECT_EQ(on.centre, whole.centre);
+  EXPECT_EQ(on.radius, whole.radius);
+  EXPECT_EQ(on.points_used, whole.points_used);
+  // Told to stop: the sphere it was asked about, after the refinement rounds, still on the head.
+  SphereFitResult seen;
+  const SphereFitResult stopped = fit_femoral_head(h.ball, {}, [&](const SphereFitResult& s) {
+    seen = s;
+    return false;
+  });
+  EXPECT_EQ(stopped.centre, seen.centre);
+  EXPECT_EQ(stopped.radius, seen.radius);
+  EXPECT_EQ(stopped.iterations, HeadFitOptions{}.refinement_rounds);
+  EXPECT_LT((stopped.centre - h.cor).norm(), 0.1);
+  EXPECT_NEAR(stopped.radius, o.head_radius_mm, 0.05);
+}
+
 TEST(SphereFit, RegionFitAndErrors) {
   HipModelOptions o;
   const HipModel h = make_hip_model(o);

@@ -35,10 +35,20 @@ Eigen::Vector3d femur_long_axis(PointsRef V, const Eigen::Vector3d& proximal_hin
 
 namespace {
 
+// Distance (mm) from p to the nearest vertex of `mesh`.
+double nearest_vertex_distance(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
+  return std::sqrt((mesh.V.rowwise() - p.transpose()).rowwise().squaredNorm().minCoeff());
+}
+
+// An end whose sphere after the refinement rounds lies this much farther from the pelvis than
+// kHeadInAcetabulumMm is not refined to its fixed point (see head_candidates).
+constexpr double kFixedPointMarginMm = 20.0;
+
 // The sphere of each end of the femur's long axis (fit_femoral_head with that end up); an end
-// without a plausible sphere has an empty result and its error in `errors`.
+// without a plausible sphere has an empty result and its error in `errors`. With a pelvis (valid, the
+// femur's frame), an end far from its acetabulum stops after the refinement rounds (may_sit below).
 std::array<std::optional<SphereFitResult>, 2> head_candidates(const TriangleMesh& femur, const HeadFitOptions& options,
-                                                              std::string& errors) {
+                                                              std::string& errors, const TriangleMesh* pelvis) {
   validate_mesh(femur);
   const Eigen::Vector3d L = femur_long_axis(femur.V, Eigen::Vector3d::Constant(std::nan("")));
   std::array<std::optional<SphereFitResult>, 2> out;
@@ -54,7 +64,15 @@ std::array<std::optional<SphereFitResult>, 2> head_candidates(const TriangleMesh
     m.F = femur.F;
     m.source = femur.source;
     try {
-      SphereFitResult r = fit_femoral_head(m, options);
+      // Beside a pelvis, an end's sphere matters only if it may sit in the acetabulum: an end whose refined
+      // sphere lies more than kFixedPointMarginMm beyond that is not the head, and is not refined to its fixed
+      // point (the refits that move the shared hips' spheres by at most 0.3 mm, and lhdl-ct's subdivided 4x by
+      // 1.4 mm, and take a distal end 11 to 50 rounds). The head's own sphere is refined as before.
+      const auto may_sit = [&](const SphereFitResult& refined) {
+        const double gap = nearest_vertex_distance(*pelvis, Q.transpose() * refined.centre) - refined.radius;
+        return std::abs(gap) <= kHeadInAcetabulumMm + kFixedPointMarginMm;
+      };
+      SphereFitResult r = pelvis != nullptr ? fit_femoral_head(m, options, may_sit) : fit_femoral_head(m, options);
       r.centre = Q.transpose() * r.centre;
       out[static_cast<std::size_t>(k)] = r;
     } catch (const Error& e) {
@@ -67,16 +85,11 @@ std::array<std::optional<SphereFitResult>, 2> head_candidates(const TriangleMesh
   return out;
 }
 
-// Distance (mm) from p to the nearest vertex of `mesh`.
-double nearest_vertex_distance(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
-  return std::sqrt((mesh.V.rowwise() - p.transpose()).rowwise().squaredNorm().minCoeff());
-}
-
 }  // namespace
 
 SphereFitResult locate_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options) {
   std::string errors;
-  const auto c = head_candidates(femur, options, errors);
+  const auto c = head_candidates(femur, options, errors, nullptr);
   require(c[0] || c[1], femur.source + ": no femoral head found at either end of the long axis (" + errors + ")");
   if (c[0] && c[1]) return c[0]->points_used >= c[1]->points_used ? *c[0] : *c[1];
   return c[0] ? *c[0] : *c[1];
@@ -86,7 +99,7 @@ SphereFitResult locate_femoral_head(const TriangleMesh& femur, const TriangleMes
                                     const HeadFitOptions& options) {
   validate_mesh(pelvis);
   std::string errors;
-  auto c = head_candidates(femur, options, errors);
+  auto c = head_candidates(femur, options, errors, &pelvis);
   require(c[0] || c[1], femur.source + ": no femoral head found at either end of the long axis (" + errors + ")");
   // Both ends can find the same sphere (a short proximal femur): one head, the better fit.
   if (c[0] && c[1] && (c[0]->centre - c[1]->centre).norm() < 2.0) {

@@ -175,6 +175,11 @@ bool sphere_through(const Eigen::Vector3d p[4], Eigen::Vector3d& c, double& r) {
 }  // namespace
 
 SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& o) {
+  return fit_femoral_head(femur, o, {});
+}
+
+SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& o,
+                                 const std::function<bool(const SphereFitResult&)>& to_fixed_point) {
   const Vertices& V = femur.V;
   require(V.rows() >= 4, femur.source + ": too few vertices for a head fit");
   const double zmax = V.col(2).maxCoeff();
@@ -235,6 +240,11 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
     std::nth_element(abs_res.begin(), abs_res.begin() + abs_res.size() / 2, abs_res.end());
     const double sigma = 1.4826 * abs_res[abs_res.size() / 2];
     threshold = std::clamp(3 * sigma, 0.2 * o.inlier_threshold_mm, o.inlier_threshold_mm);
+  }
+  res.iterations = o.refinement_rounds;
+  if (to_fixed_point) {
+    res.centre = c, res.radius = r;  // as it is after the refinement rounds (the RANSAC sphere without them)
+    if (!to_fixed_point(res)) return res;
   }
   // Then to the fixed point at the last band: refit until the inliers no longer change, so that the sphere
   // depends on the surface and not on which RANSAC draw led here (the draws follow the vertex numbering).

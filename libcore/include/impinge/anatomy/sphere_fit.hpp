@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,15 @@ struct HeadFitOptions {
 /// the re-selected inliers. `femur`: vertices in the working frame (RAS, +z superior), mm.
 /// Throws impinge::Error naming the mesh when no plausible sphere is found.
 SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options = {});
+
+/// fit_femoral_head, whose last stage (refits until the inliers no longer change, so that the sphere depends on
+/// the surface and not on the RANSAC draws) runs only when `to_fixed_point(sphere)` holds for the sphere of the
+/// refinement rounds (mm, the femur's frame); otherwise that sphere is returned (iterations =
+/// refinement_rounds). An empty function: always, as fit_femoral_head. locate_femoral_head's use: an end of the
+/// femur far from the acetabulum is not the head, and its fixed point (11 to 50 refits at a distal end of the
+/// shared hips) would not change that. Throws as fit_femoral_head, and what `to_fixed_point` throws.
+SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options,
+                                 const std::function<bool(const SphereFitResult&)>& to_fixed_point);
 
 /// Geometric fit of the femur's vertices within `region_radius_mm` of `region_centre` (a
 /// user-given selection region, as the planes of thesis Fig. 38a). Throws if fewer than 4.
