@@ -49,7 +49,10 @@ SphereFitResult locate_femoral_head(const TriangleMesh& femur, const HeadFitOpti
 /// the head is the one that sits in the acetabulum (two spheres within 2 mm of each other are one),
 /// its nearest pelvis vertex within
 /// kHeadInAcetabulumMm of its surface (the joint space; the shared hips: 0.4-1.1 mm). A distal
-/// condyle or a cut shaft can out-fit the head; it cannot lie in the acetabulum. Throws
+/// condyle or a cut shaft can out-fit the head; it cannot lie in the acetabulum. An end whose sphere
+/// after the refinement rounds lies more than 20 mm beyond that limit is not refined to its fixed
+/// point (fit_femoral_head's last stage, which moves a sphere by at most 1.4 mm on the shared hips and
+/// lhdl-ct subdivided 4x); the head itself is refined to its fixed point, as without the pelvis. Throws
 /// impinge::Error naming both meshes when neither end's sphere, or both, sit in the acetabulum (not
 /// one hip in one frame?), or when no sphere is found.
 SphereFitResult locate_femoral_head(const TriangleMesh& femur, const TriangleMesh& pelvis,
