@@ -350,6 +350,46 @@ TEST(SurfaceDistance, MemoryChangesNoDistanceOrSign) {
 
 class RealDistance : public ::testing::TestWithParam<std::string> {};
 
+TEST(SurfaceDistance, MemoryLearnsAlongAMotionNotAtAJump) {
+  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+  // The memory's new facts (empty balls, nearby triangles) cost extra walks; they are learnt only where the
+  // cluster moved within their margins since the scan before (a step of a motion), not at a first scan or
+  // after a jump (a motion of scattered poses). Whatever is learnt, every distance equals the memoryless scan's.
+  HipModelOptions ho;
+  ho.target_triangles = 6000;
+  const HipModel m = make_hip_model(ho);
+  const SignedDistanceQuery q(m.socket);
+  const Vertices P = m.ball.V.rowwise() - m.cor.transpose();
+  const DistanceScanSet s = make_distance_scan_set(P, 100);
+  const double reach = 4;
+  auto pose = [](double deg) {
+    return Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(0.6, 0.8, 0).normalized()).toRotationMatrix();
+  };
+  const Eigen::Vector3d push = 3 * Eigen::Vector3d::UnitZ();
+  std::vector<float> plain, remembered;
+  DistanceScanMemory memory;
+  auto learnt = [&] {
+    std::int64_t n = static_cast<std::int64_t>(memory.nearby.size());
+    for (const float r : memory.empty_radius) n += r > 0;
+    for (const float r : memory.cluster_empty_radius) n += r > 0;
+    return n;
+  };
+  auto scan = [&](double deg) {
+    scan_distances(s, pose(deg), push, m.cor, q, reach, {}, plain);
+    scan_distances(s, pose(deg), push, m.cor, q, reach, {}, remembered, &memory);
+    EXPECT_TRUE(same_floats(plain, remembered)) << deg << " deg";
+  };
+  scan(-10);  // the first scan: nothing to tell a step from a jump
+  EXPECT_EQ(learnt(), 0);
+  scan(-9.9);  // a step (a vertex at 60 mm moves 0.1 mm)
+  const std::int64_t after_step = learnt();
+  EXPECT_GT(after_step, 100);
+  scan(30);  // a jump of 40 deg: nothing new learnt
+  EXPECT_EQ(learnt(), after_step);
+  scan(30.1);  // a step again: learning again
+  EXPECT_GT(learnt(), after_step);
+}
+
 TEST_P(RealDistance, EveryMeasuredVertexMatchesCgalAtRestAndTenPoses) {
   if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
   const auto real = test::load_real_joint(GetParam());

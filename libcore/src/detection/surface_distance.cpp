@@ -116,7 +116,8 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
   if (memory != nullptr && (memory->query != other.id() || memory->seed.size() != k_all ||
                             memory->empty_radius.size() != k_all || memory->empty_centre.size() != k_all ||
                             memory->cluster_empty_radius.size() != c_all ||
-                            memory->cluster_empty_centre.size() != c_all || memory->nearby_slot.size() != k_all)) {
+                            memory->cluster_empty_centre.size() != c_all || memory->nearby_slot.size() != k_all ||
+                            memory->cluster_last_centre.size() != c_all)) {
     memory->query = other.id();
     memory->seed.assign(k_all, -1);
     memory->empty_centre.assign(k_all, Eigen::Vector3f::Zero());
@@ -125,6 +126,7 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
     memory->cluster_empty_radius.assign(c_all, 0.f);
     memory->nearby_slot.assign(k_all, -1);
     memory->nearby.clear();
+    memory->cluster_last_centre.assign(c_all, Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
   }
   const Eigen::Vector3d shift = cor + t;
   ClosestSurfacePoint cp;
@@ -139,6 +141,16 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
         if (g < -reach_mm) deepest = std::min(deepest, static_cast<double>(g));
       }
     const Eigen::Vector3d centre = R * set.centre[cs] + shift;
+    // How far the cluster moved since the last scan (NaN at the first): the memory's new facts (empty balls
+    // 2 and 4 mm beyond the reach, nearby triangles 2 mm beyond a search) pay back only where the next scan
+    // comes within those margins; after a jump they cost extra walks for nothing (a motion of scattered poses).
+    double moved = std::numeric_limits<double>::quiet_NaN();
+    if (memory != nullptr) {
+      const Eigen::Vector3f now = centre.cast<float>();
+      moved = static_cast<double>((now - memory->cluster_last_centre[cs]).norm());
+      memory->cluster_last_centre[cs] = now;
+    }
+    const bool learn_cluster = moved <= kClusterEmptySlackMm, learn_vertices = moved <= kEmptySlackMm;
     if (deepest == 0) {
       // No point of the surface within the cluster's ball grown by the reach: every vertex is beyond it.
       const double grown = set.radius[cs] + reach_mm;
@@ -148,6 +160,8 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       } else if (inside_empty(centre, grown, memory->cluster_empty_centre[cs], memory->cluster_empty_radius[cs])) {
         apart = true;
         ++st.clusters_recalled;
+      } else if (!learn_cluster) {
+        apart = !other.any_within(centre, grown);
       } else if (!other.any_within(centre, grown + kClusterEmptySlackMm)) {
         apart = true;  // nothing within the grown ball and the slack: remember that ball
         memory->cluster_empty_centre[cs] = centre.cast<float>();
@@ -174,7 +188,7 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       }
       const std::int64_t start = memory != nullptr && memory->seed[k] >= 0 ? memory->seed[k] : seed;
       NearbyTriangles* nearby = nullptr;
-      if (memory != nullptr) {
+      if (memory != nullptr && learn_vertices) {
         if (memory->nearby_slot[k] < 0) {
           memory->nearby_slot[k] = static_cast<std::int32_t>(memory->nearby.size());
           memory->nearby.emplace_back();
@@ -183,7 +197,7 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       }
       ++st.searches;
       bool found = false;
-      if (memory != nullptr && radius == reach_mm && !(g < reach_mm)) {
+      if (memory != nullptr && learn_vertices && radius == reach_mm && !(g < reach_mm)) {
         // Likely beyond the reach (a gap beyond it, or none): whether the surface comes within the reach
         // plus the slack (if not, that ball is remembered empty), and only then the search within the reach.
         if (!other.any_within(q, reach_mm + kEmptySlackMm)) {

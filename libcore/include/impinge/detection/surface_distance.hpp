@@ -73,6 +73,9 @@ struct DistanceScanMemory {
   /// k: each vertex's NearbyTriangles in `nearby`, or -1 (none yet: given at its first search).
   std::vector<std::int32_t> nearby_slot;
   std::vector<NearbyTriangles> nearby;
+  /// c: each cluster's centre at the last scan (the surface's frame, mm; NaN: none yet), to tell a step
+  /// along a motion from a jump.
+  std::vector<Eigen::Vector3f> cluster_last_centre;
 };
 
 /// The distance scan at one pose. For every vertex i of `set`: q = cor + R p_i + t (the other body's
@@ -100,6 +103,13 @@ struct DistanceScanMemory {
 ///   ball (NearbyTriangles); while its later searches' balls stay inside that ball, they read those groups
 ///   instead of walking the hierarchy (lhdl-ct's trial: about 9 of 10 searches, the distance scans
 ///   about 15 % cheaper on one thread).
+/// - Steps and jumps: the empty balls' pre-tests and the nearby triangles' fills cost walks of their own, and
+///   pay back only where the next scan comes within their margins. So a cluster learns them only when its
+///   centre moved at most 4 mm (its empty ball) or 2 mm (its vertices' facts) since the scan before: a step
+///   along a motion. At a first scan, and after a jump (a motion of scattered poses), it is scanned as
+///   without a memory, but for what it already knows (seeds, empty balls it lies in). lhdl-ct at 0.1 deg,
+///   1,000 poses at random, one thread: 4.6-5.0 ms a frame learning at every one, 2.8-3.0 ms so; a smooth
+///   1,000-frame trial unchanged (2.03-2.07 ms).
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
