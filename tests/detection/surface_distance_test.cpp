@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include "impinge/casters/exact_reference.hpp"
@@ -283,25 +284,37 @@ TEST(SurfaceDistance, ReachAndBadInput) {
   EXPECT_THROW(scan_distances(s, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), m.cor, q, 4, wrong, out), Error);
 }
 
-TEST(SurfaceDistance, MemoryChangesNoDistanceOrSign) {
-  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+// The generated hip pushed 3 mm into its cup (distances of both signs) for the memory's tests: the ball's
+// scan set against the cup's surface (q), the reach (mm), the scans' outputs and memory, and the poses of a
+// motion (a rotation by deg about one axis).
+class DistanceMemory : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+    query.emplace(m.socket);
+  }
+  static Eigen::Matrix3d pose(double deg) {
+    return Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(0.6, 0.8, 0).normalized()).toRotationMatrix();
+  }
+  HipModel m = [] {
+    HipModelOptions ho;
+    ho.target_triangles = 6000;
+    return make_hip_model(ho);
+  }();
+  std::optional<SignedDistanceQuery> query;
+  DistanceScanSet s = make_distance_scan_set(m.ball.V.rowwise() - m.cor.transpose(), 100);
+  double reach = 4;
+  Eigen::Vector3d push = 3 * Eigen::Vector3d::UnitZ();
+  std::vector<float> plain, remembered;  // a scan without memory, and with `memory`
+  DistanceScanMemory memory;
+};
+
+TEST_F(DistanceMemory, ChangesNoDistanceOrSign) {
   // The generated hip pushed 3 mm into its cup (distances of both signs), scanned without memory and with
   // the memory of the poses before it along a motion (seeds and empty balls), of a pose far off, of garbage
   // seeds, of another surface and of another size: every distance equal bit for bit, and the memory's empty
   // balls do spare searches (or the test would not test them).
-  HipModelOptions ho;
-  ho.target_triangles = 6000;
-  const HipModel m = make_hip_model(ho);
-  const SignedDistanceQuery q(m.socket);
-  const Vertices P = m.ball.V.rowwise() - m.cor.transpose();
-  const DistanceScanSet s = make_distance_scan_set(P, 100);
-  const double reach = 4;
-  auto pose = [](double deg) {
-    return Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(0.6, 0.8, 0).normalized()).toRotationMatrix();
-  };
-  const Eigen::Vector3d push = 3 * Eigen::Vector3d::UnitZ();
-  std::vector<float> plain, remembered;
-  DistanceScanMemory memory;
+  const SignedDistanceQuery& q = *query;
   std::int64_t measured = 0, negative = 0, recalled = 0;
   auto same = [&](const std::string& what) { ASSERT_TRUE(same_floats(plain, remembered)) << what; };
   for (double deg : {-10.0, -9.5, -9.0, -8.5, -8.0, 30.0, -7.0, -7.5}) {  // a motion, one pose far off, and back
@@ -350,24 +363,11 @@ TEST(SurfaceDistance, MemoryChangesNoDistanceOrSign) {
 
 class RealDistance : public ::testing::TestWithParam<std::string> {};
 
-TEST(SurfaceDistance, MemoryLearnsAlongAMotionNotAtAJump) {
-  if (!SignedDistanceQuery::available()) GTEST_SKIP() << "needs Embree or CGAL";
+TEST_F(DistanceMemory, LearnsAlongAMotionNotAtAJump) {
   // The memory's new facts (empty balls, nearby triangles) cost extra walks; they are learnt only where the
   // cluster moved within their margins since the scan before (a step of a motion), not at a first scan or
   // after a jump (a motion of scattered poses). Whatever is learnt, every distance equals the memoryless scan's.
-  HipModelOptions ho;
-  ho.target_triangles = 6000;
-  const HipModel m = make_hip_model(ho);
-  const SignedDistanceQuery q(m.socket);
-  const Vertices P = m.ball.V.rowwise() - m.cor.transpose();
-  const DistanceScanSet s = make_distance_scan_set(P, 100);
-  const double reach = 4;
-  auto pose = [](double deg) {
-    return Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d(0.6, 0.8, 0).normalized()).toRotationMatrix();
-  };
-  const Eigen::Vector3d push = 3 * Eigen::Vector3d::UnitZ();
-  std::vector<float> plain, remembered;
-  DistanceScanMemory memory;
+  const SignedDistanceQuery& q = *query;
   auto learnt = [&] {
     std::int64_t n = static_cast<std::int64_t>(memory.nearby.size());
     for (const float r : memory.empty_radius) n += r > 0;
