@@ -310,10 +310,9 @@ class DistanceMemory : public ::testing::Test {
 };
 
 TEST_F(DistanceMemory, ChangesNoDistanceOrSign) {
-  // The generated hip pushed 3 mm into its cup (distances of both signs), scanned without memory and with
-  // the memory of the poses before it along a motion (seeds and empty balls), of a pose far off, of garbage
-  // seeds, of another surface and of another size: every distance equal bit for bit, and the memory's empty
-  // balls do spare searches (or the test would not test them).
+  // Scanned without memory and with the memory of the poses before it along a motion (seeds and empty
+  // balls), of a pose far off, of garbage seeds, of another surface and of another size: every distance equal
+  // bit for bit, and the memory's empty balls do spare searches (or the test would not test them).
   const SignedDistanceQuery& q = *query;
   std::int64_t measured = 0, negative = 0, recalled = 0;
   auto same = [&](const std::string& what) { ASSERT_TRUE(same_floats(plain, remembered)) << what; };
@@ -361,8 +360,6 @@ TEST_F(DistanceMemory, ChangesNoDistanceOrSign) {
   same("memory of another size");
 }
 
-class RealDistance : public ::testing::TestWithParam<std::string> {};
-
 TEST_F(DistanceMemory, LearnsAlongAMotionNotAtAJump) {
   // The memory's new facts (empty balls, nearby triangles) cost extra walks; they are learnt only where the
   // cluster moved within their margins since the scan before (a step of a motion), not at a first scan or
@@ -389,6 +386,8 @@ TEST_F(DistanceMemory, LearnsAlongAMotionNotAtAJump) {
   scan(30.1);  // a step again: learning again
   EXPECT_GT(learnt(), after_step);
 }
+
+class RealDistance : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(RealDistance, EveryMeasuredVertexMatchesCgalAtRestAndTenPoses) {
   if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
