@@ -87,6 +87,11 @@ SphereFitResult fit_sphere_geometric(PointsRef P, const std::vector<double>& wei
   SphereFitResult start = fit_sphere_algebraic(P);
   const gsl_multifit_nlinear_type* T = gsl_multifit_nlinear_trust;
   gsl_multifit_nlinear_parameters params = gsl_multifit_nlinear_default_parameters();
+  // The step from the normal equations (4 x 4, Cholesky) rather than a QR of the k x 4 Jacobian: a third less
+  // time per fit (some 2,600 head points: 0.98 -> 0.70 ms), the same sphere to the last digit on the shared hips'
+  // heads (a weighted acetabular fit moved in its 16th digit). The Jacobian's columns, a unit direction and -1,
+  // are well conditioned whatever the points' offset.
+  params.solver = gsl_multifit_nlinear_solver_cholesky;
   const std::size_t n = static_cast<std::size_t>(P.rows()), p = 4;
   gsl_multifit_nlinear_workspace* w = gsl_multifit_nlinear_alloc(T, &params, n, p);
   gsl_multifit_nlinear_fdf fdf;
