@@ -22,7 +22,7 @@
 // (jemalloc gives each thread one of 4 x cores arenas, and returns the oversize arena's memory to the system
 // at once). lhdl-ct, one pose (`impinge distance`): page faults 8,850 -> 3,270, kernel time 37 -> 25 ms,
 // whole run 130 -> 119 ms (medians of 15); alternated with Open3D's job as benchmarks/whole_process.py runs
-// them, 164 -> 135 ms. Motions and ROM searches allocate little per frame: unchanged within their spread.
+// them, 134 -> 120 ms (medians of 20). Motions and ROM searches allocate little per frame: unchanged within their spread.
 extern "C" {
 const char* malloc_conf = "thp:always,metadata_thp:always,narenas:1,oversize_threshold:0";
 }
