@@ -1,16 +1,20 @@
 #include "impinge/io/mesh_io.hpp"
 
+#include <assimp/cimport.h>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <dlfcn.h>
 
 #include <algorithm>
-#include <assimp/Importer.hpp>
 #include <cctype>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <mutex>
 #include <sstream>
+#include <type_traits>
 
 #include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
@@ -19,6 +23,45 @@
 namespace impinge {
 
 namespace {
+/// assimp's C interface (assimp/cimport.h), loaded when a file first needs it: PLY, OFF and OBJ, the formats of
+/// every shipped and generated mesh, have their own readers, so most runs never load assimp and its libraries
+/// (Draco, minizip), which cost 1.3 ms of every start when linked (issue 52). IMPINGE_ASSIMP_LIBRARY is the shared
+/// library's name as CMake found it (libcore/CMakeLists.txt). Throws impinge::Error naming the file when it
+/// cannot be loaded.
+struct AssimpC {
+  decltype(&aiImportFileExWithProperties) import_file = nullptr;
+  decltype(&aiReleaseImport) release_import = nullptr;
+  decltype(&aiGetErrorString) error_string = nullptr;
+  decltype(&aiCreatePropertyStore) create_properties = nullptr;
+  decltype(&aiReleasePropertyStore) release_properties = nullptr;
+  decltype(&aiSetImportPropertyInteger) set_integer = nullptr;
+  std::string error;  ///< why it could not be loaded, empty when it was
+};
+
+const AssimpC& assimp_c() {
+  static const AssimpC a = [] {
+    AssimpC c;
+    void* lib = dlopen(IMPINGE_ASSIMP_LIBRARY, RTLD_NOW | RTLD_LOCAL);  // kept loaded for the process
+    if (lib == nullptr) {
+      const char* why = dlerror();
+      c.error = std::string(IMPINGE_ASSIMP_LIBRARY) + ": " + (why != nullptr ? why : "cannot be loaded");
+      return c;
+    }
+    const auto get = [&](auto& fn, const char* name) {
+      fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(dlsym(lib, name));
+      if (fn == nullptr && c.error.empty()) c.error = std::string(IMPINGE_ASSIMP_LIBRARY) + " has no " + name;
+    };
+    get(c.import_file, "aiImportFileExWithProperties");
+    get(c.release_import, "aiReleaseImport");
+    get(c.error_string, "aiGetErrorString");
+    get(c.create_properties, "aiCreatePropertyStore");
+    get(c.release_properties, "aiReleasePropertyStore");
+    get(c.set_integer, "aiSetImportPropertyInteger");
+    return c;
+  }();
+  return a;
+}
+
 std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -54,17 +97,28 @@ TriangleMesh load_mesh(const std::string& path) {
                    path);
   }
   in.close();  // assimp opens the file itself
+  const AssimpC& ai = assimp_c();
+  require(ai.error.empty(), [&] { return path + ": reading " + ext + " files needs assimp, which cannot be loaded (" + ai.error + ")"; });
   unsigned flags = 0;
-  Assimp::Importer importer;
+  std::unique_ptr<aiPropertyStore, decltype(ai.release_properties)> props(ai.create_properties(),
+                                                                         ai.release_properties);
   if (ext == ".stl") {
     // Weld corners by position only: drop the per-face normals and texture coordinates that
     // would otherwise keep identical positions apart.
-    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TEXCOORDS |
-                                                            aiComponent_COLORS | aiComponent_TANGENTS_AND_BITANGENTS);
+    ai.set_integer(props.get(), AI_CONFIG_PP_RVC_FLAGS,
+                   aiComponent_NORMALS | aiComponent_TEXCOORDS | aiComponent_COLORS |
+                       aiComponent_TANGENTS_AND_BITANGENTS);
     flags |= aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices;
   }
-  const aiScene* scene = importer.ReadFile(path, flags);
-  if (scene == nullptr) throw Error(path + ": cannot parse mesh: " + importer.GetErrorString());
+  // One import at a time: the C interface keeps the last error in one string for the process (the two bones
+  // are read on two threads).
+  static std::mutex one_import;
+  std::unique_lock<std::mutex> lock(one_import);
+  const std::unique_ptr<const aiScene, decltype(ai.release_import)> owned(
+      ai.import_file(path.c_str(), flags, nullptr, props.get()), ai.release_import);
+  const aiScene* scene = owned.get();
+  if (scene == nullptr) throw Error(path + ": cannot parse mesh: " + ai.error_string());
+  lock.unlock();
   require(scene->mNumMeshes > 0, path + ": file holds no mesh");
 
   std::size_t nv = 0, nf = 0;
