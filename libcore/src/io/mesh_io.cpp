@@ -98,10 +98,11 @@ TriangleMesh load_mesh(const std::string& path) {
   }
   in.close();  // assimp opens the file itself
   const AssimpC& ai = assimp_c();
-  require(ai.error.empty(), [&] { return path + ": reading " + ext + " files needs assimp, which cannot be loaded (" + ai.error + ")"; });
+  require(ai.error.empty(),
+          [&] { return path + ": reading " + ext + " files needs assimp, which cannot be loaded (" + ai.error + ")"; });
   unsigned flags = 0;
-  std::unique_ptr<aiPropertyStore, decltype(ai.release_properties)> props(ai.create_properties(),
-                                                                         ai.release_properties);
+  const std::unique_ptr<aiPropertyStore, decltype(ai.release_properties)> props(ai.create_properties(),
+                                                                               ai.release_properties);
   if (ext == ".stl") {
     // Weld corners by position only: drop the per-face normals and texture coordinates that
     // would otherwise keep identical positions apart.
