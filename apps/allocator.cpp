@@ -1,13 +1,20 @@
-// The impinge CLI's allocator: jemalloc with transparent huge pages when CMake links it
-// (IMPINGE_WITH_JEMALLOC; see IMPINGE_JEMALLOC in CMakeLists.txt), otherwise the C library's.
+// The impinge CLI's allocator: jemalloc when CMake links it (IMPINGE_WITH_JEMALLOC; see IMPINGE_JEMALLOC in
+// CMakeLists.txt), otherwise the C library's.
 //
-// Why: one run of impinge rom touches 150-250 MB of new memory within a second (two 0.1-deg maps of
-// 26 MB each, layered maps, the closest-point and ray-casting hierarchies). In 4 KiB pages that is
-// some 45,000 page faults; on a virtual machine each costs several microseconds, 15-25 % of the run.
-// In 2 MiB transparent huge pages it is a few thousand. The kernel's default THP mode
-// ("madvise") gives huge pages only to memory marked MADV_HUGEPAGE, which glibc's malloc does only
-// under an environment tunable; jemalloc marks its own mappings when its option thp is "always"
-// (jemalloc(3), "opt.thp"), and reads its options from the program's malloc_conf at start-up.
+// Why jemalloc: a run's set-up frees much of what it allocates (a body's rasteriser cones, a hierarchy's
+// scratch) on one thread while the next allocation happens on another; with one arena for every thread the
+// freed pages are used again instead of new ones being faulted in (below).
+//
+// Huge pages (issue 52): the CLI used to ask jemalloc for transparent huge pages (thp:always). They halve a
+// warm run's page faults, but on a virtual machine that reports freed memory to its host (virtio free page
+// reporting, which reports free 2 MiB blocks some 2 s after they are freed) a huge page is likely to be such a
+// block, and touching it faults in the host as well. Measured on the 2-core VM (lhdl-ct, alternated, medians):
+// one pose (`impinge distance`) 2.5 s after the last process, 189 ms with huge pages against 134 ms without;
+// right after Open3D's job (benchmarks/whole_process.py's order) 116 ms (105-211) against 128 ms (124-147);
+// `impinge rom` 770 against 670 ms after a pause, 623 against 650 ms back to back; a 1,000-frame motion 1.66
+// against 1.54 s and 1.51 against 1.54 s. Without them a run costs the same whether the machine was idle or
+// not, and a user's run usually follows a pause. So thp is left at jemalloc's "default": the system's
+// setting (/sys/kernel/mm/transparent_hugepage/enabled) decides; MALLOC_CONF=thp:always asks for them.
 
 #include "allocator.hpp"
 
@@ -15,16 +22,17 @@
 #include <jemalloc/jemalloc.h>
 
 // jemalloc(3): "malloc_conf: a string embedded in the program"; the MALLOC_CONF environment variable,
-// read after it, overrides it. metadata_thp: jemalloc's own bookkeeping in huge pages too.
+// read after it, overrides it.
 // narenas:1 and oversize_threshold:0 (issue 52): one arena for every thread, and no separate arena for
 // allocations above 8 MiB, so that memory one thread frees (a body's build, the rasteriser's cones, a
 // hierarchy's scratch) is reused by the next allocation on any thread instead of new pages being faulted in
 // (jemalloc gives each thread one of 4 x cores arenas, and returns the oversize arena's memory to the system
-// at once). lhdl-ct, one pose (`impinge distance`): page faults 8,850 -> 3,270, kernel time 37 -> 25 ms,
-// whole run 130 -> 119 ms (medians of 15); alternated with Open3D's job as benchmarks/whole_process.py runs
-// them, 134 -> 120 ms (medians of 20). Motions and ROM searches allocate little per frame: unchanged within their spread.
+// at once). lhdl-ct, one pose (`impinge distance`, then with huge pages): page faults 8,850 -> 3,270, kernel
+// time 37 -> 25 ms, whole run 130 -> 119 ms (medians of 15); alternated with Open3D's job as
+// benchmarks/whole_process.py runs them, 134 -> 120 ms (medians of 20). Motions and ROM searches allocate
+// little per frame: unchanged within their spread.
 extern "C" {
-const char* malloc_conf = "thp:always,metadata_thp:always,narenas:1,oversize_threshold:0";
+const char* malloc_conf = "narenas:1,oversize_threshold:0";
 }
 #endif
 
