@@ -63,6 +63,10 @@ TEST(MeshIo, DegenerateTrianglesSkippedAndCounted) {
   EXPECT_EQ(m.F.rows(), 2);
   EXPECT_EQ(m.degenerate_faces_skipped, 1);
   EXPECT_EQ(m.V.rows(), 4);
+  // The triangles after the skipped one move up, in the file's order.
+  ASSERT_EQ(m.F.rows(), 2);
+  EXPECT_EQ(m.F.row(0), Eigen::RowVector3i(0, 1, 2));
+  EXPECT_EQ(m.F.row(1), Eigen::RowVector3i(0, 1, 3));
 }
 
 TEST(MeshIo, PlyRoundTripKeepsOrderAndOtherFormatsLoad) {

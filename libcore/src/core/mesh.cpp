@@ -40,7 +40,8 @@ void validate_mesh(const TriangleMesh& mesh) {
 
 int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2) {
   validate_mesh(mesh);
-  Faces kept(mesh.F.rows(), 3);
+  // Kept triangles moved up in place (row k <= f), so that a mesh without degenerate triangles (the usual case)
+  // is neither copied nor reallocated.
   Eigen::Index k = 0;
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
     const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
@@ -48,10 +49,11 @@ int remove_degenerate_faces(TriangleMesh& mesh, double min_area_mm2) {
     const Eigen::Vector3d pa = mesh.V.row(a), pb = mesh.V.row(b), pc = mesh.V.row(c);
     const double area = 0.5 * (pb - pa).cross(pc - pa).norm();
     if (!(area > min_area_mm2)) continue;
-    kept.row(k++) = mesh.F.row(f);
+    if (k != f) mesh.F.row(k) = mesh.F.row(f);
+    ++k;
   }
   const int removed = static_cast<int>(mesh.F.rows() - k);
-  mesh.F = kept.topRows(k).eval();
+  if (k < mesh.F.rows()) mesh.F = mesh.F.topRows(k).eval();
   mesh.degenerate_faces_skipped += removed;
   return removed;
 }

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -89,9 +90,14 @@ TriangleMesh load_mesh(const std::string& path) {
   require(in.good(), path + ": cannot open file for reading");
   const std::string ext = lower_extension(path);
   if (ext == ".ply" || ext == ".off" || ext == ".obj") {  // our readers: the file's vertex order
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    const std::string b = bytes.str();
+    // The whole file in one read into a string of its size (no stream buffer copied twice).
+    const std::uintmax_t size = fs::file_size(path, ec);
+    require(!ec && size < std::uintmax_t(std::numeric_limits<std::streamsize>::max()),
+            [&] { return path + ": cannot read the file's size (" + ec.message() + ")"; });
+    std::string b(static_cast<std::size_t>(size), '\0');
+    in.read(b.data(), static_cast<std::streamsize>(size));
+    require(in.gcount() == static_cast<std::streamsize>(size) && in.peek() == std::char_traits<char>::eof(),
+            [&] { return path + ": the file changed while it was read (" + std::to_string(size) + " bytes expected)"; });
     return checked(ext == ".ply" ? detail::read_ply(path, b) : ext == ".off" ? detail::read_off(path, b)
                                                                              : detail::read_obj(path, b),
                    path);
