@@ -5,16 +5,17 @@
 // scratch) on one thread while the next allocation happens on another; with one arena for every thread the
 // freed pages are used again instead of new ones being faulted in (below).
 //
-// Huge pages (issue 52): the CLI used to ask jemalloc for transparent huge pages (thp:always). They halve a
-// warm run's page faults, but on a virtual machine that reports freed memory to its host (virtio free page
-// reporting, which reports free 2 MiB blocks some 2 s after they are freed) a huge page is likely to be such a
-// block, and touching it faults in the host as well. Measured on the 2-core VM (lhdl-ct, alternated, medians):
-// one pose (`impinge distance`) 2.5 s after the last process, 189 ms with huge pages against 134 ms without;
-// right after Open3D's job (benchmarks/whole_process.py's order) 116 ms (105-211) against 128 ms (124-147);
-// `impinge rom` 770 against 670 ms after a pause, 623 against 650 ms back to back; a 1,000-frame motion 1.66
-// against 1.54 s and 1.51 against 1.54 s. Without them a run costs the same whether the machine was idle or
-// not, and a user's run usually follows a pause. So thp is left at jemalloc's "default": the system's
-// setting (/sys/kernel/mm/transparent_hugepage/enabled) decides; MALLOC_CONF=thp:always asks for them.
+// Huge pages (issue 52): the CLI used to ask jemalloc for transparent huge pages (thp:always). They cut a run's page
+// faults eightfold (lhdl-ct, one pose: some 21,000 -> 2,600), but on a virtual machine that reports freed memory to
+// its host (virtio free page reporting, which reports free 2 MiB blocks some 2 s after they are freed) a huge page
+// is likely to be such a block, and touching it faults in the host as well. Measured on the 2-core VM (lhdl-ct, the
+// CLI built both ways, alternated, medians of 3 to 10): one pose (`impinge distance`) 2.5 s after the last process
+// 192 ms with huge pages against 131 ms without; right after Open3D's job (benchmarks/whole_process.py's order)
+// 123 ms (quartiles 111-139) against 122 ms (119-124); `impinge rom` 750 against 662 ms after a pause, 617 against
+// 650 ms back to back; a 1,000-frame motion 1.68 against 1.59 s and 1.56 against 1.58 s. Without them a run costs
+// about the same whether the machine was idle or not, and a user's run usually follows a pause. So thp is left at
+// jemalloc's "default": the system's setting (/sys/kernel/mm/transparent_hugepage/enabled) decides;
+// MALLOC_CONF=thp:always asks for them.
 
 #include "allocator.hpp"
 

@@ -30,8 +30,8 @@ SphereFitResult fit_sphere_algebraic(PointsRef P);
 
 /// Geometric sphere fit minimising E(c, r) = sum (|p_i - c| - r)^2 (Eberly 1999, the fit of
 /// thesis sec. 3.4), solved by GSL's Levenberg-Marquardt trust region (gsl_multifit_nlinear,
-/// steps by Cholesky of the normal equations) from the algebraic fit. P: k x 3 points, mm, k >= 4. Throws impinge::Error on too few or
-/// coplanar points.
+/// steps by Cholesky of the normal equations) from the algebraic fit. P: k x 3 points, mm, k >= 4.
+/// Throws impinge::Error on too few or coplanar points.
 SphereFitResult fit_sphere_geometric(PointsRef P);
 /// The same with a weight per point (k weights >= 0, e.g. the area each vertex stands for: the fit of a
 /// surface rather than of its vertices; GSL's weighted least squares); rms_residual is then the weighted
