@@ -31,11 +31,13 @@ struct EmbreeRayCaster::Impl {
   }
 };
 
-EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin, bool robust)
+EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin, bool robust,
+                                 HierarchyBuild build)
     : impl_(std::make_unique<Impl>()) {
   validate_mesh(mesh);
   require(origin.allFinite(), "embree: origin is not finite (" + mesh.source + ")");
-  impl_->device = rtcNewDevice("threads=1");
+  impl_->device = rtcNewDevice(build == HierarchyBuild::fast ? "threads=1,tri_accel=bvh4.triangle4v,tri_builder=morton"
+                                                             : "threads=1");
   require(impl_->device != nullptr, "embree: rtcNewDevice failed");
   impl_->scene = rtcNewScene(impl_->device);
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -232,7 +234,7 @@ std::int64_t EmbreeRayCaster::fill_map(RadialDistanceMapT<Scalar>& map) const {
 #else
 bool have_embree() { return false; }
 struct EmbreeRayCaster::Impl {};
-EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d&, bool) {
+EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d&, bool, HierarchyBuild) {
   require(false, "embree: this build has no Embree 3 (install libembree-dev and reconfigure); mesh " + mesh.source);
 }
 EmbreeRayCaster::~EmbreeRayCaster() = default;

@@ -28,7 +28,7 @@ bool FirstHitCaster::available() { return have_embree() || have_exact_reference(
 
 const Eigen::Vector3d& FirstHitCaster::origin() const { return impl_->origin; }
 
-FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin)
+FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin, HierarchyBuild build)
     : impl_(std::make_unique<Impl>()) {
   require(available(), "first-hit ray caster: this build has neither Embree nor CGAL (" + mesh.source + ")");
   require(origin.allFinite(), "first-hit ray caster: origin is not finite (" + mesh.source + ")");
@@ -95,7 +95,7 @@ FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& 
     orientation_ = volume >= 0 ? 1 : -1;
   }
   if (have_embree()) {
-    impl_->embree.emplace(clean, origin, /*robust=*/true);
+    impl_->embree.emplace(clean, origin, /*robust=*/true, build);
   } else {
     impl_->cgal.emplace(clean);
   }

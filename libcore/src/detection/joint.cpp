@@ -100,10 +100,13 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
     b.sampling = sample_surface(b.mesh, cor, so, b.map);
     b.sampling_ms = ms_since(t0);
   }
+  // A few poses (no layered maps: the direct set-up) cast few rays: the casters' trees are built fast (Morton)
+  // rather than well (SAH); the same hits either way.
+  const HierarchyBuild tree = options.layered_maps ? HierarchyBuild::quality : HierarchyBuild::fast;
   if (options.exact_at_discontinuities && FirstHitCaster::available()) {
     const auto t0 = std::chrono::steady_clock::now();
     b.nodes_marked = mark_depth_discontinuities(b.map, options.discontinuity_tolerance_mm);
-    b.exact = std::make_shared<const FirstHitCaster>(b.mesh, cor);
+    b.exact = std::make_shared<const FirstHitCaster>(b.mesh, cor, tree);
     b.marking_ms = ms_since(t0);
     b.mask = first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm, options.max_radius_mm, *b.exact);
   } else {
@@ -114,7 +117,7 @@ JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, 
   b.scan_set = make_scan_set(b.relative, b.mask);
   b.vertex_area = vertex_areas(b.mesh);
   if (options.layers > 0) {
-    b.caster = b.exact != nullptr ? b.exact : std::make_shared<const FirstHitCaster>(b.mesh, cor);
+    b.caster = b.exact != nullptr ? b.exact : std::make_shared<const FirstHitCaster>(b.mesh, cor, tree);
     if (options.layered_maps) {
       auto layered = std::make_shared<LayeredMap>(layered_scheme(options), options.layers);
       b.layered_sampling = sample_layered_map(*layered, *b.caster);

@@ -21,6 +21,15 @@ namespace impinge {
 /// True when this build has Embree 3.
 bool have_embree();
 
+/// How a ray caster's hierarchy is built. `quality`: Embree's default for a static scene (binned SAH; BVH8 where the
+/// CPU has AVX-512), for many rays (filling maps, a motion's look-ups). `fast`: Morton codes into a BVH4 (Embree's
+/// device configuration `tri_accel=bvh4.triangle4v,tri_builder=morton`), about 3x faster to build (lhdl-ct, one
+/// thread: 5.7 against 16 ms for the femur's 70k triangles, 7.9 against 23 ms for the pelvis' 95k;
+/// `impinge_bench --benchmark_filter=FirstHitCasterBuild`) and slower per ray, for the few rays of one pose. The
+/// hits are the same either way (the same triangles intersected the same way; only the tree differs).
+/// Source: impinge (issue 52: a set-up chosen by the work); Embree 3 API, rtcNewDevice's configuration.
+enum class HierarchyBuild { quality, fast };
+
 /// Embree scene of one mesh, for rays from a fixed origin (the COR). Single-threaded device
 /// ("threads=1"): every figure of this project is single thread unless it says otherwise.
 class EmbreeRayCaster {
@@ -28,9 +37,11 @@ class EmbreeRayCaster {
   /// Build the scene (BVH) of `mesh` (mm) about `origin` (mm). `robust`: Embree's watertight
   /// mode (RTC_SCENE_FLAG_ROBUST), so that a ray through a shared vertex or edge cannot slip
   /// between the triangles (slower; leave out triangles edge-on to the origin first, whose hits it
-  /// gets wrong); a robust scene also answers all_hits (RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION). Throws impinge::Error when Embree is not in this build, the mesh is invalid, or
-  /// Embree reports an error.
-  EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin, bool robust = false);
+  /// gets wrong); a robust scene also answers all_hits (RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION). `build`: the
+  /// hierarchy's builder (HierarchyBuild). Throws impinge::Error when Embree is not in this build, the mesh is
+  /// invalid, or Embree reports an error.
+  EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin, bool robust = false,
+                  HierarchyBuild build = HierarchyBuild::quality);
   ~EmbreeRayCaster();
   EmbreeRayCaster(EmbreeRayCaster&&) noexcept;
   EmbreeRayCaster& operator=(EmbreeRayCaster&&) noexcept;

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "impinge/casters/embree_ray_caster.hpp"
 #include "impinge/core/mesh.hpp"
 #include "impinge/maps/ray_crossing.hpp"
 
@@ -28,9 +29,11 @@ class FirstHitCaster {
  public:
   /// True when this build has a ray caster (Embree or CGAL).
   static bool available();
-  /// Build the BVH of `mesh` (mm) for rays from `origin` (mm). Throws impinge::Error when no ray
-  /// caster is in this build or the mesh is invalid (naming it).
-  FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin);
+  /// Build the BVH of `mesh` (mm) for rays from `origin` (mm). `build`: Embree's builder (HierarchyBuild:
+  /// `fast` for the few rays of one pose; the same hits either way; CGAL's tree ignores it). Throws
+  /// impinge::Error when no ray caster is in this build or the mesh is invalid (naming it).
+  FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin,
+                 HierarchyBuild build = HierarchyBuild::quality);
   ~FirstHitCaster();
   FirstHitCaster(FirstHitCaster&&) noexcept;
   FirstHitCaster& operator=(FirstHitCaster&&) noexcept;

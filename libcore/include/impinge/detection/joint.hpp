@@ -64,7 +64,9 @@ struct JointOptions {
   /// filling them, about 0.12 s for lhdl-ct at 0.5 deg, would not repay): the hidden vertices near the other bone
   /// are then tested by exact ray casts over their rays' crossings (scan_layered_near_exact), the value the
   /// maps' look-ups approximate. The ROM searches need the maps (find_rom_limit refuses a joint without them).
-  /// Source: impinge (issue 52: a set-up chosen by the work).
+  /// Off, the first-hit casters' trees are also built fast rather than well (HierarchyBuild::fast: Morton codes,
+  /// some 10 ms less per bone of lhdl-ct; the same hits, slower rays). Source: impinge (issue 52: a set-up chosen
+  /// by the work).
   bool layered_maps = true;
   /// The layered maps' largest node spacing, deg: `scheme` at the coarsest resolution reaching it, or
   /// `scheme` itself when that is coarser already (0: `scheme` itself). The hidden vertices lie far
