@@ -103,3 +103,45 @@ TEST(FirstHitCaster, RejectsABadOrigin) {
   const TriangleMesh s = make_uv_sphere(10, Eigen::Vector3d::Zero(), 20, 10, Eigen::Vector3d::UnitZ());
   EXPECT_THROW(FirstHitCaster(s, Eigen::Vector3d(std::nan(""), 0, 0)), Error);
 }
+
+// first_hit with a bound (the first-surface mask's question, issue 52): against the unbounded first hit, the
+// same value when that is nearer than the bound (also just inside it), and a value at least the bound
+// otherwise; nothing is nearer than a bound <= 0 or NaN.
+TEST(FirstHitCaster, BoundedFirstHitIsTheFirstHitWhenNearer) {
+  if (!FirstHitCaster::available()) GTEST_SKIP() << "no ray caster in this build";
+  HipModelOptions ho;
+  ho.target_triangles = 3000;
+  const HipModel h = make_hip_model(ho);
+  for (const HierarchyBuild build : {HierarchyBuild::quality, HierarchyBuild::fast}) {
+    const FirstHitCaster c(h.socket, h.cor, build);
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> g;
+    std::uniform_real_distribution<double> scale(0.5, 1.5);
+    int nearer = 0, beyond = 0;
+    for (int k = 0; k < 3000; ++k) {
+      const Eigen::Vector3d u(g(rng), g(rng), g(rng));
+      const double full = c.first_hit(u);
+      if (!std::isfinite(full)) {
+        EXPECT_TRUE(std::isinf(c.first_hit(u, 100.0))) << k;
+        continue;
+      }
+      // A random bound, and bounds a hair either side of the hit itself.
+      for (const double within : {full * scale(rng), std::nextafter(full, 0.0), full,
+                                  std::nextafter(full, std::numeric_limits<double>::infinity()), full * (1 + 1e-6)}) {
+        const double got = c.first_hit(u, within);
+        if (full < within) {
+          ++nearer;
+          ASSERT_EQ(got, full) << "ray " << k << " bound " << within;
+        } else {
+          ++beyond;
+          ASSERT_GE(got, within) << "ray " << k << " bound " << within;
+        }
+      }
+      EXPECT_TRUE(std::isinf(c.first_hit(u, 0.0)));
+      EXPECT_TRUE(std::isinf(c.first_hit(u, -1.0)));
+      EXPECT_TRUE(std::isinf(c.first_hit(u, std::nan(""))));
+    }
+    EXPECT_GT(nearer, 1000);
+    EXPECT_GT(beyond, 1000);
+  }
+}

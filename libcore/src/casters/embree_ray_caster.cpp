@@ -99,8 +99,9 @@ float EmbreeRayCaster::first_hit(float dx, float dy, float dz) const {
   return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? std::numeric_limits<float>::infinity() : rh.ray.tfar;
 }
 
-float EmbreeRayCaster::least_hit(const float* dirs, int k) const {
+float EmbreeRayCaster::least_hit(const float* dirs, int k, float within) const {
   require(k >= 1 && k <= 4, "embree: least_hit takes 1 to 4 rays");
+  require(within >= 0, "embree: least_hit's rays end at a distance >= 0 mm");
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   alignas(16) int valid[4] = {0, 0, 0, 0};
@@ -112,7 +113,7 @@ float EmbreeRayCaster::least_hit(const float* dirs, int k) const {
     rh.ray.org_x[j] = rh.ray.org_y[j] = rh.ray.org_z[j] = 0.f;
     rh.ray.dir_x[j] = x / len, rh.ray.dir_y[j] = y / len, rh.ray.dir_z[j] = z / len;
     rh.ray.tnear[j] = 0.f;
-    rh.ray.tfar[j] = std::numeric_limits<float>::infinity();
+    rh.ray.tfar[j] = within;
     rh.ray.mask[j] = 0xFFFFFFFFu;
     rh.ray.flags[j] = 0;
     rh.ray.time[j] = 0.f;
@@ -238,7 +239,7 @@ EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d
   require(false, "embree: this build has no Embree 3 (install libembree-dev and reconfigure); mesh " + mesh.source);
 }
 EmbreeRayCaster::~EmbreeRayCaster() = default;
-float EmbreeRayCaster::least_hit(const float*, int) const { return std::numeric_limits<float>::quiet_NaN(); }
+float EmbreeRayCaster::least_hit(const float*, int, float) const { return std::numeric_limits<float>::quiet_NaN(); }
 EmbreeRayCaster::EmbreeRayCaster(EmbreeRayCaster&&) noexcept = default;
 EmbreeRayCaster& EmbreeRayCaster::operator=(EmbreeRayCaster&&) noexcept = default;
 float EmbreeRayCaster::first_hit(float, float, float) const { return 0; }

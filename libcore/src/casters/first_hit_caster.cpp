@@ -151,6 +151,12 @@ double edge_on_hit(const Eigen::Matrix3d& T, const Eigen::Vector3d& u) {
 }  // namespace
 
 double FirstHitCaster::first_hit(const Eigen::Vector3d& direction) const {
+  return first_hit(direction, std::numeric_limits<double>::infinity());
+}
+
+double FirstHitCaster::first_hit(const Eigen::Vector3d& direction, double within_mm) const {
+  const double inf = std::numeric_limits<double>::infinity();
+  if (!(within_mm > 0)) return inf;  // nothing is nearer than that (a NaN bound asks nothing either)
   double h;
   if (impl_->embree) {
     // Embree intersects in float and is not watertight at a shared vertex: a ray exactly through
@@ -162,7 +168,11 @@ double FirstHitCaster::first_hit(const Eigen::Vector3d& direction) const {
     const Eigen::Vector3d d1 = u + 1e-6 * a, d2 = u + 1e-6 * (b * 0.866 - a * 0.5);
     const float dirs[9] = {float(u.x()),  float(u.y()),  float(u.z()),  float(d1.x()), float(d1.y()),
                            float(d1.z()), float(d2.x()), float(d2.y()), float(d2.z())};
-    h = impl_->embree->least_hit(dirs, 3);
+    // Embree's rays end at the bound rounded up to float (so a hit nearer than within_mm is still found).
+    float within = static_cast<float>(within_mm);
+    if (static_cast<double>(within) < within_mm)
+      within = std::nextafter(within, std::numeric_limits<float>::infinity());
+    h = impl_->embree->least_hit(dirs, 3, within);
   } else {
     const std::optional<double> c = impl_->cgal->first_hit(impl_->origin, direction.normalized());
     h = c ? *c : std::numeric_limits<double>::infinity();

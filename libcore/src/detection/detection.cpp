@@ -238,7 +238,10 @@ std::vector<std::uint8_t> first_surface_mask(PointsRef P, const RadialDistanceMa
       d = 0;
       for (int k = 0; k < 4; ++k) d += st.weights[k] * double(own_map.at(st.nodes[k]));
     } else {
-      d = own_exact.first_hit(p);  // +inf on a miss: nothing in front of the vertex
+      // Only a hit nearer than r - tolerance_mm matters (the test below): the rays end just beyond it (1e-6
+      // relative, so that no rounding of r - tolerance + tolerance can tell a hit there from none).
+      // +inf: nothing in front of the vertex that near.
+      d = own_exact.first_hit(p, r - tolerance_mm + 1e-6 * (1 + r));
     }
     if (r <= d + tolerance_mm) mask[static_cast<std::size_t>(i)] = 1;
   }

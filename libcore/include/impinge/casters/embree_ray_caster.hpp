@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -50,8 +51,10 @@ class EmbreeRayCaster {
   /// nearest hit, +inf on a miss. One rtcIntersect1.
   float first_hit(float dx, float dy, float dz) const;
   /// The least first_hit of k <= 4 rays (dirs: k x 3, row-major, any nonzero lengths) in one
-  /// rtcIntersect4 call: cheaper than k single rays when they are close together.
-  float least_hit(const float* dirs, int k) const;
+  /// rtcIntersect4 call: cheaper than k single rays when they are close together. `within` (mm): the
+  /// rays end there (Embree's tfar), so a nearest hit beyond it is not sought and +inf is returned
+  /// instead (a hit nearer than `within` is the same either way).
+  float least_hit(const float* dirs, int k, float within = std::numeric_limits<float>::infinity()) const;
 
   /// Every hit of the ray from the origin along (dx, dy, dz) (any nonzero length), in one traversal
   /// (a context filter records each candidate and rejects it): appends (distance along the unit

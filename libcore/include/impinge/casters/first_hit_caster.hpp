@@ -41,6 +41,10 @@ class FirstHitCaster {
   /// Distance (mm) from the origin along `direction` (any nonzero length) to the nearest hit of
   /// the mesh; +infinity when the ray misses.
   double first_hit(const Eigen::Vector3d& direction) const;
+  /// first_hit(direction) when that is nearer than `within_mm` (mm, any value; <= 0: nothing is), and a value
+  /// >= within_mm (+infinity) otherwise: the rays end at within_mm, so the traversal visits less of the tree
+  /// (the question "is anything in front of this point?" of the first-surface mask). Source: impinge (issue 52).
+  double first_hit(const Eigen::Vector3d& direction, double within_mm) const;
   /// Every crossing of the ray from the origin along `direction` (any nonzero length) with the
   /// surface, nearest first, into `out` (cleared first). Hits within 1e-4 mm of each other (a ray
   /// through a shared edge or vertex, or grazing a silhouette) are merged into one crossing whose
