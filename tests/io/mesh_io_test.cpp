@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <tuple>
 
 #include "impinge/core/error.hpp"
@@ -90,6 +93,50 @@ TEST(MeshIo, PlyRoundTripKeepsOrderAndOtherFormatsLoad) {
   const TriangleMesh st = load_mesh(d + "/t.stl");
   EXPECT_EQ(st.F.rows(), 2);
   EXPECT_EQ(st.V.rows(), 4);
+}
+
+// write_ply with per-vertex arrays (the plan's resection_mm): the file is exactly the header and the body its
+// counts give (n x (3 + arrays) floats, m faces of a uchar 3 and three ints), every value where the header says,
+// read back byte by byte here rather than by the library's reader; an array of the wrong length is an error.
+TEST(MeshIo, PlyWithArraysHoldsEveryValueWhereItsHeaderSays) {
+  const std::string d = test::temp_dir("mesh_io_arrays");
+  const TriangleMesh s = make_uv_sphere(10, Eigen::Vector3d(1, 2, 3), 12, 6, Eigen::Vector3d(0.2, 0.1, 1));
+  const auto n = static_cast<std::size_t>(s.V.rows()), m = static_cast<std::size_t>(s.F.rows());
+  std::vector<PointArray> arrays(2);
+  arrays[0].name = "resection_mm";
+  arrays[1].name = "other";
+  for (std::size_t i = 0; i < n; ++i) {
+    arrays[0].f32.push_back(0.25f * static_cast<float>(i));
+    arrays[1].f32.push_back(-static_cast<float>(i) - 0.5f);
+  }
+  write_ply(d + "/a.ply", s, arrays);
+  std::ifstream in(d + "/a.ply", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t body = bytes.find("end_header\n") + 11;
+  ASSERT_NE(bytes.find("property float resection_mm\nproperty float other\nelement face"), std::string::npos);
+  ASSERT_EQ(bytes.size(), body + n * 5 * sizeof(float) + m * 13);
+  auto f32 = [&](std::size_t at) {
+    float v;
+    std::memcpy(&v, bytes.data() + at, sizeof v);
+    return v;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t at = body + i * 5 * sizeof(float);
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(f32(at + 4 * k), static_cast<float>(s.V(i, k))) << i;
+    ASSERT_EQ(f32(at + 12), arrays[0].f32[i]) << i;
+    ASSERT_EQ(f32(at + 16), arrays[1].f32[i]) << i;
+  }
+  for (std::size_t f = 0; f < m; ++f) {
+    const std::size_t at = body + n * 5 * sizeof(float) + f * 13;
+    ASSERT_EQ(bytes[at], 3) << f;
+    for (int k = 0; k < 3; ++k) {
+      std::int32_t v;
+      std::memcpy(&v, bytes.data() + at + 1 + 4 * k, sizeof v);
+      ASSERT_EQ(v, s.F(f, k)) << f;
+    }
+  }
+  arrays[1].f32.pop_back();
+  EXPECT_THROW(write_ply(d + "/b.ply", s, arrays), Error);
 }
 
 // impinge's own PLY reader (mesh_readers.hpp): every encoding and type gives the same mesh; every
