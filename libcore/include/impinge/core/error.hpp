@@ -20,6 +20,13 @@ class Error : public std::runtime_error {
 /// Throw impinge::Error(message) unless `condition` holds.
 void require(bool condition, const std::string& message);
 
+/// Throw impinge::Error(message) unless `condition` holds: a fixed message (a string literal), which becomes a
+/// std::string only then. Without it every call with a literal built and freed a string, held or not (issue 52:
+/// checks inside loops).
+inline void require(bool condition, const char* message) {
+  if (!condition) throw Error(message);
+}
+
 /// Throw impinge::Error(message()) unless `condition` holds; `message` (a callable returning the text)
 /// is called only then. For checks made once per node, vertex or cell, where building the text every
 /// time would cost more than the check (sampling a layered map built a million strings).

@@ -1,0 +1,34 @@
+// require: each form throws impinge::Error with its message exactly when the condition fails; a fixed message (a
+// string literal, the const char* form) and a callable's text (called only then) alike.
+#include "impinge/core/error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+using namespace impinge;
+
+namespace {
+std::string message_of(void (*check)()) {
+  try {
+    check();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(nothing thrown)";
+}
+}  // namespace
+
+TEST(Require, EachFormThrowsItsMessageOnlyWhenTheConditionFails) {
+  EXPECT_NO_THROW(require(true, "fixed"));
+  EXPECT_NO_THROW(require(true, std::string("built")));
+  EXPECT_EQ(message_of([] { require(false, "a fixed message"); }), "a fixed message");
+  EXPECT_EQ(message_of([] { require(false, std::string("built ") + std::to_string(3)); }), "built 3");
+  EXPECT_EQ(message_of([] { require(false, [] { return std::string("called"); }); }), "called");
+  int calls = 0;
+  require(true, [&] {
+    ++calls;
+    return std::string("never");
+  });
+  EXPECT_EQ(calls, 0);  // the text is not built when the check holds
+}
