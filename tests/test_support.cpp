@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "impinge/anatomy/sphere_fit.hpp"
+#include "impinge/core/error.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/subject.hpp"
@@ -34,6 +35,15 @@ TriangleMesh transformed(const TriangleMesh& m, const Eigen::Matrix3d& R, const 
   TriangleMesh out = m;
   for (Eigen::Index i = 0; i < out.V.rows(); ++i) out.V.row(i) = (R * m.V.row(i).transpose() + t).transpose();
   return out;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
 }
 
 std::string temp_dir(const std::string& name) {

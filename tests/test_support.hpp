@@ -1,6 +1,7 @@
 #pragma once
 // Shared fixtures and oracles for the tests.
 #include <Eigen/Core>
+#include <functional>
 #include <optional>
 #include <random>
 #include <string>
@@ -18,6 +19,9 @@ TriangleMesh transformed(const TriangleMesh& m, const Eigen::Matrix3d& R, const 
 std::string temp_dir(const std::string& name);
 /// Write text to a file.
 void write_text(const std::string& path, const std::string& text);
+/// The message of the impinge::Error that f throws, or "(no error)" when it throws none (any other exception
+/// passes through).
+std::string error_of(const std::function<void()>& f);
 /// A real subject of ../shared/data/hips in the anatomical frame with its automatic COR, or
 /// nullopt when the shared data folder is absent (the caller skips).
 struct RealJoint {

@@ -6,25 +6,18 @@
 
 #include <string>
 
+#include "test_support.hpp"
+
 using namespace impinge;
 
-namespace {
-std::string message_of(void (*check)()) {
-  try {
-    check();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(nothing thrown)";
-}
-}  // namespace
+using test::error_of;
 
 TEST(Require, EachFormThrowsItsMessageOnlyWhenTheConditionFails) {
   EXPECT_NO_THROW(require(true, "fixed"));
   EXPECT_NO_THROW(require(true, std::string("built")));
-  EXPECT_EQ(message_of([] { require(false, "a fixed message"); }), "a fixed message");
-  EXPECT_EQ(message_of([] { require(false, std::string("built ") + std::to_string(3)); }), "built 3");
-  EXPECT_EQ(message_of([] { require(false, [] { return std::string("called"); }); }), "called");
+  EXPECT_EQ(error_of([] { require(false, "a fixed message"); }), "a fixed message");
+  EXPECT_EQ(error_of([] { require(false, std::string("built ") + std::to_string(3)); }), "built 3");
+  EXPECT_EQ(error_of([] { require(false, [] { return std::string("called"); }); }), "called");
   int calls = 0;
   require(true, [&] {
     ++calls;

@@ -11,18 +11,12 @@
 #include <set>
 
 #include "impinge/core/error.hpp"
+#include "test_support.hpp"
 
 namespace impinge {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 TEST(OptionTable, EveryRowCompleteAndNamedOnce) {
   std::set<std::string> names, keys;

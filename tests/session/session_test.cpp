@@ -32,9 +32,11 @@
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/session/records.hpp"
 #include "impinge/session/runs.hpp"
+#include "test_support.hpp"
 
 using namespace impinge;
 namespace fs = std::filesystem;
+using impinge::test::error_of;
 
 namespace {
 
@@ -75,15 +77,6 @@ SessionOptions generated_options(const std::string& frame, bool cam = true) {
 std::string test_data_subject() {
   const std::string p = std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/subject.json";
   return fs::exists(p) ? p : std::string();
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 }  // namespace
