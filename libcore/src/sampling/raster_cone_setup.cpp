@@ -99,7 +99,16 @@ std::vector<TriangleCone> triangle_cones(const TriangleMesh& mesh, const Eigen::
   std::vector<TriangleCone> cones;
   cones.reserve(faces.size());
   std::int64_t skipped = 0;
-  for (const std::int32_t f : faces) {
+  // The faces come in the plan's order (Z order of direction), not the mesh's: each one's row of F and its
+  // three corners are cache misses unless fetched ahead (the rows 16 faces ahead, the corners 8).
+  const std::size_t n = faces.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + 16 < n) __builtin_prefetch(&mesh.F(faces[i + 16], 0));
+    if (i + 8 < n) {
+      const auto g = faces[i + 8];
+      for (int j = 0; j < 3; ++j) __builtin_prefetch(&k[static_cast<std::size_t>(mesh.F(g, j))]);
+    }
+    const std::int32_t f = faces[i];
     const Corner &a = k[static_cast<std::size_t>(mesh.F(f, 0))], &b = k[static_cast<std::size_t>(mesh.F(f, 1))],
                  &c = k[static_cast<std::size_t>(mesh.F(f, 2))];
     const double det = a.p.dot(b.p.cross(c.p));
