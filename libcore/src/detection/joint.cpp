@@ -221,7 +221,6 @@ std::pair<JointBody, JointBody> Joint::build_bodies(const Eigen::Vector3d& cor, 
   return {std::move(b), std::move(s)};
 }
 
-
 std::shared_ptr<const SamplingScheme> Joint::layered_scheme() const { return layered_scheme(options_); }
 
 std::shared_ptr<const SamplingScheme> Joint::layered_scheme(const JointOptions& options) {
