@@ -90,9 +90,10 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
     // a few thousand at a time, instead of from all of them made first (240 bytes a kept triangle, faulted in
     // fresh: 34 MB for a 280k-triangle femur); a larger one from the plan's cones, in bands of rows
     // (rasterize.hpp). The same map either way.
+    constexpr double kStreamedMapBytes = 8.0 * 1024 * 1024;
     const bool streamed = rep.method == SamplingMethod::rasterize &&
-                          static_cast<double>(map.num_nodes()) * sizeof(Scalar) <= 8.0 * 1024 * 1024;
-    own = plan_rasterization(mesh, cor, 8, /*with_cones=*/!streamed);
+                          static_cast<double>(map.num_nodes()) * sizeof(Scalar) <= kStreamedMapBytes;
+    own = plan_rasterization(mesh, cor, kPlanRays, /*with_cones=*/!streamed);
     cull = &own;
     rep.planning_ms = ms_since(t0);
     t0 = std::chrono::steady_clock::now();

@@ -50,6 +50,9 @@ struct RasterPlan {
   std::uint64_t mesh_fingerprint = 0;  ///< mesh_fingerprint() of the mesh analysed
 };
 
+/// plan_rasterization's brute-force rays unless told otherwise.
+inline constexpr int kPlanRays = 8;
+
 /// A 64-bit fingerprint of a mesh's vertex coordinates (bit patterns), face indices and sizes:
 /// any edit of a coordinate or index changes it with overwhelming probability. O(n + m), about
 /// 0.1 ms for a 100k-triangle bone. Used to check that a plan belongs to the mesh it is used on.
@@ -66,7 +69,7 @@ std::uint64_t mesh_fingerprint(const TriangleMesh& mesh);
 /// Cost O(m) for the edges and cones plus O(rays x m); a once-per-mesh precomputation like
 /// building a BVH. Throws impinge::Error for an invalid
 /// mesh or a non-finite COR.
-RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays = 8,
+RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays = kPlanRays,
                               bool with_cones = true);
 
 }  // namespace impinge
