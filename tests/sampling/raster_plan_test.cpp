@@ -13,6 +13,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <utility>
+#include <vector>
 
 #include "impinge/anatomy/sphere_fit.hpp"
 #include "impinge/io/generated_models.hpp"
@@ -113,6 +115,51 @@ TEST(RasterPlan, RealBonesCulledMapsEqualFullMaps) {
     const RasterPlan fc = plan_rasterization(*m, real->cor);
     ASSERT_TRUE(fc.enabled) << m->source << ": " << fc.reason;
     EXPECT_EQ(differing_nodes(*m, real->cor, 0.25, fc), 0) << m->source;
+  }
+}
+
+// A plan made without cones (sample_surface's own, for a map up to 8 MB) has rasterize() make them as it draws
+// them: the map of the full (unplanned) rasterisation node for node, and the counts of the plan with cones
+// (triangles edge-on, culled, at a pole, across the seam; node tests; nodes covered), on a fresh map, on a dirty
+// map reset, and kept under nearer values; the generated hip and, when ../shared/data is there, lhdl-ct.
+TEST(RasterPlan, PlanWithoutConesDrawsTheSameMapAndCounts) {
+  const HipModel h = make_hip_model(HipModelOptions{});
+  std::vector<std::pair<TriangleMesh, Eigen::Vector3d>> meshes{{h.ball, h.cor}, {h.socket, h.cor}};
+  if (const auto real = test::load_real_joint("lhdl-ct")) {
+    meshes.emplace_back(real->femur, real->cor);
+    meshes.emplace_back(real->pelvis, real->cor);
+  }
+  for (std::size_t k = 0; k < meshes.size(); ++k) {
+    const auto& [m, cor] = meshes[k];
+    const RasterPlan with = plan_rasterization(m, cor), without = plan_rasterization(m, cor, 8, false);
+    EXPECT_TRUE(with.with_cones);
+    EXPECT_FALSE(without.with_cones);
+    EXPECT_TRUE(without.cones.empty());
+    EXPECT_EQ(without.triangle_order, with.triangle_order) << m.source;
+    for (double p : {0.5, 0.25}) {
+      if (k >= 2 && p < 0.5) continue;  // the real bones at the default spacing only
+      RadialDistanceMap full{EquiangularGrid(p)}, a{EquiangularGrid(p)}, b{EquiangularGrid(p)};
+      rasterize(m, cor, DistanceMode::exact, full);
+      const SamplingStats sa = rasterize(m, cor, DistanceMode::exact, a, RasterizeOptions{&with, true, MapStart::reset});
+      std::fill(b.data(), b.data() + b.num_nodes(), 0.5f);  // dirty: the reset must clear it
+      const SamplingStats sb =
+          rasterize(m, cor, DistanceMode::exact, b, RasterizeOptions{&without, true, MapStart::reset});
+      std::int64_t differ = 0;
+      for (std::int64_t i = 0; i < full.num_nodes(); ++i) differ += full.at(i) != b.at(i);
+      EXPECT_EQ(differ, 0) << m.source << " p=" << p;
+      EXPECT_GT(sb.nodes_covered, 1000) << m.source;
+      EXPECT_EQ(sb.nodes_covered, sa.nodes_covered) << m.source;
+      EXPECT_EQ(sb.node_tests, sa.node_tests) << m.source;
+      EXPECT_EQ(sb.triangles, sa.triangles) << m.source;
+      EXPECT_EQ(sb.triangles_edge_on, sa.triangles_edge_on) << m.source;
+      EXPECT_EQ(sb.triangles_culled, sa.triangles_culled) << m.source;
+      EXPECT_EQ(sb.pole_triangles, sa.pole_triangles) << m.source;
+      EXPECT_EQ(sb.seam_triangles, sa.seam_triangles) << m.source;
+      RadialDistanceMap kept{EquiangularGrid(p)};
+      std::fill(kept.data(), kept.data() + kept.num_nodes(), 0.5f);  // nearer than any surface: nothing changes
+      EXPECT_EQ(rasterize(m, cor, DistanceMode::exact, kept, RasterizeOptions{&without, true, MapStart::keep}).nodes_covered, 0);
+      EXPECT_EQ(std::count(kept.data(), kept.data() + kept.num_nodes(), 0.5f), kept.num_nodes());
+    }
   }
 }
 

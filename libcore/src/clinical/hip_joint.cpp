@@ -1,4 +1,5 @@
 #include "impinge/clinical/hip_joint.hpp"
+#include "impinge/core/concurrent.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -122,7 +123,9 @@ void HipJoint::seat_femur(TriangleMesh& femur, const SphereFitResult& sphere, co
 
 void HipJoint::build_joint(TriangleMesh femur, TriangleMesh pelvis, const HipJointOptions& options) {
   const Eigen::Matrix3d to_joint = joint_to_working_.transpose();
-  for (TriangleMesh* m : {&femur, &pelvis}) m->V = ((m->V.rowwise() - cor_.transpose()) * to_joint.transpose()).eval();
+  // Into the joint frame, the pelvis on a second thread (the same arithmetic either way).
+  auto to_joint_frame = [&](TriangleMesh& m) { m.V = ((m.V.rowwise() - cor_.transpose()) * to_joint.transpose()).eval(); };
+  run_both([&] { to_joint_frame(femur); }, [&] { to_joint_frame(pelvis); });
   if (options.ball_map_file.empty() != options.socket_map_file.empty())
     throw Error("hip joint: give both map files (ball and socket) or neither");
   if (options.ball_map_file.empty()) {

@@ -58,84 +58,167 @@ Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor,
 Joint::Joint(const Eigen::Vector3d& cor, const JointOptions& options, std::pair<JointBody, JointBody> bodies)
     : cor_(cor), options_(options), ball_(std::move(bodies.first)), socket_(std::move(bodies.second)) {}
 
+namespace {
+/// What one body's build parts hand on to its later ones (add_parts).
+struct BuildParts {
+  std::optional<RadialDistanceMap> given;  ///< the map given instead of sampled
+  double marking_ms = 0, caster_ms = 0;    ///< the marks' and the ray caster's build times, ms
+};
+
+/// The parts of building both bodies (ball, socket), for run_task_graph: each body's checks, map and marks,
+/// ray caster, layered map, first-surface mask and scan sets, closest-point hierarchy, and vertex areas with
+/// distance scan set; the socket's before the ball's, the long parts first. The bodies and parts must outlive
+/// the run.
+void add_parts(const Eigen::Vector3d& cor, const JointOptions& options,
+               const std::shared_ptr<const SamplingScheme>& layered_scheme, JointBody& ball,
+               std::optional<RadialDistanceMap> ball_map, BuildParts& ball_parts, JointBody& socket,
+               std::optional<RadialDistanceMap> socket_map, BuildParts& socket_parts,
+               std::vector<GraphTask>& tasks) {
+  JointBody* body[2] = {&ball, &socket};
+  BuildParts* parts[2] = {&ball_parts, &socket_parts};
+  parts[0]->given = std::move(ball_map);
+  parts[1]->given = std::move(socket_map);
+  const bool exact = options.exact_at_discontinuities && FirstHitCaster::available();
+  // A few poses (no layered maps: the direct set-up) cast few rays: the casters' trees are built fast (Morton)
+  // rather than well (SAH); the same hits either way.
+  const HierarchyBuild tree = options.layered_maps ? HierarchyBuild::quality : HierarchyBuild::fast;
+  auto add = [&](std::function<void()> run, std::vector<std::size_t> after, int rank) {
+    tasks.push_back({std::move(run), std::move(after), rank});
+    return tasks.size() - 1;
+  };
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::size_t prepare[2], sample[2], caster[2] = {kNone, kNone};
+  // The mesh checked, its vertices about the COR, a given map checked against the scheme.
+  for (int k = 0; k < 2; ++k) {
+    JointBody& b = *body[k];
+    BuildParts& p = *parts[k];
+    prepare[k] = add(
+        [&b, &p, &cor, &options] {
+          validate_mesh(b.mesh);
+          b.relative = b.mesh.V.rowwise() - cor.transpose();
+          if (!p.given) return;
+          const SamplingScheme& want = *options.scheme;
+          const SamplingScheme& have = p.given->scheme();
+          require(want.conformable(have), b.mesh.source + ": the given map is " + have.name() + " at " +
+                                              std::to_string(have.resolution()) + ", the joint's scheme is " +
+                                              want.name() + " at " + std::to_string(want.resolution()));
+        },
+        {}, k);
+  }
+  for (int k = 1; k >= 0; --k) {  // the socket's first
+    JointBody& b = *body[k];
+    BuildParts& p = *parts[k];
+    // The map (sampled, or the given one) and its depth-discontinuity marks.
+    sample[k] = add(
+        [&b, &p, &cor, &options, exact] {
+          if (p.given) {
+            b.map = std::move(*p.given);
+            b.sampling.nodes_covered = b.map.nodes_covered();
+          } else {
+            SamplingOptions so;
+            so.mode = options.mode;
+            so.method = options.sampling;
+            const auto t0 = std::chrono::steady_clock::now();
+            b.sampling = sample_surface(b.mesh, cor, so, b.map);
+            b.sampling_ms = ms_since(t0);
+          }
+          if (exact) {
+            const auto t0 = std::chrono::steady_clock::now();
+            b.nodes_marked = mark_depth_discontinuities(b.map, options.discontinuity_tolerance_mm);
+            p.marking_ms = ms_since(t0);
+          } else {
+            clear_depth_discontinuities(b.map);  // a given map may carry marks
+          }
+        },
+        {prepare[k]}, k);
+    // The ray caster: exact look-ups at the marks, the layered maps, the hidden vertices' casts.
+    if (exact || options.layers > 0)
+      caster[k] = add(
+          [&b, &p, &cor, &options, exact, tree] {
+            const auto t0 = std::chrono::steady_clock::now();
+            auto c = std::make_shared<const FirstHitCaster>(b.mesh, cor, tree);
+            if (exact) {
+              b.exact = c;
+              p.caster_ms = ms_since(t0);
+            }
+            if (options.layers > 0) b.caster = std::move(c);
+          },
+          {prepare[k]}, k);
+  }
+  if (options.layers > 0 && options.layered_maps)
+    for (int k = 1; k >= 0; --k) {
+      JointBody& b = *body[k];
+      add(
+          [&b, &options, layered_scheme] {
+            auto layered = std::make_shared<LayeredMap>(layered_scheme, options.layers);
+            b.layered_sampling = sample_layered_map(*layered, *b.caster);
+            b.layered = std::move(layered);
+          },
+          {caster[k]}, k);
+    }
+  for (int k = 1; k >= 0; --k) {
+    JointBody& b = *body[k];
+    BuildParts& p = *parts[k];
+    // The first-surface mask and the scan sets (the map made sparse after the mask has read it).
+    std::vector<std::size_t> after{sample[k]};
+    if (caster[k] != kNone) after.push_back(caster[k]);
+    add(
+        [&b, &p, &options, exact] {
+          b.marking_ms = p.marking_ms + p.caster_ms;
+          b.mask = exact ? first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm,
+                                              options.max_radius_mm, *b.exact)
+                         : first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm, options.max_radius_mm);
+          if (options.sparse_maps) b.map.make_sparse(options.sparse_region_mm);
+          b.scan_set = make_scan_set(b.relative, b.mask);
+          if (options.layers == 0) return;
+          std::vector<std::uint8_t> hidden(b.mask.size(), 0);
+          for (std::size_t i = 0; i < hidden.size(); ++i) {
+            const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
+            // max_radius_mm bounds every vertex tested, the hidden ones too.
+            hidden[i] = !b.mask[i] && r > 0 && r <= std::min(options.extra_articular_radius_mm, options.max_radius_mm);
+          }
+          // In boxes of 32 (order_in_boxes), each run of the clusters below compact in space.
+          b.hidden_set = order_in_boxes(make_scan_set(b.relative, hidden), {32});
+          b.hidden_clusters = cluster_scan_set(b.hidden_set, 32);
+        },
+        std::move(after), k);
+  }
+  // The closest-point hierarchy needs the mesh alone (a one-pose joint builds it later, cropped:
+  // crop_distance_queries).
+  if (options.needs_distance_queries() && !options.cropped_distance_queries)
+    for (int k = 1; k >= 0; --k) {
+      JointBody& b = *body[k];
+      add([&b] { b.distance_query = std::make_shared<const SignedDistanceQuery>(b.mesh); }, {prepare[k]}, k);
+    }
+  for (int k = 1; k >= 0; --k) {
+    JointBody& b = *body[k];
+    add(
+        [&b, &options] {
+          b.vertex_area = vertex_areas(b.mesh);
+          if (options.distances) b.distance_set = make_distance_scan_set(b.relative, options.max_radius_mm);
+        },
+        {prepare[k]}, k);
+  }
+}
+}  // namespace
+
 std::pair<JointBody, JointBody> Joint::build_bodies(const Eigen::Vector3d& cor, const JointOptions& options,
                                                     TriangleMesh ball, TriangleMesh socket,
                                                     std::optional<RadialDistanceMap> ball_map,
                                                     std::optional<RadialDistanceMap> socket_map) {
   checked(options, cor);
-  // The two bodies are independent: the socket's is built on a second thread while this one builds the
-  // ball's (much of a build is serial: hierarchies, marks, masks, page faults of the maps). A failure
-  // on either is rethrown here, after both have finished.
-  std::optional<JointBody> b, s;
-  run_both([&] { b.emplace(build(cor, options, std::move(ball), std::move(ball_map))); },
-           [&] { s.emplace(build(cor, options, std::move(socket), std::move(socket_map))); });
-  return {std::move(*b), std::move(*s)};
-}
-
-JointBody Joint::build(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh mesh,
-                       std::optional<RadialDistanceMap> given) {
-  validate_mesh(mesh);
-  JointBody b(std::move(mesh), options.scheme);
-  // The closest-point query needs the mesh alone: it is built on a thread of its own meanwhile, so that
-  // it fills the core the other body's build leaves idle when it ends first (the query's hierarchy is
-  // serial). Joined before b is returned or the build fails (the future's destructor waits).
-  std::future<std::shared_ptr<const SignedDistanceQuery>> query;
-  if (options.needs_distance_queries() && !options.cropped_distance_queries)
-    query =
-        std::async(std::launch::async, [&mesh = b.mesh] { return std::make_shared<const SignedDistanceQuery>(mesh); });
-  b.relative = b.mesh.V.rowwise() - cor.transpose();
-  if (given) {
-    const SamplingScheme& want = *options.scheme;
-    const SamplingScheme& have = given->scheme();
-    require(want.conformable(have), b.mesh.source + ": the given map is " + have.name() + " at " +
-                                        std::to_string(have.resolution()) + ", the joint's scheme is " + want.name() +
-                                        " at " + std::to_string(want.resolution()));
-    b.map = std::move(*given);
-    b.sampling.nodes_covered = b.map.nodes_covered();
-  } else {
-    SamplingOptions so;
-    so.mode = options.mode;
-    so.method = options.sampling;
-    const auto t0 = std::chrono::steady_clock::now();
-    b.sampling = sample_surface(b.mesh, cor, so, b.map);
-    b.sampling_ms = ms_since(t0);
-  }
-  // A few poses (no layered maps: the direct set-up) cast few rays: the casters' trees are built fast (Morton)
-  // rather than well (SAH); the same hits either way.
-  const HierarchyBuild tree = options.layered_maps ? HierarchyBuild::quality : HierarchyBuild::fast;
-  if (options.exact_at_discontinuities && FirstHitCaster::available()) {
-    const auto t0 = std::chrono::steady_clock::now();
-    b.nodes_marked = mark_depth_discontinuities(b.map, options.discontinuity_tolerance_mm);
-    b.exact = std::make_shared<const FirstHitCaster>(b.mesh, cor, tree);
-    b.marking_ms = ms_since(t0);
-    b.mask = first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm, options.max_radius_mm, *b.exact);
-  } else {
-    clear_depth_discontinuities(b.map);  // a given map may carry marks
-    b.mask = first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm, options.max_radius_mm);
-  }
-  if (options.sparse_maps) b.map.make_sparse(options.sparse_region_mm);
-  b.scan_set = make_scan_set(b.relative, b.mask);
-  b.vertex_area = vertex_areas(b.mesh);
-  if (options.layers > 0) {
-    b.caster = b.exact != nullptr ? b.exact : std::make_shared<const FirstHitCaster>(b.mesh, cor, tree);
-    if (options.layered_maps) {
-      auto layered = std::make_shared<LayeredMap>(layered_scheme(options), options.layers);
-      b.layered_sampling = sample_layered_map(*layered, *b.caster);
-      b.layered = std::move(layered);
-    }
-    std::vector<std::uint8_t> hidden(b.mask.size(), 0);
-    for (std::size_t i = 0; i < hidden.size(); ++i) {
-      const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
-      // max_radius_mm bounds every vertex tested, the hidden ones too.
-      hidden[i] = !b.mask[i] && r > 0 && r <= std::min(options.extra_articular_radius_mm, options.max_radius_mm);
-    }
-    // In boxes of 32 (order_in_boxes), each run of the clusters below compact in space.
-    b.hidden_set = order_in_boxes(make_scan_set(b.relative, hidden), {32});
-    b.hidden_clusters = cluster_scan_set(b.hidden_set, 32);
-  }
-  if (query.valid()) b.distance_query = query.get();
-  if (options.distances) b.distance_set = make_distance_scan_set(b.relative, options.max_radius_mm);
-  return b;
+  // The two bodies are built as their parts (add_parts), on two threads: a free thread takes the first part in
+  // the list that is ready. The socket's parts come first (the pelvis is the larger mesh), and a body's own
+  // parts run as soon as the core the other leaves idle can take them (lhdl-ct subdivided 4x, one pose: the
+  // ball's chain ended some 100 ms before the socket's when each body was built on a thread of its own). Each
+  // part writes its own members of its body, so the bodies are the same whichever thread builds which part. A
+  // failure is rethrown after the running parts have ended: the ball's before the socket's (error_rank).
+  JointBody b(std::move(ball), options.scheme), s(std::move(socket), options.scheme);
+  BuildParts pb, ps;
+  std::vector<GraphTask> tasks;
+  add_parts(cor, options, layered_scheme(options), b, std::move(ball_map), pb, s, std::move(socket_map), ps, tasks);
+  run_task_graph(tasks);
+  return {std::move(b), std::move(s)};
 }
 
 std::shared_ptr<const SamplingScheme> Joint::layered_scheme() const { return layered_scheme(options_); }

@@ -93,16 +93,14 @@ const std::vector<Corner>& vertex_corners(const TriangleMesh& mesh, const Eigen:
 
 using namespace detail;
 
-std::vector<TriangleCone> triangle_cones(const TriangleMesh& mesh, const Eigen::Vector3d& cor,
-                                         const std::vector<std::int32_t>& faces, std::int64_t* edge_on) {
-  const std::vector<Corner>& k = vertex_corners(mesh, cor);
-  std::vector<TriangleCone> cones;
-  cones.reserve(faces.size());
+std::int64_t detail::append_triangle_cones(const TriangleMesh& mesh, const std::vector<Corner>& k,
+                                           const std::vector<std::int32_t>& faces, std::size_t begin, std::size_t end,
+                                           std::vector<TriangleCone>& cones) {
   std::int64_t skipped = 0;
   // The faces come in the plan's order (Z order of direction), not the mesh's: each one's row of F and its
   // three corners are cache misses unless fetched ahead (the rows 16 faces ahead, the corners 8).
-  const std::size_t n = faces.size();
-  for (std::size_t i = 0; i < n; ++i) {
+  const std::size_t n = end;
+  for (std::size_t i = begin; i < n; ++i) {
     if (i + 16 < n) __builtin_prefetch(&mesh.F(faces[i + 16], 0));
     if (i + 8 < n) {
       const auto g = faces[i + 8];
@@ -119,6 +117,14 @@ std::vector<TriangleCone> triangle_cones(const TriangleMesh& mesh, const Eigen::
     cones.push_back(make_cone(a, b, c, det, in_cone(a.p, b.p, c.p, det, V3::UnitZ()),
                               in_cone(a.p, b.p, c.p, det, -V3::UnitZ())));
   }
+  return skipped;
+}
+
+std::vector<TriangleCone> triangle_cones(const TriangleMesh& mesh, const Eigen::Vector3d& cor,
+                                         const std::vector<std::int32_t>& faces, std::int64_t* edge_on) {
+  std::vector<TriangleCone> cones;
+  cones.reserve(faces.size());
+  const std::int64_t skipped = append_triangle_cones(mesh, vertex_corners(mesh, cor), faces, 0, faces.size(), cones);
   if (edge_on != nullptr) *edge_on = skipped;
   return cones;
 }

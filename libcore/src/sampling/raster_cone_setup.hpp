@@ -52,4 +52,11 @@ TriangleCone make_cone(const Corner& ka, const Corner& kb, const Corner& kc, dou
 /// page-faulted in on every call.
 const std::vector<Corner>& vertex_corners(const TriangleMesh& mesh, const Eigen::Vector3d& cor);
 
+/// Appends to `out` the cones of faces[begin, end) of `mesh` (in that order), whose vertices' corners are
+/// `corners` (vertex_corners), skipping those whose plane passes through the COR; returns how many were
+/// skipped. triangle_cones over all the faces at once, or a range at a time (rasterize's streamed plan).
+std::int64_t append_triangle_cones(const TriangleMesh& mesh, const std::vector<Corner>& corners,
+                                   const std::vector<std::int32_t>& faces, std::size_t begin, std::size_t end,
+                                   std::vector<TriangleCone>& out);
+
 }  // namespace impinge::detail

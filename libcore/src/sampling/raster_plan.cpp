@@ -13,7 +13,7 @@ namespace impinge {
 
 namespace {
 /// Kept triangles (all when culling is disabled) in Z-curve order of their centroid direction.
-void order_triangles(const TriangleMesh& mesh, const Eigen::Vector3d& cor, RasterPlan& fc) {
+void order_triangles(const TriangleMesh& mesh, const Eigen::Vector3d& cor, RasterPlan& fc, bool with_cones) {
   std::vector<std::pair<std::uint64_t, std::int32_t>> key;
   key.reserve(static_cast<std::size_t>(mesh.F.rows()));
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
@@ -27,7 +27,8 @@ void order_triangles(const TriangleMesh& mesh, const Eigen::Vector3d& cor, Raste
   std::sort(key.begin(), key.end());
   fc.triangle_order.resize(key.size());
   for (std::size_t k = 0; k < key.size(); ++k) fc.triangle_order[k] = key[k].second;
-  fc.cones = triangle_cones(mesh, cor, fc.triangle_order, &fc.cones_edge_on);
+  fc.with_cones = with_cones;
+  if (with_cones) fc.cones = triangle_cones(mesh, cor, fc.triangle_order, &fc.cones_edge_on);
   fc.cor = cor;
   fc.mesh_fingerprint = mesh_fingerprint(mesh);
 }
@@ -57,7 +58,7 @@ std::uint64_t mesh_fingerprint(const TriangleMesh& mesh) {
   return h ^ static_cast<std::uint64_t>(mesh.V.rows()) * 31 ^ static_cast<std::uint64_t>(mesh.F.rows());
 }
 
-RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays) {
+RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays, bool with_cones) {
   validate_mesh(mesh);
   require(cor.allFinite(), mesh.source + ": centre of rotation is not finite");
   require(rays >= 1, "face culling: at least one ray is needed");
@@ -68,7 +69,7 @@ RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& c
     fc.reason = std::to_string(fc.boundary_edges) +
                 " directed edges without exactly one reverse (open or inconsistently "
                 "oriented mesh)";
-    order_triangles(mesh, cor, fc);
+    order_triangles(mesh, cor, fc, with_cones);
     return fc;
   }
   // Orientation of the nearest hit along rays towards triangle centroids spread over the mesh (all rays in one
@@ -104,7 +105,7 @@ RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& c
   } else {
     fc.enabled = true;
   }
-  order_triangles(mesh, cor, fc);
+  order_triangles(mesh, cor, fc, with_cones);
   return fc;
 }
 

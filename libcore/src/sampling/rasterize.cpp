@@ -39,6 +39,10 @@ constexpr int kMinSpanBox = 16;
 /// 1 MiB 18-19 ms; the cones that start in a band reach into the next ones).
 constexpr std::size_t kResetBandBytes = 512 * 1024;
 
+/// Cones made and drawn at a time from a plan without cones (RasterPlan::with_cones false): 4096 of 240
+/// bytes, about 1 MB.
+constexpr std::size_t kStreamedCones = 4096;
+
 template <typename Scalar>
 class Rasterizer {
  public:
@@ -138,6 +142,13 @@ class Rasterizer {
       }
     }
     reset_to(rows);
+  }
+
+  /// exact_cone, except that a cone whose box holds no row is not counted (stats' pole and seam triangles) either:
+  /// as exact_cones_fresh counts them, so that a streamed plan reports what the plan's cones report.
+  void exact_cone_in_rows(const TriangleCone& t) {
+    const Box b = box_of(t, inv_h_, grid_.rows(), grid_.columns());
+    if (b.r1 >= b.r0) exact_cone(t, b);
   }
 
   /// exact_cone with the cone's box b (box_of).
@@ -274,21 +285,34 @@ SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, Di
   // The plan's cones: the kept triangles (all when culling is disabled), set up once.
   if (planned && (culling->cor != cor || culling->mesh_fingerprint != mesh_fingerprint(mesh)))
     throw Error(mesh.source + ": rasterisation plan was made for another mesh or centre of rotation");
-  const bool banded = planned && start == MapStart::reset;  // the reset fused with the drawing
+  const bool banded = planned && culling->with_cones && start == MapStart::reset;  // the reset fused with the drawing
   if (start == MapStart::reset && !banded)
     std::fill(map.data(), map.data() + map.num_nodes(), RadialDistanceMapT<Scalar>::no_surface());
   SamplingStats stats;
   const int keep = planned && culling->enabled ? culling->keep_sign : 0;
   Rasterizer<Scalar> raster(map, mode, stats, keep, row_spans);
   if (planned) {
-    if (banded) {
+    std::int64_t edge_on = culling->cones_edge_on;
+    if (!culling->with_cones) {
+      // The cones made and drawn kStreamedCones at a time in the plan's order (Z order of direction: each run
+      // covers a compact part of the map), so that they never take more than some 1 MB at once.
+      const std::vector<Corner>& k = vertex_corners(mesh, cor);
+      const std::vector<std::int32_t>& order = culling->triangle_order;
+      thread_local std::vector<TriangleCone> cones;
+      edge_on = 0;
+      for (std::size_t first = 0; first < order.size(); first += kStreamedCones) {
+        cones.clear();
+        edge_on += append_triangle_cones(mesh, k, order, first, std::min(order.size(), first + kStreamedCones), cones);
+        for (const TriangleCone& t : cones) raster.exact_cone_in_rows(t);
+      }
+    } else if (banded) {
       raster.exact_cones_fresh(culling->cones);
     } else {
       for (const TriangleCone& t : culling->cones) raster.exact_cone(t);
     }
     const auto kept = static_cast<std::int64_t>(culling->triangle_order.size());
     stats.triangles = mesh.F.rows();
-    stats.triangles_edge_on = culling->cones_edge_on;
+    stats.triangles_edge_on = edge_on;
     stats.triangles_culled = mesh.F.rows() - kept;
   } else {
     const std::vector<Corner>& k = vertex_corners(mesh, cor);

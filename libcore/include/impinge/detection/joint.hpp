@@ -200,13 +200,11 @@ class Joint {
 
  private:
   Joint(const Eigen::Vector3d& cor, const JointOptions& options, std::pair<JointBody, JointBody> bodies);
-  /// Both bodies, the socket's on a second thread, after checking the options (throws impinge::Error).
+  /// Both bodies, their parts on two threads, after checking the options (throws impinge::Error).
   static std::pair<JointBody, JointBody> build_bodies(const Eigen::Vector3d& cor, const JointOptions& options,
                                                       TriangleMesh ball, TriangleMesh socket,
                                                       std::optional<RadialDistanceMap> ball_map,
                                                       std::optional<RadialDistanceMap> socket_map);
-  static JointBody build(const Eigen::Vector3d& cor, const JointOptions& options, TriangleMesh mesh,
-                         std::optional<RadialDistanceMap> map);
   static std::shared_ptr<const SamplingScheme> layered_scheme(const JointOptions& options);
   Eigen::Vector3d cor_;
   JointOptions options_;

@@ -40,12 +40,18 @@ struct RasterPlan {
   std::vector<std::int32_t> triangle_order;
   /// Exact-mode set-up of each triangle of triangle_order (same order) whose plane misses the
   /// COR, made once here so that rasterize() only turns angles into rows, columns and spans.
+  /// Empty when the plan was made without cones (with_cones false): rasterize() then makes them
+  /// a few thousand at a time as it draws them (the same map).
   std::vector<TriangleCone> cones;
   std::int64_t cones_edge_on = 0;  ///< triangles of triangle_order left out of cones (edge-on)
+  bool with_cones = true;          ///< whether `cones` was made (plan_rasterization's with_cones)
   /// What the plan was made for; rasterize() refuses a plan whose mesh or COR differs.
   Eigen::Vector3d cor = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   std::uint64_t mesh_fingerprint = 0;  ///< mesh_fingerprint() of the mesh analysed
 };
+
+/// plan_rasterization's brute-force rays unless told otherwise.
+inline constexpr int kPlanRays = 8;
 
 /// A 64-bit fingerprint of a mesh's vertex coordinates (bit patterns), face indices and sizes:
 /// any edit of a coordinate or index changes it with overwhelming probability. O(n + m), about
@@ -56,10 +62,14 @@ std::uint64_t mesh_fingerprint(const TriangleMesh& mesh);
 /// rasterisation. For culling, every directed edge must have
 /// exactly one reverse edge (closed and consistently oriented), and the nearest hits of
 /// `rays` brute-force rays (towards triangle centroids spread over the mesh) must all have one
-/// orientation, which becomes keep_sign. Also makes the triangles' cones (triangle_cone.hpp).
+/// orientation, which becomes keep_sign. Also makes the triangles' cones (triangle_cone.hpp)
+/// when `with_cones`: some 240 bytes a kept triangle (34 MB for a 280k-triangle femur), worth it
+/// for a plan drawn many times (several resolutions); a plan drawn once (sample_surface's own)
+/// leaves them to rasterize(), which makes them as it draws them, for the same map.
 /// Cost O(m) for the edges and cones plus O(rays x m); a once-per-mesh precomputation like
 /// building a BVH. Throws impinge::Error for an invalid
 /// mesh or a non-finite COR.
-RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays = 8);
+RasterPlan plan_rasterization(const TriangleMesh& mesh, const Eigen::Vector3d& cor, int rays = kPlanRays,
+                              bool with_cones = true);
 
 }  // namespace impinge
