@@ -70,7 +70,9 @@ TEST(Kernels, ForcingGenericIsReported) {
   KernelScope scope;
   set_kernel_set(KernelSet::generic);
   EXPECT_EQ(kernel_set(), KernelSet::generic);
-  EXPECT_EQ(kernel_description(), "rasteriser generic, look-ups generic, fibonacci stencils generic");
+  EXPECT_EQ(kernel_description(),
+            "rasteriser generic, look-ups generic, fibonacci stencils generic, distance bounds and joint-centre sums "
+            "generic");
   set_kernel_set(KernelSet::native);
   EXPECT_EQ(kernel_set(), KernelSet::native);
   EXPECT_NE(kernel_description().find("rasteriser "), std::string::npos);

@@ -8,6 +8,7 @@
 
 #include "impinge/core/error.hpp"
 #include "impinge/schemes/fibonacci_scheme.hpp"
+#include "core/cpu_dispatch.hpp"
 #include "core/simd_clones.hpp"
 
 namespace impinge {
@@ -95,25 +96,47 @@ namespace {
 /// head centre t (3, mm): with a_j = (w_j, 1), w_j the unit direction from t to vertex j, the lower
 /// triangle of sum a_j a_j^T row by row (out[0..9]: 00, 10, 11, 20, 21, 22, 30, 31, 32, 33) and
 /// sum a_j g_j (out[10..13]), leaving out the vertices with use[j] == 0 or a non-finite gap g[j] (mm).
-/// Eight lanes (j mod 8) are summed apart and then together, so that the loop vectorises (clones).
-IMPINGE_SIMD_CLONES
-void normal_sums(const double* __restrict X, const double* __restrict Y, const double* __restrict Z,
-                 const float* __restrict g, const std::uint8_t* __restrict use, std::int64_t n,
-                 const double* __restrict t, double* __restrict out) {
-  constexpr int kLanes = 8;
-  typedef double Lanes __attribute__((vector_size(8 * kLanes)));
-  typedef float FloatLanes __attribute__((vector_size(4 * kLanes)));
-  typedef std::uint8_t ByteLanes __attribute__((vector_size(kLanes)));
+/// Eight lanes (j mod 8) are summed apart and then together, so that the loop vectorises: on AVX-512 as one
+/// register a lane vector (normal_sums_wide), else as two halves of four lanes, each half over all the vertices
+/// in turn (normal_sums_halves, AVX2 and baseline clones: the 8-lane vectors spilled to the stack there, 14 % of
+/// `impinge rom`'s time on lhdl-ct). Every lane adds the same terms in the same order either way, and the lanes
+/// are then added in lane order, so both give the same sums.
+constexpr int kSumLanes = 8;
+
+/// GCC vectors of kWidth doubles, floats and bytes (a dependent vector_size is not taken in a template).
+template <int kWidth>
+struct SumVectors;
+template <>
+struct SumVectors<8> {
+  typedef double Lanes __attribute__((vector_size(64)));
+  typedef float FloatLanes __attribute__((vector_size(32)));
+  typedef std::uint8_t ByteLanes __attribute__((vector_size(8)));
+};
+template <>
+struct SumVectors<4> {
+  typedef double Lanes __attribute__((vector_size(32)));
+  typedef float FloatLanes __attribute__((vector_size(16)));
+  typedef std::uint8_t ByteLanes __attribute__((vector_size(4)));
+};
+
+/// Lanes [first, first + kWidth) of the eight (kSumLanes) over every vertex: lane_sum[k][first + l] (k < 14).
+template <int kWidth>
+inline __attribute__((always_inline)) void normal_sum_lanes(const double* X, const double* Y, const double* Z,
+                                                            const float* g, const std::uint8_t* use, std::int64_t n,
+                                                            const double* t, int first, double (*lane_sum)[kSumLanes]) {
+  using Lanes = typename SumVectors<kWidth>::Lanes;
+  using FloatLanes = typename SumVectors<kWidth>::FloatLanes;
+  using ByteLanes = typename SumVectors<kWidth>::ByteLanes;
   Lanes acc[14] = {};
   const double tx = t[0], ty = t[1], tz = t[2];
-  // One block of kLanes vertices; past n, the last vertex repeated and left out (use 0).
+  // One block of kWidth vertices; past n, the last vertex repeated and left out (use 0).
   auto block = [&](const Lanes& x, const Lanes& y, const Lanes& z, const Lanes& gap, const Lanes& used) {
     const Lanes dx = x - tx, dy = y - ty, dz = z - tz;
     const Lanes n2 = dx * dx + dy * dy + dz * dz;
     const auto finite = gap - gap == 0;  // inf - inf and NaN - NaN are NaN
     const Lanes on = finite ? used : Lanes{};
     Lanes len = n2 > 0 ? n2 : Lanes{} + 1.0;  // a vertex at t: w = 0
-    for (int l = 0; l < kLanes; ++l) len[l] = std::sqrt(len[l]);
+    for (int l = 0; l < kWidth; ++l) len[l] = std::sqrt(len[l]);
     const Lanes a0 = dx / len * on, a1 = dy / len * on, a2 = dz / len * on, a3 = on;
     const Lanes gg = finite ? gap * on : Lanes{};
     acc[0] += a0 * a0;
@@ -131,8 +154,8 @@ void normal_sums(const double* __restrict X, const double* __restrict Y, const d
     acc[12] += a2 * gg;
     acc[13] += a3 * gg;
   };
-  const std::int64_t full = n / kLanes * kLanes;
-  for (std::int64_t j0 = 0; j0 < full; j0 += kLanes) {
+  const std::int64_t full = n / kSumLanes * kSumLanes;
+  for (std::int64_t j0 = first; j0 < full; j0 += kSumLanes) {
     Lanes x, y, z;
     FloatLanes gf;
     ByteLanes u;
@@ -142,17 +165,50 @@ void normal_sums(const double* __restrict X, const double* __restrict Y, const d
   }
   if (full < n) {
     Lanes x, y, z, gap, used;
-    for (int l = 0; l < kLanes; ++l) {
-      const std::int64_t j = std::min(full + l, n - 1);
-      x[l] = X[j], y[l] = Y[j], z[l] = Z[j], gap[l] = g[j], used[l] = full + l < n && use[j] != 0 ? 1.0 : 0.0;
+    for (int l = 0; l < kWidth; ++l) {
+      const std::int64_t i = full + first + l, j = std::min(i, n - 1);
+      x[l] = X[j], y[l] = Y[j], z[l] = Z[j], gap[l] = g[j], used[l] = i < n && use[j] != 0 ? 1.0 : 0.0;
     }
     block(x, y, z, gap, used);
   }
+  for (int k = 0; k < 14; ++k)
+    for (int l = 0; l < kWidth; ++l) lane_sum[k][first + l] = acc[k][l];
+}
+
+// The lanes' sums added in lane order into out[0..13].
+void add_lanes(const double (*lane_sum)[kSumLanes], double* out) {
   for (int k = 0; k < 14; ++k) {
     double sum = 0;
-    for (int l = 0; l < kLanes; ++l) sum += acc[k][l];
+    for (int l = 0; l < kSumLanes; ++l) sum += lane_sum[k][l];
     out[k] = sum;
   }
+}
+
+IMPINGE_SIMD_WIDE
+void normal_sums_wide(const double* __restrict X, const double* __restrict Y, const double* __restrict Z,
+                      const float* __restrict g, const std::uint8_t* __restrict use, std::int64_t n,
+                      const double* __restrict t, double* __restrict out) {
+  double lane_sum[14][kSumLanes];
+  normal_sum_lanes<kSumLanes>(X, Y, Z, g, use, n, t, 0, lane_sum);
+  add_lanes(lane_sum, out);
+}
+
+IMPINGE_SIMD_CLONES_NARROW
+void normal_sums_halves(const double* __restrict X, const double* __restrict Y, const double* __restrict Z,
+                        const float* __restrict g, const std::uint8_t* __restrict use, std::int64_t n,
+                        const double* __restrict t, double* __restrict out) {
+  double lane_sum[14][kSumLanes];
+  normal_sum_lanes<kSumLanes / 2>(X, Y, Z, g, use, n, t, 0, lane_sum);
+  normal_sum_lanes<kSumLanes / 2>(X, Y, Z, g, use, n, t, kSumLanes / 2, lane_sum);
+  add_lanes(lane_sum, out);
+}
+
+void normal_sums(const double* X, const double* Y, const double* Z, const float* g, const std::uint8_t* use,
+                 std::int64_t n, const double* t, double* out) {
+  if (detail::use_wide_vectors())
+    normal_sums_wide(X, Y, Z, g, use, n, t, out);
+  else
+    normal_sums_halves(X, Y, Z, g, use, n, t, out);
 }
 }  // namespace
 

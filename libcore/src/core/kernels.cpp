@@ -41,9 +41,20 @@ bool cpu_avx2_fma() {
   static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   return yes;
 }
+bool cpu_x86_64_v4() {
+#ifdef IMPINGE_SIMD_NO_AVX512
+  return false;
+#else
+  static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+                          __builtin_cpu_supports("avx512cd");
+  return yes;
+#endif
+}
 #else
 bool cpu_avx512() { return false; }
 bool cpu_avx2_fma() { return false; }
+bool cpu_x86_64_v4() { return false; }
 #endif
 
 }  // namespace
@@ -55,12 +66,14 @@ void set_kernel_set(KernelSet set) { g_set.store(static_cast<int>(set), std::mem
 std::string kernel_description() {
   return std::string("rasteriser ") + (detail::use_avx512() ? "avx512" : "generic") + ", look-ups " +
          (detail::use_avx2_fma() ? "avx2" : "generic") + ", fibonacci stencils " +
-         (detail::use_avx512() ? "avx512" : "generic");
+         (detail::use_avx512() ? "avx512" : "generic") + ", distance bounds and joint-centre sums " +
+         (detail::use_wide_vectors() ? "avx512" : "generic");
 }
 
 namespace detail {
 bool use_avx512() { return cpu_avx512() && native(); }
 bool use_avx2_fma() { return cpu_avx2_fma() && native(); }
+bool use_wide_vectors() { return cpu_x86_64_v4() && native(); }
 }  // namespace detail
 
 }  // namespace impinge
