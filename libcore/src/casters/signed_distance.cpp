@@ -33,66 +33,64 @@ using detail::kGroup;
 /// s_e (the triangle is the intersection of the three half-planes), and equal to it where the closest point
 /// lies on the face or an edge; below it only in a corner's region. kGroup lanes into lb2; returns the lanes
 /// whose bound is at most limit2 (bit l: lane l). Two forms with the same arithmetic lane by lane:
-/// - AVX-512: the sixteen lanes as one register a row (group_lower_bounds_avx512);
-/// - AVX2 and the baseline (clones): eight lanes at a time, each row read as it is needed
-///   (group_lower_bounds_lanes8). The sixteen-lane form spilled every row to the stack in the AVX2 clone (some
+/// - AVX-512: the sixteen lanes as one register a row (group_lower_bounds_wide);
+/// - AVX2 and the baseline (clones): eight lanes at a time (group_lower_bounds_narrow). The sixteen-lane form spilled every row to the stack in the AVX2 clone (some
 ///   300 instructions a call): lhdl-ct's 1,000-frame motion took 1.8x the CPU time of this form on a CPU
 ///   without AVX-512 (measured with -DIMPINGE_SIMD_NO_AVX512, core/simd_clones.hpp).
-typedef float GroupLanes __attribute__((vector_size(4 * kGroup)));
-IMPINGE_SIMD_WIDE
-std::uint32_t group_lower_bounds_avx512(const float (*v)[kGroup], float x, float y, float z, float limit2,
-                                        float* lb2) {
-  GroupLanes row[16];
-  for (int r = 0; r < 16; ++r) std::memcpy(&row[r], v[r], sizeof(GroupLanes));
-  const GroupLanes h = row[0] * x + row[1] * y + row[2] * z - row[3];
-  const GroupLanes s0 = row[4] * x + row[5] * y + row[6] * z - row[7];
-  const GroupLanes s1 = row[8] * x + row[9] * y + row[10] * z - row[11];
-  const GroupLanes s2 = row[12] * x + row[13] * y + row[14] * z - row[15];
-  GroupLanes s = s0 > s1 ? s0 : s1;
-  s = s > s2 ? s : s2;
-  s = s > 0 ? s : GroupLanes{};
-  const GroupLanes out = h * h + s * s;
-  std::memcpy(lb2, &out, sizeof(GroupLanes));
-  const auto within = out <= limit2;  // -1 where within, lane by lane
-  std::uint32_t bits = 0;
-  for (int l = 0; l < kGroup; ++l) bits |= static_cast<std::uint32_t>(within[l] & 1) << l;
-  return bits;
-}
+/// GCC vectors of kWidth floats (a dependent vector_size is not taken in a template).
+template <int kWidth>
+struct BoundLanes;
+template <>
+struct BoundLanes<16> {
+  typedef float Lanes __attribute__((vector_size(64)));
+};
+template <>
+struct BoundLanes<8> {
+  typedef float Lanes __attribute__((vector_size(32)));
+};
 
-typedef float Lanes8 __attribute__((vector_size(32)));
-static_assert(kGroup % 8 == 0, "group_lower_bounds takes eight lanes at a time");
-// Eight floats from p (any alignment) into t.
-inline void load8(Lanes8& t, const float* p) { std::memcpy(&t, p, sizeof(Lanes8)); }
-
-IMPINGE_SIMD_CLONES_NARROW
-std::uint32_t group_lower_bounds_lanes8(const float (*v)[kGroup], float x, float y, float z, float limit2,
-                                        float* lb2) {
+/// group_lower_bounds over kWidth lanes at a time (kGroup a multiple of it), each row read as it is needed.
+template <int kWidth>
+inline __attribute__((always_inline)) std::uint32_t lower_bound_lanes(const float (*v)[kGroup], float x, float y,
+                                                                      float z, float limit2, float* lb2) {
+  static_assert(kGroup % kWidth == 0, "the group's lanes in whole vectors");
+  using Lanes = typename BoundLanes<kWidth>::Lanes;
   std::uint32_t bits = 0;
-  for (int half = 0; half < kGroup / 8; ++half) {
-    const int o = 8 * half;
-    Lanes8 a, b, c, d;
-    load8(a, v[0] + o), load8(b, v[1] + o), load8(c, v[2] + o), load8(d, v[3] + o);
-    const Lanes8 h = a * x + b * y + c * z - d;
-    load8(a, v[4] + o), load8(b, v[5] + o), load8(c, v[6] + o), load8(d, v[7] + o);
-    const Lanes8 s0 = a * x + b * y + c * z - d;
-    load8(a, v[8] + o), load8(b, v[9] + o), load8(c, v[10] + o), load8(d, v[11] + o);
-    const Lanes8 s1 = a * x + b * y + c * z - d;
-    load8(a, v[12] + o), load8(b, v[13] + o), load8(c, v[14] + o), load8(d, v[15] + o);
-    const Lanes8 s2 = a * x + b * y + c * z - d;
-    Lanes8 s = s0 > s1 ? s0 : s1;
+  for (int o = 0; o < kGroup; o += kWidth) {
+    Lanes a, b, c, d, h, s0, s1, s2;
+    // Rows r .. r + 3 (a plane: its normal and offset) at q, lanes o .. o + kWidth - 1, into out.
+    const auto plane = [&](int r, Lanes& out) {
+      std::memcpy(&a, v[r] + o, sizeof(Lanes)), std::memcpy(&b, v[r + 1] + o, sizeof(Lanes));
+      std::memcpy(&c, v[r + 2] + o, sizeof(Lanes)), std::memcpy(&d, v[r + 3] + o, sizeof(Lanes));
+      out = a * x + b * y + c * z - d;
+    };
+    plane(0, h), plane(4, s0), plane(8, s1), plane(12, s2);
+    Lanes s = s0 > s1 ? s0 : s1;
     s = s > s2 ? s : s2;
-    s = s > 0 ? s : Lanes8{};
-    const Lanes8 out = h * h + s * s;
-    std::memcpy(lb2 + o, &out, sizeof(Lanes8));
+    s = s > 0 ? s : Lanes{};
+    const Lanes out = h * h + s * s;
+    std::memcpy(lb2 + o, &out, sizeof(Lanes));
     const auto within = out <= limit2;  // -1 where within, lane by lane
-    for (int l = 0; l < 8; ++l) bits |= static_cast<std::uint32_t>(within[l] & 1) << (o + l);
+    for (int l = 0; l < kWidth; ++l) bits |= static_cast<std::uint32_t>(within[l] & 1) << (o + l);
   }
   return bits;
 }
 
-std::uint32_t group_lower_bounds(const float (*v)[kGroup], float x, float y, float z, float limit2, float* lb2) {
-  return detail::use_wide_vectors() ? group_lower_bounds_avx512(v, x, y, z, limit2, lb2)
-                             : group_lower_bounds_lanes8(v, x, y, z, limit2, lb2);
+IMPINGE_SIMD_WIDE
+std::uint32_t group_lower_bounds_wide(const float (*v)[kGroup], float x, float y, float z, float limit2, float* lb2) {
+  return lower_bound_lanes<16>(v, x, y, z, limit2, lb2);
+}
+
+IMPINGE_SIMD_CLONES_NARROW
+std::uint32_t group_lower_bounds_narrow(const float (*v)[kGroup], float x, float y, float z, float limit2,
+                                        float* lb2) {
+  return lower_bound_lanes<8>(v, x, y, z, limit2, lb2);
+}
+
+/// group_lower_bounds (above) in the form `wide` names (detail::use_wide_vectors, decided once a search).
+std::uint32_t group_lower_bounds(bool wide, const float (*v)[kGroup], float x, float y, float z, float limit2,
+                                 float* lb2) {
+  return wide ? group_lower_bounds_wide(v, x, y, z, limit2, lb2) : group_lower_bounds_narrow(v, x, y, z, limit2, lb2);
 }
 
 #endif
@@ -141,6 +139,7 @@ struct Search {
   Eigen::Vector3d point;
   int feature = 0;
   bool any_only = false;
+  bool wide = detail::use_wide_vectors();  // the lower bounds' form (decided once a search, not once a group)
   double margin = kBoxMarginMm;  // mm: the float lower bounds' rounding at q, and more (run sets it)
   NearbyTriangles* collect = nullptr;  // filling: every group the walk reaches (the radius stays put)
 };
@@ -168,7 +167,7 @@ bool visit_group(Search* s, std::uint32_t group, float x, float y, float z) {
   const SignedDistanceQuery::Impl::Group& g = s->m->groups[group];
   float lb2[kGroup];
   const float first = static_cast<float>(s->best + s->margin);
-  std::uint32_t bits = group_lower_bounds(g.v, x, y, z, first * first, lb2);
+  std::uint32_t bits = group_lower_bounds(s->wide, g.v, x, y, z, first * first, lb2);
   bool closer = false;
   for (; bits != 0; bits &= bits - 1) {  // the lanes within the first limit, in order; the limit shrinks
     const int l = __builtin_ctz(bits);
