@@ -26,17 +26,6 @@ namespace {
 #ifdef IMPINGE_HAVE_EMBREE
 using detail::kGroup;
 
-/// The squared lower bounds of the distance from q (float, about the query's shift) to the triangles of a
-/// group (Impl::Group's rows: plane, then the three edges' lines), lane by lane: h^2 + max(0, s_0, s_1,
-/// s_2)^2, with h the distance to the triangle's plane and s_e the distance of q's foot point in that plane
-/// beyond edge e's line (negative inside). The in-plane distance to the triangle is at least the largest
-/// s_e (the triangle is the intersection of the three half-planes), and equal to it where the closest point
-/// lies on the face or an edge; below it only in a corner's region. kGroup lanes into lb2; returns the lanes
-/// whose bound is at most limit2 (bit l: lane l). Two forms with the same arithmetic lane by lane:
-/// - AVX-512: the sixteen lanes as one register a row (group_lower_bounds_wide);
-/// - AVX2 and the baseline (clones): eight lanes at a time (group_lower_bounds_narrow). The sixteen-lane form spilled every row to the stack in the AVX2 clone (some
-///   300 instructions a call): lhdl-ct's 1,000-frame motion took 1.8x the CPU time of this form on a CPU
-///   without AVX-512 (measured with -DIMPINGE_SIMD_NO_AVX512, core/simd_clones.hpp).
 /// GCC vectors of kWidth floats (a dependent vector_size is not taken in a template).
 template <int kWidth>
 struct BoundLanes;
@@ -49,7 +38,7 @@ struct BoundLanes<8> {
   typedef float Lanes __attribute__((vector_size(32)));
 };
 
-/// group_lower_bounds over kWidth lanes at a time (kGroup a multiple of it), each row read as it is needed.
+/// group_lower_bounds (below) over kWidth lanes at a time (kGroup a multiple of it), each row read as it is needed.
 template <int kWidth>
 inline __attribute__((always_inline)) std::uint32_t lower_bound_lanes(const float (*v)[kGroup], float x, float y,
                                                                       float z, float limit2, float* lb2) {
@@ -82,12 +71,23 @@ std::uint32_t group_lower_bounds_wide(const float (*v)[kGroup], float x, float y
 }
 
 IMPINGE_SIMD_CLONES_NARROW
-std::uint32_t group_lower_bounds_narrow(const float (*v)[kGroup], float x, float y, float z, float limit2,
-                                        float* lb2) {
+std::uint32_t group_lower_bounds_narrow(const float (*v)[kGroup], float x, float y, float z, float limit2, float* lb2) {
   return lower_bound_lanes<8>(v, x, y, z, limit2, lb2);
 }
 
-/// group_lower_bounds (above) in the form `wide` names (detail::use_wide_vectors, decided once a search).
+/// The squared lower bounds of the distance from q = (x, y, z) (float, mm, about the query's shift) to the
+/// triangles of a group (Impl::Group's rows v: plane, then the three edges' lines), lane by lane: h^2 + max(0,
+/// s_0, s_1, s_2)^2, with h the distance to the triangle's plane and s_e the distance of q's foot point in that
+/// plane beyond edge e's line (negative inside). The in-plane distance to the triangle is at least the largest
+/// s_e (the triangle is the intersection of the three half-planes), and equal to it where the closest point
+/// lies on the face or an edge; below it only in a corner's region. kGroup lanes into lb2 (mm^2); returns the
+/// lanes whose bound is at most limit2 (mm^2; bit l: lane l). Throws nothing. Two forms with the same
+/// arithmetic lane by lane, `wide` choosing (detail::use_wide_vectors, decided once a search):
+/// - AVX-512: the sixteen lanes as one register a row (group_lower_bounds_wide);
+/// - AVX2 and the baseline (clones): eight lanes at a time (group_lower_bounds_narrow). The sixteen-lane form
+///   spilled every row to the stack in the AVX2 clone (some 300 instructions a call): lhdl-ct's 1,000-frame
+///   motion took 1.8x the CPU time of this form on a CPU without AVX-512 (measured with
+///   -DIMPINGE_SIMD_NO_AVX512, core/simd_clones.hpp).
 std::uint32_t group_lower_bounds(bool wide, const float (*v)[kGroup], float x, float y, float z, float limit2,
                                  float* lb2) {
   return wide ? group_lower_bounds_wide(v, x, y, z, limit2, lb2) : group_lower_bounds_narrow(v, x, y, z, limit2, lb2);
@@ -140,8 +140,8 @@ struct Search {
   int feature = 0;
   bool any_only = false;
   bool wide = detail::use_wide_vectors();  // the lower bounds' form (decided once a search, not once a group)
-  double margin = kBoxMarginMm;  // mm: the float lower bounds' rounding at q, and more (run sets it)
-  NearbyTriangles* collect = nullptr;  // filling: every group the walk reaches (the radius stays put)
+  double margin = kBoxMarginMm;            // mm: the float lower bounds' rounding at q, and more (run sets it)
+  NearbyTriangles* collect = nullptr;      // filling: every group the walk reaches (the radius stays put)
 };
 
 // Whether kept triangle t at distance d replaces the best so far: nearer, or as near with a lower index
@@ -195,7 +195,8 @@ bool visit(RTCPointQueryFunctionArguments* args) {
     const float d = box_distance(s->m->group_box[args->primID], args->query->x, args->query->y, args->query->z);
     if (n.count < NearbyTriangles::kMax) {  // in order of the box's distance from the centre (insertion)
       int i = n.count;
-      for (; i > 0 && n.box_distance[i - 1] > d; --i) n.group[i] = n.group[i - 1], n.box_distance[i] = n.box_distance[i - 1];
+      for (; i > 0 && n.box_distance[i - 1] > d; --i)
+        n.group[i] = n.group[i - 1], n.box_distance[i] = n.box_distance[i - 1];
       n.group[i] = static_cast<std::int32_t>(args->primID), n.box_distance[i] = d;
     }
     ++n.count;
@@ -219,7 +220,8 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
     Eigen::Vector3d point;
     int feature = 0;
     const double d = m.distance_to(t, s.q, point, feature);
-    if (better(s, d, static_cast<std::int64_t>(t))) s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
+    if (better(s, d, static_cast<std::int64_t>(t)))
+      s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
   }
 #ifdef IMPINGE_HAVE_EMBREE
   s.margin = kBoxMarginMm + 1e-6 * (m.extent + (s.q - m.shift).cwiseAbs().maxCoeff());
@@ -228,7 +230,8 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
   query.y = static_cast<float>(s.q.y() - m.shift.y());
   query.z = static_cast<float>(s.q.z() - m.shift.z());
   query.time = 0.f;
-  query.radius = std::isfinite(s.best) ? static_cast<float>(s.best + kBoxMarginMm) : std::numeric_limits<float>::infinity();
+  query.radius =
+      std::isfinite(s.best) ? static_cast<float>(s.best + kBoxMarginMm) : std::numeric_limits<float>::infinity();
   double listed = 0;  // mm: the ball of a NearbyTriangles this walk refills
   if (nearby != nullptr && std::isfinite(s.best)) {
     const Eigen::Vector3d q(query.x, query.y, query.z);  // about the shift, as the groups' boxes
@@ -272,7 +275,8 @@ bool run(const SignedDistanceQuery::Impl& m, Search& s, double radius, std::int6
   Eigen::Vector3d point;
   int feature = 0;
   const double d = m.distance_to(t, s.q, point, feature);
-  if (better(s, d, static_cast<std::int64_t>(t))) s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
+  if (better(s, d, static_cast<std::int64_t>(t)))
+    s.best = d, s.kept = static_cast<std::int64_t>(t), s.point = point, s.feature = feature;
 #endif
   return s.kept >= 0;
 }

@@ -74,8 +74,9 @@ DistanceScanSet make_distance_scan_set(PointsRef P, double max_radius_mm, int cl
   s.position.reserve(kept.size());
   // In boxes of cluster_size (as order_in_boxes): compact clusters, whose balls prune far more than runs of
   // a Z curve (lhdl-ct: mean radius 5 to 7 mm against 11 to 13, the largest 28 mm against 140).
-  for (const std::int32_t k : detail::box_order(kept.size(), {static_cast<std::int64_t>(cluster_size)},
-                                                [&](std::int32_t j, int axis) { return kept[static_cast<std::size_t>(j)][axis]; })) {
+  for (const std::int32_t k :
+       detail::box_order(kept.size(), {static_cast<std::int64_t>(cluster_size)},
+                         [&](std::int32_t j, int axis) { return kept[static_cast<std::size_t>(j)][axis]; })) {
     s.index.push_back(keep[static_cast<std::size_t>(k)]);
     s.position.push_back(kept[static_cast<std::size_t>(k)]);
   }
@@ -111,17 +112,17 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
                                  DistanceScanMemory* memory) {
   require(reach_mm > 0 && std::isfinite(reach_mm), "distance scan: the reach must be > 0 mm and finite");
-  require(gap_mm.empty() || static_cast<std::int64_t>(gap_mm.size()) == set.vertices,
-          "distance scan: " + std::to_string(gap_mm.size()) + " gaps for " + std::to_string(set.vertices) +
-              " vertices");
+  require(
+      gap_mm.empty() || static_cast<std::int64_t>(gap_mm.size()) == set.vertices,
+      "distance scan: " + std::to_string(gap_mm.size()) + " gaps for " + std::to_string(set.vertices) + " vertices");
   DistanceScanStats st;
   distance_mm.assign(static_cast<std::size_t>(set.vertices), std::numeric_limits<float>::quiet_NaN());
   const std::size_t k_all = set.index.size(), c_all = static_cast<std::size_t>(set.clusters());
-  if (memory != nullptr && (memory->query != other.id() || memory->seed.size() != k_all ||
-                            memory->empty_radius.size() != k_all || memory->empty_centre.size() != k_all ||
-                            memory->cluster_empty_radius.size() != c_all ||
-                            memory->cluster_empty_centre.size() != c_all || memory->nearby_slot.size() != k_all ||
-                            memory->cluster_last_centre.size() != c_all)) {
+  if (memory != nullptr &&
+      (memory->query != other.id() || memory->seed.size() != k_all || memory->empty_radius.size() != k_all ||
+       memory->empty_centre.size() != k_all || memory->cluster_empty_radius.size() != c_all ||
+       memory->cluster_empty_centre.size() != c_all || memory->nearby_slot.size() != k_all ||
+       memory->cluster_last_centre.size() != c_all)) {
     memory->query = other.id();
     memory->seed.assign(k_all, -1);
     memory->empty_centre.assign(k_all, Eigen::Vector3f::Zero());
@@ -185,8 +186,10 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       const double g = gap_mm.empty() ? std::numeric_limits<double>::quiet_NaN() : gap_mm[i];
       const int hint = g > kHintMm ? 1 : (g < -kHintMm ? -1 : 0);
       double radius = reach_mm;
-      if (std::isfinite(g)) radius = g < -reach_mm ? -g + kBoundMarginMm : std::min(reach_mm, std::abs(g) + kBoundMarginMm);
-      if (memory != nullptr && radius <= reach_mm && inside_empty(q, reach_mm, memory->empty_centre[k], memory->empty_radius[k])) {
+      if (std::isfinite(g))
+        radius = g < -reach_mm ? -g + kBoundMarginMm : std::min(reach_mm, std::abs(g) + kBoundMarginMm);
+      if (memory != nullptr && radius <= reach_mm &&
+          inside_empty(q, reach_mm, memory->empty_centre[k], memory->empty_radius[k])) {
         ++st.vertices_recalled;  // no point of the surface within the reach: NaN, as a search would find
         continue;
       }
@@ -217,7 +220,8 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
       if (!found) continue;
       seed = cp.triangle;
       if (memory != nullptr)
-        memory->seed[k] = cp.triangle <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(cp.triangle) : -1;
+        memory->seed[k] =
+            cp.triangle <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(cp.triangle) : -1;
       distance_mm[i] = static_cast<float>(cp.signed_mm());
       ++st.measured;
       st.winding += cp.rule == SignRule::winding_number;
@@ -344,7 +348,9 @@ LayeredNearStats scan_layered_near(const ScanSet& set, const ScanClusters& clust
       [&](const Eigen::Vector3d& centre, double radius) {
         return cluster_apart(centre, radius, map, cor, other, reach_mm);
       },
-      [&](std::int64_t first, std::int64_t count) { return scan_layered(set, first, count, R, t, map, gap_mm, exact); });
+      [&](std::int64_t first, std::int64_t count) {
+        return scan_layered(set, first, count, R, t, map, gap_mm, exact);
+      });
 }
 
 }  // namespace impinge

@@ -76,7 +76,9 @@ inline bool eight_without_value(const ScanGaps& g, std::size_t i, int& no_surfac
   for (std::size_t k = i; k < i + 8; ++k) none &= std::isnan(g.gap_mm[k]);
   if (!g.distance_mm.empty())
     for (std::size_t k = i; k < i + 8; ++k) none &= std::isnan(g.distance_mm[k]);
-  no_surface = __builtin_popcountll(status & kLow);
+  // The bytes' sum (each 0 or 1, at most 8) gathered in the top byte: a popcount without the POPCNT
+  // instruction, which the baseline build may not use (libgcc's __popcountdi2 was 0.4 % of a pose).
+  no_surface = static_cast<int>(((status & kLow) * kLow) >> 56);
   return none;
 }
 
