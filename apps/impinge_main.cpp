@@ -140,7 +140,7 @@ int run_distance(const RunOptions& o) {
   const std::string& out = o.command.out;
   const PoseAngles pose = parse_pose(o.command.pose);
   SessionOptions so = o.session;
-  so.maps.setup = setup_for_poses(so.maps.setup, 1);  // auto: one pose, direct (the layered maps would not pay back)
+  so.setup = setup_for_poses(so.setup, 1);  // auto: one pose, direct (the layered maps would not pay back)
   so.only_poses = {pose};  // direct: the distance hierarchies cropped to it
   const Session s = open_session(so);
   const double setup_ms = ms_since(t_start);
@@ -195,7 +195,7 @@ int run_motion(const RunOptions& o) {
   // The motion file is read (and fully checked) before anything is built or written.
   const Motion motion = load_motion(mo.motion, input_side(o.session.input));
   SessionOptions so = o.session;
-  so.maps.setup = setup_for_poses(so.maps.setup, motion.frames());  // auto: by the number of frames
+  so.setup = setup_for_poses(so.setup, motion.frames());  // auto: by the number of frames
   const Session s = open_session(so);
   const double setup_ms = ms_since(t_start);
 

@@ -221,11 +221,11 @@ void write_renders(const std::vector<Subject>& subjects, const std::string& dir,
       {"neutral", {0, 0, 0}}, {"flexion90", {90, 0, 0}}, {"adduction30", {0, 30, 0}}, {"internal30", {0, 0, 30}}};
   bool wrote_poses = false;
   for (const Subject& s : subjects) {
-    MapSettings maps;
-    maps.precision = render_precision;
-    maps.mode = "exact";
-    maps.levels = kReportLevelsMm;
-    const Session session(session_options(s, maps));
+    SessionOptions so;
+    so.grid.precision = render_precision;
+    so.hip.joint.mode = DistanceMode::exact;
+    so.hip.joint.levels.thresholds_mm = kReportLevelsMm;
+    const Session session(session_options(s, so));
     const HipJoint& hip = session.hip();
     const ImpingementLevels& levels = session.joint_options().levels;
     const PoseResult res = hip.joint().detect(Eigen::Matrix3d::Identity());
@@ -279,12 +279,12 @@ void radial_vs_distance(const std::vector<Subject>& subjects, const std::string&
   const std::vector<std::pair<std::string, PoseAngles>> poses{
       {"scan", {0, 0, 0}}, {"flexion90", {90, 0, 0}}, {"extension20", {-20, 5, -5}}};
   for (const Subject& s : subjects) {
-    MapSettings maps = RunOptions::clinical().session.maps;  // the CLI's: layered maps and distances
-    maps.precision = precision;
-    maps.levels = kReportLevelsMm;
-    maps.distance_reach_mm = reach;
-    SessionOptions so = session_options(s, maps);
-    so.frames.joint_centre.clear();  // the CLI's default for the neutral
+    SessionOptions base = RunOptions::clinical().session;  // the CLI's: layered maps and distances
+    base.grid.precision = precision;
+    base.hip.joint.levels.thresholds_mm = kReportLevelsMm;
+    base.hip.joint.distance_reach_mm = reach;
+    SessionOptions so = session_options(s, base);
+    so.hip.joint_centre.reset();  // the CLI's default for the neutral
     const Session session(so);
     const HipJoint& hip = session.hip();
     const ImpingementLevels& levels = session.joint_options().levels;

@@ -232,10 +232,10 @@ struct SubjectRun {
       : subject(s), options(options_of(s, st)), session(options), run(run_rom(session, request(st))),
         ex_pelvis(session.joint().socket().mesh), ex_femur(session.joint().ball().mesh) {}
   static SessionOptions options_of(const Subject& s, const Settings& st) {
-    MapSettings maps;
-    maps.precision = st.resolution;
-    maps.levels = st.observation_levels.thresholds_mm;
-    return session_options(s, maps);
+    SessionOptions o;
+    o.grid.precision = st.resolution;
+    o.hip.joint.levels = st.observation_levels;
+    return session_options(s, o);
   }
   static RomRequest request(const Settings& st) {
     RomRequest q;
@@ -322,7 +322,7 @@ void record_limits(const SubjectRun& r, const Settings& st, Outputs& out) {
 // first extra-articular contact), each checked exactly 0.5 deg either side.
 void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
   SessionOptions lo = r.options;
-  lo.maps.layers = 4;
+  lo.hip.joint.layers = 4;
   const Session lsession(lo);
   const HipJoint& lhip = lsession.hip();
   const Joint& lj = lhip.joint();
@@ -371,7 +371,7 @@ void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
   }
   for (const JointBody* b : {&lj.ball(), &lj.socket()}) {
     const Timing ls = summarize(layered_ms[b == &lj.ball() ? 0 : 1]);
-    out.layered.row(r.subject.name, b == &lj.ball() ? "femur" : "pelvis", lo.maps.layers, b->layered->num_nodes(),
+    out.layered.row(r.subject.name, b == &lj.ball() ? "femur" : "pelvis", lo.hip.joint.layers, b->layered->num_nodes(),
                     b->layered->bytes(), b->map.bytes(), ls.median_ms, ls.q25_ms, ls.q75_ms, b->sampling_ms,
                     b->layered_sampling.nodes_covered, b->layered_sampling.nodes_truncated,
                     b->layered_sampling.nodes_not_alternating, b->layered_sampling.max_crossings, b->hidden_set.size(),
@@ -479,8 +479,8 @@ void methods(const SubjectRun& r, Outputs& out) {
   const char* axis_name[3] = {"x", "y", "z"};
   for (const char* method : {"femoral-head", "acetabular", "combined", "equidistant"}) {
     SessionOptions o = rom_session_options(r.options, q.search);
-    o.frames.joint_centre = method;
-    o.maps.layers = 4;
+    o.hip.joint_centre = parse_joint_centre(method, "joint centre");
+    o.hip.joint.layers = 4;
     const Session s(o);
     const RomRun run = run_rom(s, q);
     if (std::string(method) == "equidistant") {
@@ -519,7 +519,7 @@ void sensitivity(const SubjectRun& r, const Settings& st, Outputs& out) {
   const std::vector<StandardMotion>& motions = r.run.motions;
   auto limits_of = [&](const Eigen::Vector3d& centre, double res) {
     SessionOptions o = r.options;
-    o.maps.precision = res;
+    o.grid.precision = res;
     o.cor.given = centre;  // a perturbed centre: research, not checked against the head
     o.cor.allow_any = true;
     const Session hs(o);
@@ -561,9 +561,9 @@ void cam_check(const Settings& st) {
   for (const HipModel* model : {&without, &with_cam}) {
     const HipModel& h = *model;
     const double height = model == &without ? 0.0 : o.cam_height_mm;
-    MapSettings maps;
-    maps.precision = st.resolution;
-    const Session session(session_options(generated_subject(h, "generated-12k", "make_hip_model (cam check)"), maps));
+    SessionOptions so;
+    so.grid.precision = st.resolution;
+    const Session session(session_options(generated_subject(h, "generated-12k", "make_hip_model (cam check)"), so));
     RomRequest q;
     q.search = st.ro;
     q.map = false;

@@ -52,7 +52,11 @@ using namespace impinge::experiment;
 
 namespace {
 constexpr double kRegionMm = 45;
-constexpr double kDiscontinuityToleranceMm = 0.05;  // JointOptions' default
+// The library's default tolerance (JointOptions, its one place).
+double discontinuity_tolerance_mm() {
+  static const double t = JointOptions{}.discontinuity_tolerance_mm;
+  return t;
+}
 
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return std::nan("");
@@ -278,8 +282,8 @@ void measure_maps(const SubjectData& d, const Maps& m, Row row, DistanceMode mod
   RadialDistanceMap fmr = m.fm, pmr = m.pm;
   const double tm = median_ms(
       [&] {
-        mark_depth_discontinuities(fmr, kDiscontinuityToleranceMm);
-        mark_depth_discontinuities(pmr, kDiscontinuityToleranceMm);
+        mark_depth_discontinuities(fmr, discontinuity_tolerance_mm());
+        mark_depth_discontinuities(pmr, discontinuity_tolerance_mm());
       },
       row.precision < 0.1 ? std::min(reps, 3) : reps);
   Row refined = row;

@@ -29,7 +29,11 @@ using namespace impinge;
 using namespace impinge::experiment;
 
 namespace {
-constexpr double kOcclusionMm = 1.0;  // JointOptions' default
+// The library's default occlusion tolerance (JointOptions, its one place).
+double occlusion_mm() {
+  static const double t = JointOptions{}.occlusion_tolerance_mm;
+  return t;
+}
 
 // The mesh without triangles edge-on to o: CGAL's ray-triangle intersection gives meaningless
 // distances for a ray inside their plane, and every ray meets their points on their neighbours.
@@ -75,7 +79,7 @@ std::array<std::vector<std::uint8_t>, 2> exact_masks(const Joint& j, const Exact
     for (Eigen::Index i = 0; i < body.relative.rows(); ++i) {
       const Eigen::Vector3d q = body.relative.row(i).transpose();
       const double r = q.norm();
-      if (r > 0) mask[b][std::size_t(i)] = oracle_hit(own, j.cor(), q) >= r - kOcclusionMm;
+      if (r > 0) mask[b][std::size_t(i)] = oracle_hit(own, j.cor(), q) >= r - occlusion_mm();
     }
   }
   return mask;
@@ -88,11 +92,11 @@ void discontinuities(const Subject& s, const std::string& name, double res, doub
   std::optional<Session> sessions[2];  // 0: maps alone, 1: exact look-ups at discontinuities
   const HipJoint* hips[2];
   for (int m = 0; m < 2; ++m) {
-    MapSettings maps;
-    maps.scheme = name;
-    maps.resolution = res;
-    maps.maps_only = m == 0;
-    sessions[m].emplace(session_options(s, maps));
+    SessionOptions so;
+    so.grid.scheme = name;
+    so.grid.resolution = res;
+    so.hip.joint.exact_at_discontinuities = m != 0;
+    sessions[m].emplace(session_options(s, so));
     hips[m] = &sessions[m]->hip();
   }
   const Joint& j0 = hips[0]->joint();
@@ -190,9 +194,9 @@ void discontinuities(const Subject& s, const std::string& name, double res, doub
 void output_summaries(const Subject& s, double p, const std::vector<std::pair<std::string, PoseAngles>>& poses,
                       CsvWriter& out) {
   const double eps = 0.05;
-  MapSettings maps;
-  maps.precision = p;
-  const Session session(session_options(s, maps));
+  SessionOptions so;
+  so.grid.precision = p;
+  const Session session(session_options(s, so));
   const HipJoint& hip = session.hip();
   const Joint& jm = hip.joint();
   const ExactReference ef(without_edge_on(jm.ball().mesh, jm.cor())), ep(without_edge_on(jm.socket().mesh, jm.cor()));
@@ -297,7 +301,7 @@ int main(int argc, char** argv) {
               {"precision_deg", p},
               {"flexions_deg", flexions},
               {"discontinuity_tolerance_mm", JointOptions{}.discontinuity_tolerance_mm},
-              {"occlusion_tolerance_mm", kOcclusionMm},
+              {"occlusion_tolerance_mm", occlusion_mm()},
               {"timing", "both joints alternately, median over " + std::to_string(reps) + " runs of all poses"},
               {"oracle",
                "CGAL AABB_tree::first_intersection (Simple_cartesian<double>), triangles edge-on to the COR left "

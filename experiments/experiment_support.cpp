@@ -95,16 +95,15 @@ SphereFitResult subject_head(const Subject& s) {
 
 Eigen::Vector3d subject_cor(const Subject& s) { return s.generated ? s.true_cor : subject_head(s).centre; }
 
-SessionOptions session_options(const Subject& s, const MapSettings& maps) {
-  SessionOptions o;
+SessionOptions session_options(const Subject& s, SessionOptions o) {
   o.input.ball_mesh = s.femur;
   o.input.socket_mesh = s.pelvis;
   o.input.side = s.side == Side::right ? "right" : "left";
   o.input.frame = "RAS";
   o.input.landmarks = s.landmarks;
-  o.maps = maps;
-  o.frames.neutral = s.generated ? "scan" : "anatomical";
-  o.frames.joint_centre = "femoral-head";  // the thesis' method (issue 29: the thesis experiments keep it)
+  o.hip.neutral = s.generated ? Neutral::scan : Neutral::anatomical;
+  // The thesis' method (issue 29: the thesis experiments keep it).
+  o.hip.joint_centre = JointCentreMethod::femoral_head;
   if (s.generated) {
     o.cor.given = s.true_cor;
     o.cor.allow_any = true;  // the true centre: no fitted head to check it against (a partial femur)

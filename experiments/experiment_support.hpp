@@ -64,8 +64,9 @@ SphereFitResult subject_head(const Subject& s);
 
 /// Session options for a subject (the same set-up as the CLI's and Python's): its meshes in memory
 /// (anatomical frame, RAS), its side; anatomical neutral for real subjects, scan neutral and the
-/// true COR for generated ones; the thesis' femoral-head joint centre; `maps` as given.
-SessionOptions session_options(const Subject& s, const MapSettings& maps = {});
+/// true COR for generated ones; the thesis' femoral-head joint centre; the rest of `o` (grid, maps,
+/// detection) as given.
+SessionOptions session_options(const Subject& s, SessionOptions o = {});
 
 /// Unit direction in which the femur is pushed into the acetabulum: from the COR towards the
 /// centroid of the pelvis vertices within `radius_mm` of it (the acetabular fossa side).

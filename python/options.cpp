@@ -153,6 +153,7 @@ void bind_options(py::module_& m) {
           d["choices"] = r.choices;
           d["min"] = r.min;
           d["max"] = r.max;
+          d["min_exclusive"] = r.min_open;
           d["required"] = r.required;
           d["default"] = to_python(r, r.get(clinical));
           d["thesis_default"] = to_python(r, r.get(thesis));
@@ -168,7 +169,8 @@ void bind_options(py::module_& m) {
       "The option table (the session layer's, session/option_table.hpp) -> a list of dicts, one per option: name "
       "(the CLI's, without dashes), key (Python's keyword and the study files' key), type (text, path, choice, "
       "number, integer, flag, on_off, numbers, point, region, mesh, landmarks, path_pair), unit, choices, min and "
-      "max (numbers), required (by the CLI), default (the clinical preset's; None: decided from other options, as "
+      "max (numbers; the field's declared range), min_exclusive (min itself is not valid), required (by the CLI), "
+      "default (the clinical preset's; None: decided from other options, as "
       "help says), thesis_default (the thesis preset's), help, uses (distance, motion, rom, generate: CLI "
       "commands; joint: Joint(...); rom_limits, rom_map: those methods and the study kinds rom and envelope; "
       "study: a study file's [joint] and [[task]]; generated_hip: that function).");

@@ -105,10 +105,10 @@ const Session& generated_session(const std::string& frame) {
     transform_vertices(o.input.socket_mesh->V, M);
     o.input.frame = f == FrameConvention::LPS ? "LPS" : "RAS";
     o.cor.given = M * h.cor;
-    o.frames.neutral = "scan";
-    o.maps.precision = 1;
-    o.maps.distances = true;
-    o.maps.distance_reach_mm = 6;
+    o.hip.neutral = Neutral::scan;
+    o.grid.precision = 1;
+    o.hip.joint.distances = true;
+    o.hip.joint.distance_reach_mm = 6;
     return Session(o);
   };
   if (frame == "LPS") {

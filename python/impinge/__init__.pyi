@@ -51,8 +51,8 @@ def locate_femoral_head(V: npt.ArrayLike, F: npt.ArrayLike,
 
 def options() -> List[Dict[str, Any]]:
     """The option table (the session layer's): one dict per option with name (the CLI's), key (Python's and the
-    study files'), type, unit, choices, min, max, required, default (the clinical preset's), thesis_default,
-    help and uses (CLI commands, joint, rom_limits, rom_map, study)."""
+    study files'), type, unit, choices, min, max (the field's declared range), min_exclusive, required, default
+    (the clinical preset's), thesis_default, help and uses (CLI commands, joint, rom_limits, rom_map, study)."""
 
 def femoral_head_centre(ball: Optional[Union[str, os.PathLike, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
                         socket: Optional[Union[str, os.PathLike, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,

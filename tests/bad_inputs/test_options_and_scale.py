@@ -29,7 +29,7 @@ def test_a_bad_option_is_one_line_naming_it(generated, tmp_path, args, fragments
 def test_generate_refuses_nan_and_a_mesh_beyond_memory(tmp_path):
     one_line_error(run(["generate", "--cam", "nan", "--out", tmp_path / "g"]), "--cam: 'nan' is not a finite number")
     one_line_error(run(["generate", "--triangles", "2000000000", "--out", tmp_path / "g"]),
-                   "--triangles: 2000000000 is outside the valid range [20, 20000000]")
+                   "--triangles: 2000000000 is outside the valid range [50, 20000000]")
 
 
 def test_contacts_articular_needs_anatomical_neutral(generated, tmp_path):

@@ -45,7 +45,7 @@ TEST(Subject, BadFilesNameFileAndKey) {
          "'asis_left' must be three finite numbers");
   expect(R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p", "landmarks": [1]})", "'landmarks'");
   expect(R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p", "neutral": "supine"})",
-         "neutral 'supine'");
+         "key 'neutral': 'supine' is not one of anatomical, scan");
   EXPECT_THROW(load_subject(d + "/absent.json"), Error);
 }
 

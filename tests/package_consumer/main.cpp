@@ -18,8 +18,8 @@ int main() {
   so.input.ball_mesh = h.ball;
   so.input.socket_mesh = h.socket;
   so.cor.given = h.cor;
-  so.frames.neutral = "scan";
-  so.maps.precision = 1.0;
+  so.hip.neutral = impinge::Neutral::scan;
+  so.grid.precision = 1.0;
   const impinge::Session session(so);
   const impinge::PoseResult r = session.hip().detect(impinge::PoseAngles{});
   const nlohmann::json setup = impinge::setup_record(session);

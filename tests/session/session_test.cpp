@@ -68,8 +68,8 @@ SessionOptions generated_options(const std::string& frame, bool cam = true) {
   transform_vertices(o.input.socket_mesh->V, M);
   o.input.frame = frame;
   o.cor.given = M * h.cor;
-  o.frames.neutral = "scan";
-  o.maps.precision = 1;
+  o.hip.neutral = Neutral::scan;
+  o.grid.precision = 1;
   return o;
 }
 
@@ -124,8 +124,8 @@ TEST(Session, CorPolicyChecksAndOrder) {
   if (real.empty()) GTEST_SKIP() << "shared data absent";
   SessionOptions o;
   o.input.subject = real;
-  o.frames.neutral = "scan";
-  o.maps.precision = 2;
+  o.hip.neutral = Neutral::scan;
+  o.grid.precision = 2;
   const LoadedInput in = load_input(o.input);
   const CorResult automatic = find_centre_of_rotation(in, {});
   EXPECT_GT(automatic.head.radius, 15);
@@ -159,16 +159,24 @@ TEST(Session, BadOptionsAreRefusedBeforeAnyFileIsRead) {
     EXPECT_NE(e.find(expected), std::string::npos) << e;
     EXPECT_EQ(e.find("nonexistent"), std::string::npos) << e;
   };
-  refused([](SessionOptions& o) { o.maps.precision = 1, o.maps.spacing = 1; }, "give one of resolution");
-  refused([](SessionOptions& o) { o.maps.layers = 99; }, "layers 99");
-  refused([](SessionOptions& o) { o.maps.sparse_mm = -1; }, "sparse -1");
-  refused([](SessionOptions& o) { o.maps.mode = "cubic"; }, "cubic");
-  refused([](SessionOptions& o) { o.maps.scheme = "hexagon"; }, "hexagon");
-  refused([](SessionOptions& o) { o.maps.ball_map_file = "a.map"; }, "both map files");
-  refused([](SessionOptions& o) { o.maps.levels = {1, 2}; }, "not below");
-  refused([](SessionOptions& o) { o.frames.neutral = "sideways"; }, "sideways");
-  refused([](SessionOptions& o) { o.frames.pelvis_frame = "xyz"; }, "xyz");
-  refused([](SessionOptions& o) { o.maps.discontinuity_tolerance_mm = 0; }, "discontinuity-tolerance");
+  // The typed fields are checked against their declared ranges (JointOptions::k...Range), the same the option
+  // table's rows use; text choices are checked by the rows (option_table_test).
+  refused([](SessionOptions& o) { o.grid.precision = 1, o.grid.spacing = 1; }, "give one of resolution");
+  refused([](SessionOptions& o) { o.grid.precision = 200; }, "precision 200 deg is outside the valid range [0, 90]");
+  refused([](SessionOptions& o) { o.hip.joint.layers = 99; },
+          "JointOptions::layers 99 is outside the valid range [0, 16]");
+  refused([](SessionOptions& o) { o.hip.joint.sparse_maps = true, o.hip.joint.sparse_region_mm = -1; },
+          "sparse_region_mm -1 mm is outside the valid range (0, inf] mm");
+  refused([](SessionOptions& o) { o.grid.scheme = "hexagon"; }, "hexagon");
+  refused([](SessionOptions& o) { o.hip.ball_map_file = "a.map"; }, "both map files");
+  refused([](SessionOptions& o) { o.hip.joint.levels.thresholds_mm = {1, 2}; }, "not below");
+  refused([](SessionOptions& o) { o.hip.joint.discontinuity_tolerance_mm = 0; },
+          "discontinuity_tolerance_mm 0 mm is outside the valid range (0, 1000] mm");
+  refused([](SessionOptions& o) { o.hip.joint.layered_spacing_deg = 120; }, "layered_spacing_deg 120 deg");
+  refused([](SessionOptions& o) { o.hip.joint.extra_articular_radius_mm = 0; }, "extra_articular_radius_mm 0 mm");
+  refused([](SessionOptions& o) { o.max_memory_gb = -1; }, "max-memory -1 GB");
+  refused([](SessionOptions& o) { o.hip.joint.levels_on = LevelQuantity::distance; }, "needs distances on");
+  refused([](SessionOptions& o) { o.hip.joint.scheme = make_scheme("helix", 100), o.grid.precision = 1; }, "not both");
   EXPECT_NE(error_of([] { parse_cor("1,2", "--cor"); }).find("--cor"), std::string::npos);
   EXPECT_NE(error_of([] { parse_head_region("1,2,3,-4", "--head-region"); }).find("radius"), std::string::npos);
   EXPECT_FALSE(parse_cor("auto", "--cor").has_value());
@@ -211,10 +219,10 @@ testing::AssertionResult same_scan(const ScanGaps& a, const ScanGaps& b) {
 // pose it was set up for, bit for bit; distances on, so that the crop is exercised too.
 TEST(Session, OnePoseSessionDetectsAsAWholeSession) {
   SessionOptions whole_options = generated_options("LPS");
-  whole_options.maps.setup = "maps";
-  whole_options.maps.distances = true;
+  whole_options.setup = "maps";
+  whole_options.hip.joint.distances = true;
   SessionOptions one_options = whole_options;
-  one_options.maps.setup = "direct";
+  one_options.setup = "direct";
   one_options.only_poses = {{0, 0, 0}, {40, 10, -5}};
   const Session whole(whole_options), one(one_options);
   ASSERT_TRUE(one.joint_options().distances);
@@ -370,9 +378,9 @@ TEST_P(GivenCor, IsTheCentreOfTheRadialGapsAtTheScanPose) {
   // A head centre 0.6 mm off the fitted one, given in the input frame.
   const Eigen::Vector3d given_working = fitted + Eigen::Vector3d(0.4, -0.3, 0.33);
   o.cor.given = in.to_working.transpose() * given_working;
-  o.maps.precision = 0.1;
-  o.maps.layers = 4;
-  o.maps.distances = true;
+  o.grid.precision = 0.1;
+  o.hip.joint.layers = 4;
+  o.hip.joint.distances = true;
   const Session s(o);
   ASSERT_EQ(s.hip().joint_centre().method(), JointCentreMethod::equidistant);
   EXPECT_LT((s.head_centre_input() - *o.cor.given).norm(), 1e-9);

@@ -254,9 +254,7 @@ AnatomicalFrame femur_frame(const FemurLandmarks& L, Side side, FemurFrameKind k
 }
 
 FemurFrameKind parse_femur_frame_kind(const std::string& text, const std::string& context) {
-  if (text == "epicondyles") return FemurFrameKind::epicondyles;
-  if (text == "posterior-condyles") return FemurFrameKind::posterior_condyles;
-  throw Error(context + ": femoral frame '" + text + "' is neither 'epicondyles' nor 'posterior-condyles'");
+  return parse_enum(kFemurFrameKindNames, text, context);
 }
 
 }  // namespace impinge

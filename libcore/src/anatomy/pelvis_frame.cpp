@@ -141,9 +141,7 @@ AnatomicalFrame pelvis_frame(const PelvisLandmarks& L, const Eigen::Vector3d& hi
 }
 
 PelvisFrameKind parse_pelvis_frame_kind(const std::string& text, const std::string& context) {
-  if (text == "isb") return PelvisFrameKind::isb;
-  if (text == "app") return PelvisFrameKind::anterior_pelvic_plane;
-  throw Error(context + ": pelvic frame '" + text + "' is neither 'isb' nor 'app'");
+  return parse_enum(kPelvisFrameKindNames, text, context);
 }
 
 }  // namespace impinge

@@ -64,9 +64,7 @@ PoseAngles parse_pose(const std::string& text) {
 }
 
 Neutral parse_neutral(const std::string& text, const std::string& context) {
-  if (text == "anatomical") return Neutral::anatomical;
-  if (text == "scan") return Neutral::scan;
-  throw Error(context + ": neutral '" + text + "' is neither 'anatomical' nor 'scan'");
+  return parse_enum(kNeutralNames, text, context);
 }
 
 }  // namespace impinge

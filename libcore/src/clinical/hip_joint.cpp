@@ -27,7 +27,7 @@ double median_radius(const Vertices& V, const Eigen::Vector3d& c) {
 
 HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const SphereFitResult& head,
                    const Landmarks& given, const HipJointOptions& options)
-    : side_(side), neutral_(options.neutral), cor_(head.centre) {
+    : side_(side), neutral_(options.neutral.value_or(Neutral::anatomical)), cor_(head.centre) {
   require(cor_.allFinite(), "hip joint: centre of rotation is not finite");
   const JointCentreMethod method = options.joint_centre.value_or(
       neutral_ == Neutral::anatomical ? JointCentreMethod::equidistant : JointCentreMethod::femoral_head);
@@ -186,9 +186,9 @@ void HipJoint::save_maps(const std::string& ball_path, const std::string& socket
 void HipJoint::clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& socket) const {
   if (!socket_clock_) return;
   const JointOptions& o = joint_->options();
-  clock_summary(res.ball_gaps, ball_hours_, joint_->ball().vertex_area, o.levels, ball, o.levels_on);
+  clock_summary(res.ball_gaps, ball_hours_, joint_->ball().vertex_area, o.levels, ball, o.level_quantity());
   clock_summary(res.socket_gaps, socket_hours_, joint_->socket().vertex_area, o.levels,
-                socket, o.levels_on);
+                socket, o.level_quantity());
 }
 
 Eigen::Matrix3d HipJoint::femur_rotation(const PoseAngles& angles) const {

@@ -16,22 +16,12 @@ namespace impinge {
 JointCentreMethod parse_joint_centre(const std::string& text, const std::string& context) {
   std::string t = text;
   std::replace(t.begin(), t.end(), '_', '-');
-  if (t == "femoral-head") return JointCentreMethod::femoral_head;
-  if (t == "acetabular") return JointCentreMethod::acetabular;
-  if (t == "combined") return JointCentreMethod::combined;
-  if (t == "equidistant") return JointCentreMethod::equidistant;
-  throw Error(context + " '" + text + "': expected femoral-head, acetabular, combined or equidistant");
+  for (const EnumName<JointCentreMethod>& n : kJointCentreMethodNames)
+    if (t == n.name) return n.value;
+  return parse_enum(kJointCentreMethodNames, text, context);  // the error, naming the text as given
 }
 
-const char* to_string(JointCentreMethod m) {
-  switch (m) {
-    case JointCentreMethod::acetabular: return "acetabular";
-    case JointCentreMethod::combined: return "combined";
-    case JointCentreMethod::equidistant: return "equidistant";
-    case JointCentreMethod::femoral_head: break;
-  }
-  return "femoral-head";
-}
+const char* to_string(JointCentreMethod m) { return enum_name(kJointCentreMethodNames, m); }
 
 ScanSet lunate_sample(const RadialDistanceMap& socket_map, const LunateSphere& L, int max_vertices, bool mirror_x) {
   const Eigen::Vector3d flip(mirror_x ? -1.0 : 1.0, 1.0, 1.0);  // lattice frame <-> joint frame (its own inverse)

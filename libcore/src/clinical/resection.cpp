@@ -152,22 +152,11 @@ enum class Blocked : std::uint8_t { no = 0, head = 1, lunate = 2, depth = 3, bon
 }  // namespace
 
 const char* to_string(ResectBones bones) {
-  switch (bones) {
-    case ResectBones::femur:
-      return "femur";
-    case ResectBones::pelvis:
-      return "pelvis";
-    case ResectBones::both:
-      return "both";
-  }
-  return "femur";
+  return enum_name(kResectBonesNames, bones);
 }
 
 ResectBones parse_resect_bones(const std::string& text, const std::string& context) {
-  if (text == "femur") return ResectBones::femur;
-  if (text == "pelvis") return ResectBones::pelvis;
-  if (text == "both") return ResectBones::both;
-  throw Error(context + ": '" + text + "' is not a bone to resect; valid: femur, pelvis, both");
+  return parse_enum(kResectBonesNames, text, context);
 }
 
 double enclosed_volume(const Vertices& V, const Faces& F) {
@@ -245,11 +234,9 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
                              const RomBaseline& baseline, const ResectionOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const ResectionOptions& o = options;
-  require(std::isfinite(o.clearance_mm) && o.clearance_mm >= 0,
-          "resection: clearance " + std::to_string(o.clearance_mm) + " mm; valid: a finite number >= 0");
+  check_in_range("ResectionOptions::clearance_mm", o.clearance_mm, ResectionOptions::kClearanceRange, "mm");
   require(o.max_depth_mm > 0, "resection: safety depth " + std::to_string(o.max_depth_mm) + " mm; valid: > 0");
-  require(std::isfinite(o.burr_radius_mm) && o.burr_radius_mm >= 0,
-          "resection: burr radius " + std::to_string(o.burr_radius_mm) + " mm; valid: a finite number >= 0");
+  check_in_range("ResectionOptions::burr_radius_mm", o.burr_radius_mm, ResectionOptions::kBurrRadiusRange, "mm");
   require(o.tolerance_mm > 0 && o.max_iterations >= 1, "resection: tolerance must be > 0 and iterations >= 1");
   const Joint& joint = hip.joint();
   require(joint.options().distances,

@@ -14,22 +14,17 @@ namespace impinge {
 using namespace rom_detail;
 
 RomContacts parse_rom_contacts(const std::string& text, const std::string& context) {
-  if (text == "impingement") return RomContacts::impingement;
-  if (text == "articular") return RomContacts::articular;
-  if (text == "all") return RomContacts::all;
-  throw Error(context + " '" + text + "': expected impingement, articular or all");
+  return parse_enum(kRomContactsNames, text, context);
 }
 
 const char* to_string(RomContacts contacts) {
-  return contacts == RomContacts::impingement ? "impingement" : contacts == RomContacts::articular ? "articular" : "all";
+  return enum_name(kRomContactsNames, contacts);
 }
 
-const char* to_string(RomMetric metric) { return metric == RomMetric::distance ? "distance" : "radial"; }
+const char* to_string(RomMetric metric) { return enum_name(kRomMetricNames, metric); }
 
 RomMetric parse_rom_metric(const std::string& text, const std::string& context) {
-  if (text == "radial") return RomMetric::radial;
-  if (text == "distance") return RomMetric::distance;
-  throw Error(context + " '" + text + "': expected radial or distance");
+  return parse_enum(kRomMetricNames, text, context);
 }
 
 const char* to_string(ImpingementSite site) {

@@ -40,10 +40,12 @@ inline double scan_cut_of(const RomOptions& o) {
 }
 
 inline void check(const RomOptions& o) {
-  require(std::isfinite(o.threshold_mm), "rom: threshold must be finite");
-  require(std::isfinite(o.contact_depth_mm) && o.contact_depth_mm >= 0, "rom: contact depth must be >= 0 mm");
-  require(o.step_deg > 0 && o.max_deg > 0 && o.tolerance_deg > 0 && o.tolerance_deg <= o.step_deg,
-          "rom: need step > 0, max > 0 and 0 < tolerance <= step (degrees)");
+  // The declared ranges (RomOptions::k...Range), the option table's too.
+  check_in_range("RomOptions::threshold_mm", o.threshold_mm, RomOptions::kThresholdRange, "mm");
+  check_in_range("RomOptions::contact_depth_mm", o.contact_depth_mm, RomOptions::kContactDepthRange, "mm");
+  check_in_range("RomOptions::step_deg", o.step_deg, RomOptions::kStepRange, "deg");
+  check_in_range("RomOptions::max_deg", o.max_deg, RomOptions::kMaxRange, "deg");
+  require(o.tolerance_deg > 0 && o.tolerance_deg <= o.step_deg, "rom: need 0 < tolerance <= step (degrees)");
   require(o.metric == RomMetric::radial || o.vertices == RomVertices::all,
           "rom: the distance metric counts every vertex (RomVertices::all)");
 }

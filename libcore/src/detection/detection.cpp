@@ -255,12 +255,10 @@ ScanSummary summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const
   return s;
 }
 
-const char* to_string(LevelQuantity q) { return q == LevelQuantity::distance ? "distance" : "radial"; }
+const char* to_string(LevelQuantity q) { return enum_name(kLevelQuantityNames, q); }
 
 LevelQuantity parse_level_quantity(const std::string& text, const std::string& context) {
-  if (text == "radial") return LevelQuantity::radial_gap;
-  if (text == "distance") return LevelQuantity::distance;
-  throw Error(context + " '" + text + "': expected 'distance' or 'radial'");
+  return parse_enum(kLevelQuantityNames, text, context);
 }
 
 std::uint8_t vertex_level(const ScanGaps& g, std::size_t i, const ImpingementLevels& levels, LevelQuantity q) {

@@ -17,34 +17,37 @@ namespace impinge {
 
 namespace {
 const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
-  require(o.scheme != nullptr, "joint: no sampling scheme given");
+  o.validate();
   require(cor.allFinite(), "joint: centre of rotation is not finite");
-  require(o.occlusion_tolerance_mm >= 0, "joint: occlusion tolerance must be >= 0 mm");
-  require(o.max_radius_mm > 0, "joint: region radius must be > 0 mm");
-  require(o.sparse_region_mm > 0, "joint: sparse region must be > 0 mm");
-  require(
-      !o.exact_at_discontinuities || (std::isfinite(o.discontinuity_tolerance_mm) && o.discontinuity_tolerance_mm > 0),
-      "joint: the depth-discontinuity tolerance must be > 0 mm and finite");
-  require(o.layers >= 0 && o.layers <= LayeredMap::kMaxLayers, "joint: layers must be 0 (off) to " +
-                                                                   std::to_string(LayeredMap::kMaxLayers) + ", not " +
-                                                                   std::to_string(o.layers));
-  require(o.layers == 0 || FirstHitCaster::available(),
-          "joint: layered maps need a ray caster (Embree or CGAL), and this build has neither");
-  require(o.extra_articular_radius_mm > 0, "joint: the extra-articular radius must be > 0 mm");
-  require(std::isfinite(o.layered_spacing_deg) && o.layered_spacing_deg >= 0 && o.layered_spacing_deg <= 90,
-          "joint: the layered maps' node spacing must be 0 (the maps' own) to 90 deg");
-  o.levels.validate();
-  require(!o.distances || SignedDistanceQuery::available(),
-          "joint: distances need a closest-point engine (Embree or CGAL), and this build has neither");
-  require(std::isfinite(o.distance_reach_mm) && o.distance_reach_mm >= 0,
-          "joint: the distances' reach must be 0 (the largest level threshold) or > 0 mm");
-  require(o.levels_on == LevelQuantity::radial_gap || o.distances, "joint: levels on the distance need distances on");
-  require(o.levels_on == LevelQuantity::radial_gap || o.reach_mm() >= o.levels.thresholds_mm.front(),
-          "joint: levels on the distance need a distance reach of at least the largest level threshold (" +
-              std::to_string(o.levels.thresholds_mm.front()) + " mm)");
   return o;
 }
 }  // namespace
+
+void JointOptions::validate() const {
+  require(scheme != nullptr, "JointOptions::scheme: no sampling scheme given");
+  check_in_range("JointOptions::occlusion_tolerance_mm", occlusion_tolerance_mm, kOcclusionToleranceRange, "mm");
+  if (!std::isinf(max_radius_mm)) check_in_range("JointOptions::max_radius_mm", max_radius_mm, kMaxRadiusRange, "mm");
+  if (sparse_maps) check_in_range("JointOptions::sparse_region_mm", sparse_region_mm, kSparseRegionRange, "mm");
+  if (exact_at_discontinuities)
+    check_in_range("JointOptions::discontinuity_tolerance_mm", discontinuity_tolerance_mm, kDiscontinuityToleranceRange,
+                   "mm");
+  check_in_range("JointOptions::layers", layers, kLayersRange);
+  require(layers == 0 || FirstHitCaster::available(),
+          "joint: layered maps need a ray caster (Embree or CGAL), and this build has neither");
+  check_in_range("JointOptions::extra_articular_radius_mm", extra_articular_radius_mm, kExtraArticularRadiusRange,
+                 "mm");
+  check_in_range("JointOptions::layered_spacing_deg", layered_spacing_deg, kLayeredSpacingRange, "deg");
+  levels.validate();
+  require(!distances || SignedDistanceQuery::available(),
+          "joint: distances need a closest-point engine (Embree or CGAL), and this build has neither");
+  check_in_range("JointOptions::distance_reach_mm", distance_reach_mm, kDistanceReachRange, "mm");
+  const LevelQuantity q = level_quantity();
+  require(q == LevelQuantity::radial_gap || distances, "levels-on distance: needs distances on");
+  require(q == LevelQuantity::radial_gap || reach_mm() >= levels.thresholds_mm.front(), [&] {
+    return "levels-on distance: the distance reach (distance-reach) " + shortest_decimal(reach_mm()) +
+           " mm is below the largest level threshold (" + shortest_decimal(levels.thresholds_mm.front()) + " mm)";
+  });
+}
 
 Joint::Joint(TriangleMesh ball, TriangleMesh socket, const Eigen::Vector3d& cor, const JointOptions& options)
     : Joint(cor, options, build_bodies(cor, options, std::move(ball), std::move(socket), std::nullopt, std::nullopt)) {}
@@ -311,7 +314,7 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
       out.distance_winding = 0;
     }
     // On the body's own thread too: a pass over all its vertices (some 0.07 ms per body on lhdl-ct).
-    summarize_scan(out, own.vertex_area, options_.levels, summary, options_.levels_on);
+    summarize_scan(out, own.vertex_area, options_.levels, summary, options_.level_quantity());
   };
   auto ball_scans = [&] {
     scans(ball_, socket_, R, t, ScanSide::inside, res.ball_gaps, res.ball, res.compact_gaps,

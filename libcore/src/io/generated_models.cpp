@@ -181,7 +181,9 @@ TriangleMesh make_conchoid_surface(double a_mm, double b_mm, const Eigen::Vector
 }
 
 HipModel make_hip_model(const HipModelOptions& o) {
-  require(o.target_triangles >= 50, "hip model: target_triangles must be >= 50");
+  check_in_range("HipModelOptions::target_triangles", o.target_triangles, HipModelOptions::kTargetTrianglesRange);
+  check_in_range("HipModelOptions::cup_coverage_deg", o.cup_coverage_deg, HipModelOptions::kCupCoverageRange, "deg");
+  check_in_range("HipModelOptions::cam_height_mm", o.cam_height_mm, HipModelOptions::kCamHeightRange, "mm");
   require(o.neck_radius_mm < o.head_radius_mm && o.neck_length_mm > o.head_radius_mm,
           "hip model: need neck radius < head radius < neck length");
   HipModel h;

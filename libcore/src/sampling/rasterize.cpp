@@ -18,13 +18,11 @@
 
 namespace impinge {
 
-DistanceMode parse_distance_mode(const std::string& name) {
-  if (name == "linear") return DistanceMode::linear;
-  if (name == "exact") return DistanceMode::exact;
-  throw Error("distance mode '" + name + "': expected 'linear' or 'exact'");
+DistanceMode parse_distance_mode(const std::string& name, const std::string& context) {
+  return parse_enum(kDistanceModeNames, name, context);
 }
 
-const char* to_string(DistanceMode mode) { return mode == DistanceMode::linear ? "linear" : "exact"; }
+const char* to_string(DistanceMode mode) { return enum_name(kDistanceModeNames, mode); }
 
 namespace {
 

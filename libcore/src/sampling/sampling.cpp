@@ -12,30 +12,11 @@
 
 namespace impinge {
 
-SamplingMethod parse_sampling_method(const std::string& name) {
-  if (name == "auto") return SamplingMethod::automatic;
-  if (name == "rasterize") return SamplingMethod::rasterize;
-  if (name == "resample") return SamplingMethod::resample;
-  if (name == "ray-cast") return SamplingMethod::ray_cast;
-  if (name == "ray-cast-bvh") return SamplingMethod::ray_cast_bvh;
-  throw Error("sampling method '" + name + "': expected auto, rasterize, resample, ray-cast or ray-cast-bvh");
+SamplingMethod parse_sampling_method(const std::string& name, const std::string& context) {
+  return parse_enum(kSamplingMethodNames, name, context);
 }
 
-const char* to_string(SamplingMethod method) {
-  switch (method) {
-    case SamplingMethod::automatic:
-      return "auto";
-    case SamplingMethod::rasterize:
-      return "rasterize";
-    case SamplingMethod::resample:
-      return "resample";
-    case SamplingMethod::ray_cast:
-      return "ray-cast";
-    case SamplingMethod::ray_cast_bvh:
-      return "ray-cast-bvh";
-  }
-  return "?";
-}
+const char* to_string(SamplingMethod method) { return enum_name(kSamplingMethodNames, method); }
 
 template <typename Scalar>
 void resample(const RadialDistanceMap& source, RadialDistanceMapT<Scalar>& target) {

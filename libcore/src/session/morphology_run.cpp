@@ -18,9 +18,9 @@ MorphologyRun run_morphology(const SessionOptions& options) {
   // The head the femur shows (a given COR moves neither the head nor what is measured about it).
   SphereFitResult head = cor.head;
   if (!std::isfinite(head.radius)) head = cor.fitted_head ? *cor.fitted_head : located_head(in);
-  const HipJointOptions hip_options = hip_joint_options(options.maps, options.frames, in.neutral);
+  const HipJointOptions hip_options = resolved_hip_options(options, in.neutral);
   MorphologyRun run;
-  if (hip_options.neutral == Neutral::anatomical) {
+  if (hip_options.neutral.value_or(Neutral::anatomical) == Neutral::anatomical) {
     Landmarks given = in.landmarks;
     given["hip_centre"] = head.centre;
     run.frames = find_hip_frames(in.femur, in.pelvis, in.side, given, hip_options.frames);

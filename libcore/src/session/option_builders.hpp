@@ -1,8 +1,13 @@
 #pragma once
 // The option table's row builders (option_table.cpp, option_rows.cpp): typed rows whose setters check a
 // value's type, range or choice and name the option, the value and what is valid in their errors.
+#include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
+
+#include "impinge/core/enum_names.hpp"
+#include "impinge/core/range.hpp"
 
 #include "impinge/core/error.hpp"
 #include "impinge/session/option_table.hpp"
@@ -43,11 +48,12 @@ struct Rows {
     return rows.back();
   }
 
+  // A number member whose valid values are `range` (the member's declared Range).
   template <typename Ref>
-  OptionRow& number(std::string name, std::string key, std::string unit, unsigned uses, double lo, double hi,
+  OptionRow& number(std::string name, std::string key, std::string unit, unsigned uses, const Range& range,
                     std::string help, Ref ref, OptionType type = OptionType::number) {
     OptionRow& r = add(std::move(name), std::move(key), type, std::move(unit), uses, std::move(help));
-    r.min = lo, r.max = hi;
+    r.min = range.min, r.max = range.max, r.min_open = range.min_open;
     const OptionRow spec = r;  // the range and unit, for the setter's checks
     r.set = [ref, spec](RunOptions& o, const OptionValue& v, const std::string& as) {
       using T = std::decay_t<decltype(ref(o))>;
@@ -58,9 +64,9 @@ struct Rows {
   }
 
   template <typename Ref>
-  OptionRow& integer(std::string name, std::string key, std::string unit, unsigned uses, double lo, double hi,
+  OptionRow& integer(std::string name, std::string key, std::string unit, unsigned uses, const Range& range,
                      std::string help, Ref ref) {
-    return number(std::move(name), std::move(key), std::move(unit), uses, lo, hi, std::move(help), ref,
+    return number(std::move(name), std::move(key), std::move(unit), uses, range, std::move(help), ref,
                   OptionType::integer);
   }
 
@@ -100,21 +106,30 @@ struct Rows {
     return r;
   }
 
-  // A choice stored as an enum: `parse` (text, context) -> enum, `name` enum -> text.
-  template <typename Ref, typename Parse, typename Name>
-  OptionRow& choice(std::string name, std::string key, unsigned uses, std::vector<std::string> choices, std::string help,
-                    Ref ref, Parse parse, Name to_text) {
+  // A choice stored as an enum, or as an optional enum (unset: nothing, "auto"), spelled by the enum's one name
+  // table (enum_names.hpp).
+  template <typename Ref, typename E, std::size_t N>
+  OptionRow& choice(std::string name, std::string key, unsigned uses, const EnumNames<E, N>& names, std::string help,
+                    Ref ref) {
     OptionRow& r = add(std::move(name), std::move(key), OptionType::choice, "", uses, std::move(help));
-    r.choices = std::move(choices);
-    const std::vector<std::string> valid = r.choices;
-    r.set = [ref, parse, valid](RunOptions& o, const OptionValue& v, const std::string& as) {
-      const std::string& s = value_as<std::string>(v, as, "a string");
-      bool ok = false;
-      for (const std::string& c : valid) ok = ok || c == s;
-      require(ok, [&] { return as + ": '" + s + "' is not one of " + joined(valid); });
-      ref(o) = parse(s, as);
+    r.choices = enum_choices(names);
+    r.set = [ref, names](RunOptions& o, const OptionValue& v, const std::string& as) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(ref(o))>, std::optional<E>>) {
+        if (std::holds_alternative<std::monostate>(v)) {
+          ref(o).reset();
+          return;
+        }
+      }
+      ref(o) = parse_enum(names, value_as<std::string>(v, as, "a string"), as);
     };
-    r.get = [ref, to_text](const RunOptions& o) -> OptionValue { return std::string(to_text(ref(o))); };
+    r.get = [ref, names](const RunOptions& o) -> OptionValue {
+      if constexpr (std::is_same_v<std::decay_t<decltype(ref(o))>, std::optional<E>>) {
+        if (!ref(o)) return std::monostate{};
+        return std::string(enum_name(names, *ref(o)));
+      } else {
+        return std::string(enum_name(names, ref(o)));
+      }
+    };
     return r;
   }
 

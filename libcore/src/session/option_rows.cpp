@@ -16,6 +16,12 @@ constexpr unsigned kJointCommands = use_distance | use_motion | use_rom | use_pl
 constexpr unsigned kInput = kJointCommands | use_joint | use_morphology;
 constexpr unsigned kSetting = kJointCommands | use_joint | use_study;
 
+// A length's range with 0 added, for a row whose 0 means "no such length" (every vertex, dense maps).
+Range with_zero(Range r) {
+  r.min_open = false;
+  return r;
+}
+
 std::vector<std::string> registered_schemes() {
   std::vector<std::string> v;
   for (const auto& [name, res] : scheme_names()) v.push_back(name);
@@ -43,7 +49,8 @@ void add_input_rows(Rows& t) {
          [](auto& o) -> auto& { return o.preset; });
   t.rows.back().set = [](RunOptions& o, const OptionValue& v, const std::string& as) {
     const RunOptions p = RunOptions::named(value_as<std::string>(v, as, "a string"), as);
-    o.preset = p.preset, o.session.maps = p.session.maps, o.session.frames = p.session.frames, o.rom = p.rom;
+    o.preset = p.preset, o.rom = p.rom;
+    take_session_settings(o.session, p.session);
   };
   t.text("subject", "subject", OptionType::path, kInput, {},
          "subject.json giving side, frame (LPS or RAS) and optional landmarks; supplies --ball/--socket",
@@ -124,49 +131,83 @@ void add_input_rows(Rows& t) {
 }
 
 void add_map_rows(Rows& t) {
-  const double inf = std::numeric_limits<double>::infinity();
   t.text("scheme", "scheme", OptionType::choice, kSetting, registered_schemes(), scheme_help(),
-         [](auto& o) -> auto& { return o.session.maps.scheme; });
-  t.number("resolution", "resolution", "", kSetting, 0, 2147483647,
+         [](auto& o) -> auto& { return o.session.grid.scheme; });
+  t.number("resolution", "resolution", "", kSetting, GridRequest::kResolutionRange,
            "Resolution of the scheme (its own unit, listed with --scheme); 0: the scheme's equivalent of 0.5 deg "
            "node spacing",
-           [](auto& o) -> auto& { return o.session.maps.resolution; });
-  t.number("precision", "precision", "deg", kSetting, 0, 180,
+           [](auto& o) -> auto& { return o.session.grid.resolution; });
+  t.number("precision", "precision", "deg", kSetting, GridRequest::kPrecisionRange,
            "Alias of --resolution for equiangular grids: precision p in degrees (0: not given)",
-           [](auto& o) -> auto& { return o.session.maps.precision; });
-  t.number("turns", "turns", "", kSetting, 0, 2147483647, "Alias of --resolution for the helix: k turns (w = k^2 nodes; 0: not given)",
-           [](auto& o) -> auto& { return o.session.maps.turns; });
-  t.number("spacing", "spacing", "deg", kSetting, 0, 90,
+           [](auto& o) -> auto& { return o.session.grid.precision; });
+  t.number("turns", "turns", "", kSetting, GridRequest::kTurnsRange,
+           "Alias of --resolution for the helix: k turns (w = k^2 nodes; 0: not given)",
+           [](auto& o) -> auto& { return o.session.grid.turns; });
+  t.number("spacing", "spacing", "deg", kSetting, GridRequest::kSpacingRange,
            "Largest node spacing wanted, degrees, for any scheme: the coarsest resolution that reaches it (instead "
            "of --resolution; 0: not given)",
-           [](auto& o) -> auto& { return o.session.maps.spacing; });
-  t.text("sampling", "sampling", OptionType::choice, kSetting, {"auto", "rasterize", "resample", "ray-cast", "ray-cast-bvh"},
+           [](auto& o) -> auto& { return o.session.grid.spacing; });
+  t.choice("sampling", "sampling", kSetting, kSamplingMethodNames,
          "auto, rasterize, resample, ray-cast (naive, small meshes only) or ray-cast-bvh (exact node values for any "
          "scheme)",
-         [](auto& o) -> auto& { return o.session.maps.sampling; });
-  t.text("mode", "mode", OptionType::choice, kSetting, {"exact", "linear"},
+         [](auto& o) -> auto& { return o.session.hip.joint.sampling; });
+  t.choice("mode", "mode", kSetting, kDistanceModeNames,
          "Distance mode: 'linear' (thesis Alg. 1) or 'exact' (ray-plane)",
-         [](auto& o) -> auto& { return o.session.maps.mode; });
-  t.numbers("levels", "levels", "mm", kSetting, levels_help(), [](auto& o) -> auto& { return o.session.maps.levels; });
-  t.number("occlusion-tolerance", "occlusion_tolerance_mm", "mm", kSetting, 0, 1e3,
+         [](auto& o) -> auto& { return o.session.hip.joint.mode; });
+  OptionRow& levels = t.add("levels", "levels", OptionType::numbers, "mm", kSetting, levels_help());
+  levels.set = [](RunOptions& o, const OptionValue& v, const std::string& as) {
+    ImpingementLevels l;  // nothing: the default thresholds
+    if (!std::holds_alternative<std::monostate>(v)) l.thresholds_mm = checked_numbers(v, as, 0);
+    try {
+      l.validate();
+    } catch (const Error& e) {
+      throw Error(as + ": " + e.what());
+    }
+    o.session.hip.joint.levels = l;
+  };
+  levels.get = [](const RunOptions& o) -> OptionValue {  // the default thresholds: nothing (help gives them)
+    const std::vector<double>& thresholds = o.session.hip.joint.levels.thresholds_mm;
+    if (thresholds == ImpingementLevels{}.thresholds_mm) return std::monostate{};
+    return thresholds;
+  };
+  t.number("occlusion-tolerance", "occlusion_tolerance_mm", "mm", kSetting, JointOptions::kOcclusionToleranceRange,
            "Vertices farther than their own first surface plus this are skipped (beyond reach)",
-           [](auto& o) -> auto& { return o.session.maps.occlusion_tolerance_mm; });
-  t.number("max-radius", "max_radius_mm", "mm", kSetting, 0, 1e4,
-           "Test only vertices within this distance of the COR (0 = all)",
-           [](auto& o) -> auto& { return o.session.maps.max_radius_mm; });
-  t.number("sparse", "sparse", "mm", kSetting, 0, inf,
-           "Store both maps sparse, in tiles, keeping only tiles with a surface within this distance of the COR "
-           "('inf': any surface, the same gaps bit for bit; 0 = dense maps)",
-           [](auto& o) -> auto& { return o.session.maps.sparse_mm; });
-  t.number("discontinuity-tolerance", "discontinuity_tolerance_mm", "mm", kSetting, 0, 1e3,
+           [](auto& o) -> auto& { return o.session.hip.joint.occlusion_tolerance_mm; });
+  // Two rows whose 0 stands for a setting without a length (every vertex; dense maps): the field's range with 0
+  // added.
+  OptionRow& radius = t.number("max-radius", "max_radius_mm", "mm", kSetting, with_zero(JointOptions::kMaxRadiusRange),
+                               "Test only vertices within this distance of the COR (0 = all)",
+                               [](auto& o) -> auto& { return o.session.hip.joint.max_radius_mm; });
+  radius.set = [spec = radius](RunOptions& o, const OptionValue& v, const std::string& as) {
+    const double x = checked_number(spec, v, as);
+    o.session.hip.joint.max_radius_mm = x > 0 ? x : JointOptions::kInf;
+  };
+  radius.get = [](const RunOptions& o) -> OptionValue {
+    const double r = o.session.hip.joint.max_radius_mm;
+    return std::isinf(r) ? 0.0 : r;
+  };
+  OptionRow& sparse = t.number("sparse", "sparse", "mm", kSetting, with_zero(JointOptions::kSparseRegionRange),
+                               "Store both maps sparse, in tiles, keeping only tiles with a surface within this "
+                               "distance of the COR ('inf': any surface, the same gaps bit for bit; 0 = dense maps)",
+                               [](auto& o) -> auto& { return o.session.hip.joint.sparse_region_mm; });
+  sparse.set = [spec = sparse](RunOptions& o, const OptionValue& v, const std::string& as) {
+    const double x = checked_number(spec, v, as);
+    o.session.hip.joint.sparse_maps = x > 0;
+    o.session.hip.joint.sparse_region_mm = x > 0 ? x : JointOptions::kInf;
+  };
+  sparse.get = [](const RunOptions& o) -> OptionValue {
+    return o.session.hip.joint.sparse_maps ? o.session.hip.joint.sparse_region_mm : 0.0;
+  };
+  t.number("discontinuity-tolerance", "discontinuity_tolerance_mm", "mm", kSetting,
+           JointOptions::kDiscontinuityToleranceRange,
            "Look-ups whose stencil may be off by more than this (depth discontinuities: rims, coverage edges) are "
            "resolved by an exact ray cast",
-           [](auto& o) -> auto& { return o.session.maps.discontinuity_tolerance_mm; });
-  t.integer("layers", "layers", "", kSetting, 0, 64,
+           [](auto& o) -> auto& { return o.session.hip.joint.discontinuity_tolerance_mm; });
+  t.integer("layers", "layers", "", kSetting, JointOptions::kLayersRange,
             "N: also a layered map of N crossings per node for each bone, so that vertices hidden behind their own "
             "bone's nearer surface (trochanters, shaft, ilium) are tested too: extra-articular impingement (0 = off, "
             "the thesis' single-layer maps)",
-            [](auto& o) -> auto& { return o.session.maps.layers; });
+            [](auto& o) -> auto& { return o.session.hip.joint.layers; });
   t.text("setup", "setup", OptionType::choice, kSetting, {"auto", "maps", "direct"},
          "What to build for the work: maps (both maps and the layered maps, for many poses), direct (no layered "
          "maps: the hidden vertices by exact ray casts; distance's distance hierarchies only over the triangles its "
@@ -175,103 +216,102 @@ void add_map_rows(Rows& t) {
              " frames direct; ROM searches, plans and longer motions maps). The "
          "distances and the first-surface gaps are the same either way; the hidden vertices' gaps are exact with "
          "direct, the maps' interpolation with maps",
-         [](auto& o) -> auto& { return o.session.maps.setup; });
-  t.number("layered-spacing", "layered_spacing", "deg", kSetting, 0, 180,
+         [](auto& o) -> auto& { return o.session.setup; });
+  t.number("layered-spacing", "layered_spacing", "deg", kSetting, JointOptions::kLayeredSpacingRange,
            "The layered maps' largest node spacing (the scheme at the coarsest resolution reaching it, never finer "
            "than the maps'; 0: the maps' own); their edges are exact ray casts",
-           [](auto& o) -> auto& { return o.session.maps.layered_spacing_deg; });
-  t.number("extra-articular-radius", "extra_articular_radius_mm", "mm", kSetting, 0, 1e4,
+           [](auto& o) -> auto& { return o.session.hip.joint.layered_spacing_deg; });
+  t.number("extra-articular-radius", "extra_articular_radius_mm", "mm", kSetting,
+           JointOptions::kExtraArticularRadiusRange,
            "With --layers, test hidden vertices within this distance of the COR",
-           [](auto& o) -> auto& { return o.session.maps.extra_articular_radius_mm; });
+           [](auto& o) -> auto& { return o.session.hip.joint.extra_articular_radius_mm; });
   t.flag("distances", "distances", OptionType::on_off, kSetting,
          "on|off: beside each radial gap, the signed Euclidean distance to the other bone's surface (what 3D "
          "Slicer, VTK, Open3D and libigl report; negative inside it), exact, for every vertex (hidden ones too) "
          "within --distance-reach of the other bone",
-         [](auto& o) -> auto& { return o.session.maps.distances; });
-  t.text("levels-on", "levels_on", OptionType::choice, kSetting, {"distance", "radial"},
+         [](auto& o) -> auto& { return o.session.hip.joint.distances; });
+  t.choice("levels-on", "levels_on", kSetting, kLevelQuantityNames,
          "What the impingement levels (colours, level areas, clock sectors) classify: the Euclidean distance or the "
          "thesis' radial gap (default: the distance, or the radial gap with --distances off)",
-         [](auto& o) -> auto& { return o.session.maps.levels_on; });
-  t.number("distance-reach", "distance_reach_mm", "mm", kSetting, 0, 1e4,
+         [](auto& o) -> auto& { return o.session.hip.joint.levels_on; });
+  t.number("distance-reach", "distance_reach_mm", "mm", kSetting, JointOptions::kDistanceReachRange,
            "Vertices proven farther than this from the other bone get no distance (0: the largest --levels "
            "threshold)",
-           [](auto& o) -> auto& { return o.session.maps.distance_reach_mm; });
-  t.number("max-memory", "max_memory_gb", "GB", kSetting, 0, 1e6,
+           [](auto& o) -> auto& { return o.session.hip.joint.distance_reach_mm; });
+  t.number("max-memory", "max_memory_gb", "GB", kSetting, SessionOptions::kMaxMemoryRange,
            "The most memory the maps may take; a resolution whose maps need more is refused before anything is "
            "allocated (0: three quarters of this machine's memory)",
-           [](auto& o) -> auto& { return o.session.maps.max_memory_gb; });
+           [](auto& o) -> auto& { return o.session.max_memory_gb; });
   t.flag("maps-only", "maps_only", OptionType::flag, kSetting,
          "No exact look-ups at depth discontinuities: the maps answer alone (the thesis' algorithm)",
-         [](auto& o) -> auto& { return o.session.maps.maps_only; });
+         [](auto& o) -> auto& { return o.session.hip.joint.exact_at_discontinuities; }, true);
   OptionRow& mp = t.add("maps", "maps", OptionType::path_pair, "", use_joint,
                         "(ball_path, socket_path): maps saved by save_maps() to load instead of sampling");
   mp.set = [](RunOptions& o, const OptionValue& v, const std::string& as) {
     if (std::holds_alternative<std::monostate>(v)) {
-      o.session.maps.ball_map_file.clear(), o.session.maps.socket_map_file.clear();
+      o.session.hip.ball_map_file.clear(), o.session.hip.socket_map_file.clear();
       return;
     }
     const auto& p = value_as<std::vector<std::string>>(v, as, "a pair (ball_path, socket_path)");
     require(p.size() == 2, [&] { return as + ": expected a pair (ball_path, socket_path), got " + std::to_string(p.size()) + " items"; });
-    o.session.maps.ball_map_file = p[0], o.session.maps.socket_map_file = p[1];
+    o.session.hip.ball_map_file = p[0], o.session.hip.socket_map_file = p[1];
   };
   mp.get = [](const RunOptions& o) -> OptionValue {
-    if (o.session.maps.ball_map_file.empty()) return std::monostate{};
-    return std::vector<std::string>{o.session.maps.ball_map_file, o.session.maps.socket_map_file};
+    if (o.session.hip.ball_map_file.empty()) return std::monostate{};
+    return std::vector<std::string>{o.session.hip.ball_map_file, o.session.hip.socket_map_file};
   };
 }
 
 void add_frame_rows(Rows& t) {
-  t.text("neutral", "neutral", OptionType::choice, kSetting | use_morphology, {"anatomical", "scan"},
+  t.choice("neutral", "neutral", kSetting | use_morphology, kNeutralNames,
          "Zero pose: 'anatomical' (the femoral ISB frame parallel to the pelvic one, both found from the bones or "
          "given as landmarks in subject.json) or 'scan' (the pose in the scanner; angles about the input frame's "
          "axes: flexion about left-right, adduction about antero-posterior, rotation about superior-inferior). "
          "Default: subject.json's \"neutral\", else anatomical",
-         [](auto& o) -> auto& { return o.session.frames.neutral; });
-  t.text("pelvis-frame", "pelvis_frame", OptionType::choice, kSetting | use_morphology, {"isb", "app"},
+         [](auto& o) -> auto& { return o.session.hip.neutral; });
+  t.choice("pelvis-frame", "pelvis_frame", kSetting | use_morphology, kPelvisFrameKindNames,
          "Pelvic axes: 'isb' (Wu et al. 2002: ASIS and PSIS) or 'app' (anterior pelvic plane: ASIS and pubic "
          "tubercles, as clinical ROM tools)",
-         [](auto& o) -> auto& { return o.session.frames.pelvis_frame; });
-  t.text("joint-centre", "joint_centre", OptionType::choice, kSetting,
-         {"femoral-head", "acetabular", "combined", "equidistant"},
+         [](auto& o) -> auto& { return o.session.hip.frames.pelvis; });
+  t.choice("joint-centre", "joint_centre", kSetting, kJointCentreMethodNames,
          "How the femur moves at each pose (Puls et al. 2010, Comput Aided Surg 15:75): 'femoral-head' (rotation "
          "about the head centre: the thesis' method), 'acetabular' (about the acetabular centre), 'combined' (the "
          "head centre placed on the acetabular centre) or 'equidistant' (at each pose the femur is also translated "
          "so that the joint space over the lunate surface is as even as possible). The translation is reported per "
          "pose and limit. Default: equidistant with anatomical neutral, femoral-head with --neutral scan (which "
          "allows no other)",
-         [](auto& o) -> auto& { return o.session.frames.joint_centre; });
-  t.text("femur-frame", "femur_frame", OptionType::choice, kSetting | use_morphology, {"epicondyles", "posterior-condyles"},
+         [](auto& o) -> auto& { return o.session.hip.joint_centre; });
+  t.choice("femur-frame", "femur_frame", kSetting | use_morphology, kFemurFrameKindNames,
          "Femoral medio-lateral axis: 'epicondyles' (ISB) or 'posterior-condyles' (posterior condylar axis)",
-         [](auto& o) -> auto& { return o.session.frames.femur_frame; });
+         [](auto& o) -> auto& { return o.session.hip.frames.femur; });
 }
 
 void add_rom_rows(Rows& t) {
   const unsigned both = use_rom | use_rom_limits | use_rom_map | use_plan | use_joint_plan;
-  t.number("threshold", "threshold_mm", "mm", both, -100, 100,
+  t.number("threshold", "threshold_mm", "mm", both, RomOptions::kThresholdRange,
            "The bones meet when the least gap (--metric) is <= this less --contact-depth (0: bone contact; a "
            "cartilage offset > 0)",
            [](auto& o) -> auto& { return o.rom.search.threshold_mm; });
-  t.number("contact-depth", "contact_depth_mm", "mm", both, 0, 100,
+  t.number("contact-depth", "contact_depth_mm", "mm", both, RomOptions::kContactDepthRange,
            "A contact must reach this far past the threshold to end a search; a shallower graze is within the "
            "data's error (map interpolation, an MRI surface's roughness) and the joint's play (0: the first touch)",
            [](auto& o) -> auto& { return o.rom.search.contact_depth_mm; });
-  t.choice("metric", "metric", both, {"distance", "radial"},
+  t.choice("metric", "metric", both, kRomMetricNames,
            "What --threshold is compared with: the signed Euclidean distance to the other bone (what a depth or a "
            "cartilage offset means) or the thesis' radial gap (along the ray from the COR; where the ray runs inside "
            "the other bone it reads a depth of tens of mm for a graze). The distance needs distances on: a Python "
            "Joint built with distances=False uses the radial gap unless metric is given",
-           [](auto& o) -> auto& { return o.rom.search.metric; }, parse_rom_metric,
-           [](RomMetric m) { return to_string(m); });
-  t.choice("contacts", "contacts", use_rom | use_rom_limits | use_plan | use_joint_plan, {"impingement", "articular", "all"},
+           [](auto& o) -> auto& { return o.rom.search.metric; });
+  t.choice("contacts", "contacts", use_rom | use_rom_limits | use_plan | use_joint_plan, kRomContactsNames,
            "Which contacts end a search: 'impingement' (the head-neck junction, neck or trochanters against the rim "
            "or the pelvis beyond it; the head's joint surface meeting the lunate surface, the joint space closing, "
            "is left out), 'articular' (only that: where the joint space closes) or 'all' (every vertex, the thesis' "
            "criterion). Anatomical neutral only (the zones need the acetabulum)",
-           [](auto& o) -> auto& { return o.rom.search.contacts; }, parse_rom_contacts,
-           [](RomContacts c) { return to_string(c); });
-  t.number("step", "step_deg", "deg", use_rom | use_rom_limits | use_plan | use_joint_plan, 0.01, 90,
+           [](auto& o) -> auto& { return o.rom.search.contacts; });
+  t.number("step", "step_deg", "deg", use_rom | use_rom_limits | use_plan | use_joint_plan, RomOptions::kStepRange,
            "Coarse search step (then bisection to 0.1 deg)", [](auto& o) -> auto& { return o.rom.search.step_deg; });
-  t.number("max", "max_deg", "deg", use_rom | use_rom_limits | use_plan | use_joint_plan, 0.1, 360, "Search no farther than this from the start",
+  t.number("max", "max_deg", "deg", use_rom | use_rom_limits | use_plan | use_joint_plan, RomOptions::kMaxRange,
+           "Search no farther than this from the start",
            [](auto& o) -> auto& { return o.rom.search.max_deg; });
   t.numbers("map-flexion", "flexion", "deg", use_rom | use_rom_map, "The ROM map's flexion angles",
             [](auto& o) -> auto& { return o.rom.map_flexion_deg; });
@@ -284,7 +324,7 @@ void add_rom_rows(Rows& t) {
          "(1 deg steps) valid or in contact, by adaptive refinement (rom_envelope.csv: the valid runs of internal "
          "rotation)",
          [](auto& o) -> auto& { return o.rom.envelope; });
-  t.integer("envelope-coarse", "envelope_coarse", "", use_rom, 1, 64,
+  t.integer("envelope-coarse", "envelope_coarse", "", use_rom, RomEnvelopeOptions::kCoarseStepsRange,
             "Steps between the envelope's first poses (1: scan every pose; larger is faster and can miss a region of "
             "contact smaller than a cell)",
             [](auto& o) -> auto& { return o.rom.envelope_options.coarse_steps; });
@@ -307,18 +347,19 @@ void add_command_rows(Rows& t) {
   OptionRow& motion = t.text("motion", "motion", OptionType::path, use_motion, {}, "Motion file: .csv, .mot or .sto",
                              [](auto& o) -> auto& { return o.command.motion; });
   motion.required = true;
-  t.integer("vtp-every", "vtp_every", "", use_motion, 0, 1e9,
+  t.integer("vtp-every", "vtp_every", "", use_motion, CommandArguments::kVtpEveryRange,
             "Write the posed bones (gaps/frame_N.vtp) every N frames; 0 = every frame up to 100 frames, else at most "
             "100 files",
             [](auto& o) -> auto& { return o.command.vtp_every; });
   t.flag("quiet", "quiet", OptionType::flag, use_motion, "No progress bar or final line",
          [](auto& o) -> auto& { return o.command.quiet; });
-  t.integer("triangles", "triangles", "", use_generate | use_generated_hip, 20, 2e7,
+  t.integer("triangles", "triangles", "", use_generate | use_generated_hip, HipModelOptions::kTargetTrianglesRange,
             "Target triangles per model (at most 20 million: about 2 GB of mesh)",
             [](auto& o) -> auto& { return o.generate.target_triangles; });
-  t.number("cam", "cam_mm", "mm", use_generate | use_generated_hip, 0, 15, "Cam bump height",
+  t.number("cam", "cam_mm", "mm", use_generate | use_generated_hip, HipModelOptions::kCamHeightRange, "Cam bump height",
            [](auto& o) -> auto& { return o.generate.cam_height_mm; });
-  t.number("coverage", "coverage_deg", "deg", use_generate | use_generated_hip, 30, 170, "Cup coverage angle from the cup pole",
+  t.number("coverage", "coverage_deg", "deg", use_generate | use_generated_hip, HipModelOptions::kCupCoverageRange,
+           "Cup coverage angle from the cup pole",
            [](auto& o) -> auto& { return o.generate.cup_coverage_deg; });
 }
 
@@ -333,26 +374,25 @@ void add_plan_rows(Rows& t) {
   t.text("target-motion", "target_motion", OptionType::path, plan, {},
          "A motion file (.csv, .mot, .sto) whose every frame the plan must free of impingement",
          [](auto& o) -> auto& { return o.plan.target_motion; });
-  t.choice("resect", "resect", plan, {"femur", "pelvis", "both"},
+  t.choice("resect", "resect", plan, kResectBonesNames,
            "Which bone the plan may resect: femur (the cam: osteochondroplasty of the head-neck junction), pelvis "
            "(a rim trim) or both (each contact shared); never the head's articular surface or the lunate surface",
-           [](auto& o) -> auto& { return o.plan.resection.bones; }, parse_resect_bones,
-           [](ResectBones b) { return to_string(b); });
-  t.number("clearance-mm", "clearance_mm", "mm", plan, 0, 5,
+           [](auto& o) -> auto& { return o.plan.resection.bones; });
+  t.number("clearance-mm", "clearance_mm", "mm", plan, ResectionOptions::kClearanceRange,
            "The least distance the bones keep at every target pose after the resection",
            [](auto& o) -> auto& { return o.plan.resection.clearance_mm; });
-  t.number("max-depth-fraction", "max_depth_fraction", "", plan, 0.01, 1,
+  t.number("max-depth-fraction", "max_depth_fraction", "", plan, PlanRequest::kMaxDepthFractionRange,
            "Safety depth as a fraction of the femoral neck's least diameter (Mardones et al. 2005: deeper than "
            "about 30 % weakens the neck); a target that needs more is planned up to where it can be reached",
            [](auto& o) -> auto& { return o.plan.max_depth_fraction; });
-  t.number("max-depth-mm", "max_depth_mm", "mm", plan, 0, 100,
+  t.number("max-depth-mm", "max_depth_mm", "mm", plan, PlanRequest::kMaxDepthRange,
            "Safety depth in mm instead of the fraction (0: the fraction of the neck's diameter)",
            [](auto& o) -> auto& { return o.plan.max_depth_mm; });
-  t.number("burr-radius-mm", "burr_radius_mm", "mm", plan, 0, 10,
+  t.number("burr-radius-mm", "burr_radius_mm", "mm", plan, ResectionOptions::kBurrRadiusRange,
            "Radius of the spherical burr the removal is shaped for (arthroscopic burrs: 4-5.5 mm diameter; 0: no "
            "shaping, the least removal per vertex)",
            [](auto& o) -> auto& { return o.plan.resection.burr_radius_mm; });
-  t.number("plan-step", "plan_step_deg", "deg", plan, 0.05, 5,
+  t.number("plan-step", "plan_step_deg", "deg", plan, PlanRequest::kStepRange,
            "Poses along each target motion every this many degrees (with the clearance, a step small enough that "
            "no contact deeper than --contact-depth fits between two poses)",
            [](auto& o) -> auto& { return o.plan.step_deg; });

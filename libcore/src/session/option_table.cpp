@@ -14,17 +14,7 @@ namespace impinge {
 namespace detail {
 
 // The shortest decimal text that reads back as x.
-std::string shortest(double x) {
-  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-  if (x == std::floor(x) && std::fabs(x) < 1e15) return std::to_string(static_cast<long long>(x));
-  for (int p = 1; p <= 17; ++p) {
-    std::ostringstream o;
-    o.precision(p);
-    o << x;
-    if (std::strtod(o.str().c_str(), nullptr) == x) return o.str();
-  }
-  return std::to_string(x);
-}
+std::string shortest(double x) { return shortest_decimal(x); }
 
 std::string joined(const std::vector<std::string>& v) {
   std::string s;
@@ -41,9 +31,10 @@ double checked_number(const OptionRow& row, const OptionValue& v, const std::str
           [&] { return as + ": " + shortest(x) + " is not a finite number"; });
   require(row.type != OptionType::integer || (std::isfinite(x) && x == std::floor(x)),
           [&] { return as + ": " + shortest(x) + " is not a whole number"; });
-  require(x >= row.min && x <= row.max, [&] {
-    return as + ": " + with_unit(x, row.unit) + " is outside the valid range [" + shortest(row.min) + ", " +
-           shortest(row.max) + "]" + (row.unit.empty() ? "" : " " + row.unit);
+  const Range range{row.min, row.max, row.min_open};
+  require(range.contains(x), [&] {
+    return as + ": " + with_unit(x, row.unit) + " is outside the valid range " + range.text() +
+           (row.unit.empty() ? "" : " " + row.unit);
   });
   return x;
 }
@@ -72,11 +63,18 @@ std::vector<double> grid(int from, int to, int step) {
 using detail::joined;
 using detail::shortest;
 
+void take_session_settings(SessionOptions& to, const SessionOptions& from) {
+  to.hip = from.hip;
+  to.grid = from.grid;
+  to.setup = from.setup;
+  to.max_memory_gb = from.max_memory_gb;
+}
+
 RunOptions RunOptions::clinical() {
   RunOptions o;
   o.preset = "clinical";
-  o.session.maps.layers = 4;         // the whole bone: hidden vertices too, extra-articular (issue 29)
-  o.session.maps.distances = true;   // the Euclidean distance beside the radial gap (issue 26)
+  o.session.hip.joint.layers = 4;        // the whole bone: hidden vertices too, extra-articular (issue 29)
+  o.session.hip.joint.distances = true;  // the Euclidean distance beside the radial gap (issue 26)
   o.rom.search.metric = RomMetric::distance;
   o.rom.map_flexion_deg = grid(0, 120, 5);
   o.rom.map_adduction_deg = grid(-20, 40, 5);
@@ -87,8 +85,8 @@ RunOptions RunOptions::clinical() {
 RunOptions RunOptions::thesis() {
   RunOptions o = clinical();
   o.preset = "thesis";
-  o.session.maps = MapSettings{};            // single-layer maps, radial gaps only
-  o.session.frames.joint_centre = "femoral-head";  // rotation about the head centre (thesis sec. 3.3)
+  take_session_settings(o.session, SessionOptions{});          // single-layer maps, radial gaps only
+  o.session.hip.joint_centre = JointCentreMethod::femoral_head;  // rotation about the head centre (thesis sec. 3.3)
   o.rom.search = RomOptions{};               // the radial gap
   o.rom.search.contacts = RomContacts::all;  // every vertex counts (sec. 5.2)
   o.rom.search.contact_depth_mm = 0;         // the first touch

@@ -77,7 +77,7 @@ void write_body_ply(const std::string& path, const ImpingementLevels& levels, Le
 void write_pose_plys(const std::string& ball_path, const std::string& socket_path, const Session& s,
                      const PoseResult& res, const FemurPose& pose) {
   const ImpingementLevels& levels = s.joint_options().levels;
-  const LevelQuantity on = s.joint_options().levels_on;
+  const LevelQuantity on = s.joint_options().level_quantity();
   // The socket's file on a second thread; the ball's error first if both fail.
   run_both([&] { write_body_ply(ball_path, levels, on, s.joint().ball(), res.ball_gaps, s.femur_input(pose), true); },
            [&] { write_body_ply(socket_path, levels, on, s.joint().socket(), res.socket_gaps, s.pelvis_input(), false); });
@@ -96,8 +96,8 @@ void write_pose_vtp(const std::string& path, const Session& s, const PoseResult&
   PointArray gap{"gap_mm", {}, {}}, level{"level", {}, {}}, body{"body", {}, {}};
   gap.f32 = res.ball_gaps.gap_mm;
   gap.f32.insert(gap.f32.end(), res.socket_gaps.gap_mm.begin(), res.socket_gaps.gap_mm.end());
-  level.u8 = vertex_levels(res.ball_gaps, s.joint_options().levels, s.joint_options().levels_on);
-  const auto ls = vertex_levels(res.socket_gaps, s.joint_options().levels, s.joint_options().levels_on);
+  level.u8 = vertex_levels(res.ball_gaps, s.joint_options().levels, s.joint_options().level_quantity());
+  const auto ls = vertex_levels(res.socket_gaps, s.joint_options().levels, s.joint_options().level_quantity());
   level.u8.insert(level.u8.end(), ls.begin(), ls.end());
   body.u8.assign(static_cast<std::size_t>(nb), 0);
   body.u8.resize(static_cast<std::size_t>(nb + np), 1);

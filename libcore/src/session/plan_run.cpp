@@ -130,7 +130,7 @@ std::optional<Morphology> try_morphology(const SessionOptions& so, std::vector<s
 std::vector<ResectionTarget> plan_targets(const Session& s, const PlanRequest& request, const RomRun& before) {
   std::vector<ResectionTarget> out;
   const double step = request.step_deg;
-  require(step > 0 && step <= 5, "plan: the pose step " + std::to_string(step) + " deg must lie in (0, 5]");
+  check_in_range("plan-step", step, PlanRequest::kStepRange, "deg");
   const std::map<std::string, double> wanted = parse_targets(request.target, before.motions);
   for (std::size_t m = 0; m < before.motions.size(); ++m) {
     const StandardMotion& motion = before.motions[m];
@@ -184,9 +184,8 @@ std::vector<ResectionTarget> plan_targets(const Session& s, const PlanRequest& r
 PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const PlanRequest& request) {
   const auto t_start = Clock::now();
   PlanRun run;
-  require(
-      std::isfinite(request.max_depth_fraction) && request.max_depth_fraction > 0 && request.max_depth_fraction <= 1,
-      "--max-depth-fraction " + std::to_string(request.max_depth_fraction) + ": valid (0, 1]");
+  check_in_range("max-depth-fraction", request.max_depth_fraction, PlanRequest::kMaxDepthFractionRange);
+  check_in_range("max-depth-mm", request.max_depth_mm, PlanRequest::kMaxDepthRange, "mm");
   // The targets and the motion file are checked before anything is built (a bad one is an error in milliseconds).
   parse_targets(request.target, standard_motions());
   if (!request.target_motion.empty()) load_motion(request.target_motion, input_side(options.input));
@@ -198,9 +197,9 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   limits_only.limits = true;
   run.search = rom.search;
   SessionOptions so = rom_session_options(options, rom.search);
-  so.maps.distances = true;
-  so.maps.distance_reach_mm =
-      std::max(so.maps.distance_reach_mm, request.resection.clearance_mm + request.resection.candidate_margin_mm);
+  so.hip.joint.distances = true;
+  so.hip.joint.distance_reach_mm =
+      std::max(so.hip.joint.distance_reach_mm, request.resection.clearance_mm + request.resection.candidate_margin_mm);
   const Session s(so);
   run.setup_ms = ms_since(t_start);
   run.warnings = s.warnings();
@@ -272,8 +271,8 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
     // As the first session: the distances on, with the plan's reach (which changes no limit, only which far
     // vertices get a distance).
     SessionOptions check_options = rom_session_options(after_options, rom.search);
-    check_options.maps.distances = true;
-    check_options.maps.distance_reach_mm = so.maps.distance_reach_mm;
+    check_options.hip.joint.distances = true;
+    check_options.hip.joint.distance_reach_mm = so.hip.joint.distance_reach_mm;
     s_after = std::make_unique<Session>(check_options);
     after = run_rom(*s_after, limits_only);
     run.all_met = true;

@@ -180,7 +180,7 @@ nlohmann::json acetabulum_record(const Acetabulum& A, const AnatomicalFrame& pel
 
 std::string pelvic_frame_name(const Session& s) {
   if (s.hip().neutral() != Neutral::anatomical) return "scan";
-  return s.options().frames.pelvis_frame == "app" ? "app" : "isb";
+  return s.hip_options().frames.pelvis == PelvisFrameKind::anterior_pelvic_plane ? "app" : "isb";
 }
 
 nlohmann::json setup_record(const Session& s) {
@@ -218,7 +218,7 @@ nlohmann::json setup_record(const Session& s) {
   j["exact_at_discontinuities"] = opt.exact_at_discontinuities && s.joint().ball().exact != nullptr;
   j["discontinuity_tolerance_mm"] = opt.discontinuity_tolerance_mm;
   j["layers"] = opt.layers;
-  // What was built for the work (MapSettings::setup): the layered maps, or exact casts for the hidden vertices.
+  // What was built for the work (SessionOptions::setup): the layered maps, or exact casts for the hidden vertices.
   j["setup"] = opt.layers > 0 && !opt.layered_maps ? "direct" : "maps";
   // The distance hierarchies: over the whole meshes, or cropped to the session's poses (SessionOptions::only_poses),
   // with the searches a whole-mesh hierarchy answered (built at the first of them).
@@ -230,7 +230,7 @@ nlohmann::json setup_record(const Session& s) {
   if (s.joint().ball().distance_query && s.joint().socket().distance_query)
     j["distance_hierarchies"] = {{"ball", hierarchy(s.joint().ball())}, {"socket", hierarchy(s.joint().socket())}};
   j["distances"] = opt.distances;
-  j["levels_on"] = to_string(opt.levels_on);
+  j["levels_on"] = to_string(opt.level_quantity());
   if (opt.distances) j["distance_reach_mm"] = opt.reach_mm();
   j["nodes_marked"] = {{"ball", s.joint().ball().nodes_marked}, {"socket", s.joint().socket().nodes_marked}};
   j["neutral"] = hip.neutral() == Neutral::anatomical ? "anatomical" : "scan";

@@ -260,9 +260,10 @@ Table rom_envelope_table(const RomRun& run) {
 }
 
 SessionOptions rom_session_options(SessionOptions so, const RomOptions& search) {
-  so.maps.distances = search.metric == RomMetric::distance;
-  if (so.maps.distances && so.maps.distance_reach_mm == 0) so.maps.distance_reach_mm = std::max(search.threshold_mm, 0.0) + 1;
-  so.maps.levels_on = "radial";
+  so.hip.joint.distances = search.metric == RomMetric::distance;
+  JointOptions& jo = so.hip.joint;
+  if (jo.distances && jo.distance_reach_mm == 0) jo.distance_reach_mm = std::max(search.threshold_mm, 0.0) + 1;
+  so.hip.joint.levels_on = LevelQuantity::radial_gap;
   return so;
 }
 

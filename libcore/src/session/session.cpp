@@ -210,76 +210,36 @@ CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) 
   return r;
 }
 
-std::shared_ptr<const SamplingScheme> scheme_of(const MapSettings& m) {
-  const int given = (m.resolution > 0) + (m.precision > 0) + (m.turns > 0) + (m.spacing > 0);
+std::shared_ptr<const SamplingScheme> scheme_of(const GridRequest& g) {
+  const int given = (g.resolution > 0) + (g.precision > 0) + (g.turns > 0) + (g.spacing > 0);
   require(given <= 1, "give one of resolution, precision, turns and spacing");
-  for (const auto& [name, x] : {std::pair{"resolution", m.resolution}, std::pair{"precision", m.precision},
-                                std::pair{"turns", m.turns}, std::pair{"spacing", m.spacing}})
-    require(std::isfinite(x) && x >= 0, std::string(name) + " " + num(x) + ": must be a finite number > 0 (0: not given)");
-  double res = default_resolution(m.scheme);
-  if (m.spacing > 0) res = resolution_for_spacing(m.scheme, m.spacing);
-  if (m.resolution > 0) res = m.resolution;
-  if (m.precision > 0) res = m.precision;
-  if (m.turns > 0) res = m.turns;
-  return make_scheme(m.scheme, res);
+  check_in_range("resolution", g.resolution, GridRequest::kResolutionRange);
+  check_in_range("precision", g.precision, GridRequest::kPrecisionRange, "deg");
+  check_in_range("turns", g.turns, GridRequest::kTurnsRange);
+  check_in_range("spacing", g.spacing, GridRequest::kSpacingRange, "deg");
+  double res = default_resolution(g.scheme);
+  if (g.spacing > 0) res = resolution_for_spacing(g.scheme, g.spacing);
+  if (g.resolution > 0) res = g.resolution;
+  if (g.precision > 0) res = g.precision;
+  if (g.turns > 0) res = g.turns;
+  return make_scheme(g.scheme, res);
 }
 
-HipJointOptions hip_joint_options(const MapSettings& m, const FrameSettings& f, const std::string& subject_neutral) {
-  HipJointOptions o;
-  if (!f.neutral.empty())
-    o.neutral = parse_neutral(f.neutral, "neutral");
-  else if (!subject_neutral.empty())
-    o.neutral = parse_neutral(subject_neutral, "subject.json \"neutral\"");
-  if (!f.joint_centre.empty()) o.joint_centre = parse_joint_centre(f.joint_centre, "joint-centre");
-  o.frames.pelvis = parse_pelvis_frame_kind(f.pelvis_frame, "pelvis-frame");
-  o.frames.femur = parse_femur_frame_kind(f.femur_frame, "femur-frame");
+HipJointOptions resolved_hip_options(const SessionOptions& options, const std::string& subject_neutral) {
+  HipJointOptions o = options.hip;
+  if (!o.neutral && !subject_neutral.empty()) o.neutral = parse_neutral(subject_neutral, "subject.json \"neutral\"");
   JointOptions& jo = o.joint;
-  jo.scheme = scheme_of(m);
-  jo.mode = parse_distance_mode(m.mode);
-  jo.sampling = parse_sampling_method(m.sampling);
-  require(std::isfinite(m.occlusion_tolerance_mm) && m.occlusion_tolerance_mm >= 0,
-          "occlusion-tolerance " + num(m.occlusion_tolerance_mm) + ": must be >= 0 mm");
-  jo.occlusion_tolerance_mm = m.occlusion_tolerance_mm;
-  require(!std::isnan(m.max_radius_mm) && m.max_radius_mm >= 0,
-          "max-radius " + num(m.max_radius_mm) + ": must be >= 0 mm (0: all vertices)");
-  jo.max_radius_mm = m.max_radius_mm > 0 ? m.max_radius_mm : std::numeric_limits<double>::infinity();
-  require(std::isfinite(m.discontinuity_tolerance_mm) && m.discontinuity_tolerance_mm > 0,
-          "discontinuity-tolerance " + num(m.discontinuity_tolerance_mm) + ": must be > 0 mm");
-  jo.exact_at_discontinuities = !m.maps_only;
-  jo.discontinuity_tolerance_mm = m.discontinuity_tolerance_mm;
-  require(!std::isnan(m.sparse_mm) && m.sparse_mm >= 0,
-          "sparse " + num(m.sparse_mm) + ": must be a distance in mm >= 0, or inf");
-  jo.sparse_maps = m.sparse_mm > 0;
-  if (jo.sparse_maps) jo.sparse_region_mm = m.sparse_mm;
-  if (!m.levels.empty()) {
-    jo.levels.thresholds_mm = m.levels;
-    jo.levels.validate();
-  }
-  require(m.layers >= 0 && m.layers <= LayeredMap::kMaxLayers,
-          "layers " + std::to_string(m.layers) + ": must be 0 (off) to " + std::to_string(LayeredMap::kMaxLayers));
-  require(std::isfinite(m.extra_articular_radius_mm) && m.extra_articular_radius_mm > 0,
-          "extra-articular-radius must be > 0 mm");
-  jo.layers = m.layers;
+  require(!jo.scheme || !options.grid.given(),
+          "give the maps' scheme either as a grid request (scheme, resolution, precision, turns, spacing) or as "
+          "HipJointOptions::joint.scheme, not both");
+  if (!jo.scheme) jo.scheme = scheme_of(options.grid);
   // setup_for_poses checks the value; "auto" reaching here (a library caller that did not resolve it by its
   // number of poses) builds the maps, which serve any number of poses.
-  jo.layered_maps = setup_for_poses(m.setup, kDirectSetupMaxPoses) != "direct";
-  jo.extra_articular_radius_mm = m.extra_articular_radius_mm;
-  require(std::isfinite(m.layered_spacing_deg) && m.layered_spacing_deg >= 0 && m.layered_spacing_deg <= 90,
-          "layered-spacing " + num(m.layered_spacing_deg) + ": must be 0 (the maps' own) to 90 deg");
-  jo.layered_spacing_deg = m.layered_spacing_deg;
-  require(std::isfinite(m.distance_reach_mm) && m.distance_reach_mm >= 0,
-          "distance-reach " + num(m.distance_reach_mm) + ": must be 0 (the largest level threshold) or > 0 mm");
-  jo.distances = m.distances;
-  jo.distance_reach_mm = m.distance_reach_mm;
-  jo.levels_on = m.levels_on.empty() ? (m.distances ? LevelQuantity::distance : LevelQuantity::radial_gap)
-                                      : parse_level_quantity(m.levels_on, "levels-on");
-  require(jo.levels_on == LevelQuantity::radial_gap || jo.distances, "levels-on distance: needs --distances on");
-  require(jo.levels_on == LevelQuantity::radial_gap || jo.reach_mm() >= jo.levels.thresholds_mm.front(),
-          "levels-on distance: --distance-reach " + num(jo.reach_mm()) + " mm is below the largest level threshold (" +
-              num(jo.levels.thresholds_mm.front()) + " mm)");
-  require(m.ball_map_file.empty() == m.socket_map_file.empty(), "maps: give both map files (ball and socket) or none");
-  o.ball_map_file = m.ball_map_file;
-  o.socket_map_file = m.socket_map_file;
+  jo.layered_maps = setup_for_poses(options.setup, kDirectSetupMaxPoses) != "direct";
+  // The levels classify the distance when there are distances, unless the radial gap is asked for.
+  if (!jo.levels_on) jo.levels_on = jo.distances ? LevelQuantity::distance : LevelQuantity::radial_gap;
+  jo.validate();
+  require(o.ball_map_file.empty() == o.socket_map_file.empty(), "maps: give both map files (ball and socket) or none");
   return o;
 }
 
@@ -287,9 +247,8 @@ double map_memory_bytes(const SamplingScheme& scheme) { return 2.0 * 5.0 * doubl
 
 namespace {
 // Refuse maps that would not fit: before anything is allocated (a map at 0.005 deg met the kernel's OOM killer).
-void check_map_memory(const MapSettings& m, const SamplingScheme& scheme) {
-  require(std::isfinite(m.max_memory_gb) && m.max_memory_gb >= 0,
-          "max-memory " + num(m.max_memory_gb) + ": must be >= 0 GB (0: three quarters of this machine's)");
+void check_map_memory(const SessionOptions& m, const SamplingScheme& scheme) {
+  check_in_range("max-memory", m.max_memory_gb, SessionOptions::kMaxMemoryRange, "GB");
   const double machine = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE));
   const double limit = m.max_memory_gb > 0 ? m.max_memory_gb * 1e9 : 0.75 * machine;
   const double need = map_memory_bytes(scheme);
@@ -321,8 +280,8 @@ void check_side_and_frame(const LoadedInput& in, const Eigen::Vector3d& head, co
 
 Session::Session(const SessionOptions& options) : options_(options) {
   // The cheap options are checked before anything is read or built.
-  hip_options_ = hip_joint_options(options.maps, options.frames);
-  check_map_memory(options.maps, *hip_options_.joint.scheme);
+  hip_options_ = resolved_hip_options(options);
+  check_map_memory(options, *hip_options_.joint.scheme);
   LoadedInput in = load_input(options.input);
   const std::vector<std::string> load_warnings = in.warnings;
   // The naive ray cast tests every triangle for every node: refuse what would run for minutes.
@@ -334,8 +293,9 @@ Session::Session(const SessionOptions& options) : options_(options) {
              " ray-triangle tests (minutes; at most 5e9): use ray-cast-bvh, the same exact node values through a BVH";
     });
   }
-  if (options.frames.neutral.empty() && !in.neutral.empty())
+  if (!options.hip.neutral && !in.neutral.empty())
     hip_options_.neutral = parse_neutral(in.neutral, options.input.subject + ": \"neutral\"");
+  const Neutral neutral = hip_options_.neutral.value_or(Neutral::anatomical);
   side_ = in.side;
   frame_ = in.frame;
   to_working_ = in.to_working;
@@ -353,7 +313,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
   hip_options_.report_frame_name = std::string("input frame, ") + (in.frame == FrameConvention::LPS ? "LPS" : "RAS");
   // A given COR (or the subject's hip_centre landmark): the zones, the acetabulum and the seat still
   // come from the head the femur shows, so that they do not move with the COR.
-  if (!std::isfinite(cor_.head.radius) && hip_options_.neutral == Neutral::anatomical) {
+  if (!std::isfinite(cor_.head.radius) && neutral == Neutral::anatomical) {
     try {
       hip_options_.head_sphere = cor_.fitted_head ? *cor_.fitted_head : located_head(in);
     } catch (const Error&) {
@@ -361,7 +321,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
     }
   }
   // One pose's work (SessionOptions::only_poses): the distance hierarchies cropped to it and the scan pose.
-  hip_options_.joint.cropped_distance_queries = !options.only_poses.empty() && options.maps.setup == "direct";
+  hip_options_.joint.cropped_distance_queries = !options.only_poses.empty() && options.setup == "direct";
   try {
     auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
                                           hip_options_);
@@ -372,7 +332,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
     }
     hip_ = std::move(hip);
   } catch (const Error& e) {
-    if (hip_options_.neutral != Neutral::anatomical) throw;
+    if (neutral != Neutral::anatomical) throw;
     throw Error(std::string(e.what()) +
                 " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan "
                 "uses the scan pose instead]");

@@ -10,6 +10,7 @@
 #include "impinge/anatomy/pose.hpp"
 #include "impinge/anatomy/sphere_fit.hpp"
 #include "impinge/core/mesh.hpp"
+#include "impinge/core/enum_names.hpp"
 
 namespace impinge {
 
@@ -19,6 +20,11 @@ enum class FemurFrameKind {
   epicondyles,         ///< ISB: z in the plane of the head centre and both epicondyles
   posterior_condyles,  ///< z parallel to the posterior condylar axis (the tangent to both posterior condyles)
 };
+/// The names of the femoral frames: "epicondyles", "posterior-condyles" (the option table's choices).
+inline constexpr EnumNames<FemurFrameKind, 2> kFemurFrameKindNames{
+    {{FemurFrameKind::epicondyles, "epicondyles"}, {FemurFrameKind::posterior_condyles, "posterior-condyles"}}};
+/// "epicondyles" or "posterior-condyles".
+inline const char* to_string(FemurFrameKind kind) { return enum_name(kFemurFrameKindNames, kind); }
 
 /// Femoral landmarks, mm, working frame.
 struct FemurLandmarks {

@@ -10,6 +10,7 @@
 #include "impinge/anatomy/anatomical_frame.hpp"
 #include "impinge/anatomy/pose.hpp"
 #include "impinge/core/mesh.hpp"
+#include "impinge/core/enum_names.hpp"
 
 namespace impinge {
 
@@ -18,6 +19,11 @@ enum class PelvisFrameKind {
   isb,                     ///< Z through both ASIS (right), X in the plane of both ASIS and the PSIS midpoint (anterior)
   anterior_pelvic_plane,   ///< Z through both ASIS, X normal to the plane of both ASIS and the pubic tubercles
 };
+/// The names of the pelvic frames: "isb", "app" (the option table's choices, parse_pelvis_frame_kind).
+inline constexpr EnumNames<PelvisFrameKind, 2> kPelvisFrameKindNames{
+    {{PelvisFrameKind::isb, "isb"}, {PelvisFrameKind::anterior_pelvic_plane, "app"}}};
+/// "isb" or "app".
+inline const char* to_string(PelvisFrameKind kind) { return enum_name(kPelvisFrameKindNames, kind); }
 
 /// The six pelvic landmarks (mm, working frame) and how they were obtained.
 struct PelvisLandmarks {

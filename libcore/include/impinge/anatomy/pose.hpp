@@ -10,6 +10,7 @@
 #include <string>
 
 #include "impinge/anatomy/anatomical_frame.hpp"
+#include "impinge/core/enum_names.hpp"
 
 namespace impinge {
 
@@ -30,6 +31,10 @@ enum class Neutral {
   anatomical,  ///< the femoral ISB frame's axes parallel to the pelvic frame's (both found from the bones)
   scan,        ///< the scan pose; angles about the working frame's axes (RAS: Z = +x, X = +y, Y = +z)
 };
+/// The names of the neutrals: "anatomical", "scan" (the option table's choices, parse_neutral).
+inline constexpr EnumNames<Neutral, 2> kNeutralNames{{{Neutral::anatomical, "anatomical"}, {Neutral::scan, "scan"}}};
+/// "anatomical" or "scan".
+inline const char* to_string(Neutral neutral) { return enum_name(kNeutralNames, neutral); }
 
 /// Rotation (3 x 3) of the joint coordinate system in the pelvic frame's own axes: the femoral
 /// frame's axes relative to the pelvic frame's, R = Rz(flexion) Rx(m adduction) Ry(m internal

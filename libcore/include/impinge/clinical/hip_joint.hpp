@@ -27,7 +27,8 @@ struct FemurPose {
 /// Options of a HipJoint.
 struct HipJointOptions {
   JointOptions joint;                     ///< maps, mode, levels
-  Neutral neutral = Neutral::anatomical;  ///< what zero angles mean
+  /// What zero angles mean. Unset: anatomical (Session: the subject's "neutral", else anatomical).
+  std::optional<Neutral> neutral;
   HipFrameOptions frames;                 ///< which pelvic and femoral frames (anatomical neutral only)
   /// How the femur moves at each pose (joint_centre.hpp; Puls et al. 2010). Unset: equidistant with
   /// anatomical neutral, femoral_head (the thesis' method) with scan neutral, which allows no other

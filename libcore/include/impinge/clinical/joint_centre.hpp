@@ -46,12 +46,19 @@
 #include <vector>
 
 #include "impinge/detection/joint.hpp"
+#include "impinge/core/enum_names.hpp"
 
 namespace impinge {
 
 
 /// Puls et al. 2010's four methods (see the file comment).
 enum class JointCentreMethod { femoral_head, acetabular, combined, equidistant };
+/// The names of the joint-centre methods (the option table's choices of --joint-centre; CSV and JSON outputs).
+inline constexpr EnumNames<JointCentreMethod, 4> kJointCentreMethodNames{
+    {{JointCentreMethod::femoral_head, "femoral-head"},
+     {JointCentreMethod::acetabular, "acetabular"},
+     {JointCentreMethod::combined, "combined"},
+     {JointCentreMethod::equidistant, "equidistant"}}};
 
 /// Parse "femoral-head", "acetabular", "combined" or "equidistant" (underscores accepted for
 /// hyphens). Throws impinge::Error naming `context` otherwise.

@@ -50,6 +50,8 @@
 #include "impinge/clinical/hip_joint.hpp"
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/mesh.hpp"
+#include "impinge/core/enum_names.hpp"
+#include "impinge/core/range.hpp"
 
 namespace impinge {
 
@@ -62,6 +64,9 @@ enum class ResectBones {
   pelvis,  ///< the rim: acetabular rim trim (a pincer)
   both,    ///< each contact's depth shared half and half where both bones can take it
 };
+/// The names of ResectBones (the option table's choices of --resect).
+inline constexpr EnumNames<ResectBones, 3> kResectBonesNames{
+    {{ResectBones::femur, "femur"}, {ResectBones::pelvis, "pelvis"}, {ResectBones::both, "both"}}};
 /// "femur", "pelvis", "both".
 const char* to_string(ResectBones bones);
 /// Parse "femur", "pelvis" or "both". Throws impinge::Error naming `context` and the valid values otherwise.
@@ -79,8 +84,10 @@ struct ResectionTarget {
 struct ResectionOptions {
   ResectBones bones = ResectBones::femur;
   double clearance_mm = 0.3;  ///< c: the least distance the bones keep at every target pose, mm
+  static constexpr Range kClearanceRange{0, 5};  ///< of clearance_mm, mm
   double max_depth_mm = std::numeric_limits<double>::infinity();  ///< the safety depth, mm (the caller's)
   double burr_radius_mm = 2.5;     ///< b: the spherical burr's radius, mm (0: no widening)
+  static constexpr Range kBurrRadiusRange{0, 10};  ///< of burr_radius_mm, mm
   double tolerance_mm = 0.02;      ///< a contact asking for less than this more is met, mm
   int max_iterations = 16;         ///< rounds of step 4
   double candidate_margin_mm = 1;  ///< contacts: vertices within c + this of the other bone, mm

@@ -15,6 +15,8 @@
 
 #include "impinge/anatomy/pose.hpp"
 #include "impinge/clinical/hip_joint.hpp"
+#include "impinge/core/enum_names.hpp"
+#include "impinge/core/range.hpp"
 
 namespace impinge {
 
@@ -32,6 +34,9 @@ enum class RomContacts {
   articular,    ///< the joint surfaces only: where the joint space closes, reported apart
   all,          ///< every vertex: where the bones first meet (the thesis' criterion)
 };
+/// The names of RomContacts (the option table's choices of --contacts).
+inline constexpr EnumNames<RomContacts, 3> kRomContactsNames{
+    {{RomContacts::impingement, "impingement"}, {RomContacts::articular, "articular"}, {RomContacts::all, "all"}}};
 
 /// Parse "impingement", "articular" or "all". Throws impinge::Error naming `context` otherwise.
 RomContacts parse_rom_contacts(const std::string& text, const std::string& context);
@@ -44,6 +49,9 @@ enum class RomMetric {
   distance,  ///< the signed Euclidean distance to the other bone's surface (ScanGaps::distance_mm): what a
              ///< cartilage offset or clearance means; every pose is a full Joint::detect with distances
 };
+/// The names of RomMetric (the option table's choices of --metric).
+inline constexpr EnumNames<RomMetric, 2> kRomMetricNames{
+    {{RomMetric::distance, "distance"}, {RomMetric::radial, "radial"}}};
 /// "radial" or "distance".
 const char* to_string(RomMetric metric);
 /// Parse "radial" or "distance". Throws impinge::Error naming `context` otherwise.
@@ -57,6 +65,7 @@ inline constexpr double kIntraArticularMarginMm = 10;
 struct RomOptions {
   double threshold_mm = 0;       ///< contact when the minimum gap <= this less contact_depth_mm (0: bone contact;
                                  ///< a cartilage offset > 0)
+  static constexpr Range kThresholdRange{-100, 100};  ///< of threshold_mm, mm
   /// A contact must reach this far past the threshold to end a search, mm: a graze shallower than
   /// the data's own error (the maps' interpolation, about 0.05 mm at 0.1 deg; an MRI surface's
   /// roughness about its fitted sphere, 0.4-0.8 mm rms) does not stop a motion, whose femur the
@@ -65,6 +74,7 @@ struct RomOptions {
   /// 27 deg at 0 mm, mc22's external rotation 52 -> 4 deg at 0.1 mm; at 0.25 mm every limit of
   /// lhdl-ct, tlem2-mri and mc22 moves by at most 2 deg). 0: the first touch.
   double contact_depth_mm = 0.25;
+  static constexpr Range kContactDepthRange{0, 100};  ///< of contact_depth_mm, mm
   /// What is compared with the threshold: the radial gap, or the Euclidean distance (which needs the
   /// joint's JointOptions::distances on, with a reach of at least max(threshold_mm, 0), and counts every
   /// vertex: RomVertices::all). The two agree on whether the bones overlap; above 0 they differ, the
@@ -77,7 +87,9 @@ struct RomOptions {
   /// distance; the library's and the thesis experiments' the radial gap.
   RomMetric metric = RomMetric::radial;
   double step_deg = 2;           ///< coarse step along the motion, deg
+  static constexpr Range kStepRange{0.01, 90};  ///< of step_deg, deg
   double max_deg = 150;          ///< search no farther than this from neutral, deg
+  static constexpr Range kMaxRange{0.1, 360};   ///< of max_deg, deg
   double tolerance_deg = 0.1;    ///< bisection until the bracket is this narrow, deg
   bool use_bounds = true;        ///< skip vertex clusters whose bound cannot reach the threshold (same results,
                                  ///< fewer look-ups; equiangular maps)
@@ -253,6 +265,7 @@ struct RomEnvelopeOptions {
   double internal_rotation_min_deg = -60, internal_rotation_max_deg = 60;
   double step_deg = 1;    ///< grid step on every axis, deg (each range a whole number of steps)
   int coarse_steps = 4;   ///< the first lattice every this many steps (1: every pose evaluated)
+  static constexpr Range kCoarseStepsRange{1, 64};  ///< of coarse_steps
 };
 
 /// Every pose of a grid as valid (the bones apart: the least counted gap > the threshold) or not.

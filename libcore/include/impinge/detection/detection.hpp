@@ -18,6 +18,7 @@
 #include "impinge/detection/impingement_levels.hpp"
 #include "impinge/maps/layered_map.hpp"
 #include "impinge/maps/radial_distance_map.hpp"
+#include "impinge/core/enum_names.hpp"
 
 namespace impinge {
 
@@ -46,6 +47,9 @@ struct ScanGaps {
 /// Euclidean distance (ScanGaps::distance_mm; a vertex without one is farther than the distances' reach,
 /// which is at least the largest level threshold, so level 0).
 enum class LevelQuantity : std::uint8_t { radial_gap = 0, distance = 1 };
+/// The names of LevelQuantity (the option table's choices of --levels-on; summary.json's "levels_on").
+inline constexpr EnumNames<LevelQuantity, 2> kLevelQuantityNames{
+    {{LevelQuantity::distance, "distance"}, {LevelQuantity::radial_gap, "radial"}}};
 
 /// "radial" or "distance".
 const char* to_string(LevelQuantity q);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "impinge/casters/first_hit_caster.hpp"
+#include "impinge/core/range.hpp"
 #include "impinge/core/mesh.hpp"
 #include "impinge/detection/detection.hpp"
 #include "impinge/detection/impingement_levels.hpp"
@@ -24,16 +25,21 @@
 
 namespace impinge {
 
-/// Options of a Joint.
+/// Options of a Joint. Each numeric field's valid values are declared once, as the Range beside it
+/// (k...Range); validate() checks them, and the session layer's option table takes its rows' ranges from
+/// the same declarations (issue 78).
 struct JointOptions {
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
   /// Sampling scheme of both maps (make_scheme); default equiangular at p = 0.5 deg.
   std::shared_ptr<const SamplingScheme> scheme = make_scheme("equiangular", 0.5);
   DistanceMode mode = DistanceMode::exact;                         ///< rasterisation distance mode
   SamplingMethod sampling = SamplingMethod::automatic;             ///< how maps are filled
   double occlusion_tolerance_mm = 1.0;                             ///< a vertex farther than its own map's surface
                                                                    ///< plus this is hidden (not on the first surface)
-  double max_radius_mm = std::numeric_limits<double>::infinity();  ///< region of interest about
-                                                                   ///< the COR, mm: no vertex farther is tested (hidden ones neither)
+  static constexpr Range kOcclusionToleranceRange{0, 1e3};         ///< of occlusion_tolerance_mm, mm
+  /// Region of interest about the COR, mm: no vertex farther is tested (hidden ones neither).
+  double max_radius_mm = kInf;
+  static constexpr Range kMaxRadiusRange{0, 1e4, true};  ///< of max_radius_mm, mm, when finite (inf: every vertex)
   ImpingementLevels levels;                                        ///< gap classes
   /// Exact look-ups at depth discontinuities: mark each map's nodes where its
   /// interpolation may be off by more than discontinuity_tolerance_mm (mark_depth_discontinuities)
@@ -42,12 +48,14 @@ struct JointOptions {
   /// Off, or in a build without Embree or CGAL, the maps answer alone (the thesis' algorithm).
   bool exact_at_discontinuities = true;
   double discontinuity_tolerance_mm = 0.05;  ///< see exact_at_discontinuities, mm (> 0)
+  static constexpr Range kDiscontinuityToleranceRange{0, 1e3, true};  ///< of discontinuity_tolerance_mm, mm
   /// Store both maps sparse (RadialDistanceMapT::make_sparse) once they are filled and marked: only
   /// the tiles with a surface within sparse_region_mm of the COR (default: any surface, which gives
   /// every gap bit for bit as the dense maps; a finite region answers "no surface" beyond it).
   /// Source: impinge (not in the thesis).
   bool sparse_maps = false;
-  double sparse_region_mm = std::numeric_limits<double>::infinity();  ///< see sparse_maps, mm (> 0)
+  double sparse_region_mm = kInf;                          ///< see sparse_maps, mm (> 0)
+  static constexpr Range kSparseRegionRange{0, kInf, true};  ///< of sparse_region_mm, mm
   /// Layered maps: with layers = N > 0, each body also gets a LayeredMap of the same scheme
   /// with N crossings per node (filled by ray casts, all cores), and the vertices hidden behind their
   /// own body's nearer surface (not in the first-surface mask) within extra_articular_radius_mm of the
@@ -59,7 +67,9 @@ struct JointOptions {
   /// exceed every level threshold). 0: off (the thesis).
   /// Needs a ray caster (Embree or CGAL). Memory per map: nodes * (4 N + 1) bytes.
   int layers = 0;
+  static constexpr Range kLayersRange{0, LayeredMap::kMaxLayers};  ///< of layers
   double extra_articular_radius_mm = 150;  ///< hidden vertices farther from the COR are not tested, mm (> 0)
+  static constexpr Range kExtraArticularRadiusRange{0, 1e4, true};  ///< of extra_articular_radius_mm, mm
   /// With layers > 0: build the layered maps (true), or leave them out (false: a set-up for a few poses, which
   /// filling them, about 0.12 s for lhdl-ct at 0.5 deg, would not repay): the hidden vertices near the other bone
   /// are then tested by exact ray casts over their rays' crossings (scan_layered_near_exact), the value the
@@ -75,6 +85,7 @@ struct JointOptions {
   /// Filling a layered map by ray casts costs per node: at 0.1 deg about 3 s for both bones of
   /// lhdl-ct, at 0.5 deg about 0.12 s.
   double layered_spacing_deg = 0.5;
+  static constexpr Range kLayeredSpacingRange{0, 90};  ///< of layered_spacing_deg, deg
   /// Euclidean distances: with `distances` on, every detect also gives each vertex within
   /// max_radius_mm of the COR, on the first surface or hidden, its signed distance to the other bone's
   /// surface (ScanGaps::distance_mm; surface_distance.hpp), wherever it cannot be proven farther than
@@ -83,10 +94,12 @@ struct JointOptions {
   /// The reach of the distances, mm (> 0); 0: the largest threshold of `levels` (the cartilage offset,
   /// 4 mm by default). Vertices proven farther get NaN.
   double distance_reach_mm = 0;
+  static constexpr Range kDistanceReachRange{0, 1e4};  ///< of distance_reach_mm, mm
   /// What the impingement levels classify (ScanSummary::level_vertices, PLY colours, clock sectors): the
   /// radial gap (the thesis) or, with distances on, the Euclidean distance (then distance_reach_mm must be
-  /// 0 or at least the largest level threshold).
-  LevelQuantity levels_on = LevelQuantity::radial_gap;
+  /// 0 or at least the largest level threshold). Unset: the radial gap (level_quantity()); the Session resolves
+  /// unset to the distance when distances are on (resolved_hip_options), as the option table's help says.
+  std::optional<LevelQuantity> levels_on;
   /// Leave the distance hierarchies (JointBody::distance_query) to Joint::crop_distance_queries, for the poses
   /// the caller will ask (one `impinge distance`), instead of building them over the whole meshes: each then
   /// holds only the triangles those poses' searches can reach (5-13 % of a shared hip's at rest), and answers every
@@ -96,6 +109,11 @@ struct JointOptions {
   /// Whether the bodies need closest-point hierarchies (SignedDistanceQuery): for the distances, and for the
   /// layered scans' pruning of hidden vertices far from the other body (layers > 0).
   bool needs_distance_queries() const { return distances || layers > 0; }
+  /// levels_on resolved: as set, else the radial gap.
+  LevelQuantity level_quantity() const { return levels_on.value_or(LevelQuantity::radial_gap); }
+  /// Check every field against its declared range (and the levels, the scheme, levels_on against distances).
+  /// Throws impinge::Error naming the field (e.g. "JointOptions::layers 99 is outside the valid range [0, 16]").
+  void validate() const;
   /// distance_reach_mm resolved (the largest level threshold when 0), mm.
   double reach_mm() const { return distance_reach_mm > 0 ? distance_reach_mm : std::max(levels.thresholds_mm.front(), 1e-3); }
 };

@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "impinge/core/mesh.hpp"
+#include "impinge/core/range.hpp"
 
 namespace impinge {
 
@@ -42,13 +43,16 @@ TriangleMesh make_conchoid_surface(double a_mm, double b_mm, const Eigen::Vector
 /// Options of a generated hip (right side, anatomical RAS frame).
 struct HipModelOptions {
   int target_triangles = 3000;       ///< per model (thesis levels 300, 1k, 3k, 12k)
+  static constexpr Range kTargetTrianglesRange{50, 2e7};  ///< of target_triangles (2e7: about 2 GB of mesh)
   double head_radius_mm = 22;        ///< femoral head (44 mm diameter, thesis sec. 3.5)
   double cartilage_gap_mm = 2.5;     ///< cup inner radius minus head radius
   double neck_radius_mm = 15;        ///< femoral neck (a cylinder)
   double neck_length_mm = 50;        ///< COR to the neck's cut end
   double cup_wall_mm = 6;            ///< cup thickness
   double cup_coverage_deg = 100;     ///< rim angle from the cup pole; > 90 over-covers (pincer)
+  static constexpr Range kCupCoverageRange{30, 170};  ///< of cup_coverage_deg, deg
   double cam_height_mm = 0;          ///< cam bump at the antero-superior head-neck junction
+  static constexpr Range kCamHeightRange{0, 15};      ///< of cam_height_mm, mm
   Eigen::Vector3d cor{60, -20, 30};  ///< where the model is placed, mm
 };
 

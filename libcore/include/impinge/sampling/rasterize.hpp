@@ -10,6 +10,7 @@
 #include "impinge/maps/radial_distance_map.hpp"
 #include "impinge/sampling/raster_plan.hpp"
 #include "impinge/schemes/equiangular_grid.hpp"
+#include "impinge/core/enum_names.hpp"
 
 namespace impinge {
 
@@ -22,9 +23,12 @@ enum class DistanceMode {
   /// The distance at which the node's ray meets the triangle's plane (exact for the mesh).
   exact,
 };
+/// The names of the distance modes (the option table's choices of --mode).
+inline constexpr EnumNames<DistanceMode, 2> kDistanceModeNames{
+    {{DistanceMode::exact, "exact"}, {DistanceMode::linear, "linear"}}};
 
 /// Parse "linear" or "exact"; throws impinge::Error naming the value otherwise.
-DistanceMode parse_distance_mode(const std::string& name);
+DistanceMode parse_distance_mode(const std::string& name, const std::string& context = "distance mode");
 /// "linear" or "exact".
 const char* to_string(DistanceMode mode);
 

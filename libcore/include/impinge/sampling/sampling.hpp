@@ -10,6 +10,7 @@
 #include "impinge/core/mesh.hpp"
 #include "impinge/maps/radial_distance_map.hpp"
 #include "impinge/sampling/rasterize.hpp"
+#include "impinge/core/enum_names.hpp"
 
 namespace impinge {
 
@@ -24,9 +25,15 @@ enum class SamplingMethod {
   /// O(nodes log triangles). Throws impinge::Error when the build has no ray caster. Source: impinge (not in the thesis).
   ray_cast_bvh,
 };
+/// The names of the sampling methods (the option table's choices of --sampling; summary.json).
+inline constexpr EnumNames<SamplingMethod, 5> kSamplingMethodNames{{{SamplingMethod::automatic, "auto"},
+                                                                   {SamplingMethod::rasterize, "rasterize"},
+                                                                   {SamplingMethod::resample, "resample"},
+                                                                   {SamplingMethod::ray_cast, "ray-cast"},
+                                                                   {SamplingMethod::ray_cast_bvh, "ray-cast-bvh"}}};
 
 /// Parse "auto", "rasterize", "resample", "ray-cast", "ray-cast-bvh"; throws impinge::Error otherwise.
-SamplingMethod parse_sampling_method(const std::string& name);
+SamplingMethod parse_sampling_method(const std::string& name, const std::string& context = "sampling method");
 const char* to_string(SamplingMethod method);
 
 /// Options of sample_surface.

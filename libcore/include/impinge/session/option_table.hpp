@@ -31,6 +31,7 @@ struct CommandArguments {
   bool render = false;       ///< `distance`: also shaded renders (render.png)
   std::string motion;        ///< `motion`: the motion file (.csv, .mot, .sto)
   int vtp_every = 0;         ///< `motion`: VTP file every N frames; 0: automatic (at most 100 files)
+  static constexpr Range kVtpEveryRange{0, 1e9};
   bool quiet = false;        ///< `motion`: no progress bar or final line
 };
 
@@ -56,6 +57,10 @@ struct RunOptions {
   /// A preset by name: "clinical" or "thesis". Throws impinge::Error naming `context` otherwise.
   static RunOptions named(const std::string& name, const std::string& context);
 };
+
+/// The settings a preset sets (SessionOptions' hip, grid, setup and max_memory_gb; not its inputs, COR or
+/// poses) copied from `from` into `to`.
+void take_session_settings(SessionOptions& to, const SessionOptions& from);
 
 /// What an option's value is.
 enum class OptionType {
@@ -108,7 +113,10 @@ struct OptionRow {
   std::string unit;  ///< "mm", "deg", "mm^3" ...; empty when none
   unsigned uses = 0;                 ///< OptionUse bits
   std::vector<std::string> choices;  ///< OptionType::choice: the valid values
-  double min = -1e308, max = 1e308;  ///< number, integer: the valid range (inclusive); max inf: "inf" allowed
+  /// number, integer: the valid range, from the field's declared Range (e.g. JointOptions::kLayersRange); inclusive
+  /// unless min_open; max inf: "inf" allowed.
+  double min = -1e308, max = 1e308;
+  bool min_open = false;  ///< min itself is not valid (a length that must be > 0)
   bool required = false;             ///< the CLI commands that use it need it
   std::string help;
   std::function<void(RunOptions&, const OptionValue&, const std::string& as)> set;

@@ -14,6 +14,7 @@
 #include "impinge/clinical/resection.hpp"
 #include "impinge/session/runs.hpp"
 #include "impinge/session/session.hpp"
+#include "impinge/core/range.hpp"
 
 namespace impinge {
 
@@ -26,9 +27,12 @@ struct PlanRequest {
   std::string target_motion;        ///< a motion file (.csv, .mot, .sto) whose every frame must be free; empty: none
   ResectionOptions resection;       ///< bones, clearance, burr (max_depth_mm: set from the two below)
   double max_depth_fraction = 0.3;  ///< safety depth as a fraction of the neck's least diameter (Mardones 2005)
+  static constexpr Range kMaxDepthFractionRange{0.01, 1};  ///< of max_depth_fraction
   double max_depth_mm = 0;          ///< safety depth, mm; 0: max_depth_fraction x the neck's diameter
+  static constexpr Range kMaxDepthRange{0, 100};           ///< of max_depth_mm, mm
   bool allow_partial = false;       ///< a target missed after the check is not an error (exit 0)
   double step_deg = 0.5;            ///< poses along each target motion, deg
+  static constexpr Range kStepRange{0.05, 5};               ///< of step_deg, deg
 };
 
 /// One target before and after.

@@ -20,6 +20,7 @@
 #include "impinge/anatomy/pose.hpp"
 #include "impinge/anatomy/sphere_fit.hpp"
 #include "impinge/clinical/hip_joint.hpp"
+#include "impinge/core/range.hpp"
 #include "impinge/core/mesh.hpp"
 #include "impinge/io/subject.hpp"
 
@@ -56,47 +57,28 @@ std::optional<Eigen::Vector3d> parse_cor(const std::string& text, const std::str
 /// Parse "X,Y,Z,R" (mm) for CorOptions::head_region. Throws impinge::Error naming `context`.
 Eigen::Vector4d parse_head_region(const std::string& text, const std::string& context);
 
-/// The maps: scheme and resolution, how they are filled, and what detection does with them
-/// (JointOptions). At most one of resolution, precision, turns and spacing; none: the scheme's
-/// default (0.5 deg node spacing equivalent).
-struct MapSettings {
+/// The maps' sampling scheme and resolution as a front end asks for them (session-only: the Session
+/// resolves it, scheme_of, into HipJointOptions::joint.scheme). At most one of resolution, precision, turns and
+/// spacing; none: the scheme's default (0.5 deg node spacing equivalent).
+struct GridRequest {
   std::string scheme = "equiangular";  ///< a registered scheme (scheme_names())
   double resolution = 0;               ///< the scheme's own unit; 0: not given
-  double precision = 0;                ///< alias for equiangular grids: p, degrees
-  double turns = 0;                    ///< alias for the helix: k turns
+  static constexpr Range kResolutionRange{0, 2147483647};
+  double precision = 0;                ///< alias for equiangular grids: p, degrees; 0: not given
+  static constexpr Range kPrecisionRange{0, 90};  ///< the equiangular grid's own: p in (0, 90] dividing 180
+  double turns = 0;                    ///< alias for the helix: k turns; 0: not given
+  static constexpr Range kTurnsRange{0, 2147483647};
   double spacing = 0;                  ///< largest node spacing wanted, degrees: the coarsest resolution reaching it
-  std::string sampling = "auto";       ///< auto, rasterize, resample, ray-cast, ray-cast-bvh
-  std::string mode = "exact";          ///< exact | linear (thesis Alg. 1)
-  std::vector<double> levels;          ///< impingement thresholds, mm, decreasing; empty: ImpingementLevels' (4, 8/3, 4/3, 0)
-  double occlusion_tolerance_mm = 1.0;
-  double max_radius_mm = 0;             ///< test only vertices within this of the COR; 0: all
-  double sparse_mm = 0;                 ///< sparse maps keeping tiles with a surface within this (inf: any); 0: dense
-  double discontinuity_tolerance_mm = 0.05;
-  bool maps_only = false;               ///< no exact look-ups at depth discontinuities (the thesis' algorithm)
-  int layers = 0;                       ///< layered maps of this many crossings per node (0: off)
-  /// What to build for the work: "maps" (both maps and, with layers, the layered maps), "direct" (no layered
-  /// maps: the hidden vertices by exact ray casts, JointOptions::layered_maps off; for a few poses; no ROM
-  /// searches), "auto" (the front end's choice by the number of poses, setup_for_poses: `impinge distance` and
-  /// motions of fewer than kDirectSetupMaxPoses frames take direct; ROM searches, plans and longer motions maps).
-  std::string setup = "auto";
-  double extra_articular_radius_mm = 150;
-  double layered_spacing_deg = 0.5;     ///< the layered maps' largest node spacing (JointOptions), deg
-  bool distances = false;               ///< Euclidean distances beside the gaps (JointOptions::distances)
-  double distance_reach_mm = 0;         ///< their reach, mm; 0: the largest level threshold
-  /// What the levels classify: "radial" (the thesis' gap) | "distance"; empty: the distance when
-  /// distances are on, else the radial gap.
-  std::string levels_on;
-  std::string ball_map_file, socket_map_file;  ///< saved maps to load instead of sampling (both or neither)
-  /// The most memory the maps may take, GB; 0: three quarters of this machine's memory. A resolution whose
-  /// maps would need more is refused before anything is allocated (map_memory_bytes).
-  double max_memory_gb = 0;
+  static constexpr Range kSpacingRange{0, 90};
+  /// Whether anything but the defaults was asked for (a resolution, or a scheme other than equiangular).
+  bool given() const { return resolution > 0 || precision > 0 || turns > 0 || spacing > 0 || scheme != "equiangular"; }
 };
 
 /// About how many bytes the two maps of `scheme` take (float node values, their marks and bound pyramids:
 /// 5 bytes a node, doubled for the two bones; the layered maps, at most 0.5 deg by default, come on top).
 double map_memory_bytes(const SamplingScheme& scheme);
 
-/// Below this many poses MapSettings::setup "auto" takes "direct" (no layered maps), from this many "maps": on
+/// Below this many poses SessionOptions::setup "auto" takes "direct" (no layered maps), from this many "maps": on
 /// lhdl-ct (0.5 deg, defaults, 2 cores) the layered maps cost some 80 ms more to set up and save some 0.2 ms per
 /// pose, so they pay back from about 400 poses (impinge motion, 10 / 100 / 1,000 frames: direct 0.32 / 0.45 / 1.66 s,
 /// maps 0.33 / 0.51 / 1.56 s, medians of 5 alternated runs; issue 52).
@@ -106,26 +88,36 @@ inline constexpr std::size_t kDirectSetupMaxPoses = 400;
 /// below kDirectSetupMaxPoses poses, else "maps". Throws impinge::Error for any other value.
 std::string setup_for_poses(const std::string& setup, std::size_t poses);
 
-/// Frames and neutral (HipJointOptions).
-struct FrameSettings {
-  std::string neutral;  ///< "anatomical" | "scan"; empty: the subject's "neutral", else anatomical
-  /// How the femur moves at each pose (parse_joint_centre: femoral-head, acetabular, combined,
-  /// equidistant); empty: equidistant with anatomical neutral, femoral-head with scan neutral.
-  std::string joint_centre;
-  std::string pelvis_frame = "isb";         ///< isb | app
-  std::string femur_frame = "epicondyles";  ///< epicondyles | posterior-condyles
-};
-
-/// Everything a Session needs. Default-constructed: the library's defaults (the thesis' single-layer maps,
-/// no distances); the front ends start from RunOptions::clinical() (option_table.hpp), whose table holds each
-/// option's name, unit, range, help and default.
+/// Everything a Session needs: the inputs, how the COR is found, the library's own options of the hip
+/// (`hip`: HipJointOptions, its JointOptions `hip.joint` and their declared ranges; the one place each
+/// library option and its default live), and what only a session decides (the grid request, the set-up, the
+/// memory limit, the poses to come). Default-constructed: the library's defaults (the thesis' single-layer
+/// maps, no distances); the front ends start from RunOptions::clinical() (option_table.hpp), whose table
+/// binds each option's name, unit, help and default to one field here.
+///
+/// The Session fills these fields of `hip` itself (a value given for them is replaced): joint.scheme (from
+/// `grid`, unless `grid` is at its defaults and a scheme is set here: SessionOptions() leaves it null),
+/// joint.layered_maps (from `setup`), joint.cropped_distance_queries (from `only_poses`), joint.levels_on when
+/// unset (the distance with distances on, else the radial gap), neutral when unset
+/// (the subject's "neutral", else anatomical), allow_cor_outside_ball (cor.allow_any), head_sphere,
+/// seat_before_sampling, to_report and report_frame_name (from the input and the COR).
 struct SessionOptions {
+  SessionOptions() { hip.joint.scheme.reset(); }
   SessionInput input;
   CorOptions cor;
-  MapSettings maps;
-  FrameSettings frames;
+  HipJointOptions hip;  ///< the library's options: maps, detection, levels, neutral, frames, joint centre, map files
+  GridRequest grid;     ///< the maps' scheme and resolution as asked (resolved into hip.joint.scheme)
+  /// What to build for the work: "maps" (both maps and, with layers, the layered maps), "direct" (no layered
+  /// maps: the hidden vertices by exact ray casts, JointOptions::layered_maps off; for a few poses; no ROM
+  /// searches), "auto" (the front end's choice by the number of poses, setup_for_poses: `impinge distance` and
+  /// motions of fewer than kDirectSetupMaxPoses frames take direct; ROM searches, plans and longer motions maps).
+  std::string setup = "auto";
+  /// The most memory the maps may take, GB; 0: three quarters of this machine's memory. A resolution whose
+  /// maps would need more is refused before anything is allocated (map_memory_bytes).
+  double max_memory_gb = 0;
+  static constexpr Range kMaxMemoryRange{0, 1e6};  ///< of max_memory_gb, GB
   /// The poses the session will be asked for, when the front end knows them (`impinge distance`'s --pose; not
-  /// an option of its own). With maps.setup "direct" and distances or layers on, the distance hierarchies are
+  /// an option of its own). With setup "direct" and distances or layers on, the distance hierarchies are
   /// cropped to them and the scan pose (JointOptions::cropped_distance_queries): the same results, less set-up.
   /// Empty: built over the whole meshes.
   std::vector<PoseAngles> only_poses;
@@ -176,14 +168,15 @@ struct CorResult {
 /// head region with too few vertices, or no femoral head found.
 CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor);
 
-/// The scheme that MapSettings asks for. Throws impinge::Error on two resolutions or a bad one.
-std::shared_ptr<const SamplingScheme> scheme_of(const MapSettings& maps);
+/// The scheme a GridRequest asks for. Throws impinge::Error on two resolutions, a resolution outside its
+/// range, or an unknown scheme.
+std::shared_ptr<const SamplingScheme> scheme_of(const GridRequest& grid);
 
-/// HipJointOptions from the settings (validated: mode, sampling, levels, sparse, layers, frames).
-/// `subject_neutral`: the subject's "neutral" when FrameSettings::neutral is empty. Throws
-/// impinge::Error naming the option.
-HipJointOptions hip_joint_options(const MapSettings& maps, const FrameSettings& frames,
-                                  const std::string& subject_neutral = "");
+/// The HipJointOptions a Session builds with (before the input and the COR are known): `options.hip` with its
+/// scheme resolved (options.grid, or the scheme given in options.hip.joint.scheme), the layered maps by
+/// options.setup, and the neutral, when unset, `subject_neutral` ("anatomical" | "scan"; empty: anatomical);
+/// validated (JointOptions::validate). Throws impinge::Error naming the option.
+HipJointOptions resolved_hip_options(const SessionOptions& options, const std::string& subject_neutral = "");
 
 /// A hip set up from inputs and options: the same for the CLI, Python, experiments and benchmarks.
 /// Immutable once built; detect() and the runs are const and may be called from several threads.
