@@ -26,7 +26,7 @@ def main():
         P, G = impinge.load_mesh(os.path.join(path, "pelvis.ply"))
         j, name = impinge.Joint((V @ lps, F), (P @ lps, G), resolution=0.1), "lhdl-ct"
     else:
-        h = impinge.generated_hip(12000, 2.0)
+        h = impinge.generated_hip(triangles=12000, cam_mm=2.0)
         j, name = impinge.Joint(h["ball"], h["socket"], neutral="scan", resolution=0.1), "generated-12k"
     R = j.femur_rotation(30, 10, 5)
     reps = 11

@@ -252,7 +252,6 @@ void run_touching(CsvWriter& csv, const Schemes& schemes) {
         JointOptions o;
         o.scheme = make_scheme(scheme, res);
         o.mode = mode;
-        o.occlusion_tolerance_mm = 1.0;
         const Joint j(ball, socket, Eigen::Vector3d::Zero(), o);
         const PoseResult r = j.detect(Eigen::Matrix3d::Identity());
         double worst = 0, min_gap = std::numeric_limits<double>::infinity();

@@ -80,7 +80,7 @@ def main():
             if hip.startswith("generated"):
                 # Its flexion stops before 90 deg (a cup about a straight neck): internal rotation over the ROM map's
                 # flexions instead (NaN: in contact without rotation, or free to 150 deg).
-                ir = j.rom_map(MAP_FLEXION_DEG, [0.0])
+                ir = j.rom_map(flexion=MAP_FLEXION_DEG, adduction=[0.0])
                 for f, v in zip(MAP_FLEXION_DEG, ir[:, 0]):
                     wl.writerow([hip, "scan", f"internal_rotation_map_{f:g}_flexion", v,
                                  "limited" if v == v else "not_limited", "nan", 0])

@@ -72,6 +72,10 @@ py::object default_of(const std::string& key);
 // (preset first); a key no row of `use` takes is an error naming `caller` and the known keys.
 void set_options(RunOptions& run, const py::dict& given, unsigned use, const std::string& caller);
 void bind_options(py::module_& m);
+// "Keywords (...): a, b, c.": the keys of the rows with `use`, for a docstring.
+std::string keywords_doc(unsigned use);
+// A docstring kept for the module's lifetime (pybind11 keeps the pointer it is given).
+const char* keep_doc(std::string doc);
 
 // ---- joint.cpp ----
 void bind_joint(py::module_& m);

@@ -127,10 +127,8 @@ void bind_functions(py::module_& m) {
 
   m.def(
       "generated_hip",
-      [](const py::object& triangles, const py::object& cam_mm, const py::object& coverage_deg) {
+      [](const py::kwargs& given) {
         RunOptions run = RunOptions::clinical();
-        py::dict given;
-        given["triangles"] = triangles, given["cam_mm"] = cam_mm, given["coverage_deg"] = coverage_deg;
         set_options(run, given, use_generated_hip, "generated_hip");
         HipModel h;
         {
@@ -144,11 +142,10 @@ void bind_functions(py::module_& m) {
         d["head_radius_mm"] = run.generate.head_radius_mm;
         return d;
       },
-      py::arg("triangles") = default_of("triangles"), py::arg("cam_mm") = default_of("cam_mm"),
-      py::arg("coverage_deg") = default_of("coverage_deg"),
-      "A generated hip (sphere head with neck, optional cam bump, cup with rim; scan frame RAS, mm) -> "
-      "dict(ball=(V, F), socket=(V, F), cor, head_radius_mm). Use it with neutral='scan'. The keywords are "
-      "`impinge generate`'s (impinge.options()), checked against their ranges.");
+      keep_doc("A generated hip (sphere head with neck, optional cam bump, cup with rim; scan frame RAS, mm) -> "
+       "dict(ball=(V, F), socket=(V, F), cor, head_radius_mm). Use it with neutral='scan'. The keywords are "
+       "`impinge generate`'s (impinge.options()), checked against their ranges. " +
+       keywords_doc(use_generated_hip)));
 }
 
 void bind_types(py::module_& m) {

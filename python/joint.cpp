@@ -106,12 +106,7 @@ RomRequest rom_request(const PyJoint& j, const py::dict& given, unsigned use, co
   return run.rom;
 }
 
-py::dict rom_limits(const PyJoint& j, const py::object& threshold_mm, const py::object& contact_depth_mm,
-                    const py::object& metric, const py::object& contacts, const py::object& step_deg,
-                    const py::object& max_deg) {
-  py::dict given;
-  given["threshold_mm"] = threshold_mm, given["contact_depth_mm"] = contact_depth_mm, given["metric"] = metric;
-  given["contacts"] = contacts, given["step_deg"] = step_deg, given["max_deg"] = max_deg;
+py::dict rom_limits(const PyJoint& j, const py::kwargs& given) {
   RomRequest q = rom_request(j, given, use_rom_limits, "rom_limits");
   q.map = false;
   RomRun run;
@@ -136,24 +131,7 @@ py::dict rom_limits(const PyJoint& j, const py::object& threshold_mm, const py::
 
 // Joint.plan: a resection plan on this Joint's inputs and settings (run_plan), its check, its record as a dict with
 // the resected meshes (input frame) and each vertex's depth.
-py::dict plan(const PyJoint& j, const py::object& target, const py::object& target_motion, const py::object& resect, const py::object& clearance_mm, const py::object& max_depth_fraction, const py::object& max_depth_mm, const py::object& burr_radius_mm, const py::object& plan_step_deg, const py::object& allow_partial, const py::object& threshold_mm, const py::object& contact_depth_mm, const py::object& metric, const py::object& contacts, const py::object& step_deg, const py::object& max_deg) {
-  py::dict given;
-  given["target"] = target;
-  given["target_motion"] = target_motion;
-  given["resect"] = resect;
-  given["clearance_mm"] = clearance_mm;
-  given["max_depth_fraction"] = max_depth_fraction;
-  given["max_depth_mm"] = max_depth_mm;
-  given["burr_radius_mm"] = burr_radius_mm;
-  given["plan_step_deg"] = plan_step_deg;
-  given["allow_partial"] = allow_partial;
-  given["threshold_mm"] = threshold_mm;
-  given["contact_depth_mm"] = contact_depth_mm;
-  given["metric"] = metric;
-  given["contacts"] = contacts;
-  given["step_deg"] = step_deg;
-  given["max_deg"] = max_deg;
-
+py::dict plan(const PyJoint& j, const py::kwargs& given) {
   RunOptions run = RunOptions::clinical();
   set_options(run, given, use_joint_plan, "plan");
   PlanRun p;
@@ -182,11 +160,7 @@ py::dict plan(const PyJoint& j, const py::object& target, const py::object& targ
   return d;
 }
 
-py::array_t<double> rom_map(const PyJoint& j, const py::object& flexion, const py::object& adduction,
-                            const py::object& threshold_mm, const py::object& contact_depth_mm, const py::object& metric) {
-  py::dict given;
-  given["flexion"] = flexion, given["adduction"] = adduction, given["threshold_mm"] = threshold_mm;
-  given["contact_depth_mm"] = contact_depth_mm, given["metric"] = metric;
+py::array_t<double> rom_map(const PyJoint& j, const py::kwargs& given) {
   RomRequest q = rom_request(j, given, use_rom_map, "rom_map");
   q.limits = false;
   RomRun run;
@@ -244,31 +218,31 @@ void add_joint_queries(py::class_<PyJoint>& c) {
            "penetrating_area_mm2 = socket_penetrating_area_mm2, ball_penetrating_area_mm2, socket_levelN_area_mm2, "
            "closest clock hours and point, detection_ms). One C++ loop, frames in blocks on impinge.get_threads() "
            "threads (rows in order); the GIL is released.")
-      .def("rom_limits", &rom_limits, py::arg("threshold_mm") = default_of("threshold_mm"),
-           py::arg("contact_depth_mm") = default_of("contact_depth_mm"), py::arg("metric") = default_of("metric"),
-           py::arg("contacts") = default_of("contacts"), py::arg("step_deg") = default_of("step_deg"),
-           py::arg("max_deg") = default_of("max_deg"),
-           "ROM limits from neutral for the standard motions (flexion, extension, abduction, adduction, internal and "
+      .def("rom_limits", &rom_limits,
+           keep_doc("ROM limits from neutral for the standard motions (flexion, extension, abduction, adduction, "
+                    "internal and "
            "external rotation, both rotations at 90 deg flexion, FADIR) -> dict motion -> the CLI's rom_limits.csv "
            "row (limit_deg (NaN: none within max_deg), limited_by, contact_class, socket_clock_h, femur_clock_h, "
            "min_gap_at_limit_mm, monotone, contact_at_start, evaluations) and contact_mm (input frame); and "
            "excluded_vertices (in contact at neutral, not counted). The keywords are the option table's "
            "(impinge.options(): `impinge rom`'s --threshold, --contact-depth, --metric, --contacts, --step, --max), "
-           "with its defaults. metric 'distance' needs the Joint's distances (the default).")
-      .def("plan", &plan, py::arg("target") = default_of("target"), py::arg("target_motion") = default_of("target_motion"), py::arg("resect") = default_of("resect"), py::arg("clearance_mm") = default_of("clearance_mm"), py::arg("max_depth_fraction") = default_of("max_depth_fraction"), py::arg("max_depth_mm") = default_of("max_depth_mm"), py::arg("burr_radius_mm") = default_of("burr_radius_mm"), py::arg("plan_step_deg") = default_of("plan_step_deg"), py::arg("allow_partial") = default_of("allow_partial"), py::arg("threshold_mm") = default_of("threshold_mm"), py::arg("contact_depth_mm") = default_of("contact_depth_mm"), py::arg("metric") = default_of("metric"), py::arg("contacts") = default_of("contacts"), py::arg("step_deg") = default_of("step_deg"), py::arg("max_deg") = default_of("max_deg"),
-           "Resection plan (the CLI's `impinge plan`, plan.json as a dict): the least bone to remove so that the "
+           "with its defaults. metric 'distance' needs the Joint's distances (the default). " +
+            keywords_doc(use_rom_limits)))
+      .def("plan", &plan,
+           keep_doc("Resection plan (the CLI's `impinge plan`, plan.json as a dict): the least bone to remove so "
+                    "that the "
            "targets run free of impingement (target: 'MOTION=DEG,...' and/or 'normal'; target_motion: a motion "
            "file), shaped for a spherical burr, within the safety depth, never the head inside the labrum line or "
            "the lunate surface; checked by the ROM search on the resected bones. Adds femur_resected (V, F: input "
            "frame, the input's faces) and femur_resection_mm (per vertex), and the pelvis' with resect 'pelvis' or "
            "'both'. Raises impinge.Error when a target is missed, unless allow_partial. Keywords and defaults: the "
-           "option table's (impinge.options()).")
-      .def("rom_map", &rom_map, py::arg("flexion") = default_of("flexion"),
-           py::arg("adduction") = default_of("adduction"), py::arg("threshold_mm") = default_of("threshold_mm"),
-           py::arg("contact_depth_mm") = default_of("contact_depth_mm"), py::arg("metric") = default_of("metric"),
-           "ROM map: the largest internal rotation (deg) before contact for every flexion x adduction (deg; default "
+            "option table's (impinge.options()). " + keywords_doc(use_joint_plan)))
+      .def("rom_map", &rom_map,
+           keep_doc("ROM map: the largest internal rotation (deg) before contact for every flexion x adduction "
+                    "(deg; default "
            "`impinge rom`'s grid) -> float64 (len(flexion), len(adduction)); NaN where in contact already without "
-           "rotation or free up to 150 deg. The same search as `impinge rom`'s rom_map.csv (run_rom).")
+           "rotation or free up to 150 deg. The same search as `impinge rom`'s rom_map.csv (run_rom). " +
+            keywords_doc(use_rom_map)))
       .def(
           "morphology",
           [](const PyJoint& j) {

@@ -2,6 +2,7 @@
 // defaults from the clinical preset, and impinge.options(), the table itself, for the stub's and the study
 // spec's tests (python/tests/test_options.py) and for users.
 #include <cmath>
+#include <deque>
 
 #include "bindings.hpp"
 #include "impinge/core/error.hpp"
@@ -136,6 +137,20 @@ void set_options(RunOptions& run, const py::dict& given, unsigned use, const std
     const py::object v = given[py::str(r.key)];
     if (!v.is_none()) r.set(run, to_value(r, v, r.key), r.key);
   }
+}
+
+std::string keywords_doc(unsigned use) {
+  std::string keys;
+  for (const OptionRow& r : option_table())
+    if (r.uses & use) keys += (keys.empty() ? "" : ", ") + r.key;
+  return "Keywords, the rows of impinge.options() with '" + std::string(use_name(use)) +
+         "' in their uses (None or absent: the clinical preset's default): " + keys + ".";
+}
+
+const char* keep_doc(std::string doc) {
+  static std::deque<std::string> docs;  // a deque: earlier strings never move
+  docs.push_back(std::move(doc));
+  return docs.back().c_str();
 }
 
 void bind_options(py::module_& m) {

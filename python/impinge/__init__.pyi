@@ -60,7 +60,7 @@ def femoral_head_centre(ball: Optional[Union[str, os.PathLike, Tuple[npt.ArrayLi
     """The femoral head centre as Joint(...) finds it from the same keywords, without building maps ->
     dict(centre (3,) mm in the input frame, radius mm (NaN when given), method)."""
 
-def generated_hip(triangles: int = 3000, cam_mm: float = 0.0, coverage_deg: float = 100.0) -> Dict[str, Any]:
+def generated_hip(*, triangles: int = 3000, cam_mm: float = 0.0, coverage_deg: float = 100.0) -> Dict[str, Any]:
     """A generated hip -> dict(ball=(V, F), socket=(V, F), cor, head_radius_mm); use neutral='scan'."""
 
 class SphereFit:
@@ -96,10 +96,10 @@ class Joint:
                  mode: str = 'exact', levels: Optional[Sequence[float]] = None, occlusion_tolerance_mm: float = 1.0,
                  max_radius_mm: float = 0.0, sparse: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
                  layers: int = 4, setup: str = 'auto', layered_spacing: float = 0.5,
-                 extra_articular_radius_mm: float = 150.0,
-                 distances: bool = True, levels_on: Optional[str] = None, distance_reach_mm: float = 0.0,
-                 max_memory_gb: float = 0.0, maps_only: bool = False, maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None,
-                 pelvis_frame: str = 'isb', joint_centre: Optional[str] = None, femur_frame: str = "epicondyles") -> None:
+                 extra_articular_radius_mm: float = 150.0, distances: bool = True, levels_on: Optional[str] = None,
+                 distance_reach_mm: float = 0.0, max_memory_gb: float = 0.0, maps_only: bool = False,
+                 maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None, pelvis_frame: str = 'isb',
+                 joint_centre: Optional[str] = None, femur_frame: str = 'epicondyles') -> None:
         """Every keyword is a row of impinge.options() (the session layer's option table, shared with the CLI
         and study files), its default the clinical preset's; preset='thesis' starts from the thesis' set-up.
         ball, socket: mesh files or (V (n, 3) float mm, F (m, 3) int); or subject: a subject.json
@@ -135,18 +135,19 @@ class Joint:
     def motion(self, angles: npt.ArrayLike) -> Dict[str, npt.NDArray[np.float64]]:
         """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each. Frames
         are scanned in blocks on impinge.get_threads() threads; rows come back in order."""
-    def rom_limits(self, threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
+    def rom_limits(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
                    contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0) -> Dict[str, Any]:
         """ROM limits from neutral for the standard motions -> dict motion -> the CLI's rom_limits.csv row
         (limit_deg, limited_by, contact_class, ...). The keywords and defaults are `impinge rom`'s (the option
         table). contacts: 'impingement' (the joint surfaces meeting is left out), 'articular' (only that: the
         joint space closing) or 'all'. contact_depth_mm: how far past the threshold a contact must reach to end a
         search (0: the first touch). metric: 'distance' (needs the Joint's distances) or 'radial'."""
-    def plan(self, target: Optional[str] = None, target_motion: Optional[str] = None, resect: str = 'femur',
-             clearance_mm: float = 0.3, max_depth_fraction: float = 0.3, max_depth_mm: float = 0.0,
-             burr_radius_mm: float = 2.5, plan_step_deg: float = 0.5, allow_partial: bool = False,
-             threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
-             contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0) -> Dict[str, Any]:
+    def plan(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
+             contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0,
+             target: Optional[str] = None, target_motion: Optional[Union[str, os.PathLike]] = None,
+             resect: str = 'femur', clearance_mm: float = 0.3, max_depth_fraction: float = 0.3,
+             max_depth_mm: float = 0.0, burr_radius_mm: float = 2.5, plan_step_deg: float = 0.5,
+             allow_partial: bool = False) -> Dict[str, Any]:
         """Resection plan (`impinge plan`'s plan.json as a dict): the least bone to remove so that the targets
         ('MOTION=DEG,...' and/or 'normal'; target_motion: a motion file) run free of impingement, shaped for a
         spherical burr (burr_radius_mm), within the safety depth (max_depth_fraction of the neck's least diameter,
@@ -154,13 +155,12 @@ class Joint:
         the resected bones. Adds femur_resected (V, F: input frame, mm) and femur_resection_mm (per vertex, mm),
         and the pelvis' with resect 'pelvis' or 'both'. Raises impinge.Error when a target is missed unless
         allow_partial."""
-    def rom_map(self, flexion: Sequence[float] = [0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0,
-                                                  55.0, 60.0, 65.0, 70.0, 75.0, 80.0, 85.0, 90.0, 95.0, 100.0,
-                                                  105.0, 110.0, 115.0, 120.0],
-                adduction: Sequence[float] = [-20.0, -15.0, -10.0, -5.0, 0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0,
-                                              35.0, 40.0],
-                threshold_mm: float = 0.0, contact_depth_mm: float = 0.25,
-                metric: str = 'distance') -> npt.NDArray[np.float64]:
+    def rom_map(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
+                flexion: Sequence[float] = [0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0,
+                                            60.0, 65.0, 70.0, 75.0, 80.0, 85.0, 90.0, 95.0, 100.0, 105.0, 110.0,
+                                            115.0, 120.0],
+                adduction: Sequence[float] = [-20.0, -15.0, -10.0, -5.0, 0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0,
+                                              40.0]) -> npt.NDArray[np.float64]:
         """Largest internal rotation before contact, (len(flexion), len(adduction)) degrees: `impinge rom`'s
         ROM map (the same search)."""
     def morphology(self) -> Dict[str, Any]: ...

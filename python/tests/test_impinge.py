@@ -298,7 +298,7 @@ def test_real_subject_anatomical_frames():
         j.detect_pose(90, 0, fl)["summary"]["ball"]["min_gap_mm"] <= 0
     assert min(j.detect_pose(90, 0, fl - 0.5)["summary"]["socket"]["min_gap_mm"],
                j.detect_pose(90, 0, fl - 0.5)["summary"]["ball"]["min_gap_mm"]) > 0
-    grid = j.rom_map([0, 90], [0, 10], contact_depth_mm=0)
+    grid = j.rom_map(flexion=[0, 90], adduction=[0, 10], contact_depth_mm=0)
     assert grid.shape == (2, 2) and grid[1, 0] == pytest.approx(fl)
     # Each limit says what it is, the published normal range beside it, whether the soft tissue usually ends the
     # motion first (the bony limit past that range), and the pelvic frame the angles are measured in.

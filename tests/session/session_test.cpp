@@ -175,7 +175,7 @@ TEST(Session, BadOptionsAreRefusedBeforeAnyFileIsRead) {
   refused([](SessionOptions& o) { o.hip.joint.layered_spacing_deg = 120; }, "layered_spacing_deg 120 deg");
   refused([](SessionOptions& o) { o.hip.joint.extra_articular_radius_mm = 0; }, "extra_articular_radius_mm 0 mm");
   refused([](SessionOptions& o) { o.max_memory_gb = -1; }, "max-memory -1 GB");
-  refused([](SessionOptions& o) { o.hip.joint.levels_on = LevelQuantity::distance; }, "needs distances on");
+  refused([](SessionOptions& o) { o.hip.joint.levels_on = LevelQuantity::distance; }, "needs the distances on");
   refused([](SessionOptions& o) { o.hip.joint.scheme = make_scheme("helix", 100), o.grid.precision = 1; }, "not both");
   EXPECT_NE(error_of([] { parse_cor("1,2", "--cor"); }).find("--cor"), std::string::npos);
   EXPECT_NE(error_of([] { parse_head_region("1,2,3,-4", "--head-region"); }).find("radius"), std::string::npos);

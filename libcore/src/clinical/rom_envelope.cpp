@@ -67,7 +67,8 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
                          const RomBaseline& base) {
   check(o);
   check_metric(hip.joint(), o);
-  require(e.step_deg > 0 && e.coarse_steps >= 1, "rom envelope: need step > 0 and coarse_steps >= 1");
+  require(e.step_deg > 0, "rom envelope: need step > 0");
+  check_in_range("RomEnvelopeOptions::coarse_steps", e.coarse_steps, RomEnvelopeOptions::kCoarseStepsRange);
   RomEnvelope out;
   out.flexion_deg = envelope_axis(e.flexion_min_deg, e.flexion_max_deg, e.step_deg, "flexion");
   out.adduction_deg = envelope_axis(e.adduction_min_deg, e.adduction_max_deg, e.step_deg, "adduction");

@@ -18,6 +18,12 @@ namespace impinge {
 namespace {
 const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
   o.validate();
+  // What this build can do (the options themselves are valid: a session that builds no joint, impinge morphology,
+  // checks them without these).
+  require(o.layers == 0 || FirstHitCaster::available(),
+          "joint: layered maps need a ray caster (Embree or CGAL), and this build has neither");
+  require(!o.distances || SignedDistanceQuery::available(),
+          "joint: distances need a closest-point engine (Embree or CGAL), and this build has neither");
   require(cor.allFinite(), "joint: centre of rotation is not finite");
   return o;
 }
@@ -26,25 +32,23 @@ const JointOptions& checked(const JointOptions& o, const Eigen::Vector3d& cor) {
 void JointOptions::validate() const {
   require(scheme != nullptr, "JointOptions::scheme: no sampling scheme given");
   check_in_range("JointOptions::occlusion_tolerance_mm", occlusion_tolerance_mm, kOcclusionToleranceRange, "mm");
-  if (!std::isinf(max_radius_mm)) check_in_range("JointOptions::max_radius_mm", max_radius_mm, kMaxRadiusRange, "mm");
+  if (max_radius_mm != kInf) check_in_range("JointOptions::max_radius_mm", max_radius_mm, kMaxRadiusRange, "mm");
   if (sparse_maps) check_in_range("JointOptions::sparse_region_mm", sparse_region_mm, kSparseRegionRange, "mm");
   if (exact_at_discontinuities)
     check_in_range("JointOptions::discontinuity_tolerance_mm", discontinuity_tolerance_mm, kDiscontinuityToleranceRange,
                    "mm");
   check_in_range("JointOptions::layers", layers, kLayersRange);
-  require(layers == 0 || FirstHitCaster::available(),
-          "joint: layered maps need a ray caster (Embree or CGAL), and this build has neither");
   check_in_range("JointOptions::extra_articular_radius_mm", extra_articular_radius_mm, kExtraArticularRadiusRange,
                  "mm");
   check_in_range("JointOptions::layered_spacing_deg", layered_spacing_deg, kLayeredSpacingRange, "deg");
   levels.validate();
-  require(!distances || SignedDistanceQuery::available(),
-          "joint: distances need a closest-point engine (Embree or CGAL), and this build has neither");
   check_in_range("JointOptions::distance_reach_mm", distance_reach_mm, kDistanceReachRange, "mm");
   const LevelQuantity q = level_quantity();
-  require(q == LevelQuantity::radial_gap || distances, "levels-on distance: needs distances on");
+  require(q == LevelQuantity::radial_gap || distances,
+          "levels-on distance (levels_on): needs the distances on (--distances on, distances=True)");
   require(q == LevelQuantity::radial_gap || reach_mm() >= levels.thresholds_mm.front(), [&] {
-    return "levels-on distance: the distance reach (distance-reach) " + shortest_decimal(reach_mm()) +
+    return "levels-on distance (levels_on): the distance reach (--distance-reach, distance_reach_mm) " +
+           shortest_decimal(reach_mm()) +
            " mm is below the largest level threshold (" + shortest_decimal(levels.thresholds_mm.front()) + " mm)";
   });
 }

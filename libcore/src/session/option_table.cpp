@@ -51,14 +51,6 @@ std::vector<double> checked_numbers(const OptionValue& v, const std::string& as,
 
 }  // namespace detail
 
-namespace {
-std::vector<double> grid(int from, int to, int step) {
-  std::vector<double> v;
-  for (int x = from; x <= to; x += step) v.push_back(x);
-  return v;
-}
-
-}  // namespace
 
 using detail::joined;
 using detail::shortest;
@@ -76,8 +68,6 @@ RunOptions RunOptions::clinical() {
   o.session.hip.joint.layers = 4;        // the whole bone: hidden vertices too, extra-articular (issue 29)
   o.session.hip.joint.distances = true;  // the Euclidean distance beside the radial gap (issue 26)
   o.rom.search.metric = RomMetric::distance;
-  o.rom.map_flexion_deg = grid(0, 120, 5);
-  o.rom.map_adduction_deg = grid(-20, 40, 5);
   o.command.pose = "0,0,0";
   return o;
 }

@@ -180,10 +180,8 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
   if (q.map) {
     run.map_flexion_deg = q.map_flexion_deg;
     run.map_adduction_deg = q.map_adduction_deg;
-    if (run.map_flexion_deg.empty())
-      for (int f = 0; f <= 120; f += 5) run.map_flexion_deg.push_back(f);
-    if (run.map_adduction_deg.empty())
-      for (int a = -20; a <= 40; a += 5) run.map_adduction_deg.push_back(a);
+    if (run.map_flexion_deg.empty()) run.map_flexion_deg = RomRequest{}.map_flexion_deg;
+    if (run.map_adduction_deg.empty()) run.map_adduction_deg = RomRequest{}.map_adduction_deg;
     t0 = Clock::now();
     run.map = rom_map(hip, run.map_flexion_deg, run.map_adduction_deg, q.search, run.baseline);
     run.map_ms = ms_since(t0);

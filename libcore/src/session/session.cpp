@@ -296,6 +296,8 @@ Session::Session(const SessionOptions& options) : options_(options) {
   if (!options.hip.neutral && !in.neutral.empty())
     hip_options_.neutral = parse_neutral(in.neutral, options.input.subject + ": \"neutral\"");
   const Neutral neutral = hip_options_.neutral.value_or(Neutral::anatomical);
+  hip_options_.neutral = neutral;  // resolved: hip_options() tells what was built
+  hip_options_.head_sphere.reset();  // the session's own (below), never a caller's
   side_ = in.side;
   frame_ = in.frame;
   to_working_ = in.to_working;

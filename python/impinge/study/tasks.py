@@ -126,7 +126,7 @@ def _run_rom(joint, task, folder):
 
 def _run_envelope(joint, task, folder):
     o = task["options"]
-    ir = joint.rom_map(o["flexion"], o["adduction"], threshold_mm=o["threshold_mm"],
+    ir = joint.rom_map(flexion=o["flexion"], adduction=o["adduction"], threshold_mm=o["threshold_mm"],
                        contact_depth_mm=o["contact_depth_mm"], metric=o["metric"])
     F, A = np.meshgrid(o["flexion"], o["adduction"], indexing="ij")
     _write_csv(os.path.join(folder, "rom_map.csv"), {"flexion_deg": F.ravel(), "adduction_deg": A.ravel(),

@@ -36,7 +36,7 @@ struct JointOptions {
   SamplingMethod sampling = SamplingMethod::automatic;             ///< how maps are filled
   double occlusion_tolerance_mm = 1.0;                             ///< a vertex farther than its own map's surface
                                                                    ///< plus this is hidden (not on the first surface)
-  static constexpr Range kOcclusionToleranceRange{0, 1e3};         ///< of occlusion_tolerance_mm, mm
+  static constexpr Range kOcclusionToleranceRange{0, kInf};        ///< of occlusion_tolerance_mm, mm
   /// Region of interest about the COR, mm: no vertex farther is tested (hidden ones neither).
   double max_radius_mm = kInf;
   static constexpr Range kMaxRadiusRange{0, 1e4, true};  ///< of max_radius_mm, mm, when finite (inf: every vertex)
@@ -69,7 +69,7 @@ struct JointOptions {
   int layers = 0;
   static constexpr Range kLayersRange{0, LayeredMap::kMaxLayers};  ///< of layers
   double extra_articular_radius_mm = 150;  ///< hidden vertices farther from the COR are not tested, mm (> 0)
-  static constexpr Range kExtraArticularRadiusRange{0, 1e4, true};  ///< of extra_articular_radius_mm, mm
+  static constexpr Range kExtraArticularRadiusRange{0, kInf, true};  ///< of extra_articular_radius_mm, mm
   /// With layers > 0: build the layered maps (true), or leave them out (false: a set-up for a few poses, which
   /// filling them, about 0.12 s for lhdl-ct at 0.5 deg, would not repay): the hidden vertices near the other bone
   /// are then tested by exact ray casts over their rays' crossings (scan_layered_near_exact), the value the
@@ -94,7 +94,7 @@ struct JointOptions {
   /// The reach of the distances, mm (> 0); 0: the largest threshold of `levels` (the cartilage offset,
   /// 4 mm by default). Vertices proven farther get NaN.
   double distance_reach_mm = 0;
-  static constexpr Range kDistanceReachRange{0, 1e4};  ///< of distance_reach_mm, mm
+  static constexpr Range kDistanceReachRange{0, kInf};  ///< of distance_reach_mm, mm
   /// What the impingement levels classify (ScanSummary::level_vertices, PLY colours, clock sectors): the
   /// radial gap (the thesis) or, with distances on, the Euclidean distance (then distance_reach_mm must be
   /// 0 or at least the largest level threshold). Unset: the radial gap (level_quantity()); the Session resolves
@@ -111,8 +111,10 @@ struct JointOptions {
   bool needs_distance_queries() const { return distances || layers > 0; }
   /// levels_on resolved: as set, else the radial gap.
   LevelQuantity level_quantity() const { return levels_on.value_or(LevelQuantity::radial_gap); }
-  /// Check every field against its declared range (and the levels, the scheme, levels_on against distances).
-  /// Throws impinge::Error naming the field (e.g. "JointOptions::layers 99 is outside the valid range [0, 16]").
+  /// Check every field against its declared range (and the levels, the scheme, levels_on against distances);
+  /// not what the build can do (a ray caster for layers, a closest-point engine for distances: the Joint checks
+  /// those). Throws impinge::Error naming the field (e.g. "JointOptions::layers 99 is outside the valid range
+  /// [0, 16]").
   void validate() const;
   /// distance_reach_mm resolved (the largest level threshold when 0), mm.
   double reach_mm() const { return distance_reach_mm > 0 ? distance_reach_mm : std::max(levels.thresholds_mm.front(), 1e-3); }

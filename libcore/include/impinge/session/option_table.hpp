@@ -3,12 +3,15 @@
 /// The one table of every option a front end exposes: the CLI's (`impinge distance|motion|rom|
 /// generate`), Python's (`impinge.Joint(...)`, `Joint.rom_limits`, `Joint.rom_map`,
 /// `impinge.generated_hip`), the `.pyi` stub's and the study files' (`[joint]`, `[[task]]`). Each row
-/// holds the option's CLI name, its Python and study key, type, unit, valid range or choices, help
-/// text, where it applies, and the member of RunOptions it sets; its default is the member's value in
-/// the preset (RunOptions::clinical()), so no front end holds a default of its own. The CLI builds
-/// its options from the rows, Python its keywords, the study spec its keys; tests/session's
-/// option_table_test and python/tests' test_options fail when a front end differs from the table.
-/// Adding an option is one row here plus its use in the library.
+/// holds the option's CLI name, its Python and study key, type, unit, help text, where it applies, and
+/// the field of RunOptions it sets: a field of a library options struct (SessionOptions::hip, RomRequest,
+/// PlanRequest, ...) or a session-only one. The field holds the default (its initialiser, or the preset
+/// RunOptions::clinical() where that differs) and declares its valid range (a Range beside it) or its
+/// choices (its enum's name table), which the row takes; so no front end holds a default or a range of its
+/// own. The CLI builds its options from the rows, Python its keywords, the study spec its keys, the build
+/// the `.pyi` stub (python/gen_stub.py); tests/session's option_table_test and python/tests' test_options
+/// fail when a front end differs from the table. Adding an option: docs/architecture.md, "Options: each
+/// bound once".
 
 #include <functional>
 #include <string>
@@ -113,8 +116,8 @@ struct OptionRow {
   std::string unit;  ///< "mm", "deg", "mm^3" ...; empty when none
   unsigned uses = 0;                 ///< OptionUse bits
   std::vector<std::string> choices;  ///< OptionType::choice: the valid values
-  /// number, integer: the valid range, from the field's declared Range (e.g. JointOptions::kLayersRange); inclusive
-  /// unless min_open; max inf: "inf" allowed.
+  /// number, integer: the valid range, from the field's declared Range (e.g. JointOptions::kLayersRange), with 0
+  /// added where the row's 0 means "none" (max-radius, sparse); inclusive unless min_open; max inf: "inf" allowed.
   double min = -1e308, max = 1e308;
   bool min_open = false;  ///< min itself is not valid (a length that must be > 0)
   bool required = false;             ///< the CLI commands that use it need it

@@ -61,8 +61,16 @@ struct RomRequest {
   RomOptions search;
   bool limits = true;                     ///< the limits of the standard motions (rom_limits.csv)
   bool map = true;                        ///< the ROM map: the largest internal rotation per flexion x adduction
-  std::vector<double> map_flexion_deg;    ///< empty: 0..120 step 5
-  std::vector<double> map_adduction_deg;  ///< empty: -20..40 step 5
+  /// The ROM map's flexion angles, deg (0..120 step 5, the thesis' sec. 5.2 range); empty: the default.
+  std::vector<double> map_flexion_deg = angle_steps(0, 120, 5);
+  /// The ROM map's adduction angles, deg (-20..40 step 5); empty: the default.
+  std::vector<double> map_adduction_deg = angle_steps(-20, 40, 5);
+  /// from, from + step, ... up to `to` (whole degrees).
+  static std::vector<double> angle_steps(int from, int to, int step) {
+    std::vector<double> v;
+    for (int x = from; x <= to; x += step) v.push_back(x);
+    return v;
+  }
   bool envelope = false;                  ///< the ROM envelope (rom_envelope)
   RomEnvelopeOptions envelope_options;
 };

@@ -95,12 +95,14 @@ std::string setup_for_poses(const std::string& setup, std::size_t poses);
 /// maps, no distances); the front ends start from RunOptions::clinical() (option_table.hpp), whose table
 /// binds each option's name, unit, help and default to one field here.
 ///
-/// The Session fills these fields of `hip` itself (a value given for them is replaced): joint.scheme (from
-/// `grid`, unless `grid` is at its defaults and a scheme is set here: SessionOptions() leaves it null),
-/// joint.layered_maps (from `setup`), joint.cropped_distance_queries (from `only_poses`), joint.levels_on when
-/// unset (the distance with distances on, else the radial gap), neutral when unset
-/// (the subject's "neutral", else anatomical), allow_cor_outside_ball (cor.allow_any), head_sphere,
-/// seat_before_sampling, to_report and report_frame_name (from the input and the COR).
+/// The Session resolves these fields of `hip` itself (Session::hip_options() gives what it built with):
+/// joint.scheme (from `grid`; SessionOptions() leaves it null; a scheme set here is used as it is, and giving
+/// `grid` as well is an error), joint.layered_maps (from `setup`; a value given is replaced),
+/// joint.cropped_distance_queries (from `only_poses`; replaced), joint.levels_on when unset (the distance with
+/// distances on, else the radial gap), neutral when unset (the subject's "neutral", else anatomical), and,
+/// replacing any value given, allow_cor_outside_ball (cor.allow_any), head_sphere, seat_before_sampling, to_report
+/// and report_frame_name (from the input and the COR). SessionOptions is not an aggregate (its constructor
+/// leaves the scheme to `grid`): set its fields by name.
 struct SessionOptions {
   SessionOptions() { hip.joint.scheme.reset(); }
   SessionInput input;
@@ -174,7 +176,8 @@ std::shared_ptr<const SamplingScheme> scheme_of(const GridRequest& grid);
 
 /// The HipJointOptions a Session builds with (before the input and the COR are known): `options.hip` with its
 /// scheme resolved (options.grid, or the scheme given in options.hip.joint.scheme), the layered maps by
-/// options.setup, and the neutral, when unset, `subject_neutral` ("anatomical" | "scan"; empty: anatomical);
+/// options.setup, and the neutral, when unset, `subject_neutral` ("anatomical" | "scan"; empty: left unset, which
+/// HipJoint reads as anatomical);
 /// validated (JointOptions::validate). Throws impinge::Error naming the option.
 HipJointOptions resolved_hip_options(const SessionOptions& options, const std::string& subject_neutral = "");
 
