@@ -21,11 +21,6 @@
 #include "impinge/core/concurrent.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/timing.hpp"
-#include "impinge/io/generated_models.hpp"
-#include "impinge/io/mesh_io.hpp"
-#include "impinge/io/motion.hpp"
-#include "impinge/io/vtk_output.hpp"
-#include "impinge/maps/map_image.hpp"
 #include "impinge/session/option_table.hpp"
 #include "impinge/session/morphology_run.hpp"
 #include "impinge/session/plan_run.hpp"
@@ -150,12 +145,9 @@ int run_distance(const RunOptions& o) {
   const double pose_ms = ms_since(t);
   t = Clock::now();
   begin_output_folder(out, "distance");
-  // The map images beside the gap files (both on their own threads); the gap files' error first.
+  // The map images beside the gap files (on their own threads); the gap files' error first.
   run_both([&] { write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur); },
-           [&] {
-             write_map_png(in_dir(out, "ball_map.png"), s.joint().ball().map);
-             write_map_png(in_dir(out, "socket_map.png"), s.joint().socket().map);
-           });
+           [&] { write_map_pngs(out, s); });
   nlohmann::json j = run_record(s);
   j.update(pose_record(s, pose, femur, res));
   // Where a one-pose run's time goes (issue 52): the set-up (reading and checking the meshes, the head fit, the
@@ -201,31 +193,17 @@ int run_motion(const RunOptions& o) {
 
   begin_output_folder(out, "motion", {"gaps"});
   const std::size_t n = motion.frames();
-  const int every = mo.vtp_every > 0 ? mo.vtp_every : static_cast<int>((n + 99) / 100);
-  Table frames;
-  frames.columns = motion_columns(s.joint_options().levels);
-  std::vector<PvdEntry> pvd;
   const bool bar = !mo.quiet && isatty(fileno(stderr));
-  const auto t_loop = Clock::now();
-  const double detect_ms = run_motion(s, motion.angles, motion.time_s, [&](const MotionFrame& f) {
-    frames.add(motion_row(f));
-    if (f.index % static_cast<std::size_t>(every) == 0) {
-      std::ostringstream name;
-      name << "gaps/frame_" << std::setw(6) << std::setfill('0') << f.index << ".vtp";
-      write_pose_vtp(in_dir(out, name.str()), s, *f.result, f.pose);
-      pvd.push_back({f.time_s, name.str()});
-    }
-    if (bar && (f.index % 10 == 0 || f.index + 1 == n)) progress_bar(f.index + 1, n);
+  const MotionFiles files = write_motion_files(out, s, motion, mo.vtp_every, [&](std::size_t done, std::size_t total) {
+    if (bar && ((done - 1) % 10 == 0 || done == total)) progress_bar(done, total);
   });
-  write_csv(in_dir(out, "frames.csv"), frames);
-  write_pvd(in_dir(out, "gaps.pvd"), pvd);
-  const double write_ms = ms_since(t_loop) - detect_ms;
+  const double detect_ms = files.detect_ms, write_ms = files.write_ms;
   nlohmann::json j = run_record(s);
   j["motion_file"] = mo.motion;
   j["motion_format"] = motion.format;
   j["motion_frames"] = n;
-  j["vtp_every"] = every;
-  j["vtp_files"] = pvd.size();
+  j["vtp_every"] = files.vtp_every;
+  j["vtp_files"] = files.vtp_files;
   j["timings_ms"] = {{"setup_total", setup_ms},
                      {"ball_sampling", s.joint().ball().sampling_ms},
                      {"socket_sampling", s.joint().socket().sampling_ms},
@@ -337,22 +315,8 @@ int run_plan(const RunOptions& o) {
 }
 
 int run_generate(const RunOptions& run) {
-  const HipModelOptions& o = run.generate;
   const std::string& out = run.command.out;
-  const HipModel h = make_hip_model(o);
-  begin_output_folder(out, "generate");
-  write_ply(in_dir(out, "femur_r.ply"), h.ball);
-  write_ply(in_dir(out, "pelvis.ply"), h.socket);
-  write_json(in_dir(out, "subject.json"), {{"side", "right"},
-                                           {"frame", "RAS"},
-                                           {"units", "mm"},
-                                           {"femur", "femur_r.ply"},
-                                           {"pelvis", "pelvis.ply"},
-                                           {"generated", true},
-                                           {"neutral", "scan"},
-                                           {"true_cor_mm", {h.cor.x(), h.cor.y(), h.cor.z()}},
-                                           {"head_radius_mm", o.head_radius_mm}});
-  end_output_folder(out);
+  const HipModel h = write_generated_hip(out, run.generate);
   std::cout << "generated hip model: " << h.ball.F.rows() << " + " << h.socket.F.rows() << " triangles in " << out
             << " (a proximal femur and a cup: neutral is the scan pose)\n";
   return 0;

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <sstream>
+
 #include "impinge/core/error.hpp"
 #include "test_support.hpp"
 
@@ -57,4 +60,57 @@ TEST(Subject, LandmarksAreReadInTheFilesFrame) {
   ASSERT_EQ(s.landmarks.size(), 2u);
   EXPECT_EQ(s.landmarks.at("asis_right"), Eigen::Vector3d(-10.5, 2, 3));
   EXPECT_EQ(s.landmarks.at("hip_centre"), Eigen::Vector3d(0, 0, 100));
+}
+
+// The writer (save_subject, `impinge generate`'s subject.json) and the reader share one key list: what is written
+// reads back as it was, every key written is one the reader knows, and a file outside the json's folder is kept
+// by its absolute path.
+namespace {
+std::string read_text(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+}  // namespace
+
+TEST(Subject, WhatIsWrittenReadsBack) {
+  const std::string d = test::temp_dir("subject_write");
+  SubjectInfo in;
+  in.side = Side::left;
+  in.frame = FrameConvention::LPS;
+  in.femur_path = d + "/femur_l.ply";
+  in.pelvis_path = "/elsewhere/pelvis.ply";
+  in.neutral = "scan";
+  in.landmarks["asis_left"] = Eigen::Vector3d(1.5, -2, 3.25);
+  in.generated = true;
+  in.true_cor_mm = Eigen::Vector3d(0.5, 1, -2);
+  in.head_radius_mm = 24.5;
+  save_subject(d + "/subject.json", in);
+  const SubjectInfo out = load_subject(d + "/subject.json");
+  EXPECT_EQ(out.side, in.side);
+  EXPECT_EQ(out.frame, in.frame);
+  EXPECT_EQ(out.femur_path, d + "/femur_l.ply");
+  EXPECT_EQ(out.pelvis_path, "/elsewhere/pelvis.ply");
+  EXPECT_EQ(out.neutral, "scan");
+  ASSERT_EQ(out.landmarks.count("asis_left"), 1u);
+  EXPECT_EQ(out.landmarks.at("asis_left"), in.landmarks.at("asis_left"));
+  EXPECT_TRUE(out.generated);
+  ASSERT_TRUE(out.true_cor_mm);
+  EXPECT_EQ(*out.true_cor_mm, *in.true_cor_mm);
+  EXPECT_EQ(out.head_radius_mm, 24.5);
+  const std::string text = read_text(d + "/subject.json");
+  EXPECT_NE(text.find("\"femur\": \"femur_l.ply\""), std::string::npos) << text;  // relative to its folder
+  // A subject without the generated model's keys writes none of them.
+  SubjectInfo plain;
+  plain.femur_path = d + "/f.ply", plain.pelvis_path = d + "/p.ply";
+  save_subject(d + "/plain.json", plain);
+  const std::string p = read_text(d + "/plain.json");
+  EXPECT_EQ(p.find("generated"), std::string::npos) << p;
+  EXPECT_FALSE(load_subject(d + "/plain.json").true_cor_mm);
+  // The generated model's keys are checked when read.
+  test::write_text(d + "/bad.json",
+                   R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p", "true_cor_mm": [1, 2]})");
+  EXPECT_NE(test::error_of([&] { load_subject(d + "/bad.json"); }).find("'true_cor_mm' must be three finite numbers"),
+            std::string::npos);
 }

@@ -1,11 +1,14 @@
 #include "impinge/io/subject.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "impinge/anatomy/femur_frame.hpp"
 #include "impinge/anatomy/pelvis_frame.hpp"
+#include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
 
 namespace impinge {
@@ -20,6 +23,14 @@ Side parse_side(const std::string& s, const std::string& context) {
   if (s == "right") return Side::right;
   if (s == "left") return Side::left;
   throw Error(context + ": side '" + s + "' is neither right nor left");
+}
+
+const std::vector<std::string>& subject_keys() {
+  static const std::vector<std::string> keys{"side",      "frame",     "units",       "femur",
+                                             "pelvis",    "neutral",   "landmarks",   "generated",
+                                             "true_cor_mm", "head_radius_mm", "name", "source",
+                                             "citation",  "description"};
+  return keys;
 }
 
 SubjectInfo load_subject(const std::string& json_path) {
@@ -40,15 +51,12 @@ SubjectInfo load_subject(const std::string& json_path) {
   // Every key is one impinge reads (a misspelled one would be dropped without a word); keys starting with '_'
   // are the writer's own notes. `impinge generate` adds generated, true_cor_mm and head_radius_mm.
   require(j.is_object(), json_path + ": expected a JSON object {\"side\": ..., \"frame\": ..., ...}");
-  static const char* const kKeys[] = {"side",     "frame",     "units",       "femur",         "pelvis",
-                                      "neutral",  "landmarks", "generated",   "true_cor_mm",   "head_radius_mm",
-                                      "name",     "source",    "citation",    "description"};
   for (const auto& [key, value] : j.items()) {
     bool known = !key.empty() && key[0] == '_';
-    for (const char* k : kKeys) known = known || key == k;
+    for (const std::string& k : subject_keys()) known = known || key == k;
     require(known, [&] {
       std::string list;
-      for (const char* k : kKeys) list += (list.empty() ? "" : ", ") + std::string(k);
+      for (const std::string& k : subject_keys()) list += (list.empty() ? "" : ", ") + k;
       return json_path + ": unknown key '" + key + "' (known: " + list + "; keys starting with '_' are notes)";
     });
   }
@@ -82,7 +90,61 @@ SubjectInfo load_subject(const std::string& json_path) {
       s.landmarks[name] = p;
     }
   }
+  if (j.contains("generated")) {
+    require(j["generated"].is_boolean(), json_path + ": key 'generated' must be true or false");
+    s.generated = j["generated"].get<bool>();
+  }
+  if (j.contains("true_cor_mm")) {
+    const auto& c = j["true_cor_mm"];
+    bool ok = c.is_array() && c.size() == 3;
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; ok && k < 3; ++k) {
+      ok = c[k].is_number();
+      if (ok) p[static_cast<Eigen::Index>(k)] = c[k].get<double>();
+    }
+    require(ok && p.allFinite(), json_path + ": key 'true_cor_mm' must be three finite numbers [x, y, z] (mm)");
+    s.true_cor_mm = p;
+  }
+  if (j.contains("head_radius_mm")) {
+    const auto& r = j["head_radius_mm"];
+    require(r.is_number() && std::isfinite(r.get<double>()) && r.get<double>() > 0,
+            json_path + ": key 'head_radius_mm' must be a number > 0 (mm)");
+    s.head_radius_mm = r.get<double>();
+  }
   return s;
+}
+
+void save_subject(const std::string& json_path, const SubjectInfo& s) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::absolute(fs::path(json_path)).parent_path();
+  // A mesh in the json's folder (or below it) by its relative name, any other by its absolute path.
+  auto file = [&](const std::string& path) {
+    const fs::path p = fs::absolute(path).lexically_normal();
+    const fs::path rel = p.lexically_relative(dir);
+    return (!rel.empty() && *rel.begin() != "..") ? rel.generic_string() : p.string();
+  };
+  nlohmann::json j;
+  j["side"] = s.side == Side::right ? "right" : "left";
+  j["frame"] = s.frame == FrameConvention::LPS ? "LPS" : "RAS";
+  j["units"] = "mm";
+  j["femur"] = file(s.femur_path);
+  j["pelvis"] = file(s.pelvis_path);
+  if (!s.neutral.empty()) {
+    parse_neutral(s.neutral, json_path + ": neutral");
+    j["neutral"] = s.neutral;
+  }
+  for (const auto& [name, p] : s.landmarks) j["landmarks"][name] = {p.x(), p.y(), p.z()};
+  if (s.generated) {
+    j["generated"] = true;
+    if (s.true_cor_mm) j["true_cor_mm"] = {s.true_cor_mm->x(), s.true_cor_mm->y(), s.true_cor_mm->z()};
+    if (std::isfinite(s.head_radius_mm)) j["head_radius_mm"] = s.head_radius_mm;
+  }
+  for (const auto& [key, value] : j.items()) {
+    const auto& keys = subject_keys();
+    require(std::find(keys.begin(), keys.end(), key) != keys.end(),
+            json_path + ": save_subject would write key '" + key + "', which load_subject does not read");
+  }
+  write_file_atomically(json_path, j.dump(2) + "\n");
 }
 
 Eigen::Matrix3d to_working_frame(FrameConvention frame) {

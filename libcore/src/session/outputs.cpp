@@ -1,15 +1,22 @@
 #include "impinge/session/outputs.hpp"
 #include "impinge/core/concurrent.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <ctime>
 #include <exception>
 #include <filesystem>
+#include <iomanip>
+#include <sstream>
 
 #include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/io/mesh_io.hpp"
+#include "impinge/io/subject.hpp"
 #include "impinge/io/vtk_output.hpp"
+#include "impinge/maps/map_image.hpp"
+#include "impinge/session/records.hpp"
+#include "impinge/session/runs.hpp"
 
 namespace impinge {
 
@@ -109,6 +116,60 @@ void write_pose_vtp(const std::string& path, const Session& s, const PoseResult&
   distance.f32 = res.ball_gaps.distance_mm;
   distance.f32.insert(distance.f32.end(), res.socket_gaps.distance_mm.begin(), res.socket_gaps.distance_mm.end());
   write_vtp(path, V, F, {gap, distance, level, body});
+}
+
+void write_map_pngs(const std::string& dir, const Session& s) {
+  const std::filesystem::path d(dir);
+  run_both([&] { write_map_png((d / "ball_map.png").string(), s.joint().ball().map); },
+           [&] { write_map_png((d / "socket_map.png").string(), s.joint().socket().map); });
+}
+
+HipModel write_generated_hip(const std::string& dir, const HipModelOptions& o) {
+  const HipModel h = make_hip_model(o);
+  begin_output_folder(dir, "generate");
+  const std::filesystem::path d(dir);
+  write_ply((d / "femur_r.ply").string(), h.ball);
+  write_ply((d / "pelvis.ply").string(), h.socket);
+  SubjectInfo info;
+  info.side = Side::right;
+  info.frame = FrameConvention::RAS;
+  info.femur_path = (d / "femur_r.ply").string();
+  info.pelvis_path = (d / "pelvis.ply").string();
+  info.neutral = "scan";  // a proximal femur and a cup: no whole bones for anatomical frames
+  info.generated = true;
+  info.true_cor_mm = h.cor;
+  info.head_radius_mm = o.head_radius_mm;
+  save_subject((d / "subject.json").string(), info);
+  end_output_folder(dir);
+  return h;
+}
+
+MotionFiles write_motion_files(const std::string& dir, const Session& s, const Motion& motion, int vtp_every,
+                               const std::function<void(std::size_t, std::size_t)>& on_frame) {
+  const std::filesystem::path d(dir);
+  const std::size_t n = motion.frames();
+  MotionFiles out;
+  out.vtp_every = vtp_every > 0 ? vtp_every : static_cast<int>((n + 99) / 100);
+  Table frames;
+  frames.columns = motion_columns(s.joint_options().levels);
+  std::vector<PvdEntry> pvd;
+  const auto t_loop = std::chrono::steady_clock::now();
+  out.detect_ms = run_motion(s, motion.angles, motion.time_s, [&](const MotionFrame& f) {
+    frames.add(motion_row(f));
+    if (f.index % static_cast<std::size_t>(out.vtp_every) == 0) {
+      std::ostringstream name;
+      name << "gaps/frame_" << std::setw(6) << std::setfill('0') << f.index << ".vtp";
+      write_pose_vtp((d / name.str()).string(), s, *f.result, f.pose);
+      pvd.push_back({f.time_s, name.str()});
+    }
+    if (on_frame) on_frame(f.index + 1, n);
+  });
+  write_csv((d / "frames.csv").string(), frames);
+  write_pvd((d / "gaps.pvd").string(), pvd);
+  out.vtp_files = pvd.size();
+  out.write_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_loop).count() - out.detect_ms;
+  return out;
 }
 
 }  // namespace impinge

@@ -3,7 +3,10 @@
 /// A subject: femur and pelvis meshes, side and frame convention, from subject.json.
 
 #include <Eigen/Core>
+#include <limits>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "impinge/anatomy/anatomical_frame.hpp"
 #include "impinge/anatomy/pose.hpp"
@@ -30,12 +33,28 @@ struct SubjectInfo {
   Landmarks landmarks;  ///< given landmarks, mm, in the files' frame (`frame`)
   std::string neutral;  ///< optional "neutral": "anatomical" | "scan": the zero pose when the user gives none
                         ///< (generated models, which have no whole bones, say "scan"); empty when absent
+  /// A model of `impinge generate` (a proximal femur and a cup; "generated": true), with its exact centre of
+  /// rotation ("true_cor_mm", the files' frame, mm) and head radius ("head_radius_mm", mm).
+  bool generated = false;
+  std::optional<Eigen::Vector3d> true_cor_mm;
+  double head_radius_mm = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// The keys a subject.json may hold, the one list: load_subject refuses any other (a misspelled key would
+/// otherwise be dropped without a word; keys starting with '_' are notes) and save_subject writes only these.
+const std::vector<std::string>& subject_keys();
 
 /// Read `json_path`. Throws impinge::Error naming the file and the key on a missing or bad
 /// key, unknown side/frame, units other than mm, an unknown landmark name or a landmark that is
 /// not three finite numbers, or unreadable JSON.
 SubjectInfo load_subject(const std::string& json_path);
+
+/// Write `s` as `json_path` (atomically: a temporary file renamed into place): side, frame, units "mm", femur and
+/// pelvis (relative to the json's folder when they lie in it), neutral when set, landmarks when any, and the
+/// generated model's keys when `s.generated`; load_subject reads it back as `s` (but `name`). Throws
+/// impinge::Error naming the file when it cannot be written, or a key this writer would write that
+/// subject_keys() lacks (a test of the writer against the reader).
+void save_subject(const std::string& json_path, const SubjectInfo& s);
 
 /// Linear map (3 x 3) from `frame` coordinates (the input frame) to the working frame (RAS). Orthogonal and
 /// its own inverse for LPS (diag(-1, -1, 1)).

@@ -6,10 +6,13 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "impinge/detection/joint.hpp"
+#include "impinge/io/generated_models.hpp"
+#include "impinge/io/motion.hpp"
 #include "impinge/session/session.hpp"
 
 namespace impinge {
@@ -43,5 +46,32 @@ void write_pose_plys(const std::string& ball_path, const std::string& socket_pat
 /// femur, 1 pelvis); input frame, mm. Throws impinge::Error naming the file on I/O errors.
 void write_pose_vtp(const std::string& path, const Session& session, const PoseResult& result,
                     const FemurPose& pose);
+
+/// Both maps of `session` as PNG images (write_map_png: the map over (theta, phi)) in `dir`: ball_map.png and
+/// socket_map.png, each on its own thread. Throws impinge::Error naming a file on I/O errors.
+void write_map_pngs(const std::string& dir, const Session& session);
+
+/// `impinge generate`: a generated hip (make_hip_model(options)) written into `dir` as femur_r.ply, pelvis.ply and
+/// subject.json (save_subject: right side, RAS, mm, scan neutral, "generated" with its true centre and head
+/// radius), the folder opened and closed as every run's (begin_output_folder). Returns the model. Throws
+/// impinge::Error as make_hip_model does, or naming the file it cannot write.
+HipModel write_generated_hip(const std::string& dir, const HipModelOptions& options);
+
+/// What write_motion_files did: the motion's detection time (ms, run_motion), its VTP files, and the time spent
+/// writing (ms).
+struct MotionFiles {
+  double detect_ms = 0;
+  std::size_t vtp_files = 0;
+  int vtp_every = 1;
+  double write_ms = 0;
+};
+
+/// `impinge motion`'s files in `dir` (opened by begin_output_folder with the subfolder "gaps"): frames.csv (one
+/// motion_row per frame) and, every `vtp_every` frames (0: every frame up to 100 frames, else at most 100
+/// files), the posed bones as gaps/frame_NNNNNN.vtp (write_pose_vtp) listed by time in gaps.pvd (ParaView).
+/// `on_frame(done, total)`, when given, is called after each frame (a progress bar). Throws impinge::Error as
+/// run_motion does, or naming a file.
+MotionFiles write_motion_files(const std::string& dir, const Session& session, const Motion& motion, int vtp_every,
+                               const std::function<void(std::size_t, std::size_t)>& on_frame = {});
 
 }  // namespace impinge
