@@ -169,6 +169,6 @@ TEST(FastLookup, MovesNoGapByMoreThanATenThousandthMillimetreGenerated) {
 
 TEST(FastLookup, MovesNoGapByMoreThanATenThousandthMillimetreRealSubject) {
   const auto real = test::load_real_joint("lhdl-ct");
-  if (!real) GTEST_SKIP() << "no shared data (" << IMPINGE_SHARED_DATA << ")";
+  if (!real) GTEST_SKIP() << "shared data absent: " << IMPINGE_SHARED_DATA;
   for (double p : {0.1, 0.05}) compare_scans(real->femur, real->pelvis, real->cor, p);
 }

@@ -392,7 +392,7 @@ class RealDistance : public ::testing::TestWithParam<std::string> {};
 TEST_P(RealDistance, EveryMeasuredVertexMatchesCgalAtRestAndTenPoses) {
   if (!SignedDistanceQuery::available() || !have_exact_reference()) GTEST_SKIP() << "needs Embree or CGAL, and CGAL";
   const auto real = test::load_real_joint(GetParam());
-  if (!real) GTEST_SKIP() << "no shared data";
+  if (!real) GTEST_SKIP() << "shared data absent";
   JointOptions o;
   o.distances = true;
   o.layers = 4;

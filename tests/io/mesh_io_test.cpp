@@ -278,7 +278,7 @@ TEST(MeshIo, RealSubjectsHaveTheTriangleCountsOfTheDataReadme) {
       {"lhdl-ct", 70422, 95256}, {"mc22", 34936, 61662}, {"tlem2-mri", 33036, 74586}};
   for (const auto& [name, femur, pelvis] : subjects) {
     const std::string dir = std::string(IMPINGE_SHARED_DATA) + "/" + name;
-    if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no shared data at " << dir;
+    if (!std::filesystem::exists(dir)) GTEST_SKIP() << "shared data absent: " << dir;
     const TriangleMesh f = load_mesh(dir + "/femur_r.ply"), p = load_mesh(dir + "/pelvis.ply");
     EXPECT_EQ(f.F.rows() + f.degenerate_faces_skipped, femur) << name;
     EXPECT_EQ(p.F.rows() + p.degenerate_faces_skipped, pelvis) << name;

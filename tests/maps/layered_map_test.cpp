@@ -265,7 +265,7 @@ TEST(LayeredMap, OccupancyCoversTheSolid) {
 
 TEST(LayeredMap, RealPelvisCrossingCountsAgreeWithCgal) {
   const auto joint = test::load_real_joint("lhdl-ct");
-  if (!joint) GTEST_SKIP() << "no shared data";
+  if (!joint) GTEST_SKIP() << "shared data absent";
   if (!FirstHitCaster::available() || !have_exact_reference()) GTEST_SKIP() << "no ray caster in this build";
   const FirstHitCaster caster(joint->pelvis, joint->cor);
   const ExactReference ref(joint->pelvis);

@@ -110,7 +110,7 @@ TEST(RasterPlan, OpenMeshDisablesCullingAndSaysWhy) {
 
 TEST(RasterPlan, RealBonesCulledMapsEqualFullMaps) {
   const auto real = test::load_real_joint("lhdl-ct");
-  if (!real) GTEST_SKIP() << "no shared data (" << IMPINGE_SHARED_DATA << ")";
+  if (!real) GTEST_SKIP() << "shared data absent: " << IMPINGE_SHARED_DATA;
   for (const TriangleMesh* m : {&real->femur, &real->pelvis}) {
     const RasterPlan fc = plan_rasterization(*m, real->cor);
     ASSERT_TRUE(fc.enabled) << m->source << ": " << fc.reason;

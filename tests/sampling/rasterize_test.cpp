@@ -352,7 +352,7 @@ TEST(Rasterize, MapStartResetEqualsAFreshMapAndKeepKeepsNearerValues) {
 
 TEST(Rasterize, RowSpansOnRealBonesGiveTheSameMap) {
   const auto real = test::load_real_joint("lhdl-ct");
-  if (!real) GTEST_SKIP() << "no shared data (" << IMPINGE_SHARED_DATA << ")";
+  if (!real) GTEST_SKIP() << "shared data absent: " << IMPINGE_SHARED_DATA;
   for (const TriangleMesh* m : {&real->femur, &real->pelvis}) {
     const RasterPlan plan = plan_rasterization(*m, real->cor);
     RadialDistanceMap box{EquiangularGrid(0.1)}, span{EquiangularGrid(0.1)};
