@@ -83,6 +83,12 @@ void add_table_options(CLI::App* cmd, unsigned use, CliValues& v) {
       if (!std::holds_alternative<std::monostate>(d) || r.type == OptionType::point) o->default_str(option_text(r, d));
     }
     if (r.required) o->required();
+    for (const std::string& old : r.old_names) {  // a former name: accepted, not listed (group "": hidden)
+      if (r.type == OptionType::flag)
+        cmd->add_flag("--" + old, v.flag[old], r.help)->group("");
+      else
+        cmd->add_option("--" + old, v.text[old], r.help)->group("");
+    }
   }
 }
 
@@ -90,9 +96,18 @@ void add_table_options(CLI::App* cmd, unsigned use, CliValues& v) {
 RunOptions given_options(const CLI::App* cmd, unsigned use, const CliValues& v) {
   RunOptions run = RunOptions::clinical();
   for (const OptionRow& r : option_table()) {
-    const std::string as = "--" + r.name;
-    if (!(r.uses & use) || cmd->count(as) == 0) continue;
-    r.set(run, r.type == OptionType::flag ? OptionValue(v.flag.at(r.name)) : parse_option_text(r, v.text.at(r.name), as),
+    if (!(r.uses & use)) continue;
+    std::string name = r.name;  // the name given: the row's, or a former one (said, once)
+    for (const std::string& old : r.old_names) {
+      if (cmd->count("--" + old) == 0) continue;
+      require(cmd->count("--" + r.name) == 0, "give --" + r.name + " or --" + old + " (its former name), not both");
+      std::cerr << "impinge: warning: --" << old << " is deprecated and will be removed in the next release: use --"
+                << r.name << "\n";
+      name = old;
+    }
+    const std::string as = "--" + name;
+    if (cmd->count(as) == 0) continue;
+    r.set(run, r.type == OptionType::flag ? OptionValue(v.flag.at(name)) : parse_option_text(r, v.text.at(name), as),
           as);
   }
   return run;

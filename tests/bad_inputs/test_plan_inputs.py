@@ -23,15 +23,40 @@ def cam(tmp_path_factory):
     (["--target", "flexion"], ["'flexion' is not MOTION=DEG or 'normal'"]),
     ([], ["no target: give --target"]),
     (["--target-motion", "/nonexistent/walk.mot"], ["/nonexistent/walk.mot"]),
+    (["--target", "flexion=60", "--clearance", "-1"], ["--clearance: -1 mm is outside the valid range"]),
     (["--target", "flexion=60", "--clearance-mm", "-1"], ["--clearance-mm: -1 mm is outside the valid range"]),
     (["--target", "flexion=60", "--resect", "tibia"], ["--resect: 'tibia' is not one of femur, pelvis, both"]),
     (["--target", "flexion=60", "--max-depth-fraction", "2"], ["--max-depth-fraction: 2 is outside the valid range"]),
-    (["--target", "flexion=60", "--burr-radius-mm", "nan"], ["--burr-radius-mm: 'nan' is not a finite number"]),
+    (["--target", "flexion=60", "--burr-radius", "nan"], ["--burr-radius: 'nan' is not a finite number"]),
+    (["--target", "flexion=60", "--max-depth", "-2"], ["--max-depth: -2 mm is outside the valid range [0, 100] mm"]),
+    (["--target", "flexion=60", "--clearance", "0.3", "--clearance-mm", "0.3"],
+     ["give --clearance or --clearance-mm (its former name), not both"]),
 ])
 def test_bad_plan_inputs_are_one_line_errors_naming_them(cam, tmp_path, args, fragments):
     r = run(["plan", "--subject", cam, "--out", tmp_path / "p", "--precision", 2] + args)
     one_line_error(r, *fragments)
     assert not (tmp_path / "p" / "plan.json").exists()
+
+
+def test_a_former_option_name_works_for_one_release_with_a_deprecation_line(cam, tmp_path):
+    """--clearance-mm, --max-depth-mm and --burr-radius-mm (issue 78: CLI names carry no unit) still work, each
+    saying once which name replaces it; the plan is the one the new names give."""
+    plans = {}
+    for names in (("--clearance", "--burr-radius", "--max-depth"), ("--clearance-mm", "--burr-radius-mm",
+                                                                      "--max-depth-mm")):
+        out = tmp_path / names[0].strip("-")
+        r = run(["plan", "--subject", cam, "--out", out, "--precision", 2, "--target", "flexion=60", "--allow-partial",
+                 names[0], "0.4", names[1], "2", names[2], "3"])
+        assert r.returncode == 0, r.stderr
+        warned = [x for x in r.stderr.splitlines() if "deprecated" in x]
+        if names[0].endswith("-mm"):
+            assert len(warned) == 3 and all(f"{old} is deprecated" in w and f"use {old[:-3]}" in w
+                                            for old, w in zip(sorted(names), sorted(warned))), warned
+        else:
+            assert warned == [], warned
+        p = json.load(open(out / "plan.json"))
+        plans[names[0]] = (p["options"], p["targets"])
+    assert plans["--clearance"] == plans["--clearance-mm"]
 
 
 def test_a_motion_file_with_a_bad_cell_is_refused_naming_its_line(cam, tmp_path):

@@ -1,4 +1,5 @@
 // The option table's rows: every option of the CLI, Python and the study files (option_table.hpp).
+#include <algorithm>
 #include <limits>
 
 #include "impinge/detection/impingement_levels.hpp"
@@ -378,20 +379,23 @@ void add_plan_rows(Rows& t) {
            "Which bone the plan may resect: femur (the cam: osteochondroplasty of the head-neck junction), pelvis "
            "(a rim trim) or both (each contact shared); never the head's articular surface or the lunate surface",
            [](auto& o) -> auto& { return o.plan.resection.bones; });
-  t.number("clearance-mm", "clearance_mm", "mm", plan, ResectionOptions::kClearanceRange,
+  t.number("clearance", "clearance_mm", "mm", plan, ResectionOptions::kClearanceRange,
            "The least distance the bones keep at every target pose after the resection",
-           [](auto& o) -> auto& { return o.plan.resection.clearance_mm; });
+           [](auto& o) -> auto& { return o.plan.resection.clearance_mm; })
+      .old_names = {"clearance-mm"};
   t.number("max-depth-fraction", "max_depth_fraction", "", plan, PlanRequest::kMaxDepthFractionRange,
            "Safety depth as a fraction of the femoral neck's least diameter (Mardones et al. 2005: deeper than "
            "about 30 % weakens the neck); a target that needs more is planned up to where it can be reached",
            [](auto& o) -> auto& { return o.plan.max_depth_fraction; });
-  t.number("max-depth-mm", "max_depth_mm", "mm", plan, PlanRequest::kMaxDepthRange,
+  t.number("max-depth", "max_depth_mm", "mm", plan, PlanRequest::kMaxDepthRange,
            "Safety depth in mm instead of the fraction (0: the fraction of the neck's diameter)",
-           [](auto& o) -> auto& { return o.plan.max_depth_mm; });
-  t.number("burr-radius-mm", "burr_radius_mm", "mm", plan, ResectionOptions::kBurrRadiusRange,
+           [](auto& o) -> auto& { return o.plan.max_depth_mm; })
+      .old_names = {"max-depth-mm"};
+  t.number("burr-radius", "burr_radius_mm", "mm", plan, ResectionOptions::kBurrRadiusRange,
            "Radius of the spherical burr the removal is shaped for (arthroscopic burrs: 4-5.5 mm diameter; 0: no "
            "shaping, the least removal per vertex)",
-           [](auto& o) -> auto& { return o.plan.resection.burr_radius_mm; });
+           [](auto& o) -> auto& { return o.plan.resection.burr_radius_mm; })
+      .old_names = {"burr-radius-mm"};
   t.number("plan-step", "plan_step_deg", "deg", plan, PlanRequest::kStepRange,
            "Poses along each target motion every this many degrees (with the clearance, a step small enough that "
            "no contact deeper than --contact-depth fits between two poses)",
@@ -419,7 +423,9 @@ const std::vector<OptionRow>& option_table() {
 
 const OptionRow* find_option(const std::string& name) {
   for (const OptionRow& r : option_table())
-    if (r.name == name || r.key == name) return &r;
+    if (r.name == name || r.key == name ||
+        std::find(r.old_names.begin(), r.old_names.end(), name) != r.old_names.end())
+      return &r;
   return nullptr;
 }
 

@@ -185,7 +185,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   const auto t_start = Clock::now();
   PlanRun run;
   check_in_range("max-depth-fraction", request.max_depth_fraction, PlanRequest::kMaxDepthFractionRange);
-  check_in_range("max-depth-mm", request.max_depth_mm, PlanRequest::kMaxDepthRange, "mm");
+  check_in_range("max-depth", request.max_depth_mm, PlanRequest::kMaxDepthRange, "mm");
   // The targets and the motion file are checked before anything is built (a bad one is an error in milliseconds).
   parse_targets(request.target, standard_motions());
   if (!request.target_motion.empty()) load_motion(request.target_motion, input_side(options.input));
@@ -229,7 +229,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
     require(std::isfinite(run.neck_diameter_mm),
             "plan: the neck's diameter could not be measured (" +
                 (run.notes.empty() ? std::string("no neck found") : run.notes.back()) +
-                "), so the safety depth is unknown: give --max-depth-mm");
+                "), so the safety depth is unknown: give --max-depth");
     run.max_depth_mm = request.max_depth_fraction * run.neck_diameter_mm;
   }
   ResectionOptions ro = request.resection;

@@ -121,6 +121,10 @@ struct OptionRow {
   double min = -1e308, max = 1e308;
   bool min_open = false;  ///< min itself is not valid (a length that must be > 0)
   bool required = false;             ///< the CLI commands that use it need it
+  /// Former CLI names (without dashes) still accepted for one release: the CLI says which name replaces one.
+  /// Naming convention: CLI names carry no unit (the unit is in the help and the value's name: NUMBER mm); Python
+  /// and study keys carry it on lengths and angles (`clearance_mm`, `step_deg`).
+  std::vector<std::string> old_names;
   std::string help;
   std::function<void(RunOptions&, const OptionValue&, const std::string& as)> set;
   std::function<OptionValue(const RunOptions&)> get;
@@ -128,7 +132,7 @@ struct OptionRow {
 
 /// Every option, in the order the CLI's help lists them. Built once; thread-safe to read.
 const std::vector<OptionRow>& option_table();
-/// The row named `name` (CLI name or key); nullptr when none.
+/// The row named `name` (CLI name, former CLI name or key); nullptr when none.
 const OptionRow* find_option(const std::string& name);
 
 /// A CLI text as the row's value: "auto" or "" for a point is nothing; numbers must be finite (or
