@@ -95,14 +95,14 @@ write_macros(d, "macros", macros)
 rows = []
 for r in cam_plans.itertuples():
     rows.append([r.subject, "added cam", r.motion.replace("_", " "), f(r.limit_free_deg), f(r.limit_cam_deg),
-                 f(r.limit_after_deg), "yes" if r.met else "no", f(r.volume_mm3, 0), f(r.max_depth_mm),
+                 f(r.limit_after_deg), "yes" if r.met else "no", f(r.volume_mm3, 0), f(r.deepest_cut_mm),
                  f(100 * r.on_cam_share, 0)])
 for r in ir.itertuples():
     rows.append([r.subject, f"IR90 +10, {r.resect}", "IR at 90 flexion", f(r.limit_before_deg), f(r.target_deg),
                  f(r.limit_after_deg), "yes" if r.met else "no", f(r.femur_volume_mm3 + r.pelvis_volume_mm3, 0),
-                 f(max(r.femur_max_depth_mm, r.pelvis_max_depth_mm)), ""])
+                 f(max(r.femur_deepest_cut_mm, r.pelvis_deepest_cut_mm)), ""])
 write_table(d, "table_plans", ["hip", "plan", "motion", "limit before", "target", "after", "met", "volume (mm$^3$)",
-                               "max depth (mm)", "on cam (\\%)"], rows, align="lllrrrlrrr")
+                               "deepest cut (mm)", "on cam (\\%)"], rows, align="lllrrrlrrr")
 
 # Planned volume against the cam's.
 fig, ax = plt.subplots(figsize=(3.6, 3.4))

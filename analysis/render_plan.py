@@ -57,7 +57,7 @@ def main():
     r = plan[f"{bone}_resection"]
     ax = fig.add_subplot(1, 2, 1, projection="polar")
     clock_panel(ax, props, centre,
-                f"{bone}: {r['volume_mm3']:.0f} mm$^3$, max {r['max_depth_mm']:.1f} mm, "
+                f"{bone}: {r['volume_mm3']:.0f} mm$^3$, deepest {r['deepest_cut_mm']:.1f} mm, "
                 f"{r['area_mm2']:.0f} mm$^2$\n(radius: distance from the head centre, mm)")
     ax = fig.add_subplot(1, 2, 2)
     targets = [t for t in plan["targets"] if t.get("target_deg") is not None]

@@ -308,9 +308,9 @@ int run_plan(const RunOptions& o) {
   const BoneResection& f = run.plan.femur;
   const BoneResection& p = run.plan.pelvis;
   std::cout << std::fixed << std::setprecision(1) << "plan: ";
-  if (f.allowed) std::cout << "femur " << f.volume_mm3 << " mm^3 (max depth " << f.max_depth_mm << " mm)";
+  if (f.allowed) std::cout << "femur " << f.volume_mm3 << " mm^3 (deepest cut " << f.deepest_cut_mm << " mm)";
   if (f.allowed && p.allowed) std::cout << ", ";
-  if (p.allowed) std::cout << "pelvis " << p.volume_mm3 << " mm^3 (max depth " << p.max_depth_mm << " mm)";
+  if (p.allowed) std::cout << "pelvis " << p.volume_mm3 << " mm^3 (deepest cut " << p.deepest_cut_mm << " mm)";
   std::cout << "; targets:";
   for (const PlanTargetCheck& c : run.targets) {
     std::cout << " " << c.name;

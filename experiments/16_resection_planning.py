@@ -88,7 +88,7 @@ def main():
     hips = sorted(h for h in os.listdir(data) if os.path.exists(os.path.join(data, h, "subject.json"))) \
         if data and os.path.isdir(data) else []
     shutil.copyfile(os.path.join(HERE, "16_published.csv"), os.path.join(d, "published.csv"))
-    plan_columns = ["volume_mm3", "area_mm2", "max_depth_mm", "mean_depth_mm", "clock_from_h", "clock_to_h"]
+    plan_columns = ["volume_mm3", "area_mm2", "deepest_cut_mm", "mean_depth_mm", "clock_from_h", "clock_to_h"]
 
     timed = {}  # plans whose time the paper quotes: timed again below, with their spread
 

@@ -181,7 +181,7 @@ def test_internal_rotation_in_flexion_ten_degrees_more_on_a_real_hip(tmp_path):
         assert np.array_equal(Fr, F)
         assert abs((volume(V, F) - volume(Vr, F)) - plan[key]["volume_mm3"]) <= 1e-3 * plan[key]["volume_mm3"] + 0.05
         assert props["resection_mm"].max() <= plan["safety_depth"]["value_mm"] + 1e-6
-        assert abs(props["resection_mm"].max() - plan[key]["max_depth_mm"]) <= 1e-4
+        assert abs(props["resection_mm"].max() - plan[key]["deepest_cut_mm"]) <= 1e-4
 
 
 @pytest.mark.skipif(not os.path.isdir(os.path.join(DATA, "tlem2-mri")), reason="shared data absent")

@@ -215,7 +215,7 @@ void summarize_resection(BoneResection& out, const Vertices& original, const Fac
               std::to_string(out.resected.rows()) + " resected vertices and " + std::to_string(vertex_area.size()) +
               " areas for " + std::to_string(n) + " vertices");
   out.volume_mm3 = enclosed_volume(original, F) - enclosed_volume(out.resected, F);
-  out.area_mm2 = out.max_depth_mm = out.mean_depth_mm = 0;
+  out.area_mm2 = out.deepest_cut_mm = out.mean_depth_mm = 0;
   out.vertices = out.capped_vertices = 0;
   double weighted = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -225,7 +225,7 @@ void summarize_resection(BoneResection& out, const Vertices& original, const Fac
     ++out.vertices;
     out.area_mm2 += vertex_area[static_cast<Eigen::Index>(i)];
     weighted += vertex_area[static_cast<Eigen::Index>(i)] * d;
-    out.max_depth_mm = std::max(out.max_depth_mm, d);
+    out.deepest_cut_mm = std::max(out.deepest_cut_mm, d);
   }
   out.mean_depth_mm = out.area_mm2 > 0 ? weighted / out.area_mm2 : 0;
 }
@@ -235,7 +235,7 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
   const auto t0 = std::chrono::steady_clock::now();
   const ResectionOptions& o = options;
   check_in_range("ResectionOptions::clearance_mm", o.clearance_mm, ResectionOptions::kClearanceRange, "mm");
-  require(o.max_depth_mm > 0, "resection: safety depth " + std::to_string(o.max_depth_mm) + " mm; valid: > 0");
+  require(o.safety_depth_mm > 0, "resection: safety depth " + std::to_string(o.safety_depth_mm) + " mm; valid: > 0");
   check_in_range("ResectionOptions::burr_radius_mm", o.burr_radius_mm, ResectionOptions::kBurrRadiusRange, "mm");
   require(o.tolerance_mm > 0 && o.max_iterations >= 1, "resection: tolerance must be > 0 and iterations >= 1");
   const Joint& joint = hip.joint();
@@ -248,7 +248,7 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
 
   ResectionPlan plan;
   plan.options = o;
-  const double c = o.clearance_mm, cap = o.max_depth_mm;
+  const double c = o.clearance_mm, cap = o.safety_depth_mm;
 
   BoneState bone[2];  // 0 femur, 1 pelvis
   for (int b = 0; b < 2; ++b) {

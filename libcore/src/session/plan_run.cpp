@@ -196,6 +196,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   limits_only.envelope = false;
   limits_only.limits = true;
   run.search = rom.search;
+  run.request = request;
   SessionOptions so = rom_session_options(options, rom.search);
   so.hip.joint.distances = true;
   so.hip.joint.distance_reach_mm =
@@ -224,16 +225,16 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
                                             hip.head_radius_mm(), neck);
   }
   if (request.max_depth_mm > 0) {
-    run.max_depth_mm = request.max_depth_mm;
+    run.safety_depth_mm = request.max_depth_mm;
   } else {
     require(std::isfinite(run.neck_diameter_mm),
             "plan: the neck's diameter could not be measured (" +
                 (run.notes.empty() ? std::string("no neck found") : run.notes.back()) +
                 "), so the safety depth is unknown: give --max-depth");
-    run.max_depth_mm = request.max_depth_fraction * run.neck_diameter_mm;
+    run.safety_depth_mm = request.max_depth_fraction * run.neck_diameter_mm;
   }
   ResectionOptions ro = request.resection;
-  ro.max_depth_mm = run.max_depth_mm;
+  ro.safety_depth_mm = run.safety_depth_mm;
   t = Clock::now();
   run.plan = plan_resection(hip, targets, before.baseline, ro);
   run.plan_ms = ms_since(t);
@@ -306,7 +307,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
     const ResectionPlan next =
         plan_resection(s_after->hip(), plan_targets(*s_after, request, after), after.baseline, more);
     extra_plan_ms += ms_since(t_pass);
-    if (next.femur.max_depth_mm <= kResectedDepthMm && next.pelvis.max_depth_mm <= kResectedDepthMm) break;
+    if (next.femur.deepest_cut_mm <= kResectedDepthMm && next.pelvis.deepest_cut_mm <= kResectedDepthMm) break;
     auto add = [&](BoneResection& total, const BoneResection& pass_plan, const JointBody& body_after,
                    const JointBody& body, const Vertices& scan, TriangleMesh& mesh) {
       if (!total.allowed) return;
@@ -314,7 +315,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
       for (std::size_t i = 0; i < total.depth_mm.size(); ++i) total.depth_mm[i] += pass_plan.depth_mm[i];
       // In the first session's joint frame (the frame of total.resected): the input-frame displacement, rotated.
       total.resected = body.relative + (mesh.V - scan) * joint_to_input;
-      summarize_resection(total, body.relative, body.mesh.F, body.vertex_area, ro.max_depth_mm);
+      summarize_resection(total, body.relative, body.mesh.F, body.vertex_area, ro.safety_depth_mm);
       total.thin_vertices += pass_plan.thin_vertices;
     };
     add(run.plan.femur, next.femur, s_after->joint().ball(), s.joint().ball(), femur_scan, run.femur_resected);
@@ -363,16 +364,17 @@ nlohmann::json plan_record(const PlanRun& run) {
   j["options"] = {{"resect", to_string(o.bones)},
                   {"clearance_mm", o.clearance_mm},
                   {"burr_radius_mm", o.burr_radius_mm},
-                  {"max_depth_mm", run.max_depth_mm},
+                  {"max_depth_fraction", run.request.max_depth_fraction},
+                  {"max_depth_mm", run.request.max_depth_mm},
                   {"tolerance_mm", o.tolerance_mm}};
   j["neck_diameter_mm"] = number_or_null(run.neck_diameter_mm);
-  j["safety_depth"] = {{"value_mm", run.max_depth_mm},
+  j["safety_depth"] = {{"value_mm", run.safety_depth_mm},
                        {"source", "Mardones et al. 2005, J Bone Joint Surg Am 87:273 (30 % of the neck's diameter)"}};
   auto bone = [&](const BoneResection& b, int k) {
     nlohmann::json r = {{"resected", b.allowed},
                         {"volume_mm3", b.volume_mm3},
                         {"area_mm2", b.area_mm2},
-                        {"max_depth_mm", b.max_depth_mm},
+                        {"deepest_cut_mm", b.deepest_cut_mm},
                         {"mean_depth_mm", b.mean_depth_mm},
                         {"vertices", b.vertices},
                         {"vertices_at_safety_depth", b.capped_vertices},

@@ -202,7 +202,7 @@ def _run_plan(joint, task, folder):
     for bone in ("femur", "pelvis"):
         r = d[f"{bone}_resection"]
         if r["resected"]:
-            for k in ("volume_mm3", "area_mm2", "max_depth_mm", "mean_depth_mm"):
+            for k in ("volume_mm3", "area_mm2", "deepest_cut_mm", "mean_depth_mm"):
                 out[f"{bone}_{k}"] = float(r[k])
     for t in d["targets"]:
         if "limit_after_deg" in t:

@@ -85,7 +85,9 @@ struct ResectionOptions {
   ResectBones bones = ResectBones::femur;
   double clearance_mm = 0.3;  ///< c: the least distance the bones keep at every target pose, mm
   static constexpr Range kClearanceRange{0, 5};  ///< of clearance_mm, mm
-  double max_depth_mm = std::numeric_limits<double>::infinity();  ///< the safety depth, mm (the caller's)
+  /// The safety depth, mm: no vertex is resected deeper (the caller's; run_plan sets it from PlanRequest's
+  /// max_depth_mm or max_depth_fraction).
+  double safety_depth_mm = std::numeric_limits<double>::infinity();
   double burr_radius_mm = 2.5;     ///< b: the spherical burr's radius, mm (0: no widening)
   static constexpr Range kBurrRadiusRange{0, 10};  ///< of burr_radius_mm, mm
   double tolerance_mm = 0.02;      ///< a contact asking for less than this more is met, mm
@@ -93,7 +95,7 @@ struct ResectionOptions {
   double candidate_margin_mm = 1;  ///< contacts: vertices within c + this of the other bone, mm
   /// Per vertex of the femur and of the pelvis (or empty: none), the depth an earlier plan already removed, mm
   /// (a further round on its resected bones, run_plan): the safety depth caps the sum, this round's depth at
-  /// max_depth_mm less it.
+  /// safety_depth_mm less it.
   std::vector<double> femur_removed_mm, pelvis_removed_mm;
 };
 
@@ -106,13 +108,13 @@ struct BoneResection {
   Vertices normals;                            ///< n x 3 unit outward vertex normals (area-weighted), joint frame
   double volume_mm3 = 0;                       ///< the input's enclosed volume less the resected one's
   double area_mm2 = 0;                         ///< surface whose depth exceeds kResectedDepthMm (vertex areas)
-  double max_depth_mm = 0, mean_depth_mm = 0;  ///< mean: area-weighted over that surface
+  double deepest_cut_mm = 0, mean_depth_mm = 0;  ///< the largest and the mean depth (area-weighted over that surface)
   std::int64_t vertices = 0;                   ///< vertices with depth > kResectedDepthMm
   std::int64_t capped_vertices = 0;            ///< vertices held at the safety depth
   std::int64_t thin_vertices = 0;              ///< vertices held at half the bone's thickness under them
 };
 
-/// Fill `out`'s summary (volume_mm3, area_mm2, max_depth_mm, mean_depth_mm, vertices, capped_vertices; not
+/// Fill `out`'s summary (volume_mm3, area_mm2, deepest_cut_mm, mean_depth_mm, vertices, capped_vertices; not
 /// thin_vertices) from its depth_mm (n, mm) and resected (n x 3, mm): `original` (n x 3, mm, the same frame) and `F`
 /// the bone before any resection, `vertex_area` (n, mm^2) its vertex areas, `cap_mm` the safety depth. Throws
 /// impinge::Error when the sizes differ.

@@ -25,7 +25,7 @@ struct PlanRequest {
   /// none (then `target_motion` must be given).
   std::string target;
   std::string target_motion;        ///< a motion file (.csv, .mot, .sto) whose every frame must be free; empty: none
-  ResectionOptions resection;       ///< bones, clearance, burr (max_depth_mm: set from the two below)
+  ResectionOptions resection;       ///< bones, clearance, burr (safety_depth_mm: set from the two below)
   double max_depth_fraction = 0.3;  ///< safety depth as a fraction of the neck's least diameter (Mardones 2005)
   static constexpr Range kMaxDepthFractionRange{0.01, 1};  ///< of max_depth_fraction
   double max_depth_mm = 0;          ///< safety depth, mm; 0: max_depth_fraction x the neck's diameter
@@ -54,7 +54,8 @@ struct PlanRun {
   bool all_met = false;
   RomOptions search;  ///< the ROM search's options (the check's)
   double neck_diameter_mm = std::numeric_limits<double>::quiet_NaN();
-  double max_depth_mm = 0;                        ///< the safety depth used
+  PlanRequest request;                            ///< what was asked
+  double safety_depth_mm = 0;                     ///< the safety depth used (from request's cap or fraction), mm
   std::optional<Morphology> before, after;        ///< morphology of the input and of the resected femur
   std::vector<std::string> notes;                 ///< what could not be measured or checked
   TriangleMesh femur_resected, pelvis_resected;   ///< input frame, mm (the input's faces and vertex order)
