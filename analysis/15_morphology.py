@@ -39,7 +39,8 @@ rows = []
 names = {"alpha_max_deg": "alpha angle, largest (deg)", "head_neck_offset_ratio": "head-neck offset ratio",
          "neck_shaft_angle_deg": "neck-shaft angle (deg)",
          "version_posterior_condylar_deg": "femoral version, post. condylar (deg)",
-         "inclination_deg": "acetabular inclination (deg)", "version_deg": "acetabular version (deg)",
+         "radiographic_inclination_deg": "acetabular inclination (deg)",
+         "radiographic_anteversion_deg": "acetabular anteversion (deg)",
          "lateral_centre_edge_deg": "lateral centre-edge angle (deg)",
          "anterior_centre_edge_deg": "anterior centre-edge angle (deg)"}
 for p in pub.itertuples():
@@ -76,7 +77,7 @@ if hips:
         macros["MOversionLR"] = f(l.version_posterior_condylar_deg - r.version_posterior_condylar_deg)
         macros["MOversionTeLR"] = f(l.version_transepicondylar_deg - r.version_transepicondylar_deg)
         macros["MOlceLR"] = f(l.lateral_centre_edge_deg - r.lateral_centre_edge_deg)
-        macros["MOacetVersionLR"] = f(l.version_deg - r.version_deg)
+        macros["MOacetVersionLR"] = f(l.radiographic_anteversion_deg - r.radiographic_anteversion_deg)
     app = lim[(lim.pelvic_frame == "app") & (lim.motion == "internal_rotation_90_flexion")]
     reached = app[app.status == "limited"]
     macros["MOirNinetyReached"] = str(len(reached))

@@ -285,7 +285,7 @@ int run_morphology(const RunOptions& o) {
   std::cout << std::fixed << std::setprecision(1) << "morphology: head radius " << m.head_radius_mm
             << " mm, alpha max " << m.alpha_max_deg << " deg at " << std::setprecision(0) << m.alpha_max_hour
             << " o'clock, femoral version " << std::setprecision(1) << m.version_posterior_condylar_deg
-            << " deg, acetabular version " << m.orientation_app.anteversion_deg << " deg, LCE "
+            << " deg, acetabular anteversion " << m.orientation_app.anteversion_deg << " deg, LCE "
             << m.lateral_centre_edge_deg << " deg; written to " << out << "\n";
   return 0;
 }

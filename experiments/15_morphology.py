@@ -35,8 +35,8 @@ MAP_FLEXION_DEG = [0.0, 20.0, 40.0]  # generated hips (12,000 triangles, scan ne
 MORPH_COLUMNS = ["subject", "side", "head_radius_mm", "head_fit_rms_mm", "sphericity_rms_mm", "sphericity_max_mm",
                  "neck_shaft_angle_deg", "version_posterior_condylar_deg", "version_transepicondylar_deg",
                  "alpha_max_deg", "alpha_max_hour"] + [f"alpha_{h}h_deg" for h in range(1, 13)] + \
-                ["head_neck_offset_ratio", "acetabular_radius_mm", "inclination_deg", "version_deg",
-                 "lateral_centre_edge_deg", "anterior_centre_edge_deg", "head_coverage", "ms"]
+                ["head_neck_offset_ratio", "acetabular_radius_mm", "radiographic_inclination_deg",
+                 "radiographic_anteversion_deg", "lateral_centre_edge_deg", "anterior_centre_edge_deg", "head_coverage", "ms"]
 
 
 def value(part, key):
@@ -75,8 +75,8 @@ def main():
                 "version_posterior_condylar_deg", "version_transepicondylar_deg", "alpha_max_deg", "alpha_max_hour")] +
                 [("nan" if alpha[str(h)] is None else alpha[str(h)]) for h in range(1, 13)] +
                 [value(f, "head_neck_offset_ratio")] + [value(a, k) for k in (
-                    "radius_mm", "inclination_deg", "version_deg", "lateral_centre_edge_deg",
-                    "anterior_centre_edge_deg", "head_coverage")] + [ms])
+                    "radius_mm", "radiographic_inclination_deg", "radiographic_anteversion_deg",
+                    "lateral_centre_edge_deg", "anterior_centre_edge_deg", "head_coverage")] + [ms])
             if hip.startswith("generated"):
                 # Its flexion stops before 90 deg (a cup about a straight neck): internal rotation over the ROM map's
                 # flexions instead (NaN: in contact without rotation, or free to 150 deg).

@@ -98,7 +98,8 @@ def test_head_radius_matches_an_independent_sphere_fit(hip, tmp_path):
     assert 100 < f["neck_shaft_angle_deg"]["value"] < 150
     assert -30 < f["version_posterior_condylar_deg"]["value"] < 50
     assert all(15 < v < 90 for v in f["alpha_deg_by_hour"]["value"].values() if v is not None)
-    assert 30 < a["inclination_deg"]["value"] < 70 and -10 < a["version_deg"]["value"] < 45
+    assert 30 < a["radiographic_inclination_deg"]["value"] < 70
+    assert -10 < a["radiographic_anteversion_deg"]["value"] < 45
     assert 0.2 < a["head_coverage"]["value"] < 0.7
 
 

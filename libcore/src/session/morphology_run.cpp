@@ -128,17 +128,17 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
   a["fit_rms_mm"] =
       measure(number_or_null(m.acetabular_fit_rms_mm), "mm", "area-weighted rms of the lunate surface about it", "");
   a["lunate_area_mm2"] = measure(number_or_null(m.lunate_area_mm2), "mm^2", "area the sphere is fitted on", "");
-  a["inclination_deg"] = measure(number_or_null(m.orientation_app.inclination_deg), "deg",
-                                 "radiographic inclination of the rim plane's normal in the anterior pelvic plane "
-                                 "(normal 40-50)",
-                                 "Murray 1993, J Bone Joint Surg Br 75:228");
-  a["version_deg"] =
+  a["radiographic_inclination_deg"] =
+      measure(number_or_null(m.orientation_app.inclination_deg), "deg",
+              "radiographic inclination of the rim plane's normal in the anterior pelvic plane (normal 40-50)",
+              "Murray 1993, J Bone Joint Surg Br 75:228");
+  a["radiographic_anteversion_deg"] =
       measure(number_or_null(m.orientation_app.anteversion_deg), "deg",
-              "radiographic version (anteversion) of the same (normal 10-25; retroversion under 0)", "Murray 1993");
-  a["inclination_isb_deg"] = measure(number_or_null(m.orientation_isb.inclination_deg), "deg",
-                                     "the same in the ISB pelvic frame", "Murray 1993; Wu et al. 2002");
-  a["version_isb_deg"] = measure(number_or_null(m.orientation_isb.anteversion_deg), "deg",
-                                 "the same in the ISB pelvic frame", "Murray 1993; Wu et al. 2002");
+              "radiographic anteversion of the same (normal 10-25; retroversion under 0)", "Murray 1993");
+  a["radiographic_inclination_isb_deg"] = measure(number_or_null(m.orientation_isb.inclination_deg), "deg",
+                                                  "the same in the ISB pelvic frame", "Murray 1993; Wu et al. 2002");
+  a["radiographic_anteversion_isb_deg"] = measure(number_or_null(m.orientation_isb.anteversion_deg), "deg",
+                                                  "the same in the ISB pelvic frame", "Murray 1993; Wu et al. 2002");
   a["lateral_centre_edge_deg"] =
       measure(number_or_null(m.lateral_centre_edge_deg), "deg",
               "in the coronal plane (anterior pelvic plane frame) through the head centre, from the superior axis to "
