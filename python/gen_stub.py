@@ -37,16 +37,18 @@ def type_of(row):
 
 def default_of(row):
     d = row["default"]
-    if isinstance(d, float) and d == float("inf"):
-        return "float('inf')"
+    values = d if isinstance(d, list) else [d]
+    if any(isinstance(x, float) and not (x == x and abs(x) != float("inf")) for x in values):
+        raise SystemExit(f"gen_stub: the default of '{row['key']}' ({d!r}) is not a finite number: a stub default "
+                         "must be a Python literal (give the row a finite default, or teach gen_stub this one)")
     return repr(d)
 
 
 def wrapped_list(text, column, suffix_len=0):
     """A parameter `text` starting at `column` whose list default runs past WIDTH, broken after its commas and
     aligned after its '['; `suffix_len` characters follow it on its last line."""
-    if column + len(text) + suffix_len <= WIDTH or "= [" not in text:
-        return text
+    if column + len(text) + suffix_len <= WIDTH or "= [" not in text or "'" in text[text.index("= ["):]:
+        return text  # short, no list, or a list of strings (whose items may hold ", "): left whole
     at = text.index("= [") + 3
     head, rest = text[:at], text[at:]
     items, tail = rest[:rest.rindex("]")].split(", "), rest[rest.rindex("]"):]
@@ -70,6 +72,9 @@ def render(use, exclude, column, rows, suffix_len, first_column=None):
     `first_column`, default `column`); the last line leaves room for the `suffix_len` characters that follow the
     placeholder."""
     first_column = column if first_column is None else first_column
+    unknown = exclude - {r["key"] for r in rows if use in r["uses"]}
+    if unknown:
+        raise SystemExit(f"gen_stub: @keywords {use} leaves out {sorted(unknown)}, which it does not have")
     params = [f"{r['key']}: {type_of(r)} = {default_of(r)}" for r in rows
               if use in r["uses"] and r["key"] not in exclude]
     if not params:

@@ -77,20 +77,28 @@ TEST(PlanRun, APlanRestoresTheCamFreeLimitsRemovingAboutTheCam) {
   EXPECT_GT(removed, 0);
   EXPECT_LE(removed, 1.2 * cam_volume);
   EXPECT_NEAR(p.plan.femur.volume_mm3, removed, std::max(0.5, 0.02 * removed));
-  // Never outwards; most of the removal (depth x vertex area) where the cam was.
+  // Never outwards (each vertex moves against the input's outward normal, found here from the faces, oriented by
+  // the signed volume, and by its reported depth); most of the removal (depth x vertex area) where the cam was.
   const Eigen::Index n = cam.ball.V.rows();
   ASSERT_EQ(p.plan.femur.depth_mm.size(), std::size_t(n));
   Eigen::VectorXd area = Eigen::VectorXd::Zero(n);
+  Vertices normal = Vertices::Zero(n, 3);
+  double signed_volume = 0;
   for (Eigen::Index f = 0; f < cam.ball.F.rows(); ++f) {
     const Eigen::Vector3d a = cam.ball.V.row(cam.ball.F(f, 0)), b = cam.ball.V.row(cam.ball.F(f, 1)),
                           c = cam.ball.V.row(cam.ball.F(f, 2));
-    const double third = 0.5 * (b - a).cross(c - a).norm() / 3;
-    for (int k = 0; k < 3; ++k) area[cam.ball.F(f, k)] += third;
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    signed_volume += a.dot(b.cross(c)) / 6;
+    for (int k = 0; k < 3; ++k) area[cam.ball.F(f, k)] += cross.norm() / 6, normal.row(cam.ball.F(f, k)) += cross;
   }
+  const double outward = signed_volume > 0 ? 1 : -1;
   double on_cam = 0, all = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
     const double d = p.plan.femur.depth_mm[std::size_t(i)];
-    EXPECT_GE(d, 0) << "vertex " << i;
+    const Eigen::Vector3d move = (p.femur_resected.V.row(i) - cam.ball.V.row(i)).transpose();
+    const Eigen::Vector3d nrm = outward * normal.row(i).transpose().normalized();
+    EXPECT_LE(move.dot(nrm), 1e-6) << "vertex " << i << " moved outwards";
+    EXPECT_NEAR(move.norm(), d, 1e-4) << "vertex " << i;  // moved by its reported depth
     all += area[i] * d;
     if ((cam.ball.V.row(i) - free.ball.V.row(i)).norm() > 0.05) on_cam += area[i] * d;
   }

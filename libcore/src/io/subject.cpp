@@ -116,10 +116,11 @@ SubjectInfo load_subject(const std::string& json_path) {
 
 void save_subject(const std::string& json_path, const SubjectInfo& s) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::absolute(fs::path(json_path)).parent_path();
-  // A mesh in the json's folder (or below it) by its relative name, any other by its absolute path.
+  // Both the folder and the meshes resolved through the file system (symbolic links, '..'), so that a mesh in the
+  // json's folder (or below it) is named relative to it, any other by its absolute path.
+  const fs::path dir = fs::weakly_canonical(fs::absolute(fs::path(json_path))).parent_path();
   auto file = [&](const std::string& path) {
-    const fs::path p = fs::absolute(path).lexically_normal();
+    const fs::path p = fs::weakly_canonical(fs::absolute(path));
     const fs::path rel = p.lexically_relative(dir);
     return (!rel.empty() && *rel.begin() != "..") ? rel.generic_string() : p.string();
   };
