@@ -58,11 +58,11 @@ def wrapped_list(text, column, suffix_len=0):
         last = i + 1 == len(items)
         piece = item + (tail if last else ",")
         used = (column if not lines else inner) + len(cur)
-        if cur.strip() and not cur.endswith("[") and used + 1 + len(piece) + (suffix_len if last else 0) > WIDTH:
+        if not cur.endswith("[") and used + 1 + len(piece) + (suffix_len if last else 0) > WIDTH:
             lines.append(cur)
             cur = piece
         else:
-            cur += ("" if cur.endswith("[") or not cur else " ") + piece
+            cur += ("" if cur.endswith("[") else " ") + piece
     lines.append(cur)
     return ("\n" + " " * inner).join(lines)
 
@@ -92,10 +92,9 @@ def render(use, exclude, column, rows, suffix_len, first_column=None):
         start = at + (len(cur) + 1 if cur else 0)
         piece = wrapped_list(piece, start, suffix_len if last else 0)
         cur = piece if not cur else cur + " " + piece
-        if "\n" in piece:  # a list broken over lines ends its own line
-            if not last:
-                lines.append(cur)
-                cur = ""
+        if "\n" in piece and not last:  # a list broken over lines ends its own line
+            lines.append(cur)
+            cur = ""
     lines.append(cur)
     return ("\n" + " " * column).join(x for x in lines if x)
 
@@ -122,9 +121,8 @@ def generate(template_text, rows):
         if m:
             exclude = {x for x in m.group(2).split(" -") if x.strip()}
             before, after = line[:m.start()], line[m.end():]
-            column = open_column(before) if before.strip() else m.start()
-            if before.strip() and not before.rstrip().endswith(","):
-                column = m.start()
+            # After "(..., " the parameters line up inside the parenthesis; on a line of their own, at the placeholder.
+            column = open_column(before) if before.rstrip().endswith(",") else m.start()
             body = render(m.group(1), exclude, column, rows, len(after.rstrip("\n")), m.start())
             line = before + body + after
         out.append(line)

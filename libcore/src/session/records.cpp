@@ -180,7 +180,7 @@ nlohmann::json acetabulum_record(const Acetabulum& A, const AnatomicalFrame& pel
 
 std::string pelvic_frame_name(const Session& s) {
   if (s.hip().neutral() != Neutral::anatomical) return "scan";
-  return s.hip_options().frames.pelvis == PelvisFrameKind::anterior_pelvic_plane ? "app" : "isb";
+  return to_string(s.hip_options().frames.pelvis);
 }
 
 nlohmann::json setup_record(const Session& s) {

@@ -225,9 +225,16 @@ std::shared_ptr<const SamplingScheme> scheme_of(const GridRequest& g) {
   return make_scheme(g.scheme, res);
 }
 
+namespace {
+// The subject's "neutral" (`context` names it in errors) where the options leave the neutral unset.
+void take_subject_neutral(HipJointOptions& o, const std::string& subject_neutral, const std::string& context) {
+  if (!o.neutral && !subject_neutral.empty()) o.neutral = parse_neutral(subject_neutral, context);
+}
+}  // namespace
+
 HipJointOptions resolved_hip_options(const SessionOptions& options, const std::string& subject_neutral) {
   HipJointOptions o = options.hip;
-  if (!o.neutral && !subject_neutral.empty()) o.neutral = parse_neutral(subject_neutral, "subject.json \"neutral\"");
+  take_subject_neutral(o, subject_neutral, "subject.json \"neutral\"");
   JointOptions& jo = o.joint;
   require(!jo.scheme || !options.grid.given(),
           "give the maps' scheme either as a grid request (scheme, resolution, precision, turns, spacing) or as "
@@ -293,8 +300,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
              " ray-triangle tests (minutes; at most 5e9): use ray-cast-bvh, the same exact node values through a BVH";
     });
   }
-  if (!options.hip.neutral && !in.neutral.empty())
-    hip_options_.neutral = parse_neutral(in.neutral, options.input.subject + ": \"neutral\"");
+  take_subject_neutral(hip_options_, in.neutral, options.input.subject + ": \"neutral\"");
   const Neutral neutral = hip_options_.neutral.value_or(Neutral::anatomical);
   hip_options_.neutral = neutral;  // resolved: hip_options() tells what was built
   hip_options_.head_sphere.reset();  // the session's own (below), never a caller's

@@ -61,7 +61,8 @@ Eigen::Vector4d parse_head_region(const std::string& text, const std::string& co
 /// resolves it, scheme_of, into HipJointOptions::joint.scheme). At most one of resolution, precision, turns and
 /// spacing; none: the scheme's default (0.5 deg node spacing equivalent).
 struct GridRequest {
-  std::string scheme = "equiangular";  ///< a registered scheme (scheme_names())
+  static constexpr const char* kDefaultScheme = "equiangular";
+  std::string scheme = kDefaultScheme;  ///< a registered scheme (scheme_names())
   double resolution = 0;               ///< the scheme's own unit; 0: not given
   static constexpr Range kResolutionRange{0, 2147483647};
   double precision = 0;                ///< alias for equiangular grids: p, degrees; 0: not given
@@ -71,7 +72,9 @@ struct GridRequest {
   double spacing = 0;                  ///< largest node spacing wanted, degrees: the coarsest resolution reaching it
   static constexpr Range kSpacingRange{0, 90};
   /// Whether anything but the defaults was asked for (a resolution, or a scheme other than equiangular).
-  bool given() const { return resolution > 0 || precision > 0 || turns > 0 || spacing > 0 || scheme != "equiangular"; }
+  bool given() const {
+    return resolution > 0 || precision > 0 || turns > 0 || spacing > 0 || scheme != kDefaultScheme;
+  }
 };
 
 /// About how many bytes the two maps of `scheme` take (float node values, their marks and bound pyramids:
