@@ -150,7 +150,7 @@ int run_distance(const RunOptions& o) {
   const std::string& out = o.command.out;
   const PoseAngles pose = parse_pose(o.command.pose);
   SessionOptions so = o.session;
-  so.setup = setup_for_poses(so.setup, 1);  // auto: one pose, direct (the layered maps would not pay back)
+  so.query_strategy = query_strategy_for_poses(so.query_strategy, 1);  // auto: one pose, direct (the layered maps would not pay back)
   so.only_poses = {pose};  // direct: the distance hierarchies cropped to it
   const Session s = open_session(so);
   const double setup_ms = ms_since(t_start);
@@ -202,7 +202,7 @@ int run_motion(const RunOptions& o) {
   // The motion file is read (and fully checked) before anything is built or written.
   const Motion motion = load_motion(mo.motion, input_side(o.session.input));
   SessionOptions so = o.session;
-  so.setup = setup_for_poses(so.setup, motion.frames());  // auto: by the number of frames
+  so.query_strategy = query_strategy_for_poses(so.query_strategy, motion.frames());  // auto: by the number of frames
   const Session s = open_session(so);
   const double setup_ms = ms_since(t_start);
 

@@ -2,6 +2,7 @@
 // defaults from the clinical preset, and impinge.options(), the table itself, for the stub's and the study
 // spec's tests (python/tests/test_options.py) and for users.
 #include <cmath>
+#include <algorithm>
 #include <deque>
 
 #include "bindings.hpp"
@@ -129,13 +130,25 @@ void set_options(RunOptions& run, const py::dict& given, unsigned use, const std
   for (const auto& [k, v] : given) {
     const std::string key = py::str(k).cast<std::string>();
     bool ok = false;
-    for (const OptionRow& r : option_table()) ok = ok || ((r.uses & use) && r.key == key);
+    for (const OptionRow& r : option_table())
+      ok = ok || ((r.uses & use) && (r.key == key || std::count(r.old_keys.begin(), r.old_keys.end(), key)));
     if (!ok) throw Error(caller + ": unknown option '" + key + "' (options: " + known + ")");
   }
   for (const OptionRow& r : option_table()) {  // the table's order: preset first
-    if (!(r.uses & use) || !given.contains(r.key)) continue;
-    const py::object v = given[py::str(r.key)];
-    if (!v.is_none()) r.set(run, to_value(r, v, r.key), r.key);
+    if (!(r.uses & use)) continue;
+    std::string key = r.key;  // the key given: the row's, or a former one (warned)
+    for (const std::string& old : r.old_keys) {
+      if (!given.contains(old)) continue;
+      if (given.contains(r.key))
+        throw Error(caller + ": give " + r.key + " or " + old + " (its former name), not both");
+      const std::string msg = caller + ": '" + old + "' is deprecated and will be removed in the next release: use '" +
+                              r.key + "'";
+      if (PyErr_WarnEx(PyExc_DeprecationWarning, msg.c_str(), 1) != 0) throw py::error_already_set();
+      key = old;
+    }
+    if (!given.contains(key)) continue;
+    const py::object v = given[py::str(key)];
+    if (!v.is_none()) r.set(run, to_value(r, v, key), key);
   }
 }
 
@@ -173,6 +186,8 @@ void bind_options(py::module_& m) {
           d["default"] = to_python(r, r.get(clinical));
           d["thesis_default"] = to_python(r, r.get(thesis));
           d["help"] = r.help;
+          d["old_names"] = r.old_names;
+          d["old_keys"] = r.old_keys;
           py::list uses;
           for (unsigned bit = 1; bit <= use_joint_plan; bit <<= 1)
             if (r.uses & bit) uses.append(use_name(bit));

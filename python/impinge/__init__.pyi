@@ -92,10 +92,10 @@ class Joint:
                  landmarks: Optional[Dict[str, Sequence[float]]] = None,
                  cor: Optional[Union[str, Sequence[float]]] = None, allow_any_cor: bool = False,
                  head_region: Optional[Sequence[float]] = None, scheme: str = 'equiangular', resolution: float = 0.0,
-                 precision: float = 0.0, turns: float = 0.0, spacing: float = 0.0, sampling: str = 'auto',
+                 precision: float = 0.0, turns: float = 0.0, spacing_deg: float = 0.0, sampling: str = 'auto',
                  mode: str = 'exact', levels: Optional[Sequence[float]] = None, occlusion_tolerance_mm: float = 1.0,
-                 max_radius_mm: float = 0.0, sparse: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
-                 layers: int = 4, setup: str = 'auto', layered_spacing: float = 0.5,
+                 max_radius_mm: float = 0.0, sparse_region_mm: float = 0.0, discontinuity_tolerance_mm: float = 0.05,
+                 layers: int = 4, query_strategy: str = 'auto', layered_spacing_deg: float = 0.5,
                  extra_articular_radius_mm: float = 150.0, distances: bool = True, levels_on: Optional[str] = None,
                  distance_reach_mm: float = 0.0, max_memory_gb: float = 0.0, maps_only: bool = False,
                  maps: Optional[Tuple[str, str]] = None, neutral: Optional[str] = None, pelvis_frame: str = 'isb',
@@ -108,8 +108,8 @@ class Joint:
         (x, y, z) mm, the femoral head centre about which the radial gaps at the scan pose are measured; head_region: (x, y, z, r) mm, fit the head there; allow_any_cor: accept a COR
         outside the head. scheme and one of resolution/precision/turns/spacing (0: the scheme's
         0.5 deg default); sampling; mode 'exact'/'linear'; levels: thresholds mm, decreasing;
-        sparse: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for
-        hidden vertices (extra-articular), within extra_articular_radius_mm, at layered_spacing deg (0: the maps' own); setup: 'maps', 'direct' (no
+        sparse_region_mm: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for
+        hidden vertices (extra-articular), within extra_articular_radius_mm, at layered_spacing_deg (0: the maps' own); query_strategy: 'maps', 'direct' (no
         layered maps: the hidden vertices by exact ray casts, for a few poses; no ROM searches) or 'auto' (maps); distances: the signed
         Euclidean distance to the other bone beside each gap (results' ball_distance_mm, socket_distance_mm),
         for every vertex within distance_reach_mm of it (0: the largest level threshold); levels_on: what the

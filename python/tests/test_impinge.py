@@ -62,14 +62,14 @@ def test_gaps_equal_the_cli_on_a_generated_hip(generated):
     # Where the one pose's time went: the parts within the whole (set-up, pose and output in order; each body's
     # sampling and marking within the set-up, both scans within the pose), no layered maps with the direct set-up.
     t = summary["timings_ms"]
-    assert summary["setup"] == "direct" and t["ball_layered_sampling"] == t["socket_layered_sampling"] == 0
+    assert summary["query_strategy"] == "direct" and t["ball_layered_sampling"] == t["socket_layered_sampling"] == 0
     assert 0 < t["setup_total"] + t["pose"] + t["output"] <= t["total"]
     for part in ("ball", "socket"):
         assert 0 < t[f"{part}_sampling"] + t[f"{part}_marking"] <= t["setup_total"]
         assert t[f"{part}_detection"] + t[f"{part}_distance"] <= t["pose"]
     ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
-    # The CLI's distance sets up for its one pose (setup auto: direct, no layered maps); the Joint, the same.
-    j = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0, setup="direct")
+    # The CLI's distance sets up for its one pose (query strategy auto: direct, no layered maps); the Joint, the same.
+    j = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0, query_strategy="direct")
     r = j.detect_pose(30, -10, 5)
     assert r["ball_gap_mm"].dtype == np.float32 and r["ball_gap_mm"].shape == (len(ball[0]),)
     # With the layered maps (the Joint's default, for many poses): the same distances and first-surface gaps; the
@@ -122,8 +122,8 @@ def test_motion_equals_detect_pose_and_maps_are_views(generated):
 
 
 def test_motion_set_up_chosen_by_its_frames(generated):
-    """impinge motion with --setup auto: a short motion builds no layered maps (direct), one of 400 frames or more
-    builds them (maps), as summary.json says; forcing either gives the same distances, first-surface gaps and
+    """impinge motion with --query-strategy auto: a short motion builds no layered maps (direct), one of 400
+    frames or more builds them (maps), as summary.json says; forcing either gives the same distances, first-surface gaps and
     levels frame by frame (only the hidden vertices' radial gaps may differ: exact against interpolated)."""
     d = generated
 
@@ -138,14 +138,18 @@ def test_motion_set_up_chosen_by_its_frames(generated):
         subprocess.run([CLI, "motion", "--subject", d + "/s/subject.json", "--motion", mot, "--precision", "2",
                         "--quiet", "--vtp-every", "1000000", "--out", out, *extra], check=True, capture_output=True)
         with open(out + "/summary.json") as f:
-            setup = json.load(f)["setup"]
+            setup = json.load(f)["query_strategy"]
         with open(out + "/frames.csv") as f:
             rows = list(csv.DictReader(f))
         return setup, rows
 
     short, rows = motion(5, "m5")
-    forced, rows_maps = motion(5, "m5maps", "--setup", "maps")
+    forced, rows_maps = motion(5, "m5maps", "--query-strategy", "maps")
     assert (short, forced) == ("direct", "maps")
+    assert motion(5, "m5setup", "--setup", "maps")[0] == "maps"  # the former name, for one release
+    r = subprocess.run([CLI, "distance", "--subject", d + "/s/subject.json", "--precision", "2", "--setup", "maps",
+                        "--out", d + "/setup_alias"], capture_output=True, text=True)
+    assert r.returncode == 0 and "--setup is deprecated" in r.stderr and "use --query-strategy" in r.stderr
     for a, b in zip(rows, rows_maps):
         for col in ("ball_min_distance_mm", "socket_min_distance_mm", "socket_level0_area_mm2",
                     "socket_level2_area_mm2"):
@@ -180,7 +184,7 @@ def test_sparse_maps_give_the_same_gaps(generated):
     d = generated
     ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
     dense = impinge.Joint(ball, socket, neutral="scan", resolution=0.5)
-    sparse = impinge.Joint(ball, socket, neutral="scan", resolution=0.5, sparse=float("inf"))
+    sparse = impinge.Joint(ball, socket, neutral="scan", resolution=0.5, sparse_region_mm=float("inf"))
     assert sparse.socket_map.sparse and not dense.socket_map.sparse
     assert sparse.socket_map.bytes < dense.socket_map.bytes
     np.testing.assert_array_equal(sparse.socket_map.values, dense.socket_map.values)
@@ -189,7 +193,7 @@ def test_sparse_maps_give_the_same_gaps(generated):
         np.testing.assert_array_equal(a["ball_gap_mm"], b["ball_gap_mm"])
         np.testing.assert_array_equal(a["socket_gap_mm"], b["socket_gap_mm"])
     with pytest.raises(impinge.Error, match="sparse"):
-        impinge.Joint(ball, socket, neutral="scan", resolution=2.0, sparse=-1.0)
+        impinge.Joint(ball, socket, neutral="scan", resolution=2.0, sparse_region_mm=-1.0)
 
 
 def test_layered_maps_test_hidden_vertices_and_leave_the_others(generated):
@@ -310,11 +314,11 @@ def test_real_subject_anatomical_frames():
 
 
 def test_a_joint_set_up_without_layered_maps_refuses_rom_searches(generated):
-    """setup='direct' leaves the layered maps out (a few poses); a ROM search needs them and says so."""
+    """query_strategy='direct' leaves the layered maps out (a few poses); a ROM search needs them and says so."""
     d = generated
     ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
-    j = impinge.Joint(ball, socket, neutral="scan", resolution=2.0, setup="direct")
-    assert j.setup["setup"] == "direct"
-    with pytest.raises(impinge.Error, match="without its layered maps.*setup 'maps'"):
+    j = impinge.Joint(ball, socket, neutral="scan", resolution=2.0, query_strategy="direct")
+    assert j.setup["query_strategy"] == "direct"
+    with pytest.raises(impinge.Error, match="without its layered maps.*query strategy 'maps'"):
         j.rom_limits()
-    assert impinge.Joint(ball, socket, neutral="scan", resolution=2.0).setup["setup"] == "maps"
+    assert impinge.Joint(ball, socket, neutral="scan", resolution=2.0).setup["query_strategy"] == "maps"

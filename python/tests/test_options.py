@@ -149,6 +149,37 @@ def test_keyword_functions_take_the_tables_keywords(owner, method, use, small_jo
             fn(**{other: 1})
 
 
+FORMER_KEYS = [(old, o["key"]) for o in OPTIONS for old in o["old_keys"]]
+
+
+@pytest.mark.parametrize("old,new", FORMER_KEYS)
+def test_former_keys_still_work_with_a_warning(old, new, small_joint):
+    """A renamed Python keyword (issue 78: keys carry their unit; --setup is --query-strategy) is accepted for one
+    release with a DeprecationWarning naming its replacement; giving both is an error; a bad value is reported
+    under the name given."""
+    h = impinge.generated_hip(triangles=3000)
+    with pytest.warns(DeprecationWarning, match=f"'{old}' is deprecated .* use '{new}'"):
+        with pytest.raises(impinge.Error, match=f"{old}"):
+            impinge.Joint(h["ball"], h["socket"], neutral="scan", precision=2.0, **{old: -1.0 if old != "setup"
+                                                                                  else "sometimes"})
+    with pytest.raises(impinge.Error, match=f"give {new} or {old} \\(its former name\\), not both"):
+        impinge.Joint(h["ball"], h["socket"], neutral="scan", **{old: 1.0, new: 1.0})
+
+
+def test_former_keys_in_a_study_file_are_renamed_with_a_warning(tmp_path):
+    path = tmp_path / "study.toml"
+    path.write_text("subjects = [{generated = {}}]\n[joint]\nsparse = 40.0\n[[task]]\nkind = 'rom'\n"
+                    "layered_spacing = 1.0\n")
+    with pytest.warns(DeprecationWarning, match="joint.sparse: 'sparse' is deprecated"):
+        study = spec.load_study(str(path))
+    assert study["joint"] == {"sparse_region_mm": [40.0]} or study["joint"] == {"sparse_region_mm": 40.0}
+    assert "layered_spacing_deg" in study["tasks"][0]["joint"]
+    path.write_text("subjects = [{generated = {}}]\n[joint]\nsparse = 40.0\nsparse_region_mm = 1.0\n"
+                    "[[task]]\nkind = 'rom'\n")
+    with pytest.raises(spec.StudyError, match="give sparse_region_mm or sparse"):
+        spec.load_study(str(path))
+
+
 def test_committed_stub_is_the_generated_one():
     """The build writes impinge/__init__.pyi from the template and the table (python/gen_stub.py); the committed
     stub must be that file (regenerate it as gen_stub.py says)."""

@@ -66,8 +66,8 @@ def test_a_subject_in_lps_gives_the_cli_gaps():
         summary = json.load(f)
     assert summary["input_frame"] == "LPS"
 
-    # Python reading the same subject.json (set up as the CLI's distance sets up its one pose: setup direct).
-    j = impinge.Joint(subject=subject, precision=1, setup="direct", **extra)
+    # Python reading the same subject.json (set up as the CLI's distance sets up its one pose: query strategy direct).
+    j = impinge.Joint(subject=subject, precision=1, query_strategy="direct", **extra)
     r = j.detect_pose(30, 5, 10)
     np.testing.assert_array_equal(r["ball_gap_mm"], cli_ball)
     np.testing.assert_array_equal(r["socket_gap_mm"], cli_socket)
@@ -81,7 +81,7 @@ def test_a_subject_in_lps_gives_the_cli_gaps():
         s = json.load(f)
     base = os.path.dirname(subject)
     ball, socket = (impinge.load_mesh(os.path.join(base, s[k])) for k in ("femur", "pelvis"))
-    j2 = impinge.Joint(ball, socket, frame="LPS", side=s["side"], neutral=s.get("neutral"), precision=1, setup="direct",
+    j2 = impinge.Joint(ball, socket, frame="LPS", side=s["side"], neutral=s.get("neutral"), precision=1, query_strategy="direct",
                        **extra)
     np.testing.assert_array_equal(j2.detect_pose(30, 5, 10)["ball_gap_mm"], cli_ball)
     np.testing.assert_array_equal(j2.detect_pose(30, 5, 10)["socket_gap_mm"], cli_socket)

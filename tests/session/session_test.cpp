@@ -219,10 +219,10 @@ testing::AssertionResult same_scan(const ScanGaps& a, const ScanGaps& b) {
 // pose it was set up for, bit for bit; distances on, so that the crop is exercised too.
 TEST(Session, OnePoseSessionDetectsAsAWholeSession) {
   SessionOptions whole_options = generated_options("LPS");
-  whole_options.setup = "maps";
+  whole_options.query_strategy = "maps";
   whole_options.hip.joint.distances = true;
   SessionOptions one_options = whole_options;
-  one_options.setup = "direct";
+  one_options.query_strategy = "direct";
   one_options.only_poses = {{0, 0, 0}, {40, 10, -5}};
   const Session whole(whole_options), one(one_options);
   ASSERT_TRUE(one.joint_options().distances);

@@ -73,8 +73,8 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
   check(o);
   check_metric(hip.joint(), o);
   require(hip.joint().options().layers == 0 || hip.joint().options().layered_maps,
-          "ROM search: the joint was set up without its layered maps (setup 'direct', for a few poses); ROM "
-          "searches need them: set it up with setup 'maps' (or 'auto')");
+          "ROM search: the joint was set up without its layered maps (query strategy 'direct', for a few poses); ROM "
+          "searches need them: set it up with query strategy 'maps' (or 'auto')");
   PoseResult r;
   hip.joint().detect(R, hip.joint_translation(R), r);
   RomBaseline b;

@@ -144,10 +144,11 @@ void add_map_rows(Rows& t) {
   t.number("turns", "turns", "", kSetting, GridRequest::kTurnsRange,
            "Alias of --resolution for the helix: k turns (w = k^2 nodes; 0: not given)",
            [](auto& o) -> auto& { return o.session.grid.turns; });
-  t.number("spacing", "spacing", "deg", kSetting, GridRequest::kSpacingRange,
+  t.number("spacing", "spacing_deg", "deg", kSetting, GridRequest::kSpacingRange,
            "Largest node spacing wanted, degrees, for any scheme: the coarsest resolution that reaches it (instead "
            "of --resolution; 0: not given)",
-           [](auto& o) -> auto& { return o.session.grid.spacing; });
+           [](auto& o) -> auto& { return o.session.grid.spacing; })
+      .old_keys = {"spacing"};
   t.choice("sampling", "sampling", kSetting, kSamplingMethodNames,
          "auto, rasterize, resample, ray-cast (naive, small meshes only) or ray-cast-bvh (exact node values for any "
          "scheme)",
@@ -187,10 +188,11 @@ void add_map_rows(Rows& t) {
     const double r = o.session.hip.joint.max_radius_mm;
     return std::isinf(r) ? 0.0 : r;
   };
-  OptionRow& sparse = t.number("sparse", "sparse", "mm", kSetting, with_zero(JointOptions::kSparseRegionRange),
+  OptionRow& sparse = t.number("sparse", "sparse_region_mm", "mm", kSetting, with_zero(JointOptions::kSparseRegionRange),
                                "Store both maps sparse, in tiles, keeping only tiles with a surface within this "
                                "distance of the COR ('inf': any surface, the same gaps bit for bit; 0 = dense maps)",
                                [](auto& o) -> auto& { return o.session.hip.joint.sparse_region_mm; });
+  sparse.old_keys = {"sparse"};
   sparse.set = [spec = sparse](RunOptions& o, const OptionValue& v, const std::string& as) {
     const double x = checked_number(spec, v, as);
     o.session.hip.joint.sparse_maps = x > 0;
@@ -209,19 +211,22 @@ void add_map_rows(Rows& t) {
             "bone's nearer surface (trochanters, shaft, ilium) are tested too: extra-articular impingement (0 = off, "
             "the thesis' single-layer maps)",
             [](auto& o) -> auto& { return o.session.hip.joint.layers; });
-  t.text("setup", "setup", OptionType::choice, kSetting, {"auto", "maps", "direct"},
+  OptionRow& strategy = t.text("query-strategy", "query_strategy", OptionType::choice, kSetting, {"auto", "maps", "direct"},
          "What to build for the work: maps (both maps and the layered maps, for many poses), direct (no layered "
          "maps: the hidden vertices by exact ray casts; distance's distance hierarchies only over the triangles its "
          "pose can reach; a few poses; no ROM searches), auto (by the number of poses: "
-         "distance and motions of fewer than " + std::to_string(kDirectSetupMaxPoses) +
+         "distance and motions of fewer than " + std::to_string(kDirectQueryMaxPoses) +
              " frames direct; ROM searches, plans and longer motions maps). The "
          "distances and the first-surface gaps are the same either way; the hidden vertices' gaps are exact with "
          "direct, the maps' interpolation with maps",
-         [](auto& o) -> auto& { return o.session.setup; });
-  t.number("layered-spacing", "layered_spacing", "deg", kSetting, JointOptions::kLayeredSpacingRange,
+         [](auto& o) -> auto& { return o.session.query_strategy; });
+  strategy.old_names = {"setup"};
+  strategy.old_keys = {"setup"};
+  t.number("layered-spacing", "layered_spacing_deg", "deg", kSetting, JointOptions::kLayeredSpacingRange,
            "The layered maps' largest node spacing (the scheme at the coarsest resolution reaching it, never finer "
            "than the maps'; 0: the maps' own); their edges are exact ray casts",
-           [](auto& o) -> auto& { return o.session.hip.joint.layered_spacing_deg; });
+           [](auto& o) -> auto& { return o.session.hip.joint.layered_spacing_deg; })
+      .old_keys = {"layered_spacing"};
   t.number("extra-articular-radius", "extra_articular_radius_mm", "mm", kSetting,
            JointOptions::kExtraArticularRadiusRange,
            "With --layers, test hidden vertices within this distance of the COR",
@@ -424,7 +429,8 @@ const std::vector<OptionRow>& option_table() {
 const OptionRow* find_option(const std::string& name) {
   for (const OptionRow& r : option_table())
     if (r.name == name || r.key == name ||
-        std::find(r.old_names.begin(), r.old_names.end(), name) != r.old_names.end())
+        std::find(r.old_names.begin(), r.old_names.end(), name) != r.old_names.end() ||
+        std::find(r.old_keys.begin(), r.old_keys.end(), name) != r.old_keys.end())
       return &r;
   return nullptr;
 }

@@ -58,7 +58,7 @@ using detail::shortest;
 void take_session_settings(SessionOptions& to, const SessionOptions& from) {
   to.hip = from.hip;
   to.grid = from.grid;
-  to.setup = from.setup;
+  to.query_strategy = from.query_strategy;
   to.max_memory_gb = from.max_memory_gb;
 }
 

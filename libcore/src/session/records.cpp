@@ -218,8 +218,8 @@ nlohmann::json setup_record(const Session& s) {
   j["exact_at_discontinuities"] = opt.exact_at_discontinuities && s.joint().ball().exact != nullptr;
   j["discontinuity_tolerance_mm"] = opt.discontinuity_tolerance_mm;
   j["layers"] = opt.layers;
-  // What was built for the work (SessionOptions::setup): the layered maps, or exact casts for the hidden vertices.
-  j["setup"] = opt.layers > 0 && !opt.layered_maps ? "direct" : "maps";
+  // What was built for the work (SessionOptions::query_strategy): the layered maps, or exact casts for the hidden vertices.
+  j["query_strategy"] = opt.layers > 0 && !opt.layered_maps ? "direct" : "maps";
   // The distance hierarchies: over the whole meshes, or cropped to the session's poses (SessionOptions::only_poses),
   // with the searches a whole-mesh hierarchy answered (built at the first of them).
   auto hierarchy = [](const JointBody& b) {

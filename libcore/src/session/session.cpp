@@ -154,11 +154,11 @@ LoadedInput load_input(const SessionInput& input) {
   return in;
 }
 
-std::string setup_for_poses(const std::string& setup, std::size_t poses) {
-  require(setup == "auto" || setup == "maps" || setup == "direct",
-          "setup '" + setup + "': must be maps, direct or auto");
-  if (setup != "auto") return setup;
-  return poses < kDirectSetupMaxPoses ? "direct" : "maps";
+std::string query_strategy_for_poses(const std::string& strategy, std::size_t poses) {
+  require(strategy == "auto" || strategy == "maps" || strategy == "direct",
+          "query strategy '" + strategy + "': must be maps, direct or auto");
+  if (strategy != "auto") return strategy;
+  return poses < kDirectQueryMaxPoses ? "direct" : "maps";
 }
 
 SphereFitResult located_head(const LoadedInput& in) {
@@ -240,9 +240,9 @@ HipJointOptions resolved_hip_options(const SessionOptions& options, const std::s
           "give the maps' scheme either as a grid request (scheme, resolution, precision, turns, spacing) or as "
           "HipJointOptions::joint.scheme, not both");
   if (!jo.scheme) jo.scheme = scheme_of(options.grid);
-  // setup_for_poses checks the value; "auto" reaching here (a library caller that did not resolve it by its
+  // query_strategy_for_poses checks the value; "auto" reaching here (a library caller that did not resolve it by its
   // number of poses) builds the maps, which serve any number of poses.
-  jo.layered_maps = setup_for_poses(options.setup, kDirectSetupMaxPoses) != "direct";
+  jo.layered_maps = query_strategy_for_poses(options.query_strategy, kDirectQueryMaxPoses) != "direct";
   // The levels classify the distance when there are distances, unless the radial gap is asked for.
   if (!jo.levels_on) jo.levels_on = jo.distances ? LevelQuantity::distance : LevelQuantity::radial_gap;
   jo.validate();
@@ -329,7 +329,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
     }
   }
   // One pose's work (SessionOptions::only_poses): the distance hierarchies cropped to it and the scan pose.
-  hip_options_.joint.cropped_distance_queries = !options.only_poses.empty() && options.setup == "direct";
+  hip_options_.joint.cropped_distance_queries = !options.only_poses.empty() && options.query_strategy == "direct";
   try {
     auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
                                           hip_options_);

@@ -11,6 +11,7 @@ import json
 import math
 import os
 import tomllib
+import warnings
 import zlib
 
 import numpy as np
@@ -46,6 +47,8 @@ KIND_TYPES = dict({o["key"]: _PY_TYPES[o["type"]] for o in _table("rom_limits") 
                   motion=str, poses=list)
 # Keys whose value is itself a list: a list of such lists sweeps them (not a plain list).
 LIST_VALUED = {o["key"] for o in impinge.options() if o["type"] in ("numbers", "region", "point")}
+# Former keys still accepted for one release (a warning names the key that replaces each).
+OLD_KEYS = {old: o["key"] for o in impinge.options() for old in o["old_keys"]}
 TOP_KEYS = {"name", "seed", "subjects", "joint", "task", "perturb", "threads"}
 PERTURB_KEYS = {"cor_sd_mm": float, "samples": int}
 
@@ -56,6 +59,19 @@ class StudyError(ValueError):
 
 def _fail(path, key, message):
     raise StudyError(f"{path}: {key}: {message}")
+
+
+def _current(path, where, table, k):
+    """The key `k` of `table` as the option table names it now: a former key is renamed, with a
+    DeprecationWarning naming the file and the key; giving both is an error."""
+    if k not in OLD_KEYS:
+        return k
+    new = OLD_KEYS[k]
+    if new in table:
+        _fail(path, f"{where}.{k}", f"give {new} or {k} (its former name), not both")
+    warnings.warn(f"{path}: {where}.{k}: '{k}' is deprecated and will be removed in the next release: use '{new}'",
+                  DeprecationWarning, stacklevel=3)
+    return new
 
 
 def _typed(path, key, value, kind):
@@ -222,6 +238,7 @@ def load_study(path, overrides=None):
         _fail(path, "joint", "expected a table of Joint options")
     study["joint"] = {}
     for k, v in joint.items():
+        k = _current(path, "joint", joint, k)
         if k not in JOINT_KEYS:
             _fail(path, f"joint.{k}", f"unknown Joint option (known: {', '.join(sorted(JOINT_KEYS))})")
         study["joint"][k] = _values(path, f"joint.{k}", v, JOINT_KEYS[k])
@@ -252,6 +269,7 @@ def load_study(path, overrides=None):
         for k, v in t.items():
             if k in ("kind", "label"):
                 continue
+            k = _current(path, key, t, k)
             if k in JOINT_KEYS:
                 entry["joint"][k] = _values(path, f"{key}.{k}", v, JOINT_KEYS[k])
             elif k == "poses":

@@ -61,7 +61,7 @@ struct RunOptions {
   static RunOptions named(const std::string& name, const std::string& context);
 };
 
-/// The settings a preset sets (SessionOptions' hip, grid, setup and max_memory_gb; not its inputs, COR or
+/// The settings a preset sets (SessionOptions' hip, grid, query_strategy and max_memory_gb; not its inputs, COR or
 /// poses) copied from `from` into `to`.
 void take_session_settings(SessionOptions& to, const SessionOptions& from);
 
@@ -125,6 +125,9 @@ struct OptionRow {
   /// Naming convention: CLI names carry no unit (the unit is in the help and the value's name: NUMBER mm); Python
   /// and study keys carry it on lengths and angles (`clearance_mm`, `step_deg`).
   std::vector<std::string> old_names;
+  /// Former Python keywords and study keys still accepted for one release (Python warns with a
+  /// DeprecationWarning naming the key that replaces one; a study spec names it in its warning).
+  std::vector<std::string> old_keys;
   std::string help;
   std::function<void(RunOptions&, const OptionValue&, const std::string& as)> set;
   std::function<OptionValue(const RunOptions&)> get;
@@ -132,7 +135,7 @@ struct OptionRow {
 
 /// Every option, in the order the CLI's help lists them. Built once; thread-safe to read.
 const std::vector<OptionRow>& option_table();
-/// The row named `name` (CLI name, former CLI name or key); nullptr when none.
+/// The row named `name` (CLI name, former CLI name, key or former key); nullptr when none.
 const OptionRow* find_option(const std::string& name);
 
 /// A CLI text as the row's value: "auto" or "" for a point is nothing; numbers must be finite (or

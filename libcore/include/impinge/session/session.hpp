@@ -81,15 +81,15 @@ struct GridRequest {
 /// 5 bytes a node, doubled for the two bones; the layered maps, at most 0.5 deg by default, come on top).
 double map_memory_bytes(const SamplingScheme& scheme);
 
-/// Below this many poses SessionOptions::setup "auto" takes "direct" (no layered maps), from this many "maps": on
+/// Below this many poses SessionOptions::query_strategy "auto" takes "direct" (no layered maps), from this many "maps": on
 /// lhdl-ct (0.5 deg, defaults, 2 cores) the layered maps cost some 80 ms more to set up and save some 0.2 ms per
 /// pose, so they pay back from about 400 poses (impinge motion, 10 / 100 / 1,000 frames: direct 0.32 / 0.45 / 1.66 s,
 /// maps 0.33 / 0.51 / 1.56 s, medians of 5 alternated runs; issue 52).
-inline constexpr std::size_t kDirectSetupMaxPoses = 400;
+inline constexpr std::size_t kDirectQueryMaxPoses = 400;
 
-/// The set-up a run of `poses` poses takes: `setup` itself when it is "maps" or "direct"; for "auto", "direct"
-/// below kDirectSetupMaxPoses poses, else "maps". Throws impinge::Error for any other value.
-std::string setup_for_poses(const std::string& setup, std::size_t poses);
+/// The query strategy a run of `poses` poses takes: `strategy` itself when it is "maps" or "direct"; for "auto", "direct"
+/// below kDirectQueryMaxPoses poses, else "maps". Throws impinge::Error for any other value.
+std::string query_strategy_for_poses(const std::string& strategy, std::size_t poses);
 
 /// Everything a Session needs: the inputs, how the COR is found, the library's own options of the hip
 /// (`hip`: HipJointOptions, its JointOptions `hip.joint` and their declared ranges; the one place each
@@ -100,7 +100,7 @@ std::string setup_for_poses(const std::string& setup, std::size_t poses);
 ///
 /// The Session resolves these fields of `hip` itself (Session::hip_options() gives what it built with):
 /// joint.scheme (from `grid`; SessionOptions() leaves it null; a scheme set here is used as it is, and giving
-/// `grid` as well is an error), joint.layered_maps (from `setup`; a value given is replaced),
+/// `grid` as well is an error), joint.layered_maps (from `query_strategy`; a value given is replaced),
 /// joint.cropped_distance_queries (from `only_poses`; replaced), joint.levels_on when unset (the distance with
 /// distances on, else the radial gap), neutral when unset (the subject's "neutral", else anatomical), and,
 /// replacing any value given, allow_cor_outside_ball (cor.allow_any), head_sphere, seat_before_sampling, to_report
@@ -114,15 +114,15 @@ struct SessionOptions {
   GridRequest grid;     ///< the maps' scheme and resolution as asked (resolved into hip.joint.scheme)
   /// What to build for the work: "maps" (both maps and, with layers, the layered maps), "direct" (no layered
   /// maps: the hidden vertices by exact ray casts, JointOptions::layered_maps off; for a few poses; no ROM
-  /// searches), "auto" (the front end's choice by the number of poses, setup_for_poses: `impinge distance` and
-  /// motions of fewer than kDirectSetupMaxPoses frames take direct; ROM searches, plans and longer motions maps).
-  std::string setup = "auto";
+  /// searches), "auto" (the front end's choice by the number of poses, query_strategy_for_poses: `impinge distance` and
+  /// motions of fewer than kDirectQueryMaxPoses frames take direct; ROM searches, plans and longer motions maps).
+  std::string query_strategy = "auto";
   /// The most memory the maps may take, GB; 0: three quarters of this machine's memory. A resolution whose
   /// maps would need more is refused before anything is allocated (map_memory_bytes).
   double max_memory_gb = 0;
   static constexpr Range kMaxMemoryRange{0, 1e6};  ///< of max_memory_gb, GB
   /// The poses the session will be asked for, when the front end knows them (`impinge distance`'s --pose; not
-  /// an option of its own). With setup "direct" and distances or layers on, the distance hierarchies are
+  /// an option of its own). With query_strategy "direct" and distances or layers on, the distance hierarchies are
   /// cropped to them and the scan pose (JointOptions::cropped_distance_queries): the same results, less set-up.
   /// Empty: built over the whole meshes.
   std::vector<PoseAngles> only_poses;
@@ -179,7 +179,7 @@ std::shared_ptr<const SamplingScheme> scheme_of(const GridRequest& grid);
 
 /// The HipJointOptions a Session builds with (before the input and the COR are known): `options.hip` with its
 /// scheme resolved (options.grid, or the scheme given in options.hip.joint.scheme), the layered maps by
-/// options.setup, and the neutral, when unset, `subject_neutral` ("anatomical" | "scan"; empty: left unset, which
+/// options.query_strategy, and the neutral, when unset, `subject_neutral` ("anatomical" | "scan"; empty: left unset, which
 /// HipJoint reads as anatomical);
 /// validated (JointOptions::validate). Throws impinge::Error naming the option.
 HipJointOptions resolved_hip_options(const SessionOptions& options, const std::string& subject_neutral = "");
