@@ -168,10 +168,10 @@ for s in subjects:
     cup = (row.rim_radius_mm + 3.0) if clock else row.head_radius_mm + 8.0
     fig = plt.figure(figsize=(10, 3.6))
     for k, (view, names) in enumerate((("anterior", ("ball", "socket")), ("lateral", ("ball", "socket")),
-                                       ("socket_medial", ("socket",)))):
+                                       ("acetabulum_medial", ("socket",)))):
         ax = fig.add_subplot(1, 3, k + 1, projection="3d")
         draw(ax, [bodies[n] for n in names], view, row.side, clock if view != "anterior" else None,
-             radius=cup if view == "socket_medial" else 60.0)
+             radius=cup if view == "acetabulum_medial" else 60.0)
     fig.suptitle(f"{s}: impingement levels at the scan pose", fontsize=9)
     level_key(fig)
     save(fig, d, f"render_{s}")

@@ -290,7 +290,7 @@ for s in clk.subject:
             # width); the socket's closest point, marked, and the least gap in the title are what changes.
             finite = np.where(np.isfinite(gap))[0]
             closest = finite[np.argmin(gap[finite])] if len(finite) else None
-            draw(ax, [(V, F, rgb)], "socket_medial", row.side, clock, radius=row.rim_radius_mm + 3,
+            draw(ax, [(V, F, rgb)], "acetabulum_medial", row.side, clock, radius=row.rim_radius_mm + 3,
                  title=f"{m.replace('_', ' ')} {ang:g} deg" +
                  (f"\nleast gap {gap[closest]:.2f} mm" if closest is not None else ""))
             if closest is not None:

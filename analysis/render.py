@@ -91,7 +91,7 @@ VIEWS = {
     # name: (azimuth for a right hip, elevation, title)
     "anterior": (90, 5, "anterior"),
     "lateral": (0, 5, "lateral"),
-    "socket_medial": (180, 5, "socket, medial view"),
+    "acetabulum_medial": (180, 5, "acetabulum, medial view"),
 }
 
 

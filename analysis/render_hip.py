@@ -1,7 +1,7 @@
 """Shaded renders of an `impinge distance` output folder (called by `impinge distance --render`).
 
 usage: /usr/bin/python3 analysis/render_hip.py OUT_DIR
-Reads OUT_DIR/summary.json, ball_gaps.ply and socket_gaps.ply; writes OUT_DIR/render.png (anterior,
+Reads OUT_DIR/summary.json, femur_gaps.ply and pelvis_gaps.ply; writes OUT_DIR/render.png (anterior,
 lateral and socket medial views side by side) and render_<view>.png for each view. The bones are
 shown in the pelvic frame (anatomical neutral) or the input frame's anatomical axes (scan
 neutral), within 60 mm of the hip centre; the acetabular clock face is drawn when known."""
@@ -41,10 +41,10 @@ def main():
     # The cup: within the rim radius plus 3 mm of the hip centre (or head radius + 8 mm without a rim).
     cup_radius = (clock["radius_mm"] + 3.0) if clock else ((s.get("head_radius_mm") or 25.0) + 8.0)
     bodies = {}
-    for name in ("ball", "socket"):
+    for name in ("femur", "pelvis"):
         V, F, rgb, _ = read_gap_ply(os.path.join(d, f"{name}_gaps.ply"))
         bodies[name] = (to_frame(V, cor, axes), F, rgb)
-    views = [("anterior", ["ball", "socket"]), ("lateral", ["ball", "socket"]), ("socket_medial", ["socket"])]
+    views = [("anterior", ["femur", "pelvis"]), ("lateral", ["femur", "pelvis"]), ("acetabulum_medial", ["pelvis"])]
     fig = plt.figure(figsize=(12, 4.2))
     for k, (view, names) in enumerate(views):
         for target in (fig.add_subplot(1, 3, k + 1, projection="3d"), None):
@@ -52,7 +52,7 @@ def main():
                 f1 = plt.figure(figsize=(4.5, 4.5))
                 target = f1.add_subplot(1, 1, 1, projection="3d")
             draw(target, [bodies[n] for n in names], view, s["side"], clock if view != "anterior" else None,
-                 radius=cup_radius if view == "socket_medial" else 60.0)
+                 radius=cup_radius if view == "acetabulum_medial" else 60.0)
             if target.figure is not fig:
                 target.figure.savefig(os.path.join(d, f"render_{view}.png"), dpi=130)
                 plt.close(target.figure)

@@ -161,7 +161,7 @@ int run_distance(const RunOptions& o) {
   t = Clock::now();
   begin_output_folder(out, "distance");
   // The map images beside the gap files (on their own threads); the gap files' error first.
-  run_both([&] { write_pose_plys(in_dir(out, "ball_gaps.ply"), in_dir(out, "socket_gaps.ply"), s, res, femur); },
+  run_both([&] { write_pose_plys(in_dir(out, "femur_gaps.ply"), in_dir(out, "pelvis_gaps.ply"), s, res, femur); },
            [&] { write_map_pngs(out, s); });
   nlohmann::json j = run_record(s);
   j.update(pose_record(s, pose, femur, res));
@@ -172,24 +172,24 @@ int run_distance(const RunOptions& o) {
   const JointBody& socket = s.joint().socket();
   j["timings_ms"] = {{"setup_total", setup_ms},
                      {"frames", s.hip().frames_ms()},
-                     {"ball_sampling", ball.sampling_ms},
-                     {"socket_sampling", socket.sampling_ms},
-                     {"ball_marking", ball.marking_ms},
-                     {"socket_marking", socket.marking_ms},
-                     {"ball_layered_sampling", ball.layered_sampling.sampling_ms},
-                     {"socket_layered_sampling", socket.layered_sampling.sampling_ms},
+                     {"femur_sampling", ball.sampling_ms},
+                     {"pelvis_sampling", socket.sampling_ms},
+                     {"femur_marking", ball.marking_ms},
+                     {"pelvis_marking", socket.marking_ms},
+                     {"femur_layered_sampling", ball.layered_sampling.sampling_ms},
+                     {"pelvis_layered_sampling", socket.layered_sampling.sampling_ms},
                      {"pose", pose_ms},
-                     {"ball_detection", res.ball_detection_ms},
-                     {"socket_detection", res.socket_detection_ms},
-                     {"ball_distance", res.ball_distance_ms},
-                     {"socket_distance", res.socket_distance_ms},
+                     {"femur_detection", res.ball_detection_ms},
+                     {"pelvis_detection", res.socket_detection_ms},
+                     {"femur_distance", res.ball_distance_ms},
+                     {"pelvis_distance", res.socket_distance_ms},
                      {"output", ms_since(t)},
                      {"total", ms_since(t_start)}};
   write_json(in_dir(out, "summary.json"), j);
   if (o.command.render) render(out);  // reads summary.json; a failure leaves the folder marked incomplete
   end_output_folder(out);
-  std::cout << "ball: " << res.ball.vertices_tested << " tested, min gap " << res.ball.min_gap_mm << " mm, "
-            << res.ball.vertices_penetrating << " penetrating; socket: " << res.socket.vertices_tested
+  std::cout << "femur: " << res.ball.vertices_tested << " tested, min gap " << res.ball.min_gap_mm << " mm, "
+            << res.ball.vertices_penetrating << " penetrating; pelvis: " << res.socket.vertices_tested
             << " tested, min gap " << res.socket.min_gap_mm << " mm, " << res.socket.vertices_penetrating
             << " penetrating; written to " << out << "\n";
   return 0;
@@ -220,8 +220,8 @@ int run_motion(const RunOptions& o) {
   j["vtp_every"] = files.vtp_every;
   j["vtp_files"] = files.vtp_files;
   j["timings_ms"] = {{"setup_total", setup_ms},
-                     {"ball_sampling", s.joint().ball().sampling_ms},
-                     {"socket_sampling", s.joint().socket().sampling_ms},
+                     {"femur_sampling", s.joint().ball().sampling_ms},
+                     {"pelvis_sampling", s.joint().socket().sampling_ms},
                      {"frames", s.hip().frames_ms()},
                      {"detection_total", detect_ms},
                      {"detection_per_frame", n ? detect_ms / static_cast<double>(n) : 0.0},
@@ -253,8 +253,8 @@ int run_rom(const RunOptions& o) {
   nlohmann::json j = run_record(s);
   j.update(rom_record(run));
   j["timings_ms"] = {{"setup_total", setup_ms},
-                     {"ball_sampling", s.joint().ball().sampling_ms},
-                     {"socket_sampling", s.joint().socket().sampling_ms},
+                     {"femur_sampling", s.joint().ball().sampling_ms},
+                     {"pelvis_sampling", s.joint().socket().sampling_ms},
                      {"limits", run.limits_ms},
                      {"rom_map", run.map_ms},
                      {"envelope", run.envelope_ms},

@@ -44,5 +44,5 @@ for label, extra in (("no VTP files", ["--vtp-every", "1000000"]), ("default VTP
             parts.setdefault(k, []).append(v)
     med = {k: statistics.median(v) for k, v in parts.items()}
     print(f"{label}: 1000 frames at {res} deg, median total {statistics.median(totals):.0f} ms over {reps} runs "
-          f"(sampling {med['ball_sampling'] + med['socket_sampling']:.0f} ms, frames {med['frames']:.0f} ms, "
+          f"(sampling {med['femur_sampling'] + med['pelvis_sampling']:.0f} ms, frames {med['frames']:.0f} ms, "
           f"detection {med['detection_total']:.0f} ms, output {med['output']:.0f} ms)")

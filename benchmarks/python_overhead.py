@@ -27,7 +27,7 @@ def main():
         j, name = impinge.Joint((V @ lps, F), (P @ lps, G), resolution=0.1), "lhdl-ct"
     else:
         h = impinge.generated_hip(triangles=12000, cam_mm=2.0)
-        j, name = impinge.Joint(h["ball"], h["socket"], neutral="scan", resolution=0.1), "generated-12k"
+        j, name = impinge.Joint(h["femur"], h["pelvis"], neutral="scan", resolution=0.1), "generated-12k"
     R = j.femur_rotation(30, 10, 5)
     reps = 11
     py_ns, cpp_ns = [], []

@@ -3,7 +3,7 @@ minimum gap over time and the gap-coloured acetabulum at the closest pose.
 
 usage: PYTHONPATH=build/python /usr/bin/python3 examples/motion_study.py OUT_DIR [DATA_DIR]
 Uses the shared subject lhdl-ct (DATA_DIR, default ../shared/data/hips) when present, otherwise a
-generated hip with a 2 mm cam bump. Writes OUT_DIR/min_gap.png, OUT_DIR/socket_gaps.png and
+generated hip with a 2 mm cam bump. Writes OUT_DIR/min_gap.png, OUT_DIR/pelvis_gaps.png and
 OUT_DIR/motion.csv. Run by ./reproduce --quick so it cannot rot."""
 import os
 import sys
@@ -26,7 +26,7 @@ def load_hip(data_dir):
         P, G = impinge.load_mesh(os.path.join(subject, "pelvis.ply"))
         return (V @ lps_to_ras, F), (P @ lps_to_ras, G), "anatomical", "lhdl-ct"
     h = impinge.generated_hip(triangles=12000, cam_mm=2.0)
-    return h["ball"], h["socket"], "scan", "generated hip (2 mm cam)"
+    return h["femur"], h["pelvis"], "scan", "generated hip (2 mm cam)"
 
 
 def main():
@@ -40,7 +40,7 @@ def main():
     t = np.linspace(0.0, 5.0, 251)
     angles = np.column_stack([100 * t / 5, 10 * t / 5, 25 * (t / 5) ** 2])
     m = joint.motion(angles)
-    gap = np.fmin(m["ball_min_gap_mm"], m["socket_min_gap_mm"])
+    gap = np.fmin(m["femur_min_gap_mm"], m["pelvis_min_gap_mm"])
     np.savetxt(os.path.join(out, "motion.csv"), np.column_stack([t, angles, gap]), delimiter=",",
                header="time_s,flexion_deg,adduction_deg,internal_rotation_deg,min_gap_mm", comments="")
 
@@ -58,16 +58,16 @@ def main():
     k = int(np.nanargmin(gap))
     r = joint.detect_pose(*angles[k])
     V = socket[0] - joint.cor
-    near = (np.linalg.norm(V, axis=1) < 40) & np.isfinite(r["socket_gap_mm"])
+    near = (np.linalg.norm(V, axis=1) < 40) & np.isfinite(r["pelvis_gap_mm"])
     fig = plt.figure(figsize=(5, 4.5))
     ax = fig.add_subplot(projection="3d")
-    sc = ax.scatter(V[near, 0], V[near, 1], V[near, 2], c=r["socket_gap_mm"][near], cmap="RdYlBu", vmin=0, vmax=6,
+    sc = ax.scatter(V[near, 0], V[near, 1], V[near, 2], c=r["pelvis_gap_mm"][near], cmap="RdYlBu", vmin=0, vmax=6,
                     s=2)
     fig.colorbar(sc, ax=ax, shrink=0.6, label="gap (mm)")
     ax.view_init(elev=10, azim=0)
     ax.set_axis_off()
     ax.set_title(f"acetabulum at t = {t[k]:.2f} s (min gap {gap[k]:.2f} mm)", fontsize=9)
-    fig.savefig(os.path.join(out, "socket_gaps.png"), dpi=120)
+    fig.savefig(os.path.join(out, "pelvis_gaps.png"), dpi=120)
     plt.close(fig)
     print(f"motion_study: {name}, {len(t)} poses, least gap {gap[k]:.3f} mm at t = {t[k]:.2f} s; written to {out}")
 

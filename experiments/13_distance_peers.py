@@ -94,7 +94,7 @@ def subjects(data):
                         impinge.load_mesh(os.path.join(folder, info["pelvis"]))))
     if not out:
         h = impinge.generated_hip(triangles=12000, cam_mm=2.0)
-        out.append(("generated", {"ball": h["ball"], "socket": h["socket"], "neutral": "scan"}, h["ball"], h["socket"]))
+        out.append(("generated", {"femur": h["femur"], "pelvis": h["pelvis"], "neutral": "scan"}, h["femur"], h["pelvis"]))
     return out
 
 
@@ -112,8 +112,8 @@ def main():
     rows = []
     for name, options, (femur_V, femur_F), (pelvis_V, pelvis_F) in subjects(data):
         print(f"[13_distance_peers] {name}", flush=True)
-        ball = options.pop("ball", None)
-        socket = options.pop("socket", None)
+        ball = options.pop("femur", None)
+        socket = options.pop("pelvis", None)
         j = impinge.Joint(ball, socket, resolution=resolution, distances=True, **options)
         pelvis_scene, femur_scene = o3d_scene(pelvis_V, pelvis_F), o3d_scene(femur_V, femur_F)
         pelvis_vtk, femur_vtk = vtk_distance(pelvis_V, pelvis_F), vtk_distance(femur_V, femur_F)
@@ -122,7 +122,7 @@ def main():
         for pose in poses:
             R, t = j.femur_pose(*pose)
             r = j.detect_pose(*pose)  # warm-up, and the vertices within reach that the peers are given
-            bd, sd = r["ball_distance_mm"], r["socket_distance_mm"]
+            bd, sd = r["femur_distance_mm"], r["pelvis_distance_mm"]
             bi, si = np.flatnonzero(np.isfinite(bd)), np.flatnonzero(np.isfinite(sd))
             # Femur vertices posed into the pelvis' frame; pelvis vertices into the femur's (its scene stays put).
             qb = (femur_V[bi] - cor) @ R.T + cor + t
@@ -136,8 +136,8 @@ def main():
             radial, distance, o3d_runs = [], [], []
             for _ in range(reps):
                 s = j.detect_pose(*pose)["summary"]
-                radial.append(s["ball_detection_ms"] + s["socket_detection_ms"])
-                distance.append(s["ball_distance_ms"] + s["socket_distance_ms"])
+                radial.append(s["femur_detection_ms"] + s["pelvis_detection_ms"])
+                distance.append(s["femur_distance_ms"] + s["pelvis_distance_ms"])
                 t0 = time.perf_counter()
                 run_open3d()
                 o3d_runs.append((time.perf_counter() - t0) * 1e3)

@@ -61,7 +61,7 @@ def main():
         for cam in CAMS_MM:
             h = impinge.generated_hip(triangles=12000, cam_mm=cam)
             runs.append((f"generated-cam{cam:g}", lambda frame, h=h: impinge.Joint(
-                h["ball"], h["socket"], resolution=resolution, neutral="scan")))
+                h["femur"], h["pelvis"], resolution=resolution, neutral="scan")))
         for hip, make in runs:
             print(f"[15_morphology] {hip}", flush=True)
             j = make("isb")

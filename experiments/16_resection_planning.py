@@ -98,17 +98,17 @@ def main():
         w.writerow(["cam_mm", "cam_volume_mm3"] + plan_columns + ["on_cam_share", "motion", "limit_free_deg",
                                                                  "limit_cam_deg", "limit_after_deg", "met", "plan_ms"])
         free_hip = impinge.generated_hip(triangles=12000, cam_mm=0.0)
-        free = limits_of(impinge.Joint(free_hip["ball"], free_hip["socket"], precision=precision, neutral="scan"))
+        free = limits_of(impinge.Joint(free_hip["femur"], free_hip["pelvis"], precision=precision, neutral="scan"))
         for cam in CAMS_MM:
             print(f"[16_resection_planning] generated cam {cam:g} mm", flush=True)
             h = impinge.generated_hip(triangles=12000, cam_mm=cam)
-            j = impinge.Joint(h["ball"], h["socket"], precision=precision, neutral="scan")
+            j = impinge.Joint(h["femur"], h["pelvis"], precision=precision, neutral="scan")
             before = limits_of(j)
             target = ",".join(f"{m}={free[m]['limit_deg']:.2f}" for m in GENERATED_TARGETS
                               if before[m]["limit_deg"] < free[m]["limit_deg"] - 0.5)
             if not target:
                 for m in GENERATED_TARGETS:
-                    w.writerow([cam, volume(h["ball"][0], h["ball"][1]) - volume(free_hip["ball"][0], free_hip["ball"][1])]
+                    w.writerow([cam, volume(h["femur"][0], h["femur"][1]) - volume(free_hip["femur"][0], free_hip["femur"][1])]
                                + [0.0] * 4 + ["nan", "nan", "nan", m, free[m]["limit_deg"], before[m]["limit_deg"],
                                              before[m]["limit_deg"], 1, 0.0])
                 continue
@@ -118,8 +118,8 @@ def main():
             ms = (time.perf_counter() - t0) * 1e3
             timed["generated"] = (f"generated hip with the {cam:g} mm cam", plan)
             r = p["femur_resection"]
-            cam_volume = volume(h["ball"][0], h["ball"][1]) - volume(free_hip["ball"][0], free_hip["ball"][1])
-            share = on_cam_share(np.asarray(h["ball"][0]), np.asarray(free_hip["ball"][0]), np.asarray(h["ball"][1]),
+            cam_volume = volume(h["femur"][0], h["femur"][1]) - volume(free_hip["femur"][0], free_hip["femur"][1])
+            share = on_cam_share(np.asarray(h["femur"][0]), np.asarray(free_hip["femur"][0]), np.asarray(h["femur"][1]),
                                  np.asarray(p["femur_resection_mm"]))
             after = {t["target"]: t for t in p["targets"]}
             for m in GENERATED_TARGETS:

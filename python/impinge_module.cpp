@@ -136,14 +136,14 @@ void bind_functions(py::module_& m) {
           h = make_hip_model(run.generate);
         }
         py::dict d;
-        d["ball"] = mesh_arrays(h.ball);
-        d["socket"] = mesh_arrays(h.socket);
+        d["femur"] = mesh_arrays(h.ball);
+        d["pelvis"] = mesh_arrays(h.socket);
         d["cor"] = h.cor;
         d["head_radius_mm"] = run.generate.head_radius_mm;
         return d;
       },
       keep_doc("A generated hip (sphere head with neck, optional cam bump, cup with rim; scan frame RAS, mm) -> "
-       "dict(ball=(V, F), socket=(V, F), cor, head_radius_mm). Use it with neutral='scan'. The keywords are "
+       "dict(femur=(V, F), pelvis=(V, F), cor, head_radius_mm). Use it with neutral='scan'. The keywords are "
        "`impinge generate`'s (impinge.options()), checked against their ranges. " +
        keywords_doc(use_generated_hip)));
 }

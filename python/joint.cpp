@@ -43,23 +43,23 @@ py::dict result_dict(const Session& session, PoseResult&& r) {
   const auto ns = static_cast<py::ssize_t>(r.socket_gaps.gap_mm.size());
   const ImpingementLevels& levels = session.joint_options().levels;
   py::dict summary;
-  summary["ball"] = from_json(scan_record(session.joint().ball(), r.ball, r.ball_detection_ms, levels, nullptr));
-  summary["socket"] =
+  summary["femur"] = from_json(scan_record(session.joint().ball(), r.ball, r.ball_detection_ms, levels, nullptr));
+  summary["pelvis"] =
       from_json(scan_record(session.joint().socket(), r.socket, r.socket_detection_ms, levels, nullptr));
-  summary["ball_detection_ms"] = r.ball_detection_ms;
-  summary["socket_detection_ms"] = r.socket_detection_ms;
+  summary["femur_detection_ms"] = r.ball_detection_ms;
+  summary["pelvis_detection_ms"] = r.socket_detection_ms;
   if (session.joint_options().distances) {
-    summary["ball_distance_ms"] = r.ball_distance_ms;
-    summary["socket_distance_ms"] = r.socket_distance_ms;
+    summary["femur_distance_ms"] = r.ball_distance_ms;
+    summary["pelvis_distance_ms"] = r.socket_distance_ms;
   }
-  d["ball_gap_mm"] = own(std::move(r.ball_gaps.gap_mm), {nb});
-  d["socket_gap_mm"] = own(std::move(r.socket_gaps.gap_mm), {ns});
+  d["femur_gap_mm"] = own(std::move(r.ball_gaps.gap_mm), {nb});
+  d["pelvis_gap_mm"] = own(std::move(r.socket_gaps.gap_mm), {ns});
   if (!r.ball_gaps.distance_mm.empty()) {
-    d["ball_distance_mm"] = own(std::move(r.ball_gaps.distance_mm), {nb});
-    d["socket_distance_mm"] = own(std::move(r.socket_gaps.distance_mm), {ns});
+    d["femur_distance_mm"] = own(std::move(r.ball_gaps.distance_mm), {nb});
+    d["pelvis_distance_mm"] = own(std::move(r.socket_gaps.distance_mm), {ns});
   }
-  d["ball_status"] = own(std::move(r.ball_gaps.status), {nb});
-  d["socket_status"] = own(std::move(r.socket_gaps.status), {ns});
+  d["femur_status"] = own(std::move(r.ball_gaps.status), {nb});
+  d["pelvis_status"] = own(std::move(r.socket_gaps.status), {ns});
   d["summary"] = summary;
   return d;
 }
@@ -75,7 +75,7 @@ py::dict motion(const PyJoint& j, const py::handle& angles_obj) {
     run_motion(*j.session, poses, {}, [&](const MotionFrame& f) { t.rows.push_back(motion_row(f)); });
   }
   py::dict d = table_columns(t);
-  d["socket_penetrating_area_mm2"] = d["penetrating_area_mm2"];
+  d["pelvis_penetrating_area_mm2"] = d["penetrating_area_mm2"];
   return d;
 }
 
@@ -189,9 +189,9 @@ void add_joint_queries(py::class_<PyJoint>& c) {
        },
        py::arg("R") = py::none(), py::arg("t") = py::none(),
        "Both scans with the femur rotated by R (3, 3; input frame) about its head centre (`cor`), then translated by t (3,) "
-       "mm -> dict(ball_gap_mm, socket_gap_mm: float32 (n,) in the input's vertex order, NaN where not "
-       "tested; ball_distance_mm, socket_distance_mm: float32 (n,), the signed Euclidean distance to the other "
-       "bone, NaN beyond the reach (with distances on); ball_status, socket_status: uint8 (0 tested, 1 no "
+       "mm -> dict(femur_gap_mm, pelvis_gap_mm: float32 (n,) in the input's vertex order, NaN where not "
+       "tested; femur_distance_mm, pelvis_distance_mm: float32 (n,), the signed Euclidean distance to the other "
+       "bone, NaN beyond the reach (with distances on); femur_status, pelvis_status: uint8 (0 tested, 1 no "
        "surface, 2 beyond reach); summary).")
       .def(
           "detect_pose",
@@ -214,15 +214,15 @@ void add_joint_queries(py::class_<PyJoint>& c) {
           "(input frame, mm) after its rotation about the COR.")
       .def("motion", &motion, py::arg("angles"),
            "Both scans at every row of angles (k, 3): flexion, adduction, internal rotation in degrees -> dict of "
-           "(k,) arrays, the columns of the CLI's frames.csv (ball_min_gap_mm, socket_min_gap_mm, "
-           "penetrating_area_mm2 = socket_penetrating_area_mm2, ball_penetrating_area_mm2, socket_levelN_area_mm2, "
+           "(k,) arrays, the columns of the CLI's frames.csv (femur_min_gap_mm, pelvis_min_gap_mm, "
+           "penetrating_area_mm2 = pelvis_penetrating_area_mm2, femur_penetrating_area_mm2, pelvis_levelN_area_mm2, "
            "closest clock hours and point, detection_ms). One C++ loop, frames in blocks on impinge.get_threads() "
            "threads (rows in order); the GIL is released.")
       .def("rom_limits", &rom_limits,
            keep_doc("ROM limits from neutral for the standard motions (flexion, extension, abduction, adduction, "
                     "internal and "
            "external rotation, both rotations at 90 deg flexion, FADIR) -> dict motion -> the CLI's rom_limits.csv "
-           "row (limit_deg (NaN: none within max_deg), limited_by, contact_class, socket_clock_h, femur_clock_h, "
+           "row (limit_deg (NaN: none within max_deg), limited_by, contact_class, pelvis_clock_h, femur_clock_h, "
            "min_gap_at_limit_mm, monotone, contact_at_start, evaluations) and contact_mm (input frame); and "
            "excluded_vertices (in contact at neutral, not counted). The keywords are the option table's "
            "(impinge.options(): `impinge rom`'s --threshold, --contact-depth, --metric, --contacts, --step, --max), "
@@ -299,10 +299,19 @@ void add_joint_properties(py::class_<PyJoint>& c) {
           },
           "The acetabular centre (the sphere fitted to the acetabulum) (3,), mm, input frame; None with scan "
           "neutral.")
-      .def_property_readonly("ball_map",
+      .def_property_readonly(
+          "pivot",
+          [](const PyJoint& j) -> py::object {
+            const auto p = pivot_input(*j.session);
+            return p ? py::cast(Eigen::Vector3d(*p)) : py::none();
+          },
+          "The point the femur turns about under the joint-centre method (3,), mm, input frame, the pelvis fixed: "
+          "the head centre (femoral-head), the acetabular centre (acetabular, combined); None for equidistant (its "
+          "centre moves with each pose) and without an acetabular centre. summary.json's pivot_mm.")
+      .def_property_readonly("femur_map",
                              [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().ball().map}; })
       .def_property_readonly(
-          "socket_map", [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().socket().map}; })
+          "pelvis_map", [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().socket().map}; })
       .def_property_readonly(
           "frames",
           [](const PyJoint& j) -> py::object {

@@ -61,7 +61,7 @@ def femoral_head_centre(ball: Optional[Union[str, os.PathLike, Tuple[npt.ArrayLi
     dict(centre (3,) mm in the input frame, radius mm (NaN when given), method)."""
 
 def generated_hip(*, triangles: int = 3000, cam_mm: float = 0.0, coverage_deg: float = 100.0) -> Dict[str, Any]:
-    """A generated hip -> dict(ball=(V, F), socket=(V, F), cor, head_radius_mm); use neutral='scan'."""
+    """A generated hip -> dict(femur=(V, F), pelvis=(V, F), cor, head_radius_mm); use neutral='scan'."""
 
 class SphereFit:
     centre: npt.NDArray[np.float64]
@@ -111,7 +111,7 @@ class Joint:
         sparse_region_mm: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for
         hidden vertices (extra-articular), within extra_articular_radius_mm, at layered_spacing_deg (0: the maps' own); query_strategy: 'maps', 'direct' (no
         layered maps: the hidden vertices by exact ray casts, for a few poses; no ROM searches) or 'auto' (maps); distances: the signed
-        Euclidean distance to the other bone beside each gap (results' ball_distance_mm, socket_distance_mm),
+        Euclidean distance to the other bone beside each gap (results' femur_distance_mm, pelvis_distance_mm),
         for every vertex within distance_reach_mm of it (0: the largest level threshold); levels_on: what the
         levels classify, 'distance' or 'radial' (the thesis' gap; default: distance, radial with distances off); maps_only: no exact
         look-ups at depth discontinuities; maps: (ball_path, socket_path) from save_maps().
@@ -123,10 +123,10 @@ class Joint:
     def save_maps(self, ball_path: str, socket_path: str) -> None:
         """Save both maps for Joint(..., maps=(ball_path, socket_path))."""
     def detect(self, R: Optional[npt.ArrayLike] = None, t: Optional[Sequence[float]] = None) -> Dict[str, Any]:
-        """Both scans, femur rotated by R about its head centre (`cor`) and translated by t -> dict(ball_gap_mm,
-        socket_gap_mm (float32, NaN untested), ball_distance_mm, socket_distance_mm (float32, the signed
-        Euclidean distance to the other bone, NaN beyond the reach; with distances on), ball_status,
-        socket_status (uint8), summary: each scan's record as summary.json gives it)."""
+        """Both scans, femur rotated by R about its head centre (`cor`) and translated by t -> dict(femur_gap_mm,
+        pelvis_gap_mm (float32, NaN untested), femur_distance_mm, pelvis_distance_mm (float32, the signed
+        Euclidean distance to the other bone, NaN beyond the reach; with distances on), femur_status,
+        pelvis_status (uint8), summary: each scan's record as summary.json gives it)."""
     def detect_pose(self, flexion: float = 0.0, adduction: float = 0.0,
                     internal_rotation: float = 0.0) -> Dict[str, Any]:
         """Both scans at clinical angles (degrees, ISB), the femur placed by the joint-centre method; the
@@ -171,14 +171,18 @@ class Joint:
         """(R, t) at the clinical angles with the joint-centre method's translation: posed vertices =
         (V - cor) R^T + cor + t (input frame); detect(R, t) scans that pose."""
     cor: npt.NDArray[np.float64]
-    """The femoral head centre, the centre of rotation (input frame, mm): the `cor` given, else fitted."""
+    """The femoral head centre (input frame, mm): the `cor` given, else fitted; the femur's rotations are
+    about it (then translated by the joint-centre method: see pivot)."""
     map_centre: npt.NDArray[np.float64]
     """The maps' centre (the rays' origin): the head centre, or the acetabular centre where a fitted head
     was seated before sampling."""
     acetabular_centre: Optional[npt.NDArray[np.float64]]
     """The acetabular centre (anatomical neutral), input frame, mm."""
-    ball_map: Map
-    socket_map: Map
+    pivot: Optional[npt.NDArray[np.float64]]
+    """The point the femur turns about under the joint-centre method (input frame, mm, the pelvis fixed): the
+    head centre (femoral-head) or the acetabular centre (acetabular, combined); None for equidistant."""
+    femur_map: Map
+    pelvis_map: Map
     frames: Optional[Dict[str, Any]]
     """summary.json's "frames" record (anatomical neutral; None with scan neutral), input frame."""
     setup: Dict[str, Any]

@@ -55,50 +55,50 @@ def test_gaps_equal_the_cli_on_a_generated_hip(generated):
     d = generated
     subprocess.run([CLI, "distance", "--subject", d + "/s/subject.json", "--precision", "1", "--pose=30,-10,5",
                     "--out", d + "/cli"], check=True, capture_output=True)
-    cli_ball, cli_socket = read_gaps(d + "/cli/ball_gaps.ply"), read_gaps(d + "/cli/socket_gaps.ply")
+    cli_ball, cli_socket = read_gaps(d + "/cli/femur_gaps.ply"), read_gaps(d + "/cli/pelvis_gaps.ply")
     with open(d + "/cli/summary.json") as f:
         summary = json.load(f)
     cor = summary["head_centre_mm"]
     # Where the one pose's time went: the parts within the whole (set-up, pose and output in order; each body's
     # sampling and marking within the set-up, both scans within the pose), no layered maps with the direct set-up.
     t = summary["timings_ms"]
-    assert summary["query_strategy"] == "direct" and t["ball_layered_sampling"] == t["socket_layered_sampling"] == 0
+    assert summary["query_strategy"] == "direct" and t["femur_layered_sampling"] == t["pelvis_layered_sampling"] == 0
     assert 0 < t["setup_total"] + t["pose"] + t["output"] <= t["total"]
-    for part in ("ball", "socket"):
+    for part in ("femur", "pelvis"):
         assert 0 < t[f"{part}_sampling"] + t[f"{part}_marking"] <= t["setup_total"]
         assert t[f"{part}_detection"] + t[f"{part}_distance"] <= t["pose"]
     ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
     # The CLI's distance sets up for its one pose (query strategy auto: direct, no layered maps); the Joint, the same.
     j = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0, query_strategy="direct")
     r = j.detect_pose(30, -10, 5)
-    assert r["ball_gap_mm"].dtype == np.float32 and r["ball_gap_mm"].shape == (len(ball[0]),)
+    assert r["femur_gap_mm"].dtype == np.float32 and r["femur_gap_mm"].shape == (len(ball[0]),)
     # With the layered maps (the Joint's default, for many poses): the same distances and first-surface gaps; the
     # hidden vertices' gaps the maps' interpolation of the exact ones, within 0.1 mm here.
     m = impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0).detect_pose(30, -10, 5)
-    for part in ("ball", "socket"):
+    for part in ("femur", "pelvis"):
         np.testing.assert_array_equal(m[f"{part}_distance_mm"], r[f"{part}_distance_mm"])
         first = m[f"{part}_status"] == 0
         np.testing.assert_array_equal(m[f"{part}_gap_mm"][first], r[f"{part}_gap_mm"][first])
         np.testing.assert_array_equal(m[f"{part}_status"], r[f"{part}_status"])
         np.testing.assert_allclose(m[f"{part}_gap_mm"], r[f"{part}_gap_mm"], atol=0.1)
-    np.testing.assert_array_equal(r["ball_gap_mm"], cli_ball)
-    np.testing.assert_array_equal(r["socket_gap_mm"], cli_socket)
+    np.testing.assert_array_equal(r["femur_gap_mm"], cli_ball)
+    np.testing.assert_array_equal(r["pelvis_gap_mm"], cli_socket)
     # The Euclidean distances beside them (issue 26): the CLI's, and never larger in size than a gap.
-    np.testing.assert_array_equal(r["ball_distance_mm"], read_ply_vertices(d + "/cli/ball_gaps.ply")["distance_mm"])
-    np.testing.assert_array_equal(r["socket_distance_mm"], read_ply_vertices(d + "/cli/socket_gaps.ply")["distance_mm"])
-    both = np.isfinite(r["ball_gap_mm"]) & np.isfinite(r["ball_distance_mm"])
+    np.testing.assert_array_equal(r["femur_distance_mm"], read_ply_vertices(d + "/cli/femur_gaps.ply")["distance_mm"])
+    np.testing.assert_array_equal(r["pelvis_distance_mm"], read_ply_vertices(d + "/cli/pelvis_gaps.ply")["distance_mm"])
+    both = np.isfinite(r["femur_gap_mm"]) & np.isfinite(r["femur_distance_mm"])
     assert np.count_nonzero(both) > 50
-    assert np.all(np.abs(r["ball_distance_mm"][both]) <= np.abs(r["ball_gap_mm"][both]) + 0.05)
-    assert r["summary"]["ball"]["min_distance_mm"] == pytest.approx(float(np.nanmin(r["ball_distance_mm"])))
+    assert np.all(np.abs(r["femur_distance_mm"][both]) <= np.abs(r["femur_gap_mm"][both]) + 0.05)
+    assert r["summary"]["femur"]["min_distance_mm"] == pytest.approx(float(np.nanmin(r["femur_distance_mm"])))
     # Off: no distance arrays.
-    assert "ball_distance_mm" not in impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0,
+    assert "femur_distance_mm" not in impinge.Joint(ball, socket, cor=cor, neutral="scan", resolution=1.0,
                                                    distances=False).detect_pose(30, -10, 5)
     # The same pose as a rotation matrix.
     R = j.femur_rotation(30, -10, 5)
-    np.testing.assert_array_equal(j.detect(R)["ball_gap_mm"], cli_ball)
-    s = r["summary"]["ball"]
-    assert s["vertices_tested"] == int(np.count_nonzero(r["ball_status"] == 0))
-    assert s["min_gap_mm"] == pytest.approx(float(np.nanmin(r["ball_gap_mm"])))
+    np.testing.assert_array_equal(j.detect(R)["femur_gap_mm"], cli_ball)
+    s = r["summary"]["femur"]
+    assert s["vertices_tested"] == int(np.count_nonzero(r["femur_status"] == 0))
+    assert s["min_gap_mm"] == pytest.approx(float(np.nanmin(r["femur_gap_mm"])))
 
 
 def test_motion_equals_detect_pose_and_maps_are_views(generated):
@@ -109,9 +109,9 @@ def test_motion_equals_detect_pose_and_maps_are_views(generated):
     m = j.motion(angles)
     for k, a in enumerate(angles):
         r = j.detect_pose(*a)
-        assert m["ball_min_gap_mm"][k] == r["summary"]["ball"]["min_gap_mm"]
-        assert m["socket_min_gap_mm"][k] == r["summary"]["socket"]["min_gap_mm"]
-    mp = j.socket_map
+        assert m["femur_min_gap_mm"][k] == r["summary"]["femur"]["min_gap_mm"]
+        assert m["pelvis_min_gap_mm"][k] == r["summary"]["pelvis"]["min_gap_mm"]
+    mp = j.pelvis_map
     v = mp.values
     assert v.dtype == np.float32 and v.shape == (mp.num_nodes,) and not v.flags.writeable
     assert mp.num_nodes == (180 // 2 + 1) * (360 // 2)
@@ -151,8 +151,8 @@ def test_motion_set_up_chosen_by_its_frames(generated):
                         "--out", d + "/setup_alias"], capture_output=True, text=True)
     assert r.returncode == 0 and "--setup is deprecated" in r.stderr and "use --query-strategy" in r.stderr
     for a, b in zip(rows, rows_maps):
-        for col in ("ball_min_distance_mm", "socket_min_distance_mm", "socket_level0_area_mm2",
-                    "socket_level2_area_mm2"):
+        for col in ("femur_min_distance_mm", "pelvis_min_distance_mm", "pelvis_level0_area_mm2",
+                    "pelvis_level2_area_mm2"):
             assert a[col] == b[col], col
     assert motion(400, "m400")[0] == "maps"
     assert motion(399, "m399")[0] == "direct"
@@ -164,8 +164,8 @@ def test_maps_saved_and_loaded_give_the_same_gaps(generated):
     j = impinge.Joint(ball, socket, neutral="scan", resolution=1.0)
     j.save_maps(d + "/b.map", d + "/s.map")
     k = impinge.Joint(ball, socket, neutral="scan", resolution=1.0, maps=(d + "/b.map", d + "/s.map"))
-    np.testing.assert_array_equal(k.socket_map.values, j.socket_map.values)
-    np.testing.assert_array_equal(k.detect_pose(20, 5, 5)["ball_gap_mm"], j.detect_pose(20, 5, 5)["ball_gap_mm"])
+    np.testing.assert_array_equal(k.pelvis_map.values, j.pelvis_map.values)
+    np.testing.assert_array_equal(k.detect_pose(20, 5, 5)["femur_gap_mm"], j.detect_pose(20, 5, 5)["femur_gap_mm"])
     with pytest.raises(impinge.Error, match="another subject or COR"):
         impinge.Joint(ball, socket, cor=j.cor + [0.5, 0, 0], neutral="scan", resolution=1.0,
                       maps=(d + "/b.map", d + "/s.map"))
@@ -185,13 +185,13 @@ def test_sparse_maps_give_the_same_gaps(generated):
     ball, socket = impinge.load_mesh(d + "/s/femur_r.ply"), impinge.load_mesh(d + "/s/pelvis.ply")
     dense = impinge.Joint(ball, socket, neutral="scan", resolution=0.5)
     sparse = impinge.Joint(ball, socket, neutral="scan", resolution=0.5, sparse_region_mm=float("inf"))
-    assert sparse.socket_map.sparse and not dense.socket_map.sparse
-    assert sparse.socket_map.bytes < dense.socket_map.bytes
-    np.testing.assert_array_equal(sparse.socket_map.values, dense.socket_map.values)
+    assert sparse.pelvis_map.sparse and not dense.pelvis_map.sparse
+    assert sparse.pelvis_map.bytes < dense.pelvis_map.bytes
+    np.testing.assert_array_equal(sparse.pelvis_map.values, dense.pelvis_map.values)
     for pose in ((0, 0, 0), (30, -10, 5), (90, 10, 25)):
         a, b = dense.detect_pose(*pose), sparse.detect_pose(*pose)
-        np.testing.assert_array_equal(a["ball_gap_mm"], b["ball_gap_mm"])
-        np.testing.assert_array_equal(a["socket_gap_mm"], b["socket_gap_mm"])
+        np.testing.assert_array_equal(a["femur_gap_mm"], b["femur_gap_mm"])
+        np.testing.assert_array_equal(a["pelvis_gap_mm"], b["pelvis_gap_mm"])
     with pytest.raises(impinge.Error, match="sparse"):
         impinge.Joint(ball, socket, neutral="scan", resolution=2.0, sparse_region_mm=-1.0)
 
@@ -202,14 +202,14 @@ def test_layered_maps_test_hidden_vertices_and_leave_the_others(generated):
     single = impinge.Joint(ball, socket, neutral="scan", resolution=1.0, layers=0)
     layered = impinge.Joint(ball, socket, neutral="scan", resolution=1.0)  # layers=4: the default
     a, b = single.detect_pose(20, 5, 10), layered.detect_pose(20, 5, 10)
-    for key in ("ball_gap_mm", "socket_gap_mm"):
+    for key in ("femur_gap_mm", "pelvis_gap_mm"):
         tested = ~np.isnan(a[key])
         np.testing.assert_array_equal(a[key][tested], b[key][tested])  # first-surface gaps unchanged
     # The cup's outer wall is hidden behind its inner surface: tested by the femur's layered map now,
     # and outside the femur (the head lies inside the cup's hollow).
-    s = b["summary"]["socket"]
+    s = b["summary"]["pelvis"]
     assert s["vertices_tested_layered"] > 0 and s["min_gap_layered_mm"] > 0
-    assert a["summary"]["socket"]["vertices_tested_layered"] == 0
+    assert a["summary"]["pelvis"]["vertices_tested_layered"] == 0
     with pytest.raises(impinge.Error, match="layers"):
         impinge.Joint(ball, socket, neutral="scan", resolution=2.0, layers=99)
 
@@ -293,15 +293,15 @@ def test_real_subject_anatomical_frames():
     axes = np.column_stack([f["pelvis"]["x_axis"], f["pelvis"]["y_axis"], f["pelvis"]["z_axis"]])
     np.testing.assert_allclose(axes.T @ axes, np.eye(3), atol=1e-12)
     m = j.motion(np.array([[0, 0, 0], [90, 0, 0]]))
-    assert np.all(np.isfinite(m["ball_min_gap_mm"]))
+    assert np.all(np.isfinite(m["femur_min_gap_mm"]))
     # ROM from Python: a limit is where detect_pose first shows contact (the first touch: no contact depth).
     lim = j.rom_limits(contact_depth_mm=0)
     fl = lim["internal_rotation_90_flexion"]["limit_deg"]
     assert 0 < fl < 150
-    assert j.detect_pose(90, 0, fl)["summary"]["socket"]["min_gap_mm"] <= 0 or \
-        j.detect_pose(90, 0, fl)["summary"]["ball"]["min_gap_mm"] <= 0
-    assert min(j.detect_pose(90, 0, fl - 0.5)["summary"]["socket"]["min_gap_mm"],
-               j.detect_pose(90, 0, fl - 0.5)["summary"]["ball"]["min_gap_mm"]) > 0
+    assert j.detect_pose(90, 0, fl)["summary"]["pelvis"]["min_gap_mm"] <= 0 or \
+        j.detect_pose(90, 0, fl)["summary"]["femur"]["min_gap_mm"] <= 0
+    assert min(j.detect_pose(90, 0, fl - 0.5)["summary"]["pelvis"]["min_gap_mm"],
+               j.detect_pose(90, 0, fl - 0.5)["summary"]["femur"]["min_gap_mm"]) > 0
     grid = j.rom_map(flexion=[0, 90], adduction=[0, 10], contact_depth_mm=0)
     assert grid.shape == (2, 2) and grid[1, 0] == pytest.approx(fl)
     # Each limit says what it is, the published normal range beside it, whether the soft tissue usually ends the

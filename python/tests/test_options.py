@@ -130,7 +130,7 @@ def test_joint_keywords_are_the_tables_in_the_stub_with_its_defaults():
 @pytest.fixture(scope="module")
 def small_joint():
     h = impinge.generated_hip(triangles=3000)
-    return impinge.Joint(h["ball"], h["socket"], neutral="scan", precision=2.0)
+    return impinge.Joint(h["femur"], h["pelvis"], neutral="scan", precision=2.0)
 
 
 @pytest.mark.parametrize("owner,method,use", [("Joint", "rom_limits", "rom_limits"), ("Joint", "rom_map", "rom_map"),
@@ -160,10 +160,10 @@ def test_former_keys_still_work_with_a_warning(old, new, small_joint):
     h = impinge.generated_hip(triangles=3000)
     with pytest.warns(DeprecationWarning, match=f"'{old}' is deprecated .* use '{new}'"):
         with pytest.raises(impinge.Error, match=f"{old}"):
-            impinge.Joint(h["ball"], h["socket"], neutral="scan", precision=2.0, **{old: -1.0 if old != "setup"
+            impinge.Joint(h["femur"], h["pelvis"], neutral="scan", precision=2.0, **{old: -1.0 if old != "setup"
                                                                                   else "sometimes"})
     with pytest.raises(impinge.Error, match=f"give {new} or {old} \\(its former name\\), not both"):
-        impinge.Joint(h["ball"], h["socket"], neutral="scan", **{old: 1.0, new: 1.0})
+        impinge.Joint(h["femur"], h["pelvis"], neutral="scan", **{old: 1.0, new: 1.0})
 
 
 def test_former_keys_in_a_study_file_are_renamed_with_a_warning(tmp_path):

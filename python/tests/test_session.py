@@ -61,7 +61,7 @@ def test_a_subject_in_lps_gives_the_cli_gaps():
     cli_extra = [f"--cor={','.join(map(repr, extra['cor']))}"] if "cor" in extra else []
     subprocess.run([CLI, "distance", "--subject", subject, "--precision", "1", "--pose=30,5,10", "--out", d + "/cli"]
                    + cli_extra, check=True, capture_output=True)
-    cli_ball, cli_socket = read_gaps(d + "/cli/ball_gaps.ply"), read_gaps(d + "/cli/socket_gaps.ply")
+    cli_ball, cli_socket = read_gaps(d + "/cli/femur_gaps.ply"), read_gaps(d + "/cli/pelvis_gaps.ply")
     with open(d + "/cli/summary.json") as f:
         summary = json.load(f)
     assert summary["input_frame"] == "LPS"
@@ -69,8 +69,8 @@ def test_a_subject_in_lps_gives_the_cli_gaps():
     # Python reading the same subject.json (set up as the CLI's distance sets up its one pose: query strategy direct).
     j = impinge.Joint(subject=subject, precision=1, query_strategy="direct", **extra)
     r = j.detect_pose(30, 5, 10)
-    np.testing.assert_array_equal(r["ball_gap_mm"], cli_ball)
-    np.testing.assert_array_equal(r["socket_gap_mm"], cli_socket)
+    np.testing.assert_array_equal(r["femur_gap_mm"], cli_ball)
+    np.testing.assert_array_equal(r["pelvis_gap_mm"], cli_socket)
     np.testing.assert_allclose(j.cor, summary["head_centre_mm"], rtol=0, atol=1e-9)
     np.testing.assert_allclose(j.map_centre, summary["map_centre_mm"], rtol=0, atol=1e-9)
     assert j.setup["input_frame"] == "LPS"
@@ -83,15 +83,15 @@ def test_a_subject_in_lps_gives_the_cli_gaps():
     ball, socket = (impinge.load_mesh(os.path.join(base, s[k])) for k in ("femur", "pelvis"))
     j2 = impinge.Joint(ball, socket, frame="LPS", side=s["side"], neutral=s.get("neutral"), precision=1, query_strategy="direct",
                        **extra)
-    np.testing.assert_array_equal(j2.detect_pose(30, 5, 10)["ball_gap_mm"], cli_ball)
-    np.testing.assert_array_equal(j2.detect_pose(30, 5, 10)["socket_gap_mm"], cli_socket)
+    np.testing.assert_array_equal(j2.detect_pose(30, 5, 10)["femur_gap_mm"], cli_ball)
+    np.testing.assert_array_equal(j2.detect_pose(30, 5, 10)["pelvis_gap_mm"], cli_socket)
 
     # Rotations are in the input frame: the pose's rotation about the COR, applied to the LPS
     # vertices, gives the same gaps, and moves the femur as the CLI's posed PLY shows it.
     R, t = j.femur_pose(30, 5, 10)
-    np.testing.assert_array_equal(j.detect(R, t)["ball_gap_mm"], cli_ball)
+    np.testing.assert_array_equal(j.detect(R, t)["femur_gap_mm"], cli_ball)
     posed = (ball[0] - j.cor) @ R.T + j.cor + t
-    rec = read_ply_vertices(d + "/cli/ball_gaps.ply")
+    rec = read_ply_vertices(d + "/cli/femur_gaps.ply")
     xyz = np.stack([rec["x"], rec["y"], rec["z"]], axis=1)
     np.testing.assert_allclose(posed, xyz, atol=1e-3)
 

@@ -94,7 +94,7 @@ def test_serial_study_writes_every_task_and_its_figures(serial):
     assert all(len(v) == 1 for v in offsets.values())
     # the nominal rom task equals Joint.rom_limits on the same hip (an independent call of the module)
     h = impinge.generated_hip(triangles=4000, cam_mm=2.0)
-    j = impinge.Joint(h["ball"], h["socket"], neutral="scan", resolution=1.0)
+    j = impinge.Joint(h["femur"], h["pelvis"], neutral="scan", resolution=1.0)
     lim = j.rom_limits()
     nominal = next(r for r in rows if r["kind"] == "rom" and r["subject"] == "cam2" and r["sample"] == "0")
     for m in ("flexion", "internal_rotation", "abduction"):
@@ -201,7 +201,7 @@ def test_a_task_id_is_its_inputs_contents(tmp_path):
     h = impinge.generated_hip(triangles=3000)
     folder = tmp_path / "subj"
     folder.mkdir()
-    for name, (V, F) in (("femur_r.ply", h["ball"]), ("pelvis.ply", h["socket"])):
+    for name, (V, F) in (("femur_r.ply", h["femur"]), ("pelvis.ply", h["pelvis"])):
         write_ply(str(folder / name), V, F)
     (folder / "subject.json").write_text('{"side": "right", "frame": "RAS", "units": "mm", "femur": "femur_r.ply", '
                                          '"pelvis": "pelvis.ply", "neutral": "scan"}')
@@ -210,7 +210,7 @@ def test_a_task_id_is_its_inputs_contents(tmp_path):
     ids = [t["id"] for t in spec.expand(spec.load_study(path))]
     assert len(ids) == 2 and len(set(ids)) == 2  # parameters enter the id
     assert [t["id"] for t in spec.expand(spec.load_study(path))] == ids  # and nothing else that varies
-    V, F = h["socket"]
+    V, F = h["pelvis"]
     write_ply(str(folder / "pelvis.ply"), V + np.array([0.0, 0.0, 1e-3]), F)  # a mesh's contents change
     assert not set(ids) & {t["id"] for t in spec.expand(spec.load_study(path))}
 
@@ -277,25 +277,25 @@ def test_vtk_meshes_give_the_ply_gaps(tmp_path):
     folder.mkdir()
     w = vtkXMLPolyDataWriter()  # OpenSim's geometry: XML PolyData
     w.SetFileName(str(folder / "femur_r.vtp"))
-    w.SetInputData(vtk_polydata(*h["ball"]))
+    w.SetInputData(vtk_polydata(*h["femur"]))
     w.Write()
     w = vtkPolyDataWriter()  # the legacy format (binary: ASCII would round the coordinates)
     w.SetFileTypeToBinary()
     w.SetFileName(str(folder / "pelvis.vtk"))
-    w.SetInputData(vtk_polydata(*h["socket"]))
+    w.SetInputData(vtk_polydata(*h["pelvis"]))
     w.Write()
     V, F = impinge.load_mesh(str(folder / "femur_r.vtp"))
-    assert np.array_equal(V, h["ball"][0]) and np.array_equal(F, h["ball"][1])
+    assert np.array_equal(V, h["femur"][0]) and np.array_equal(F, h["femur"][1])
     V, F = impinge.load_mesh(str(folder / "pelvis.vtk"))
-    assert np.array_equal(V, h["socket"][0]) and np.array_equal(F, h["socket"][1])
+    assert np.array_equal(V, h["pelvis"][0]) and np.array_equal(F, h["pelvis"][1])
     (folder / "vtk.json").write_text('{"side": "right", "frame": "RAS", "units": "mm", "femur": "femur_r.vtp", '
                                      '"pelvis": "pelvis.vtk", "neutral": "scan"}')
     # the reference: the same vertices handed over as arrays (a PLY through assimp would round them to float32)
-    a = impinge.Joint(h["ball"], h["socket"], neutral="scan", resolution=1.0).detect_pose(60, 0, 10)
+    a = impinge.Joint(h["femur"], h["pelvis"], neutral="scan", resolution=1.0).detect_pose(60, 0, 10)
     b = impinge.Joint(subject=str(folder / "vtk.json"), resolution=1.0).detect_pose(60, 0, 10)
     c = impinge.Joint(str(folder / "femur_r.vtp"), str(folder / "pelvis.vtk"), neutral="scan",
                       resolution=1.0).detect_pose(60, 0, 10)
-    for k in ("ball_gap_mm", "socket_gap_mm", "ball_distance_mm", "socket_distance_mm"):
+    for k in ("femur_gap_mm", "pelvis_gap_mm", "femur_distance_mm", "pelvis_distance_mm"):
         np.testing.assert_array_equal(a[k], b[k])
         np.testing.assert_array_equal(a[k], c[k])
     (folder / "broken.vtp").write_text("<VTKFile>not a mesh")
@@ -352,7 +352,7 @@ target = "flexion=50"
     rows = read(out)
     assert len(rows) == 1 and rows[0]["status"] == "ok", rows
     h = impinge.generated_hip(triangles=6000, cam_mm=3.0)
-    expected = impinge.Joint(h["ball"], h["socket"], precision=1.0, neutral="scan").plan(target="flexion=50")
+    expected = impinge.Joint(h["femur"], h["pelvis"], precision=1.0, neutral="scan").plan(target="flexion=50")
     assert float(rows[0]["femur_volume_mm3"]) == pytest.approx(expected["femur_resection"]["volume_mm3"])
     assert rows[0]["met_flexion"] == "true" and float(rows[0]["limit_after_flexion_deg"]) >= 50 - 0.1
     folder = os.path.join(out, "tasks", rows[0]["task_id"])

@@ -102,7 +102,7 @@ def outcome(subject, out):
     r = run(["distance", "--subject", subject, "--precision", "0.5", "--pose", "30,5,10", "--out", out / "d"])
     assert r.returncode == 0, r.stderr
     s = json.load(open(out / "d" / "summary.json"))
-    return limits, (s["ball"]["min_distance_mm"], s["socket"]["min_distance_mm"])
+    return limits, (s["femur"]["min_distance_mm"], s["pelvis"]["min_distance_mm"])
 
 
 @pytest.mark.skipif(not os.path.exists(SUBJECT), reason="shared data absent")

@@ -53,4 +53,4 @@ def test_meshes_in_metres_and_a_femur_far_away(generated):
     j = impinge.Joint((V, F), (P, G), neutral="scan", resolution=2.0)
     with pytest.raises(impinge.Error, match=r"t: the femur translated by 100000 mm.*at most the head radius, 22 mm"):
         j.detect(None, (1e5, 0, 0))
-    assert np.isfinite(j.detect(None, (1, 0, 0))["summary"]["ball"]["min_gap_mm"])
+    assert np.isfinite(j.detect(None, (1, 0, 0))["summary"]["femur"]["min_gap_mm"])

@@ -51,7 +51,7 @@ def test_vtk_meshes_give_the_ply_gaps(generated, tmp_path):
     (tmp_path / "subject.json").write_text(json.dumps(s))
     r = run(["distance", "--subject", tmp_path / "subject.json", "--out", tmp_path / "subject"] + common)
     assert r.returncode == 0, r.stderr
-    for scan in ("ball_gaps.ply", "socket_gaps.ply"):
+    for scan in ("femur_gaps.ply", "pelvis_gaps.ply"):
         assert gaps(tmp_path / "subject" / scan) == gaps(tmp_path / "ply" / scan)
 
 

@@ -58,7 +58,7 @@ TEST(EndToEnd, CliOnGeneratedSubject) {
   const nlohmann::json j = nlohmann::json::parse(js);
   for (const char* key : {"head_centre_mm", "map_centre_mm", "head_radius_mm", "sphere_fit_rms_mm", "precision_deg", "mode", "pose_deg"})
     EXPECT_TRUE(j.contains(key)) << key;
-  for (const char* body : {"ball", "socket"})
+  for (const char* body : {"femur", "pelvis"})
     for (const char* key : {"vertices_tested", "vertices_no_surface", "min_gap_mm", "vertices_penetrating", "map_nodes",
                             "map_nodes_covered", "map_bytes", "sampling_ms", "detection_ms"})
       EXPECT_TRUE(j[body].contains(key)) << body << "." << key;
@@ -79,24 +79,24 @@ TEST(EndToEnd, CliOnGeneratedSubject) {
     const nlohmann::json k = nlohmann::json::parse(on);
     EXPECT_NE(k["allocator"].get<std::string>().find("transparent huge pages: default"), std::string::npos)
         << k["allocator"];
-    EXPECT_EQ(k["ball"]["min_gap_mm"], j["ball"]["min_gap_mm"]);
-    EXPECT_EQ(k["socket"]["min_gap_mm"], j["socket"]["min_gap_mm"]);
+    EXPECT_EQ(k["femur"]["min_gap_mm"], j["femur"]["min_gap_mm"]);
+    EXPECT_EQ(k["pelvis"]["min_gap_mm"], j["pelvis"]["min_gap_mm"]);
   }
 #else
   EXPECT_EQ(j["allocator"], "C library");
 #endif
   EXPECT_NEAR(j["head_radius_mm"].get<double>(), 22, 0.05);
-  EXPECT_EQ(j["ball"]["map_nodes"], 65160);
+  EXPECT_EQ(j["femur"]["map_nodes"], 65160);
   const TriangleMesh femur = load_mesh(d + "/subject/femur_r.ply");
-  EXPECT_EQ(ply_vertex_count(d + "/out/ball_gaps.ply"), femur.V.rows());
+  EXPECT_EQ(ply_vertex_count(d + "/out/femur_gaps.ply"), femur.V.rows());
   // the written PLY is readable again, same vertex count and order of faces
-  EXPECT_EQ(load_mesh(d + "/out/ball_gaps.ply").F, femur.F);
-  EXPECT_TRUE(fs::file_size(d + "/out/ball_map.png") > 100);
-  EXPECT_TRUE(fs::file_size(d + "/out/socket_map.png") > 100);
+  EXPECT_EQ(load_mesh(d + "/out/femur_gaps.ply").F, femur.F);
+  EXPECT_TRUE(fs::file_size(d + "/out/femur_map.png") > 100);
+  EXPECT_TRUE(fs::file_size(d + "/out/pelvis_map.png") > 100);
   // Shaded renders.
   ASSERT_EQ(run("distance --subject " + d + "/subject/subject.json --precision 2 --render --out " + d + "/r", &out), 0)
       << out;
-  for (const char* f : {"render.png", "render_anterior.png", "render_lateral.png", "render_socket_medial.png"})
+  for (const char* f : {"render.png", "render_anterior.png", "render_lateral.png", "render_acetabulum_medial.png"})
     EXPECT_GT(fs::file_size(d + "/r/" + f), 10000u) << f;
 }
 
@@ -210,7 +210,7 @@ TEST_P(SchemesAgree, HelixAndEquiangularGapsAgree) {
   ASSERT_EQ(run("distance --subject " + json + pose + " --scheme helix --turns 458 --out " + d + "/helix", &out), 0) << out;
   ASSERT_EQ(run("distance --subject " + json + pose + " --scheme equiangular --precision 0.5 --out " + d + "/eq", &out), 0)
       << out;
-  for (const char* body : {"ball", "socket"}) {
+  for (const char* body : {"femur", "pelvis"}) {
     const std::vector<float> h = read_gap_ply(d + "/helix/" + body + "_gaps.ply"),
                              e = read_gap_ply(d + "/eq/" + body + "_gaps.ply");
     ASSERT_EQ(h.size(), e.size());
@@ -242,8 +242,8 @@ std::vector<FrameRow> read_frames_csv(const std::string& path) {
   std::ifstream in(path);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line.rfind("frame,time_s,flexion_deg,adduction_deg,internal_rotation_deg,ball_min_gap_mm,"
-                       "socket_min_gap_mm,ball_min_distance_mm,socket_min_distance_mm,penetrating_area_mm2",
+  EXPECT_EQ(line.rfind("frame,time_s,flexion_deg,adduction_deg,internal_rotation_deg,femur_min_gap_mm,"
+                       "pelvis_min_gap_mm,femur_min_distance_mm,pelvis_min_distance_mm,penetrating_area_mm2",
                        0),
             0u)
       << line;
@@ -273,10 +273,10 @@ void expect_motion_equals_distance(const std::string& subject_args, const std::s
     const std::string od = d + "/pose" + std::to_string(k);
     ASSERT_EQ(run("distance " + subject_args + " --pose=" + poses[k] + " --out " + od, &out), 0) << out;
     const nlohmann::json j = read_json(od + "/summary.json");
-    EXPECT_NEAR(rows[k].ball_min, j["ball"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
-    EXPECT_NEAR(rows[k].socket_min, j["socket"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
-    for (const char* body : {"ball", "socket"}) {
-      const double row = body[0] == 'b' ? rows[k].ball_min_distance : rows[k].socket_min_distance;
+    EXPECT_NEAR(rows[k].ball_min, j["femur"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
+    EXPECT_NEAR(rows[k].socket_min, j["pelvis"]["min_gap_mm"].get<double>(), 1e-6) << poses[k];
+    for (const char* body : {"femur", "pelvis"}) {
+      const double row = body[0] == 'f' ? rows[k].ball_min_distance : rows[k].socket_min_distance;
       if (j[body]["min_distance_mm"].is_null()) {
         EXPECT_TRUE(std::isnan(row)) << poses[k];
       } else {
@@ -297,7 +297,7 @@ TEST(EndToEnd, MotionCsvOnAGeneratedSubjectEqualsDistanceAtEachPose) {
   const nlohmann::json j = read_json(d + "/motion/summary.json");
   EXPECT_EQ(j["neutral"], "scan");  // the generated subject says so
   EXPECT_EQ(j["motion_frames"], 3);
-  for (const char* key : {"ball_sampling", "socket_sampling", "detection_total", "total"})
+  for (const char* key : {"femur_sampling", "pelvis_sampling", "detection_total", "total"})
     EXPECT_TRUE(j["timings_ms"].contains(key)) << key;
   EXPECT_TRUE(fs::exists(d + "/motion/gaps.pvd"));
   EXPECT_TRUE(fs::exists(d + "/motion/gaps/frame_000002.vtp"));
@@ -385,22 +385,22 @@ TEST(EndToEnd, DistancesMatchTheOracleAtMc22LeftsDeepestExtension) {
     std::ifstream js(d + "/" + layers + "/summary.json");
     const nlohmann::json j = nlohmann::json::parse(js);
     EXPECT_TRUE(j["distances"].get<bool>());
-    EXPECT_NEAR(j["ball"]["min_distance_mm"].get<double>(), -2.526, 0.02) << layers;
-    EXPECT_NEAR(j["socket"]["min_distance_mm"].get<double>(), -1.737, 0.02) << layers;
-    EXPECT_EQ(j["ball"]["vertices_inside"], 95) << layers;
-    EXPECT_EQ(j["socket"]["vertices_inside"], 31) << layers;
+    EXPECT_NEAR(j["femur"]["min_distance_mm"].get<double>(), -2.526, 0.02) << layers;
+    EXPECT_NEAR(j["pelvis"]["min_distance_mm"].get<double>(), -1.737, 0.02) << layers;
+    EXPECT_EQ(j["femur"]["vertices_inside"], 95) << layers;
+    EXPECT_EQ(j["pelvis"]["vertices_inside"], 31) << layers;
     // The radial gap parts from the distance here (at the earlier head fit it read -27 mm; at this one the rays miss
     // the 1.7 mm penetration and it reads +0.9 mm): the artefact stays visible.
-    EXPECT_GT(std::abs(j["socket"]["min_gap_mm"].get<double>() - j["socket"]["min_distance_mm"].get<double>()), 1.0)
+    EXPECT_GT(std::abs(j["pelvis"]["min_gap_mm"].get<double>() - j["pelvis"]["min_distance_mm"].get<double>()), 1.0)
         << layers;
     // The levels classify the distance by default: the last level (<= 0 mm) holds the vertices inside.
     EXPECT_EQ(j["levels_on"], "distance");
-    for (const char* body : {"ball", "socket"}) {
+    for (const char* body : {"femur", "pelvis"}) {
       const auto& lv = j[body]["levels"];
       EXPECT_EQ(lv[lv.size() - 1]["vertices"].get<std::int64_t>(), j[body]["vertices_inside"].get<std::int64_t>())
           << body;
     }
-    std::ifstream ply(d + "/" + layers + "/ball_gaps.ply", std::ios::binary);
+    std::ifstream ply(d + "/" + layers + "/femur_gaps.ply", std::ios::binary);
     std::string header, line;
     while (std::getline(ply, line) && line != "end_header") header += line + "\n";
     EXPECT_NE(header.find("property float distance_mm"), std::string::npos) << header;
@@ -411,8 +411,8 @@ TEST(EndToEnd, DistancesMatchTheOracleAtMc22LeftsDeepestExtension) {
     std::ifstream rs(d + "/radial/summary.json");
     const nlohmann::json r = nlohmann::json::parse(rs);
     EXPECT_EQ(r["levels_on"], "radial");
-    const auto& lv = r["ball"]["levels"];
-    EXPECT_EQ(lv[lv.size() - 1]["vertices"].get<std::int64_t>(), r["ball"]["vertices_penetrating"].get<std::int64_t>());
+    const auto& lv = r["femur"]["levels"];
+    EXPECT_EQ(lv[lv.size() - 1]["vertices"].get<std::int64_t>(), r["femur"]["vertices_penetrating"].get<std::int64_t>());
   }
   // Contradictions are one-line errors naming the option.
   std::string err;
@@ -427,6 +427,6 @@ TEST(EndToEnd, DistancesMatchTheOracleAtMc22LeftsDeepestExtension) {
   std::ifstream js(d + "/off/summary.json");
   const nlohmann::json j = nlohmann::json::parse(js);
   EXPECT_FALSE(j["distances"].get<bool>());
-  EXPECT_FALSE(j["ball"].contains("min_distance_mm"));
+  EXPECT_FALSE(j["femur"].contains("min_distance_mm"));
   EXPECT_EQ(j["levels_on"], "radial");
 }

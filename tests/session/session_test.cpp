@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -248,7 +250,7 @@ TEST(Session, MotionRunEqualsDetectAtEachPose) {
   t.columns = motion_columns(s.joint_options().levels);
   run_motion(s, poses, {0.0, 0.5, 1.0, 1.5}, [&](const MotionFrame& f) { t.add(motion_row(f)); });
   ASSERT_EQ(t.rows.size(), poses.size());
-  const auto ball = t.column("ball_min_gap_mm"), socket = t.column("socket_min_gap_mm"), time = t.column("time_s");
+  const auto ball = t.column("femur_min_gap_mm"), socket = t.column("pelvis_min_gap_mm"), time = t.column("time_s");
   for (std::size_t k = 0; k < poses.size(); ++k) {
     const PoseResult r = s.joint().detect(s.hip().femur_rotation(poses[k]));
     EXPECT_EQ(ball[k].get<double>(), r.ball.min_gap_mm);
@@ -412,3 +414,36 @@ TEST_P(GivenCor, IsTheCentreOfTheRadialGapsAtTheScanPose) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, GivenCor, ::testing::Values("lhdl-ct", "mc22", "mc22-left", "tlem2-mri"));
+
+// The pivot each joint-centre method names (pivot_input, summary.json's pivot_mm) is the point the posed femur
+// turns about: the rigid motion taking the femur's scan vertices to their posed positions (input frame, fitted by
+// Umeyama's least squares over every vertex, an oracle independent of how the session poses) leaves the pivot where
+// it is at any pose, for femoral-head and acetabular; for combined it takes the femoral head centre onto it (the head
+// seated on the acetabular centre); equidistant names none (its centre moves with each pose).
+TEST(Session, ThePivotIsTheFixedPointOfTheFemursMotion) {
+  const std::string json = std::string(IMPINGE_SHARED_DATA) + "/lhdl-ct/subject.json";
+  if (!fs::exists(json)) GTEST_SKIP() << "shared data absent: " << json;
+  for (const JointCentreMethod method : {JointCentreMethod::femoral_head, JointCentreMethod::acetabular,
+                                         JointCentreMethod::combined, JointCentreMethod::equidistant}) {
+    SessionOptions o;
+    o.input.subject = json;
+    o.grid.precision = 1.0;
+    o.hip.joint_centre = method;
+    const Session s(o);
+    const auto pivot = pivot_input(s);
+    EXPECT_EQ(setup_record(s)["pivot_mm"].is_null(), !pivot.has_value()) << to_string(method);
+    if (method == JointCentreMethod::equidistant) {
+      EXPECT_FALSE(pivot) << "equidistant names no fixed pivot";
+      continue;
+    }
+    ASSERT_TRUE(pivot) << to_string(method);
+    const Vertices scan = s.femur_input(s.hip().scan_pose());
+    const Vertices posed = s.femur_input(s.hip().femur_pose({50, 10, 20}));
+    const Eigen::Matrix4d m = Eigen::umeyama(scan.transpose(), posed.transpose(), false);
+    const Eigen::Vector3d moved_from = method == JointCentreMethod::combined ? s.head_centre_input() : *pivot;
+    const Eigen::Vector3d moved = m.topLeftCorner<3, 3>() * moved_from + m.topRightCorner<3, 1>();
+    EXPECT_LT((moved - *pivot).norm(), 1e-6) << to_string(method);
+    if (method == JointCentreMethod::femoral_head) EXPECT_LT((*pivot - s.head_centre_input()).norm(), 1e-12);
+    if (method != JointCentreMethod::femoral_head) EXPECT_LT((*pivot - *s.acetabular_centre_input()).norm(), 1e-12);
+  }
+}

@@ -120,8 +120,8 @@ void write_pose_vtp(const std::string& path, const Session& s, const PoseResult&
 
 void write_map_pngs(const std::string& dir, const Session& s) {
   const std::filesystem::path d(dir);
-  run_both([&] { write_map_png((d / "ball_map.png").string(), s.joint().ball().map); },
-           [&] { write_map_png((d / "socket_map.png").string(), s.joint().socket().map); });
+  run_both([&] { write_map_png((d / "femur_map.png").string(), s.joint().ball().map); },
+           [&] { write_map_png((d / "pelvis_map.png").string(), s.joint().socket().map); });
 }
 
 HipModel write_generated_hip(const std::string& dir, const HipModelOptions& o) {

@@ -183,14 +183,28 @@ std::string pelvic_frame_name(const Session& s) {
   return to_string(s.hip_options().frames.pelvis);
 }
 
+std::optional<Eigen::Vector3d> pivot_input(const Session& s) {
+  switch (s.hip().joint_centre().method()) {
+    case JointCentreMethod::femoral_head:
+      return s.head_centre_input();
+    case JointCentreMethod::acetabular:
+    case JointCentreMethod::combined:
+      if (const auto a = s.acetabular_centre_input()) return Eigen::Vector3d(*a);
+      return std::nullopt;
+    case JointCentreMethod::equidistant:
+      return std::nullopt;
+  }
+  return std::nullopt;
+}
+
 nlohmann::json setup_record(const Session& s) {
   const Eigen::Matrix3d to_input = s.to_input();
   const JointOptions& opt = s.joint_options();
   const HipJoint& hip = s.hip();
   nlohmann::json j;
   j["impinge_version"] = IMPINGE_VERSION;
-  j["ball_file"] = s.ball_source();
-  j["socket_file"] = s.socket_source();
+  j["femur_file"] = s.ball_source();
+  j["pelvis_file"] = s.socket_source();
   j["side"] = s.side() == Side::right ? "right" : "left";
   j["input_frame"] = s.input_frame() == FrameConvention::LPS ? "LPS" : "RAS";
   // Three centres, each with its own name: the femoral head centre (the COR the femur rotates about: given or
@@ -202,6 +216,11 @@ nlohmann::json setup_record(const Session& s) {
   j["cor_method"] = s.cor_method();
   j["head_radius_mm"] = number_or_null(s.head().radius);
   j["joint_centre"] = to_string(hip.joint_centre().method());
+  // The pivot (input frame, the pelvis fixed): the point the femur turns about under the joint-centre method, the
+  // head centre (femoral-head) or the acetabular centre (acetabular; combined, the head seated on it); null for
+  // equidistant, whose centre moves with each pose (a pose's joint_translation_mm).
+  j["pivot_mm"] = nullptr;
+  if (const auto pivot = pivot_input(s)) j["pivot_mm"] = vec(*pivot);
   // The lunate vertices the equidistant placement keeps open at every pose because something of the femur closed
   // them at neutral (a head past its sphere, a segmentation overlap): 0 on a clean hip.
   if (hip.joint_centre().method() == JointCentreMethod::equidistant)
@@ -228,11 +247,11 @@ nlohmann::json setup_record(const Session& s) {
                           {"whole_mesh_searches", q.cropped_fallbacks()}};
   };
   if (s.joint().ball().distance_query && s.joint().socket().distance_query)
-    j["distance_hierarchies"] = {{"ball", hierarchy(s.joint().ball())}, {"socket", hierarchy(s.joint().socket())}};
+    j["distance_hierarchies"] = {{"femur", hierarchy(s.joint().ball())}, {"pelvis", hierarchy(s.joint().socket())}};
   j["distances"] = opt.distances;
   j["levels_on"] = to_string(opt.level_quantity());
   if (opt.distances) j["distance_reach_mm"] = opt.reach_mm();
-  j["nodes_marked"] = {{"ball", s.joint().ball().nodes_marked}, {"socket", s.joint().socket().nodes_marked}};
+  j["nodes_marked"] = {{"femur", s.joint().ball().nodes_marked}, {"pelvis", s.joint().socket().nodes_marked}};
   j["neutral"] = hip.neutral() == Neutral::anatomical ? "anatomical" : "scan";
   j["pelvic_frame"] = pelvic_frame_name(s);
   j["warnings"] = s.warnings();
@@ -284,16 +303,16 @@ nlohmann::json pose_record(const Session& s, const PoseAngles& pose, const Femur
   s.hip().clocks(res, ball_clock, socket_clock);
   const bool clocks = s.hip().socket_clock().has_value();
   const ImpingementLevels& levels = s.joint_options().levels;
-  j["ball"] = scan_record(s.joint().ball(), res.ball, res.ball_detection_ms, levels, clocks ? &ball_clock : nullptr);
-  j["socket"] =
+  j["femur"] = scan_record(s.joint().ball(), res.ball, res.ball_detection_ms, levels, clocks ? &ball_clock : nullptr);
+  j["pelvis"] =
       scan_record(s.joint().socket(), res.socket, res.socket_detection_ms, levels, clocks ? &socket_clock : nullptr);
   if (s.joint_options().distances) {
-    j["ball"]["distance_ms"] = res.ball_distance_ms;
-    j["socket"]["distance_ms"] = res.socket_distance_ms;
+    j["femur"]["distance_ms"] = res.ball_distance_ms;
+    j["pelvis"]["distance_ms"] = res.socket_distance_ms;
   }
   // Where each scan comes closest, classed (articular, intra- or extra-articular impingement).
   for (const bool ball : {true, false})
-    j[ball ? "ball" : "socket"]["closest_contact_class"] =
+    j[ball ? "femur" : "pelvis"]["closest_contact_class"] =
         to_string(closest_point(s, ball, ball ? res.ball_gaps : res.socket_gaps, femur).contact_class);
   return j;
 }

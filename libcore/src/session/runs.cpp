@@ -18,12 +18,12 @@ namespace impinge {
 
 std::vector<std::string> motion_columns(const ImpingementLevels& levels) {
   std::vector<std::string> c = {"frame",           "time_s",          "flexion_deg",          "adduction_deg",
-                                "internal_rotation_deg", "ball_min_gap_mm", "socket_min_gap_mm",
-                                "ball_min_distance_mm", "socket_min_distance_mm",
-                                "penetrating_area_mm2",  "ball_penetrating_area_mm2"};
-  for (int k = 0; k < levels.count(); ++k) c.push_back("socket_level" + std::to_string(k) + "_area_mm2");
-  for (const char* name : {"socket_closest_clock_h", "femur_closest_clock_h", "socket_closest_x_mm",
-                           "socket_closest_y_mm", "socket_closest_z_mm", "socket_closest_class",
+                                "internal_rotation_deg", "femur_min_gap_mm", "pelvis_min_gap_mm",
+                                "femur_min_distance_mm", "pelvis_min_distance_mm",
+                                "penetrating_area_mm2",  "femur_penetrating_area_mm2"};
+  for (int k = 0; k < levels.count(); ++k) c.push_back("pelvis_level" + std::to_string(k) + "_area_mm2");
+  for (const char* name : {"pelvis_closest_clock_h", "femur_closest_clock_h", "pelvis_closest_x_mm",
+                           "pelvis_closest_y_mm", "pelvis_closest_z_mm", "pelvis_closest_class",
                            "joint_translation_x_mm", "joint_translation_y_mm", "joint_translation_z_mm", "detection_ms"})
     c.emplace_back(name);
   return c;
@@ -208,7 +208,7 @@ bool soft_tissue_ends_first(const std::string& motion, const RomLimit& l) {
 
 Table rom_limits_table(const Session& s, const RomRun& run) {
   Table t;
-  t.columns = {"motion",      "limit_deg",        "status",       "limited_by",     "contact_class", "socket_clock_h",
+  t.columns = {"motion",      "limit_deg",        "status",       "limited_by",     "contact_class", "pelvis_clock_h",
                "femur_clock_h", "min_gap_at_limit_mm", "monotone", "contact_at_start", "contact_x_mm", "contact_y_mm",
                "contact_z_mm", "joint_translation_x_mm", "joint_translation_y_mm", "joint_translation_z_mm",
                "evaluations", "normal_deg", "soft_tissue_first", "pelvic_frame", "note"};

@@ -48,7 +48,7 @@ def _nominal_cor(task):
     if key not in _NOMINAL_COR:
         if "generated" in subject:
             h = _generated(subject["generated"])
-            found = impinge.femoral_head_centre(h["ball"], h["socket"])
+            found = impinge.femoral_head_centre(h["femur"], h["pelvis"])
         else:
             found = impinge.femoral_head_centre(subject=subject["path"])
         _NOMINAL_COR[key] = np.asarray(found["centre"], dtype=float)
@@ -67,7 +67,7 @@ def build_joint(task):
     if "generated" in subject:
         h = _generated(subject["generated"])
         kw.setdefault("neutral", "scan")  # a generated hip has no whole bones
-        return impinge.Joint(h["ball"], h["socket"], **kw)
+        return impinge.Joint(h["femur"], h["pelvis"], **kw)
     return impinge.Joint(subject=subject["path"], **kw)
 
 
@@ -144,11 +144,11 @@ def _run_motion(joint, task, folder):
     columns = {k: v for k, v in r.items() if k not in ("detection_ms",)}
     columns["time_s"] = m["time_s"]
     _write_csv(os.path.join(folder, "frames.csv"), columns)
-    gap = np.fmin(r["ball_min_gap_mm"], r["socket_min_gap_mm"])
+    gap = np.fmin(r["femur_min_gap_mm"], r["pelvis_min_gap_mm"])
     out = {"frames": int(len(gap)), "min_gap_mm": float(np.nanmin(gap)) if np.isfinite(gap).any() else float("nan")}
     out["min_gap_time_s"] = float(m["time_s"][int(np.nanargmin(gap))]) if np.isfinite(gap).any() else float("nan")
-    if "ball_min_distance_mm" in r:
-        dist = np.fmin(r["ball_min_distance_mm"], r["socket_min_distance_mm"])
+    if "femur_min_distance_mm" in r:
+        dist = np.fmin(r["femur_min_distance_mm"], r["pelvis_min_distance_mm"])
         out["min_distance_mm"] = float(np.nanmin(dist)) if np.isfinite(dist).any() else float("nan")
         measure = dist
     else:
@@ -165,7 +165,7 @@ def _run_distance(joint, task, folder):
     arrays = {k: v for k, v in d.items() if isinstance(v, np.ndarray)}
     np.savez_compressed(os.path.join(folder, "gaps.npz"), **arrays)
     out = {}
-    for bone in ("ball", "socket"):
+    for bone in ("femur", "pelvis"):
         for q in ("gap", "distance"):
             x = d.get(f"{bone}_{q}_mm")
             if x is None:

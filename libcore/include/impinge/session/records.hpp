@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,13 @@ nlohmann::json acetabulum_record(const Acetabulum& acetabulum, const AnatomicalF
 /// input frame, COR and how it was found, scheme and resolution, map settings, neutral, warnings,
 /// the scan-pose overlap, and with anatomical neutral the frames, the scan pose and the acetabulum.
 nlohmann::json setup_record(const Session& session);
+
+/// The three centres are named apart: the femoral head centre (Session::head_centre_input, "COR" of --cor), the
+/// maps' centre (Session::map_centre_input: the rays' origin) and this pivot: the point (input frame, mm, the pelvis
+/// fixed) the femur turns about under the joint-centre method (Puls et al. 2010; joint_centre.hpp): the head centre
+/// for femoral-head, the acetabular centre for acetabular and combined (the head seated on it); nullopt for
+/// equidistant, whose centre moves with each pose, and when the acetabular centre is unknown (scan neutral).
+std::optional<Eigen::Vector3d> pivot_input(const Session& session);
 
 /// The pelvic frame the clinical angles are measured in: "isb" (Wu et al. 2002: ASIS and PSIS), "app" (the
 /// anterior pelvic plane of clinical ROM tools: ASIS and pubic tubercles) or "scan" (scan neutral: the input
