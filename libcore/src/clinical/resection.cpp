@@ -149,6 +149,248 @@ struct Contact {
 
 enum class Blocked : std::uint8_t { no = 0, head = 1, lunate = 2, depth = 3, bone = 4 };
 
+/// Bone b's state (0 femur, 1 pelvis) at the start: no depth, limits `cap` mm less depths removed before.
+void prepare_bone(BoneState& s, int b, const Joint& joint, const ResectionOptions& o, double cap) {
+  const JointBody& body = b == 0 ? joint.ball() : joint.socket();
+  s.allowed = b == 0 ? o.bones != ResectBones::pelvis : o.bones != ResectBones::femur;
+  s.V = &body.relative;
+  s.F = &body.mesh.F;
+  s.area = &body.vertex_area;
+  s.normals = vertex_normals(body.relative, body.mesh.F);
+  const auto n = static_cast<std::size_t>(body.relative.rows());
+  s.protect.assign(n, 0);
+  s.required.assign(n, 0.0);
+  s.depth.assign(n, 0.0);
+  s.resected = body.relative;
+  s.limit.assign(n, cap);
+  const std::vector<double>& removed = b == 0 ? o.femur_removed_mm : o.pelvis_removed_mm;
+  require(removed.empty() || removed.size() == n, "resection: " + std::to_string(removed.size()) +
+                                                      " depths removed before for " + std::to_string(n) +
+                                                      " vertices of " + body.mesh.source);
+  for (std::size_t i = 0; i < removed.size(); ++i) s.limit[i] = std::max(0.0, cap - removed[i]);
+  s.thin.assign(n, 0);
+  s.thickness_known.assign(n, 0);
+  if (s.allowed) {
+    TriangleMesh m;
+    m.V = body.relative;
+    m.F = body.mesh.F;
+    m.source = body.mesh.source;
+    s.original = std::make_unique<ExactReference>(m);
+  }
+}
+
+/// Marks the protected surfaces (file comment, step 3) and holds them at depth 0.
+void protect_surfaces(const HipJoint& hip, BoneState (&bone)[2]) {
+  const auto& art = hip.articular();
+  const Eigen::Vector3d hc = hip.head_centre_joint();
+  const double rh = hip.head_radius_mm();
+  // The labrum line: the rim plane with the femur at neutral; the head's surface inside it is protected, the
+  // head-neck junction outside it (where an osteochondroplasty restores the offset) is not.
+  const auto& acetabulum = hip.acetabulum();
+  const FemurPose neutral = hip.femur_pose({});
+  for (Eigen::Index i = 0; i < bone[0].V->rows(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (art && acetabulum) {
+      const Eigen::Vector3d w = hip.to_working(neutral.R * bone[0].V->row(i).transpose() + neutral.t);
+      bone[0].protect[k] = art->femur[k] && (w - acetabulum->rim_centre).dot(acetabulum->opening) < 0;
+    } else if (art)
+      bone[0].protect[k] = art->femur[k];
+    else
+      bone[0].protect[k] = std::abs((bone[0].V->row(i).transpose() - hc).norm() - rh) <= 0.5;
+  }
+  for (Eigen::Index i = 0; i < bone[1].V->rows(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (art) {
+      bone[1].protect[k] = art->pelvis[k];
+    } else {
+      const Eigen::Vector3d u = bone[1].V->row(i).transpose();
+      bone[1].protect[k] = u.norm() <= rh + 3 && bone[1].normals.row(i).dot(-u.normalized()) > 0.7;
+    }
+  }
+  for (BoneState& s : bone)
+    for (std::size_t i = 0; i < s.limit.size(); ++i)
+      if (s.protect[i]) s.limit[i] = 0;
+}
+
+/// One target pose, flattened: its target, its index there, and its femur pose (set by find_contacts).
+struct PoseRef {
+  int target = 0;
+  std::size_t index = 0;
+  FemurPose pose;
+};
+
+/// Step 1, the contacts at every pose (file comment); sets each pose's FemurPose. Parallel over the poses.
+std::vector<std::vector<Contact>> find_contacts(const HipJoint& hip, const std::vector<ResectionTarget>& targets,
+                                                const RomBaseline& baseline, const ResectionOptions& o,
+                                                const BoneState (&bone)[2], std::vector<PoseRef>& poses) {
+  std::vector<std::vector<Contact>> per_pose(poses.size());
+  const double reach_head = baseline.head_sphere_reach_mm;
+  std::string pose_error;
+#pragma omp parallel
+  {
+    PoseResult res;
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t p = 0; p < poses.size(); ++p) {
+      try {
+        const ResectionTarget& tg = targets[static_cast<std::size_t>(poses[p].target)];
+        const FemurPose P = hip.femur_pose(tg.poses[poses[p].index]);
+        poses[p].pose = P;
+        hip.joint().detect(P.R, P.t, res);
+        for (int b = 0; b < 2; ++b) {
+          const ScanGaps& g = b == 0 ? res.ball_gaps : res.socket_gaps;
+          const std::vector<std::uint8_t>& skip = b == 0 ? baseline.skip_ball : baseline.skip_socket;
+          for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
+            if (!skip.empty() && skip[i]) continue;
+            const float d = g.distance_mm.empty() ? std::nanf("") : g.distance_mm[i];
+            const bool near = std::isfinite(d) ? d < o.clearance_mm + o.candidate_margin_mm : (g.gap_mm[i] < 0);
+            if (!near) continue;
+            if (b == 1 && std::isfinite(reach_head)) {
+              const Eigen::Vector3d u = bone[1].V->row(static_cast<Eigen::Index>(i)).transpose();
+              if ((P.R.transpose() * (u - P.t) - baseline.head_centre).norm() <= reach_head) continue;
+            }
+            per_pose[p].push_back({static_cast<std::int32_t>(p), b == 0, static_cast<std::int64_t>(i), -1, 0, -1});
+          }
+        }
+      } catch (const std::exception& e) {
+#pragma omp critical(resection_error)
+        if (pose_error.empty()) pose_error = e.what();
+      }
+    }
+  }
+  require(pose_error.empty(), "resection: " + pose_error);
+  return per_pose;
+}
+
+/// Step 3, who takes each deficit into `need` (mm per vertex), or what blocks its pose; returns the largest taken.
+double share_deficits(const std::vector<Contact>& contacts, const BoneState (&bone)[2], double tolerance_mm,
+                      std::vector<double> (&need)[2], std::vector<Blocked>& pose_blocked) {
+  double residual = 0;
+  for (const Contact& ct : contacts) {
+    if (ct.deficit <= tolerance_mm) continue;
+    const int a = ct.ball ? 0 : 1, b = 1 - a;
+    const bool own_can = bone[a].can_take(ct.vertex);
+    std::int64_t tri[3] = {-1, -1, -1};
+    bool other_can = false;
+    if (bone[b].allowed && ct.triangle >= 0)
+      for (int m = 0; m < 3; ++m) {
+        tri[m] = (*bone[b].F)(ct.triangle, m);
+        other_can = other_can || bone[b].can_take(tri[m]);
+      }
+    if (!own_can && !other_can) {
+      Blocked why = Blocked::bone;
+      const bool own_protected = bone[a].allowed && bone[a].protect[static_cast<std::size_t>(ct.vertex)];
+      bool other_protected = bone[b].allowed;
+      for (int m = 0; m < 3 && tri[m] >= 0; ++m)
+        other_protected = other_protected && bone[b].protect[static_cast<std::size_t>(tri[m])];
+      if (own_protected || other_protected)
+        why = (own_protected ? a : b) == 0 ? Blocked::head : Blocked::lunate;
+      else if (bone[a].allowed || bone[b].allowed)
+        why = Blocked::depth;
+      Blocked& pb = pose_blocked[static_cast<std::size_t>(ct.pose)];
+      if (pb == Blocked::no) pb = why;
+      continue;
+    }
+    residual = std::max(residual, ct.deficit);
+    const double share = own_can && other_can ? 0.5 * ct.deficit : ct.deficit;
+    if (own_can)
+      need[a][static_cast<std::size_t>(ct.vertex)] = std::max(need[a][static_cast<std::size_t>(ct.vertex)], share);
+    if (other_can)
+      for (int m = 0; m < 3; ++m)
+        if (bone[b].can_take(tri[m]))
+          need[b][static_cast<std::size_t>(tri[m])] = std::max(need[b][static_cast<std::size_t>(tri[m])], share);
+  }
+  return residual;
+}
+
+/// One round, steps 2-4 on `contacts` from the input bones (file comment); marks the poses it cannot clear.
+void plan_round(ResectionPlan& plan, const ResectionOptions& o, BoneState (&bone)[2], const std::vector<PoseRef>& poses,
+                std::vector<Contact>& contacts, std::vector<Blocked>& pose_blocked) {
+  for (BoneState& s : bone) {
+    std::fill(s.required.begin(), s.required.end(), 0.0);
+    std::fill(s.depth.begin(), s.depth.end(), 0.0);
+    s.resected = *s.V;
+    s.changed = true;
+  }
+  std::fill(pose_blocked.begin(), pose_blocked.end(), Blocked::no);
+  plan.residual_mm = 0;
+  for (int it = 0; it < o.max_iterations; ++it) {
+    plan.iterations = it + 1;
+    bone[0].rebuild_query("femur");
+    bone[1].rebuild_query("pelvis");
+    // 2. Each contact's signed distance to the other (resected) bone.
+#pragma omp parallel for schedule(dynamic, 64)
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      Contact& ct = contacts[k];
+      const FemurPose& P = poses[static_cast<std::size_t>(ct.pose)].pose;
+      const BoneState& own = bone[ct.ball ? 0 : 1];
+      const BoneState& other = bone[ct.ball ? 1 : 0];
+      const Eigen::Vector3d x = own.resected.row(static_cast<Eigen::Index>(ct.vertex)).transpose();
+      const Eigen::Vector3d q = ct.ball ? Eigen::Vector3d(P.R * x + P.t) : Eigen::Vector3d(P.R.transpose() * (x - P.t));
+      ClosestSurfacePoint cp;
+      if (other.query->signed_distance(q, kInf, 0, cp, ct.seed)) {
+        ct.seed = cp.triangle;
+        ct.triangle = cp.triangle;
+        ct.deficit = o.clearance_mm - cp.signed_mm();
+      } else {
+        ct.deficit = 0;
+      }
+    }
+    std::vector<double> need[2] = {std::vector<double>(bone[0].depth.size(), 0.0),
+                                   std::vector<double>(bone[1].depth.size(), 0.0)};
+    const double residual = share_deficits(contacts, bone, o.tolerance_mm, need, pose_blocked);
+    plan.residual_mm = residual;
+    if (residual <= o.tolerance_mm) break;
+    if (it + 1 == o.max_iterations) break;
+    for (int b = 0; b < 2; ++b) {  // the burr (file comment, step 3) on the depths asked so far
+      if (!bone[b].allowed) continue;
+      for (std::size_t i = 0; i < need[b].size(); ++i) bone[b].required[i] += need[b][i];
+      bone[b].apply_burr(o.burr_radius_mm);
+    }
+  }
+  // Poses still asking for more after the last round are not cleared either.
+  if (plan.residual_mm > o.tolerance_mm)
+    for (const Contact& ct : contacts)
+      if (ct.deficit > o.tolerance_mm && pose_blocked[static_cast<std::size_t>(ct.pose)] == Blocked::no)
+        pose_blocked[static_cast<std::size_t>(ct.pose)] = Blocked::depth;
+}
+
+/// Drops each target's poses from its first blocked pose on (noting why); returns whether any was dropped.
+bool drop_blocked_poses(ResectionPlan& plan, const std::vector<ResectionTarget>& targets,
+                        const std::vector<PoseRef>& poses, const std::vector<Blocked>& pose_blocked,
+                        std::vector<std::uint8_t>& pose_kept) {
+  bool dropped = false;
+  for (std::size_t p = 0; p < poses.size(); ++p) {
+    if (!pose_kept[p] || pose_blocked[p] == Blocked::no) continue;
+    const int t = poses[p].target;
+    ResectionTargetResult& r = plan.targets[static_cast<std::size_t>(t)];
+    r.reachable = false;
+    const char* what = pose_blocked[p] == Blocked::head     ? "the femoral head's articular surface"
+                       : pose_blocked[p] == Blocked::lunate ? "the acetabulum's lunate surface"
+                       : pose_blocked[p] == Blocked::depth  ? "more than the safety depth or the bone's thickness"
+                                                            : "a bone the plan may not resect (--resect)";
+    const double theta = targets[static_cast<std::size_t>(t)].theta_deg[poses[p].index];
+    r.note = "the bones meet at " +
+             (std::isnan(theta) ? std::string("the way to the motion's start")
+                                : std::to_string(theta).substr(0, 6) + " deg") +
+             " where clearing them would take " + what;
+    for (std::size_t q = p; q < poses.size() && poses[q].target == t; ++q) pose_kept[q] = 0;
+    dropped = true;
+  }
+  return dropped;
+}
+
+/// One bone's result from its final state: depths, protection, resected mesh and sums (cap: the safety depth, mm).
+void bone_result(BoneResection& out, const BoneState& s, double cap) {
+  out.allowed = s.allowed;
+  out.depth_mm = s.depth;
+  out.protected_vertex = s.protect;
+  out.resected = s.resected;
+  out.normals = s.normals;
+  summarize_resection(out, *s.V, *s.F, *s.area, cap);  // a further pass's sums are run_plan's, over every pass
+  for (std::size_t i = 0; i < s.depth.size(); ++i)
+    if (s.thin[i] && s.depth[i] > 0) ++out.thin_vertices;
+}
+
 }  // namespace
 
 const char* to_string(ResectBones bones) {
@@ -245,71 +487,13 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
           "resection: the distances' reach " + std::to_string(joint.options().reach_mm()) +
               " mm is below the clearance + margin (" + std::to_string(o.clearance_mm + o.candidate_margin_mm) +
               " mm); give --distance-reach");
-
   ResectionPlan plan;
   plan.options = o;
-  const double c = o.clearance_mm, cap = o.safety_depth_mm;
+  const double cap = o.safety_depth_mm;
 
   BoneState bone[2];  // 0 femur, 1 pelvis
-  for (int b = 0; b < 2; ++b) {
-    const JointBody& body = b == 0 ? joint.ball() : joint.socket();
-    BoneState& s = bone[b];
-    s.allowed = b == 0 ? o.bones != ResectBones::pelvis : o.bones != ResectBones::femur;
-    s.V = &body.relative;
-    s.F = &body.mesh.F;
-    s.area = &body.vertex_area;
-    s.normals = vertex_normals(body.relative, body.mesh.F);
-    const auto n = static_cast<std::size_t>(body.relative.rows());
-    s.protect.assign(n, 0);
-    s.required.assign(n, 0.0);
-    s.depth.assign(n, 0.0);
-    s.resected = body.relative;
-    s.limit.assign(n, cap);
-    const std::vector<double>& removed = b == 0 ? o.femur_removed_mm : o.pelvis_removed_mm;
-    require(removed.empty() || removed.size() == n, "resection: " + std::to_string(removed.size()) +
-                                                        " depths removed before for " + std::to_string(n) +
-                                                        " vertices of " + body.mesh.source);
-    for (std::size_t i = 0; i < removed.size(); ++i) s.limit[i] = std::max(0.0, cap - removed[i]);
-    s.thin.assign(n, 0);
-    s.thickness_known.assign(n, 0);
-    if (s.allowed) {
-      TriangleMesh m;
-      m.V = body.relative;
-      m.F = body.mesh.F;
-      m.source = body.mesh.source;
-      s.original = std::make_unique<ExactReference>(m);
-    }
-  }
-  // The protected surfaces.
-  const auto& art = hip.articular();
-  const Eigen::Vector3d hc = hip.head_centre_joint();
-  const double rh = hip.head_radius_mm();
-  // The labrum line: the rim plane with the femur at neutral; the head's surface inside it is protected, the
-  // head-neck junction outside it (where an osteochondroplasty restores the offset) is not.
-  const auto& acetabulum = hip.acetabulum();
-  const FemurPose neutral = hip.femur_pose({});
-  for (Eigen::Index i = 0; i < bone[0].V->rows(); ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (art && acetabulum) {
-      const Eigen::Vector3d w = hip.to_working(neutral.R * bone[0].V->row(i).transpose() + neutral.t);
-      bone[0].protect[k] = art->femur[k] && (w - acetabulum->rim_centre).dot(acetabulum->opening) < 0;
-    } else if (art)
-      bone[0].protect[k] = art->femur[k];
-    else
-      bone[0].protect[k] = std::abs((bone[0].V->row(i).transpose() - hc).norm() - rh) <= 0.5;
-  }
-  for (Eigen::Index i = 0; i < bone[1].V->rows(); ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (art) {
-      bone[1].protect[k] = art->pelvis[k];
-    } else {
-      const Eigen::Vector3d u = bone[1].V->row(i).transpose();
-      bone[1].protect[k] = u.norm() <= rh + 3 && bone[1].normals.row(i).dot(-u.normalized()) > 0.7;
-    }
-  }
-  for (BoneState& s : bone)
-    for (std::size_t i = 0; i < s.limit.size(); ++i)
-      if (s.protect[i]) s.limit[i] = 0;
+  for (int b = 0; b < 2; ++b) prepare_bone(bone[b], b, joint, o, cap);
+  protect_surfaces(hip, bone);
   for (BoneState& s : bone)
     if (s.allowed) {
       std::vector<std::uint8_t> use(s.protect.size());
@@ -318,11 +502,6 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
     }
 
   // The poses, flattened, and their targets.
-  struct PoseRef {
-    int target = 0;
-    std::size_t index = 0;
-    FemurPose pose;
-  };
   std::vector<PoseRef> poses;
   for (std::size_t t = 0; t < targets.size(); ++t) {
     require(targets[t].theta_deg.size() == targets[t].poses.size(),
@@ -331,43 +510,7 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
   }
   plan.poses = static_cast<std::int64_t>(poses.size());
 
-  // 1. The contacts at every pose.
-  std::vector<std::vector<Contact>> per_pose(poses.size());
-  const double reach_head = baseline.head_sphere_reach_mm;
-  std::string pose_error;
-#pragma omp parallel
-  {
-    PoseResult res;
-#pragma omp for schedule(dynamic, 1)
-    for (std::size_t p = 0; p < poses.size(); ++p) {
-      try {
-        const ResectionTarget& tg = targets[static_cast<std::size_t>(poses[p].target)];
-        const FemurPose P = hip.femur_pose(tg.poses[poses[p].index]);
-        poses[p].pose = P;
-        joint.detect(P.R, P.t, res);
-        for (int b = 0; b < 2; ++b) {
-          const ScanGaps& g = b == 0 ? res.ball_gaps : res.socket_gaps;
-          const std::vector<std::uint8_t>& skip = b == 0 ? baseline.skip_ball : baseline.skip_socket;
-          for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
-            if (!skip.empty() && skip[i]) continue;
-            const float d = g.distance_mm.empty() ? std::nanf("") : g.distance_mm[i];
-            const bool near = std::isfinite(d) ? d < c + o.candidate_margin_mm : (g.gap_mm[i] < 0);
-            if (!near) continue;
-            if (b == 1 && std::isfinite(reach_head)) {
-              const Eigen::Vector3d u = bone[1].V->row(static_cast<Eigen::Index>(i)).transpose();
-              if ((P.R.transpose() * (u - P.t) - baseline.head_centre).norm() <= reach_head) continue;
-            }
-            per_pose[p].push_back({static_cast<std::int32_t>(p), b == 0, static_cast<std::int64_t>(i), -1, 0, -1});
-          }
-        }
-      } catch (const std::exception& e) {
-#pragma omp critical(resection_error)
-        if (pose_error.empty()) pose_error = e.what();
-      }
-    }
-  }
-  require(pose_error.empty(), "resection: " + pose_error);
-
+  const std::vector<std::vector<Contact>> per_pose = find_contacts(hip, targets, baseline, o, bone, poses);
   std::vector<std::uint8_t> pose_kept(poses.size(), 1);
   std::vector<Blocked> pose_blocked(poses.size(), Blocked::no);
   plan.targets.resize(targets.size());
@@ -379,113 +522,13 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
 
   for (int round = 0; round < 8; ++round) {
     plan.rounds = round + 1;
-    std::vector<Contact> contacts;
+    std::vector<Contact> contacts;  // the kept poses'
     for (std::size_t p = 0; p < poses.size(); ++p)
       if (pose_kept[p]) contacts.insert(contacts.end(), per_pose[p].begin(), per_pose[p].end());
     plan.contacts = static_cast<std::int64_t>(contacts.size());
-    for (BoneState& s : bone) {
-      std::fill(s.required.begin(), s.required.end(), 0.0);
-      std::fill(s.depth.begin(), s.depth.end(), 0.0);
-      s.resected = *s.V;
-      s.changed = true;
-    }
-    std::fill(pose_blocked.begin(), pose_blocked.end(), Blocked::no);
-    plan.residual_mm = 0;
-    for (int it = 0; it < o.max_iterations; ++it) {
-      plan.iterations = it + 1;
-      bone[0].rebuild_query("femur");
-      bone[1].rebuild_query("pelvis");
-      // 2. Each contact's signed distance to the other (resected) bone.
-#pragma omp parallel for schedule(dynamic, 64)
-      for (std::size_t k = 0; k < contacts.size(); ++k) {
-        Contact& ct = contacts[k];
-        const FemurPose& P = poses[static_cast<std::size_t>(ct.pose)].pose;
-        const BoneState& own = bone[ct.ball ? 0 : 1];
-        const BoneState& other = bone[ct.ball ? 1 : 0];
-        const Eigen::Vector3d x = own.resected.row(static_cast<Eigen::Index>(ct.vertex)).transpose();
-        const Eigen::Vector3d q =
-            ct.ball ? Eigen::Vector3d(P.R * x + P.t) : Eigen::Vector3d(P.R.transpose() * (x - P.t));
-        ClosestSurfacePoint cp;
-        if (other.query->signed_distance(q, kInf, 0, cp, ct.seed)) {
-          ct.seed = cp.triangle;
-          ct.triangle = cp.triangle;
-          ct.deficit = c - cp.signed_mm();
-        } else {
-          ct.deficit = 0;
-        }
-      }
-      // 3. Who takes each deficit.
-      std::vector<double> need[2] = {std::vector<double>(bone[0].depth.size(), 0.0),
-                                     std::vector<double>(bone[1].depth.size(), 0.0)};
-      double residual = 0;
-      for (const Contact& ct : contacts) {
-        if (ct.deficit <= o.tolerance_mm) continue;
-        const int a = ct.ball ? 0 : 1, b = 1 - a;
-        const bool own_can = bone[a].can_take(ct.vertex);
-        std::int64_t tri[3] = {-1, -1, -1};
-        bool other_can = false;
-        if (bone[b].allowed && ct.triangle >= 0)
-          for (int m = 0; m < 3; ++m) {
-            tri[m] = (*bone[b].F)(ct.triangle, m);
-            other_can = other_can || bone[b].can_take(tri[m]);
-          }
-        if (!own_can && !other_can) {
-          Blocked why = Blocked::bone;
-          const bool own_protected = bone[a].allowed && bone[a].protect[static_cast<std::size_t>(ct.vertex)];
-          bool other_protected = bone[b].allowed;
-          for (int m = 0; m < 3 && tri[m] >= 0; ++m)
-            other_protected = other_protected && bone[b].protect[static_cast<std::size_t>(tri[m])];
-          if (own_protected || other_protected)
-            why = (own_protected ? a : b) == 0 ? Blocked::head : Blocked::lunate;
-          else if (bone[a].allowed || bone[b].allowed)
-            why = Blocked::depth;
-          Blocked& pb = pose_blocked[static_cast<std::size_t>(ct.pose)];
-          if (pb == Blocked::no) pb = why;
-          continue;
-        }
-        residual = std::max(residual, ct.deficit);
-        const double share = own_can && other_can ? 0.5 * ct.deficit : ct.deficit;
-        if (own_can)
-          need[a][static_cast<std::size_t>(ct.vertex)] = std::max(need[a][static_cast<std::size_t>(ct.vertex)], share);
-        if (other_can)
-          for (int m = 0; m < 3; ++m)
-            if (bone[b].can_take(tri[m]))
-              need[b][static_cast<std::size_t>(tri[m])] = std::max(need[b][static_cast<std::size_t>(tri[m])], share);
-      }
-      plan.residual_mm = residual;
-      if (residual <= o.tolerance_mm) break;
-      if (it + 1 == o.max_iterations) break;
-      for (int b = 0; b < 2; ++b) {
-        if (!bone[b].allowed) continue;
-        for (std::size_t i = 0; i < need[b].size(); ++i) bone[b].required[i] += need[b][i];
-        bone[b].apply_burr(o.burr_radius_mm);
-      }
-    }
-    // Poses still asking for more after the last round are not cleared either.
-    if (plan.residual_mm > o.tolerance_mm)
-      for (const Contact& ct : contacts)
-        if (ct.deficit > o.tolerance_mm && pose_blocked[static_cast<std::size_t>(ct.pose)] == Blocked::no)
-          pose_blocked[static_cast<std::size_t>(ct.pose)] = Blocked::depth;
+    plan_round(plan, o, bone, poses, contacts, pose_blocked);
     // Drop each target's poses from its first blocked pose on, and plan again without them.
-    bool dropped = false;
-    for (std::size_t p = 0; p < poses.size(); ++p) {
-      if (!pose_kept[p] || pose_blocked[p] == Blocked::no) continue;
-      const int t = poses[p].target;
-      ResectionTargetResult& r = plan.targets[static_cast<std::size_t>(t)];
-      r.reachable = false;
-      const char* what = pose_blocked[p] == Blocked::head     ? "the femoral head's articular surface"
-                         : pose_blocked[p] == Blocked::lunate ? "the acetabulum's lunate surface"
-                         : pose_blocked[p] == Blocked::depth  ? "more than the safety depth or the bone's thickness"
-                                                              : "a bone the plan may not resect (--resect)";
-      const double theta = targets[static_cast<std::size_t>(t)].theta_deg[poses[p].index];
-      r.note = "the bones meet at " +
-               (std::isnan(theta) ? std::string("the way to the motion's start")
-                                  : std::to_string(theta).substr(0, 6) + " deg") +
-               " where clearing them would take " + what;
-      for (std::size_t q = p; q < poses.size() && poses[q].target == t; ++q) pose_kept[q] = 0;
-      dropped = true;
-    }
-    if (!dropped) break;
+    if (!drop_blocked_poses(plan, targets, poses, pose_blocked, pose_kept)) break;
   }
   for (std::size_t p = 0; p < poses.size(); ++p) {
     ResectionTargetResult& r = plan.targets[static_cast<std::size_t>(poses[p].target)];
@@ -498,19 +541,8 @@ ResectionPlan plan_resection(const HipJoint& hip, const std::vector<ResectionTar
     ResectionTargetResult& r = plan.targets[t];
     if (r.reachable && !std::isnan(r.angle_deg)) r.reachable_deg = r.angle_deg;
   }
-
-  for (int b = 0; b < 2; ++b) {
-    BoneState& s = bone[b];
-    BoneResection& out = b == 0 ? plan.femur : plan.pelvis;
-    out.allowed = s.allowed;
-    out.depth_mm = s.depth;
-    out.protected_vertex = s.protect;
-    out.resected = s.resected;
-    out.normals = s.normals;
-    summarize_resection(out, *s.V, *s.F, *s.area, cap);  // a further pass's sums are run_plan's, over every pass
-    for (std::size_t i = 0; i < s.depth.size(); ++i)
-      if (s.thin[i] && s.depth[i] > 0) ++out.thin_vertices;
-  }
+  bone_result(plan.femur, bone[0], cap);
+  bone_result(plan.pelvis, bone[1], cap);
   plan.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return plan;
 }
