@@ -75,19 +75,10 @@ std::vector<std::size_t> on_sphere(const std::vector<Facet>& T, const Eigen::Vec
   }
   return sel;
 }
-}  // namespace
 
-Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c, double r, const AnatomicalFrame& P,
-                           double margin) {
-  const std::string ctx = pelvis.source + ": acetabulum";
-  require(c.allFinite() && std::isfinite(r) && r > 0, ctx + ": head centre and radius must be finite");
-  const Vertices& V = pelvis.V;
-  Acetabulum A;
-  // The lunate surface and its sphere, from the triangles (their centroids and areas: the surface's, not its
-  // vertices', so a file that splits, duplicates or renumbers them gives the same sphere).
-  const std::vector<Facet> T = facets(pelvis);
-  // 1. The joint space at the scan pose: the mode (area-weighted, 0.25 mm bins smoothed over +-1 mm) of the
-  //    distance from the head sphere of the triangles facing the head within [-3, 12] mm of it.
+// 1. The joint space at the scan pose (mm): the mode (area-weighted, 0.25 mm bins smoothed over +-1 mm) of the
+//    distance from the head sphere (c, r) of the triangles facing the head within [-3, 12] mm of it.
+double joint_space_mode(const std::vector<Facet>& T, const Eigen::Vector3d& c, double r, const std::string& ctx) {
   constexpr double kBin = 0.25, kLow = -3, kHigh = 12;
   std::vector<double> hist(static_cast<std::size_t>((kHigh - kLow) / kBin), 0.0);
   for (const Facet& t : T) {
@@ -106,12 +97,15 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
   }
   require(best > 0, ctx + ": no pelvis surface faces the femoral head within 12 mm of its sphere (is the head in "
                           "the acetabulum?)");
-  A.joint_space_mode_mm = kLow + (static_cast<double>(mode) + 0.5) * kBin;
-  // 2. The lunate sphere: from the head-centred sphere at that joint space, refit (area-weighted, geometric) on
-  //    the facing triangles within kLunateBandMm of the last sphere until the selection no longer changes (the
-  //    deeper fossa and the rim's flare stay out; the whole lunate surface is in, however wide the joint space).
-  Eigen::Vector3d centre = c;
-  double radius = r + A.joint_space_mode_mm;
+  return kLow + (static_cast<double>(mode) + 0.5) * kBin;
+}
+
+// 2. The lunate sphere (A.sphere, A.lunate_area_mm2, A.lunate_triangles): from the sphere (centre, radius; mm) given,
+//    refit (area-weighted, geometric) on the facing triangles within kLunateBandMm of the last sphere until the
+//    selection no longer changes (the deeper fossa and the rim's flare stay out; the whole lunate surface is in,
+//    however wide the joint space); centre and radius end as the last sphere.
+void fit_lunate_sphere(const std::vector<Facet>& T, const std::string& ctx, Acetabulum& A, Eigen::Vector3d& centre,
+                       double& radius) {
   std::vector<std::size_t> sel, previous;
   for (int it = 0; it < 50; ++it) {
     sel = on_sphere(T, centre, radius, kLunateBandMm);
@@ -131,40 +125,48 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
   A.lunate_area_mm2 = 0;
   for (std::size_t f : previous) A.lunate_area_mm2 += T[f].area;
   A.lunate_triangles = static_cast<std::int64_t>(previous.size());
-  // 3. The cup: pelvis vertices within the acetabular radius + margin of its centre.
+}
+
+// 3. The cup: the pelvis vertices within radius + margin (mm) of the acetabular centre; `mean_dir` gets the sum of
+//    their unit directions from the centre, weighted by vertex area.
+std::vector<Eigen::Index> cup_vertices(const TriangleMesh& pelvis, const Eigen::Vector3d& centre, double radius,
+                                       double margin, Eigen::Vector3d& mean_dir) {
+  const Vertices& V = pelvis.V;
   const Eigen::VectorXd area = vertex_areas(pelvis);
   std::vector<Eigen::Index> cup;
-  Eigen::Vector3d mean_dir = Eigen::Vector3d::Zero();
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     const Eigen::Vector3d d = V.row(i).transpose() - centre;
     const double n = d.norm();
     if (n > 0 && n < radius + margin) cup.push_back(i), mean_dir += area[i] * d / n;
   }
-  A.cup_vertices = static_cast<std::int64_t>(cup.size());
-  require(cup.size() >= 50, ctx + ": only " + std::to_string(cup.size()) + " pelvis vertices within " +
-                                std::to_string(radius + margin) + " mm of the acetabular centre");
-  // The cup's pole (its deepest direction) and axis out of the cup.
-  const Eigen::Vector3d pole = mean_dir.normalized();
-  const Eigen::Vector3d axis = -pole;
-  const Eigen::Vector3d e1 = in_plane(P.axes.col(1), axis);  // superior, in the plane across the axis
-  const Eigen::Vector3d e2 = axis.cross(e1);
-  // Rim: per 5-degree azimuth bin, the cup vertex with the largest angle from the pole.
-  constexpr int kBins = 72;
-  std::vector<double> cover(kBins, -1);
-  std::vector<Eigen::Vector3d> rim(kBins);
+  return cup;
+}
+
+constexpr int kRimBins = 72;  // the rim's azimuth bins: 5 degrees each
+
+// The rim: per 5-degree azimuth bin around the cup's axis (from e1 towards e2), the cup vertex with the largest angle
+// from the pole, appended to `rim` in bin order; `cover`: each bin's angle (rad; -1 where the bin has no vertex).
+void find_rim(const Vertices& V, const std::vector<Eigen::Index>& cup, const Eigen::Vector3d& centre,
+              const Eigen::Vector3d& pole, const Eigen::Vector3d& e1, const Eigen::Vector3d& e2,
+              std::vector<double>& cover, std::vector<Eigen::Vector3d>& rim_out) {
+  cover.assign(kRimBins, -1);
+  std::vector<Eigen::Vector3d> rim(kRimBins);
   for (Eigen::Index i : cup) {
     const Eigen::Vector3d d = V.row(i).transpose() - centre;
     const double theta = std::acos(std::clamp(d.normalized().dot(pole), -1.0, 1.0));
     double psi = std::atan2(d.dot(e2), d.dot(e1));
     if (psi < 0) psi += 2 * M_PI;
-    const int b = std::min(kBins - 1, static_cast<int>(psi / (2 * M_PI) * kBins));
-    if (theta > cover[static_cast<std::size_t>(b)]) cover[static_cast<std::size_t>(b)] = theta, rim[static_cast<std::size_t>(b)] = V.row(i).transpose();
+    const int b = std::min(kRimBins - 1, static_cast<int>(psi / (2 * M_PI) * kRimBins));
+    if (theta > cover[static_cast<std::size_t>(b)])
+      cover[static_cast<std::size_t>(b)] = theta, rim[static_cast<std::size_t>(b)] = V.row(i).transpose();
   }
-  for (int b = 0; b < kBins; ++b)
-    if (cover[static_cast<std::size_t>(b)] >= 0) A.rim.push_back(rim[static_cast<std::size_t>(b)]);
-  require(A.rim.size() >= 36, ctx + ": the cup has vertices in only " + std::to_string(A.rim.size()) +
-                                  " of 72 azimuths around its axis: no rim");
-  // Rim plane.
+  for (int b = 0; b < kRimBins; ++b)
+    if (cover[static_cast<std::size_t>(b)] >= 0) rim_out.push_back(rim[static_cast<std::size_t>(b)]);
+}
+
+// The rim plane: A.rim_centre the rim points' mean, A.opening the plane's normal out of the cup (along `axis`), the
+// rim's mean radius and the points' rms distance from the plane (mm).
+void fit_rim_plane(Acetabulum& A, const Eigen::Vector3d& axis) {
   Eigen::Vector3d m = Eigen::Vector3d::Zero();
   for (const auto& p : A.rim) m += p;
   m /= static_cast<double>(A.rim.size());
@@ -179,31 +181,72 @@ Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c,
   for (const auto& p : A.rim) rr += (p - m).norm(), rms += std::pow((p - m).dot(n), 2);
   A.rim_radius_mm = rr / static_cast<double>(A.rim.size());
   A.rim_plane_rms_mm = std::sqrt(rms / static_cast<double>(A.rim.size()));
-  // Notch: least extent (smoothed over +-22.5 deg; empty bins count as no extent) in the inferior half.
-  std::vector<double> cov(kBins);
-  for (int b = 0; b < kBins; ++b) cov[static_cast<std::size_t>(b)] = std::max(0.0, cover[static_cast<std::size_t>(b)]);
+}
+
+// The notch, the least rim extent (`cover` smoothed over +-22.5 deg; empty bins count as no extent) in the inferior
+// half (by P's y), and the acetabular clock on the rim plane with 6 o'clock there and 3 o'clock anterior; also the
+// median and the notch's coverage (deg).
+void find_notch_and_clock(Acetabulum& A, const std::vector<double>& cover, const Eigen::Vector3d& e1,
+                          const Eigen::Vector3d& e2, const AnatomicalFrame& P) {
+  const Eigen::Vector3d m = A.rim_centre, n = A.opening;
+  std::vector<double> cov(kRimBins);
+  for (int b = 0; b < kRimBins; ++b)
+    cov[static_cast<std::size_t>(b)] = std::max(0.0, cover[static_cast<std::size_t>(b)]);
   int notch = -1;
   double best_v = 1e300;
   std::vector<double> sorted;
-  for (int b = 0; b < kBins; ++b) {
+  for (int b = 0; b < kRimBins; ++b) {
     double s = 0;
-    for (int k = -4; k <= 4; ++k) s += cov[static_cast<std::size_t>((b + k + kBins) % kBins)];
+    for (int k = -4; k <= 4; ++k) s += cov[static_cast<std::size_t>((b + k + kRimBins) % kRimBins)];
     s /= 9;
-    const double psi = (b + 0.5) * 2 * M_PI / kBins;
+    const double psi = (b + 0.5) * 2 * M_PI / kRimBins;
     const Eigen::Vector3d dir = std::cos(psi) * e1 + std::sin(psi) * e2;
     if (dir.dot(P.axes.col(1)) < 0 && s < best_v) best_v = s, notch = b;
     sorted.push_back(cov[static_cast<std::size_t>(b)]);
   }
-  std::nth_element(sorted.begin(), sorted.begin() + kBins / 2, sorted.end());
-  A.median_coverage_deg = sorted[kBins / 2] * 180 / M_PI;
+  std::nth_element(sorted.begin(), sorted.begin() + kRimBins / 2, sorted.end());
+  A.median_coverage_deg = sorted[kRimBins / 2] * 180 / M_PI;
   A.notch_coverage_deg = best_v * 180 / M_PI;
-  const double psi = (notch + 0.5) * 2 * M_PI / kBins;
+  const double psi = (notch + 0.5) * 2 * M_PI / kRimBins;
   const Eigen::Vector3d six = in_plane(std::cos(psi) * e1 + std::sin(psi) * e2, n);
   A.clock.centre = m;
   A.clock.axis = n;
   A.clock.twelve = -six;
   A.clock.three = n.cross(A.clock.twelve);
   if (A.clock.three.dot(P.axes.col(0)) < 0) A.clock.three = -A.clock.three;  // 3 o'clock anterior on both sides
+}
+}  // namespace
+
+Acetabulum find_acetabulum(const TriangleMesh& pelvis, const Eigen::Vector3d& c, double r, const AnatomicalFrame& P,
+                           double margin) {
+  const std::string ctx = pelvis.source + ": acetabulum";
+  require(c.allFinite() && std::isfinite(r) && r > 0, ctx + ": head centre and radius must be finite");
+  const Vertices& V = pelvis.V;
+  Acetabulum A;
+  // The lunate surface and its sphere, from the triangles (their centroids and areas: the surface's, not its
+  // vertices', so a file that splits, duplicates or renumbers them gives the same sphere).
+  const std::vector<Facet> T = facets(pelvis);
+  A.joint_space_mode_mm = joint_space_mode(T, c, r, ctx);
+  // The lunate sphere, from the head-centred sphere at that joint space.
+  Eigen::Vector3d centre = c;
+  double radius = r + A.joint_space_mode_mm;
+  fit_lunate_sphere(T, ctx, A, centre, radius);
+  Eigen::Vector3d mean_dir = Eigen::Vector3d::Zero();
+  const std::vector<Eigen::Index> cup = cup_vertices(pelvis, centre, radius, margin, mean_dir);
+  A.cup_vertices = static_cast<std::int64_t>(cup.size());
+  require(cup.size() >= 50, ctx + ": only " + std::to_string(cup.size()) + " pelvis vertices within " +
+                                std::to_string(radius + margin) + " mm of the acetabular centre");
+  // The cup's pole (its deepest direction) and axis out of the cup.
+  const Eigen::Vector3d pole = mean_dir.normalized();
+  const Eigen::Vector3d axis = -pole;
+  const Eigen::Vector3d e1 = in_plane(P.axes.col(1), axis);  // superior, in the plane across the axis
+  const Eigen::Vector3d e2 = axis.cross(e1);
+  std::vector<double> cover;
+  find_rim(V, cup, centre, pole, e1, e2, cover, A.rim);
+  require(A.rim.size() >= 36, ctx + ": the cup has vertices in only " + std::to_string(A.rim.size()) +
+                                  " of 72 azimuths around its axis: no rim");
+  fit_rim_plane(A, axis);
+  find_notch_and_clock(A, cover, e1, e2, P);
   return A;
 }
 

@@ -55,29 +55,11 @@ double centre_edge_deg(const ExactReference& pelvis, const Eigen::Vector3d& c, d
   const std::size_t k = edges.size() / 2;
   return edges.size() % 2 == 1 ? edges[k] : 0.5 * (edges[k - 1] + edges[k]);
 }
-}  // namespace
 
-Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pelvis, Side side, const HipFrames& frames,
-                              const Acetabulum& A) {
-  Morphology m;
-  const SphereFitResult& head = frames.head;
-  const Eigen::Vector3d c = head.centre;
-  const double r = head.radius;
-  require(c.allFinite() && std::isfinite(r) && r > 0,
-          femur.source + ": morphology: the femoral head sphere is not set");
-  m.head_centre_mm = c;
-  m.head_radius_mm = r;
-  m.head_fit_rms_mm = head.rms_residual;
-  const double lateral_sign = side == Side::right ? 1.0 : -1.0;
-  const AnatomicalFrame& F = frames.femur;
-  const Eigen::Vector3d fx = F.axes.col(0), fy = F.axes.col(1);
-
-  // Neck axis (towards the head) and the head-neck clock.
-  const ClockFace clock = femoral_clock_face(femur, c, r, F);
-  const Eigen::Vector3d n = clock.axis, down_neck = -n;
-  m.neck_axis = n;
-
-  // Sphericity over the head's cap away from the neck.
+// Sphericity over the head's cap away from the neck: each vertex's deviation from the sphere (c, r) within r + 5 mm
+// and at least 100 deg from `down_neck` into m.head_deviation_mm, and their rms and largest (mm).
+void measure_sphericity(const TriangleMesh& femur, const Eigen::Vector3d& c, double r, const Eigen::Vector3d& down_neck,
+                        Morphology& m) {
   m.head_deviation_mm.assign(static_cast<std::size_t>(femur.V.rows()), kNaN);
   const double cap = std::cos(100.0 / kDeg);
   double sum2 = 0;
@@ -92,17 +74,12 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
     ++m.sphericity_vertices;
   }
   m.sphericity_rms_mm = m.sphericity_vertices > 0 ? std::sqrt(sum2 / double(m.sphericity_vertices)) : kNaN;
+}
 
-  // Without femoral landmarks (scan neutral: a generated hip, a proximal femur) there is no knee: no shaft, no version.
-  const FemurLandmarks& L = frames.femur_landmarks;
-  const bool landmarks = !L.source.empty();
-  if (!landmarks) {
-    m.neck_shaft_angle_deg = m.version_posterior_condylar_deg = m.version_transepicondylar_deg = kNaN;
-    m.notes.push_back(
-        "no femoral landmarks (scan neutral): no neck-shaft angle or femoral version; the input frame's "
-        "axes stand for the femoral and pelvic frames");
-  }
-  // Shaft axis: the principal axis of the diaphysis' surface (35-65 % of the head-to-knee length).
+// The shaft axis, the principal axis of the diaphysis' surface (35-65 % of the head-to-knee length along fy), and
+// the neck-shaft angle (deg) against the neck axis n; nothing without landmarks (the caller has noted why).
+void measure_neck_shaft(const TriangleMesh& femur, const Eigen::Vector3d& c, const Eigen::Vector3d& fy,
+                        const Eigen::Vector3d& n, const FemurLandmarks& L, bool landmarks, Morphology& m) {
   const Eigen::Vector3d knee = 0.5 * (L.epicondyle_lateral + L.epicondyle_medial);
   const double length = (c - knee).dot(fy);
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -124,20 +101,15 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
     m.neck_shaft_angle_deg = kNaN;
     m.notes.push_back("neck-shaft angle: fewer than 30 vertices on the diaphysis (a proximal femur only?)");
   }
+}
 
-  // Femoral version against both condylar axes, across the long axis (ISB y).
-  if (landmarks) {
-    m.version_posterior_condylar_deg = version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, fy, fx);
-    m.version_transepicondylar_deg = version_deg(n, L.epicondyle_medial, L.epicondyle_lateral, fy, fx);
-  }
-
-  // Alpha angle per clock hour and the anterior head-neck offset, by exact rays from inside the femur.
-  const ExactReference ref(femur);
-  const double tol = std::max(0.5, std::isfinite(head.rms_residual) ? 2 * head.rms_residual : 0.0);
-  // Swept from the neck (5 deg from its axis, where the ray leaves through the neck far from the centre) towards
-  // the head: the first direction in which the surface lies within the head's radius + tol is where the contour
-  // crosses the circle (Noetzli's point, seen from the neck side: the fovea and any bump on the head beyond it
-  // are never reached).
+// The alpha angle (deg) per clock hour and its largest, by exact rays from the head centre c (radius r, mm; `tol`
+// mm beyond it counts as the head). Swept from the neck (5 deg from its axis, where the ray leaves through the neck
+// far from the centre) towards the head: the first direction in which the surface lies within the head's radius +
+// tol is where the contour crosses the circle (Noetzli's point, seen from the neck side: the fovea and any bump on
+// the head beyond it are never reached).
+void measure_alpha_angles(const ExactReference& ref, const Eigen::Vector3d& c, double r, double tol,
+                          const ClockFace& clock, const Eigen::Vector3d& down_neck, Morphology& m) {
   constexpr double kStep = 0.5, kFrom = 5, kTo = 150;
   m.alpha_max_deg = -1;
   for (int h = 1; h <= 12; ++h) {
@@ -159,6 +131,12 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
     if (std::isfinite(alpha) && alpha > m.alpha_max_deg) m.alpha_max_deg = alpha, m.alpha_max_hour = h;
   }
   if (m.alpha_max_deg < 0) m.alpha_max_deg = m.alpha_max_hour = kNaN;
+}
+
+// The anterior head-neck offset (mm) and its ratio to the head's diameter: r less the neck's narrowest anterior
+// depth (along the clock's three) 0.5-1.3 r down the neck from the head centre c.
+void measure_head_neck_offset(const ExactReference& ref, const Eigen::Vector3d& c, double r, const ClockFace& clock,
+                              const Eigen::Vector3d& down_neck, Morphology& m) {
   double waist = std::numeric_limits<double>::infinity();
   for (double s = 0.5 * r; s <= 1.3 * r; s += 0.25) {
     const std::optional<double> w = ref.first_hit(c + s * down_neck, clock.three);
@@ -171,6 +149,73 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
     m.head_neck_offset_mm = m.head_neck_offset_ratio = kNaN;
     m.notes.push_back("head-neck offset: no anterior neck surface found along the neck axis");
   }
+}
+
+// Coverage: the cap inside the rim, seen from the head centre c (the pole: into the acetabulum): the share of the
+// head sphere covered and the rim's angle from the pole (deg) per acetabular clock hour.
+void measure_coverage(const Acetabulum& A, const Eigen::Vector3d& c, Morphology& m) {
+  std::vector<Eigen::Vector3d> d;  // the rim points relative to the head centre
+  for (const Eigen::Vector3d& p : A.rim) d.push_back(p - c);
+  const Eigen::Vector3d pole = -A.opening;
+  std::array<double, 12> sum{};
+  std::array<int, 12> count{};
+  double covered = 0;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const double theta = std::acos(std::clamp(d[i].normalized().dot(pole), -1.0, 1.0));
+    covered += (1 - std::cos(theta)) / 2;
+    const double hour = A.clock.hour(A.rim[i]);
+    if (std::isfinite(hour)) {
+      const auto k = static_cast<std::size_t>(ClockFace::sector(hour));
+      sum[k] += theta * kDeg, ++count[k];
+    }
+  }
+  m.head_coverage = d.empty() ? kNaN : covered / double(d.size());
+  for (std::size_t k = 0; k < 12; ++k) m.coverage_deg[k] = count[k] > 0 ? sum[k] / count[k] : kNaN;
+}
+}  // namespace
+
+Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pelvis, Side side, const HipFrames& frames,
+                              const Acetabulum& A) {
+  Morphology m;
+  const SphereFitResult& head = frames.head;
+  const Eigen::Vector3d c = head.centre;
+  const double r = head.radius;
+  require(c.allFinite() && std::isfinite(r) && r > 0,
+          femur.source + ": morphology: the femoral head sphere is not set");
+  m.head_centre_mm = c;
+  m.head_radius_mm = r;
+  m.head_fit_rms_mm = head.rms_residual;
+  const double lateral_sign = side == Side::right ? 1.0 : -1.0;
+  const AnatomicalFrame& F = frames.femur;
+  const Eigen::Vector3d fx = F.axes.col(0), fy = F.axes.col(1);
+
+  // Neck axis (towards the head) and the head-neck clock.
+  const ClockFace clock = femoral_clock_face(femur, c, r, F);
+  const Eigen::Vector3d n = clock.axis, down_neck = -n;
+  m.neck_axis = n;
+  measure_sphericity(femur, c, r, down_neck, m);
+
+  // Without femoral landmarks (scan neutral: a generated hip, a proximal femur) there is no knee: no shaft, no version.
+  const FemurLandmarks& L = frames.femur_landmarks;
+  const bool landmarks = !L.source.empty();
+  if (!landmarks) {
+    m.neck_shaft_angle_deg = m.version_posterior_condylar_deg = m.version_transepicondylar_deg = kNaN;
+    m.notes.push_back(
+        "no femoral landmarks (scan neutral): no neck-shaft angle or femoral version; the input frame's "
+        "axes stand for the femoral and pelvic frames");
+  }
+  measure_neck_shaft(femur, c, fy, n, L, landmarks, m);
+  // Femoral version against both condylar axes, across the long axis (ISB y).
+  if (landmarks) {
+    m.version_posterior_condylar_deg = version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, fy, fx);
+    m.version_transepicondylar_deg = version_deg(n, L.epicondyle_medial, L.epicondyle_lateral, fy, fx);
+  }
+
+  // Alpha angle per clock hour and the anterior head-neck offset, by exact rays from inside the femur.
+  const ExactReference ref(femur);
+  const double tol = std::max(0.5, std::isfinite(head.rms_residual) ? 2 * head.rms_residual : 0.0);
+  measure_alpha_angles(ref, c, r, tol, clock, down_neck, m);
+  measure_head_neck_offset(ref, c, r, clock, down_neck, m);
 
   // The acetabulum.
   m.acetabular_centre_mm = A.sphere.centre;
@@ -192,24 +237,7 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
     m.notes.push_back("lateral centre-edge angle: no bone of the pelvis above the head within its radius + 10 mm");
   if (std::isnan(m.anterior_centre_edge_deg))
     m.notes.push_back("anterior centre-edge angle: no bone of the pelvis above the head within its radius + 10 mm");
-  // Coverage: the cap inside the rim, seen from the head centre (the pole: into the acetabulum).
-  std::vector<Eigen::Vector3d> d;  // the rim points relative to the head centre
-  for (const Eigen::Vector3d& p : A.rim) d.push_back(p - c);
-  const Eigen::Vector3d pole = -A.opening;
-  std::array<double, 12> sum{};
-  std::array<int, 12> count{};
-  double covered = 0;
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    const double theta = std::acos(std::clamp(d[i].normalized().dot(pole), -1.0, 1.0));
-    covered += (1 - std::cos(theta)) / 2;
-    const double hour = A.clock.hour(A.rim[i]);
-    if (std::isfinite(hour)) {
-      const auto k = static_cast<std::size_t>(ClockFace::sector(hour));
-      sum[k] += theta * kDeg, ++count[k];
-    }
-  }
-  m.head_coverage = d.empty() ? kNaN : covered / double(d.size());
-  for (std::size_t k = 0; k < 12; ++k) m.coverage_deg[k] = count[k] > 0 ? sum[k] / count[k] : kNaN;
+  measure_coverage(A, c, m);
   return m;
 }
 
