@@ -200,6 +200,80 @@ void normal_sums(const double* X, const double* Y, const double* Z, const float*
   else
     normal_sums_halves(X, Y, Z, g, use, n, t, out);
 }
+
+/// Which lunate points face the head's joint surface, with the head centre at `at` (mm; Rt: the femur's rotation
+/// transposed): on_head[j] = 1 where the gap g[j] (mm) is finite and the femur's surface in q_j's direction,
+/// |R^T (q_j - at)| - g[j] from the head centre, lies within reach_mm of it. Returns how many.
+std::int64_t mark_on_head(const ScanSet& lunate, const float* g, const Eigen::Matrix3d& Rt, const Eigen::Vector3d& at,
+                          double reach_mm, std::uint8_t* on_head) {
+  std::int64_t used = 0;
+  for (std::int64_t j = 0; j < lunate.size(); ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    const double r = (Rt * (Eigen::Vector3d(lunate.x[j], lunate.y[j], lunate.z[j]) - at)).norm();
+    on_head[k] = std::isfinite(g[k]) && r - g[k] <= reach_mm;
+    used += on_head[k];
+  }
+  return used;
+}
+
+/// The equidistant normal equations A (d, m) = b at the head centre t (mm), over the lunate points with on_head[j]
+/// and their gaps g (mm): gap_j(t + d) ~ gap_j(t) - w_j . d (w_j: unit direction from the head centre t to q_j; exact
+/// for a spherical head). Least squares of gap_j - w_j . d - m over d and the mean joint space m: the normal
+/// equations of a_j . (d, m) = gap_j, a_j = (w_j, 1).
+void normal_equations(const ScanSet& lunate, const float* g, const std::uint8_t* on_head, const Eigen::Vector3d& t,
+                      Eigen::Matrix4d& A, Eigen::Vector4d& b) {
+  double sums[14];
+  normal_sums(lunate.x.data(), lunate.y.data(), lunate.z.data(), g, on_head, lunate.size(), t.data(), sums);
+  for (int i = 0, k = 0; i < 4; ++i)
+    for (int c = 0; c <= i; ++c, ++k) A(i, c) = A(c, i) = sums[k];
+  b = Eigen::Vector4d(sums[10], sums[11], sums[12], sums[13]);
+}
+
+/// The guard's tests at one pose of JointCentre::solve (Rt: the femur's rotation transposed; mm).
+struct GuardTest {
+  const Joint& joint;
+  const Eigen::Matrix3d& Rt;
+  double reach_mm;                                  // the head sphere's reach
+  bool guard_all;                                   // every closure guarded (at neutral)
+  const std::vector<std::uint8_t>& neutral_closed;  // per guard vertex: closed at neutral, guarded always
+  // The gaps (mm) of set's vertices with the head centre at `at`, into `out`.
+  void scan(const ScanSet& set, const Eigen::Vector3d& at, float* out) const {
+    scan_gaps_compact(set, Rt, Eigen::Vector3d(-(Rt * at)), joint.ball().map, ScanSide::outside, out);
+  }
+  // Whether the femur's surface that set's vertex k faces, with the head centre at `at`, is the head's joint surface
+  // (within the head sphere's reach, as on_head): only there is a closed joint space the head pressed into the
+  // socket. A neck or a cam meeting the rim is an impingement, the ROM's to find, not the placement's to avoid
+  // (guarding it levered the femur out of the socket: lhdl-ct by 6 mm at 70 deg of extension, 23-60 mm beyond).
+  bool faces_head(const ScanSet& set, std::int64_t k, const Eigen::Vector3d& at, float gap) const {
+    if (!std::isfinite(gap)) return false;
+    const double r = (Rt * (Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) - at)).norm();
+    return r - gap <= reach_mm;
+  }
+  // Whether guard vertex `guard_k`'s closure is guarded: any closure at neutral (guard_all) and at the vertices
+  // closed there (neutral_closed), elsewhere the head's (guard_at_neutral).
+  bool guarded(std::int64_t guard_k, const ScanSet& set, std::int64_t k, const Eigen::Vector3d& at, float gap) const {
+    if (!std::isfinite(gap)) return false;
+    return guard_all || (!neutral_closed.empty() && neutral_closed[static_cast<std::size_t>(guard_k)]) ||
+           faces_head(set, k, at, gap);
+  }
+};
+
+/// Watches the guard vertices closing at t: those not yet watched whose guarded gap (guard_gap, mm) is below 0.25 mm
+/// are marked in is_watched (and closed_out, if given) and appended to `watched`, their guard indices to watched_k.
+void watch_closing(const ScanSet& guard, const float* guard_gap, const GuardTest& test, const Eigen::Vector3d& t,
+                   std::vector<std::uint8_t>& is_watched, std::vector<std::int64_t>& watched_k, ScanSet& watched,
+                   std::vector<std::uint8_t>* closed_out) {
+  constexpr float kNearMm = 0.25f;
+  for (std::int64_t k = 0; k < guard.size(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    if (is_watched[i] || !(guard_gap[i] < kNearMm) || !test.guarded(k, guard, k, t, guard_gap[i])) continue;
+    is_watched[i] = 1;
+    watched_k.push_back(k);
+    if (closed_out) (*closed_out)[i] = 1;
+    watched.index.push_back(guard.index[i]);
+    watched.x.push_back(guard.x[k]), watched.y.push_back(guard.y[k]), watched.z.push_back(guard.z[k]);
+  }
+}
 }  // namespace
 
 Eigen::Vector3d JointCentre::constrained_step(const Eigen::Matrix4d& H, const Eigen::Vector4d& b, const Eigen::Vector3d& t,
@@ -304,13 +378,7 @@ Eigen::Vector3d JointCentre::solve(const Joint& joint, const Eigen::Matrix3d& R,
   // surface in q's direction lies |y| - gap from the head centre.
   const Eigen::Matrix3d Rt = R.transpose();
   gaps(joint, R, start_, g.data());
-  std::int64_t used = 0;
-  for (std::int64_t j = 0; j < n; ++j) {
-    const auto k = static_cast<std::size_t>(j);
-    const double r = (Rt * (Eigen::Vector3d(lunate_.x[j], lunate_.y[j], lunate_.z[j]) - start_)).norm();
-    on_head[k] = std::isfinite(g[k]) && r - g[k] <= reach_mm_;
-    used += on_head[k];
-  }
+  const std::int64_t used = mark_on_head(lunate_, g.data(), Rt, start_, reach_mm_, on_head.data());
   require(used >= 16, "joint centre equidistant: fewer than 16 lunate vertices face the femoral head's joint surface "
                       "at this pose");
   // The guard: every lunate vertex's joint space must stay open. Those found closed at a converged t are
@@ -328,46 +396,22 @@ Eigen::Vector3d JointCentre::solve(const Joint& joint, const Eigen::Matrix3d& R,
   watched_k.clear();
   watched.index.clear(), watched.x.clear(), watched.y.clear(), watched.z.clear();
   watched.vertices = guard_.vertices;
-  auto scan = [&](const ScanSet& set, const Eigen::Vector3d& at, float* out) {
-    scan_gaps_compact(set, Rt, Eigen::Vector3d(-(Rt * at)), joint.ball().map, ScanSide::outside, out);
-  };
-  // Whether the femur's surface that set's vertex k faces, with the head centre at `at`, is the head's joint surface
-  // (within the head sphere's reach, as on_head): only there is a closed joint space the head pressed into the
-  // socket. A neck or a cam meeting the rim is an impingement, the ROM's to find, not the placement's to avoid
-  // (guarding it levered the femur out of the socket: lhdl-ct by 6 mm at 70 deg of extension, 23-60 mm beyond).
-  auto faces_head = [&](const ScanSet& set, std::int64_t k, const Eigen::Vector3d& at, float gap) {
-    if (!std::isfinite(gap)) return false;
-    const double r = (Rt * (Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) - at)).norm();
-    return r - gap <= reach_mm_;
-  };
-  // Whether guard vertex `guard_k`'s closure is guarded: any closure at neutral (guard_all) and at the vertices
-  // closed there (neutral_closed_), elsewhere the head's (guard_at_neutral).
-  auto guarded = [&](std::int64_t guard_k, const ScanSet& set, std::int64_t k, const Eigen::Vector3d& at, float gap) {
-    if (!std::isfinite(gap)) return false;
-    return guard_all || (!neutral_closed_.empty() && neutral_closed_[static_cast<std::size_t>(guard_k)]) ||
-           faces_head(set, k, at, gap);
-  };
+  const GuardTest test{joint, Rt, reach_mm_, guard_all, neutral_closed_};
   Eigen::Vector3d t = start_, previous = Eigen::Vector3d::Zero();
   const int max_iterations = 4 * options_.max_iterations;
   for (int it = 0, steps = 0; it < max_iterations; ++it) {
     if (it > 0) gaps(joint, R, t, g.data());  // the first step uses the selection's gaps
-    // gap_j(t + d) ~ gap_j(t) - w_j . d (w_j: unit direction from the head centre t to q_j; exact
-    // for a spherical head). Least squares of gap_j - w_j . d - m over d and the mean joint space m:
-    // the normal equations of a_j . (d, m) = gap_j, a_j = (w_j, 1).
-    double sums[14];
-    normal_sums(lunate_.x.data(), lunate_.y.data(), lunate_.z.data(), g.data(), on_head.data(), n, t.data(), sums);
     Eigen::Matrix4d A;
-    for (int i = 0, k = 0; i < 4; ++i)
-      for (int c = 0; c <= i; ++c, ++k) A(i, c) = A(c, i) = sums[k];
-    const Eigen::Vector4d b(sums[10], sums[11], sums[12], sums[13]);
+    Eigen::Vector4d b;
+    normal_equations(lunate_, g.data(), on_head.data(), t, A, b);
     open.clear();
     for (std::int64_t j = 0; j < n; ++j)
       if (on_head[static_cast<std::size_t>(j)]) open.add(lunate_.x[j], lunate_.y[j], lunate_.z[j], g[static_cast<std::size_t>(j)]);
     if (watched.size() > 0) {
       watched_gap.resize(static_cast<std::size_t>(watched.size()));
-      scan(watched, t, watched_gap.data());
+      test.scan(watched, t, watched_gap.data());
       for (std::int64_t k = 0; k < watched.size(); ++k)
-        if (guarded(watched_k[static_cast<std::size_t>(k)], watched, k, t, watched_gap[static_cast<std::size_t>(k)]))
+        if (test.guarded(watched_k[static_cast<std::size_t>(k)], watched, k, t, watched_gap[static_cast<std::size_t>(k)]))
           open.add(watched.x[k], watched.y[k], watched.z[k], watched_gap[static_cast<std::size_t>(k)]);
     }
     Eigen::Vector3d d = constrained_step(A, b, t, open, active);
@@ -377,24 +421,15 @@ Eigen::Vector3d JointCentre::solve(const Joint& joint, const Eigen::Matrix3d& R,
     if (!t.allFinite()) throw Error("joint centre equidistant: the iteration diverged (no joint space to even out)");
     if (d.norm() >= options_.tolerance_mm && ++steps < options_.max_iterations) continue;
     // Converged (or out of steps): is the joint space open at every guard vertex not yet watched?
-    scan(guard_, t, guard_gap.data());
+    test.scan(guard_, t, guard_gap.data());
     bool closed = false;
     for (std::int64_t k = 0; k < ng && !closed; ++k)
       closed = !is_watched[static_cast<std::size_t>(k)] && guard_gap[static_cast<std::size_t>(k)] < -options_.tolerance_mm &&
-               guarded(k, guard_, k, t, guard_gap[static_cast<std::size_t>(k)]);
+               test.guarded(k, guard_, k, t, guard_gap[static_cast<std::size_t>(k)]);
     if (!closed) break;
     // Closed by the head's joint surface (or, at neutral, by anything of the femur): watch it, and its guarded
-    // neighbours in closing (within kNearMm), so that the next round does not close them in turn.
-    constexpr float kNearMm = 0.25f;
-    for (std::int64_t k = 0; k < ng; ++k) {
-      const auto i = static_cast<std::size_t>(k);
-      if (is_watched[i] || !(guard_gap[i] < kNearMm) || !guarded(k, guard_, k, t, guard_gap[i])) continue;
-      is_watched[i] = 1;
-      watched_k.push_back(k);
-      if (closed_out) (*closed_out)[i] = 1;
-      watched.index.push_back(guard_.index[i]);
-      watched.x.push_back(guard_.x[k]), watched.y.push_back(guard_.y[k]), watched.z.push_back(guard_.z[k]);
-    }
+    // neighbours in closing (within 0.25 mm), so that the next round does not close them in turn.
+    watch_closing(guard_, guard_gap.data(), test, t, is_watched, watched_k, watched, closed_out);
     steps = 0;
   }
   return t;

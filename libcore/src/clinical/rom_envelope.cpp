@@ -61,6 +61,56 @@ void split_box(const Box& b, std::vector<Box>& out) {
                        {parts[0] == 1 ? cut[0][2] : cut[0][x + 1], parts[1] == 1 ? cut[1][2] : cut[1][y + 1],
                         parts[2] == 1 ? cut[2][2] : cut[2][z + 1]}});
 }
+
+// The index of pose (i, j, k) in a grid of n[a] poses per axis (the last axis fastest).
+std::size_t grid_index(const std::array<int, 3>& n, int i, int j, int k) {
+  return (std::size_t(i) * n[1] + j) * n[2] + k;
+}
+
+// The index of box b's corner c (bit a set: the box's hi end on axis a, else its lo end).
+std::size_t corner_index(const std::array<int, 3>& n, const Box& b, int c) {
+  return grid_index(n, (c & 1) ? b.hi[0] : b.lo[0], (c & 2) ? b.hi[1] : b.lo[1], (c & 4) ? b.hi[2] : b.lo[2]);
+}
+
+// Appends the corners of box b not yet known (state < 0) to `list` and marks them listed (state 2).
+void list_unknown_corners(const Box& b, const std::array<int, 3>& n, std::vector<std::int8_t>& state,
+                          std::vector<std::size_t>& list) {
+  for (int c = 0; c < 8; ++c) {
+    const std::size_t p = corner_index(n, b, c);
+    if (state[p] < 0) {
+      state[p] = 2;  // listed
+      list.push_back(p);
+    }
+  }
+}
+
+// The next level's boxes: each box whose corners (all scanned) disagree, split; those whose corners agree (all
+// contact or all valid) are appended to `uniform` instead.
+std::vector<Box> split_mixed_boxes(const std::vector<Box>& boxes, const std::array<int, 3>& n,
+                                   const std::vector<std::int8_t>& state, std::vector<Box>& uniform) {
+  std::vector<Box> next;
+  for (const Box& b : boxes) {
+    int sum = 0;
+    for (int c = 0; c < 8; ++c) sum += state[corner_index(n, b, c)];
+    if (sum == 0 || sum == 8) {
+      uniform.push_back(b);
+      continue;
+    }
+    split_box(b, next);
+  }
+  return next;
+}
+
+// Every pose of each uniform box not yet known takes the state of the box's corners.
+void fill_uniform_boxes(const std::vector<Box>& uniform, const std::array<int, 3>& n, std::vector<std::int8_t>& state) {
+  for (const Box& b : uniform) {
+    const std::int8_t v = state[grid_index(n, b.lo[0], b.lo[1], b.lo[2])];
+    for (int i = b.lo[0]; i <= b.hi[0]; ++i)
+      for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+        for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+          if (state[grid_index(n, i, j, k)] < 0) state[grid_index(n, i, j, k)] = v;
+  }
+}
 }  // namespace
 
 RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const RomOptions& o,
@@ -77,7 +127,6 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
   const std::array<int, 3> n{static_cast<int>(out.flexion_deg.size()), static_cast<int>(out.adduction_deg.size()),
                              static_cast<int>(out.internal_rotation_deg.size())};
   out.poses = std::int64_t(n[0]) * n[1] * n[2];
-  auto index = [&](int i, int j, int k) { return (std::size_t(i) * n[1] + j) * n[2] + k; };
   std::vector<std::int8_t> state(static_cast<std::size_t>(out.poses), -1);  // -1 unknown, 0 contact, 1 valid
   const Joint& joint = hip.joint();
   const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(joint, o, base);
@@ -109,43 +158,16 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
     require(error.empty(), error);
     out.poses_evaluated += m;
   };
-  // The corners of a box not yet known.
-  auto unknown_corners = [&](const Box& b, std::vector<std::size_t>& list) {
-    for (int c = 0; c < 8; ++c) {
-      const std::size_t p = index((c & 1) ? b.hi[0] : b.lo[0], (c & 2) ? b.hi[1] : b.lo[1], (c & 4) ? b.hi[2] : b.lo[2]);
-      if (state[p] < 0) {
-        state[p] = 2;  // listed
-        list.push_back(p);
-      }
-    }
-  };
-  // The coarse lattice's cells.
+  // The coarse lattice's cells, then their parts where the corners disagree, scanning the corners not yet known.
   std::vector<Box> boxes = coarse_boxes(n, e.coarse_steps);
   std::vector<Box> uniform;  // boxes whose corners agree: filled at the end
   while (!boxes.empty()) {
     std::vector<std::size_t> list;
-    for (const Box& b : boxes) unknown_corners(b, list);
+    for (const Box& b : boxes) list_unknown_corners(b, n, state, list);
     scan_all(list);
-    std::vector<Box> next;
-    for (const Box& b : boxes) {
-      int sum = 0;
-      for (int c = 0; c < 8; ++c)
-        sum += state[index((c & 1) ? b.hi[0] : b.lo[0], (c & 2) ? b.hi[1] : b.lo[1], (c & 4) ? b.hi[2] : b.lo[2])];
-      if (sum == 0 || sum == 8) {
-        uniform.push_back(b);
-        continue;
-      }
-      split_box(b, next);
-    }
-    boxes = std::move(next);
+    boxes = split_mixed_boxes(boxes, n, state, uniform);
   }
-  for (const Box& b : uniform) {
-    const std::int8_t v = state[index(b.lo[0], b.lo[1], b.lo[2])];
-    for (int i = b.lo[0]; i <= b.hi[0]; ++i)
-      for (int j = b.lo[1]; j <= b.hi[1]; ++j)
-        for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-          if (state[index(i, j, k)] < 0) state[index(i, j, k)] = v;
-  }
+  fill_uniform_boxes(uniform, n, state);
   out.valid.resize(state.size());
   for (std::size_t p = 0; p < state.size(); ++p) {
     require(state[p] == 0 || state[p] == 1, "rom envelope: internal error, a pose was left undecided");
