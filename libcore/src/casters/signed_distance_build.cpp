@@ -143,18 +143,23 @@ SignedDistanceQuery::SignedDistanceQuery(const TriangleMesh& mesh, const std::ve
   build(mesh, &keep);
 }
 
-void SignedDistanceQuery::build(const TriangleMesh& mesh, const std::vector<std::uint8_t>* keep) {
-  require(available(), "signed distance: needs Embree or CGAL, and this build has neither (" + mesh.source + ")");
-  Impl& m = *impl_;
-  static std::atomic<std::uint64_t> built{0};
-  m.serial = ++built;
+namespace {
+// The number of triangles build keeps: all of the mesh's F (keep null), or those with keep[f] != 0.
+std::size_t kept_count(const TriangleMesh& mesh, const std::vector<std::uint8_t>* keep) {
+  if (keep == nullptr) return static_cast<std::size_t>(mesh.F.rows());
+  return static_cast<std::size_t>(std::count_if(keep->begin(), keep->end(), [](std::uint8_t x) { return x != 0; }));
+}
+
+// The kept triangles (of nonzero area, and keep[f] != 0 when keep is given) into m: corners a, b, c (mm), their
+// face (index in F), corner vertex indices and unit normals (in the triangles' own winding). Returns the signed
+// volume of every triangle of nonzero area, kept or not (mm^3); any_area: whether there is one.
+double keep_triangles(const TriangleMesh& mesh, const std::vector<std::uint8_t>* keep, SignedDistanceQuery::Impl& m,
+                      bool& any_area) {
   double volume = 0;  // of every triangle, kept or not
-  bool any_area = false;
+  any_area = false;
   // Room for the kept triangles only: a crop keeps some 5-10% of a bone's (a one-pose run), and room reserved for
   // all of them would be faulted in (and zeroed) a huge page at a time once written.
-  const std::size_t faces =
-      keep == nullptr ? static_cast<std::size_t>(mesh.F.rows())
-                      : static_cast<std::size_t>(std::count_if(keep->begin(), keep->end(), [](std::uint8_t x) { return x != 0; }));
+  const std::size_t faces = kept_count(mesh, keep);
   m.a.reserve(faces), m.b.reserve(faces), m.c.reserve(faces), m.face.reserve(faces), m.corner.reserve(faces);
   m.face_normal.reserve(faces);
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
@@ -170,33 +175,38 @@ void SignedDistanceQuery::build(const TriangleMesh& mesh, const std::vector<std:
                         static_cast<std::int32_t>(mesh.F(f, 2))});
     m.face_normal.push_back(n.normalized());
   }
-  require(any_area, "signed distance: " + mesh.source + " has no triangle of nonzero area");
-  m.kept.assign(static_cast<std::size_t>(mesh.F.rows()), -1);
-  for (std::size_t t = 0; t < m.face.size(); ++t) m.kept[static_cast<std::size_t>(m.face[t])] = static_cast<std::int64_t>(t);
-  orientation_ = m.orientation = volume >= 0 ? 1 : -1;
-  const std::size_t k = m.a.size();
-  for (auto& n : m.face_normal) n *= m.orientation;
+  return volume;
+}
 
-  // Edges: directed (from, to) of each kept triangle's edge k (0: ab, 1: bc, 2: ca), grouped undirected:
-  // bucketed by their lower vertex (counting sort), each bucket ordered by the higher vertex, then by
-  // 3 * tri + k (the half-edges are placed in that order and the bucket sort is stable).
-  const std::size_t nv = static_cast<std::size_t>(mesh.V.rows());
-  std::vector<std::int64_t> start(nv + 1, 0);
+// The kept triangles' half-edges grouped undirected: a half-edge h = 3 * tri + k is the directed (from, to) of
+// kept triangle tri's edge k (0: ab, 1: bc, 2: ca). They are bucketed by their lower vertex (counting sort over
+// the nv vertices: bucket w is [start[w], start[w + 1]), start: nv + 1), each entry (higher vertex, h) in order
+// of h (the bucket sort is stable); pair_edges orders each bucket by the higher vertex.
+void bucket_half_edges(const SignedDistanceQuery::Impl& m, std::size_t nv, std::vector<std::int64_t>& start,
+                       std::vector<std::pair<std::int32_t, std::int64_t>>& bucket) {
+  const std::size_t k = m.a.size();
+  start.assign(nv + 1, 0);
   auto ends = [&](std::size_t h) {
     const std::int32_t u = m.corner[h / 3][h % 3], v = m.corner[h / 3][(h % 3 + 1) % 3];
     return std::pair{std::min(u, v), std::max(u, v)};
   };
   for (std::size_t h = 0; h < 3 * k; ++h) ++start[static_cast<std::size_t>(ends(h).first) + 1];
   for (std::size_t w = 0; w < nv; ++w) start[w + 1] += start[w];
-  std::vector<std::pair<std::int32_t, std::int64_t>> bucket(3 * k);  // (higher vertex, 3 * tri + k)
-  {
-    std::vector<std::int64_t> next(start.begin(), start.end() - 1);
-    for (std::size_t h = 0; h < 3 * k; ++h) {
-      const auto [lo, hi] = ends(h);
-      bucket[static_cast<std::size_t>(next[static_cast<std::size_t>(lo)]++)] = {hi, static_cast<std::int64_t>(h)};
-    }
+  bucket.assign(3 * k, {});  // (higher vertex, 3 * tri + k)
+  std::vector<std::int64_t> next(start.begin(), start.end() - 1);
+  for (std::size_t h = 0; h < 3 * k; ++h) {
+    const auto [lo, hi] = ends(h);
+    bucket[static_cast<std::size_t>(next[static_cast<std::size_t>(lo)]++)] = {hi, static_cast<std::int64_t>(h)};
   }
-  m.edge_twin.assign(3 * k, -1);
+}
+
+// The edges' twins from bucket_half_edges' buckets: an edge is regular when exactly two kept triangles share it,
+// wound against each other (m.edge_twin: 3 per kept triangle, the triangle across, else -1); the vertices of an
+// irregular edge are marked (m.vertex_irregular: nv). Also sizes m.vertex_normal (nv, zero). Returns the number
+// of irregular edges.
+std::int64_t pair_edges(SignedDistanceQuery::Impl& m, std::size_t nv, const std::vector<std::int64_t>& start,
+                        std::vector<std::pair<std::int32_t, std::int64_t>>& bucket) {
+  m.edge_twin.assign(3 * m.a.size(), -1);
   m.vertex_normal.assign(nv, Eigen::Vector3d::Zero());
   m.vertex_irregular.assign(nv, 0);
   std::int64_t irregular = 0;
@@ -225,9 +235,13 @@ void SignedDistanceQuery::build(const TriangleMesh& mesh, const std::vector<std:
       i = j;
     }
   }
-  irregular_edges_ = irregular;
-  // Corners: normals weighted by the triangle's angle there.
-  for (std::size_t t = 0; t < k; ++t) {
+  return irregular;
+}
+
+// The corners' pseudo-normals: m.vertex_normal (nv, zeroed by pair_edges) gains each kept triangle's outward unit
+// normal weighted by the triangle's angle at that corner (radians).
+void add_corner_normals(SignedDistanceQuery::Impl& m) {
+  for (std::size_t t = 0; t < m.a.size(); ++t) {
     const std::array<const Eigen::Vector3d*, 3> p{&m.a[t], &m.b[t], &m.c[t]};
     for (int e = 0; e < 3; ++e) {
       const Eigen::Vector3d u = (*p[(e + 1) % 3] - *p[e]).normalized(), v = (*p[(e + 2) % 3] - *p[e]).normalized();
@@ -235,57 +249,76 @@ void SignedDistanceQuery::build(const TriangleMesh& mesh, const std::vector<std:
       m.vertex_normal[static_cast<std::size_t>(m.corner[t][e])] += angle * m.face_normal[t];
     }
   }
+}
 
 #ifdef IMPINGE_HAVE_EMBREE
+// One lane l of group G: kept triangle t's rows (Impl::Group: its unit normal and plane offset, then per edge
+// the in-plane unit normal away from the triangle and its line's offset; float, about m.shift). Widens the box
+// [lo, hi] (mm, about m.shift) by its corners.
+void fill_lane(const SignedDistanceQuery::Impl& m, std::size_t t, int l, SignedDistanceQuery::Impl::Group& G,
+               Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  G.triangle[l] = static_cast<std::int32_t>(t);
+  const std::array<Eigen::Vector3d, 3> p{m.a[t] - m.shift, m.b[t] - m.shift, m.c[t] - m.shift};
+  const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+  for (int d = 0; d < 3; ++d) G.v[d][l] = static_cast<float>(n[d]);
+  G.v[3][l] = static_cast<float>(n.dot(p[0]));
+  for (int e = 0; e < 3; ++e) {  // edge e from corner e to corner e + 1; the in-plane normal away from the third
+    const Eigen::Vector3d& u = p[static_cast<std::size_t>(e)];
+    Eigen::Vector3d w = (p[static_cast<std::size_t>((e + 1) % 3)] - u).cross(n).normalized();
+    if (w.dot(p[static_cast<std::size_t>((e + 2) % 3)] - u) > 0) w = -w;
+    for (int d = 0; d < 3; ++d) G.v[4 + 4 * e + d][l] = static_cast<float>(w[d]);
+    G.v[7 + 4 * e][l] = static_cast<float>(w.dot(u));
+  }
+  for (const Eigen::Vector3d& x : p) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+}
+
+// The point query's groups (m.groups, m.group_box: (k + kGroup - 1) / kGroup each) over the k kept triangles:
+// compact in space (their centroids in boxes of kGroup, every group but the last full), each box widened by
+// kBoxMarginMm and the float rounding at m.extent (mm).
+void fill_groups(SignedDistanceQuery::Impl& m) {
+  const std::size_t k = m.a.size();
+  std::vector<Eigen::Vector3d> centroid(k);
+  for (std::size_t t = 0; t < k; ++t) centroid[t] = (m.a[t] + m.b[t] + m.c[t]) / 3.0;
+  // Groups compact in space: the centroids in boxes of kGroup (every group but the last full).
+  const std::vector<std::int32_t> order = detail::box_order(
+      k, {kGroup}, [&](std::int32_t t, int axis) { return centroid[static_cast<std::size_t>(t)][axis]; });
+  const std::size_t groups = (k + kGroup - 1) / kGroup;
+  m.groups.resize(groups);
+  m.group_box.resize(groups);
+  const double widen = kBoxMarginMm + 1e-6 * m.extent;  // the boxes' and rows' float rounding, and more
+  for (std::size_t g = 0; g < groups; ++g) {
+    SignedDistanceQuery::Impl::Group& G = m.groups[g];
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (int l = 0; l < kGroup; ++l) {
+      const std::size_t j = g * kGroup + static_cast<std::size_t>(l);
+      if (j >= k) {  // past the kept triangles: a plane far away, never a candidate
+        for (auto& row : G.v) row[l] = 0.f;
+        G.v[3][l] = -1e18f;
+        G.triangle[l] = -1;
+        continue;
+      }
+      fill_lane(m, static_cast<std::size_t>(order[j]), l, G, lo, hi);
+    }
+    for (int d = 0; d < 3; ++d) {
+      m.group_box[g][static_cast<std::size_t>(d)] = static_cast<float>(lo[d] - widen);
+      m.group_box[g][static_cast<std::size_t>(d) + 3] = static_cast<float>(hi[d] + widen);
+    }
+  }
+}
+
+// Embree's point-query hierarchy over the kept triangles: m.shift (their centroids' mean, mm), the device and
+// scene, m.extent (mm), the groups (fill_groups) as one user geometry. Throws impinge::Error naming `source`
+// when Embree fails.
+void build_embree_hierarchy(SignedDistanceQuery::Impl& m, const std::string& source) {
+  const std::size_t k = m.a.size();
   for (std::size_t t = 0; t < k; ++t) m.shift += (m.a[t] + m.b[t] + m.c[t]) / 3.0;
   if (k > 0) m.shift /= static_cast<double>(k);  // a crop may keep no triangle (an empty hierarchy)
   m.device = rtcNewDevice(nullptr);  // the build on every core; each query runs on its caller's thread
-  require(m.device != nullptr, "signed distance: rtcNewDevice failed (" + mesh.source + ")");
+  require(m.device != nullptr, "signed distance: rtcNewDevice failed (" + source + ")");
   m.scene = rtcNewScene(m.device);
   for (std::size_t t = 0; t < k; ++t)
     for (const Eigen::Vector3d* p : {&m.a[t], &m.b[t], &m.c[t]}) m.extent = std::max(m.extent, (*p - m.shift).cwiseAbs().maxCoeff());
-  {
-    std::vector<Eigen::Vector3d> centroid(k);
-    for (std::size_t t = 0; t < k; ++t) centroid[t] = (m.a[t] + m.b[t] + m.c[t]) / 3.0;
-    // Groups compact in space: the centroids in boxes of kGroup (every group but the last full).
-    const std::vector<std::int32_t> order = detail::box_order(
-        k, {kGroup}, [&](std::int32_t t, int axis) { return centroid[static_cast<std::size_t>(t)][axis]; });
-    const std::size_t groups = (k + kGroup - 1) / kGroup;
-    m.groups.resize(groups);
-    m.group_box.resize(groups);
-    const double widen = kBoxMarginMm + 1e-6 * m.extent;  // the boxes' and rows' float rounding, and more
-    for (std::size_t g = 0; g < groups; ++g) {
-      Impl::Group& G = m.groups[g];
-      Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-      for (int l = 0; l < kGroup; ++l) {
-        const std::size_t j = g * kGroup + static_cast<std::size_t>(l);
-        if (j >= k) {  // past the kept triangles: a plane far away, never a candidate
-          for (auto& row : G.v) row[l] = 0.f;
-          G.v[3][l] = -1e18f;
-          G.triangle[l] = -1;
-          continue;
-        }
-        const auto t = static_cast<std::size_t>(order[j]);
-        G.triangle[l] = static_cast<std::int32_t>(t);
-        const std::array<Eigen::Vector3d, 3> p{m.a[t] - m.shift, m.b[t] - m.shift, m.c[t] - m.shift};
-        const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
-        for (int d = 0; d < 3; ++d) G.v[d][l] = static_cast<float>(n[d]);
-        G.v[3][l] = static_cast<float>(n.dot(p[0]));
-        for (int e = 0; e < 3; ++e) {  // edge e from corner e to corner e + 1; the in-plane normal away from the third
-          const Eigen::Vector3d& u = p[static_cast<std::size_t>(e)];
-          Eigen::Vector3d w = (p[static_cast<std::size_t>((e + 1) % 3)] - u).cross(n).normalized();
-          if (w.dot(p[static_cast<std::size_t>((e + 2) % 3)] - u) > 0) w = -w;
-          for (int d = 0; d < 3; ++d) G.v[4 + 4 * e + d][l] = static_cast<float>(w[d]);
-          G.v[7 + 4 * e][l] = static_cast<float>(w.dot(u));
-        }
-        for (const Eigen::Vector3d& x : p) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-      }
-      for (int d = 0; d < 3; ++d) {
-        m.group_box[g][static_cast<std::size_t>(d)] = static_cast<float>(lo[d] - widen);
-        m.group_box[g][static_cast<std::size_t>(d) + 3] = static_cast<float>(hi[d] + widen);
-      }
-    }
-  }
+  fill_groups(m);
   RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(m.groups.size()));
   rtcSetGeometryUserData(g, &m);
@@ -298,15 +331,47 @@ void SignedDistanceQuery::build(const TriangleMesh& mesh, const std::vector<std:
   rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_MEDIUM);
   rtcCommitScene(m.scene);
   require(rtcGetDeviceError(m.device) == RTC_ERROR_NONE,
-          "signed distance: building the hierarchy of " + mesh.source + " failed");
+          "signed distance: building the hierarchy of " + source + " failed");
+}
 #elif defined(IMPINGE_HAVE_CGAL)
-  for (std::size_t t = 0; t < k; ++t)
-    m.triangles.emplace_back(Impl::K::Point_3(m.a[t].x(), m.a[t].y(), m.a[t].z()),
-                             Impl::K::Point_3(m.b[t].x(), m.b[t].y(), m.b[t].z()),
-                             Impl::K::Point_3(m.c[t].x(), m.c[t].y(), m.c[t].z()));
+// CGAL's AABB tree over the kept triangles (m.triangles: their corners, mm), with its distance queries' tree.
+void build_cgal_tree(SignedDistanceQuery::Impl& m) {
+  for (std::size_t t = 0; t < m.a.size(); ++t)
+    m.triangles.emplace_back(SignedDistanceQuery::Impl::K::Point_3(m.a[t].x(), m.a[t].y(), m.a[t].z()),
+                             SignedDistanceQuery::Impl::K::Point_3(m.b[t].x(), m.b[t].y(), m.b[t].z()),
+                             SignedDistanceQuery::Impl::K::Point_3(m.c[t].x(), m.c[t].y(), m.c[t].z()));
   m.tree.insert(m.triangles.begin(), m.triangles.end());
   m.tree.build();
   m.tree.accelerate_distance_queries();
+}
+#endif
+}  // namespace
+
+void SignedDistanceQuery::build(const TriangleMesh& mesh, const std::vector<std::uint8_t>* keep) {
+  require(available(), "signed distance: needs Embree or CGAL, and this build has neither (" + mesh.source + ")");
+  Impl& m = *impl_;
+  static std::atomic<std::uint64_t> built{0};
+  m.serial = ++built;
+  bool any_area = false;
+  const double volume = keep_triangles(mesh, keep, m, any_area);
+  require(any_area, "signed distance: " + mesh.source + " has no triangle of nonzero area");
+  m.kept.assign(static_cast<std::size_t>(mesh.F.rows()), -1);
+  for (std::size_t t = 0; t < m.face.size(); ++t) m.kept[static_cast<std::size_t>(m.face[t])] = static_cast<std::int64_t>(t);
+  orientation_ = m.orientation = volume >= 0 ? 1 : -1;
+  for (auto& n : m.face_normal) n *= m.orientation;
+
+  // Edges: paired undirected (regular: two kept triangles wound against each other), then the corners' normals.
+  const std::size_t nv = static_cast<std::size_t>(mesh.V.rows());
+  std::vector<std::int64_t> start;
+  std::vector<std::pair<std::int32_t, std::int64_t>> bucket;
+  bucket_half_edges(m, nv, start, bucket);
+  irregular_edges_ = pair_edges(m, nv, start, bucket);
+  add_corner_normals(m);
+
+#ifdef IMPINGE_HAVE_EMBREE
+  build_embree_hierarchy(m, mesh.source);
+#elif defined(IMPINGE_HAVE_CGAL)
+  build_cgal_tree(m);
 #endif
 }
 
