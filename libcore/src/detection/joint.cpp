@@ -72,6 +72,98 @@ struct BuildParts {
   double marking_ms = 0, caster_ms = 0;    ///< the marks' and the ray caster's build times, ms
 };
 
+// A body's first part: its mesh checked, its vertices about the COR (b.relative: n x 3, mm), a given map
+// (p.given) checked against the joint's scheme. Throws impinge::Error naming the mesh.
+void prepare_body(JointBody& b, const BuildParts& p, const Eigen::Vector3d& cor, const JointOptions& options) {
+  validate_mesh(b.mesh);
+  b.relative = b.mesh.V.rowwise() - cor.transpose();
+  if (!p.given) return;
+  const SamplingScheme& want = *options.scheme;
+  const SamplingScheme& have = p.given->scheme();
+  require(want.conformable(have), b.mesh.source + ": the given map is " + have.name() + " at " +
+                                      std::to_string(have.resolution()) + ", the joint's scheme is " +
+                                      want.name() + " at " + std::to_string(want.resolution()));
+}
+
+// A body's map (sampled about the COR, with its time b.sampling_ms; or the given one, moved from p.given) and
+// its depth-discontinuity marks when exact (their time p.marking_ms, ms; else any marks cleared).
+void sample_map(JointBody& b, BuildParts& p, const Eigen::Vector3d& cor, const JointOptions& options, bool exact) {
+  if (p.given) {
+    b.map = std::move(*p.given);
+    b.sampling.nodes_covered = b.map.nodes_covered();
+  } else {
+    SamplingOptions so;
+    so.mode = options.mode;
+    so.method = options.sampling;
+    const auto t0 = std::chrono::steady_clock::now();
+    b.sampling = sample_surface(b.mesh, cor, so, b.map);
+    b.sampling_ms = ms_since(t0);
+  }
+  if (exact) {
+    const auto t0 = std::chrono::steady_clock::now();
+    b.nodes_marked = mark_depth_discontinuities(b.map, options.discontinuity_tolerance_mm);
+    p.marking_ms = ms_since(t0);
+  } else {
+    clear_depth_discontinuities(b.map);  // a given map may carry marks
+  }
+}
+
+// A body's ray caster about the COR (its hierarchy built as `tree` says): b.exact when exact (its build time
+// p.caster_ms, ms), b.caster when layers > 0.
+void build_caster(JointBody& b, BuildParts& p, const Eigen::Vector3d& cor, const JointOptions& options, bool exact,
+                  HierarchyBuild tree) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto c = std::make_shared<const FirstHitCaster>(b.mesh, cor, tree);
+  if (exact) {
+    b.exact = c;
+    p.caster_ms = ms_since(t0);
+  }
+  if (options.layers > 0) b.caster = std::move(c);
+}
+
+// A body's layered map (options.layers layers over layered_scheme), filled by its ray caster b.caster.
+void build_layered_map(JointBody& b, const JointOptions& options,
+                       const std::shared_ptr<const SamplingScheme>& layered_scheme) {
+  auto layered = std::make_shared<LayeredMap>(layered_scheme, options.layers);
+  b.layered_sampling = sample_layered_map(*layered, *b.caster);
+  b.layered = std::move(layered);
+}
+
+// With layers > 0: a body's hidden vertices (not on the first surface, within the extra-articular radius and
+// max_radius_mm of the COR) as b.hidden_set, in boxes of 32, and their clusters of 32 (b.hidden_clusters).
+void hidden_vertices(JointBody& b, const JointOptions& options) {
+  std::vector<std::uint8_t> hidden(b.mask.size(), 0);
+  for (std::size_t i = 0; i < hidden.size(); ++i) {
+    const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
+    // max_radius_mm bounds every vertex tested, the hidden ones too.
+    hidden[i] = !b.mask[i] && r > 0 && r <= std::min(options.extra_articular_radius_mm, options.max_radius_mm);
+  }
+  // In boxes of 32 (order_in_boxes), each run of the clusters below compact in space.
+  b.hidden_set = order_in_boxes(make_scan_set(b.relative, hidden), {32});
+  b.hidden_clusters = cluster_scan_set(b.hidden_set, 32);
+}
+
+// A body's first-surface mask (b.mask: n, 1 on the first surface; through the exact caster when exact) and scan
+// set, the map made sparse after the mask has read it, and with layers > 0 the hidden vertices (hidden_vertices).
+// b.marking_ms: the marks' and the caster's times together (ms).
+void mask_and_scan_sets(JointBody& b, const BuildParts& p, const JointOptions& options, bool exact) {
+  b.marking_ms = p.marking_ms + p.caster_ms;
+  b.mask = exact ? first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm, options.max_radius_mm,
+                                      *b.exact)
+                 : first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm, options.max_radius_mm);
+  if (options.sparse_maps) b.map.make_sparse(options.sparse_region_mm);
+  b.scan_set = make_scan_set(b.relative, b.mask);
+  if (options.layers == 0) return;
+  hidden_vertices(b, options);
+}
+
+// A body's vertex areas (b.vertex_area: n, mm^2) and, with distances, its distance scan set (the vertices within
+// max_radius_mm of the COR).
+void areas_and_distance_set(JointBody& b, const JointOptions& options) {
+  b.vertex_area = vertex_areas(b.mesh);
+  if (options.distances) b.distance_set = make_distance_scan_set(b.relative, options.max_radius_mm);
+}
+
 /// The parts of building both bodies (ball, socket), for run_task_graph: each body's checks, map and marks,
 /// ray caster, layered map, first-surface mask and scan sets, closest-point hierarchy, and vertex areas with
 /// distance scan set; the socket's before the ball's, the long parts first. The bodies and parts must outlive
@@ -99,69 +191,22 @@ void add_parts(const Eigen::Vector3d& cor, const JointOptions& options,
   for (int k = 0; k < 2; ++k) {
     JointBody& b = *body[k];
     BuildParts& p = *parts[k];
-    prepare[k] = add(
-        [&b, &p, &cor, &options] {
-          validate_mesh(b.mesh);
-          b.relative = b.mesh.V.rowwise() - cor.transpose();
-          if (!p.given) return;
-          const SamplingScheme& want = *options.scheme;
-          const SamplingScheme& have = p.given->scheme();
-          require(want.conformable(have), b.mesh.source + ": the given map is " + have.name() + " at " +
-                                              std::to_string(have.resolution()) + ", the joint's scheme is " +
-                                              want.name() + " at " + std::to_string(want.resolution()));
-        },
-        {}, k);
+    prepare[k] = add([&b, &p, &cor, &options] { prepare_body(b, p, cor, options); }, {}, k);
   }
   for (int k = 1; k >= 0; --k) {  // the socket's first
     JointBody& b = *body[k];
     BuildParts& p = *parts[k];
     // The map (sampled, or the given one) and its depth-discontinuity marks.
-    sample[k] = add(
-        [&b, &p, &cor, &options, exact] {
-          if (p.given) {
-            b.map = std::move(*p.given);
-            b.sampling.nodes_covered = b.map.nodes_covered();
-          } else {
-            SamplingOptions so;
-            so.mode = options.mode;
-            so.method = options.sampling;
-            const auto t0 = std::chrono::steady_clock::now();
-            b.sampling = sample_surface(b.mesh, cor, so, b.map);
-            b.sampling_ms = ms_since(t0);
-          }
-          if (exact) {
-            const auto t0 = std::chrono::steady_clock::now();
-            b.nodes_marked = mark_depth_discontinuities(b.map, options.discontinuity_tolerance_mm);
-            p.marking_ms = ms_since(t0);
-          } else {
-            clear_depth_discontinuities(b.map);  // a given map may carry marks
-          }
-        },
-        {prepare[k]}, k);
+    sample[k] = add([&b, &p, &cor, &options, exact] { sample_map(b, p, cor, options, exact); }, {prepare[k]}, k);
     // The ray caster: exact look-ups at the marks, the layered maps, the hidden vertices' casts.
     if (exact || options.layers > 0)
-      caster[k] = add(
-          [&b, &p, &cor, &options, exact, tree] {
-            const auto t0 = std::chrono::steady_clock::now();
-            auto c = std::make_shared<const FirstHitCaster>(b.mesh, cor, tree);
-            if (exact) {
-              b.exact = c;
-              p.caster_ms = ms_since(t0);
-            }
-            if (options.layers > 0) b.caster = std::move(c);
-          },
-          {prepare[k]}, k);
+      caster[k] = add([&b, &p, &cor, &options, exact, tree] { build_caster(b, p, cor, options, exact, tree); },
+                      {prepare[k]}, k);
   }
   if (options.layers > 0 && options.layered_maps)
     for (int k = 1; k >= 0; --k) {
       JointBody& b = *body[k];
-      add(
-          [&b, &options, layered_scheme] {
-            auto layered = std::make_shared<LayeredMap>(layered_scheme, options.layers);
-            b.layered_sampling = sample_layered_map(*layered, *b.caster);
-            b.layered = std::move(layered);
-          },
-          {caster[k]}, k);
+      add([&b, &options, layered_scheme] { build_layered_map(b, options, layered_scheme); }, {caster[k]}, k);
     }
   for (int k = 1; k >= 0; --k) {
     JointBody& b = *body[k];
@@ -169,26 +214,7 @@ void add_parts(const Eigen::Vector3d& cor, const JointOptions& options,
     // The first-surface mask and the scan sets (the map made sparse after the mask has read it).
     std::vector<std::size_t> after{sample[k]};
     if (caster[k] != kNone) after.push_back(caster[k]);
-    add(
-        [&b, &p, &options, exact] {
-          b.marking_ms = p.marking_ms + p.caster_ms;
-          b.mask = exact ? first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm,
-                                              options.max_radius_mm, *b.exact)
-                         : first_surface_mask(b.relative, b.map, options.occlusion_tolerance_mm, options.max_radius_mm);
-          if (options.sparse_maps) b.map.make_sparse(options.sparse_region_mm);
-          b.scan_set = make_scan_set(b.relative, b.mask);
-          if (options.layers == 0) return;
-          std::vector<std::uint8_t> hidden(b.mask.size(), 0);
-          for (std::size_t i = 0; i < hidden.size(); ++i) {
-            const double r = b.relative.row(static_cast<Eigen::Index>(i)).norm();
-            // max_radius_mm bounds every vertex tested, the hidden ones too.
-            hidden[i] = !b.mask[i] && r > 0 && r <= std::min(options.extra_articular_radius_mm, options.max_radius_mm);
-          }
-          // In boxes of 32 (order_in_boxes), each run of the clusters below compact in space.
-          b.hidden_set = order_in_boxes(make_scan_set(b.relative, hidden), {32});
-          b.hidden_clusters = cluster_scan_set(b.hidden_set, 32);
-        },
-        std::move(after), k);
+    add([&b, &p, &options, exact] { mask_and_scan_sets(b, p, options, exact); }, std::move(after), k);
   }
   // The closest-point hierarchy needs the mesh alone (a one-pose joint builds it later, cropped:
   // crop_distance_queries).
@@ -199,12 +225,7 @@ void add_parts(const Eigen::Vector3d& cor, const JointOptions& options,
     }
   for (int k = 1; k >= 0; --k) {
     JointBody& b = *body[k];
-    add(
-        [&b, &options] {
-          b.vertex_area = vertex_areas(b.mesh);
-          if (options.distances) b.distance_set = make_distance_scan_set(b.relative, options.max_radius_mm);
-        },
-        {prepare[k]}, k);
+    add([&b, &options] { areas_and_distance_set(b, options); }, {prepare[k]}, k);
   }
 }
 }  // namespace
