@@ -105,6 +105,161 @@ bool inside_empty(const Eigen::Vector3d& q, double radius_mm, const Eigen::Vecto
   const double margin = kFloatMarginMm + 0x1p-20 * (c.cwiseAbs().maxCoeff() + static_cast<double>(empty));
   return (q - c).norm() + radius_mm < static_cast<double>(empty) - margin;
 }
+
+// Forgets what `memory` knew when it is about another surface (query: that surface's id) or sized for another set
+// (k_all vertices, c_all clusters): no seeds, empty balls, nearby triangles or last centres (NaN) any more.
+void fit_memory(DistanceScanMemory& memory, std::uint64_t query, std::size_t k_all, std::size_t c_all) {
+  if (memory.query != query || memory.seed.size() != k_all || memory.empty_radius.size() != k_all ||
+      memory.empty_centre.size() != k_all || memory.cluster_empty_radius.size() != c_all ||
+      memory.cluster_empty_centre.size() != c_all || memory.nearby_slot.size() != k_all ||
+      memory.cluster_last_centre.size() != c_all) {
+    memory.query = query;
+    memory.seed.assign(k_all, -1);
+    memory.empty_centre.assign(k_all, Eigen::Vector3f::Zero());
+    memory.empty_radius.assign(k_all, 0.f);
+    memory.cluster_empty_centre.assign(c_all, Eigen::Vector3f::Zero());
+    memory.cluster_empty_radius.assign(c_all, 0.f);
+    memory.nearby_slot.assign(k_all, -1);
+    memory.nearby.clear();
+    memory.cluster_last_centre.assign(c_all, Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
+  }
+}
+
+// What the steps of one scan_distances call share: the set, its pose (q = R p + shift, mm, shift = cor + t),
+// the other surface, the reach (mm), the radial gaps (n, mm; or empty), the distances written (n, mm), the memory
+// (or null), the counts and the closest point's scratch.
+struct DistanceScan {
+  const DistanceScanSet& set;
+  const Eigen::Matrix3d& R;
+  const Eigen::Vector3d& shift;
+  const SignedDistanceQuery& other;
+  double reach_mm;
+  const std::vector<float>& gap_mm;
+  std::vector<float>& distance_mm;
+  DistanceScanMemory* memory;
+  DistanceScanStats& st;
+  ClosestSurfacePoint& cp;
+};
+
+// The most negative radial gap (mm) of the set's vertices [b, e) below -reach, or 0 when none is (or no gaps).
+double deepest_gap(const DistanceScan& s, std::size_t b, std::size_t e) {
+  double deepest = 0;  // the most negative gap of the cluster below -reach
+  if (!s.gap_mm.empty())
+    for (std::size_t k = b; k < e; ++k) {
+      const float g = s.gap_mm[static_cast<std::size_t>(s.set.index[k])];
+      if (g < -s.reach_mm) deepest = std::min(deepest, static_cast<double>(g));
+    }
+  return deepest;
+}
+
+// How far cluster cs's posed centre (mm) moved since the last scan (NaN at the first, or without memory); the
+// memory keeps the new centre (float).
+double cluster_moved(const DistanceScan& s, std::size_t cs, const Eigen::Vector3d& centre) {
+  double moved = std::numeric_limits<double>::quiet_NaN();
+  if (s.memory != nullptr) {
+    const Eigen::Vector3f now = centre.cast<float>();
+    moved = static_cast<double>((now - s.memory->cluster_last_centre[cs]).norm());
+    s.memory->cluster_last_centre[cs] = now;
+  }
+  return moved;
+}
+
+// Whether no point of the other surface lies within `grown` (mm: the cluster's ball grown by the reach) of
+// cluster cs's posed centre (mm): recalled from the memory's empty ball (counted in st.clusters_recalled), or
+// tested; when learn_cluster, tested first with kClusterEmptySlackMm more, an empty ball then remembered.
+bool cluster_beyond_reach(DistanceScan& s, std::size_t cs, const Eigen::Vector3d& centre, double grown,
+                          bool learn_cluster) {
+  DistanceScanMemory* memory = s.memory;
+  bool apart = false;
+  if (memory == nullptr) {
+    apart = !s.other.any_within(centre, grown);
+  } else if (inside_empty(centre, grown, memory->cluster_empty_centre[cs], memory->cluster_empty_radius[cs])) {
+    apart = true;
+    ++s.st.clusters_recalled;
+  } else if (!learn_cluster) {
+    apart = !s.other.any_within(centre, grown);
+  } else if (!s.other.any_within(centre, grown + kClusterEmptySlackMm)) {
+    apart = true;  // nothing within the grown ball and the slack: remember that ball
+    memory->cluster_empty_centre[cs] = centre.cast<float>();
+    memory->cluster_empty_radius[cs] = static_cast<float>(grown + kClusterEmptySlackMm);
+  } else {
+    apart = !s.other.any_within(centre, grown);
+  }
+  return apart;
+}
+
+// The first search's radius (mm) of a vertex whose radial gap is g (mm; NaN: none): the reach, or the gap's
+// bound (|g| plus kBoundMarginMm, at most the reach; beyond it below -reach).
+double search_radius(double g, double reach_mm) {
+  double radius = reach_mm;
+  if (std::isfinite(g))
+    radius = g < -reach_mm ? -g + kBoundMarginMm : std::min(reach_mm, std::abs(g) + kBoundMarginMm);
+  return radius;
+}
+
+// Vertex k's nearby triangles in the memory (a slot given at its first search) when it learns; else null.
+NearbyTriangles* nearby_of(DistanceScanMemory* memory, std::size_t k, bool learn_vertices) {
+  if (memory == nullptr || !learn_vertices) return nullptr;
+  if (memory->nearby_slot[k] < 0) {
+    memory->nearby_slot[k] = static_cast<std::int32_t>(memory->nearby.size());
+    memory->nearby.emplace_back();
+  }
+  return &memory->nearby[static_cast<std::size_t>(memory->nearby_slot[k])];
+}
+
+// The search of vertex k posed at q (mm), its gap g (mm; NaN: none) and first radius (mm), sign hint, seed
+// triangle `start` and nearby triangles: whether s.cp found a point of the other surface within the reach.
+bool search_vertex(DistanceScan& s, std::size_t k, const Eigen::Vector3d& q, double g, double radius, int hint,
+                   std::int64_t start, NearbyTriangles* nearby, bool learn_vertices) {
+  const double reach_mm = s.reach_mm;
+  bool found = false;
+  if (s.memory != nullptr && learn_vertices && radius == reach_mm && !(g < reach_mm)) {
+    // Likely beyond the reach (a gap beyond it, or none): whether the surface comes within the reach
+    // plus the slack (if not, that ball is remembered empty), and only then the search within the reach.
+    if (!s.other.any_within(q, reach_mm + kEmptySlackMm)) {
+      s.memory->empty_centre[k] = q.cast<float>();
+      s.memory->empty_radius[k] = static_cast<float>(reach_mm + kEmptySlackMm);
+    } else {
+      found = s.other.signed_distance(q, reach_mm, hint, s.cp, start, nearby);
+    }
+  } else {
+    found = s.other.signed_distance(q, radius, hint, s.cp, start, nearby);
+    if (!found && radius < reach_mm) found = s.other.signed_distance(q, reach_mm, hint, s.cp, start, nearby);
+  }
+  return found;
+}
+
+// The set's vertices [b, e) (one cluster not pruned): each one's signed distance (s.distance_mm at its index, mm)
+// when a search finds the surface within the reach; NaN left where the memory's empty ball or the search proves
+// it beyond. Each search starts from the vertex's remembered seed, else the previous vertex's closest triangle.
+void measure_cluster(DistanceScan& s, std::size_t b, std::size_t e, bool learn_vertices) {
+  const double reach_mm = s.reach_mm;
+  DistanceScanMemory* memory = s.memory;
+  std::int64_t seed = -1;  // the previous vertex's closest triangle: neighbours share them
+  for (std::size_t k = b; k < e; ++k) {
+    const auto i = static_cast<std::size_t>(s.set.index[k]);
+    const Eigen::Vector3d q = s.R * s.set.position[k] + s.shift;
+    const double g = s.gap_mm.empty() ? std::numeric_limits<double>::quiet_NaN() : s.gap_mm[i];
+    const int hint = g > kHintMm ? 1 : (g < -kHintMm ? -1 : 0);
+    const double radius = search_radius(g, reach_mm);
+    if (memory != nullptr && radius <= reach_mm &&
+        inside_empty(q, reach_mm, memory->empty_centre[k], memory->empty_radius[k])) {
+      ++s.st.vertices_recalled;  // no point of the surface within the reach: NaN, as a search would find
+      continue;
+    }
+    const std::int64_t start = memory != nullptr && memory->seed[k] >= 0 ? memory->seed[k] : seed;
+    NearbyTriangles* nearby = nearby_of(memory, k, learn_vertices);
+    ++s.st.searches;
+    if (!search_vertex(s, k, q, g, radius, hint, start, nearby, learn_vertices)) continue;
+    seed = s.cp.triangle;
+    if (memory != nullptr)
+      memory->seed[k] =
+          s.cp.triangle <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(s.cp.triangle) : -1;
+    s.distance_mm[i] = static_cast<float>(s.cp.signed_mm());
+    ++s.st.measured;
+    s.st.winding += s.cp.rule == SignRule::winding_number;
+  }
+}
 }  // namespace
 
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
@@ -118,114 +273,27 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
   DistanceScanStats st;
   distance_mm.assign(static_cast<std::size_t>(set.vertices), std::numeric_limits<float>::quiet_NaN());
   const std::size_t k_all = set.index.size(), c_all = static_cast<std::size_t>(set.clusters());
-  if (memory != nullptr &&
-      (memory->query != other.id() || memory->seed.size() != k_all || memory->empty_radius.size() != k_all ||
-       memory->empty_centre.size() != k_all || memory->cluster_empty_radius.size() != c_all ||
-       memory->cluster_empty_centre.size() != c_all || memory->nearby_slot.size() != k_all ||
-       memory->cluster_last_centre.size() != c_all)) {
-    memory->query = other.id();
-    memory->seed.assign(k_all, -1);
-    memory->empty_centre.assign(k_all, Eigen::Vector3f::Zero());
-    memory->empty_radius.assign(k_all, 0.f);
-    memory->cluster_empty_centre.assign(c_all, Eigen::Vector3f::Zero());
-    memory->cluster_empty_radius.assign(c_all, 0.f);
-    memory->nearby_slot.assign(k_all, -1);
-    memory->nearby.clear();
-    memory->cluster_last_centre.assign(c_all, Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
-  }
+  if (memory != nullptr) fit_memory(*memory, other.id(), k_all, c_all);
   const Eigen::Vector3d shift = cor + t;
   ClosestSurfacePoint cp;
+  DistanceScan s{set, R, shift, other, reach_mm, gap_mm, distance_mm, memory, st, cp};
   for (std::int64_t c = 0; c < set.clusters(); ++c) {
     const auto cs = static_cast<std::size_t>(c);
     const auto b = static_cast<std::size_t>(set.cluster_begin[cs]);
     const auto e = static_cast<std::size_t>(set.cluster_begin[cs + 1]);
-    double deepest = 0;  // the most negative gap of the cluster below -reach
-    if (!gap_mm.empty())
-      for (std::size_t k = b; k < e; ++k) {
-        const float g = gap_mm[static_cast<std::size_t>(set.index[k])];
-        if (g < -reach_mm) deepest = std::min(deepest, static_cast<double>(g));
-      }
+    const double deepest = deepest_gap(s, b, e);
     const Eigen::Vector3d centre = R * set.centre[cs] + shift;
     // How far the cluster moved since the last scan (NaN at the first): the memory's new facts (empty balls
     // 2 and 4 mm beyond the reach, nearby triangles 2 mm beyond a search) pay back only where the next scan
     // comes within those margins; after a jump they cost extra walks for nothing (a motion of scattered poses).
-    double moved = std::numeric_limits<double>::quiet_NaN();
-    if (memory != nullptr) {
-      const Eigen::Vector3f now = centre.cast<float>();
-      moved = static_cast<double>((now - memory->cluster_last_centre[cs]).norm());
-      memory->cluster_last_centre[cs] = now;
-    }
+    const double moved = cluster_moved(s, cs, centre);
     const bool learn_cluster = moved <= kClusterEmptySlackMm, learn_vertices = moved <= kEmptySlackMm;
-    if (deepest == 0) {
-      // No point of the surface within the cluster's ball grown by the reach: every vertex is beyond it.
-      const double grown = set.radius[cs] + reach_mm;
-      bool apart = false;
-      if (memory == nullptr) {
-        apart = !other.any_within(centre, grown);
-      } else if (inside_empty(centre, grown, memory->cluster_empty_centre[cs], memory->cluster_empty_radius[cs])) {
-        apart = true;
-        ++st.clusters_recalled;
-      } else if (!learn_cluster) {
-        apart = !other.any_within(centre, grown);
-      } else if (!other.any_within(centre, grown + kClusterEmptySlackMm)) {
-        apart = true;  // nothing within the grown ball and the slack: remember that ball
-        memory->cluster_empty_centre[cs] = centre.cast<float>();
-        memory->cluster_empty_radius[cs] = static_cast<float>(grown + kClusterEmptySlackMm);
-      } else {
-        apart = !other.any_within(centre, grown);
-      }
-      if (apart) {
-        ++st.clusters_pruned;
-        continue;
-      }
+    // No point of the surface within the cluster's ball grown by the reach: every vertex is beyond it.
+    if (deepest == 0 && cluster_beyond_reach(s, cs, centre, set.radius[cs] + reach_mm, learn_cluster)) {
+      ++st.clusters_pruned;
+      continue;
     }
-    std::int64_t seed = -1;  // the previous vertex's closest triangle: neighbours share them
-    for (std::size_t k = b; k < e; ++k) {
-      const auto i = static_cast<std::size_t>(set.index[k]);
-      const Eigen::Vector3d q = R * set.position[k] + shift;
-      const double g = gap_mm.empty() ? std::numeric_limits<double>::quiet_NaN() : gap_mm[i];
-      const int hint = g > kHintMm ? 1 : (g < -kHintMm ? -1 : 0);
-      double radius = reach_mm;
-      if (std::isfinite(g))
-        radius = g < -reach_mm ? -g + kBoundMarginMm : std::min(reach_mm, std::abs(g) + kBoundMarginMm);
-      if (memory != nullptr && radius <= reach_mm &&
-          inside_empty(q, reach_mm, memory->empty_centre[k], memory->empty_radius[k])) {
-        ++st.vertices_recalled;  // no point of the surface within the reach: NaN, as a search would find
-        continue;
-      }
-      const std::int64_t start = memory != nullptr && memory->seed[k] >= 0 ? memory->seed[k] : seed;
-      NearbyTriangles* nearby = nullptr;
-      if (memory != nullptr && learn_vertices) {
-        if (memory->nearby_slot[k] < 0) {
-          memory->nearby_slot[k] = static_cast<std::int32_t>(memory->nearby.size());
-          memory->nearby.emplace_back();
-        }
-        nearby = &memory->nearby[static_cast<std::size_t>(memory->nearby_slot[k])];
-      }
-      ++st.searches;
-      bool found = false;
-      if (memory != nullptr && learn_vertices && radius == reach_mm && !(g < reach_mm)) {
-        // Likely beyond the reach (a gap beyond it, or none): whether the surface comes within the reach
-        // plus the slack (if not, that ball is remembered empty), and only then the search within the reach.
-        if (!other.any_within(q, reach_mm + kEmptySlackMm)) {
-          memory->empty_centre[k] = q.cast<float>();
-          memory->empty_radius[k] = static_cast<float>(reach_mm + kEmptySlackMm);
-        } else {
-          found = other.signed_distance(q, reach_mm, hint, cp, start, nearby);
-        }
-      } else {
-        found = other.signed_distance(q, radius, hint, cp, start, nearby);
-        if (!found && radius < reach_mm) found = other.signed_distance(q, reach_mm, hint, cp, start, nearby);
-      }
-      if (!found) continue;
-      seed = cp.triangle;
-      if (memory != nullptr)
-        memory->seed[k] =
-            cp.triangle <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(cp.triangle) : -1;
-      distance_mm[i] = static_cast<float>(cp.signed_mm());
-      ++st.measured;
-      st.winding += cp.rule == SignRule::winding_number;
-    }
+    measure_cluster(s, b, e, learn_vertices);
   }
   return st;
 }
