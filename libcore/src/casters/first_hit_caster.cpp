@@ -29,6 +29,88 @@ bool FirstHitCaster::available() { return have_embree() || have_exact_reference(
 
 const Eigen::Vector3d& FirstHitCaster::origin() const { return impl_->origin; }
 
+namespace {
+// Welds the vertices of `mesh` (V: n x 3, mm) that coincide to 1e-6 mm: each face corner (F) goes to the first
+// vertex (lowest index) of its 1e-6 mm cell. The cells sit in an open-addressing table (twice as many slots as
+// vertices, linear probing), filled in index order, so that a cell's slot holds its first vertex (a sort by
+// (cell, index) gave the same map at some 4x the time: issue 52). V is left as it is.
+void weld_coincident_vertices(TriangleMesh& mesh) {
+  const auto n = static_cast<std::size_t>(mesh.V.rows());
+  std::vector<std::array<std::int64_t, 3>> cell(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    cell[i] = {std::llround(mesh.V(r, 0) * 1e6), std::llround(mesh.V(r, 1) * 1e6), std::llround(mesh.V(r, 2) * 1e6)};
+  }
+  std::size_t slots = 16;
+  while (slots < 2 * n) slots *= 2;
+  std::vector<std::int32_t> slot(slots, -1);  // a vertex index, or -1: empty
+  std::vector<int> to(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& c = cell[i];
+    std::uint64_t h = static_cast<std::uint64_t>(c[0]) * 0x9E3779B97F4A7C15ull;
+    h = (h ^ (h >> 29) ^ static_cast<std::uint64_t>(c[1])) * 0xBF58476D1CE4E5B9ull;
+    h = (h ^ (h >> 31) ^ static_cast<std::uint64_t>(c[2])) * 0x94D049BB133111EBull;
+    h ^= h >> 32;
+    for (std::size_t k = h & (slots - 1);; k = (k + 1) & (slots - 1)) {
+      if (slot[k] < 0) {
+        slot[k] = static_cast<std::int32_t>(i);
+        to[i] = static_cast<int>(i);
+        break;
+      }
+      if (cell[static_cast<std::size_t>(slot[k])] == c) {
+        to[i] = slot[k];
+        break;
+      }
+    }
+  }
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) mesh.F(f, k) = to[static_cast<std::size_t>(mesh.F(f, k))];
+}
+
+// Drops from mesh.F the triangles edge-on to `origin` (mm: their plane through it, within 1e-6 of their corners'
+// largest distance from it), each kept in edge_on (columns: its corners relative to the origin, mm). Returns how
+// many were dropped.
+Eigen::Index drop_edge_on_triangles(TriangleMesh& mesh, const Eigen::Vector3d& origin,
+                                    std::vector<Eigen::Matrix3d>& edge_on) {
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose() - origin,
+                          b = mesh.V.row(mesh.F(f, 1)).transpose() - origin,
+                          c = mesh.V.row(mesh.F(f, 2)).transpose() - origin;
+    const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+    const double scale = std::max({a.norm(), b.norm(), c.norm()});
+    if (std::abs(n.dot(a)) > 1e-6 * scale)
+      keep.push_back(f);
+    else {
+      Eigen::Matrix3d T;
+      T << a, b, c;
+      edge_on.push_back(T);
+    }
+  }
+  const Eigen::Index dropped = mesh.F.rows() - static_cast<Eigen::Index>(keep.size());
+  Faces F(static_cast<Eigen::Index>(keep.size()), 3);
+  for (std::size_t k = 0; k < keep.size(); ++k) F.row(static_cast<Eigen::Index>(k)) = mesh.F.row(keep[k]);
+  mesh.F = std::move(F);
+  return dropped;
+}
+
+// The orientation of `mesh`'s triangles about `origin` (mm): 1 when their signed volume is >= 0, else -1; normals
+// gets each triangle's unit normal (float, in F's order).
+int orientation_and_normals(const TriangleMesh& mesh, const Eigen::Vector3d& origin,
+                            std::vector<Eigen::Vector3f>& normals) {
+  double volume = 0;
+  normals.reserve(static_cast<std::size_t>(mesh.F.rows()));
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose() - origin,
+                          b = mesh.V.row(mesh.F(f, 1)).transpose() - origin,
+                          c = mesh.V.row(mesh.F(f, 2)).transpose() - origin;
+    volume += a.dot(b.cross(c)) / 6;
+    normals.push_back((b - a).cross(c - a).normalized().cast<float>());
+  }
+  return volume >= 0 ? 1 : -1;
+}
+}  // namespace
+
 FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& origin, HierarchyBuild build)
     : impl_(std::make_unique<Impl>()) {
   require(available(), "first-hit ray caster: this build has neither Embree nor CGAL (" + mesh.source + ")");
@@ -43,78 +125,12 @@ FirstHitCaster::FirstHitCaster(const TriangleMesh& mesh, const Eigen::Vector3d& 
   // Vertices that coincide to 1e-6 mm but are distinct (the seam of a generated surface, a crack
   // of a segmentation) are welded: Embree's watertightness holds for identical corners only, and a
   // ray along such a seam would otherwise slip through it.
-  {
-    // Each vertex goes to the first vertex (lowest index) of its 1e-6 mm cell: the cells in an open-addressing
-    // table (twice as many slots as vertices, linear probing), filled in index order, so that a cell's slot holds
-    // its first vertex (a sort by (cell, index) gave the same map at some 4x the time: issue 52).
-    const auto n = static_cast<std::size_t>(clean.V.rows());
-    std::vector<std::array<std::int64_t, 3>> cell(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto r = static_cast<Eigen::Index>(i);
-      cell[i] = {std::llround(clean.V(r, 0) * 1e6), std::llround(clean.V(r, 1) * 1e6),
-                 std::llround(clean.V(r, 2) * 1e6)};
-    }
-    std::size_t slots = 16;
-    while (slots < 2 * n) slots *= 2;
-    std::vector<std::int32_t> slot(slots, -1);  // a vertex index, or -1: empty
-    std::vector<int> to(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& c = cell[i];
-      std::uint64_t h = static_cast<std::uint64_t>(c[0]) * 0x9E3779B97F4A7C15ull;
-      h = (h ^ (h >> 29) ^ static_cast<std::uint64_t>(c[1])) * 0xBF58476D1CE4E5B9ull;
-      h = (h ^ (h >> 31) ^ static_cast<std::uint64_t>(c[2])) * 0x94D049BB133111EBull;
-      h ^= h >> 32;
-      for (std::size_t k = h & (slots - 1);; k = (k + 1) & (slots - 1)) {
-        if (slot[k] < 0) {
-          slot[k] = static_cast<std::int32_t>(i);
-          to[i] = static_cast<int>(i);
-          break;
-        }
-        if (cell[static_cast<std::size_t>(slot[k])] == c) {
-          to[i] = slot[k];
-          break;
-        }
-      }
-    }
-    for (Eigen::Index f = 0; f < clean.F.rows(); ++f)
-      for (int k = 0; k < 3; ++k) clean.F(f, k) = to[static_cast<std::size_t>(clean.F(f, k))];
-  }
+  weld_coincident_vertices(clean);
   remove_degenerate_faces(clean);
-  {
-    std::vector<Eigen::Index> keep;
-    for (Eigen::Index f = 0; f < clean.F.rows(); ++f) {
-      const Eigen::Vector3d a = clean.V.row(clean.F(f, 0)).transpose() - origin,
-                            b = clean.V.row(clean.F(f, 1)).transpose() - origin,
-                            c = clean.V.row(clean.F(f, 2)).transpose() - origin;
-      const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
-      const double scale = std::max({a.norm(), b.norm(), c.norm()});
-      if (std::abs(n.dot(a)) > 1e-6 * scale)
-        keep.push_back(f);
-      else {
-        Eigen::Matrix3d T;
-        T << a, b, c;
-        impl_->edge_on.push_back(T);
-      }
-    }
-    edge_on_ = clean.F.rows() - static_cast<Eigen::Index>(keep.size());
-    Faces F(static_cast<Eigen::Index>(keep.size()), 3);
-    for (std::size_t k = 0; k < keep.size(); ++k) F.row(static_cast<Eigen::Index>(k)) = clean.F.row(keep[k]);
-    clean.F = std::move(F);
-  }
-  {
-    // Orientation by the signed volume of the triangles kept (a closed mesh's edge-on triangles
-    // add no volume about the origin, which lies in their plane).
-    double volume = 0;
-    impl_->normals.reserve(static_cast<std::size_t>(clean.F.rows()));
-    for (Eigen::Index f = 0; f < clean.F.rows(); ++f) {
-      const Eigen::Vector3d a = clean.V.row(clean.F(f, 0)).transpose() - origin,
-                            b = clean.V.row(clean.F(f, 1)).transpose() - origin,
-                            c = clean.V.row(clean.F(f, 2)).transpose() - origin;
-      volume += a.dot(b.cross(c)) / 6;
-      impl_->normals.push_back((b - a).cross(c - a).normalized().cast<float>());
-    }
-    orientation_ = volume >= 0 ? 1 : -1;
-  }
+  edge_on_ = drop_edge_on_triangles(clean, origin, impl_->edge_on);
+  // Orientation by the signed volume of the triangles kept (a closed mesh's edge-on triangles
+  // add no volume about the origin, which lies in their plane).
+  orientation_ = orientation_and_normals(clean, origin, impl_->normals);
   if (have_embree()) {
     impl_->embree.emplace(clean, origin, /*robust=*/true, build);
   } else {
