@@ -80,59 +80,35 @@ TriangleMesh checked(TriangleMesh mesh, const std::string& path) {
   require(mesh.F.rows() > 0, path + ": every triangle is degenerate (zero area)");
   return mesh;
 }
-}  // namespace
 
-TriangleMesh load_mesh(const std::string& path) {
+// A PLY, OFF or OBJ file (ext: its lower-case extension) through our readers, in the file's vertex order: read
+// whole from `in` (open, binary) in one read into a string of its size (no stream buffer copied twice), then
+// checked. Throws impinge::Error naming path when its size cannot be read or it changed while read.
+TriangleMesh read_with_own_reader(const std::string& path, const std::string& ext, std::ifstream& in) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  require(fs::exists(path, ec), path + ": file does not exist");
-  require(fs::is_regular_file(path, ec), path + ": not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  require(in.good(), path + ": cannot open file for reading");
-  const std::string ext = lower_extension(path);
-  if (ext == ".ply" || ext == ".off" || ext == ".obj") {  // our readers: the file's vertex order
-    // The whole file in one read into a string of its size (no stream buffer copied twice).
-    const std::uintmax_t size = fs::file_size(path, ec);
-    require(!ec && size < std::uintmax_t(std::numeric_limits<std::streamsize>::max()),
-            [&] { return path + ": cannot read the file's size (" + ec.message() + ")"; });
-    std::string b(static_cast<std::size_t>(size), '\0');
-    in.read(b.data(), static_cast<std::streamsize>(size));
-    require(in.gcount() == static_cast<std::streamsize>(size) && in.peek() == std::char_traits<char>::eof(),
-            [&] { return path + ": the file changed while it was read (" + std::to_string(size) + " bytes expected)"; });
-    return checked(ext == ".ply" ? detail::read_ply(path, b) : ext == ".off" ? detail::read_off(path, b)
-                                                                             : detail::read_obj(path, b),
-                   path);
-  }
-  in.close();  // assimp opens the file itself
-  const AssimpC& ai = assimp_c();
-  require(ai.error.empty(),
-          [&] { return path + ": reading " + ext + " files needs assimp, which cannot be loaded (" + ai.error + ")"; });
-  unsigned flags = 0;
-  const std::unique_ptr<aiPropertyStore, decltype(ai.release_properties)> props(ai.create_properties(),
-                                                                               ai.release_properties);
-  if (ext == ".stl") {
-    // Weld corners by position only: drop the per-face normals and texture coordinates that
-    // would otherwise keep identical positions apart.
-    ai.set_integer(props.get(), AI_CONFIG_PP_RVC_FLAGS,
-                   aiComponent_NORMALS | aiComponent_TEXCOORDS | aiComponent_COLORS |
-                       aiComponent_TANGENTS_AND_BITANGENTS);
-    flags |= aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices;
-  }
-  // One import at a time: the C interface keeps the last error in one string for the process (the two bones
-  // are read on two threads).
-  static std::mutex one_import;
-  std::unique_lock<std::mutex> lock(one_import);
-  const std::unique_ptr<const aiScene, decltype(ai.release_import)> owned(
-      ai.import_file(path.c_str(), flags, nullptr, props.get()), ai.release_import);
-  const aiScene* scene = owned.get();
-  if (scene == nullptr) throw Error(path + ": cannot parse mesh: " + ai.error_string());
-  lock.unlock();
-  require(scene->mNumMeshes > 0, path + ": file holds no mesh");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  require(!ec && size < std::uintmax_t(std::numeric_limits<std::streamsize>::max()),
+          [&] { return path + ": cannot read the file's size (" + ec.message() + ")"; });
+  std::string b(static_cast<std::size_t>(size), '\0');
+  in.read(b.data(), static_cast<std::streamsize>(size));
+  require(in.gcount() == static_cast<std::streamsize>(size) && in.peek() == std::char_traits<char>::eof(),
+          [&] { return path + ": the file changed while it was read (" + std::to_string(size) + " bytes expected)"; });
+  return checked(ext == ".ply" ? detail::read_ply(path, b) : ext == ".off" ? detail::read_off(path, b)
+                                                                           : detail::read_obj(path, b),
+                 path);
+}
+
+// The meshes of an assimp scene read from `path` as one mesh: V (n x 3, the file's units: mm) and F (the
+// triangles, their indices past the meshes before), unchecked. Throws impinge::Error naming path when the scene
+// holds no mesh, no vertex or no face, or a face is not a triangle or indexes outside its mesh.
+TriangleMesh mesh_of_scene(const aiScene& scene, const std::string& path) {
+  require(scene.mNumMeshes > 0, path + ": file holds no mesh");
 
   std::size_t nv = 0, nf = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    nv += scene->mMeshes[m]->mNumVertices;
-    nf += scene->mMeshes[m]->mNumFaces;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    nv += scene.mMeshes[m]->mNumVertices;
+    nf += scene.mMeshes[m]->mNumFaces;
   }
   require(nv > 0, path + ": mesh has no vertices");
   require(nf > 0, path + ": mesh has no triangles");
@@ -141,8 +117,8 @@ TriangleMesh load_mesh(const std::string& path) {
   mesh.V.resize(static_cast<Eigen::Index>(nv), 3);
   mesh.F.resize(static_cast<Eigen::Index>(nf), 3);
   Eigen::Index vo = 0, fo = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* am = scene->mMeshes[m];
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* am = scene.mMeshes[m];
     for (unsigned i = 0; i < am->mNumVertices; ++i) {
       mesh.V(vo + i, 0) = am->mVertices[i].x;
       mesh.V(vo + i, 1) = am->mVertices[i].y;
@@ -169,7 +145,44 @@ TriangleMesh load_mesh(const std::string& path) {
     vo += am->mNumVertices;
     fo += am->mNumFaces;
   }
-  return checked(std::move(mesh), path);
+  return mesh;
+}
+}  // namespace
+
+TriangleMesh load_mesh(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  require(fs::exists(path, ec), path + ": file does not exist");
+  require(fs::is_regular_file(path, ec), path + ": not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  require(in.good(), path + ": cannot open file for reading");
+  const std::string ext = lower_extension(path);
+  if (ext == ".ply" || ext == ".off" || ext == ".obj") return read_with_own_reader(path, ext, in);
+  in.close();  // assimp opens the file itself
+  const AssimpC& ai = assimp_c();
+  require(ai.error.empty(),
+          [&] { return path + ": reading " + ext + " files needs assimp, which cannot be loaded (" + ai.error + ")"; });
+  unsigned flags = 0;
+  const std::unique_ptr<aiPropertyStore, decltype(ai.release_properties)> props(ai.create_properties(),
+                                                                               ai.release_properties);
+  if (ext == ".stl") {
+    // Weld corners by position only: drop the per-face normals and texture coordinates that
+    // would otherwise keep identical positions apart.
+    ai.set_integer(props.get(), AI_CONFIG_PP_RVC_FLAGS,
+                   aiComponent_NORMALS | aiComponent_TEXCOORDS | aiComponent_COLORS |
+                       aiComponent_TANGENTS_AND_BITANGENTS);
+    flags |= aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices;
+  }
+  // One import at a time: the C interface keeps the last error in one string for the process (the two bones
+  // are read on two threads).
+  static std::mutex one_import;
+  std::unique_lock<std::mutex> lock(one_import);
+  const std::unique_ptr<const aiScene, decltype(ai.release_import)> owned(
+      ai.import_file(path.c_str(), flags, nullptr, props.get()), ai.release_import);
+  const aiScene* scene = owned.get();
+  if (scene == nullptr) throw Error(path + ": cannot parse mesh: " + ai.error_string());
+  lock.unlock();
+  return checked(mesh_of_scene(*scene, path), path);
 }
 
 namespace {
