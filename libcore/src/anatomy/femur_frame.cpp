@@ -138,6 +138,59 @@ std::vector<Eigen::Index> distal_slab(const Vertices& V, const Eigen::Vector3d& 
   return slab;
 }
 
+// v without its component along the unit long axis L.
+Eigen::Vector3d perp(Eigen::Vector3d v, const Eigen::Vector3d& L) { return Eigen::Vector3d(v - v.dot(L) * L); }
+
+// p: the vertex of `set` farthest along dir (the first of equals).
+void extreme(const Vertices& V, const Eigen::Vector3d& dir, const std::vector<Eigen::Index>& set, Eigen::Vector3d& p) {
+  double best = -std::numeric_limits<double>::infinity();
+  for (Eigen::Index i : set) {
+    const double s = V.row(i).dot(dir);
+    if (s > best) best = s, p = V.row(i).transpose();
+  }
+}
+
+// The epicondyles (mm): the slab's extremes along e (medial) and -e (lateral), e turned to their direction across
+// the long axis L until it settles (at most 20 rounds). e: the start in, the last direction out.
+void find_epicondyles(const Vertices& V, const Eigen::Vector3d& L, const std::vector<Eigen::Index>& slab,
+                      const std::string& ctx, Eigen::Vector3d& e, Eigen::Vector3d& med, Eigen::Vector3d& lat) {
+  for (int it = 0; it < 20; ++it) {
+    extreme(V, e, slab, med);
+    extreme(V, -e, slab, lat);
+    Eigen::Vector3d e2 = perp(med - lat, L);
+    require(e2.norm() > 1e-6, ctx + ": the epicondyles coincide");
+    e2.normalize();
+    if ((e2 - e).norm() < 1e-12) break;
+    e = e2;
+  }
+}
+
+// Posterior condyles (mm): split the slab at the midpoint of the epicondyles (med, lat; e the medial direction);
+// posterior = -(anterior), anterior = L x (lateral direction) for a right femur (x = y x z with z = lateral),
+// mirrored for the left; each half's extreme along posterior, posterior turned normal to L and the condylar axis
+// until it settles (at most 20 rounds).
+void find_posterior_condyles(const Vertices& V, const Eigen::Vector3d& L, const std::vector<Eigen::Index>& slab,
+                             const Eigen::Vector3d& e, const Eigen::Vector3d& med, const Eigen::Vector3d& lat,
+                             Side side, const std::string& ctx, Eigen::Vector3d& pm, Eigen::Vector3d& pl) {
+  const Eigen::Vector3d lateral_dir = -e;
+  const Eigen::Vector3d right_dir = side == Side::right ? lateral_dir : Eigen::Vector3d(-lateral_dir);
+  Eigen::Vector3d post = -L.cross(right_dir).normalized();
+  const double split = 0.5 * (med + lat).dot(e);
+  std::vector<Eigen::Index> med_half, lat_half;
+  for (Eigen::Index i : slab) (V.row(i).dot(e) > split ? med_half : lat_half).push_back(i);
+  require(!med_half.empty() && !lat_half.empty(), ctx + ": a condyle is missing from the distal slab");
+  for (int it = 0; it < 20; ++it) {
+    extreme(V, post, med_half, pm);
+    extreme(V, post, lat_half, pl);
+    Eigen::Vector3d axis = perp(pm - pl, L);
+    require(axis.norm() > 1e-6, ctx + ": the posterior condyles coincide");
+    Eigen::Vector3d post2 = L.cross(axis).normalized();
+    if (post2.dot(post) < 0) post2 = -post2;
+    if ((post2 - post).norm() < 1e-12) break;
+    post = post2;
+  }
+}
+
 }  // namespace
 
 FemurLandmarks find_femur_landmarks(const TriangleMesh& femur, const Eigen::Vector3d& head_centre, Side side,
@@ -159,64 +212,30 @@ FemurLandmarks find_femur_landmarks(const TriangleMesh& femur, const Eigen::Vect
     require(slab.size() >= 50,
             ctx + ": the femur is too short or too coarse along its long axis for a distal slab (a whole femur "
                   "is needed; give the landmarks in subject.json)");
-    auto perp = [&](Eigen::Vector3d v) { return Eigen::Vector3d(v - v.dot(L) * L); };
     Eigen::Vector3d slab_centre = Eigen::Vector3d::Zero();
     for (Eigen::Index i : slab) slab_centre += V.row(i).transpose();
     slab_centre /= static_cast<double>(slab.size());
     // Medial: towards the head's offset from the shaft's line through the slab centre.
-    Eigen::Vector3d medial = perp(head_centre - slab_centre);
+    Eigen::Vector3d medial = perp(head_centre - slab_centre, L);
     require(medial.norm() > 1e-6, ctx + ": the head centre lies on the long axis; cannot tell medial from lateral");
     medial.normalize();
     // Start from the slab's widest direction across the long axis (2-D principal axis), medial sign.
     Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
     for (Eigen::Index i : slab) {
-      const Eigen::Vector3d d = perp(V.row(i).transpose() - slab_centre);
+      const Eigen::Vector3d d = perp(V.row(i).transpose() - slab_centre, L);
       C += d * d.transpose();
     }
     Eigen::Vector3d e = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(C).eigenvectors().col(2);
     if (e.dot(medial) < 0) e = -e;
-    auto extreme = [&](const Eigen::Vector3d& dir, const std::vector<Eigen::Index>& set, Eigen::Vector3d& p) {
-      double best = -std::numeric_limits<double>::infinity();
-      for (Eigen::Index i : set) {
-        const double s = V.row(i).dot(dir);
-        if (s > best) best = s, p = V.row(i).transpose();
-      }
-    };
     Eigen::Vector3d med = Eigen::Vector3d::Zero(), lat = Eigen::Vector3d::Zero();
-    for (int it = 0; it < 20; ++it) {
-      extreme(e, slab, med);
-      extreme(-e, slab, lat);
-      Eigen::Vector3d e2 = perp(med - lat);
-      require(e2.norm() > 1e-6, ctx + ": the epicondyles coincide");
-      e2.normalize();
-      if ((e2 - e).norm() < 1e-12) break;
-      e = e2;
-    }
+    find_epicondyles(V, L, slab, ctx, e, med, lat);
     require(length >= 3 * (med - lat).norm(),
             ctx + ": the mesh is " + std::to_string(length) + " mm long but " + std::to_string((med - lat).norm()) +
                 " mm wide at its distal end: not a whole femur (give the landmarks in subject.json)");
     found["epicondyle_medial"] = med;
     found["epicondyle_lateral"] = lat;
-    // Posterior condyles: split the slab at the midpoint of the epicondyles; posterior = -(anterior),
-    // anterior = L x (lateral direction) for a right femur (x = y x z with z = lateral), mirrored for the left.
-    const Eigen::Vector3d lateral_dir = -e;
-    const Eigen::Vector3d right_dir = side == Side::right ? lateral_dir : Eigen::Vector3d(-lateral_dir);
-    Eigen::Vector3d post = -L.cross(right_dir).normalized();
-    const double split = 0.5 * (med + lat).dot(e);
-    std::vector<Eigen::Index> med_half, lat_half;
-    for (Eigen::Index i : slab) (V.row(i).dot(e) > split ? med_half : lat_half).push_back(i);
-    require(!med_half.empty() && !lat_half.empty(), ctx + ": a condyle is missing from the distal slab");
     Eigen::Vector3d pm = Eigen::Vector3d::Zero(), pl = Eigen::Vector3d::Zero();
-    for (int it = 0; it < 20; ++it) {
-      extreme(post, med_half, pm);
-      extreme(post, lat_half, pl);
-      Eigen::Vector3d axis = perp(pm - pl);
-      require(axis.norm() > 1e-6, ctx + ": the posterior condyles coincide");
-      Eigen::Vector3d post2 = L.cross(axis).normalized();
-      if (post2.dot(post) < 0) post2 = -post2;
-      if ((post2 - post).norm() < 1e-12) break;
-      post = post2;
-    }
+    find_posterior_condyles(V, L, slab, e, med, lat, side, ctx, pm, pl);
     found["posterior_condyle_medial"] = pm;
     found["posterior_condyle_lateral"] = pl;
   }

@@ -32,6 +32,61 @@ bool all_given(const Landmarks& given) {
   return true;
 }
 
+// 1. The anterior pelvic plane's hull face: the hull triangle of V with the largest area x longest edge; a1, a2: the
+//    ends of that edge (the two ASIS), pub: its third corner (the pubis).
+void find_app_face(const Vertices& V, const ConvexHull& hull, const std::string& ctx, Eigen::Vector3d& a1,
+                   Eigen::Vector3d& a2, Eigen::Vector3d& pub) {
+  double best = -1;
+  Eigen::Index best_f = -1;
+  int best_edge = 0;
+  for (Eigen::Index f = 0; f < hull.triangles.rows(); ++f) {
+    const Eigen::Vector3d p[3] = {V.row(hull.triangles(f, 0)).transpose(), V.row(hull.triangles(f, 1)).transpose(),
+                                  V.row(hull.triangles(f, 2)).transpose()};
+    const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    int e = 0;
+    double longest = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double len = (p[(k + 1) % 3] - p[k]).norm();
+      if (len > longest) longest = len, e = k;
+    }
+    if (area * longest > best) best = area * longest, best_f = f, best_edge = e;
+  }
+  require(best_f >= 0, ctx + ": empty convex hull");
+  a1 = V.row(hull.triangles(best_f, best_edge)).transpose();
+  a2 = V.row(hull.triangles(best_f, (best_edge + 1) % 3)).transpose();
+  pub = V.row(hull.triangles(best_f, (best_edge + 2) % 3)).transpose();
+}
+
+// 3. Pubic tubercles and 4. PSIS, per side of the midline (mid: the ASIS' midpoint; X, Y, Z: the APP's axes), from
+//    the hull vertices, into `found`: below the hip centre the one least far behind the ASIS plane as seen from mid
+//    (the largest angle atan2(d.X, -d.Y), d from mid), above it the most posterior (the least d.X).
+void find_tubercles_and_psis(const Vertices& V, const ConvexHull& hull, const Eigen::Vector3d& hip_centre,
+                             const Eigen::Vector3d& mid, const Eigen::Vector3d& pub, const Eigen::Vector3d& X,
+                             const Eigen::Vector3d& Y, const Eigen::Vector3d& Z, const std::string& ctx,
+                             Landmarks& found) {
+  double best_pt[2] = {-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  double best_ps[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  Eigen::Vector3d pt[2] = {pub, pub}, ps[2] = {mid, mid};
+  bool have_ps[2] = {false, false};
+  for (Eigen::Index i : hull.vertices) {
+    const Eigen::Vector3d v = V.row(i).transpose();
+    const Eigen::Vector3d d = v - mid;
+    const int s = d.dot(Z) > 0 ? 0 : 1;  // 0: right of the midline, 1: left
+    const double h = (v - hip_centre).dot(Y);
+    if (h < 0) {
+      const double psi = std::atan2(d.dot(X), -d.dot(Y));  // angle behind the ASIS plane, <= 0
+      if (psi > best_pt[s]) best_pt[s] = psi, pt[s] = v;
+    } else if (d.dot(X) < best_ps[s]) {
+      best_ps[s] = d.dot(X), ps[s] = v, have_ps[s] = true;
+    }
+  }
+  require(have_ps[0] && have_ps[1], ctx + ": no posterior iliac crest above the hip centre on one side");
+  found["pubic_tubercle_right"] = pt[0];
+  found["pubic_tubercle_left"] = pt[1];
+  found["psis_right"] = ps[0];
+  found["psis_left"] = ps[1];
+}
+
 }  // namespace
 
 PelvisLandmarks find_pelvis_landmarks(const TriangleMesh& pelvis, const Eigen::Vector3d& hip_centre, Side side,
@@ -47,25 +102,8 @@ PelvisLandmarks find_pelvis_landmarks(const TriangleMesh& pelvis, const Eigen::V
     const ConvexHull hull = convex_hull(V);
     const Eigen::Vector3d centroid = V.colwise().mean().transpose();
     // 1. The anterior pelvic plane's hull face.
-    double best = -1;
-    Eigen::Index best_f = -1;
-    int best_edge = 0;
-    for (Eigen::Index f = 0; f < hull.triangles.rows(); ++f) {
-      const Eigen::Vector3d p[3] = {V.row(hull.triangles(f, 0)).transpose(), V.row(hull.triangles(f, 1)).transpose(),
-                                    V.row(hull.triangles(f, 2)).transpose()};
-      const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
-      int e = 0;
-      double longest = 0;
-      for (int k = 0; k < 3; ++k) {
-        const double len = (p[(k + 1) % 3] - p[k]).norm();
-        if (len > longest) longest = len, e = k;
-      }
-      if (area * longest > best) best = area * longest, best_f = f, best_edge = e;
-    }
-    require(best_f >= 0, ctx + ": empty convex hull");
-    const Eigen::Vector3d a1 = V.row(hull.triangles(best_f, best_edge)).transpose();
-    const Eigen::Vector3d a2 = V.row(hull.triangles(best_f, (best_edge + 1) % 3)).transpose();
-    const Eigen::Vector3d pub = V.row(hull.triangles(best_f, (best_edge + 2) % 3)).transpose();
+    Eigen::Vector3d a1, a2, pub;
+    find_app_face(V, hull, ctx, a1, a2, pub);
     // 2. Sides: the ASIS nearer the hip centre is on the hip's side.
     const bool a1_near = (a1 - hip_centre).norm() < (a2 - hip_centre).norm();
     const Eigen::Vector3d near = a1_near ? a1 : a2, far = a1_near ? a2 : a1;
@@ -79,28 +117,8 @@ PelvisLandmarks find_pelvis_landmarks(const TriangleMesh& pelvis, const Eigen::V
     require((mid - pub).dot(Y) > 0 && (mid - hip_centre).dot(Y) > 0 && (hip_centre - pub).dot(Y) > 0,
             ctx + ": the convex hull's largest face does not look like the anterior pelvic plane (both ASIS above "
                   "the hip centre, the pubis below); is this a whole pelvis? Give the landmarks in subject.json");
-    // 3. Pubic tubercles and 4. PSIS, per side of the midline, from the hull vertices.
-    double best_pt[2] = {-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-    double best_ps[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-    Eigen::Vector3d pt[2] = {pub, pub}, ps[2] = {mid, mid};
-    bool have_ps[2] = {false, false};
-    for (Eigen::Index i : hull.vertices) {
-      const Eigen::Vector3d v = V.row(i).transpose();
-      const Eigen::Vector3d d = v - mid;
-      const int s = d.dot(Z) > 0 ? 0 : 1;  // 0: right of the midline, 1: left
-      const double h = (v - hip_centre).dot(Y);
-      if (h < 0) {
-        const double psi = std::atan2(d.dot(X), -d.dot(Y));  // angle behind the ASIS plane, <= 0
-        if (psi > best_pt[s]) best_pt[s] = psi, pt[s] = v;
-      } else if (d.dot(X) < best_ps[s]) {
-        best_ps[s] = d.dot(X), ps[s] = v, have_ps[s] = true;
-      }
-    }
-    require(have_ps[0] && have_ps[1], ctx + ": no posterior iliac crest above the hip centre on one side");
-    found["pubic_tubercle_right"] = pt[0];
-    found["pubic_tubercle_left"] = pt[1];
-    found["psis_right"] = ps[0];
-    found["psis_left"] = ps[1];
+    // 3. Pubic tubercles and 4. PSIS.
+    find_tubercles_and_psis(V, hull, hip_centre, mid, pub, X, Y, Z, ctx, found);
   }
   auto pick = [&](const char* name, Eigen::Vector3d& out) {
     const auto g = given.find(name);

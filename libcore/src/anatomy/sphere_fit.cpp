@@ -177,30 +177,18 @@ bool sphere_through(const Eigen::Vector3d p[4], Eigen::Vector3d& c, double& r) {
   r = (p[0] - c).norm();
   return std::isfinite(r);
 }
-}  // namespace
 
-SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& o) {
-  return fit_femoral_head(femur, o, {});
-}
-
-SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& o,
-                                 const std::function<bool(const SphereFitResult&)>& to_fixed_point) {
-  const Vertices& V = femur.V;
-  require(V.rows() >= 4, femur.source + ": too few vertices for a head fit");
-  const double zmax = V.col(2).maxCoeff();
-  std::vector<Eigen::Index> cand;
-  for (Eigen::Index i = 0; i < V.rows(); ++i)
-    if (V(i, 2) >= zmax - o.proximal_extent_mm) cand.push_back(i);
-  require(cand.size() >= 4, femur.source + ": too few proximal vertices for a head fit");
-
+/// RANSAC over the candidate vertices `cand` of V: o.ransac_iterations spheres through four random candidates
+/// (seeded by o.seed), those of radius within o's range scored by their candidates within o.inlier_threshold_mm.
+/// Returns the best score; best_c, best_r (mm): its sphere (unchanged when none scores).
+std::size_t ransac_sphere(const Vertices& V, const std::vector<Eigen::Index>& cand, const HeadFitOptions& o,
+                          Eigen::Vector3d& best_c, double& best_r) {
   // The candidates' coordinates side by side, for the inlier counts (3000 passes over them).
   std::vector<double> cx(cand.size()), cy(cand.size()), cz(cand.size());
   for (std::size_t k = 0; k < cand.size(); ++k) cx[k] = V(cand[k], 0), cy[k] = V(cand[k], 1), cz[k] = V(cand[k], 2);
   std::mt19937_64 rng(o.seed);
   std::uniform_int_distribution<std::size_t> pick(0, cand.size() - 1);
   std::size_t best_count = 0;
-  Eigen::Vector3d best_c = Eigen::Vector3d::Zero();
-  double best_r = 0;
   for (int it = 0; it < o.ransac_iterations; ++it) {
     Eigen::Vector3d p[4];
     for (auto& q : p) q = V.row(cand[pick(rng)]).transpose();
@@ -217,15 +205,15 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
       best_r = r;
     }
   }
-  std::ostringstream msg;
-  msg << femur.source << ": no sphere of radius " << o.min_radius_mm << "-" << o.max_radius_mm
-      << " mm found on the proximal femur (is +z superior?)";
-  require(best_count >= 20, msg.str());
+  return best_count;
+}
 
+/// The refinement rounds: o.refinement_rounds geometric refits of the sphere (c, r; mm, in and out) on the candidates
+/// within `threshold` mm of it (in and out: tightened each round). Returns the last fit (a default result when there
+/// are no rounds); throws `failure` when fewer than 4 candidates are left.
+SphereFitResult refine_sphere(const Vertices& V, const std::vector<Eigen::Index>& cand, const HeadFitOptions& o,
+                              const std::string& failure, Eigen::Vector3d& c, double& r, double& threshold) {
   SphereFitResult res;
-  Eigen::Vector3d c = best_c;
-  double r = best_r;
-  double threshold = o.inlier_threshold_mm;
   for (int round = 0; round < o.refinement_rounds; ++round) {
     std::vector<Eigen::Index> in;
     std::vector<double> abs_res;
@@ -236,7 +224,7 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
         abs_res.push_back(e);
       }
     }
-    require(in.size() >= 4, msg.str());
+    require(in.size() >= 4, failure);
     res = fit_sphere_geometric(gather(V, in));
     c = res.centre;
     r = res.radius;
@@ -246,6 +234,36 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
     const double sigma = 1.4826 * abs_res[abs_res.size() / 2];
     threshold = std::clamp(3 * sigma, 0.2 * o.inlier_threshold_mm, o.inlier_threshold_mm);
   }
+  return res;
+}
+}  // namespace
+
+SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& o) {
+  return fit_femoral_head(femur, o, {});
+}
+
+SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& o,
+                                 const std::function<bool(const SphereFitResult&)>& to_fixed_point) {
+  const Vertices& V = femur.V;
+  require(V.rows() >= 4, femur.source + ": too few vertices for a head fit");
+  const double zmax = V.col(2).maxCoeff();
+  std::vector<Eigen::Index> cand;
+  for (Eigen::Index i = 0; i < V.rows(); ++i)
+    if (V(i, 2) >= zmax - o.proximal_extent_mm) cand.push_back(i);
+  require(cand.size() >= 4, femur.source + ": too few proximal vertices for a head fit");
+
+  Eigen::Vector3d best_c = Eigen::Vector3d::Zero();
+  double best_r = 0;
+  const std::size_t best_count = ransac_sphere(V, cand, o, best_c, best_r);
+  std::ostringstream msg;
+  msg << femur.source << ": no sphere of radius " << o.min_radius_mm << "-" << o.max_radius_mm
+      << " mm found on the proximal femur (is +z superior?)";
+  require(best_count >= 20, msg.str());
+
+  Eigen::Vector3d c = best_c;
+  double r = best_r;
+  double threshold = o.inlier_threshold_mm;
+  SphereFitResult res = refine_sphere(V, cand, o, msg.str(), c, r, threshold);
   res.iterations = o.refinement_rounds;
   if (to_fixed_point) {
     res.centre = c, res.radius = r;  // as it is after the refinement rounds (the RANSAC sphere without them)
