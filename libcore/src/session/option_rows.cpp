@@ -42,6 +42,8 @@ std::string levels_help() {
          "offset in thirds)";
 }
 
+// The inputs' rows: the preset (applied first), the subject, the bones (ball and socket: a file, or a mesh from
+// Python), side, frame and landmarks (input frame, mm).
 void add_input_rows(Rows& t) {
   t.text("preset", "preset", OptionType::choice, kSetting, {"clinical", "thesis"},
          "Named defaults, applied before every other option: 'clinical' (layered maps, Euclidean distances, the ROM "
@@ -92,6 +94,11 @@ void add_input_rows(Rows& t) {
     if (o.session.input.landmarks.empty()) return std::monostate{};
     return o.session.input.landmarks;
   };
+}
+
+// The centre of rotation's rows: cor (the femoral head centre, input frame, mm, or auto), allow-any-cor and
+// head-region (X,Y,Z,R mm: where the head sphere is fitted).
+void add_cor_rows(Rows& t) {
   OptionRow& cor = t.add("cor", "cor", OptionType::point, "mm", kInput,
                          "The femoral head centre, the centre of rotation: 'auto' (a sphere fitted to the femoral head, "
                          "in any scan orientation) or X,Y,Z in the input files' frame; the radial gaps at the scan "
@@ -131,7 +138,9 @@ void add_input_rows(Rows& t) {
   };
 }
 
-void add_map_rows(Rows& t) {
+// The grid's rows: the sampling scheme, its resolution or the aliases precision (deg) and turns, the largest node
+// spacing wanted (deg), and the sampling method.
+void add_grid_rows(Rows& t) {
   t.text("scheme", "scheme", OptionType::choice, kSetting, registered_schemes(), scheme_help(),
          [](auto& o) -> auto& { return o.session.grid.scheme; });
   t.number("resolution", "resolution", "", kSetting, GridRequest::kResolutionRange,
@@ -153,6 +162,11 @@ void add_map_rows(Rows& t) {
          "auto, rasterize, resample, ray-cast (naive, small meshes only) or ray-cast-bvh (exact node values for any "
          "scheme)",
          [](auto& o) -> auto& { return o.session.hip.joint.sampling; });
+}
+
+// How the radial gaps are read and classified: the distance mode, the impingement levels (mm), the occlusion
+// tolerance (mm), the vertices tested (max-radius, mm), sparse maps (mm) and the discontinuity tolerance (mm).
+void add_gap_rows(Rows& t) {
   t.choice("mode", "mode", kSetting, kDistanceModeNames,
          "Distance mode: 'linear' (thesis Alg. 1) or 'exact' (ray-plane)",
          [](auto& o) -> auto& { return o.session.hip.joint.mode; });
@@ -206,6 +220,11 @@ void add_map_rows(Rows& t) {
            "Look-ups whose stencil may be off by more than this (depth discontinuities: rims, coverage edges) are "
            "resolved by an exact ray cast",
            [](auto& o) -> auto& { return o.session.hip.joint.discontinuity_tolerance_mm; });
+}
+
+// The layered maps' rows (the vertices hidden behind their own bone): layers, the query strategy (layered maps or
+// exact casts), the layered maps' node spacing (deg) and the extra-articular radius (mm).
+void add_layer_rows(Rows& t) {
   t.integer("layers", "layers", "", kSetting, JointOptions::kLayersRange,
             "N: also a layered map of N crossings per node for each bone, so that vertices hidden behind their own "
             "bone's nearer surface (trochanters, shaft, ilium) are tested too: extra-articular impingement (0 = off, "
@@ -231,6 +250,11 @@ void add_map_rows(Rows& t) {
            JointOptions::kExtraArticularRadiusRange,
            "With --layers, test hidden vertices within this distance of the COR",
            [](auto& o) -> auto& { return o.session.hip.joint.extra_articular_radius_mm; });
+}
+
+// The Euclidean distances' rows: distances on or off, what the levels classify (distance or radial gap) and the
+// distance reach (mm).
+void add_distance_rows(Rows& t) {
   t.flag("distances", "distances", OptionType::on_off, kSetting,
          "on|off: beside each radial gap, the signed Euclidean distance to the other bone's surface (what 3D "
          "Slicer, VTK, Open3D and libigl report; negative inside it), exact, for every vertex (hidden ones too) "
@@ -244,6 +268,10 @@ void add_map_rows(Rows& t) {
            "Vertices proven farther than this from the other bone get no distance (0: the largest --levels "
            "threshold)",
            [](auto& o) -> auto& { return o.session.hip.joint.distance_reach_mm; });
+}
+
+// The maps' remaining rows: the memory limit (GB), maps-only look-ups and saved maps to load instead of sampling.
+void add_map_rows(Rows& t) {
   t.number("max-memory", "max_memory_gb", "GB", kSetting, SessionOptions::kMaxMemoryRange,
            "The most memory the maps may take; a resolution whose maps need more is refused before anything is "
            "allocated (0: three quarters of this machine's memory)",
@@ -416,6 +444,11 @@ const std::vector<OptionRow>& option_table() {
   static const std::vector<OptionRow> table = [] {
     Rows t;
     add_input_rows(t);
+    add_cor_rows(t);
+    add_grid_rows(t);
+    add_gap_rows(t);
+    add_layer_rows(t);
+    add_distance_rows(t);
     add_map_rows(t);
     add_frame_rows(t);
     add_rom_rows(t);
