@@ -60,6 +60,92 @@ Side checked_side(const SessionInput& input, const std::optional<Side>& subject_
               (*subject_side == Side::right ? "right" : "left") + ")");
   return s;
 }
+
+// The frame: the subject's (subject_frame), or the given one (input.frame, LPS or RAS; default RAS); both must agree.
+FrameConvention checked_frame(const SessionInput& input, const std::optional<FrameConvention>& subject_frame) {
+  FrameConvention frame = subject_frame.value_or(FrameConvention::RAS);
+  if (!input.frame.empty()) {
+    const FrameConvention f = parse_frame(input.frame, "frame");
+    require(!subject_frame || *subject_frame == f,
+            "frame '" + input.frame + "' contradicts " + input.subject + " (its \"frame\" is " +
+                (*subject_frame == FrameConvention::LPS ? "LPS" : "RAS") + ")");
+    frame = f;
+  }
+  return frame;
+}
+
+// A bone from memory (`mesh`) or from its file (`path`) into `out`, and what to call it in messages (`source`:
+// the path, the mesh's own source, or `name` "(in memory)").
+void take_bone(const std::optional<TriangleMesh>& mesh, const std::string& path, const char* name, TriangleMesh& out,
+               std::string& source) {
+  out = mesh ? *mesh : load_mesh(path);
+  source = !mesh ? path : out.source.empty() ? std::string(name) + " (in memory)" : out.source;
+}
+
+// Both bones into `in` (femur, pelvis and their sources): from input's meshes or the files `ball` and `socket`
+// (the subject's when not given), checked to be given once each and to be two different meshes.
+void read_bones(const SessionInput& input, const std::string& ball, const std::string& socket, LoadedInput& in) {
+  require(input.ball_mesh || !ball.empty(), "no femur: give ball (a mesh file or mesh) or subject");
+  require(input.ball_mesh || input.socket_mesh || ball.empty() || ball != socket,
+          "ball and socket are the same file (" + ball + "): give the femur and the pelvis");
+  require(input.socket_mesh || !socket.empty(), "no pelvis: give socket (a mesh file or mesh) or subject");
+  require(!(input.ball_mesh && !input.ball.empty()), "give ball as a file or a mesh, not both");
+  require(!(input.socket_mesh && !input.socket.empty()), "give socket as a file or a mesh, not both");
+  // The two files are read at once (the pelvis on a second thread); the femur's error first, as before.
+  run_both([&] { take_bone(input.ball_mesh, ball, "ball", in.femur, in.femur_source); },
+           [&] { take_bone(input.socket_mesh, socket, "socket", in.pelvis, in.pelvis_source); });
+  require(!(in.femur.V.rows() == in.pelvis.V.rows() && in.femur.F.rows() == in.pelvis.F.rows() &&
+            in.femur.V.isApprox(in.pelvis.V, 1e-12)),
+          in.femur_source + " and " + in.pelvis_source + ": the femur and the pelvis are the same mesh");
+}
+
+// The given landmarks (input frame, mm) into `landmarks` (over the subject's), each name known and its point finite.
+void add_given_landmarks(const SessionInput& input, Landmarks& landmarks) {
+  for (const auto& [name, p] : input.landmarks) {
+    bool known = name == "hip_centre";
+    std::string names = "hip_centre";
+    for (const char* n : kPelvisLandmarkNames) known = known || name == n, names += std::string(", ") + n;
+    for (const char* n : kFemurLandmarkNames) known = known || name == n, names += std::string(", ") + n;
+    require(known, [&] { return "landmarks: unknown name '" + name + "' (known: " + names + ")"; });
+    require(p.allFinite(), "landmark " + name + ": not three finite numbers");
+    landmarks[name] = p;
+  }
+}
+
+// Winding: triangles that face against their neighbours would flip the sign of the distances around them
+// (a femur 1.15 mm from the pelvis read as 123 mm inside it): both bones' flipped to agree, and said in
+// in.warnings (with the edges that cannot be wound consistently). The pelvis on a second thread.
+void orient_bones(LoadedInput& in) {
+  std::int64_t femur_conflicts = 0, pelvis_conflicts = 0, femur_flipped = 0, pelvis_flips = 0;
+  run_both([&] { femur_flipped = orient_consistently(in.femur, &femur_conflicts); },
+           [&] { pelvis_flips = orient_consistently(in.pelvis, &pelvis_conflicts); });
+  for (const auto& [mesh, source, flipped, conflicts] :
+       {std::tuple{&in.femur, &in.femur_source, femur_flipped, femur_conflicts},
+        std::tuple{&in.pelvis, &in.pelvis_source, pelvis_flips, pelvis_conflicts}}) {
+    if (flipped > 0)
+      in.warnings.push_back(*source + ": " + std::to_string(flipped) + " of " + std::to_string(mesh->F.rows()) +
+                            " triangles were wound against their neighbours; flipped to agree with them");
+    if (conflicts > 0)
+      in.warnings.push_back(*source + ": " + std::to_string(conflicts) +
+                            " shared edges cannot be wound consistently (a non-orientable surface): distances' signs "
+                            "near them are not to be trusted");
+  }
+}
+
+// Units: a femur or pelvis (or a part of one holding the joint) spans tens to hundreds of millimetres; a bone
+// whose bounding box's diagonal is under 20 or over 3000 (file units) is an error naming the likely unit.
+void check_units(const LoadedInput& in) {
+  for (const auto& [mesh, source] : {std::pair{&in.femur, &in.femur_source}, std::pair{&in.pelvis, &in.pelvis_source}}) {
+    const double span = (mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff()).norm();
+    require(span >= 20 && span <= 3000, [&, span = span, source = source] {
+      return *source + ": the bone spans " + num(span) + " (its bounding box's diagonal) in the file's units; a femur or "
+             "pelvis in millimetres spans about 50 to 1,000: " +
+             (span < 20 ? std::string("metres (scale by 1000) or inches (by 25.4)?") : std::string("micrometres?")) +
+             " impinge reads millimetres";
+    });
+  }
+}
+
 }  // namespace
 
 Side input_side(const SessionInput& input) {
@@ -85,68 +171,11 @@ LoadedInput load_input(const SessionInput& input) {
     in.name = info.name;
   }
   in.side = checked_side(input, subject_side);
-  in.frame = subject_frame.value_or(FrameConvention::RAS);
-  if (!input.frame.empty()) {
-    const FrameConvention f = parse_frame(input.frame, "frame");
-    require(!subject_frame || *subject_frame == f,
-            "frame '" + input.frame + "' contradicts " + input.subject + " (its \"frame\" is " +
-                (*subject_frame == FrameConvention::LPS ? "LPS" : "RAS") + ")");
-    in.frame = f;
-  }
-  require(input.ball_mesh || !ball.empty(), "no femur: give ball (a mesh file or mesh) or subject");
-  require(input.ball_mesh || input.socket_mesh || ball.empty() || ball != socket,
-          "ball and socket are the same file (" + ball + "): give the femur and the pelvis");
-  require(input.socket_mesh || !socket.empty(), "no pelvis: give socket (a mesh file or mesh) or subject");
-  require(!(input.ball_mesh && !input.ball.empty()), "give ball as a file or a mesh, not both");
-  require(!(input.socket_mesh && !input.socket.empty()), "give socket as a file or a mesh, not both");
-  // A bone from memory or from its file, and what to call it in messages.
-  auto take = [](const std::optional<TriangleMesh>& mesh, const std::string& path, const char* name,
-                 TriangleMesh& out, std::string& source) {
-    out = mesh ? *mesh : load_mesh(path);
-    source = !mesh ? path : out.source.empty() ? std::string(name) + " (in memory)" : out.source;
-  };
-  // The two files are read at once (the pelvis on a second thread); the femur's error first, as before.
-  run_both([&] { take(input.ball_mesh, ball, "ball", in.femur, in.femur_source); },
-           [&] { take(input.socket_mesh, socket, "socket", in.pelvis, in.pelvis_source); });
-  require(!(in.femur.V.rows() == in.pelvis.V.rows() && in.femur.F.rows() == in.pelvis.F.rows() &&
-            in.femur.V.isApprox(in.pelvis.V, 1e-12)),
-          in.femur_source + " and " + in.pelvis_source + ": the femur and the pelvis are the same mesh");
-  for (const auto& [name, p] : input.landmarks) {
-    bool known = name == "hip_centre";
-    std::string names = "hip_centre";
-    for (const char* n : kPelvisLandmarkNames) known = known || name == n, names += std::string(", ") + n;
-    for (const char* n : kFemurLandmarkNames) known = known || name == n, names += std::string(", ") + n;
-    require(known, [&] { return "landmarks: unknown name '" + name + "' (known: " + names + ")"; });
-    require(p.allFinite(), "landmark " + name + ": not three finite numbers");
-    landmarks[name] = p;
-  }
-  // Winding: triangles that face against their neighbours would flip the sign of the distances around them
-  // (a femur 1.15 mm from the pelvis read as 123 mm inside it): flipped to agree, and said.
-  // The pelvis on a second thread.
-  std::int64_t femur_conflicts = 0, pelvis_conflicts = 0, femur_flipped = 0, pelvis_flips = 0;
-  run_both([&] { femur_flipped = orient_consistently(in.femur, &femur_conflicts); },
-           [&] { pelvis_flips = orient_consistently(in.pelvis, &pelvis_conflicts); });
-  for (const auto& [mesh, source, flipped, conflicts] :
-       {std::tuple{&in.femur, &in.femur_source, femur_flipped, femur_conflicts},
-        std::tuple{&in.pelvis, &in.pelvis_source, pelvis_flips, pelvis_conflicts}}) {
-    if (flipped > 0)
-      in.warnings.push_back(*source + ": " + std::to_string(flipped) + " of " + std::to_string(mesh->F.rows()) +
-                            " triangles were wound against their neighbours; flipped to agree with them");
-    if (conflicts > 0)
-      in.warnings.push_back(*source + ": " + std::to_string(conflicts) +
-                            " shared edges cannot be wound consistently (a non-orientable surface): distances' signs "
-                            "near them are not to be trusted");
-  }
-  // Units: a femur or pelvis (or a part of one holding the joint) spans tens to hundreds of millimetres.
-  for (const auto& [mesh, source] : {std::pair{&in.femur, &in.femur_source}, std::pair{&in.pelvis, &in.pelvis_source}}) {
-    const double span = (mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff()).norm();
-    require(span >= 20 && span <= 3000, [&, span = span, source = source] {
-      return *source + ": the bone spans " + num(span) + " (its bounding box's diagonal) in the file's units; a femur or "
-             "pelvis in millimetres spans about 50 to 1,000: " +
-             (span < 20 ? std::string("metres (scale by 1000) or inches (by 25.4)?") : std::string("micrometres?")) +
-             " impinge reads millimetres";
-    });
-  }
+  in.frame = checked_frame(input, subject_frame);
+  read_bones(input, ball, socket, in);
+  add_given_landmarks(input, landmarks);
+  orient_bones(in);
+  check_units(in);
   in.to_working = to_working_frame(in.frame);
   transform_vertices(in.femur.V, in.to_working);
   transform_vertices(in.pelvis.V, in.to_working);
