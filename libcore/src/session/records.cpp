@@ -197,16 +197,13 @@ std::optional<Eigen::Vector3d> pivot_input(const Session& s) {
   return std::nullopt;
 }
 
-nlohmann::json setup_record(const Session& s) {
-  const Eigen::Matrix3d to_input = s.to_input();
-  const JointOptions& opt = s.joint_options();
+namespace {
+
+// summary.json's centres (input frame, mm): the femoral head centre, the acetabular centre (when found), the maps'
+// centre, how the COR was found, the head radius (mm), the joint-centre method and its pivot (null for
+// equidistant), and with the equidistant joint centre the lunate vertices guarded at neutral.
+void add_centres(nlohmann::json& j, const Session& s) {
   const HipJoint& hip = s.hip();
-  nlohmann::json j;
-  j["impinge_version"] = IMPINGE_VERSION;
-  j["femur_file"] = s.ball_source();
-  j["pelvis_file"] = s.socket_source();
-  j["side"] = s.side() == Side::right ? "right" : "left";
-  j["input_frame"] = s.input_frame() == FrameConvention::LPS ? "LPS" : "RAS";
   // Three centres, each with its own name: the femoral head centre (the COR the femur rotates about: given or
   // fitted), the acetabular centre, and the maps' centre (the rays' origin: the head centre, or the acetabular
   // centre when a fitted head was seated before sampling).
@@ -225,6 +222,13 @@ nlohmann::json setup_record(const Session& s) {
   // them at neutral (a head past its sphere, a segmentation overlap): 0 on a clean hip.
   if (hip.joint_centre().method() == JointCentreMethod::equidistant)
     j["equidistant_guarded_at_neutral"] = hip.joint_centre().guarded_at_neutral();
+}
+
+// summary.json's maps and distances: the head fit's rms (mm) and points, the scheme, its resolution and largest
+// node spacing (deg), the sampling, distance mode, levels (mm), tolerances (mm), layers and query strategy, the
+// distance hierarchies, whether distances are on, what the levels classify, the reach (mm) and the nodes marked.
+void add_map_settings(nlohmann::json& j, const Session& s) {
+  const JointOptions& opt = s.joint_options();
   j["sphere_fit_rms_mm"] = number_or_null(s.head().rms_residual);
   j["sphere_fit_points"] = s.head().points_used;
   j["scheme"] = opt.scheme->name();
@@ -252,6 +256,41 @@ nlohmann::json setup_record(const Session& s) {
   j["levels_on"] = to_string(opt.level_quantity());
   if (opt.distances) j["distance_reach_mm"] = opt.reach_mm();
   j["nodes_marked"] = {{"femur", s.joint().ball().nodes_marked}, {"pelvis", s.joint().socket().nodes_marked}};
+}
+
+// summary.json's frames (the hip's `frames`; input frame, mm): the pelvic and femoral frames (the femur's quality
+// the head fit's rms), the scan pose (deg), the frames' time (ms), the acetabulum and the seat.
+nlohmann::json frames_record(const Session& s, const HipFrames& frames) {
+  const Eigen::Matrix3d to_input = s.to_input();
+  const HipJoint& hip = s.hip();
+  nlohmann::json f;
+  AnatomicalFrame femur = frames.femur;
+  femur.quality_mm = s.head().rms_residual;
+  f["pelvis"] = frame_record(frames.pelvis, to_input, "app_out_of_plane_mm");
+  f["femur"] = frame_record(femur, to_input, "head_fit_rms_mm");
+  f["scan_pose_deg"] = {{"flexion", frames.scan_pose.flexion_deg},
+                        {"adduction", frames.scan_pose.adduction_deg},
+                        {"internal_rotation", frames.scan_pose.internal_rotation_deg}};
+  f["frames_ms"] = hip.frames_ms();
+  f["acetabulum"] = acetabulum_record(*hip.acetabulum(), frames.pelvis, s.side(), to_input);
+  // Combined and equidistant joint centres: the head seated on the acetabular centre (then the COR).
+  f["seat_mm"] = vec(to_input * hip.seat_mm());
+  f["axes_note"] = "axes and positions in the input files' frame; x anterior, y superior, z right (ISB)";
+  return f;
+}
+
+}  // namespace
+
+nlohmann::json setup_record(const Session& s) {
+  const HipJoint& hip = s.hip();
+  nlohmann::json j;
+  j["impinge_version"] = IMPINGE_VERSION;
+  j["femur_file"] = s.ball_source();
+  j["pelvis_file"] = s.socket_source();
+  j["side"] = s.side() == Side::right ? "right" : "left";
+  j["input_frame"] = s.input_frame() == FrameConvention::LPS ? "LPS" : "RAS";
+  add_centres(j, s);
+  add_map_settings(j, s);
   j["neutral"] = hip.neutral() == Neutral::anatomical ? "anatomical" : "scan";
   j["pelvic_frame"] = pelvic_frame_name(s);
   j["warnings"] = s.warnings();
@@ -261,22 +300,7 @@ nlohmann::json setup_record(const Session& s) {
       "ISB joint coordinate system (Wu et al. 2002): flexion about the pelvic Z axis, adduction about the floating "
       "axis, internal rotation about the femoral y axis; flexion, adduction and internal rotation positive; left "
       "hips mirrored";
-  if (const auto& frames = hip.frames()) {
-    nlohmann::json f;
-    AnatomicalFrame femur = frames->femur;
-    femur.quality_mm = s.head().rms_residual;
-    f["pelvis"] = frame_record(frames->pelvis, to_input, "app_out_of_plane_mm");
-    f["femur"] = frame_record(femur, to_input, "head_fit_rms_mm");
-    f["scan_pose_deg"] = {{"flexion", frames->scan_pose.flexion_deg},
-                          {"adduction", frames->scan_pose.adduction_deg},
-                          {"internal_rotation", frames->scan_pose.internal_rotation_deg}};
-    f["frames_ms"] = hip.frames_ms();
-    f["acetabulum"] = acetabulum_record(*hip.acetabulum(), frames->pelvis, s.side(), to_input);
-    // Combined and equidistant joint centres: the head seated on the acetabular centre (then the COR).
-    f["seat_mm"] = vec(to_input * hip.seat_mm());
-    f["axes_note"] = "axes and positions in the input files' frame; x anterior, y superior, z right (ISB)";
-    j["frames"] = f;
-  }
+  if (const auto& frames = hip.frames()) j["frames"] = frames_record(s, *frames);
   return j;
 }
 
