@@ -62,20 +62,14 @@ nlohmann::json per_hour(const std::array<double, 12>& v) {
   for (int h = 1; h <= 12; ++h) j[std::to_string(h)] = number_or_null(v[static_cast<std::size_t>(h - 1)]);
   return j;
 }
-}  // namespace
 
-nlohmann::json morphology_record(const MorphologyRun& run) {
+// morphology.json's femur: the head sphere (centre, input frame, and radius, mm; its fit), sphericity (mm), neck
+// and shaft axes (unit vectors, input frame), neck-shaft angle and version (deg), alpha angles per head-neck
+// clock hour (deg), head-neck offset (mm) and ratio, and the femoral frame.
+nlohmann::json femur_measures(const MorphologyRun& run) {
   const Morphology& m = run.morphology;
   const Eigen::Matrix3d& T = run.to_input;
-  nlohmann::json j;
-  j["femur_file"] = run.femur_source;
-  j["pelvis_file"] = run.pelvis_source;
-  j["side"] = run.side == Side::right ? "right" : "left";
-  j["input_frame"] = run.input_frame == FrameConvention::LPS ? "LPS" : "RAS";
-  j["axes_note"] =
-      "points and axes in the input files' frame, mm; angles in degrees; left hips measured mirrored, "
-      "so that both sides read alike";
-  nlohmann::json& f = j["femur"];
+  nlohmann::json f;
   f["head_centre_mm"] = measure(vec(T * m.head_centre_mm), "mm", "centre of the sphere fitted to the femoral head",
                                 "geometric sphere fit, thesis sec. 3.4");
   f["head_radius_mm"] = measure(number_or_null(m.head_radius_mm), "mm", "radius of that sphere", "thesis sec. 3.4");
@@ -121,7 +115,16 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
       measure(number_or_null(m.head_neck_offset_ratio), "",
               "offset / head diameter (normal over 0.15-0.17; a cam under)", "Eijer et al. 2001");
   f["frame"] = frame_record(run.frames.femur, T, "head_fit_rms_mm");
-  nlohmann::json& a = j["acetabulum"];
+  return f;
+}
+
+// morphology.json's acetabulum: the lunate surface's sphere (centre, input frame, and radius, mm; its fit and
+// area), radiographic inclination and anteversion (deg, APP and ISB frames), centre-edge angles (deg), head
+// coverage (share, and deg per acetabular clock hour), the rim (input frame, mm) and the pelvic frame.
+nlohmann::json acetabulum_measures(const MorphologyRun& run) {
+  const Morphology& m = run.morphology;
+  const Eigen::Matrix3d& T = run.to_input;
+  nlohmann::json a;
   a["centre_mm"] = measure(vec(T * m.acetabular_centre_mm), "mm",
                            "centre of the sphere fitted to the whole lunate surface", "impinge (find_acetabulum)");
   a["radius_mm"] = measure(number_or_null(m.acetabular_radius_mm), "mm", "its radius", "impinge");
@@ -164,6 +167,22 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
                         "farthest from its pole",
                         "impinge (find_acetabulum)");
   a["pelvic_frame"] = frame_record(run.frames.pelvis, T, "app_out_of_plane_mm");
+  return a;
+}
+}  // namespace
+
+nlohmann::json morphology_record(const MorphologyRun& run) {
+  const Morphology& m = run.morphology;
+  nlohmann::json j;
+  j["femur_file"] = run.femur_source;
+  j["pelvis_file"] = run.pelvis_source;
+  j["side"] = run.side == Side::right ? "right" : "left";
+  j["input_frame"] = run.input_frame == FrameConvention::LPS ? "LPS" : "RAS";
+  j["axes_note"] =
+      "points and axes in the input files' frame, mm; angles in degrees; left hips measured mirrored, "
+      "so that both sides read alike";
+  j["femur"] = femur_measures(run);
+  j["acetabulum"] = acetabulum_measures(run);
   j["notes"] = m.notes;
   j["warnings"] = run.warnings;
   j["ms"] = run.ms;
