@@ -14,7 +14,6 @@
 #include "impinge/core/parse.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/motion.hpp"
-#include "impinge/io/vtk_output.hpp"
 #include "impinge/session/morphology_run.hpp"
 #include "impinge/session/records.hpp"
 
@@ -181,41 +180,54 @@ std::vector<ResectionTarget> plan_targets(const Session& s, const PlanRequest& r
   return out;
 }
 
-PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const PlanRequest& request) {
-  const auto t_start = Clock::now();
-  PlanRun run;
+namespace {
+
+/// Checks what can be checked before anything is built (a bad one is an error in milliseconds): the safety depth's
+/// fraction and cap (mm), the targets' text, the motion file, and that there is a target at all.
+void check_plan_request(const SessionOptions& options, const PlanRequest& request) {
   check_in_range("max-depth-fraction", request.max_depth_fraction, PlanRequest::kMaxDepthFractionRange);
   check_in_range("max-depth", request.max_depth_mm, PlanRequest::kMaxDepthRange, "mm");
-  // The targets and the motion file are checked before anything is built (a bad one is an error in milliseconds).
   parse_targets(request.target, standard_motions());
   if (!request.target_motion.empty()) load_motion(request.target_motion, input_side(options.input));
   require(!request.target.empty() || !request.target_motion.empty(),
           "plan: no target: give --target (MOTION=DEG,... or normal) or --target-motion");
+}
+
+/// `rom` asking for the ROM limits alone (no map, no envelope): the searches before and on the resected bones.
+RomRequest limits_only_request(const RomRequest& rom) {
   RomRequest limits_only = rom;
   limits_only.map = false;
   limits_only.envelope = false;
   limits_only.limits = true;
-  run.search = rom.search;
-  run.request = request;
-  SessionOptions so = rom_session_options(options, rom.search);
+  return limits_only;
+}
+
+/// The plan's session options: the ROM search's (rom_session_options), with the distances on and a distance
+/// reach (mm) of at least the clearance plus the candidate margin (mm).
+SessionOptions plan_session_options(const SessionOptions& options, const RomOptions& search,
+                                    const PlanRequest& request) {
+  SessionOptions so = rom_session_options(options, search);
   so.hip.joint.distances = true;
   so.hip.joint.distance_reach_mm =
       std::max(so.hip.joint.distance_reach_mm, request.resection.clearance_mm + request.resection.candidate_margin_mm);
-  const Session s(so);
-  run.setup_ms = ms_since(t_start);
+  return so;
+}
+
+/// What the plan is computed on, from session `s`: its warnings, subject, bones' sources, input frame and the
+/// head centre at the scan pose (input frame, mm).
+void describe_session(PlanRun& run, const Session& s) {
   run.warnings = s.warnings();
   run.subject = s.subject_name();
   run.femur_source = s.ball_source();
   run.pelvis_source = s.socket_source();
   run.input_frame = s.input_frame();
   run.head_centre_mm = s.head_centre_input();
+}
 
-  auto t = Clock::now();
-  const RomRun before = run_rom(s, limits_only);
-  run.before_ms = ms_since(t);
-  const std::vector<ResectionTarget> targets = plan_targets(s, request, before);
-
-  // The safety depth: given, or a fraction of the neck's least diameter (Mardones et al. 2005).
+/// The morphology before (on `options`' inputs; a note when it cannot be measured), the neck's least diameter
+/// (mm, about the neck axis it found) and the safety depth (mm): the cap given, or the fraction of the neck's
+/// diameter (Mardones et al. 2005). Throws impinge::Error when neither is there.
+void set_safety_depth(PlanRun& run, const Session& s, const SessionOptions& options, const PlanRequest& request) {
   run.before = try_morphology(options, run.notes, "before");
   const HipJoint& hip = s.hip();
   if (run.before) {
@@ -233,103 +245,151 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
                 "), so the safety depth is unknown: give --max-depth");
     run.safety_depth_mm = request.max_depth_fraction * run.neck_diameter_mm;
   }
-  ResectionOptions ro = request.resection;
-  ro.safety_depth_mm = run.safety_depth_mm;
-  t = Clock::now();
-  run.plan = plan_resection(hip, targets, before.baseline, ro);
-  run.plan_ms = ms_since(t);
+}
 
-  // The resected meshes in the input frame: the scan-pose vertices moved by the plan's (joint-frame) displacement.
-  // `session` is the one the plan was made on; its input is the bones as they were before that plan.
-  auto resected = [](const Session& session, const BoneResection& b, const JointBody& body, const Vertices& scan_pose,
-                     const char* name) {
-    const Eigen::Matrix3d joint_to_input = session.to_input() * session.hip().joint_to_working();
-    TriangleMesh m;
-    m.V = scan_pose + (b.resected - body.relative) * joint_to_input.transpose();
-    m.F = body.mesh.F;
-    m.source = name;
-    return m;
-  };
-  const Vertices femur_scan = s.femur_input(hip.scan_pose()), pelvis_scan = s.pelvis_input();
-  run.femur_resected = resected(s, run.plan.femur, s.joint().ball(), femur_scan, "femur_resected");
-  run.pelvis_resected = resected(s, run.plan.pelvis, s.joint().socket(), pelvis_scan, "pelvis_resected");
+/// A resected mesh in the input frame (mm): the scan-pose vertices `scan_pose` moved by the plan's (joint-frame)
+/// displacement of `body`, b.resected - body.relative; the body's faces, named `name`. `session` is the one the
+/// plan was made on; its input is the bones as they were before that plan.
+TriangleMesh resected_mesh(const Session& session, const BoneResection& b, const JointBody& body,
+                           const Vertices& scan_pose, const char* name) {
+  const Eigen::Matrix3d joint_to_input = session.to_input() * session.hip().joint_to_working();
+  TriangleMesh m;
+  m.V = scan_pose + (b.resected - body.relative) * joint_to_input.transpose();
+  m.F = body.mesh.F;
+  m.source = name;
+  return m;
+}
 
-  // The check: a new session on the resected meshes, as `impinge rom` on the written files. Where it misses a
-  // target, a further pass plans on those resected bones, with their own joint placement, acetabulum and joint
-  // surfaces (which the resection may have moved a little: the equidistant joint centre, the rim), within what
-  // the safety depth leaves of each vertex, and adds to the resection; at most kPlanPasses passes.
-  t = Clock::now();
+/// What the check's passes share: the call's options and ROM request, the limits-only request, the first session's
+/// distance reach (mm), the first session (the plan's joint frame) with its limits before, the targets, the
+/// resection's options and the bones' scan-pose vertices (input frame, mm).
+struct PlanCheck {
+  const SessionOptions& options;
+  const RomRequest& rom;
+  const PlanRequest& request;
+  const RomRequest& limits_only;
+  double distance_reach_mm;
+  const Session& s;
+  const RomRun& before;
+  const std::vector<ResectionTarget>& targets;
+  const ResectionOptions& ro;
+  const Vertices& femur_scan;
+  const Vertices& pelvis_scan;
+};
+
+/// The check's session: `c.options` with the bones the plan may resect replaced by run's resected meshes, as the
+/// first session (rom_session_options, the distances on, the plan's reach: which changes no limit, only which far
+/// vertices get a distance).
+std::unique_ptr<Session> check_session(const PlanRun& run, const PlanCheck& c) {
+  SessionOptions after_options = c.options;
+  if (run.plan.femur.allowed) after_options.input.ball_mesh = run.femur_resected, after_options.input.ball.clear();
+  if (run.plan.pelvis.allowed)
+    after_options.input.socket_mesh = run.pelvis_resected, after_options.input.socket.clear();
+  SessionOptions check_options = rom_session_options(after_options, c.rom.search);
+  check_options.hip.joint.distances = true;
+  check_options.hip.joint.distance_reach_mm = c.distance_reach_mm;
+  return std::make_unique<Session>(check_options);
+}
+
+/// Each target before and after (run.targets, run.all_met): a standard motion's limits (deg) before and on the
+/// resected bones (`after`, of session `s_after`), met when free or limited within 0.1 deg of the target, else its
+/// shortfall (deg); a motion file's frames in contact before and after, met when none is after.
+void check_targets(PlanRun& run, const PlanCheck& c, const Session& s_after, const RomRun& after) {
+  const RomRun& before = c.before;
+  run.all_met = true;
+  run.targets.clear();
+  for (const ResectionTarget& target : c.targets) {
+    PlanTargetCheck t;
+    t.name = target.name;
+    t.target_deg = target.angle_deg;
+    if (!std::isnan(target.angle_deg)) {
+      for (std::size_t m = 0; m < before.motions.size(); ++m)
+        if (before.motions[m].name == target.name) t.before = before.limits[m], t.after = after.limits[m];
+      t.met = t.after.status == RomLimitStatus::free ||
+              (t.after.status == RomLimitStatus::limited && t.after.limit_deg >= target.angle_deg - 0.1);
+      if (!t.met)
+        t.shortfall_deg =
+            t.after.status == RomLimitStatus::limited ? target.angle_deg - t.after.limit_deg : target.angle_deg;
+    } else {
+      t.frames_in_contact_before = frames_in_contact(c.s, before.baseline, c.rom.search, target.poses);
+      t.frames_in_contact_after = frames_in_contact(s_after, after.baseline, c.rom.search, target.poses);
+      t.met = t.frames_in_contact_after == 0;
+    }
+    run.all_met = run.all_met && t.met;
+    run.targets.push_back(t);
+  }
+}
+
+/// Adds a further pass's removal of one bone to the plan's `total` (when that bone may be resected): `mesh` (input
+/// frame, mm) moved by the pass's displacement of `body_after` on session `s_after`, the depths (mm) summed, the
+/// resected vertices back in the first session's joint frame (the frame of total.resected; joint_to_input: that
+/// session's joint-to-input rotation), the measures summarised again under the safety depth (mm).
+void add_pass_removal(BoneResection& total, const BoneResection& pass_plan, const Session& s_after,
+                      const JointBody& body_after, const JointBody& body, const Vertices& scan, TriangleMesh& mesh,
+                      const Eigen::Matrix3d& joint_to_input, double safety_depth_mm) {
+  if (!total.allowed) return;
+  mesh = resected_mesh(s_after, pass_plan, body_after, mesh.V, mesh.source.c_str());
+  for (std::size_t i = 0; i < total.depth_mm.size(); ++i) total.depth_mm[i] += pass_plan.depth_mm[i];
+  // In the first session's joint frame (the frame of total.resected): the input-frame displacement, rotated.
+  total.resected = body.relative + (mesh.V - scan) * joint_to_input;
+  summarize_resection(total, body.relative, body.mesh.F, body.vertex_area, safety_depth_mm);
+  total.thin_vertices += pass_plan.thin_vertices;
+}
+
+/// Adds pass `pass`'s plan `next` (made on session `s_after`) to run.plan: both bones' removals, and the pass's
+/// targets, iterations and residual (mm) in place of the earlier ones, its rounds, poses, contacts and time (ms)
+/// added; run.plan.passes = pass + 1.
+void add_pass(PlanRun& run, const PlanCheck& c, const Session& s_after, const ResectionPlan& next,
+              const Eigen::Matrix3d& joint_to_input, int pass) {
+  const Session& s = c.s;
+  add_pass_removal(run.plan.femur, next.femur, s_after, s_after.joint().ball(), s.joint().ball(), c.femur_scan,
+                   run.femur_resected, joint_to_input, c.ro.safety_depth_mm);
+  add_pass_removal(run.plan.pelvis, next.pelvis, s_after, s_after.joint().socket(), s.joint().socket(), c.pelvis_scan,
+                   run.pelvis_resected, joint_to_input, c.ro.safety_depth_mm);
+  run.plan.targets = next.targets;
+  run.plan.iterations = next.iterations;
+  run.plan.rounds += next.rounds;
+  run.plan.residual_mm = next.residual_mm;
+  run.plan.poses += next.poses;
+  run.plan.contacts += next.contacts;
+  run.plan.ms += next.ms;
+  run.plan.passes = pass + 1;
+}
+
+/// The check: a new session on the resected meshes, as `impinge rom` on the written files. Where it misses a
+/// target, a further pass plans on those resected bones, with their own joint placement, acetabulum and joint
+/// surfaces (which the resection may have moved a little: the equidistant joint centre, the rim), within what
+/// the safety depth leaves of each vertex, and adds to the resection; at most kPlanPasses passes. Sets
+/// run.targets and run.all_met; returns the further passes' planning time (ms).
+double check_plan(PlanRun& run, const PlanCheck& c) {
   constexpr int kPlanPasses = 3;
-  const Eigen::Matrix3d joint_to_input = s.to_input() * hip.joint_to_working();  // the first session's
+  const Eigen::Matrix3d joint_to_input = c.s.to_input() * c.s.hip().joint_to_working();  // the first session's
   double extra_plan_ms = 0;
   std::unique_ptr<Session> s_after;
   RomRun after;
   for (int pass = 1;; ++pass) {
-    SessionOptions after_options = options;
-    if (run.plan.femur.allowed) after_options.input.ball_mesh = run.femur_resected, after_options.input.ball.clear();
-    if (run.plan.pelvis.allowed)
-      after_options.input.socket_mesh = run.pelvis_resected, after_options.input.socket.clear();
-    // As the first session: the distances on, with the plan's reach (which changes no limit, only which far
-    // vertices get a distance).
-    SessionOptions check_options = rom_session_options(after_options, rom.search);
-    check_options.hip.joint.distances = true;
-    check_options.hip.joint.distance_reach_mm = so.hip.joint.distance_reach_mm;
-    s_after = std::make_unique<Session>(check_options);
-    after = run_rom(*s_after, limits_only);
-    run.all_met = true;
-    run.targets.clear();
-    for (const ResectionTarget& target : targets) {
-      PlanTargetCheck c;
-      c.name = target.name;
-      c.target_deg = target.angle_deg;
-      if (!std::isnan(target.angle_deg)) {
-        for (std::size_t m = 0; m < before.motions.size(); ++m)
-          if (before.motions[m].name == target.name) c.before = before.limits[m], c.after = after.limits[m];
-        c.met = c.after.status == RomLimitStatus::free ||
-                (c.after.status == RomLimitStatus::limited && c.after.limit_deg >= target.angle_deg - 0.1);
-        if (!c.met)
-          c.shortfall_deg =
-              c.after.status == RomLimitStatus::limited ? target.angle_deg - c.after.limit_deg : target.angle_deg;
-      } else {
-        c.frames_in_contact_before = frames_in_contact(s, before.baseline, rom.search, target.poses);
-        c.frames_in_contact_after = frames_in_contact(*s_after, after.baseline, rom.search, target.poses);
-        c.met = c.frames_in_contact_after == 0;
-      }
-      run.all_met = run.all_met && c.met;
-      run.targets.push_back(c);
-    }
+    s_after = check_session(run, c);
+    after = run_rom(*s_after, c.limits_only);
+    check_targets(run, c, *s_after, after);
     if (run.all_met || pass >= kPlanPasses) break;
     // A further pass on the resected bones, its depths added to the earlier passes'.
     const auto t_pass = Clock::now();
-    ResectionOptions more = ro;
+    ResectionOptions more = c.ro;
     more.femur_removed_mm = run.plan.femur.depth_mm;
     more.pelvis_removed_mm = run.plan.pelvis.depth_mm;
     const ResectionPlan next =
-        plan_resection(s_after->hip(), plan_targets(*s_after, request, after), after.baseline, more);
+        plan_resection(s_after->hip(), plan_targets(*s_after, c.request, after), after.baseline, more);
     extra_plan_ms += ms_since(t_pass);
     if (next.femur.deepest_cut_mm <= kResectedDepthMm && next.pelvis.deepest_cut_mm <= kResectedDepthMm) break;
-    auto add = [&](BoneResection& total, const BoneResection& pass_plan, const JointBody& body_after,
-                   const JointBody& body, const Vertices& scan, TriangleMesh& mesh) {
-      if (!total.allowed) return;
-      mesh = resected(*s_after, pass_plan, body_after, mesh.V, mesh.source.c_str());
-      for (std::size_t i = 0; i < total.depth_mm.size(); ++i) total.depth_mm[i] += pass_plan.depth_mm[i];
-      // In the first session's joint frame (the frame of total.resected): the input-frame displacement, rotated.
-      total.resected = body.relative + (mesh.V - scan) * joint_to_input;
-      summarize_resection(total, body.relative, body.mesh.F, body.vertex_area, ro.safety_depth_mm);
-      total.thin_vertices += pass_plan.thin_vertices;
-    };
-    add(run.plan.femur, next.femur, s_after->joint().ball(), s.joint().ball(), femur_scan, run.femur_resected);
-    add(run.plan.pelvis, next.pelvis, s_after->joint().socket(), s.joint().socket(), pelvis_scan, run.pelvis_resected);
-    run.plan.targets = next.targets;
-    run.plan.iterations = next.iterations;
-    run.plan.rounds += next.rounds;
-    run.plan.residual_mm = next.residual_mm;
-    run.plan.poses += next.poses;
-    run.plan.contacts += next.contacts;
-    run.plan.ms += next.ms;
-    run.plan.passes = pass + 1;
+    add_pass(run, c, *s_after, next, joint_to_input, pass);
   }
-  run.plan_ms += extra_plan_ms;
+  return extra_plan_ms;
+}
+
+/// Per vertex of each bone with a clock (anatomical neutral), its clock hour (run.femur_hours, pelvis_hours), and
+/// the resection's extent on that clock (run.clock_from_h, clock_to_h: femur, pelvis; hours).
+void set_clock_extents(PlanRun& run, const Session& s) {
+  const HipJoint& hip = s.hip();
   if (hip.ball_clock()) {
     run.femur_hours = clock_hours(s.joint().ball().relative, *hip.ball_clock());
     clock_extent(run.femur_hours, run.plan.femur.depth_mm, run.clock_from_h[0], run.clock_to_h[0]);
@@ -338,124 +398,63 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
     run.pelvis_hours = clock_hours(s.joint().socket().relative, *hip.socket_clock());
     clock_extent(run.pelvis_hours, run.plan.pelvis.depth_mm, run.clock_from_h[1], run.clock_to_h[1]);
   }
-  run.check_ms = ms_since(t) - extra_plan_ms;
+}
+
+/// The morphology of the resected femur (run.after; a note when it cannot be measured), when the femur was
+/// resected and the morphology before was measured: `options` with the resected femur.
+void measure_after(PlanRun& run, const SessionOptions& options) {
   if (run.plan.femur.allowed && run.before) {
     SessionOptions mo = options;
     mo.input.ball_mesh = run.femur_resected;
     mo.input.ball.clear();
     run.after = try_morphology(mo, run.notes, "after");
   }
+}
+
+}  // namespace
+
+PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const PlanRequest& request) {
+  const auto t_start = Clock::now();
+  PlanRun run;
+  check_plan_request(options, request);
+  const RomRequest limits_only = limits_only_request(rom);
+  run.search = rom.search;
+  run.request = request;
+  const SessionOptions so = plan_session_options(options, rom.search, request);
+  const Session s(so);
+  run.setup_ms = ms_since(t_start);
+  describe_session(run, s);
+
+  auto t = Clock::now();
+  const RomRun before = run_rom(s, limits_only);
+  run.before_ms = ms_since(t);
+  const std::vector<ResectionTarget> targets = plan_targets(s, request, before);
+
+  // The safety depth: given, or a fraction of the neck's least diameter (Mardones et al. 2005).
+  set_safety_depth(run, s, options, request);
+  const HipJoint& hip = s.hip();
+  ResectionOptions ro = request.resection;
+  ro.safety_depth_mm = run.safety_depth_mm;
+  t = Clock::now();
+  run.plan = plan_resection(hip, targets, before.baseline, ro);
+  run.plan_ms = ms_since(t);
+
+  // The resected meshes in the input frame: the scan-pose vertices moved by the plan's (joint-frame) displacement.
+  const Vertices femur_scan = s.femur_input(hip.scan_pose()), pelvis_scan = s.pelvis_input();
+  run.femur_resected = resected_mesh(s, run.plan.femur, s.joint().ball(), femur_scan, "femur_resected");
+  run.pelvis_resected = resected_mesh(s, run.plan.pelvis, s.joint().socket(), pelvis_scan, "pelvis_resected");
+
+  // The check on the resected bones, with further passes where it misses a target (check_plan).
+  t = Clock::now();
+  const PlanCheck check{options, rom, request,    limits_only, so.hip.joint.distance_reach_mm, s, before,
+                        targets, ro,  femur_scan, pelvis_scan};
+  const double extra_plan_ms = check_plan(run, check);
+  run.plan_ms += extra_plan_ms;
+  set_clock_extents(run, s);
+  run.check_ms = ms_since(t) - extra_plan_ms;
+  measure_after(run, options);
   run.total_ms = ms_since(t_start);
   return run;
-}
-
-nlohmann::json plan_record(const PlanRun& run) {
-  nlohmann::json j;
-  const ResectionOptions& o = run.plan.options;
-  j["subject"] = run.subject;
-  j["femur"] = run.femur_source;
-  j["pelvis"] = run.pelvis_source;
-  j["head_centre_mm"] = {run.head_centre_mm.x(), run.head_centre_mm.y(), run.head_centre_mm.z()};
-  j["input_frame"] = run.input_frame == FrameConvention::LPS ? "LPS" : "RAS";
-  j["method"] =
-      "least removal: per vertex, the depth that keeps every target pose's counted contacts at least the clearance "
-      "apart (exact signed distances, iterated on the resected bones), widened to what a spherical burr cuts, "
-      "capped at the safety depth, never on the articular surfaces (impinge, clinical/resection.hpp)";
-  j["options"] = {{"resect", to_string(o.bones)},
-                  {"clearance_mm", o.clearance_mm},
-                  {"burr_radius_mm", o.burr_radius_mm},
-                  {"max_depth_fraction", run.request.max_depth_fraction},
-                  {"max_depth_mm", run.request.max_depth_mm},
-                  {"tolerance_mm", o.tolerance_mm}};
-  j["neck_diameter_mm"] = number_or_null(run.neck_diameter_mm);
-  j["safety_depth"] = {{"value_mm", run.safety_depth_mm},
-                       {"source", "Mardones et al. 2005, J Bone Joint Surg Am 87:273 (30 % of the neck's diameter)"}};
-  auto bone = [&](const BoneResection& b, int k) {
-    nlohmann::json r = {{"resected", b.allowed},
-                        {"volume_mm3", b.volume_mm3},
-                        {"area_mm2", b.area_mm2},
-                        {"deepest_cut_mm", b.deepest_cut_mm},
-                        {"mean_depth_mm", b.mean_depth_mm},
-                        {"vertices", b.vertices},
-                        {"vertices_at_safety_depth", b.capped_vertices},
-                        {"vertices_held_by_thickness", b.thin_vertices},
-                        {"clock_from_h", number_or_null(run.clock_from_h[k])},
-                        {"clock_to_h", number_or_null(run.clock_to_h[k])}};
-    return r;
-  };
-  j["femur_resection"] = bone(run.plan.femur, 0);
-  j["pelvis_resection"] = bone(run.plan.pelvis, 1);
-  if (run.before) {
-    nlohmann::json a = nlohmann::json::object();
-    a["before_deg"] = nlohmann::json::array();
-    a["after_deg"] = nlohmann::json::array();
-    for (int h = 0; h < 12; ++h) {
-      a["before_deg"].push_back(number_or_null(run.before->alpha_deg[static_cast<std::size_t>(h)]));
-      a["after_deg"].push_back(run.after ? number_or_null(run.after->alpha_deg[static_cast<std::size_t>(h)]) : nullptr);
-    }
-    a["max_before_deg"] = number_or_null(run.before->alpha_max_deg);
-    a["max_after_deg"] = run.after ? number_or_null(run.after->alpha_max_deg) : nullptr;
-    a["definition"] = "alpha angle per head-neck clock hour 1..12 (Notzli et al. 2002; impinge morphology)";
-    j["femur_resection"]["alpha"] = a;
-  }
-  nlohmann::json targets = nlohmann::json::array();
-  for (std::size_t k = 0; k < run.targets.size(); ++k) {
-    const PlanTargetCheck& c = run.targets[k];
-    const ResectionTargetResult& r = run.plan.targets[k];
-    nlohmann::json t = {{"target", c.name},
-                        {"target_deg", number_or_null(c.target_deg)},
-                        {"met", c.met},
-                        {"planned_reachable", r.reachable},
-                        {"planned_reachable_deg", number_or_null(r.reachable_deg)},
-                        {"poses", r.poses},
-                        {"poses_cleared", r.poses_cleared},
-                        {"note", r.note}};
-    if (!std::isnan(c.target_deg)) {
-      t["limit_before_deg"] = number_or_null(c.before.limit_deg);
-      t["status_before"] = to_string(c.before.status);
-      t["limit_after_deg"] = number_or_null(c.after.limit_deg);
-      t["status_after"] = to_string(c.after.status);
-      t["shortfall_deg"] = c.shortfall_deg;
-    } else {
-      t["frames_in_contact_before"] = c.frames_in_contact_before;
-      t["frames_in_contact_after"] = c.frames_in_contact_after;
-    }
-    targets.push_back(t);
-  }
-  j["targets"] = targets;
-  j["all_targets_met"] = run.all_met;
-  j["plan"] = {{"iterations", run.plan.iterations},
-               {"rounds", run.plan.rounds},
-               {"passes", run.plan.passes},
-               {"residual_mm", run.plan.residual_mm},
-               {"poses", run.plan.poses},
-               {"contacts", run.plan.contacts}};
-  j["timings_ms"] = {{"setup", run.setup_ms},
-                     {"limits_before", run.before_ms},
-                     {"plan", run.plan_ms},
-                     {"check", run.check_ms},
-                     {"total", run.total_ms}};
-  j["notes"] = run.notes;
-  j["warnings"] = run.warnings;
-  return j;
-}
-
-void write_plan_meshes(const std::string& dir, const PlanRun& run) {
-  auto one = [&](const TriangleMesh& m, const BoneResection& b, const std::vector<double>& hours, const char* stem) {
-    std::vector<PointArray> arrays(1);
-    arrays[0].name = "resection_mm";
-    for (double d : b.depth_mm) arrays[0].f32.push_back(static_cast<float>(d));
-    if (!hours.empty()) {
-      PointArray h;
-      h.name = "clock_hour";
-      for (double x : hours) h.f32.push_back(static_cast<float>(x));
-      arrays.push_back(h);
-    }
-    write_ply(dir + "/" + stem + ".ply", m, arrays);
-    write_vtp(dir + "/" + stem + ".vtp", m.V, m.F, arrays);
-  };
-  if (run.plan.femur.allowed) one(run.femur_resected, run.plan.femur, run.femur_hours, "femur_resected");
-  if (run.plan.pelvis.allowed) one(run.pelvis_resected, run.plan.pelvis, run.pelvis_hours, "pelvis_resected");
 }
 
 }  // namespace impinge

@@ -1,0 +1,137 @@
+// A plan run's outputs (plan_run.hpp): its record, plan.json, and the resected meshes.
+#include <cmath>
+
+#include "impinge/io/mesh_io.hpp"
+#include "impinge/io/vtk_output.hpp"
+#include "impinge/session/plan_run.hpp"
+#include "impinge/session/records.hpp"
+
+namespace impinge {
+
+namespace {
+
+/// One bone's resection in plan.json: whether resected, volume (mm^3), area (mm^2), deepest and mean cut (mm),
+/// vertices (all, at the safety depth, held by thickness) and the clock extent (hours; k: 0 femur, 1 pelvis).
+nlohmann::json bone_record(const PlanRun& run, const BoneResection& b, int k) {
+  nlohmann::json r = {{"resected", b.allowed},
+                      {"volume_mm3", b.volume_mm3},
+                      {"area_mm2", b.area_mm2},
+                      {"deepest_cut_mm", b.deepest_cut_mm},
+                      {"mean_depth_mm", b.mean_depth_mm},
+                      {"vertices", b.vertices},
+                      {"vertices_at_safety_depth", b.capped_vertices},
+                      {"vertices_held_by_thickness", b.thin_vertices},
+                      {"clock_from_h", number_or_null(run.clock_from_h[k])},
+                      {"clock_to_h", number_or_null(run.clock_to_h[k])}};
+  return r;
+}
+
+/// The femur's alpha angles (deg) before and after the resection, per head-neck clock hour 1..12 and the largest;
+/// after: null when not measured. Needs run.before.
+nlohmann::json alpha_record(const PlanRun& run) {
+  nlohmann::json a = nlohmann::json::object();
+  a["before_deg"] = nlohmann::json::array();
+  a["after_deg"] = nlohmann::json::array();
+  for (int h = 0; h < 12; ++h) {
+    a["before_deg"].push_back(number_or_null(run.before->alpha_deg[static_cast<std::size_t>(h)]));
+    a["after_deg"].push_back(run.after ? number_or_null(run.after->alpha_deg[static_cast<std::size_t>(h)]) : nullptr);
+  }
+  a["max_before_deg"] = number_or_null(run.before->alpha_max_deg);
+  a["max_after_deg"] = run.after ? number_or_null(run.after->alpha_max_deg) : nullptr;
+  a["definition"] = "alpha angle per head-neck clock hour 1..12 (Notzli et al. 2002; impinge morphology)";
+  return a;
+}
+
+/// plan.json's targets: each one's angle (deg), whether met, what the plan reached and its note; a standard
+/// motion's limits (deg) and statuses before and after and its shortfall (deg), a motion file's frames in contact.
+nlohmann::json targets_record(const PlanRun& run) {
+  nlohmann::json targets = nlohmann::json::array();
+  for (std::size_t k = 0; k < run.targets.size(); ++k) {
+    const PlanTargetCheck& c = run.targets[k];
+    const ResectionTargetResult& r = run.plan.targets[k];
+    nlohmann::json t = {{"target", c.name},
+                        {"target_deg", number_or_null(c.target_deg)},
+                        {"met", c.met},
+                        {"planned_reachable", r.reachable},
+                        {"planned_reachable_deg", number_or_null(r.reachable_deg)},
+                        {"poses", r.poses},
+                        {"poses_cleared", r.poses_cleared},
+                        {"note", r.note}};
+    if (!std::isnan(c.target_deg)) {
+      t["limit_before_deg"] = number_or_null(c.before.limit_deg);
+      t["status_before"] = to_string(c.before.status);
+      t["limit_after_deg"] = number_or_null(c.after.limit_deg);
+      t["status_after"] = to_string(c.after.status);
+      t["shortfall_deg"] = c.shortfall_deg;
+    } else {
+      t["frames_in_contact_before"] = c.frames_in_contact_before;
+      t["frames_in_contact_after"] = c.frames_in_contact_after;
+    }
+    targets.push_back(t);
+  }
+  return targets;
+}
+
+}  // namespace
+
+nlohmann::json plan_record(const PlanRun& run) {
+  nlohmann::json j;
+  const ResectionOptions& o = run.plan.options;
+  j["subject"] = run.subject;
+  j["femur"] = run.femur_source;
+  j["pelvis"] = run.pelvis_source;
+  j["head_centre_mm"] = {run.head_centre_mm.x(), run.head_centre_mm.y(), run.head_centre_mm.z()};
+  j["input_frame"] = run.input_frame == FrameConvention::LPS ? "LPS" : "RAS";
+  j["method"] =
+      "least removal: per vertex, the depth that keeps every target pose's counted contacts at least the clearance "
+      "apart (exact signed distances, iterated on the resected bones), widened to what a spherical burr cuts, "
+      "capped at the safety depth, never on the articular surfaces (impinge, clinical/resection.hpp)";
+  j["options"] = {{"resect", to_string(o.bones)},
+                  {"clearance_mm", o.clearance_mm},
+                  {"burr_radius_mm", o.burr_radius_mm},
+                  {"max_depth_fraction", run.request.max_depth_fraction},
+                  {"max_depth_mm", run.request.max_depth_mm},
+                  {"tolerance_mm", o.tolerance_mm}};
+  j["neck_diameter_mm"] = number_or_null(run.neck_diameter_mm);
+  j["safety_depth"] = {{"value_mm", run.safety_depth_mm},
+                       {"source", "Mardones et al. 2005, J Bone Joint Surg Am 87:273 (30 % of the neck's diameter)"}};
+  j["femur_resection"] = bone_record(run, run.plan.femur, 0);
+  j["pelvis_resection"] = bone_record(run, run.plan.pelvis, 1);
+  if (run.before) j["femur_resection"]["alpha"] = alpha_record(run);
+  j["targets"] = targets_record(run);
+  j["all_targets_met"] = run.all_met;
+  j["plan"] = {{"iterations", run.plan.iterations},
+               {"rounds", run.plan.rounds},
+               {"passes", run.plan.passes},
+               {"residual_mm", run.plan.residual_mm},
+               {"poses", run.plan.poses},
+               {"contacts", run.plan.contacts}};
+  j["timings_ms"] = {{"setup", run.setup_ms},
+                     {"limits_before", run.before_ms},
+                     {"plan", run.plan_ms},
+                     {"check", run.check_ms},
+                     {"total", run.total_ms}};
+  j["notes"] = run.notes;
+  j["warnings"] = run.warnings;
+  return j;
+}
+
+void write_plan_meshes(const std::string& dir, const PlanRun& run) {
+  auto one = [&](const TriangleMesh& m, const BoneResection& b, const std::vector<double>& hours, const char* stem) {
+    std::vector<PointArray> arrays(1);
+    arrays[0].name = "resection_mm";
+    for (double d : b.depth_mm) arrays[0].f32.push_back(static_cast<float>(d));
+    if (!hours.empty()) {
+      PointArray h;
+      h.name = "clock_hour";
+      for (double x : hours) h.f32.push_back(static_cast<float>(x));
+      arrays.push_back(h);
+    }
+    write_ply(dir + "/" + stem + ".ply", m, arrays);
+    write_vtp(dir + "/" + stem + ".vtp", m.V, m.F, arrays);
+  };
+  if (run.plan.femur.allowed) one(run.femur_resected, run.plan.femur, run.femur_hours, "femur_resected");
+  if (run.plan.pelvis.allowed) one(run.pelvis_resected, run.plan.pelvis, run.pelvis_hours, "pelvis_resected");
+}
+
+}  // namespace impinge
