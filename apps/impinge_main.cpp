@@ -11,7 +11,9 @@
 #include <cmath>
 #include <exception>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -28,6 +30,7 @@
 #include "impinge/session/records.hpp"
 #include "impinge/session/runs.hpp"
 #include "impinge/session/session.hpp"
+#include "impinge/session/view.hpp"
 
 #include "allocator.hpp"
 #include "vtk_meshes.hpp"
@@ -337,6 +340,43 @@ int run_generate(const RunOptions& run) {
   return 0;
 }
 
+// The options given to `cmd` on the command line as its tokens ("--name=value", "--flag"), for the rows with `use`
+// that are not the view's own (those whose only use is `use_view`): what the viewer's server parses again.
+std::vector<std::string> given_tokens(const CLI::App* cmd, unsigned use, const CliValues& v) {
+  std::vector<std::string> out;
+  for (const OptionRow& r : option_table()) {
+    if (!(r.uses & use) || r.uses == use_view) continue;
+    std::vector<std::string> names = {r.name};
+    names.insert(names.end(), r.old_names.begin(), r.old_names.end());
+    for (const std::string& n : names) {
+      if (cmd->count("--" + n) == 0) continue;
+      if (r.type == OptionType::flag) {
+        if (v.flag.at(n)) out.push_back("--" + n);
+      } else {
+        out.push_back("--" + n + "=" + v.text.at(n));
+      }
+    }
+  }
+  return out;
+}
+
+// `impinge view`: the options checked here (the table's rows for view), then the server runs in this process's place
+// (exec), so Ctrl-C and the exit status are its own.
+int run_view(const RunOptions& o, const std::vector<std::string>& tokens) {
+  const std::string warning = view_host_warning(o.view.host);
+  if (!warning.empty()) std::cerr << "impinge: warning: " << warning << "\n";
+  const ViewCommand c = view_command(o.view, tokens, IMPINGE_PYTHON_BUILD_DIR);
+  const char* old = std::getenv("PYTHONPATH");
+  const std::string path = c.python_path + (old != nullptr && *old != '\0' ? ":" + std::string(old) : "");
+  setenv("PYTHONPATH", path.c_str(), 1);
+  std::vector<char*> argv;
+  for (const std::string& a : c.argv) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  std::cout.flush();
+  execv(argv[0], argv.data());
+  throw Error("impinge view: cannot run " + c.argv[0] + ": " + std::strerror(errno));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -374,7 +414,13 @@ int main(int argc, char** argv) {
       {app.add_subcommand("generate", "Write a generated hip model (femur_r.ply, pelvis.ply, subject.json)"),
        use_generate, run_generate},
   };
+  CLI::App* view = app.add_subcommand(
+      "view",
+      "Joint3D in the browser (thesis sec. 3.4): a local page where the hip moves with sliders and the impingement "
+      "levels, gaps or distances are coloured on both bones, each pose detected as `impinge distance` detects it. "
+      "Takes distance's inputs and settings; prints the page's address (with its access token)");
   for (const Command& c : commands) add_table_options(c.app, c.use, values);
+  add_table_options(view, use_view, values);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -383,6 +429,7 @@ int main(int argc, char** argv) {
   try {
     for (const Command& c : commands)
       if (*c.app) return c.run(given_options(c.app, c.use, values));
+    if (*view) return run_view(given_options(view, use_view, values), given_tokens(view, use_view, values));
   } catch (const std::bad_alloc&) {
     std::cerr << "impinge: error: out of memory: the meshes or maps do not fit in this machine's memory; try a "
                  "coarser --resolution, fewer --layers or a larger --layered-spacing\n";

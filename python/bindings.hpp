@@ -71,6 +71,10 @@ py::object default_of(const std::string& key);
 // Every row (uses & use) given in `given` (key -> value; None: the default) set on `run`, in the table's order
 // (preset first); a key no row of `use` takes is an error naming `caller` and the known keys.
 void set_options(RunOptions& run, const py::dict& given, unsigned use, const std::string& caller);
+// The CLI's tokens (--name VALUE, --name=VALUE, --flag) of the rows with `use`, parsed as the CLI parses them
+// (parse_option_text) and set on `run` in the table's order; an unknown or repeated option, or one without its value,
+// is an error naming `caller`; a former name warns (DeprecationWarning).
+void set_cli_options(RunOptions& run, const std::vector<std::string>& args, unsigned use, const std::string& caller);
 void bind_options(py::module_& m);
 // "Keywords (...): a, b, c.": the keys of the rows with `use`, for a docstring.
 std::string keywords_doc(unsigned use);

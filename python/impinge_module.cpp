@@ -7,6 +7,7 @@
 #include <omp.h>
 
 #include "bindings.hpp"
+#include "impinge/detection/impingement_levels.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/kernels.hpp"
 #include "impinge/core/provenance.hpp"
@@ -45,6 +46,27 @@ void bind_functions(py::module_& m) {
       py::arg("n"),
       "Threads (OpenMP) of the calling thread's later calls: ROM searches and maps, sampling. Default: one per "
       "core (or OMP_NUM_THREADS). Studies give each task one thread (impinge.study).");
+  m.def(
+      "level_colours",
+      [](int count) {
+        if (count < 2 || count > 255) throw Error("level_colours: count " + std::to_string(count) + ": must be 2-255");
+        py::dict d;
+        for (const bool femur : {true, false}) {
+          py::list l;
+          for (int k = 0; k < count; ++k) {
+            const auto c = level_colour(static_cast<std::uint8_t>(k), count, femur);
+            l.append(py::make_tuple(c[0], c[1], c[2]));
+          }
+          d[femur ? "femur" : "pelvis"] = l;
+        }
+        const auto u = level_colour(255, count, true);
+        d["untested"] = py::make_tuple(u[0], u[1], u[2]);
+        return d;
+      },
+      py::arg("count"),
+      "The impingement levels' colours (thesis sec. 3.4, Figure 41), as the PLY files give them, for `count` levels "
+      "(len(levels) + 1) -> dict(femur=[(r, g, b) per level 0..count-1], pelvis=[...], untested=(r, g, b)), 0-255; "
+      "level 0 (none) is green on the femur and blue on the pelvis. Raises impinge.Error outside 2-255.");
   m.def("get_threads", []() { return omp_get_max_threads(); },
         "Threads (OpenMP) the calling thread's next parallel call would use.");
   m.def(

@@ -9,6 +9,7 @@
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/session/morphology_run.hpp"
+#include "impinge/session/outputs.hpp"
 #include "impinge/session/plan_run.hpp"
 #include "impinge/session/runs.hpp"
 
@@ -35,6 +36,18 @@ PyJoint make_joint(const py::object& ball, const py::object& socket, const py::k
   return j;
 }
 
+// The Joint `impinge view` serves: its options the CLI's tokens, read through the option table as the CLI reads them.
+PyJoint joint_from_cli(const std::vector<std::string>& args) {
+  RunOptions run = RunOptions::clinical();
+  set_cli_options(run, args, use_view, "impinge view");
+  PyJoint j;
+  {
+    py::gil_scoped_release release;
+    j.session = std::make_shared<const Session>(run.session);
+  }
+  return j;
+}
+
 // Both scans as Python: the gaps and statuses as numpy arrays (owning the C++ buffers), and each
 // scan's summary as summary.json records it (scan_record).
 py::dict result_dict(const Session& session, PoseResult&& r) {
@@ -42,6 +55,11 @@ py::dict result_dict(const Session& session, PoseResult&& r) {
   const auto nb = static_cast<py::ssize_t>(r.ball_gaps.gap_mm.size());
   const auto ns = static_cast<py::ssize_t>(r.socket_gaps.gap_mm.size());
   const ImpingementLevels& levels = session.joint_options().levels;
+  // The impingement level of each vertex (0 none .. count-1 deepest; 255 untested), as the PLY files give it; taken
+  // before the gaps move into their arrays.
+  const LevelQuantity on = session.joint_options().level_quantity();
+  std::vector<std::uint8_t> femur_level = vertex_levels(r.ball_gaps, levels, on);
+  std::vector<std::uint8_t> pelvis_level = vertex_levels(r.socket_gaps, levels, on);
   py::dict summary;
   summary["femur"] = from_json(scan_record(session.joint().ball(), r.ball, r.ball_detection_ms, levels, nullptr));
   summary["pelvis"] =
@@ -58,6 +76,8 @@ py::dict result_dict(const Session& session, PoseResult&& r) {
     d["femur_distance_mm"] = own(std::move(r.ball_gaps.distance_mm), {nb});
     d["pelvis_distance_mm"] = own(std::move(r.socket_gaps.distance_mm), {ns});
   }
+  d["femur_level"] = own(std::move(femur_level), {nb});
+  d["pelvis_level"] = own(std::move(pelvis_level), {ns});
   d["femur_status"] = own(std::move(r.ball_gaps.status), {nb});
   d["pelvis_status"] = own(std::move(r.socket_gaps.status), {ns});
   d["summary"] = summary;
@@ -192,7 +212,8 @@ void add_joint_queries(py::class_<PyJoint>& c) {
        "mm -> dict(femur_gap_mm, pelvis_gap_mm: float32 (n,) in the input's vertex order, NaN where not "
        "tested; femur_distance_mm, pelvis_distance_mm: float32 (n,), the signed Euclidean distance to the other "
        "bone, NaN beyond the reach (with distances on); femur_status, pelvis_status: uint8 (0 tested, 1 no "
-       "surface, 2 beyond reach); summary).")
+       "surface, 2 beyond reach); femur_level, pelvis_level: uint8 (n,), the impingement level (0 none .. "
+       "len(levels) deepest, 255 untested; level_colours() gives the PLY files' colours); summary).")
       .def(
           "detect_pose",
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
@@ -313,6 +334,17 @@ void add_joint_properties(py::class_<PyJoint>& c) {
       .def_property_readonly(
           "pelvis_map", [](const PyJoint& j) { return MapView{j.session->shared_hip(), &j.hip().joint().socket().map}; })
       .def_property_readonly(
+          "meshes",
+          [](const PyJoint& j) {
+            const Session& s = *j.session;
+            py::dict d;
+            d["femur"] = py::make_tuple(Vertices(s.femur_input(s.hip().scan_pose())), s.joint().ball().mesh.F);
+            d["pelvis"] = py::make_tuple(Vertices(s.pelvis_input()), s.joint().socket().mesh.F);
+            return d;
+          },
+          "Both bones as given, in the input frame at the scan pose -> dict(femur=(V (n, 3) float64 mm, F (m, 3) "
+          "int), pelvis=(V, F)): the vertex order of every per-vertex result.")
+      .def_property_readonly(
           "frames",
           [](const PyJoint& j) -> py::object {
             const nlohmann::json r = setup_record(*j.session);
@@ -396,6 +428,10 @@ void bind_joint(py::module_& m) {
   py::class_<PyJoint> c(m, "Joint", "A hip set up as the CLI sets it up (the session layer); see __init__.");
   static const std::string doc = joint_doc();  // pybind11 keeps the pointer
   c.def(py::init(&make_joint), py::arg("ball") = py::none(), py::arg("socket") = py::none(), doc.c_str());
+  c.def_static("_from_cli", &joint_from_cli, py::arg("args"),
+               "A Joint set up from `impinge view`'s command-line options (['--subject', 'S', '--precision', '0.5', "
+               "...]: the option table's rows for view, parsed as the CLI parses them). Raises impinge.Error naming "
+               "the option. For impinge.view; warnings are in .warnings.");
   add_joint_queries(c);
   add_joint_properties(c);
   add_joint_benchmarks(c);

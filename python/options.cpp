@@ -3,6 +3,7 @@
 // spec's tests (python/tests/test_options.py) and for users.
 #include <cmath>
 #include <algorithm>
+#include <map>
 #include <deque>
 
 #include "bindings.hpp"
@@ -42,6 +43,7 @@ const char* use_name(unsigned bit) {
     case use_morphology: return "morphology";
     case use_plan: return "plan";
     case use_joint_plan: return "joint_plan";
+    case use_view: return "view";
     default: return "?";
   }
 }
@@ -152,6 +154,39 @@ void set_options(RunOptions& run, const py::dict& given, unsigned use, const std
   }
 }
 
+void set_cli_options(RunOptions& run, const std::vector<std::string>& args, unsigned use, const std::string& caller) {
+  // The tokens as the CLI gives them: --name VALUE, --name=VALUE, or --flag; a former name warns.
+  std::map<const OptionRow*, std::pair<std::string, std::string>> given;  // row -> (name as given, text)
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a.rfind("--", 0) != 0) throw Error(caller + ": '" + a + "': expected an option --NAME");
+    const std::size_t eq = a.find('=');
+    const std::string name = a.substr(2, eq == std::string::npos ? std::string::npos : eq - 2);
+    const OptionRow* r = find_option(name);
+    if (r == nullptr || !(r->uses & use) || (r->name != name && !std::count(r->old_names.begin(), r->old_names.end(), name)))
+      throw Error(caller + ": unknown option --" + name);
+    if (given.count(r)) throw Error(caller + ": --" + name + " given twice");
+    std::string text;
+    if (eq != std::string::npos) {
+      text = a.substr(eq + 1);
+    } else if (r->type != OptionType::flag) {
+      if (i + 1 >= args.size()) throw Error(caller + ": --" + name + " needs a value");
+      text = args[++i];
+    }
+    if (name != r->name) {
+      const std::string msg = "--" + name + " is deprecated and will be removed in the next release: use --" + r->name;
+      if (PyErr_WarnEx(PyExc_DeprecationWarning, msg.c_str(), 1) != 0) throw py::error_already_set();
+    }
+    given[r] = {name, text};
+  }
+  for (const OptionRow& r : option_table()) {  // the table's order: preset first
+    const auto it = given.find(&r);
+    if (it == given.end()) continue;
+    const std::string as = "--" + it->second.first;
+    r.set(run, r.type == OptionType::flag ? OptionValue(true) : parse_option_text(r, it->second.second, as), as);
+  }
+}
+
 std::string keywords_doc(unsigned use) {
   std::string keys;
   for (const OptionRow& r : option_table())
@@ -189,7 +224,7 @@ void bind_options(py::module_& m) {
           d["old_names"] = r.old_names;
           d["old_keys"] = r.old_keys;
           py::list uses;
-          for (unsigned bit = 1; bit <= use_joint_plan; bit <<= 1)
+          for (unsigned bit = 1; bit <= use_last; bit <<= 1)
             if (r.uses & bit) uses.append(use_name(bit));
           d["uses"] = uses;
           rows.append(d);

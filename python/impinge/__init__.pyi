@@ -49,6 +49,9 @@ def locate_femoral_head(V: npt.ArrayLike, F: npt.ArrayLike,
     """Femoral head sphere of a femur in any orientation; with its pelvis (same frame), the end that
     sits in the acetabulum, as the CLI finds it."""
 
+def level_colours(count: int) -> Dict[str, Any]:
+    """The impingement levels' colours (0-255) as the PLY files give them, for `count` levels -> dict(femur=[(r, g,
+    b) per level], pelvis=[...], untested=(r, g, b))."""
 def options() -> List[Dict[str, Any]]:
     """The option table (the session layer's): one dict per option with name (the CLI's), key (Python's and the
     study files'), type, unit, choices, min, max (the field's declared range), min_exclusive, required, default
@@ -126,7 +129,8 @@ class Joint:
         """Both scans, femur rotated by R about its head centre (`cor`) and translated by t -> dict(femur_gap_mm,
         pelvis_gap_mm (float32, NaN untested), femur_distance_mm, pelvis_distance_mm (float32, the signed
         Euclidean distance to the other bone, NaN beyond the reach; with distances on), femur_status,
-        pelvis_status (uint8), summary: each scan's record as summary.json gives it)."""
+        pelvis_status (uint8), femur_level, pelvis_level (uint8, the impingement level; 255 untested), summary: each
+        scan's record as summary.json gives it)."""
     def detect_pose(self, flexion: float = 0.0, adduction: float = 0.0,
                     internal_rotation: float = 0.0) -> Dict[str, Any]:
         """Both scans at clinical angles (degrees, ISB), the femur placed by the joint-centre method; the
@@ -181,6 +185,8 @@ class Joint:
     pivot: Optional[npt.NDArray[np.float64]]
     """The point the femur turns about under the joint-centre method (input frame, mm, the pelvis fixed): the
     head centre (femoral-head) or the acetabular centre (acetabular, combined); None for equidistant."""
+    meshes: Dict[str, Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]]
+    """Both bones as given (input frame, scan pose): dict(femur=(V, F), pelvis=(V, F))."""
     femur_map: Map
     pelvis_map: Map
     frames: Optional[Dict[str, Any]]

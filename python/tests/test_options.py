@@ -53,7 +53,7 @@ def cli_help(command):
             if m.group(1) != "help"}
 
 
-@pytest.mark.parametrize("command", ["distance", "motion", "rom", "generate", "morphology", "plan"])
+@pytest.mark.parametrize("command", ["distance", "motion", "rom", "generate", "morphology", "plan", "view"])
 def test_cli_options_are_the_tables(command):
     shown = cli_help(command)
     table = {o["name"]: o for o in rows(command)}

@@ -14,8 +14,8 @@ namespace {
 using namespace detail;
 
 constexpr unsigned kJointCommands = use_distance | use_motion | use_rom | use_plan;
-constexpr unsigned kInput = kJointCommands | use_joint | use_morphology;
-constexpr unsigned kSetting = kJointCommands | use_joint | use_study;
+constexpr unsigned kInput = kJointCommands | use_joint | use_morphology | use_view;
+constexpr unsigned kSetting = kJointCommands | use_joint | use_study | use_view;
 
 // A length's range with 0 added, for a row whose 0 means "no such length" (every vertex, dense maps).
 Range with_zero(Range r) {
@@ -438,6 +438,20 @@ void add_plan_rows(Rows& t) {
          [](auto& o) -> auto& { return o.plan.allow_partial; });
 }
 
+// `impinge view`'s own rows (ViewOptions): where its server listens and whether it opens the page.
+void add_view_rows(Rows& t) {
+  t.text("host", "host", OptionType::text, use_view, {},
+         "The address the viewer's server listens on (127.0.0.1: this machine only; another address serves the "
+         "network, with a warning; the page's token still guards every request)",
+         [](auto& o) -> auto& { return o.view.host; });
+  t.integer("port", "port", "", use_view, ViewOptions::kPortRange,
+            "The viewer's TCP port (0: a free one, printed with the page's address)",
+            [](auto& o) -> auto& { return o.view.port; });
+  t.flag("no-browser", "no_browser", OptionType::flag, use_view,
+         "Print the page's address without opening it in a browser",
+         [](auto& o) -> auto& { return o.view.open_browser; }, true);
+}
+
 }  // namespace
 
 const std::vector<OptionRow>& option_table() {
@@ -454,6 +468,7 @@ const std::vector<OptionRow>& option_table() {
     add_rom_rows(t);
     add_plan_rows(t);
     add_command_rows(t);
+    add_view_rows(t);
     return std::move(t.rows);
   }();
   return table;

@@ -24,6 +24,7 @@
 #include "impinge/session/plan_run.hpp"
 #include "impinge/session/runs.hpp"
 #include "impinge/session/session.hpp"
+#include "impinge/session/view.hpp"
 
 namespace impinge {
 
@@ -49,6 +50,7 @@ struct RunOptions {
   HipModelOptions generate;
   PlanRequest plan;  ///< `impinge plan`, Joint.plan, a study's `plan` task
   CommandArguments command;
+  ViewOptions view;  ///< `impinge view`'s server
   /// The front ends' defaults (CLI, Python, studies): layered maps (4 crossings) for hidden vertices,
   /// Euclidean distances beside the gaps, the ROM metric the distance, the ROM map on its 0..120 x
   /// -20..40 deg grid; the joint-centre method follows the neutral (equidistant, Puls et al. 2010, at
@@ -98,6 +100,8 @@ enum OptionUse : unsigned {
   use_morphology = 1u << 9,     ///< `impinge morphology`, Python impinge.morphology(...)
   use_plan = 1u << 10,          ///< `impinge plan`
   use_joint_plan = 1u << 11,    ///< Python Joint.plan(...); a study's `plan` task
+  use_view = 1u << 12,          ///< `impinge view` (its server's Joint: Python Joint._from_cli)
+  use_last = use_view,          ///< the highest bit (for loops over the bits)
   use_cli_commands = use_distance | use_motion | use_rom | use_generate | use_morphology | use_plan,
 };
 

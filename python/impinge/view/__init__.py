@@ -1,0 +1,282 @@
+"""impinge view: the thesis' Joint3D (section 3.4) as a page in the browser (issue 79).
+
+A local aiohttp server around one `impinge.Joint`, set up from the same options as `impinge distance` (the option
+table's rows, parsed by the library: `Joint._from_cli`). The page (three.js, bundled by esbuild at build time into
+static/viewer.js; nothing is fetched from a network when it runs) shows both bones; every pose it asks for is detected
+by the library (`Joint.detect_pose`: the joint-centre method, exact look-ups, Euclidean distances) and answered with
+the per-vertex values the page colours.
+
+Safety: the server listens on 127.0.0.1 unless told otherwise; every request must carry the random token printed in
+the page's address (as Jupyter does), else 403. It reads only the files named on the command line.
+
+Protocol (WebSocket /ws): the page sends {"type": "pose", "id": n, "pose": [flexion, adduction, internal_rotation]}
+(degrees, ISB); the server answers the newest pose it has (an older pending one is dropped, never queued) with one
+binary message: a little-endian uint32 header length, the header (JSON: id, pose, R (9, row-major, input frame), t
+(3, mm), summary, ms), then float32 femur gaps, float32 pelvis gaps, float32 femur distances, float32 pelvis
+distances (absent: NaN), uint8 femur levels, uint8 pelvis levels, each padded to 4 bytes. A bad message gets
+{"type": "error", "message": ...} and the server keeps serving.
+"""
+import asyncio
+import json
+import math
+import os
+import secrets
+import struct
+import sys
+import webbrowser
+import weakref
+
+import numpy as np
+
+import impinge
+
+STATIC = os.path.join(os.path.dirname(__file__), "static")
+MAX_MESSAGE_BYTES = 4096  # a pose message is < 200 bytes; anything larger is refused
+
+
+class BadMessage(ValueError):
+    """A message from the page that is not a valid request (said back to the page)."""
+
+
+def parse_pose_message(text):
+    """A page's message -> (id, (flexion, adduction, internal_rotation)) in degrees. Raises BadMessage naming
+    what is wrong (not JSON, not an object, unknown type, a pose not three finite numbers within +-360 deg)."""
+    if len(text) > MAX_MESSAGE_BYTES:
+        raise BadMessage(f"message of {len(text)} bytes: at most {MAX_MESSAGE_BYTES}")
+    try:
+        m = json.loads(text)
+    except ValueError as e:
+        raise BadMessage(f"not JSON: {e}") from None
+    if not isinstance(m, dict):
+        raise BadMessage("expected an object {type, id, pose}")
+    if m.get("type") != "pose":
+        raise BadMessage(f"unknown message type {m.get('type')!r} (known: pose)")
+    pose = m.get("pose")
+    if not isinstance(pose, list) or len(pose) != 3 or not all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) for x in pose):
+        raise BadMessage(f"pose {pose!r}: expected [flexion, adduction, internal_rotation] in degrees")
+    if not all(math.isfinite(x) and abs(x) <= 360 for x in pose):
+        raise BadMessage(f"pose {pose!r}: each angle must be finite and within +-360 deg")
+    ident = m.get("id", 0)
+    if not isinstance(ident, int) or isinstance(ident, bool):
+        raise BadMessage(f"id {ident!r}: expected an integer")
+    return ident, tuple(float(x) for x in pose)
+
+
+def _padded(a):
+    b = np.ascontiguousarray(a).tobytes()
+    return b + b"\0" * (-len(b) % 4)
+
+
+class Viewer:
+    """One Joint and what the page needs of it: the scene (meshes, levels, palette, axes) and posed frames."""
+
+    def __init__(self, joint):
+        self.joint = joint
+        setup = joint.setup
+        self.meshes = joint.meshes
+        thresholds = list(setup["levels_thresholds_mm"])
+        frames = setup.get("frames")
+        axes = None
+        if frames:  # anatomical neutral: the pelvic frame's axes (input frame): x anterior, y superior, z right (ISB)
+            p = frames["pelvis"]
+            axes = {"x": p["x_axis"], "y": p["y_axis"], "z": p["z_axis"]}
+        self.scene = {
+            "impinge_version": impinge.__version__,
+            "femur_vertices": int(len(self.meshes["femur"][0])),
+            "pelvis_vertices": int(len(self.meshes["pelvis"][0])),
+            "femur_triangles": int(len(self.meshes["femur"][1])),
+            "pelvis_triangles": int(len(self.meshes["pelvis"][1])),
+            "levels_thresholds_mm": thresholds,
+            "levels_on": setup["levels_on"],
+            "distances": bool(setup["distances"]),
+            "palette": impinge.level_colours(len(thresholds) + 1),
+            "head_centre_mm": list(map(float, joint.cor)),
+            "head_radius_mm": setup.get("head_radius_mm"),
+            "side": setup["side"],
+            "input_frame": setup["input_frame"],
+            "neutral": setup["neutral"],
+            "joint_centre": setup["joint_centre"],
+            "pelvic_frame": setup.get("pelvic_frame"),
+            "axes": axes,
+            "warnings": list(setup.get("warnings", [])),
+        }
+
+    def mesh_bytes(self, bone):
+        """A bone as binary: uint32 vertex count, uint32 triangle count, float32 V (n x 3), uint32 F (m x 3)."""
+        V, F = self.meshes[bone]
+        return struct.pack("<II", len(V), len(F)) + _padded(np.asarray(V, "<f4")) + _padded(np.asarray(F, "<u4"))
+
+    def frame_bytes(self, ident, pose):
+        """The binary answer to one pose (the module docstring's layout). Runs the detection (GIL released)."""
+        import time
+        t0 = time.perf_counter()
+        r = self.joint.detect_pose(*pose)
+        R, t = self.joint.femur_pose(*pose)
+        ms = (time.perf_counter() - t0) * 1e3
+        fs, ps = r["summary"]["femur"], r["summary"]["pelvis"]
+        nan = float("nan")
+
+        def least(a, b):
+            v = [x for x in (a, b) if x is not None and math.isfinite(x)]
+            return min(v) if v else None
+
+        summary = {
+            "least_gap_mm": least(fs.get("min_gap_mm"), ps.get("min_gap_mm")),
+            "least_distance_mm": least(fs.get("min_distance_mm"), ps.get("min_distance_mm")),
+            "contact_area_mm2": float(ps.get("area_penetrating_mm2") or 0.0),
+            "inside_area_mm2": ps.get("area_inside_mm2"),
+            "femur": {k: fs.get(k) for k in ("min_gap_mm", "min_distance_mm", "vertices_penetrating",
+                                              "vertices_inside")},
+            "pelvis": {k: ps.get(k) for k in ("min_gap_mm", "min_distance_mm", "vertices_penetrating",
+                                               "vertices_inside")},
+        }
+        header = json.dumps({"id": ident, "pose": list(pose), "R": np.asarray(R).ravel().tolist(),
+                             "t": np.asarray(t).ravel().tolist(), "summary": summary, "ms": ms},
+                            allow_nan=False, default=lambda x: None).encode()
+        nf, npv = self.scene["femur_vertices"], self.scene["pelvis_vertices"]
+        fd = r.get("femur_distance_mm", np.full(nf, nan, np.float32))
+        pd = r.get("pelvis_distance_mm", np.full(npv, nan, np.float32))
+        parts = [struct.pack("<I", len(header)), header + b" " * (-len(header) % 4),
+                 _padded(r["femur_gap_mm"].astype("<f4")), _padded(r["pelvis_gap_mm"].astype("<f4")),
+                 _padded(np.asarray(fd, "<f4")), _padded(np.asarray(pd, "<f4")),
+                 _padded(r["femur_level"]), _padded(r["pelvis_level"])]
+        return b"".join(parts)
+
+
+def make_app(viewer, token):
+    """The aiohttp application: the page, its script, the scene, both meshes and the pose WebSocket; every
+    request must carry `token` (query `token` or header X-Impinge-Token), else 403."""
+    from aiohttp import web, WSMsgType
+
+    @web.middleware
+    async def require_token(request, handler):
+        given = request.query.get("token") or request.headers.get("X-Impinge-Token", "")
+        if not secrets.compare_digest(given, token):
+            return web.Response(status=403, text="impinge view: a request without this server's token is refused\n")
+        return await handler(request)
+
+    async def page(request):
+        with open(os.path.join(STATIC, "index.html"), encoding="utf-8") as f:
+            html = f.read()
+        resp = web.Response(text=html.replace("__TOKEN__", token), content_type="text/html")
+        resp.headers["Cache-Control"] = "no-store"
+        return resp
+
+    async def script(request):
+        return web.FileResponse(os.path.join(STATIC, "viewer.js"), headers={"Content-Type": "text/javascript"})
+
+    async def scene(request):
+        return web.json_response(viewer.scene)
+
+    async def mesh(request):
+        bone = request.match_info["bone"]
+        if bone not in ("femur", "pelvis"):
+            raise web.HTTPNotFound(text=f"no bone {bone!r} (femur, pelvis)")
+        return web.Response(body=viewer.mesh_bytes(bone), content_type="application/octet-stream")
+
+    async def socket(request):
+        ws = web.WebSocketResponse(max_msg_size=MAX_MESSAGE_BYTES * 4)
+        await ws.prepare(request)
+        request.app["sockets"].add(ws)
+        pending = {"req": None}
+        wake = asyncio.Event()
+        loop = asyncio.get_running_loop()
+
+        async def worker():
+            while not ws.closed:
+                await wake.wait()
+                wake.clear()
+                req, pending["req"] = pending["req"], None
+                if req is None:
+                    continue
+                try:
+                    data = await loop.run_in_executor(None, viewer.frame_bytes, *req)
+                except impinge.Error as e:
+                    await ws.send_str(json.dumps({"type": "error", "id": req[0], "message": str(e)}))
+                    continue
+                if not ws.closed:
+                    await ws.send_bytes(data)
+
+        task = asyncio.ensure_future(worker())
+        try:
+            async for msg in ws:
+                if msg.type == WSMsgType.TEXT:
+                    try:
+                        pending["req"] = parse_pose_message(msg.data)  # the newest replaces an older pending one
+                        wake.set()
+                    except BadMessage as e:
+                        await ws.send_str(json.dumps({"type": "error", "message": str(e)}))
+                elif msg.type == WSMsgType.BINARY:
+                    await ws.send_str(json.dumps({"type": "error", "message": "binary messages are not accepted"}))
+                elif msg.type == WSMsgType.ERROR:
+                    break
+        finally:
+            task.cancel()
+        return ws
+
+    async def close_sockets(app):  # on Ctrl-C: the open pages are told the server has gone, not waited for
+        for ws in list(app["sockets"]):
+            await ws.close(code=1001, message=b"server stopped")
+
+    app = web.Application(middlewares=[require_token], client_max_size=64 * 1024)
+    app["sockets"] = weakref.WeakSet()
+    app.on_shutdown.append(close_sockets)
+    app.add_routes([web.get("/", page), web.get("/viewer.js", script), web.get("/api/scene", scene),
+                    web.get("/api/mesh/{bone}", mesh), web.get("/ws", socket)])
+    return app
+
+
+async def serve(viewer, host, port, open_browser, token, ready=None):
+    """Serve until cancelled (Ctrl-C). Prints the page's address; opens it unless open_browser is False.
+    `ready`: an optional callback given the address once listening."""
+    from aiohttp import web
+    runner = web.AppRunner(make_app(viewer, token), handle_signals=False)
+    await runner.setup()
+    site = web.TCPSite(runner, host, port)
+    await site.start()
+    bound = site._server.sockets[0].getsockname()[1]
+    shown = f"[{host}]" if ":" in host else host
+    url = f"http://{shown}:{bound}/?token={token}"
+    print(f"impinge view: {url}", flush=True)
+    if ready:
+        ready(url)
+    if open_browser:
+        webbrowser.open(url)
+    try:
+        while True:
+            await asyncio.sleep(3600)
+    finally:
+        await runner.cleanup()
+
+
+def main(argv=None):
+    """`python3 -m impinge.view --view-json JSON -- CLI_OPTIONS...`, as `impinge view` runs it: JSON holds host,
+    port, open_browser (the option table's view rows, checked by the CLI); the options after `--` are `impinge
+    distance`'s, parsed by the library (Joint._from_cli). Returns the exit status."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if len(argv) < 2 or argv[0] != "--view-json":
+        print("usage: python3 -m impinge.view --view-json JSON [-- impinge distance options]", file=sys.stderr)
+        return 2
+    view = json.loads(argv[1])
+    rest = argv[3:] if len(argv) > 2 and argv[2] == "--" else argv[2:]
+    if not os.path.exists(os.path.join(STATIC, "viewer.js")):
+        print("impinge view: the page was not built (no impinge/view/static/viewer.js): run tools/install-deps "
+              "(npm ci in web/) and rebuild", file=sys.stderr)
+        return 1
+    try:
+        joint = impinge.Joint._from_cli(rest)
+    except impinge.Error as e:
+        print(f"impinge: error: {e}", file=sys.stderr)
+        return 1
+    for w in joint.warnings:
+        print(f"impinge: warning: {w}", file=sys.stderr)
+    token = view.get("token") or secrets.token_urlsafe(24)
+    try:
+        asyncio.run(serve(Viewer(joint), view["host"], int(view["port"]), bool(view["open_browser"]), token))
+    except KeyboardInterrupt:
+        print("impinge view: stopped", file=sys.stderr)
+    except OSError as e:
+        print(f"impinge: error: cannot listen on {view['host']}:{view['port']}: {e.strerror or e}", file=sys.stderr)
+        return 1
+    return 0

@@ -1,0 +1,195 @@
+"""impinge view (issue 79) tested as a person uses it: a real headless Chromium (Debian's chromium and
+chromium-driver through python3-selenium; WebGL2 by SwiftShader) loads the page a real `impinge view` serves.
+
+- The page's colours and values at a pose equal `impinge distance` at that pose (its PLY files' level colours and
+  distances, bit for bit), set through the page's slider as a user would and through its test hook.
+- Every request needs the page's token (403 without); the server listens on 127.0.0.1 only.
+- Hostile messages (not JSON, NaN, wrong types, huge, binary, a flood) get an error and the server keeps serving;
+  of a flood only the newest pose is answered last.
+- The screenshot is not blank and shows the bones' colours; Ctrl-C stops the server cleanly.
+"""
+import asyncio
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+
+import numpy as np
+import pytest
+
+CLI = os.environ.get("IMPINGE_CLI", "build/impinge")
+HERE = os.path.dirname(__file__)
+sys.path.insert(0, os.path.join(HERE, "..", "..", "python", "tests"))
+from test_impinge import read_ply_vertices  # noqa: E402
+
+SHOTS = os.environ.get("IMPINGE_VIEWER_SHOTS", tempfile.gettempdir())
+
+
+def start_server(subject, *extra):
+    p = subprocess.Popen([CLI, "view", "--subject", subject, "--precision", "1", "--no-browser", "--port", "0",
+                          *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = p.stdout.readline()
+    if not line.startswith("impinge view: http://"):
+        p.kill()
+        raise AssertionError(f"no address: {line!r} {p.stderr.read()}")
+    return p, line.split()[-1]
+
+
+@pytest.fixture(scope="module")
+def hip():
+    d = tempfile.mkdtemp(prefix="impinge_view_")
+    subprocess.run([CLI, "generate", "--triangles", "3000", "--cam", "2", "--out", d + "/s"], check=True,
+                   capture_output=True)
+    return d
+
+
+@pytest.fixture(scope="module")
+def server(hip):
+    p, url = start_server(hip + "/s/subject.json")
+    yield url
+    p.send_signal(signal.SIGINT)
+    p.wait(timeout=20)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    from selenium import webdriver
+    from selenium.webdriver.chrome.options import Options
+    o = Options()
+    for a in ("--headless=new", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox",
+              "--window-size=1100,750", "--disable-dev-shm-usage"):
+        o.add_argument(a)
+    o.binary_location = "/usr/bin/chromium"
+    o.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    d = webdriver.Chrome(options=o)
+    d.set_script_timeout(60)
+    yield d
+    d.quit()
+
+
+def open_page(browser, url):
+    browser.get(url)
+    for _ in range(300):
+        ready, error = browser.execute_script("return [window.__impinge.ready, window.__impinge.error]")
+        if ready or error:
+            break
+        time.sleep(0.1)
+    assert ready and not error, (error, browser.get_log("browser"))
+
+
+def pose_in_page(browser, f, a, r):
+    return browser.execute_async_script(
+        "const done = arguments[3]; window.__impinge.setPose(arguments[0], arguments[1], arguments[2])"
+        ".then(fr => done({pose: fr.pose, id: fr.id}))", f, a, r)
+
+
+def test_the_page_colours_what_impinge_distance_computes(hip, server, browser):
+    open_page(browser, server)
+    got = pose_in_page(browser, 40, 5, 10)
+    assert got["pose"] == [40, 5, 10]
+    out = hip + "/distance"
+    subprocess.run([CLI, "distance", "--subject", hip + "/s/subject.json", "--precision", "1", "--query-strategy",
+                    "maps", "--pose", "40,5,10", "--out", out], check=True, capture_output=True)
+    colours = browser.execute_script("return window.__impinge.colours()")
+    for bone in ("femur", "pelvis"):
+        ply = read_ply_vertices(f"{out}/{bone}_gaps.ply")
+        page = np.array(browser.execute_script(f"return window.__impinge.values('{bone}', 'distance')"),
+                        dtype=np.float32)
+        np.testing.assert_array_equal(page, ply["distance_mm"])
+        gap = np.array(browser.execute_script(f"return window.__impinge.values('{bone}', 'gap')"), dtype=np.float32)
+        np.testing.assert_array_equal(gap, ply["gap_mm"])
+        rgb = np.array(colours[bone], dtype=np.uint8).reshape(-1, 3)
+        np.testing.assert_array_equal(rgb, np.column_stack([ply["red"], ply["green"], ply["blue"]]))
+
+
+def test_the_slider_moves_the_hip(server, browser):
+    from selenium.webdriver.common.by import By
+    open_page(browser, server)
+    slider = browser.find_element(By.ID, "flexion")
+    browser.execute_script("arguments[0].value = 75; arguments[0].dispatchEvent(new Event('input'))", slider)
+    for _ in range(100):
+        pose = browser.execute_script("return window.__impinge.frame && window.__impinge.frame.pose")
+        if pose and pose[0] == 75:
+            break
+        time.sleep(0.1)
+    assert pose == [75, 0, 0]
+    assert browser.find_element(By.ID, "flexion-n").get_attribute("value") == "75"
+    assert "75" in browser.find_element(By.ID, "status").text
+    path = os.path.join(SHOTS, "impinge_view.png")
+    browser.save_screenshot(path)
+    # Not blank, and the bones' colours in view: the drawing area holds many colours, some of them the levels'.
+    from PIL import Image
+    img = np.asarray(Image.open(path).convert("RGB"))[:, :-320]
+    assert img.reshape(-1, 3).std(axis=0).mean() > 10
+    blue = (img[..., 2].astype(int) > img[..., 0].astype(int) + 60) & (img[..., 2] > 150)  # level 0 blue, lit
+    assert blue.mean() > 0.002, blue.mean()
+
+
+def test_every_request_needs_the_token(server):
+    base = server.split("?")[0]
+    token = server.split("token=")[1]
+    for path in ("", "api/scene", "viewer.js", "api/mesh/femur"):
+        for query in ("", "?token=wrong"):
+            with pytest.raises(urllib.error.HTTPError) as e:
+                urllib.request.urlopen(base + path + query, timeout=10)
+            assert e.value.code == 403, (path, query)
+    with urllib.request.urlopen(f"{base}api/scene?token={token}", timeout=10) as r:
+        scene = json.load(r)
+    assert scene["femur_vertices"] > 0 and scene["levels_thresholds_mm"]
+    assert base.startswith("http://127.0.0.1:")
+
+
+def test_hostile_messages_get_an_error_and_the_server_keeps_serving(server):
+    import aiohttp
+    ws_url = server.replace("http://", "ws://").replace("/?", "/ws?")
+
+    async def run():
+        async with aiohttp.ClientSession() as s:
+            async with s.ws_connect(ws_url) as ws:
+                bad = ["not json", "[1, 2]", '{"type": "dance"}', '{"type": "pose", "pose": [NaN, 0, 0]}',
+                       '{"type": "pose", "pose": [1e9, 0, 0]}', '{"type": "pose", "pose": ["a", 0, 0]}',
+                       '{"type": "pose", "pose": [1, 2]}', '{"type": "pose", "pose": [1, 2, 3], "id": "x"}',
+                       '{"type": "pose", "pose": [' + ",".join(["1"] * 5000) + "]}"]
+                for m in bad:
+                    await ws.send_str(m)
+                    reply = await ws.receive(timeout=20)
+                    assert reply.type == aiohttp.WSMsgType.TEXT and json.loads(reply.data)["type"] == "error", m
+                await ws.send_bytes(b"\0" * 100)
+                reply = await ws.receive(timeout=20)
+                assert json.loads(reply.data)["type"] == "error"
+                # A flood: answered with frames, the newest last, fewer than asked (older pending poses dropped).
+                for k in range(1, 201):
+                    await ws.send_str(json.dumps({"type": "pose", "id": k, "pose": [k * 0.5, 0, 0]}))
+                ids = []
+                while not ids or ids[-1] != 200:
+                    reply = await ws.receive(timeout=30)
+                    assert reply.type == aiohttp.WSMsgType.BINARY
+                    n = int.from_bytes(reply.data[:4], "little")
+                    ids.append(json.loads(reply.data[4:4 + n])["id"])
+                assert ids == sorted(ids) and len(ids) < 200
+
+    asyncio.run(run())
+
+
+def test_ctrl_c_stops_the_server(hip):
+    p, url = start_server(hip + "/s/subject.json")
+    p.send_signal(signal.SIGINT)
+    assert p.wait(timeout=20) == 0
+    port = int(url.split(":")[2].split("/")[0])
+    with socket.socket() as s:
+        assert s.connect_ex(("127.0.0.1", port)) != 0  # nothing listens any more
+
+
+def test_bad_options_fail_before_serving(hip):
+    r = subprocess.run([CLI, "view", "--subject", hip + "/s/subject.json", "--port", "70000", "--no-browser"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode != 0 and "--port" in r.stderr and "65535" in r.stderr
+    r = subprocess.run([CLI, "view", "--subject", hip + "/s/subject.json", "--precision", "-1", "--no-browser"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode != 0 and "--precision" in r.stderr
