@@ -135,7 +135,7 @@ async function start() {
     lastView = name;
     const [dir, up] = presets[name];
     const d = dir.clone().normalize();
-    const dist = 3.2 * ($('crop').checked ? cropRadius : wholeRadius);
+    const dist = $('crop').checked ? 5.5 * cropRadius : 2.8 * wholeRadius;
     camera.position.copy(centre).addScaledVector(d, dist);
     camera.up.copy(up);
     controls.target.copy(centre);
