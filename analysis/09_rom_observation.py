@@ -55,7 +55,7 @@ write_table(d, "table_observation", ["subject", "patient", "extremity", "angle",
 rows = []
 for r in lim.itertuples():
     rows.append([r.subject, r.motion.replace("_", " "), f(r.limit_deg), r.limited_by if isinstance(r.limited_by, str) else "",
-                 f(r.socket_clock_h), f(r.femur_clock_h), f(r.exact_gap_before_mm, 3), f(r.exact_gap_after_mm, 3),
+                 f(r.pelvis_clock_h), f(r.femur_clock_h), f(r.exact_gap_before_mm, 3), f(r.exact_gap_after_mm, 3),
                  r.validated])
 write_table(d, "table_limits", ["subject", "motion", "limit", "where", "socket h", "femur h", "exact $-0.5^\\circ$",
                                 "exact $+0.5^\\circ$", "confirmed"], rows, align="llrlrrrrl")

@@ -2,7 +2,7 @@
 
 usage: /usr/bin/python3 analysis/render_hip.py OUT_DIR
 Reads OUT_DIR/summary.json, femur_gaps.ply and pelvis_gaps.ply; writes OUT_DIR/render.png (anterior,
-lateral and socket medial views side by side) and render_<view>.png for each view. The bones are
+lateral and acetabulum medial views side by side) and render_<view>.png for each view. The bones are
 shown in the pelvic frame (anatomical neutral) or the input frame's anatomical axes (scan
 neutral), within 60 mm of the hip centre; the acetabular clock face is drawn when known."""
 import json

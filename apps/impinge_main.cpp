@@ -85,7 +85,7 @@ void add_table_options(CLI::App* cmd, unsigned use, CliValues& v) {
       const OptionValue d = r.get(defaults);
       if (!std::holds_alternative<std::monostate>(d) || r.type == OptionType::point) o->default_str(option_text(r, d));
     }
-    if (r.required) o->required();
+    if (r.required && !(r.optional_for & use)) o->required();
     for (const std::string& old : r.old_names) {  // a former name: accepted, not listed (group "": hidden)
       if (r.type == OptionType::flag)
         cmd->add_flag("--" + old, v.flag[old], r.help)->group("");
@@ -373,7 +373,7 @@ int run_view(const RunOptions& o, const std::vector<std::string>& tokens) {
   for (const std::string& a : c.argv) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   std::cout.flush();
-  execv(argv[0], argv.data());
+  execvp(argv[0], argv.data());
   throw Error("impinge view: cannot run " + c.argv[0] + ": " + std::strerror(errno));
 }
 
@@ -417,7 +417,7 @@ int main(int argc, char** argv) {
   CLI::App* view = app.add_subcommand(
       "view",
       "Joint3D in the browser (thesis sec. 3.4): a local page where the hip moves with sliders and the impingement "
-      "levels, gaps or distances are coloured on both bones, each pose detected as `impinge distance` detects it. "
+      "levels, gaps or distances are coloured on both bones, each pose detected as `impinge distance --query-strategy maps` detects it. "
       "Takes distance's inputs and settings; prints the page's address (with its access token)");
   for (const Command& c : commands) add_table_options(c.app, c.use, values);
   add_table_options(view, use_view, values);

@@ -37,7 +37,7 @@ PyJoint make_joint(const py::object& ball, const py::object& socket, const py::k
 }
 
 // The Joint `impinge view` serves: its options the CLI's tokens, read through the option table as the CLI reads them.
-PyJoint joint_from_cli(const std::vector<std::string>& args) {
+py::tuple joint_from_cli(const std::vector<std::string>& args) {
   RunOptions run = RunOptions::clinical();
   set_cli_options(run, args, use_view, "impinge view");
   PyJoint j;
@@ -45,7 +45,9 @@ PyJoint joint_from_cli(const std::vector<std::string>& args) {
     py::gil_scoped_release release;
     j.session = std::make_shared<const Session>(run.session);
   }
-  return j;
+  py::dict command;
+  command["motion"] = run.command.motion.empty() ? py::object(py::none()) : py::object(py::str(run.command.motion));
+  return py::make_tuple(j, command);
 }
 
 // Both scans as Python: the gaps and statuses as numpy arrays (owning the C++ buffers), and each
@@ -143,6 +145,16 @@ py::dict rom_limits(const PyJoint& j, const py::kwargs& given) {
       e[py::str(t.columns[c])] = x.is_null() ? py::object(py::float_(std::nan(""))) : from_json(x);
     }
     e["contact_mm"] = Eigen::Vector3d(j.session->to_input(run.limits[k].contact_mm));
+    const PoseAngles& start = run.motions[k].start;
+    e["start_deg"] = py::make_tuple(start.flexion_deg, start.adduction_deg, start.internal_rotation_deg);
+    // The pose at the limit (degrees, ISB): the motion's angles there; None without a limit.
+    const double limit = run.limits[k].limit_deg;
+    if (std::isfinite(limit)) {
+      const PoseAngles p = run.motions[k].angles(limit);
+      e["pose_at_limit_deg"] = py::make_tuple(p.flexion_deg, p.adduction_deg, p.internal_rotation_deg);
+    } else {
+      e["pose_at_limit_deg"] = py::none();
+    }
     d[py::str(run.motions[k].name)] = e;
   }
   d["excluded_vertices"] = run.baseline.excluded_vertices;
@@ -244,7 +256,9 @@ void add_joint_queries(py::class_<PyJoint>& c) {
                     "internal and "
            "external rotation, both rotations at 90 deg flexion, FADIR) -> dict motion -> the CLI's rom_limits.csv "
            "row (limit_deg (NaN: none within max_deg), limited_by, contact_class, pelvis_clock_h, femur_clock_h, "
-           "min_gap_at_limit_mm, monotone, contact_at_start, evaluations) and contact_mm (input frame); and "
+           "min_gap_at_limit_mm, monotone, contact_at_start, evaluations), contact_mm (input frame) and "
+           "pose_at_limit_deg ((flexion, adduction, internal rotation) at the limit; None without one), start_deg (where "
+           "the motion starts); and "
            "excluded_vertices (in contact at neutral, not counted). The keywords are the option table's "
            "(impinge.options(): `impinge rom`'s --threshold, --contact-depth, --metric, --contacts, --step, --max), "
            "with its defaults. metric 'distance' needs the Joint's distances (the default). " +
@@ -429,9 +443,9 @@ void bind_joint(py::module_& m) {
   static const std::string doc = joint_doc();  // pybind11 keeps the pointer
   c.def(py::init(&make_joint), py::arg("ball") = py::none(), py::arg("socket") = py::none(), doc.c_str());
   c.def_static("_from_cli", &joint_from_cli, py::arg("args"),
-               "A Joint set up from `impinge view`'s command-line options (['--subject', 'S', '--precision', '0.5', "
-               "...]: the option table's rows for view, parsed as the CLI parses them). Raises impinge.Error naming "
-               "the option. For impinge.view; warnings are in .warnings.");
+               "(Joint, dict(motion: path or None)) set up from `impinge view`'s command-line options (['--subject', "
+               "'S', '--precision', '0.5', ...]: the option table's rows for view, parsed as the CLI parses them). "
+               "Raises impinge.Error naming the option. For impinge.view; warnings are in .warnings.");
   add_joint_queries(c);
   add_joint_properties(c);
   add_joint_benchmarks(c);

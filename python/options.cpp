@@ -165,16 +165,25 @@ void set_cli_options(RunOptions& run, const std::vector<std::string>& args, unsi
     const OptionRow* r = find_option(name);
     if (r == nullptr || !(r->uses & use) || (r->name != name && !std::count(r->old_names.begin(), r->old_names.end(), name)))
       throw Error(caller + ": unknown option --" + name);
-    if (given.count(r)) throw Error(caller + ": --" + name + " given twice");
+    if (given.count(r)) {
+      const std::string before = given[r].first;
+      if (before != name)
+        throw Error(caller + ": give --" + r->name + " or --" + (name == r->name ? before : name) +
+                    " (its former name), not both");
+      throw Error(caller + ": --" + name + " given twice");
+    }
     std::string text;
     if (eq != std::string::npos) {
       text = a.substr(eq + 1);
+      if (r->type == OptionType::flag && text != "true" && text != "false")
+        throw Error(caller + ": --" + name + "=" + text + ": a flag takes no value (or true, false)");
     } else if (r->type != OptionType::flag) {
       if (i + 1 >= args.size()) throw Error(caller + ": --" + name + " needs a value");
       text = args[++i];
     }
     if (name != r->name) {
-      const std::string msg = "--" + name + " is deprecated and will be removed in the next release: use --" + r->name;
+      const std::string msg =
+          caller + ": --" + name + " is deprecated and will be removed in the next release: use --" + r->name;
       if (PyErr_WarnEx(PyExc_DeprecationWarning, msg.c_str(), 1) != 0) throw py::error_already_set();
     }
     given[r] = {name, text};
@@ -183,7 +192,9 @@ void set_cli_options(RunOptions& run, const std::vector<std::string>& args, unsi
     const auto it = given.find(&r);
     if (it == given.end()) continue;
     const std::string as = "--" + it->second.first;
-    r.set(run, r.type == OptionType::flag ? OptionValue(true) : parse_option_text(r, it->second.second, as), as);
+    r.set(run, r.type == OptionType::flag ? OptionValue(it->second.second != "false")
+                                          : parse_option_text(r, it->second.second, as),
+          as);
   }
 }
 

@@ -49,6 +49,7 @@ def locate_femoral_head(V: npt.ArrayLike, F: npt.ArrayLike,
     """Femoral head sphere of a femur in any orientation; with its pelvis (same frame), the end that
     sits in the acetabulum, as the CLI finds it."""
 
+
 def level_colours(count: int) -> Dict[str, Any]:
     """The impingement levels' colours (0-255) as the PLY files give them, for `count` levels -> dict(femur=[(r, g,
     b) per level], pelvis=[...], untested=(r, g, b))."""
@@ -109,7 +110,7 @@ class Joint:
         (meshes, side, frame, landmarks, neutral). side: 'right'/'left'; frame: 'LPS'/'RAS' (the
         meshes' frame; default the subject's, else RAS). cor: 'auto' (the femoral head fitted) or
         (x, y, z) mm, the femoral head centre about which the radial gaps at the scan pose are measured; head_region: (x, y, z, r) mm, fit the head there; allow_any_cor: accept a COR
-        outside the head. scheme and one of resolution/precision/turns/spacing (0: the scheme's
+        outside the head. scheme and one of resolution/precision/turns/spacing_deg (0: the scheme's
         0.5 deg default); sampling; mode 'exact'/'linear'; levels: thresholds mm, decreasing;
         sparse_region_mm: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for
         hidden vertices (extra-articular), within extra_articular_radius_mm, at layered_spacing_deg (0: the maps' own); query_strategy: 'maps', 'direct' (no

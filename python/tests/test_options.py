@@ -159,7 +159,7 @@ def test_former_keys_still_work_with_a_warning(old, new, small_joint):
     under the name given."""
     h = impinge.generated_hip(triangles=3000)
     with pytest.warns(DeprecationWarning, match=f"'{old}' is deprecated .* use '{new}'"):
-        with pytest.raises(impinge.Error, match=f"{old}"):
+        with pytest.raises(impinge.Error, match=rf"(^|[^\w]){old}(?!\w)"):  # the name given, not the new one
             impinge.Joint(h["femur"], h["pelvis"], neutral="scan", precision=2.0, **{old: -1.0 if old != "setup"
                                                                                   else "sometimes"})
     with pytest.raises(impinge.Error, match=f"give {new} or {old} \\(its former name\\), not both"):
@@ -170,7 +170,7 @@ def test_former_keys_in_a_study_file_are_renamed_with_a_warning(tmp_path):
     path = tmp_path / "study.toml"
     path.write_text("subjects = [{generated = {}}]\n[joint]\nsparse = 40.0\n[[task]]\nkind = 'rom'\n"
                     "layered_spacing = 1.0\n")
-    with pytest.warns(DeprecationWarning, match="joint.sparse: 'sparse' is deprecated"):
+    with pytest.warns(FutureWarning, match="joint.sparse: 'sparse' is deprecated"):
         study = spec.load_study(str(path))
     assert study["joint"] == {"sparse_region_mm": [40.0]} or study["joint"] == {"sparse_region_mm": 40.0}
     assert "layered_spacing_deg" in study["tasks"][0]["joint"]
@@ -244,3 +244,16 @@ def test_bad_values_name_the_option_the_value_and_the_range():
     assert r.returncode == 2 and "--step: 0 deg is outside the valid range [0.01, 90] deg" in r.stderr, r.stderr
     r = subprocess.run([CLI, "generate", "--cam", "nan", "--out", "/tmp/never"], capture_output=True, text=True)
     assert r.returncode == 2 and "--cam: 'nan' is not a finite number" in r.stderr, r.stderr
+
+
+def test_the_pivot_is_named_apart_from_the_head_centre(small_joint):
+    """Joint.pivot (summary.json's pivot_mm): the point the femur turns about. A scan-neutral generated hip turns
+    about its femoral head centre, so the pivot is `cor`, and the posed femur keeps that point fixed (femur_pose's
+    (R, t): V -> (V - cor) R^T + cor + t)."""
+    import numpy as np
+    assert small_joint.setup["joint_centre"] == "femoral-head"
+    np.testing.assert_array_equal(small_joint.pivot, small_joint.cor)
+    np.testing.assert_array_equal(small_joint.setup["pivot_mm"], small_joint.cor)
+    R, t = small_joint.femur_pose(40, 10, 20)
+    c = np.asarray(small_joint.pivot)
+    np.testing.assert_allclose((c - small_joint.cor) @ np.asarray(R).T + small_joint.cor + t, c, atol=1e-9)

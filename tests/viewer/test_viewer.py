@@ -131,6 +131,90 @@ def test_the_slider_moves_the_hip(server, browser):
     assert blue.mean() > 0.002, blue.mean()
 
 
+def wait_for(browser, script, timeout=120):
+    """Poll `script` (returning a value) until it returns something truthy."""
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        v = browser.execute_script(script)
+        if v:
+            return v
+        time.sleep(0.2)
+    raise AssertionError(f"timed out: {script}")
+
+
+def test_a_motion_plays_as_impinge_motion_computes_it(hip, browser):
+    """--motion: the timeline's frames are the motion's poses and each one's least distance is frames.csv's; the
+    plot's curve (Joint.motion in the background) is frames.csv's column; Play runs through the frames."""
+    import csv
+    mot = hip + "/walk.csv"
+    with open(mot, "w") as f:
+        f.write("time_s,flexion_deg,adduction_deg,internal_rotation_deg\n")
+        for i in range(40):
+            f.write(f"{i * 0.025:.3f},{i * 1.7:.2f},{(i % 7) * 0.5:.2f},{i * 0.4:.2f}\n")
+    subprocess.run([CLI, "motion", "--subject", hip + "/s/subject.json", "--motion", mot, "--precision", "1",
+                    "--quiet", "--out", hip + "/motion"], check=True, capture_output=True)
+    with open(hip + "/motion/frames.csv") as f:
+        rows = list(csv.DictReader(f))
+    want = [min(float(r["femur_min_distance_mm"]), float(r["pelvis_min_distance_mm"])) for r in rows]
+    p, url = start_server(hip + "/s/subject.json", "--motion", mot)
+    try:
+        open_page(browser, url)
+        least = wait_for(browser, "return window.__impinge.motionLeast")
+        np.testing.assert_allclose(least["least_distance_mm"], want, rtol=0, atol=1e-6)
+        for k in (0, 13, 39):
+            browser.execute_script("window.__impinge.showFrame(arguments[0])", k)
+            angles = [float(rows[k][c]) for c in ("flexion_deg", "adduction_deg", "internal_rotation_deg")]
+            for _ in range(100):
+                fr = browser.execute_script("return window.__impinge.frame")
+                if fr and np.allclose(fr["pose"], angles, atol=1e-9):
+                    break
+                time.sleep(0.1)
+            assert np.allclose(fr["pose"], angles, atol=1e-9), (fr["pose"], angles)
+            assert abs(fr["summary"]["least_distance_mm"] - want[k]) < 1e-6, (k, fr["summary"], want[k])
+        browser.find_element("id", "play").click()
+        time.sleep(1.5)  # the motion lasts 0.975 s
+        fr = browser.execute_script("return window.__impinge.frame")
+        assert np.allclose(fr["pose"], [float(rows[-1][c]) for c in ("flexion_deg", "adduction_deg",
+                                                                       "internal_rotation_deg")], atol=1e-9)
+    finally:
+        p.send_signal(signal.SIGINT)
+        p.wait(timeout=30)
+
+
+def test_rom_limits_and_morphology_beside_the_view(hip, server, browser):
+    """The ROM panel's limits are `impinge rom`'s; its 'at' button moves the hip to the pose at the limit, where the
+    bones touch; the morphology panel's values are `impinge morphology`'s."""
+    import csv
+    open_page(browser, server)
+    rom = wait_for(browser, "return window.__impinge.rom")
+    subprocess.run([CLI, "rom", "--subject", hip + "/s/subject.json", "--precision", "1", "--no-map", "--out",
+                    hip + "/rom"], check=True, capture_output=True)
+    with open(hip + "/rom/rom_limits.csv") as f:
+        limits = {r["motion"]: r for r in csv.DictReader(f)}
+    assert [r["motion"] for r in rom] == list(limits)
+    for r in rom:
+        want = limits[r["motion"]]["limit_deg"]
+        assert (r["limit_deg"] is None) == (want in ("", "nan", "NaN")), r
+        if r["limit_deg"] is not None:
+            assert abs(r["limit_deg"] - float(want)) < 1e-9, (r, want)
+    k = next(i for i, r in enumerate(rom) if r["pose_at_limit_deg"])
+    browser.execute_script(f"document.querySelector('#rom button[data-k=\"{k}\"][data-at=\"at\"]').click()")
+    at = rom[k]["pose_at_limit_deg"]
+    for _ in range(100):
+        fr = browser.execute_script("return window.__impinge.frame")
+        if np.allclose(fr["pose"], at, atol=1e-9):
+            break
+        time.sleep(0.1)
+    assert np.allclose(fr["pose"], at, atol=1e-9)
+    subprocess.run([CLI, "morphology", "--subject", hip + "/s/subject.json", "--out", hip + "/morph"], check=True,
+                   capture_output=True)
+    with open(hip + "/morph/morphology.json") as f:
+        morph = json.load(f)
+    m = wait_for(browser, "return window.__impinge.morphology")
+    assert m["alpha_max_deg"] == pytest.approx(morph["femur"]["alpha_max_deg"]["value"] if isinstance(
+        morph["femur"]["alpha_max_deg"], dict) else morph["femur"]["alpha_max_deg"], abs=1e-9)
+
+
 def test_every_request_needs_the_token(server):
     base = server.split("?")[0]
     token = server.split("token=")[1]
@@ -220,3 +304,20 @@ def test_a_ct_hip_as_a_new_user_opens_it(browser):
     finally:
         p.send_signal(signal.SIGINT)
         p.wait(timeout=30)
+
+
+def test_the_servers_parser_reads_the_cli_tokens_as_the_cli_does(hip):
+    """Joint._from_cli (the server's Joint): the CLI's tokens through the option table; a flag takes no value but
+    true/false; a former name and its new one together are refused as the CLI refuses them; unknown options too."""
+    import impinge
+    s = hip + "/s/subject.json"
+    j, command = impinge.Joint._from_cli(["--subject", s, "--precision", "2", "--maps-only=false"])
+    assert j.setup["exact_at_discontinuities"] and command == {"motion": None}
+    j, _ = impinge.Joint._from_cli(["--subject", s, "--precision=2", "--maps-only"])
+    assert not j.setup["exact_at_discontinuities"]
+    for bad, message in ((["--maps-only=maybe"], "a flag takes no value"),
+                         (["--setup", "maps", "--query-strategy", "maps"], "give --query-strategy or --setup"),
+                         (["--out", "x"], "unknown option --out"), (["--precision"], "needs a value"),
+                         (["--precision", "2", "--precision", "1"], "given twice")):
+        with pytest.raises(impinge.Error, match=message):
+            impinge.Joint._from_cli(["--subject", s, *bad])

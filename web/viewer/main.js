@@ -292,12 +292,149 @@ async function start() {
   const hook = window.__impinge;
   hook.scene = scene;
   hook.setPose = (f, a, r) => {
-    for (const [n, v] of [['flexion', f], ['adduction', a], ['internal_rotation', r]]) { $(n).value = v; $(n + '-n').value = v; }
+    for (const [n, v] of [['flexion', f], ['adduction', a], ['internal_rotation', r]]) {
+      $(n).value = v;
+      $(n + '-n').value = Number(v.toFixed(2));
+    }
     const id = sendPose([f, a, r]);
     return new Promise((resolve) => hook.waiting.push({ id, resolve }));
   };
   hook.colours = () => ({ femur: Array.from(femur.colour), pelvis: Array.from(pelvis.colour) });
   hook.values = (bone, what) => Array.from(hook.frame[bone][what]);
+
+  // The acetabular clock face (thesis Figure 62c; Blankenbaker et al. 2007): a ring over the rim with its hours.
+  const clockGroup = new THREE.Group();
+  if (scene.clock) {
+    const c = new THREE.Vector3(...scene.clock.centre_mm), u12 = new THREE.Vector3(...scene.clock.twelve).normalize();
+    const u3 = new THREE.Vector3(...scene.clock.three).normalize(), r = scene.clock.radius_mm + 3;
+    const at = (h, rr) => c.clone().addScaledVector(u12, rr * Math.cos(h * Math.PI / 6))
+        .addScaledVector(u3, rr * Math.sin(h * Math.PI / 6));
+    const ring = [];
+    for (let k = 0; k <= 120; ++k) ring.push(at(k / 10, r));
+    clockGroup.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(ring),
+                                  new THREE.LineBasicMaterial({ color: 0x333333 })));
+    for (let h = 1; h <= 12; ++h) {
+      clockGroup.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints([at(h, r - 2), at(h, r + 2)]),
+                                    new THREE.LineBasicMaterial({ color: 0x333333 })));
+      const cv = document.createElement('canvas');
+      cv.width = cv.height = 64;
+      const g = cv.getContext('2d');
+      g.font = 'bold 40px sans-serif'; g.textAlign = 'center'; g.textBaseline = 'middle'; g.fillStyle = '#222';
+      g.fillText(String(h), 32, 34);
+      const label = new THREE.Sprite(new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(cv), depthTest: false }));
+      label.position.copy(at(h, r + 6));
+      label.scale.set(6, 6, 1);
+      clockGroup.add(label);
+    }
+    view.add(clockGroup);
+  } else {
+    $('show-clock').parentElement.hidden = true;
+  }
+  $('show-clock').onchange = () => { clockGroup.visible = $('show-clock').checked; requestDraw(); };
+
+  // A motion (--motion): a timeline played in wall-clock time (frames skipped, never queued, when the answers are
+  // slower than the motion), and the least distance over time (Joint.motion, computed once in the background).
+  if (scene.motion) {
+    const m = await (await fetchChecked('/api/motion')).json();
+    const n = m.time_s.length;
+    $('motion-panel').hidden = false;
+    $('motion-name').textContent = m.name;
+    $('timeline').max = n - 1;
+    let playing = false, startWall = 0, startT = 0, shown = -1;
+    const showFrame = (k) => {
+      k = Math.max(0, Math.min(n - 1, k));
+      $('timeline').value = k;
+      $('motion-time').textContent = `${m.time_s[k].toFixed(2)} s (frame ${k + 1} of ${n})`;
+      if (k === shown) return;
+      shown = k;
+      const [f, a, r] = m.angles[k];
+      for (const [id, v] of [['flexion', f], ['adduction', a], ['internal_rotation', r]]) {
+        $(id).value = v; $(id + '-n').value = Number(v.toFixed(2));
+      }
+      sendPose([f, a, r]);
+      drawPlot();
+    };
+    const frameAt = (t) => { let k = 0; while (k + 1 < n && m.time_s[k + 1] <= t) ++k; return k; };
+    const tick = () => {
+      if (!playing) return;
+      const t = startT + (performance.now() - startWall) / 1000 * Number($('speed').value);
+      if (t > m.time_s[n - 1]) { playing = false; $('play').textContent = 'Play'; showFrame(n - 1); return; }
+      showFrame(frameAt(t));
+      requestAnimationFrame(tick);
+    };
+    $('play').onclick = () => {
+      playing = !playing;
+      $('play').textContent = playing ? 'Pause' : 'Play';
+      if (playing) {
+        if (shown >= n - 1) shown = -1, $('timeline').value = 0;
+        startT = m.time_s[Number($('timeline').value)];
+        startWall = performance.now();
+        requestAnimationFrame(tick);
+      }
+    };
+    $('speed').onchange = () => { startT = m.time_s[Math.max(0, shown)]; startWall = performance.now(); };
+    $('timeline').addEventListener('input', () => { playing = false; $('play').textContent = 'Play'; showFrame(Number($('timeline').value)); });
+    let least = null;
+    const drawPlot = () => {
+      const cv = $('plot'), g = cv.getContext('2d');
+      g.clearRect(0, 0, cv.width, cv.height);
+      if (!least) return;
+      const y = least.least_distance_mm || least.least_gap_mm;
+      const finite = y.filter((v) => v !== null);
+      if (!finite.length) return;
+      const lo = Math.min(0, ...finite), hi = Math.max(...finite, lo + 1);
+      const X = (k) => 4 + (cv.width - 8) * k / Math.max(1, n - 1), Y = (v) => cv.height - 4 - (cv.height - 8) * (v - lo) / (hi - lo);
+      g.strokeStyle = '#bbb'; g.beginPath(); g.moveTo(0, Y(0)); g.lineTo(cv.width, Y(0)); g.stroke();
+      g.strokeStyle = '#1f5fbf'; g.beginPath();
+      y.forEach((v, k) => { if (v !== null) (k ? g.lineTo(X(k), Y(v)) : g.moveTo(X(k), Y(v))); });
+      g.stroke();
+      if (shown >= 0) { g.strokeStyle = '#d22'; g.beginPath(); g.moveTo(X(shown), 0); g.lineTo(X(shown), cv.height); g.stroke(); }
+      $('plot-note').textContent = `least ${least.least_distance_mm ? 'distance' : 'radial gap'} over the motion, ` +
+          `${lo.toFixed(1)} to ${hi.toFixed(1)} mm (0: grey line)`;
+    };
+    hook.showFrame = showFrame;
+    poll('/api/motion/least', (r) => { least = r; hook.motionLeast = r; drawPlot(); }, $('plot-note'));
+  }
+
+  // ROM limits (impinge rom's, computed once in the background) with the poses just before and at each limit.
+  poll('/api/rom', (rows) => {
+    $('rom-state').textContent = `limits in the ${rows.length ? rows[0].pelvic_frame : ''} frame; bony, beside the ` +
+        'normal range of living subjects';
+    $('rom').innerHTML = '<tr><td></td><td class="v">limit</td><td class="v">normal</td><td></td></tr>' + rows.map((r, k) =>
+      `<tr><td>${r.motion.replaceAll('_', ' ')}</td><td class="v">${r.limit_deg === null ? 'free' : r.limit_deg.toFixed(1)}</td>` +
+      `<td class="v">${r.normal_deg === null ? '' : r.normal_deg}</td><td>${r.pose_at_limit_deg ?
+        `<button data-k="${k}" data-at="before">before</button><button data-k="${k}" data-at="at">at</button>` : ''}</td></tr>`).join('');
+    for (const b of $('rom').querySelectorAll('button')) {
+      b.onclick = () => {
+        const r = rows[Number(b.dataset.k)];
+        const p = r.pose_at_limit_deg, q = p.slice();
+        // Just before: 2 deg short of the limit along the motion (the standard motions are straight from their start).
+        if (b.dataset.at === 'before' && r.limit_deg > 0) {
+          const s = Math.max(0, r.limit_deg - 2) / r.limit_deg, start = r.start_deg;
+          for (let i = 0; i < 3; ++i) q[i] = start[i] + (p[i] - start[i]) * s;
+        }
+        hook.setPose(...q);
+      };
+    }
+    hook.rom = rows;
+  }, $('rom-state'));
+
+  // Morphology beside the view.
+  poll('/api/morphology', (m) => {
+    const f = (x, d = 1) => (x === null || x === undefined ? 'n/a' : x.toFixed(d));
+    $('morph-state').textContent = '';
+    const hours = Object.entries(m.alpha_deg_by_hour).sort((a, b) => Number(a[0]) - Number(b[0]))
+        .map(([h, v]) => `${h}: ${f(v, 0)}`).join(', ');
+    $('morph').innerHTML = [
+      ['alpha angle, largest', `${f(m.alpha_max_deg)} deg at ${f(m.alpha_max_hour, 0)} o'clock`],
+      ['alpha by hour', hours], ['head radius', `${f(m.head_radius_mm)} mm`],
+      ['neck-shaft angle', `${f(m.neck_shaft_angle_deg)} deg`],
+      ['femoral version (posterior condyles)', `${f(m.version_posterior_condylar_deg)} deg`],
+      ['acetabular anteversion, inclination', `${f(m.radiographic_anteversion_deg)}, ${f(m.radiographic_inclination_deg)} deg`],
+      ['centre-edge, lateral / anterior', `${f(m.lateral_centre_edge_deg)} / ${f(m.anterior_centre_edge_deg)} deg`],
+    ].map(([k, v]) => `<tr><td>${k}</td><td>${v}</td></tr>`).join('');
+    hook.morphology = m;
+  }, $('morph-state'));
 
   display();
   setView('anterior');
@@ -305,6 +442,23 @@ async function start() {
   await opened;
   await hook.setPose(0, 0, 0);
   hook.ready = true;
+}
+
+// Poll a background job (impinge.view's job states) until it is done; `el` shows its progress.
+async function poll(path, done, el) {
+  for (;;) {
+    let r;
+    try {
+      r = await (await fetchChecked(path)).json();
+    } catch (e) {
+      el.textContent = String(e);
+      return;
+    }
+    if (r.state === 'done') { el.textContent = ''; done(r.result); return; }
+    if (r.state === 'error') { el.textContent = r.message; return; }
+    el.textContent = `computing... ${r.seconds} s`;
+    await new Promise((res) => setTimeout(res, 500));
+  }
 }
 
 window.__impinge = { ready: false, waiting: [], frame: null, draws: 0, drawMs: NaN, error: null };

@@ -378,9 +378,11 @@ void add_command_rows(Rows& t) {
          "Also write shaded renders with matplotlib (distance: render.png, anterior, lateral and the socket's medial "
          "view with the acetabular clock face; plan: plan.png, the resection's depth on the head-neck clock face)",
          [](auto& o) -> auto& { return o.command.render; });
-  OptionRow& motion = t.text("motion", "motion", OptionType::path, use_motion, {}, "Motion file: .csv, .mot or .sto",
+  OptionRow& motion = t.text("motion", "motion", OptionType::path, use_motion | use_view, {},
+                             "Motion file: .csv, .mot or .sto (view: optional, played with a timeline)",
                              [](auto& o) -> auto& { return o.command.motion; });
   motion.required = true;
+  motion.optional_for = use_view;
   t.integer("vtp-every", "vtp_every", "", use_motion, CommandArguments::kVtpEveryRange,
             "Write the posed bones (gaps/frame_N.vtp) every N frames; 0 = every frame up to 100 frames, else at most "
             "100 files",

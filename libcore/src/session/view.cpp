@@ -29,8 +29,9 @@ ViewCommand view_command(const ViewOptions& view, const std::vector<std::string>
   const std::string python = env_python != nullptr && *env_python != '\0' ? env_python : "/usr/bin/python3";
   if (python.find('/') != std::string::npos && !fs::exists(python))
     throw Error("impinge view: no Python interpreter " + python + " (install python3, or set IMPINGE_PYTHON)");
+  // -P: the current folder is not put first on sys.path (an impinge/ or aiohttp.py there must not be imported).
   const nlohmann::json j = {{"host", view.host}, {"port", view.port}, {"open_browser", view.open_browser}};
-  c.argv = {python, "-m", "impinge.view", "--view-json", j.dump(), "--"};
+  c.argv = {python, "-P", "-m", "impinge.view", "--view-json", j.dump(), "--"};
   c.argv.insert(c.argv.end(), distance_args.begin(), distance_args.end());
   return c;
 }

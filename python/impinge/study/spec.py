@@ -63,14 +63,15 @@ def _fail(path, key, message):
 
 def _current(path, where, table, k):
     """The key `k` of `table` as the option table names it now: a former key is renamed, with a
-    DeprecationWarning naming the file and the key; giving both is an error."""
+    FutureWarning (shown by default: a study file is the user's data, not code) naming the file and the key; giving
+    both is an error."""
     if k not in OLD_KEYS:
         return k
     new = OLD_KEYS[k]
     if new in table:
         _fail(path, f"{where}.{k}", f"give {new} or {k} (its former name), not both")
     warnings.warn(f"{path}: {where}.{k}: '{k}' is deprecated and will be removed in the next release: use '{new}'",
-                  DeprecationWarning, stacklevel=3)
+                  FutureWarning, stacklevel=3)
     return new
 
 

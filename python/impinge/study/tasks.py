@@ -112,7 +112,8 @@ def _run_rom(joint, task, folder):
     d = joint.rom_limits(threshold_mm=o["threshold_mm"], step_deg=o["step_deg"], max_deg=o["max_deg"],
                          contacts=o["contacts"], contact_depth_mm=o["contact_depth_mm"], metric=o["metric"])
     motions = [k for k, v in d.items() if isinstance(v, dict)]
-    fields = [k for k in d[motions[0]] if k != "contact_mm"]
+    # rom_limits.csv's columns, as the CLI writes them (not the contact point or the poses at and before the limit)
+    fields = [k for k in d[motions[0]] if k not in ("contact_mm", "pose_at_limit_deg", "start_deg")]
     _write_csv(os.path.join(folder, "rom_limits.csv"),
                dict({"motion": motions}, **{k: [d[m][k] for m in motions] for k in fields}))
     figures = {}

@@ -23,7 +23,9 @@ import os
 import secrets
 import struct
 import sys
+import time
 import webbrowser
+from concurrent.futures import ThreadPoolExecutor
 import weakref
 
 import numpy as np
@@ -63,6 +65,15 @@ def parse_pose_message(text):
     return ident, tuple(float(x) for x in pose)
 
 
+def _finite(x):
+    """A number for JSON: None for NaN, inf or a missing value."""
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        return None
+    return x if math.isfinite(x) else None
+
+
 def _padded(a):
     b = np.ascontiguousarray(a).tobytes()
     return b + b"\0" * (-len(b) % 4)
@@ -71,8 +82,15 @@ def _padded(a):
 class Viewer:
     """One Joint and what the page needs of it: the scene (meshes, levels, palette, axes) and posed frames."""
 
-    def __init__(self, joint):
+    def __init__(self, joint, motion=None):
         self.joint = joint
+        self.motion = None
+        if motion:  # read now: a bad file is an error before the page opens
+            m = impinge.load_motion(motion, joint.setup["side"])
+            self.motion = {"name": os.path.basename(motion), "format": m["format"],
+                           "time_s": np.asarray(m["time_s"]).tolist(), "angles": np.asarray(m["angles"]).tolist()}
+        self._jobs = {}
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="impinge-view-job")
         setup = joint.setup
         self.meshes = joint.meshes
         thresholds = list(setup["levels_thresholds_mm"])
@@ -81,6 +99,11 @@ class Viewer:
         if frames:  # anatomical neutral: the pelvic frame's axes (input frame): x anterior, y superior, z right (ISB)
             p = frames["pelvis"]
             axes = {"x": p["x_axis"], "y": p["y_axis"], "z": p["z_axis"]}
+        clock = None
+        if frames and "acetabulum" in frames:  # the acetabular clock face (Blankenbaker et al. 2007), input frame
+            ac = frames["acetabulum"]
+            clock = {"centre_mm": ac["rim_centre_mm"], "twelve": ac["clock_twelve"], "three": ac["clock_three"],
+                     "radius_mm": ac["rim_radius_mm"], "convention": ac.get("convention")}
         self.scene = {
             "impinge_version": impinge.__version__,
             "femur_vertices": int(len(self.meshes["femur"][0])),
@@ -99,8 +122,70 @@ class Viewer:
             "joint_centre": setup["joint_centre"],
             "pelvic_frame": setup.get("pelvic_frame"),
             "axes": axes,
+            "clock": clock,
+            "motion": None if self.motion is None else {k: self.motion[k] for k in ("name", "format")},
             "warnings": list(setup.get("warnings", [])),
         }
+
+    def job(self, name):
+        """The state of a background job ('rom', 'morphology', 'motion'), started at its first request:
+        {"state": "running", "seconds": s} | {"state": "done", "result": ...} | {"state": "error", "message": ...}."""
+        if name not in self._jobs:
+            fn = {"rom": self._rom, "morphology": self._morphology, "motion": self._motion_least}[name]
+            self._jobs[name] = (time.perf_counter(), self._pool.submit(fn))
+        t0, fut = self._jobs[name]
+        if not fut.done():
+            return {"state": "running", "seconds": round(time.perf_counter() - t0, 1)}
+        try:
+            return {"state": "done", "seconds": round(time.perf_counter() - t0, 1), "result": fut.result()}
+        except impinge.Error as e:
+            return {"state": "error", "message": str(e)}
+
+    def _rom(self):
+        """The standard motions' limits (Joint.rom_limits, `impinge rom`'s defaults) with the pose at each limit and
+        where each motion starts."""
+        limits = self.joint.rom_limits()
+        out = []
+        for name, row in limits.items():
+            if not isinstance(row, dict):
+                continue
+            at = row.get("pose_at_limit_deg")
+            entry = {"motion": name, "limit_deg": _finite(row.get("limit_deg")), "status": row.get("status"),
+                     "limited_by": row.get("limited_by"), "contact_class": row.get("contact_class"),
+                     "normal_deg": _finite(row.get("normal_deg")), "pelvic_frame": row.get("pelvic_frame"),
+                     "pose_at_limit_deg": list(at) if at is not None else None,
+                     "start_deg": list(row.get("start_deg") or (0, 0, 0))}
+            out.append(entry)
+        return out
+
+    def _morphology(self):
+        """The morphology values the page shows beside the view (Joint.morphology(): each measure's value)."""
+        m = self.joint.morphology()
+
+        def value(part, key):
+            x = m[part].get(key)
+            return x.get("value") if isinstance(x, dict) else x
+
+        by_hour = value("femur", "alpha_deg_by_hour") or {}
+        out = {"alpha_deg_by_hour": {h: _finite(v) for h, v in by_hour.items()}}
+        for part, keys in (("femur", ("alpha_max_deg", "alpha_max_hour", "head_radius_mm", "neck_shaft_angle_deg",
+                                      "version_posterior_condylar_deg")),
+                           ("acetabulum", ("lateral_centre_edge_deg", "anterior_centre_edge_deg",
+                                           "radiographic_anteversion_deg", "radiographic_inclination_deg"))):
+            for k in keys:
+                out[k] = _finite(value(part, k))
+        return out
+
+    def _motion_least(self):
+        """Per frame of the motion: the least distance and the least radial gap of both bones (Joint.motion)."""
+        if self.motion is None:
+            raise impinge.Error("no motion was given (impinge view --motion FILE)")
+        r = self.joint.motion(np.asarray(self.motion["angles"], dtype=float))
+        out = {"least_gap_mm": [_finite(x) for x in np.fmin(r["femur_min_gap_mm"], r["pelvis_min_gap_mm"])]}
+        if "femur_min_distance_mm" in r:
+            out["least_distance_mm"] = [_finite(x) for x in
+                                        np.fmin(r["femur_min_distance_mm"], r["pelvis_min_distance_mm"])]
+        return out
 
     def mesh_bytes(self, bone):
         """A bone as binary: uint32 vertex count, uint32 triangle count, float32 V (n x 3), uint32 F (m x 3)."""
@@ -109,7 +194,6 @@ class Viewer:
 
     def frame_bytes(self, ident, pose):
         """The binary answer to one pose (the module docstring's layout). Runs the detection (GIL released)."""
-        import time
         t0 = time.perf_counter()
         r = self.joint.detect_pose(*pose)
         R, t = self.joint.femur_pose(*pose)
@@ -152,7 +236,7 @@ def make_app(viewer, token):
     @web.middleware
     async def require_token(request, handler):
         given = request.query.get("token") or request.headers.get("X-Impinge-Token", "")
-        if not secrets.compare_digest(given, token):
+        if not secrets.compare_digest(given.encode("utf-8", "surrogateescape"), token.encode()):
             return web.Response(status=403, text="impinge view: a request without this server's token is refused\n")
         return await handler(request)
 
@@ -192,8 +276,9 @@ def make_app(viewer, token):
                     continue
                 try:
                     data = await loop.run_in_executor(None, viewer.frame_bytes, *req)
-                except impinge.Error as e:
-                    await ws.send_str(json.dumps({"type": "error", "id": req[0], "message": str(e)}))
+                except Exception as e:  # noqa: BLE001 - any failure is said to the page; the server goes on
+                    if not ws.closed:
+                        await ws.send_str(json.dumps({"type": "error", "id": req[0], "message": str(e)}))
                     continue
                 if not ws.closed:
                     await ws.send_bytes(data)
@@ -219,11 +304,23 @@ def make_app(viewer, token):
         for ws in list(app["sockets"]):
             await ws.close(code=1001, message=b"server stopped")
 
+    async def motion(request):
+        if viewer.motion is None:
+            raise web.HTTPNotFound(text="no motion was given (impinge view --motion FILE)")
+        return web.json_response(viewer.motion)
+
+    def job_route(name):
+        async def handler(request):
+            return web.json_response(viewer.job(name), dumps=lambda x: json.dumps(x, allow_nan=False))
+        return handler
+
     app = web.Application(middlewares=[require_token], client_max_size=64 * 1024)
     app["sockets"] = weakref.WeakSet()
     app.on_shutdown.append(close_sockets)
     app.add_routes([web.get("/", page), web.get("/viewer.js", script), web.get("/api/scene", scene),
-                    web.get("/api/mesh/{bone}", mesh), web.get("/ws", socket)])
+                    web.get("/api/mesh/{bone}", mesh), web.get("/ws", socket), web.get("/api/motion", motion),
+                    web.get("/api/motion/least", job_route("motion")), web.get("/api/rom", job_route("rom")),
+                    web.get("/api/morphology", job_route("morphology"))])
     return app
 
 
@@ -265,7 +362,8 @@ def main(argv=None):
               "(npm ci in web/) and rebuild", file=sys.stderr)
         return 1
     try:
-        joint = impinge.Joint._from_cli(rest)
+        joint, command = impinge.Joint._from_cli(rest)
+        viewer = Viewer(joint, motion=command["motion"])
     except impinge.Error as e:
         print(f"impinge: error: {e}", file=sys.stderr)
         return 1
@@ -273,7 +371,7 @@ def main(argv=None):
         print(f"impinge: warning: {w}", file=sys.stderr)
     token = view.get("token") or secrets.token_urlsafe(24)
     try:
-        asyncio.run(serve(Viewer(joint), view["host"], int(view["port"]), bool(view["open_browser"]), token))
+        asyncio.run(serve(viewer, view["host"], int(view["port"]), bool(view["open_browser"]), token))
     except KeyboardInterrupt:
         print("impinge view: stopped", file=sys.stderr)
     except OSError as e:

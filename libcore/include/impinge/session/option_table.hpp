@@ -124,7 +124,8 @@ struct OptionRow {
   /// added where the row's 0 means "none" (max-radius, sparse); inclusive unless min_open; max inf: "inf" allowed.
   double min = -1e308, max = 1e308;
   bool min_open = false;  ///< min itself is not valid (a length that must be > 0)
-  bool required = false;             ///< the CLI commands that use it need it
+  bool required = false;             ///< the CLI commands that use it need it (but those in optional_for)
+  unsigned optional_for = 0;         ///< OptionUse bits of commands where a required row may be left out
   /// Former CLI names (without dashes) still accepted for one release: the CLI says which name replaces one.
   /// Naming convention: CLI names carry no unit (the unit is in the help and the value's name: NUMBER mm); Python
   /// and study keys carry it on lengths and angles (`clearance_mm`, `step_deg`).

@@ -1,7 +1,7 @@
 #pragma once
 /// @file outputs.hpp
 /// A run's output folder, and the posed bones with their gaps as mesh files, in the input frame: PLY per
-/// bone (the CLI's ball_gaps.ply and socket_gaps.ply) and one VTK PolyData per motion frame (ParaView).
+/// bone (the CLI's femur_gaps.ply and pelvis_gaps.ply) and one VTK PolyData per motion frame (ParaView).
 /// Every file is written whole or not at all (core/atomic_file.hpp).
 
 #include <Eigen/Core>
@@ -47,8 +47,8 @@ void write_pose_plys(const std::string& ball_path, const std::string& socket_pat
 void write_pose_vtp(const std::string& path, const Session& session, const PoseResult& result,
                     const FemurPose& pose);
 
-/// Both maps of `session` as PNG images (write_map_png: the map over (theta, phi)) in `dir`: ball_map.png and
-/// socket_map.png, each on its own thread. Throws impinge::Error naming a file on I/O errors.
+/// Both maps of `session` as PNG images (write_map_png: the map over (theta, phi)) in `dir`: femur_map.png and
+/// pelvis_map.png, each on its own thread. Throws impinge::Error naming a file on I/O errors.
 void write_map_pngs(const std::string& dir, const Session& session);
 
 /// `impinge generate`: a generated hip (make_hip_model(options)) written into `dir` as femur_r.ply, pelvis.ply and

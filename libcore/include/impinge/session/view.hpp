@@ -29,7 +29,8 @@ struct ViewCommand {
 };
 
 /// The server's command for `view` and `distance_args` (the `impinge distance` options given, as the CLI's tokens:
-/// "--name=value" or "--flag"). The interpreter is $IMPINGE_PYTHON or /usr/bin/python3 (Debian's, with numpy);
+/// "--name=value" or "--flag"). The interpreter is $IMPINGE_PYTHON (a path, or a name looked up on PATH) or
+/// /usr/bin/python3 (Debian's, with numpy; 3.11 or later: it runs with -P, so the current folder is not imported);
 /// the package is found in $IMPINGE_PYTHONPATH, else `build_python_dir` (the build tree's BUILD/python) when it holds
 /// impinge/view. Throws impinge::Error naming what is missing (no package, no interpreter) and how to get it.
 ViewCommand view_command(const ViewOptions& view, const std::vector<std::string>& distance_args,
