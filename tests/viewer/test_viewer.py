@@ -239,7 +239,9 @@ def test_hostile_messages_get_an_error_and_the_server_keeps_serving(server):
                 bad = ["not json", "[1, 2]", '{"type": "dance"}', '{"type": "pose", "pose": [NaN, 0, 0]}',
                        '{"type": "pose", "pose": [1e9, 0, 0]}', '{"type": "pose", "pose": ["a", 0, 0]}',
                        '{"type": "pose", "pose": [1, 2]}', '{"type": "pose", "pose": [1, 2, 3], "id": "x"}',
-                       '{"type": "pose", "pose": [' + ",".join(["1"] * 5000) + "]}"]
+                       '{"type": "pose", "pose": [' + ",".join(["1"] * 5000) + "]}",
+                       '{"type": "pose", "pose": [1' + "0" * 400 + ', 0, 0]}', "[" * 1500 + "]" * 1500,
+                       "é" * 2100, '{"type": "pose", "pose": [1, 2, 3], "pad": "' + "x" * 20000 + '"}']
                 for m in bad:
                     await ws.send_str(m)
                     reply = await ws.receive(timeout=20)
@@ -261,10 +263,12 @@ def test_hostile_messages_get_an_error_and_the_server_keeps_serving(server):
     asyncio.run(run())
 
 
-def test_ctrl_c_stops_the_server(hip):
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_ctrl_c_and_termination_stop_the_server(hip, sig):
     p, url = start_server(hip + "/s/subject.json")
-    p.send_signal(signal.SIGINT)
+    p.send_signal(sig)
     assert p.wait(timeout=20) == 0
+    assert "stopped" in p.stderr.read()
     port = int(url.split(":")[2].split("/")[0])
     with socket.socket() as s:
         assert s.connect_ex(("127.0.0.1", port)) != 0  # nothing listens any more
@@ -321,3 +325,49 @@ def test_the_servers_parser_reads_the_cli_tokens_as_the_cli_does(hip):
                          (["--precision", "2", "--precision", "1"], "given twice")):
         with pytest.raises(impinge.Error, match=message):
             impinge.Joint._from_cli(["--subject", s, *bad])
+
+
+def test_an_export_opens_from_disk_offline_and_holds_what_the_server_computes(hip, browser):
+    """--export: one HTML file that opens from disk with the network off; its stored poses' values are the server's
+    (impinge distance --query-strategy maps at that pose); the page says what it holds; --export-max-mb decimates a
+    motion to fit, and the file is written whole (no temporary file left)."""
+    out = hip + "/export.html"
+    r = subprocess.run([CLI, "view", "--subject", hip + "/s/subject.json", "--precision", "1", "--export", out],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "wrote" in r.stdout, r.stderr
+    browser.execute_cdp_cmd("Network.enable", {})
+    browser.execute_cdp_cmd("Network.emulateNetworkConditions", {"offline": True, "latency": 0,
+                                                                 "downloadThroughput": 0, "uploadThroughput": 0})
+    try:
+        open_page(browser, "file://" + out)
+        note = browser.find_element("id", "stored").text
+        assert "stored poses" in note and "Nothing is computed here" in note
+        rom = wait_for(browser, "return window.__impinge.rom")
+        at = next(x["pose_at_limit_deg"] for x in rom if x["pose_at_limit_deg"])
+        got = pose_in_page(browser, *at)
+        assert np.allclose(got["pose"], at, atol=1e-12)
+        dist = hip + "/export_check"
+        subprocess.run([CLI, "distance", "--subject", hip + "/s/subject.json", "--precision", "1", "--query-strategy",
+                        "maps", "--pose", ",".join(repr(float(x)) for x in at), "--out", dist], check=True,
+                       capture_output=True)
+        for bone in ("femur", "pelvis"):
+            page = np.array(browser.execute_script(f"return window.__impinge.values('{bone}', 'distance')"),
+                            dtype=np.float32)
+            np.testing.assert_array_equal(page, read_ply_vertices(f"{dist}/{bone}_gaps.ply")["distance_mm"])
+    finally:
+        browser.execute_cdp_cmd("Network.emulateNetworkConditions", {"offline": False, "latency": 0,
+                                                                     "downloadThroughput": -1, "uploadThroughput": -1})
+    mot = hip + "/sweep.csv"
+    with open(mot, "w") as f:
+        f.write("time_s,flexion_deg,adduction_deg,internal_rotation_deg\n")
+        for i in range(200):
+            f.write(f"{i * 0.01:.2f},{i * 0.5:.2f},0,0\n")
+    small = hip + "/small.html"
+    r = subprocess.run([CLI, "view", "--subject", hip + "/s/subject.json", "--precision", "1", "--motion", mot,
+                        "--export", small, "--export-max-mb", "1.5"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "of 200" in r.stdout, (r.stdout, r.stderr)
+    assert os.path.getsize(small) <= 1.5e6
+    assert not [f for f in os.listdir(hip) if f.startswith(".impinge-export-")]
+    r = subprocess.run([CLI, "view", "--subject", hip + "/s/subject.json", "--precision", "1", "--export", small,
+                        "--export-poses", "10,0,abc"], capture_output=True, text=True, timeout=300)
+    assert r.returncode != 0 and "--export-poses: pose 1 '10,0,abc'" in r.stderr

@@ -18,9 +18,22 @@ async function fetchChecked(path) {
   return r;
 }
 
+// An exported file (impinge view --export) carries the server's answers inside it: no server, no network.
+const stored = window.__IMPINGE_EXPORT__ || null;
+const fromBase64 = (t) => Uint8Array.from(atob(t), (c) => c.charCodeAt(0)).buffer;
+async function getJSON(path) {
+  if (!stored) return (await fetchChecked(path)).json();
+  if (!(path in stored.json)) throw new Error(`${path}: not in this exported file`);
+  return stored.json[path];
+}
+async function getBuffer(path) {
+  if (!stored) return (await fetchChecked(path)).arrayBuffer();
+  return fromBase64(stored.buffers[path]);
+}
+
 // A bone from /api/mesh/NAME: uint32 n, uint32 m, float32 V (n x 3), uint32 F (m x 3).
 async function fetchMesh(name) {
-  const buf = await (await fetchChecked(`/api/mesh/${name}`)).arrayBuffer();
+  const buf = await getBuffer(`/api/mesh/${name}`);
   const [n, m] = new Uint32Array(buf, 0, 2);
   const V = new Float32Array(buf, 8, n * 3);
   const F = new Uint32Array(buf, 8 + n * 12, m * 3);
@@ -56,7 +69,8 @@ function rampColour(x) {
 }
 
 async function start() {
-  const scene = await (await fetchChecked('/api/scene')).json();
+  const scene = await getJSON('/api/scene');
+  if (stored) $('stored').textContent = stored.note;
   const [femurMesh, pelvisMesh] = await Promise.all([fetchMesh('femur'), fetchMesh('pelvis')]);
   $('subject').textContent = `${scene.side} hip, ${scene.femur_triangles + scene.pelvis_triangles} triangles; ` +
       `joint centre ${scene.joint_centre}; neutral ${scene.neutral}; impinge ${scene.impinge_version}`;
@@ -176,6 +190,9 @@ async function start() {
       const stops = palette.pelvis.map((c, k) => `rgb(${c}) ${100 * k / palette.pelvis.length}% ${100 * (k + 1) / palette.pelvis.length}%`);
       $('legend').style.background = `linear-gradient(to right, ${stops.join(', ')})`;
       const mm = (x) => Number(x.toFixed(2));
+      $('legend-note').innerHTML = `none: <span class="swatch" style="background:rgb(${palette.femur[0]})"></span> femur, ` +
+          `<span class="swatch" style="background:rgb(${palette.pelvis[0]})"></span> pelvis; ` +
+          `<span class="swatch" style="background:rgb(${palette.untested})"></span> not tested (beyond reach, no surface)`;
       $('legend-labels').innerHTML = ['&gt;' + mm(t[0])].concat(t.slice(1).map((x, k) => `${mm(t[k])}-${mm(x)}`))
           .concat(['&le;' + mm(t[t.length - 1])]).map((s) => `<span>${s}</span>`).join('') + '<span>mm</span>';
     } else {
@@ -183,6 +200,8 @@ async function start() {
       const stops = RAMP.map(([x, c]) => `rgb(${c}) ${100 * (x - lo) / (hi - lo)}%`);
       $('legend').style.background = `linear-gradient(to right, ${stops.join(', ')})`;
       $('legend-labels').innerHTML = RAMP.map(([x]) => `<span>${x}</span>`).join('') + '<span>mm</span>';
+      $('legend-note').innerHTML = `<span class="swatch" style="background:rgb(${palette.untested})"></span> ` +
+          'not measured (beyond the distance reach, or no surface on the ray)';
     }
   }
   function recolour() {
@@ -235,9 +254,19 @@ async function start() {
   }
 
   // The WebSocket: the newest pose only (the server drops older pending ones too).
-  const ws = new WebSocket(withToken(`${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws`));
-  ws.binaryType = 'arraybuffer';
   let nextId = 1;
+  // Live: the server's WebSocket. Exported: the stored pose nearest the one asked for (said on the page).
+  const storedFrames = stored ? stored.frames.map((f) => ({ pose: f.pose, buf: fromBase64(f.data) })) : null;
+  const ws = stored ? { send: (text) => {
+    const m = JSON.parse(text);
+    let best = storedFrames[0], bestD = Infinity;
+    for (const f of storedFrames) {
+      const d = (f.pose[0] - m.pose[0]) ** 2 + (f.pose[1] - m.pose[1]) ** 2 + (f.pose[2] - m.pose[2]) ** 2;
+      if (d < bestD) { bestD = d; best = f; }
+    }
+    setTimeout(() => applyFrame({ ...decodeFrame(best.buf, femur.n, pelvis.n), id: m.id }), 0);
+  } } : new WebSocket(withToken(`${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws`));
+  ws.binaryType = 'arraybuffer';
   ws.onmessage = (e) => {
     if (typeof e.data === 'string') {
       const m = JSON.parse(e.data);
@@ -247,10 +276,15 @@ async function start() {
     showError('');
     applyFrame(decodeFrame(e.data, femur.n, pelvis.n));
   };
-  ws.onclose = () => { $('status').textContent = 'the server has stopped'; };
-  const opened = new Promise((resolve) => { ws.onopen = resolve; });
+  ws.onclose = () => {
+    $('status').textContent = 'the server has stopped: restart impinge view and reload this page';
+    for (const el of document.querySelectorAll('#panel input, #panel button, #panel select')) el.disabled = true;
+    for (const w of hook.waiting.splice(0)) w.reject(new Error('the server has stopped'));
+  };
+  const opened = stored ? Promise.resolve() : new Promise((resolve) => { ws.onopen = resolve; });
 
   function sendPose(pose) {
+    if (!stored && ws.readyState !== WebSocket.OPEN) return nextId;
     const id = nextId++;
     ws.send(JSON.stringify({ type: 'pose', id, pose }));
     return id;
@@ -259,10 +293,22 @@ async function start() {
   function currentPose() { return names.map((n) => Number($(n + '-n').value)); }
   for (const n of names) {
     $(n).addEventListener('input', () => { $(n + '-n').value = $(n).value; sendPose(currentPose()); });
-    $(n + '-n').addEventListener('change', () => { $(n).value = $(n + '-n').value; sendPose(currentPose()); });
+    $(n + '-n').addEventListener('change', () => {
+      const v = Number($(n + '-n').value);
+      if ($(n + '-n').value.trim() === '' || !Number.isFinite(v) || Math.abs(v) > 360) {
+        showError(`${n.replace('_', ' ')}: enter a number of degrees within -360..360`);
+        $(n + '-n').value = last ? Number(last.pose[names.indexOf(n)].toFixed(2)) : 0;  // the pose shown
+        return;
+      }
+      $(n).value = v;
+      sendPose(currentPose());
+    });
   }
   $('neutral').onclick = () => { for (const n of names) { $(n).value = 0; $(n + '-n').value = 0; } sendPose([0, 0, 0]); };
   $('colour').onchange = recolour;
+  if (!scene.distances) {  // --distances off: no Euclidean distances to colour by
+    $('colour').querySelector('option[value=distance]').remove();
+  }
   for (const id of ['display', 'show-femur', 'show-pelvis']) $(id).onchange = display;
   $('crop').onchange = () => { display(); setView(lastView); };
 
@@ -297,9 +343,33 @@ async function start() {
       $(n + '-n').value = Number(v.toFixed(2));
     }
     const id = sendPose([f, a, r]);
-    return new Promise((resolve) => hook.waiting.push({ id, resolve }));
+    return new Promise((resolve, reject) => hook.waiting.push({ id, resolve, reject }));
   };
   hook.colours = () => ({ femur: Array.from(femur.colour), pelvis: Array.from(pelvis.colour) });
+  // For benchmarks/viewer_latency.py: the data path of `n` poses (a slider's change to the new values in the colour
+  // buffer: request, detection, transfer, decode, colouring; not the draw), and the draw alone (one colour-buffer
+  // upload and one render, waited for by reading a pixel back), each in ms.
+  hook.timePoses = async (poses) => {
+    const out = [];
+    for (const p of poses) {
+      const t0 = performance.now();
+      await hook.setPose(...p);
+      out.push(performance.now() - t0);
+    }
+    return out;
+  };
+  hook.timeDraws = (n) => {
+    const gl = renderer.getContext(), out = [], px = new Uint8Array(4);
+    for (let k = 0; k < n; ++k) {
+      const t0 = performance.now();
+      femur.geometry.attributes.color.needsUpdate = true;
+      pelvis.geometry.attributes.color.needsUpdate = true;
+      renderer.render(view, camera);
+      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);  // waits for the drawing to finish
+      out.push(performance.now() - t0);
+    }
+    return out;
+  };
   hook.values = (bone, what) => Array.from(hook.frame[bone][what]);
 
   // The acetabular clock face (thesis Figure 62c; Blankenbaker et al. 2007): a ring over the rim with its hours.
@@ -335,7 +405,7 @@ async function start() {
   // A motion (--motion): a timeline played in wall-clock time (frames skipped, never queued, when the answers are
   // slower than the motion), and the least distance over time (Joint.motion, computed once in the background).
   if (scene.motion) {
-    const m = await (await fetchChecked('/api/motion')).json();
+    const m = await getJSON('/api/motion');
     const n = m.time_s.length;
     $('motion-panel').hidden = false;
     $('motion-name').textContent = m.name;
@@ -449,7 +519,7 @@ async function poll(path, done, el) {
   for (;;) {
     let r;
     try {
-      r = await (await fetchChecked(path)).json();
+      r = await getJSON(path);
     } catch (e) {
       el.textContent = String(e);
       return;

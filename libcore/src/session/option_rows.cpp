@@ -452,6 +452,17 @@ void add_view_rows(Rows& t) {
   t.flag("no-browser", "no_browser", OptionType::flag, use_view,
          "Print the page's address without opening it in a browser",
          [](auto& o) -> auto& { return o.view.open_browser; }, true);
+  t.text("export", "export", OptionType::path, use_view, {},
+         "Write one self-contained HTML file (the meshes and the --export-poses, opens from disk with no server or "
+         "network) instead of serving",
+         [](auto& o) -> auto& { return o.view.export_path; });
+  t.text("export-poses", "export_poses", OptionType::text, use_view, {},
+         "The poses an --export holds: auto (the motion's frames with --motion, else rom), rom (neutral, and 2 deg "
+         "before and at each standard motion's limit), motion, or F,A,R;F,A,R;... (degrees, ISB)",
+         [](auto& o) -> auto& { return o.view.export_poses; });
+  t.number("export-max-mb", "export_max_mb", "MB", use_view, ViewOptions::kExportMaxMbRange,
+           "The export's largest size; a motion's frames are decimated evenly to fit",
+           [](auto& o) -> auto& { return o.view.export_max_mb; });
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // `impinge view`'s server command (session/view.hpp).
 #include "impinge/session/view.hpp"
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,7 @@ namespace fs = std::filesystem;
 ViewCommand view_command(const ViewOptions& view, const std::vector<std::string>& distance_args,
                          const std::string& build_python_dir) {
   check_in_range("--port", view.port, ViewOptions::kPortRange, "");
+  require(!view.host.empty(), "--host '': give an address (127.0.0.1: this machine only; 0.0.0.0: every interface)");
   ViewCommand c;
   const char* env_path = std::getenv("IMPINGE_PYTHONPATH");
   if (env_path != nullptr && *env_path != '\0') {
@@ -30,14 +32,22 @@ ViewCommand view_command(const ViewOptions& view, const std::vector<std::string>
   if (python.find('/') != std::string::npos && !fs::exists(python))
     throw Error("impinge view: no Python interpreter " + python + " (install python3, or set IMPINGE_PYTHON)");
   // -P: the current folder is not put first on sys.path (an impinge/ or aiohttp.py there must not be imported).
-  const nlohmann::json j = {{"host", view.host}, {"port", view.port}, {"open_browser", view.open_browser}};
+  check_in_range("--export-max-mb", view.export_max_mb, ViewOptions::kExportMaxMbRange, "MB");
+  const nlohmann::json j = {{"host", view.host},
+                            {"port", view.port},
+                            {"open_browser", view.open_browser},
+                            {"export", view.export_path},
+                            {"export_poses", view.export_poses},
+                            {"export_max_mb", view.export_max_mb}};
   c.argv = {python, "-P", "-m", "impinge.view", "--view-json", j.dump(), "--"};
   c.argv.insert(c.argv.end(), distance_args.begin(), distance_args.end());
   return c;
 }
 
 std::string view_host_warning(const std::string& host) {
-  if (host == "127.0.0.1" || host == "::1" || host == "localhost") return "";
+  std::string h = host;
+  for (char& c : h) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (h.rfind("127.", 0) == 0 || h == "::1" || h == "localhost") return "";  // this machine's loopback
   return "--host " + host + " serves the page beyond this machine: anyone who can reach it and knows the page's "
          "token can pose the hip and read the meshes";
 }

@@ -23,6 +23,7 @@ import os
 import secrets
 import struct
 import sys
+import tempfile
 import time
 import webbrowser
 from concurrent.futures import ThreadPoolExecutor
@@ -43,11 +44,12 @@ class BadMessage(ValueError):
 def parse_pose_message(text):
     """A page's message -> (id, (flexion, adduction, internal_rotation)) in degrees. Raises BadMessage naming
     what is wrong (not JSON, not an object, unknown type, a pose not three finite numbers within +-360 deg)."""
-    if len(text) > MAX_MESSAGE_BYTES:
-        raise BadMessage(f"message of {len(text)} bytes: at most {MAX_MESSAGE_BYTES}")
+    size = len(text.encode("utf-8", "surrogatepass"))
+    if size > MAX_MESSAGE_BYTES:
+        raise BadMessage(f"message of {size} bytes: at most {MAX_MESSAGE_BYTES}")
     try:
         m = json.loads(text)
-    except ValueError as e:
+    except (ValueError, RecursionError) as e:
         raise BadMessage(f"not JSON: {e}") from None
     if not isinstance(m, dict):
         raise BadMessage("expected an object {type, id, pose}")
@@ -57,7 +59,11 @@ def parse_pose_message(text):
     if not isinstance(pose, list) or len(pose) != 3 or not all(
             isinstance(x, (int, float)) and not isinstance(x, bool) for x in pose):
         raise BadMessage(f"pose {pose!r}: expected [flexion, adduction, internal_rotation] in degrees")
-    if not all(math.isfinite(x) and abs(x) <= 360 for x in pose):
+    try:
+        finite = all(math.isfinite(x) and abs(x) <= 360 for x in pose)
+    except OverflowError:  # an integer too large for a float
+        finite = False
+    if not finite:
         raise BadMessage(f"pose {pose!r}: each angle must be finite and within +-360 deg")
     ident = m.get("id", 0)
     if not isinstance(ident, int) or isinstance(ident, bool):
@@ -228,6 +234,96 @@ class Viewer:
         return b"".join(parts)
 
 
+def export_poses(viewer, spec):
+    """The poses (degrees, ISB) an export holds and what they are: `spec` "auto" (the motion's frames when there is
+    one, else "rom"), "rom" (neutral, and per standard motion with a limit the pose 2 deg before it and at it),
+    "motion", or "F,A,R;F,A,R;...". Raises impinge.Error naming the option on a bad spec."""
+    if spec == "auto":
+        spec = "motion" if viewer.motion is not None else "rom"
+    if spec == "motion":
+        if viewer.motion is None:
+            raise impinge.Error("--export-poses motion: no --motion was given")
+        return [tuple(p) for p in viewer.motion["angles"]], "the motion's frames"
+    if spec == "rom":
+        poses = [(0.0, 0.0, 0.0)]
+        for r in viewer._rom():
+            at, start = r["pose_at_limit_deg"], r["start_deg"]
+            if at is None:
+                continue
+            f = max(0.0, r["limit_deg"] - 2) / r["limit_deg"] if r["limit_deg"] > 0 else 0.0
+            poses.append(tuple(s0 + (a0 - s0) * f for s0, a0 in zip(start, at)))
+            poses.append(tuple(at))
+        return poses, "neutral and, per standard motion, the poses 2 deg before and at its limit"
+    poses = []
+    for k, item in enumerate(spec.split(";")):
+        try:
+            p = tuple(float(x) for x in item.split(","))
+        except ValueError:
+            p = ()
+        if len(p) != 3 or not all(math.isfinite(x) and abs(x) <= 360 for x in p):
+            raise impinge.Error(f"--export-poses: pose {k + 1} '{item}': expected FLEXION,ADDUCTION,INTERNAL_ROTATION "
+                                "in degrees (each within +-360), poses separated by ';'; or auto, rom, motion")
+        poses.append(p)
+    return poses, "the poses given"
+
+
+def export_html(viewer, path, spec, max_mb):
+    """Write `path`: one HTML file holding the page's script, the meshes, the chosen poses' values (as the server
+    sends them), the ROM limits, the morphology and the motion, so that it opens from disk with no server and no
+    network. Poses beyond `max_mb` (MB) are decimated evenly (first and last kept); the page says what it holds and
+    that between stored poses nothing is computed. Written atomically (a temporary file, then renamed). Returns
+    (poses kept, poses asked, bytes). Raises impinge.Error when even the meshes and one pose exceed max_mb."""
+    import base64
+    poses, what = export_poses(viewer, spec)
+    b64 = lambda b: base64.b64encode(b).decode("ascii")  # noqa: E731
+    with open(os.path.join(STATIC, "viewer.js"), encoding="utf-8") as f:
+        script = f.read().replace("</script", "<\\/script")
+    with open(os.path.join(STATIC, "index.html"), encoding="utf-8") as f:
+        html = f.read()
+    meshes = {f"/api/mesh/{bone}": b64(viewer.mesh_bytes(bone)) for bone in ("femur", "pelvis")}
+    first = viewer.frame_bytes(0, poses[0])
+    per_pose = len(b64(first)) + 80
+    base = len(script) + len(html) + sum(len(m) for m in meshes.values()) + 200_000  # JSON of ROM, morphology ...
+    room = int((max_mb * 1e6 - base) // per_pose)
+    if room < 1:
+        raise impinge.Error(f"--export-max-mb {max_mb:g}: the meshes and one pose need {(base + per_pose) / 1e6:.1f} MB")
+    asked = len(poses)
+    if asked > room:
+        keep = sorted({round(k * (asked - 1) / (room - 1)) for k in range(room)}) if room > 1 else [0]
+        poses = [poses[k] for k in keep]
+    frames = [{"pose": list(p), "data": b64(first if k == 0 else viewer.frame_bytes(k, p))}
+              for k, p in enumerate(poses)]
+    done = lambda result: {"state": "done", "seconds": 0, "result": result}  # noqa: E731
+    json_parts = {"/api/scene": viewer.scene, "/api/rom": done(viewer._rom())}
+    try:
+        json_parts["/api/morphology"] = done(viewer._morphology())
+    except impinge.Error as e:
+        json_parts["/api/morphology"] = {"state": "error", "message": str(e)}
+    if viewer.motion is not None:
+        json_parts["/api/motion"] = viewer.motion
+        json_parts["/api/motion/least"] = done(viewer._motion_least())
+    note = (f"Exported file: {len(poses)} stored poses ({what}"
+            + (f", {asked} asked, decimated evenly to fit {max_mb:g} MB" if len(poses) < asked else "")
+            + "). Nothing is computed here: a slider or the timeline shows the stored pose nearest to it.")
+    data = {"json": json_parts, "buffers": meshes, "frames": frames, "note": note}
+    text = json.dumps(data, allow_nan=False, default=lambda x: None).replace("</", "<\\/")
+    page = html.replace('<script src="viewer.js?token=__TOKEN__"></script>',
+                        f"<script>window.__IMPINGE_EXPORT__ = {text};</script>\n<script>{script}</script>")
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".impinge-export-", suffix=".html", dir=folder)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(page)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return len(poses), asked, len(page.encode())
+
+
 def make_app(viewer, token):
     """The aiohttp application: the page, its script, the scene, both meshes and the pose WebSocket; every
     request must carry `token` (query `token` or header X-Impinge-Token), else 403."""
@@ -260,7 +356,7 @@ def make_app(viewer, token):
         return web.Response(body=viewer.mesh_bytes(bone), content_type="application/octet-stream")
 
     async def socket(request):
-        ws = web.WebSocketResponse(max_msg_size=MAX_MESSAGE_BYTES * 4)
+        ws = web.WebSocketResponse(max_msg_size=1 << 20)  # larger than a pose: answered with an error, not closed
         await ws.prepare(request)
         request.app["sockets"].add(ws)
         pending = {"req": None}
@@ -292,6 +388,8 @@ def make_app(viewer, token):
                         wake.set()
                     except BadMessage as e:
                         await ws.send_str(json.dumps({"type": "error", "message": str(e)}))
+                    except Exception as e:  # noqa: BLE001 - never drop the page for a message
+                        await ws.send_str(json.dumps({"type": "error", "message": f"bad message: {e}"}))
                 elif msg.type == WSMsgType.BINARY:
                     await ws.send_str(json.dumps({"type": "error", "message": "binary messages are not accepted"}))
                 elif msg.type == WSMsgType.ERROR:
@@ -325,9 +423,14 @@ def make_app(viewer, token):
 
 
 async def serve(viewer, host, port, open_browser, token, ready=None):
-    """Serve until cancelled (Ctrl-C). Prints the page's address; opens it unless open_browser is False.
-    `ready`: an optional callback given the address once listening."""
+    """Serve until Ctrl-C, SIGTERM or SIGHUP (the open pages' sockets are closed first). Prints the page's address;
+    opens it unless open_browser is False. `ready`: an optional callback given the address once listening."""
+    import signal
     from aiohttp import web
+    stop = asyncio.Event()
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        loop.add_signal_handler(sig, stop.set)
     runner = web.AppRunner(make_app(viewer, token), handle_signals=False)
     await runner.setup()
     site = web.TCPSite(runner, host, port)
@@ -341,10 +444,10 @@ async def serve(viewer, host, port, open_browser, token, ready=None):
     if open_browser:
         webbrowser.open(url)
     try:
-        while True:
-            await asyncio.sleep(3600)
+        await stop.wait()
     finally:
         await runner.cleanup()
+    print("impinge view: stopped", file=sys.stderr)
 
 
 def main(argv=None):
@@ -360,15 +463,25 @@ def main(argv=None):
     if not os.path.exists(os.path.join(STATIC, "viewer.js")):
         print("impinge view: the page was not built (no impinge/view/static/viewer.js): run tools/install-deps "
               "(npm ci in web/) and rebuild", file=sys.stderr)
-        return 1
+        return 2
     try:
         joint, command = impinge.Joint._from_cli(rest)
         viewer = Viewer(joint, motion=command["motion"])
     except impinge.Error as e:
         print(f"impinge: error: {e}", file=sys.stderr)
-        return 1
+        return 2
     for w in joint.warnings:
         print(f"impinge: warning: {w}", file=sys.stderr)
+    if view.get("export"):
+        try:
+            kept, asked, size = export_html(viewer, view["export"], view.get("export_poses", "auto"),
+                                            float(view.get("export_max_mb", 25)))
+        except (impinge.Error, OSError) as e:
+            print(f"impinge: error: {e}", file=sys.stderr)
+            return 1
+        print(f"impinge view: wrote {view['export']} ({kept} poses" + (f" of {asked}" if kept < asked else "") +
+              f", {size / 1e6:.1f} MB)", flush=True)
+        return 0
     token = view.get("token") or secrets.token_urlsafe(24)
     try:
         asyncio.run(serve(viewer, view["host"], int(view["port"]), bool(view["open_browser"]), token))
@@ -376,5 +489,5 @@ def main(argv=None):
         print("impinge view: stopped", file=sys.stderr)
     except OSError as e:
         print(f"impinge: error: cannot listen on {view['host']}:{view['port']}: {e.strerror or e}", file=sys.stderr)
-        return 1
+        return 2
     return 0

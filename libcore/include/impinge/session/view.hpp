@@ -19,6 +19,14 @@ struct ViewOptions {
   int port = 0;  ///< TCP port; 0: a free one chosen by the system (printed with the page's address)
   static constexpr Range kPortRange{0, 65535};  ///< of port
   bool open_browser = true;  ///< open the page in the user's browser (webbrowser: $BROWSER, xdg-open)
+  /// Write one self-contained HTML file here instead of serving (no server, no network when it is opened): the meshes
+  /// and the poses `export_poses` names, each pose's values as the server would send them. Empty: serve.
+  std::string export_path;
+  /// Which poses an export holds: "auto" (the motion's frames with --motion, else "rom"), "rom" (neutral and, per
+  /// standard motion, the pose 2 deg before its limit and at it), "motion", or "F,A,R;F,A,R;..." (degrees, ISB).
+  std::string export_poses = "auto";
+  double export_max_mb = 25;  ///< the export's largest size, MB (10^6 bytes); more poses are decimated to fit
+  static constexpr Range kExportMaxMbRange{1, 2000};  ///< of export_max_mb, MB
 };
 
 /// How to start the server: the interpreter and its arguments (argv, [0] the program) and the PYTHONPATH entry
