@@ -371,3 +371,37 @@ def test_an_export_opens_from_disk_offline_and_holds_what_the_server_computes(hi
     r = subprocess.run([CLI, "view", "--subject", hip + "/s/subject.json", "--precision", "1", "--export", small,
                         "--export-poses", "10,0,abc"], capture_output=True, text=True, timeout=300)
     assert r.returncode != 0 and "--export-poses: pose 1 '10,0,abc'" in r.stderr
+
+
+def test_a_plan_shows_the_resected_bone_before_and_after(hip, browser):
+    """--plan DIR: the page holds the plan's resected femur (femur_resected.ply's positions and resection_mm, bit for
+    bit), shows it after the resection when asked, coloured by the depth removed, with each target's limits."""
+    plan = hip + "/plan"
+    r = subprocess.run([CLI, "plan", "--subject", hip + "/s/subject.json", "--precision", "1", "--target",
+                        "flexion=70", "--allow-partial", "--out", plan], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    p, url = start_server(hip + "/s/subject.json", "--plan", plan)
+    try:
+        open_page(browser, url)
+        ply = read_ply_vertices(plan + "/femur_resected.ply")
+        V = np.array(browser.execute_script("return Array.from(window.__impinge.planned.femur.V)"), np.float32)
+        np.testing.assert_array_equal(V.reshape(-1, 3), np.column_stack([ply["x"], ply["y"], ply["z"]]))
+        depth = np.array(browser.execute_script("return Array.from(window.__impinge.planned.femur.depth)"), np.float32)
+        np.testing.assert_array_equal(depth, ply["resection_mm"])
+        assert depth.max() > 0
+        browser.find_element("id", "plan-after").click()
+        assert browser.find_element("id", "colour").get_attribute("value") == "resection"
+        shown = np.array(browser.execute_script(
+            "return Array.from(window.__impinge.scene && document.querySelector('canvas') && "
+            "window.__impinge.planned.femur.V)"), np.float32)
+        assert shown.size == V.size
+        rows = browser.find_element("id", "plan").text
+        assert "flexion" in rows and ("met" in rows or "missed" in rows)
+        colours = np.array(browser.execute_script("return window.__impinge.colours().femur"), np.uint8).reshape(-1, 3)
+        assert ((colours != 200).any(axis=1) == (depth > 0.01)).all()  # coloured exactly where bone is removed
+    finally:
+        p.send_signal(signal.SIGINT)
+        p.wait(timeout=30)
+    r = subprocess.run([CLI, "view", "--subject", hip + "/s/subject.json", "--plan", hip + "/nowhere", "--no-browser"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "--plan" in r.stderr and "plan.json" in r.stderr

@@ -170,9 +170,12 @@ async function start() {
   function colourBody(b, values, bone) {
     const mode = $('colour').value, c = b.colour;
     const pal = palette[bone], untested = palette.untested;
+    const depth = planned[bone] ? planned[bone].depth : null;
     for (let i = 0; i < b.n; ++i) {
       let rgb;
-      if (mode === 'levels') {
+      if (mode === 'resection') {
+        rgb = depth && depth[i] > 0.01 ? rampColour(-2 * depth[i] / planDepthMax) : untested;
+      } else if (mode === 'levels') {
         const k = values.level[i];
         rgb = k === 255 ? untested : pal[k];
       } else {
@@ -185,6 +188,14 @@ async function start() {
   }
   function legend() {
     const mode = $('colour').value;
+    if (mode === 'resection') {
+      const stops = [0, 0.25, 0.5, 1].map((w) => `rgb(${rampColour(-2 * w)}) ${100 * w}%`);
+      $('legend').style.background = `linear-gradient(to right, ${stops.join(', ')})`;
+      $('legend-labels').innerHTML = [0, planDepthMax / 4, planDepthMax / 2, planDepthMax]
+          .map((x) => `<span>${x.toFixed(2)}</span>`).join('') + '<span>mm</span>';
+      $('legend-note').innerHTML = 'depth of bone the plan removes (resection_mm); grey: none';
+      return;
+    }
     if (mode === 'levels') {
       const t = scene.levels_thresholds_mm;
       const stops = palette.pelvis.map((c, k) => `rgb(${c}) ${100 * k / palette.pelvis.length}% ${100 * (k + 1) / palette.pelvis.length}%`);
@@ -371,6 +382,44 @@ async function start() {
     return out;
   };
   hook.values = (bone, what) => Array.from(hook.frame[bone][what]);
+
+  // A plan (--plan DIR): the resected bones, coloured by the depth removed, before and after; each target's limit.
+  const planned = {};
+  let planDepthMax = 0.1;
+  if (scene.plan) {
+    $('plan-panel').hidden = false;
+    for (const bone of Object.keys(scene.plan.bones)) {
+      const buf = await getBuffer(`/api/plan/mesh/${bone}`);
+      const b = bone === 'femur' ? femur : pelvis;
+      planned[bone] = { V: new Float32Array(buf, 0, b.n * 3), depth: new Float32Array(buf, b.n * 12, b.n),
+                        before: Float32Array.from(b.geometry.attributes.position.array) };
+      for (const d of planned[bone].depth) if (d > planDepthMax) planDepthMax = d;
+    }
+    const opt = document.createElement('option');
+    opt.value = 'resection';
+    opt.textContent = 'Resection depth (mm)';
+    $('colour').append(opt);
+    const f = (x, d = 1) => (x === null || x === undefined ? 'n/a' : Number(x).toFixed(d));
+    $('plan').innerHTML = '<tr><td>target</td><td class="v">deg</td><td class="v">before</td><td class="v">after</td><td></td></tr>' +
+      scene.plan.targets.map((t) => `<tr><td>${String(t.target).replaceAll('_', ' ')}</td><td class="v">${f(t.target_deg)}</td>` +
+        `<td class="v">${f(t.limit_before_deg)}</td><td class="v">${f(t.limit_after_deg)}</td><td>${t.met ? 'met' : 'missed'}</td></tr>`).join('') +
+      Object.entries(scene.plan.bones).map(([b, x]) => `<tr><td colspan="5">${b}: ${f(x.volume_mm3, 0)} mm³, deepest ` +
+        `${f(x.deepest_cut_mm, 2)} mm</td></tr>`).join('');
+    $('plan-after').onchange = () => {
+      const after = $('plan-after').checked;
+      for (const [bone, p] of Object.entries(planned)) {
+        const b = bone === 'femur' ? femur : pelvis;
+        b.geometry.attributes.position.array.set(after ? p.V : p.before);
+        b.geometry.attributes.position.needsUpdate = true;
+        b.geometry.computeVertexNormals();
+      }
+      $('plan-note').textContent = after ? 'The bones after the resection, coloured by the depth removed; the ' +
+          "sliders' gaps and distances are the bones' before it." : '';
+      $('colour').value = after ? 'resection' : 'levels';
+      recolour();
+    };
+    hook.planned = planned;
+  }
 
   // The acetabular clock face (thesis Figure 62c; Blankenbaker et al. 2007): a ring over the rim with its hours.
   const clockGroup = new THREE.Group();

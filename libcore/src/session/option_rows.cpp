@@ -460,6 +460,10 @@ void add_view_rows(Rows& t) {
          "The poses an --export holds: auto (the motion's frames with --motion, else rom), rom (neutral, and 2 deg "
          "before and at each standard motion's limit), motion, or F,A,R;F,A,R;... (degrees, ISB)",
          [](auto& o) -> auto& { return o.view.export_poses; });
+  t.text("plan", "plan", OptionType::path, use_view, {},
+         "An impinge plan output folder: the resected bones coloured by their depth, before and after, with each "
+         "target's limit before and after",
+         [](auto& o) -> auto& { return o.view.plan_dir; });
   t.number("export-max-mb", "export_max_mb", "MB", use_view, ViewOptions::kExportMaxMbRange,
            "The export's largest size; a motion's frames are decimated evenly to fit",
            [](auto& o) -> auto& { return o.view.export_max_mb; });

@@ -38,7 +38,8 @@ ViewCommand view_command(const ViewOptions& view, const std::vector<std::string>
                             {"open_browser", view.open_browser},
                             {"export", view.export_path},
                             {"export_poses", view.export_poses},
-                            {"export_max_mb", view.export_max_mb}};
+                            {"export_max_mb", view.export_max_mb},
+                            {"plan", view.plan_dir}};
   c.argv = {python, "-P", "-m", "impinge.view", "--view-json", j.dump(), "--"};
   c.argv.insert(c.argv.end(), distance_args.begin(), distance_args.end());
   return c;

@@ -88,7 +88,7 @@ def _padded(a):
 class Viewer:
     """One Joint and what the page needs of it: the scene (meshes, levels, palette, axes) and posed frames."""
 
-    def __init__(self, joint, motion=None):
+    def __init__(self, joint, motion=None, plan=None):
         self.joint = joint
         self.motion = None
         if motion:  # read now: a bad file is an error before the page opens
@@ -99,6 +99,7 @@ class Viewer:
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="impinge-view-job")
         setup = joint.setup
         self.meshes = joint.meshes
+        self.plan = read_plan(plan, self.meshes) if plan else None
         thresholds = list(setup["levels_thresholds_mm"])
         frames = setup.get("frames")
         axes = None
@@ -130,6 +131,7 @@ class Viewer:
             "axes": axes,
             "clock": clock,
             "motion": None if self.motion is None else {k: self.motion[k] for k in ("name", "format")},
+            "plan": None if self.plan is None else self.plan["summary"],
             "warnings": list(setup.get("warnings", [])),
         }
 
@@ -193,6 +195,11 @@ class Viewer:
                                         np.fmin(r["femur_min_distance_mm"], r["pelvis_min_distance_mm"])]
         return out
 
+    def plan_bytes(self, bone):
+        """A bone after the plan as binary: float32 V (n x 3, input frame, mm) then float32 resection_mm (n)."""
+        V, depth = self.plan["bones"][bone]
+        return _padded(V) + _padded(depth)
+
     def mesh_bytes(self, bone):
         """A bone as binary: uint32 vertex count, uint32 triangle count, float32 V (n x 3), uint32 F (m x 3)."""
         V, F = self.meshes[bone]
@@ -232,6 +239,68 @@ class Viewer:
                  _padded(np.asarray(fd, "<f4")), _padded(np.asarray(pd, "<f4")),
                  _padded(r["femur_level"]), _padded(r["pelvis_level"])]
         return b"".join(parts)
+
+
+def read_ply_vertices(path):
+    """The vertex records of a binary little-endian PLY (as impinge writes it) by the header's property names."""
+    kinds = {"float": "<f4", "double": "<f8", "uchar": "u1", "int": "<i4", "uint": "<u4"}
+    with open(path, "rb") as f:
+        n, props, elem = 0, [], None
+        while True:
+            line = f.readline()
+            if not line:
+                raise impinge.Error(f"{path}: no end_header: not a PLY file impinge wrote")
+            t = line.decode("ascii", "replace").split()
+            if t[:2] == ["element", "vertex"]:
+                n, elem = int(t[2]), "vertex"
+            elif t[:1] == ["element"]:
+                elem = t[1]
+            elif t[:1] == ["property"] and elem == "vertex":
+                if t[1] not in kinds:
+                    raise impinge.Error(f"{path}: vertex property type {t[1]!r} not read here")
+                props.append((t[2], kinds[t[1]]))
+            elif t[:1] == ["format"] and t[1] != "binary_little_endian":
+                raise impinge.Error(f"{path}: format {t[1]}: expected binary_little_endian (as impinge plan writes)")
+            elif t == ["end_header"]:
+                break
+        dtype = np.dtype(props)
+        data = f.read(n * dtype.itemsize)
+        if len(data) < n * dtype.itemsize:
+            raise impinge.Error(f"{path}: {n} vertices announced, the file ends before them")
+        return np.frombuffer(data, dtype=dtype, count=n)
+
+
+def read_plan(folder, meshes):
+    """An `impinge plan` output folder for this hip -> {"summary": targets and per-bone figures (plan.json),
+    "bones": {bone: (V float32 (n, 3) mm input frame, resection_mm float32 (n,))}}. Raises impinge.Error naming the
+    file when plan.json or a resected mesh is missing or was made for another mesh (its vertex count)."""
+    path = os.path.join(folder, "plan.json")
+    try:
+        with open(path, encoding="utf-8") as f:
+            p = json.load(f)
+    except OSError as e:
+        raise impinge.Error(f"--plan {folder}: cannot read {path}: {e.strerror}") from None
+    except ValueError as e:
+        raise impinge.Error(f"--plan {folder}: {path} is not JSON: {e}") from None
+    bones = {}
+    for bone in ("femur", "pelvis"):
+        ply = os.path.join(folder, f"{bone}_resected.ply")
+        if not os.path.exists(ply):
+            continue
+        v = read_ply_vertices(ply)
+        n = len(meshes[bone][0])
+        if len(v) != n or "resection_mm" not in v.dtype.names:
+            raise impinge.Error(f"--plan: {ply} has {len(v)} vertices{'' if 'resection_mm' in v.dtype.names else ' and no resection_mm'}"
+                                f"; this {bone} has {n}: a plan of another hip?")
+        bones[bone] = (np.column_stack([v["x"], v["y"], v["z"]]).astype("<f4"), v["resection_mm"].astype("<f4"))
+    if not bones:
+        raise impinge.Error(f"--plan {folder}: no femur_resected.ply or pelvis_resected.ply")
+    keep = ("target", "target_deg", "limit_before_deg", "limit_after_deg", "met", "note")
+    summary = {"folder": os.path.abspath(folder), "all_targets_met": p.get("all_targets_met"),
+               "targets": [{k: t.get(k) for k in keep} for t in p.get("targets", [])],
+               "bones": {b: {k: (p.get(f"{b}_resection") or {}).get(k) for k in
+                             ("volume_mm3", "area_mm2", "deepest_cut_mm", "mean_depth_mm")} for b in bones}}
+    return {"summary": summary, "bones": bones}
 
 
 def export_poses(viewer, spec):
@@ -281,6 +350,8 @@ def export_html(viewer, path, spec, max_mb):
     with open(os.path.join(STATIC, "index.html"), encoding="utf-8") as f:
         html = f.read()
     meshes = {f"/api/mesh/{bone}": b64(viewer.mesh_bytes(bone)) for bone in ("femur", "pelvis")}
+    if viewer.plan is not None:
+        meshes.update({f"/api/plan/mesh/{bone}": b64(viewer.plan_bytes(bone)) for bone in viewer.plan["bones"]})
     first = viewer.frame_bytes(0, poses[0])
     per_pose = len(b64(first)) + 80
     base = len(script) + len(html) + sum(len(m) for m in meshes.values()) + 200_000  # JSON of ROM, morphology ...
@@ -402,6 +473,12 @@ def make_app(viewer, token):
         for ws in list(app["sockets"]):
             await ws.close(code=1001, message=b"server stopped")
 
+    async def plan_mesh(request):
+        bone = request.match_info["bone"]
+        if viewer.plan is None or bone not in viewer.plan["bones"]:
+            raise web.HTTPNotFound(text=f"no plan of the {bone} (impinge view --plan DIR)")
+        return web.Response(body=viewer.plan_bytes(bone), content_type="application/octet-stream")
+
     async def motion(request):
         if viewer.motion is None:
             raise web.HTTPNotFound(text="no motion was given (impinge view --motion FILE)")
@@ -418,7 +495,8 @@ def make_app(viewer, token):
     app.add_routes([web.get("/", page), web.get("/viewer.js", script), web.get("/api/scene", scene),
                     web.get("/api/mesh/{bone}", mesh), web.get("/ws", socket), web.get("/api/motion", motion),
                     web.get("/api/motion/least", job_route("motion")), web.get("/api/rom", job_route("rom")),
-                    web.get("/api/morphology", job_route("morphology"))])
+                    web.get("/api/morphology", job_route("morphology")),
+                    web.get("/api/plan/mesh/{bone}", plan_mesh)])
     return app
 
 
@@ -466,7 +544,7 @@ def main(argv=None):
         return 2
     try:
         joint, command = impinge.Joint._from_cli(rest)
-        viewer = Viewer(joint, motion=command["motion"])
+        viewer = Viewer(joint, motion=command["motion"], plan=view.get("plan") or None)
     except impinge.Error as e:
         print(f"impinge: error: {e}", file=sys.stderr)
         return 2

@@ -25,6 +25,9 @@ struct ViewOptions {
   /// Which poses an export holds: "auto" (the motion's frames with --motion, else "rom"), "rom" (neutral and, per
   /// standard motion, the pose 2 deg before its limit and at it), "motion", or "F,A,R;F,A,R;..." (degrees, ISB).
   std::string export_poses = "auto";
+  /// An `impinge plan` output folder (plan.json, femur_resected.ply, pelvis_resected.ply) to show: the resected
+  /// bones coloured by resection_mm, before and after, with each target's limit before and after. Empty: none.
+  std::string plan_dir;
   double export_max_mb = 25;  ///< the export's largest size, MB (10^6 bytes); more poses are decimated to fit
   static constexpr Range kExportMaxMbRange{1, 2000};  ///< of export_max_mb, MB
 };
