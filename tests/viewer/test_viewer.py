@@ -405,3 +405,42 @@ def test_a_plan_shows_the_resected_bone_before_and_after(hip, browser):
     r = subprocess.run([CLI, "view", "--subject", hip + "/s/subject.json", "--plan", hip + "/nowhere", "--no-browser"],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and "--plan" in r.stderr and "plan.json" in r.stderr
+
+
+def test_a_motion_chosen_in_the_page_from_the_allowed_folder_only(hip, browser):
+    """--motion-folder: the page lists the folder's motion files and plays the one chosen (its curve is impinge
+    motion's); the server refuses any other file: a path, '..', an absolute path, a symbolic link out."""
+    folder = hip + "/motions"
+    os.makedirs(folder, exist_ok=True)
+    for name, scale in (("a.csv", 1.0), ("b.csv", 0.5)):
+        with open(os.path.join(folder, name), "w") as f:
+            f.write("time_s,flexion_deg,adduction_deg,internal_rotation_deg\n")
+            for i in range(20):
+                f.write(f"{i * 0.05:.2f},{i * 3 * scale:.2f},0,{i * scale:.2f}\n")
+    outside = hip + "/secret.csv"
+    with open(outside, "w") as f:
+        f.write("time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,1,2,3\n")
+    link = os.path.join(folder, "link.csv")
+    if not os.path.lexists(link):
+        os.symlink(outside, link)
+    p, url = start_server(hip + "/s/subject.json", "--motion-folder", folder)
+    try:
+        base, token = url.split("?")[0], url.split("token=")[1]
+        with urllib.request.urlopen(f"{base}api/motions?token={token}", timeout=10) as r:
+            assert json.load(r)["files"] == ["a.csv", "b.csv"]
+        for bad in ("link.csv", "../secret.csv", outside, "motions/a.csv", "%2e%2e%2fsecret.csv"):
+            with pytest.raises(urllib.error.HTTPError) as e:
+                urllib.request.urlopen(f"{base}api/motion?file={bad}&token={token}", timeout=10)
+            assert e.value.code == 404, bad
+        open_page(browser, url)
+        browser.execute_script("window.__impinge.chooseMotion('b.csv')")
+        least = wait_for(browser, "return window.__impinge.motionLeast")
+        subprocess.run([CLI, "motion", "--subject", hip + "/s/subject.json", "--motion", folder + "/b.csv",
+                        "--precision", "1", "--quiet", "--out", hip + "/motion_b"], check=True, capture_output=True)
+        import csv
+        with open(hip + "/motion_b/frames.csv") as f:
+            want = [min(float(r["femur_min_distance_mm"]), float(r["pelvis_min_distance_mm"])) for r in csv.DictReader(f)]
+        np.testing.assert_allclose(least["least_distance_mm"], want, rtol=0, atol=1e-6)
+    finally:
+        p.send_signal(signal.SIGINT)
+        p.wait(timeout=30)

@@ -453,8 +453,11 @@ async function start() {
 
   // A motion (--motion): a timeline played in wall-clock time (frames skipped, never queued, when the answers are
   // slower than the motion), and the least distance over time (Joint.motion, computed once in the background).
-  if (scene.motion) {
-    const m = await getJSON('/api/motion');
+  let motionGeneration = 0;
+  async function setupMotion(file) {
+    const query = file ? `?file=${encodeURIComponent(file)}` : '';
+    const m = await getJSON('/api/motion' + query);
+    const generation = ++motionGeneration;
     const n = m.time_s.length;
     $('motion-panel').hidden = false;
     $('motion-name').textContent = m.name;
@@ -475,7 +478,7 @@ async function start() {
     };
     const frameAt = (t) => { let k = 0; while (k + 1 < n && m.time_s[k + 1] <= t) ++k; return k; };
     const tick = () => {
-      if (!playing) return;
+      if (!playing || generation !== motionGeneration) return;
       const t = startT + (performance.now() - startWall) / 1000 * Number($('speed').value);
       if (t > m.time_s[n - 1]) { playing = false; $('play').textContent = 'Play'; showFrame(n - 1); return; }
       showFrame(frameAt(t));
@@ -492,7 +495,7 @@ async function start() {
       }
     };
     $('speed').onchange = () => { startT = m.time_s[Math.max(0, shown)]; startWall = performance.now(); };
-    $('timeline').addEventListener('input', () => { playing = false; $('play').textContent = 'Play'; showFrame(Number($('timeline').value)); });
+    $('timeline').oninput = () => { playing = false; $('play').textContent = 'Play'; showFrame(Number($('timeline').value)); };
     let least = null;
     const drawPlot = () => {
       const cv = $('plot'), g = cv.getContext('2d');
@@ -512,7 +515,18 @@ async function start() {
           `${lo.toFixed(1)} to ${hi.toFixed(1)} mm (0: grey line)`;
     };
     hook.showFrame = showFrame;
-    poll('/api/motion/least', (r) => { least = r; hook.motionLeast = r; drawPlot(); }, $('plot-note'));
+    $('play').textContent = 'Play';
+    poll('/api/motion/least' + query, (r) => { if (generation === motionGeneration) { least = r; hook.motionLeast = r; drawPlot(); } }, $('plot-note'));
+  }
+  if (scene.motion) await setupMotion(null);
+  // --motion-folder: the page chooses among its motion files (the server reads only those).
+  if (scene.motion_folder) {
+    const list = await getJSON('/api/motions');
+    $('motion-choice').hidden = false;
+    $('motion-files').innerHTML = '<option value="">choose a motion file</option>' +
+        list.files.map((f) => `<option>${f.replace(/[<&"]/g, '')}</option>`).join('');
+    $('motion-files').onchange = () => { if ($('motion-files').value) setupMotion($('motion-files').value); };
+    hook.chooseMotion = (f) => setupMotion(f);
   }
 
   // ROM limits (impinge rom's, computed once in the background) with the poses just before and at each limit.

@@ -464,6 +464,9 @@ void add_view_rows(Rows& t) {
          "An impinge plan output folder: the resected bones coloured by their depth, before and after, with each "
          "target's limit before and after",
          [](auto& o) -> auto& { return o.view.plan_dir; });
+  t.text("motion-folder", "motion_folder", OptionType::path, use_view, {},
+         "A folder whose motion files (.csv, .mot, .sto) the page may choose from (only those, directly in it)",
+         [](auto& o) -> auto& { return o.view.motion_folder; });
   t.number("export-max-mb", "export_max_mb", "MB", use_view, ViewOptions::kExportMaxMbRange,
            "The export's largest size; a motion's frames are decimated evenly to fit",
            [](auto& o) -> auto& { return o.view.export_max_mb; });

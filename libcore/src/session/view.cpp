@@ -39,7 +39,8 @@ ViewCommand view_command(const ViewOptions& view, const std::vector<std::string>
                             {"export", view.export_path},
                             {"export_poses", view.export_poses},
                             {"export_max_mb", view.export_max_mb},
-                            {"plan", view.plan_dir}};
+                            {"plan", view.plan_dir},
+                            {"motion_folder", view.motion_folder}};
   c.argv = {python, "-P", "-m", "impinge.view", "--view-json", j.dump(), "--"};
   c.argv.insert(c.argv.end(), distance_args.begin(), distance_args.end());
   return c;

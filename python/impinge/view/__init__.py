@@ -88,13 +88,15 @@ def _padded(a):
 class Viewer:
     """One Joint and what the page needs of it: the scene (meshes, levels, palette, axes) and posed frames."""
 
-    def __init__(self, joint, motion=None, plan=None):
+    def __init__(self, joint, motion=None, plan=None, motion_folder=None):
         self.joint = joint
-        self.motion = None
-        if motion:  # read now: a bad file is an error before the page opens
-            m = impinge.load_motion(motion, joint.setup["side"])
-            self.motion = {"name": os.path.basename(motion), "format": m["format"],
-                           "time_s": np.asarray(m["time_s"]).tolist(), "angles": np.asarray(m["angles"]).tolist()}
+        self.motion = self._read_motion(motion) if motion else None  # read now: a bad file fails before the page
+        self.motion_folder = None
+        if motion_folder:
+            if not os.path.isdir(motion_folder):
+                raise impinge.Error(f"--motion-folder {motion_folder}: not a folder")
+            self.motion_folder = os.path.realpath(motion_folder)
+        self._folder_motions = {}
         self._jobs = {}
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="impinge-view-job")
         setup = joint.setup
@@ -131,15 +133,50 @@ class Viewer:
             "axes": axes,
             "clock": clock,
             "motion": None if self.motion is None else {k: self.motion[k] for k in ("name", "format")},
+            "motion_folder": motion_folder is not None,
             "plan": None if self.plan is None else self.plan["summary"],
             "warnings": list(setup.get("warnings", [])),
         }
 
-    def job(self, name):
-        """The state of a background job ('rom', 'morphology', 'motion'), started at its first request:
+    def _read_motion(self, path):
+        m = impinge.load_motion(path, self.joint.setup["side"])
+        return {"name": os.path.basename(path), "format": m["format"],
+                "time_s": np.asarray(m["time_s"]).tolist(), "angles": np.asarray(m["angles"]).tolist()}
+
+    def motion_files(self):
+        """The motion files (.csv, .mot, .sto) directly in --motion-folder, by name; [] without one. An entry that
+        resolves outside the folder (a symbolic link out) is not listed."""
+        if self.motion_folder is None:
+            return []
+        out = []
+        for e in sorted(os.listdir(self.motion_folder)):
+            p = os.path.join(self.motion_folder, e)
+            if e.lower().endswith((".csv", ".mot", ".sto")) and os.path.isfile(p) and \
+                    os.path.dirname(os.path.realpath(p)) == self.motion_folder:
+                out.append(e)
+        return out
+
+    def motion_of(self, name):
+        """The motion the page shows: --motion's (name None) or the file `name` of --motion-folder. Raises
+        impinge.Error for a name that is not one of motion_files() (a path, '..', a link out: refused)."""
+        if name is None:
+            if self.motion is None:
+                raise impinge.Error("no motion was given (impinge view --motion FILE)")
+            return self.motion
+        if name not in self.motion_files():
+            raise impinge.Error(f"motion {name!r}: not a motion file of the motion folder "
+                                f"({', '.join(self.motion_files()) or 'none'})")
+        if name not in self._folder_motions:
+            self._folder_motions[name] = self._read_motion(os.path.join(self.motion_folder, name))
+        return self._folder_motions[name]
+
+    def job(self, name, motion=None):
+        """The state of a background job ('rom', 'morphology', 'motion' of `motion`), started at its first request:
         {"state": "running", "seconds": s} | {"state": "done", "result": ...} | {"state": "error", "message": ...}."""
+        key = name if name != "motion" else f"motion:{motion}"
+        name = key
         if name not in self._jobs:
-            fn = {"rom": self._rom, "morphology": self._morphology, "motion": self._motion_least}[name]
+            fn = {"rom": self._rom, "morphology": self._morphology}.get(name) or (lambda: self._motion_least(motion))
             self._jobs[name] = (time.perf_counter(), self._pool.submit(fn))
         t0, fut = self._jobs[name]
         if not fut.done():
@@ -184,11 +221,10 @@ class Viewer:
                 out[k] = _finite(value(part, k))
         return out
 
-    def _motion_least(self):
-        """Per frame of the motion: the least distance and the least radial gap of both bones (Joint.motion)."""
-        if self.motion is None:
-            raise impinge.Error("no motion was given (impinge view --motion FILE)")
-        r = self.joint.motion(np.asarray(self.motion["angles"], dtype=float))
+    def _motion_least(self, name=None):
+        """Per frame of a motion (motion_of(name)): the least distance and the least radial gap of both bones
+        (Joint.motion)."""
+        r = self.joint.motion(np.asarray(self.motion_of(name)["angles"], dtype=float))
         out = {"least_gap_mm": [_finite(x) for x in np.fmin(r["femur_min_gap_mm"], r["pelvis_min_gap_mm"])]}
         if "femur_min_distance_mm" in r:
             out["least_distance_mm"] = [_finite(x) for x in
@@ -480,13 +516,23 @@ def make_app(viewer, token):
         return web.Response(body=viewer.plan_bytes(bone), content_type="application/octet-stream")
 
     async def motion(request):
-        if viewer.motion is None:
-            raise web.HTTPNotFound(text="no motion was given (impinge view --motion FILE)")
-        return web.json_response(viewer.motion)
+        try:
+            return web.json_response(viewer.motion_of(request.query.get("file")))
+        except impinge.Error as e:
+            raise web.HTTPNotFound(text=str(e))
+
+    async def motions(request):
+        return web.json_response({"files": viewer.motion_files()})
 
     def job_route(name):
         async def handler(request):
-            return web.json_response(viewer.job(name), dumps=lambda x: json.dumps(x, allow_nan=False))
+            motion = request.query.get("file")
+            if name == "motion":
+                try:
+                    viewer.motion_of(motion)
+                except impinge.Error as e:
+                    raise web.HTTPNotFound(text=str(e))
+            return web.json_response(viewer.job(name, motion), dumps=lambda x: json.dumps(x, allow_nan=False))
         return handler
 
     app = web.Application(middlewares=[require_token], client_max_size=64 * 1024)
@@ -496,7 +542,7 @@ def make_app(viewer, token):
                     web.get("/api/mesh/{bone}", mesh), web.get("/ws", socket), web.get("/api/motion", motion),
                     web.get("/api/motion/least", job_route("motion")), web.get("/api/rom", job_route("rom")),
                     web.get("/api/morphology", job_route("morphology")),
-                    web.get("/api/plan/mesh/{bone}", plan_mesh)])
+                    web.get("/api/plan/mesh/{bone}", plan_mesh), web.get("/api/motions", motions)])
     return app
 
 
@@ -544,7 +590,8 @@ def main(argv=None):
         return 2
     try:
         joint, command = impinge.Joint._from_cli(rest)
-        viewer = Viewer(joint, motion=command["motion"], plan=view.get("plan") or None)
+        viewer = Viewer(joint, motion=command["motion"], plan=view.get("plan") or None,
+                        motion_folder=view.get("motion_folder") or None)
     except impinge.Error as e:
         print(f"impinge: error: {e}", file=sys.stderr)
         return 2

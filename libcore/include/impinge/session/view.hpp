@@ -28,6 +28,9 @@ struct ViewOptions {
   /// An `impinge plan` output folder (plan.json, femur_resected.ply, pelvis_resected.ply) to show: the resected
   /// bones coloured by resection_mm, before and after, with each target's limit before and after. Empty: none.
   std::string plan_dir;
+  /// A folder whose motion files (.csv, .mot, .sto, directly in it) the page may choose from; the server reads no
+  /// other file for them (a name with a path, '..', or a link out of the folder is refused). Empty: none.
+  std::string motion_folder;
   double export_max_mb = 25;  ///< the export's largest size, MB (10^6 bytes); more poses are decimated to fit
   static constexpr Range kExportMaxMbRange{1, 2000};  ///< of export_max_mb, MB
 };
