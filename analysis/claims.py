@@ -601,6 +601,30 @@ claim("Ch. 6", "the systems extend to deformable models such as cartilage, becau
       "sampling, whose cost per map is in experiment 02 (Table 3's row)", S02,
       kind="qualitative", tolerance="--", conditions="--", same_subjects=True)
 
+# --- 17: Joint3D in the browser (Sec. 3.4, Fig. 36, 44) ---------------------------------------------------------
+S17 = "17_viewer"
+vw_images, vw_latency = csv_of(S17, "images.csv"), csv_of(S17, "latency.csv")
+if vw_images is not None and len(vw_images) and vw_latency is not None and len(vw_latency):
+    first = vw_latency.iloc[0]
+    claim("Fig. 36", "Joint3D lets the user control the hip's motion and watch the impingement detected and the "
+          "distances on the joint surfaces", "interactive system",
+          f"impinge view: a page where sliders pose the hip and both bones are coloured by the library's detection; "
+          f"{n(first.data_path_median_ms)} ms median from a pose to its values ({first.hip}, "
+          f"{int(first.triangles):,} triangles)", "holds" if first.data_path_median_ms <= 30 else "partly",
+          "the page's values at a pose equal impinge distance's files (tests/viewer); the draw is the browser's",
+          S17, kind="measured", tolerance="a pose's values in the page within a frame of a slider's move (30 ms)",
+          conditions=f"{first.resolution_deg:g} deg, distances on, 2 cores, headless Chromium", same_subjects=False)
+    f44 = vw_images[vw_images.figure == "Fig. 44"]
+    claim("Fig. 44", "three visualisation options (filled polygons, lines, blending) in three views (anterior, medial, "
+          "oblique)", "3 x 3 views", f"{len(f44)} pictures, the same modes and views, from the page", "holds",
+          "the page's display modes and view presets, photographed", S17,
+          kind="qualitative", tolerance="--", conditions="headless Chromium, SwiftShader", same_subjects=False)
+else:
+    missing("Fig. 36", "Joint3D: control the motion, watch the impingement", "interactive system", "images.csv", S17,
+            kind="measured", tolerance="--", conditions="--", same_subjects=False)
+    missing("Fig. 44", "filled, lines, blending in three views", "3 x 3 views", "images.csv", S17,
+            kind="qualitative", tolerance="--", conditions="--", same_subjects=False)
+
 # --- write -------------------------------------------------------------------------------------------------
 out = os.path.join(ROOT, "claims.csv")
 with open(out, "w", newline="") as f:

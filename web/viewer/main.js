@@ -357,6 +357,7 @@ async function start() {
     return new Promise((resolve, reject) => hook.waiting.push({ id, resolve, reject }));
   };
   hook.colours = () => ({ femur: Array.from(femur.colour), pelvis: Array.from(pelvis.colour) });
+  hook.setView = (name) => setView(name);  // anterior, lateral, medial, superior, oblique
   // For benchmarks/viewer_latency.py: the data path of `n` poses (a slider's change to the new values in the colour
   // buffer: request, detection, transfer, decode, colouring; not the draw), and the draw alone (one colour-buffer
   // upload and one render, waited for by reading a pixel back), each in ms.

@@ -1,0 +1,88 @@
+"""17_viewer: impinge view's pictures as the thesis showed Joint3D's, and its speed (issue 79).
+
+Reads RESULTS/17_viewer/{images,latency}.csv and the PNGs images.csv names; writes fig44.pdf/png (three display modes
+x three views, the thesis' Figure 44), fig36.pdf/png (the page, Figure 36), fig42.pdf/png (per hip: both bones from
+anterior and lateral, the acetabulum from medial, at the scan pose), extremities.pdf/png (the acetabulum at each
+motion's ROM limit, Tables 12-13) and macros.tex (the first hip's data path, draw, first frame and export)."""
+import os
+
+import matplotlib.pyplot as plt
+import numpy as np
+from PIL import Image
+
+from common import experiment_dir, read_csv, save, write_macros
+
+d = experiment_dir("17_viewer")
+images = read_csv(d, "images.csv")
+latency = read_csv(d, "latency.csv")
+
+
+def crop(path):
+    """The picture without the page's empty background around the bones (a margin of 12 pixels kept)."""
+    a = np.asarray(Image.open(os.path.join(d, path)).convert("RGB"))
+    ink = np.abs(a.astype(int) - [244, 244, 242]).sum(axis=2) > 12
+    ink[-40:, :330] = False  # the pose line in the corner
+    ys, xs = np.nonzero(ink)
+    if len(xs) == 0:
+        return a
+    return a[max(0, ys.min() - 12):ys.max() + 12, max(0, xs.min() - 12):xs.max() + 12]
+
+
+def grid(rows, row_labels, col_labels, stem, width=7.0):
+    n_r, n_c = len(rows), max(len(r) for r in rows)
+    fig, axes = plt.subplots(n_r, n_c, figsize=(width, width * n_r / n_c * 0.85), squeeze=False)
+    for i, r in enumerate(rows):
+        for j in range(n_c):
+            ax = axes[i][j]
+            ax.axis("off")
+            if j < len(r) and r[j] is not None:
+                ax.imshow(crop(r[j]))
+            if i == 0 and j < len(col_labels):
+                ax.set_title(col_labels[j], fontsize=8)
+        axes[i][0].text(-0.04, 0.5, row_labels[i], transform=axes[i][0].transAxes, rotation=90, ha="right",
+                        va="center", fontsize=8)
+    fig.tight_layout()
+    save(fig, d, stem)
+
+
+def file_of(**match):
+    sel = images
+    for k, v in match.items():
+        sel = sel[sel[k] == v]
+    return sel.file.iloc[0] if len(sel) else None
+
+
+f44 = images[images.figure == "Fig. 44"]
+views, displays = ["anterior", "medial", "oblique"], ["filled", "lines", "blending"]
+grid([[file_of(figure="Fig. 44", view=v, display=m) for m in displays] for v in views], views,
+     ["filled polygons", "lines", "blending"], "fig44")
+
+fig = plt.figure(figsize=(7.0, 4.7))
+ax = fig.add_axes([0, 0, 1, 1])
+ax.axis("off")
+ax.imshow(np.asarray(Image.open(os.path.join(d, file_of(figure="Fig. 36")))))
+save(fig, d, "fig36", rect=(0, 0, 1, 1))
+
+hips = list(dict.fromkeys(images.hip))
+grid([[file_of(figure="Fig. 42", hip=h, view=v) for v in ("anterior", "lateral", "medial")] for h in hips], hips,
+     ["anterior", "lateral", "acetabulum, medial"], "fig42", width=6.0)
+
+motions = ["flexion", "abduction", "internal_rotation_90_flexion", "external_rotation"]
+ext = images[images.figure == "Tables 12-13"]
+grid([[file_of(figure="Tables 12-13", hip=h, file=f"extremity_{h}_{m}.png") for m in motions] for h in hips], hips,
+     ["flexion", "abduction", "IR at 90 flexion", "external rotation"], "extremities")
+
+first = latency.iloc[0]
+macros = {
+    "VWhip": str(first.hip).replace("_", r"\_"), "VWresolution": f"{first.resolution_deg:g}",
+    "VWvertices": f"{int(first.vertices):,}", "VWtriangles": f"{int(first.triangles):,}", "VWposes": str(int(first.poses)),
+    "VWmedianMs": f"{first.data_path_median_ms:.1f}", "VWpNinetyFiveMs": f"{first.data_path_p95_ms:.1f}",
+    "VWposesPerSecond": f"{1000 / first.data_path_median_ms:.0f}",
+    "VWdrawMedianMs": f"{first.draw_median_ms:.0f}", "VWdrawPNinetyFiveMs": f"{first.draw_p95_ms:.0f}",
+    "VWfirstFrameS": f"{first.first_coloured_frame_s:.1f}", "VWexportMB": f"{first.export_mb:.1f}",
+    "VWexportPoses": str(int(first.export_poses)), "VWexportS": f"{first.export_s:.1f}",
+    "VWhips": str(len(latency)), "VWimages": str(len(images)),
+    "VWmedianLow": f"{latency.data_path_median_ms.min():.1f}", "VWmedianHigh": f"{latency.data_path_median_ms.max():.1f}",
+    "VWbareShareLow": f"{100 * images.bone_share.min():.0f}",
+}
+write_macros(d, "macros", macros)
