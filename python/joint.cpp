@@ -231,12 +231,18 @@ void add_joint_queries(py::class_<PyJoint>& c) {
           [](const PyJoint& j, double flexion, double adduction, double internal_rotation) {
             PoseResult r;
             FemurPose p;
+            ClosestPoint femur_closest, pelvis_closest;
             {
               py::gil_scoped_release release;
               p = j.hip().femur_pose(PoseAngles{flexion, adduction, internal_rotation});
               j.hip().joint().detect(p.R, p.t, r);
+              femur_closest = closest_point(*j.session, true, r.ball_gaps, p);
+              pelvis_closest = closest_point(*j.session, false, r.socket_gaps, p);
             }
             py::dict d = result_dict(*j.session, std::move(r));
+            // Where each scan comes closest, classed as summary.json's closest_contact_class.
+            d["summary"]["femur"]["closest_contact_class"] = to_string(femur_closest.contact_class);
+            d["summary"]["pelvis"]["closest_contact_class"] = to_string(pelvis_closest.contact_class);
             d["joint_translation_mm"] = Eigen::Vector3d(j.session->to_input(j.hip().femur_translation(p.t)));
             return d;
           },
@@ -244,7 +250,8 @@ void add_joint_queries(py::class_<PyJoint>& c) {
           "Both scans at clinical angles (degrees, ISB joint coordinate system: flexion, adduction and internal "
           "rotation positive; zero per `neutral`), the femur placed by the joint-centre method (option "
           "joint_centre) -> the same dict as detect(), with joint_translation_mm (3,): the femur's translation "
-          "(input frame, mm) after its rotation about the COR.")
+          "(input frame, mm) after its rotation about the COR, and each scan's summary with closest_contact_class "
+          "(where it comes closest: articular, intra-articular or extra-articular impingement, as summary.json).")
       .def("motion", &motion, py::arg("angles"),
            "Both scans at every row of angles (k, 3): flexion, adduction, internal rotation in degrees -> dict of "
            "(k,) arrays, the columns of the CLI's frames.csv (femur_min_gap_mm, pelvis_min_gap_mm, "

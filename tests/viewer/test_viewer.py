@@ -97,6 +97,10 @@ def test_the_page_colours_what_impinge_distance_computes(hip, server, browser):
     subprocess.run([CLI, "distance", "--subject", hip + "/s/subject.json", "--precision", "1", "--query-strategy",
                     "maps", "--pose", "40,5,10", "--out", out], check=True, capture_output=True)
     colours = browser.execute_script("return window.__impinge.colours()")
+    with open(out + "/summary.json") as f:
+        summary = json.load(f)
+    shown = browser.execute_script("return window.__impinge.frame.summary.contact_class")
+    assert shown == summary["pelvis"]["closest_contact_class"], (shown, summary["pelvis"])
     for bone in ("femur", "pelvis"):
         ply = read_ply_vertices(f"{out}/{bone}_gaps.ply")
         page = np.array(browser.execute_script(f"return window.__impinge.values('{bone}', 'distance')"),
@@ -302,6 +306,8 @@ def test_a_ct_hip_as_a_new_user_opens_it(browser):
         assert got["pose"] == [60, 10, 20]
         colours = np.array(browser.execute_script("return window.__impinge.colours().pelvis"), np.uint8).reshape(-1, 3)
         assert (colours != 200).any(axis=1).mean() > 0.05  # levels coloured, not all untested grey
+        assert browser.execute_script("return window.__impinge.frame.summary.contact_class") in (
+            "articular", "intra_articular_impingement", "extra_articular_impingement", "")
         path = os.path.join(SHOTS, "impinge_view_lhdl-ct.png")
         browser.save_screenshot(path)
         print(f"lhdl-ct: first coloured frame {first:.2f} s after the command started; screenshot {path}")

@@ -244,6 +244,7 @@ async function start() {
     $('numbers').innerHTML = [
       ['least distance', fmt(s.least_distance_mm), 'mm'], ['least radial gap', fmt(s.least_gap_mm), 'mm'],
       ['contact area (pelvis, overlapping)', fmt(s.contact_area_mm2, 1), 'mm²'],
+      ['closest contact', s.contact_class ? s.contact_class.replaceAll('_', ' ') : 'none', ''],
       ['detection', fmt(f.ms, 1), 'ms'],
     ].map(([k, v, u]) => `<tr><td>${k}</td><td class="v">${v}</td><td>${u}</td></tr>`).join('');
   }

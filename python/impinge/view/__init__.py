@@ -258,6 +258,7 @@ class Viewer:
             "least_gap_mm": least(fs.get("min_gap_mm"), ps.get("min_gap_mm")),
             "least_distance_mm": least(fs.get("min_distance_mm"), ps.get("min_distance_mm")),
             "contact_area_mm2": float(ps.get("area_penetrating_mm2") or 0.0),
+            "contact_class": ps.get("closest_contact_class"),
             "inside_area_mm2": ps.get("area_inside_mm2"),
             "femur": {k: fs.get(k) for k in ("min_gap_mm", "min_distance_mm", "vertices_penetrating",
                                               "vertices_inside")},
