@@ -81,6 +81,7 @@ macros = {
     "VWdrawMedianMs": f"{first.draw_median_ms:.0f}", "VWdrawPNinetyFiveMs": f"{first.draw_p95_ms:.0f}",
     "VWfirstFrameS": f"{first.first_coloured_frame_s:.1f}", "VWexportMB": f"{first.export_mb:.1f}",
     "VWexportPoses": str(int(first.export_poses)), "VWexportS": f"{first.export_s:.1f}",
+    "VWexportLoadS": f"{first.export_load_s:.1f}",
     "VWhips": str(len(latency)), "VWimages": str(len(images)),
     "VWmedianLow": f"{latency.data_path_median_ms.min():.1f}", "VWmedianHigh": f"{latency.data_path_median_ms.max():.1f}",
     "VWbareShareLow": f"{100 * images.bone_share.min():.0f}",

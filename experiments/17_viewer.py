@@ -11,7 +11,8 @@ drives its page in Debian's headless Chromium (SwiftShader). Writes to OUT/17_vi
   acetabulum from medial at each of four motions' ROM limits) per hip;
 - latency.csv per hip: the data path (a pose asked to its values in the page's colour buffer: request, detection,
   transfer, decode, colouring) over many poses, the draw (one colour upload and one render, waited for by reading a
-  pixel back), the first coloured frame after the command starts, and the size and poses of a --export file;
+  pixel back), the first coloured frame after the command starts, and the size, poses, writing time and load time
+  (from disk, no server) of a --export file;
 - meta.json."""
 import csv
 import os
@@ -169,12 +170,16 @@ def main():
             export_s = time.time() - t1
             export_poses = int(r.stdout.split("(")[1].split()[0])
             export_mb = os.path.getsize(export) / 1e6
-            os.remove(export)  # its size is the figure; the file itself is not kept in the results
+            t2 = time.time()  # the file opened from disk, with no server, until its first pose is coloured
+            d.get("file://" + os.path.abspath(export))
+            wait(d, "return window.__impinge && (window.__impinge.ready || window.__impinge.error)")
+            export_load_s = time.time() - t2
+            os.remove(export)  # its size and load time are the figures; the file itself is not kept
             latency.append([hip, resolution, scene["femur_vertices"] + scene["pelvis_vertices"],
                             scene["femur_triangles"] + scene["pelvis_triangles"], n,
                             round(statistics.median(data_ms), 3), round(quantile(data_ms, 0.95), 3),
                             round(statistics.median(draw_ms), 3), round(quantile(draw_ms, 0.95), 3), round(first_s, 3),
-                            round(export_mb, 3), export_poses, round(export_s, 3)])
+                            round(export_mb, 3), export_poses, round(export_s, 3), round(export_load_s, 3)])
     finally:
         d.quit()
     with open(os.path.join(d_out, "images.csv"), "w", newline="") as f:
@@ -186,7 +191,7 @@ def main():
         w = csv.writer(f)
         w.writerow(["hip", "resolution_deg", "vertices", "triangles", "poses", "data_path_median_ms",
                     "data_path_p95_ms", "draw_median_ms", "draw_p95_ms", "first_coloured_frame_s", "export_mb",
-                    "export_poses", "export_s"])
+                    "export_poses", "export_s", "export_load_s"])
         w.writerows(latency)
     write_meta(d_out, "17_viewer", quick=quick, data_folder=data if hips else None,
                timing="wall clock in the page (performance.now) and of the command; each hip once: medians and 95th "
