@@ -78,7 +78,7 @@ macros = {
     "VWvertices": f"{int(first.vertices):,}", "VWtriangles": f"{int(first.triangles):,}", "VWposes": str(int(first.poses)),
     "VWmedianMs": f"{first.data_path_median_ms:.1f}", "VWpNinetyFiveMs": f"{first.data_path_p95_ms:.1f}",
     "VWposesPerSecond": f"{1000 / first.data_path_median_ms:.0f}",
-    "VWdrawMedianMs": f"{first.draw_median_ms:.0f}", "VWdrawPNinetyFiveMs": f"{first.draw_p95_ms:.0f}",
+    "VWdrawMedianMs": f"{first.draw_median_ms:.0f}", "VWtrianglesDrawn": f"{int(first.triangles_drawn):,}", "VWdrawPNinetyFiveMs": f"{first.draw_p95_ms:.0f}",
     "VWfirstFrameS": f"{first.first_coloured_frame_s:.1f}", "VWexportMB": f"{first.export_mb:.1f}",
     "VWexportPoses": str(int(first.export_poses)), "VWexportS": f"{first.export_s:.1f}",
     "VWexportLoadS": f"{first.export_load_s:.1f}",

@@ -10,8 +10,8 @@ drives its page in Debian's headless Chromium (SwiftShader). Writes to OUT/17_vi
   (anterior and lateral with both bones, the acetabulum from medial) and Tables 12-13's extremity images (the
   acetabulum from medial at each of four motions' ROM limits) per hip;
 - latency.csv per hip: the data path (a pose asked to its values in the page's colour buffer: request, detection,
-  transfer, decode, colouring) over many poses, the draw (one colour upload and one render, waited for by reading a
-  pixel back), the first coloured frame after the command starts, and the size, poses, writing time and load time
+  transfer, decode, colouring) over many poses, the draw (one colour upload and one render of the page as it opens:
+  both bones, the pelvis cropped to the acetabulum; triangles_drawn; waited for by reading a pixel back), the first coloured frame after the command starts, and the size, poses, writing time and load time
   (from disk, no server) of a --export file;
 - meta.json."""
 import csv
@@ -128,6 +128,9 @@ def main():
             try:
                 d.get(url)
                 wait(d, "return window.__impinge.ready || window.__impinge.error")
+                error = d.execute_script("return window.__impinge.error")
+                if error:
+                    raise SystemExit(f"impinge view on {hip}: the page failed: {error}")
                 first_s = time.time() - t0
                 pose = (60.0, 10.0, 20.0)
                 set_pose(d, pose)
@@ -145,7 +148,9 @@ def main():
                     page_state(d, femur=femur)
                     shoot(d, d_out, f"fig42_{hip}_{view}.png", images, hip, "Fig. 42", view, "filled", zero)
                 # Tables 12-13: the acetabulum from medial at each motion's ROM limit.
-                rom = {r["motion"]: r for r in wait(d, "return window.__impinge.rom")}
+                rom = wait(d, "return window.__impinge.rom || (document.getElementById('rom-state').textContent"
+                              ".startsWith('computing') ? null : [])")  # [] when the ROM search failed (said)
+                rom = {r["motion"]: r for r in rom}
                 for motion in EXTREMITY_MOTIONS:
                     at = rom.get(motion, {}).get("pose_at_limit_deg")
                     if not at:
@@ -158,7 +163,10 @@ def main():
                 n = 40 if quick else 200
                 poses = [[30 + 60 * i / n, 10 * ((i % 20) / 20 - 0.5), 40 * (i / n - 0.5)] for i in range(n)]
                 data_ms = d.execute_async_script("window.__impinge.timePoses(arguments[0]).then(arguments[1])", poses)
+                page_state(d)  # the page as it opens: both bones, the pelvis cropped to the acetabulum
+                d.execute_script("window.__impinge.setView('anterior')")
                 draw_ms = d.execute_script("return window.__impinge.timeDraws(arguments[0])", 10 if quick else 30)
+                drawn = d.execute_script("return window.__impinge.trianglesDrawn")
                 scene = d.execute_script("return window.__impinge.scene")
             finally:
                 p.send_signal(signal.SIGINT)
@@ -178,7 +186,8 @@ def main():
             latency.append([hip, resolution, scene["femur_vertices"] + scene["pelvis_vertices"],
                             scene["femur_triangles"] + scene["pelvis_triangles"], n,
                             round(statistics.median(data_ms), 3), round(quantile(data_ms, 0.95), 3),
-                            round(statistics.median(draw_ms), 3), round(quantile(draw_ms, 0.95), 3), round(first_s, 3),
+                            drawn, round(statistics.median(draw_ms), 3), round(quantile(draw_ms, 0.95), 3),
+                            round(first_s, 3),
                             round(export_mb, 3), export_poses, round(export_s, 3), round(export_load_s, 3)])
     finally:
         d.quit()
@@ -190,7 +199,8 @@ def main():
     with open(os.path.join(d_out, "latency.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["hip", "resolution_deg", "vertices", "triangles", "poses", "data_path_median_ms",
-                    "data_path_p95_ms", "draw_median_ms", "draw_p95_ms", "first_coloured_frame_s", "export_mb",
+                    "data_path_p95_ms", "triangles_drawn", "draw_median_ms", "draw_p95_ms", "first_coloured_frame_s",
+                    "export_mb",
                     "export_poses", "export_s", "export_load_s"])
         w.writerows(latency)
     write_meta(d_out, "17_viewer", quick=quick, data_folder=data if hips else None,

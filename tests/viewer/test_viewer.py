@@ -210,6 +210,15 @@ def test_rom_limits_and_morphology_beside_the_view(hip, server, browser):
             break
         time.sleep(0.1)
     assert np.allclose(fr["pose"], at, atol=1e-9)
+    browser.execute_script(f"document.querySelector('#rom button[data-k=\"{k}\"][data-at=\"before\"]').click()")
+    start, limit = np.array(rom[k]["start_deg"]), rom[k]["limit_deg"]
+    before = start + (np.array(at) - start) * max(0.0, limit - 2) / limit  # 2 deg short along the motion
+    for _ in range(100):
+        fr = browser.execute_script("return window.__impinge.frame")
+        if np.allclose(fr["pose"], before, atol=1e-9):
+            break
+        time.sleep(0.1)
+    assert np.allclose(fr["pose"], before, atol=1e-9), (fr["pose"], before)
     subprocess.run([CLI, "morphology", "--subject", hip + "/s/subject.json", "--out", hip + "/morph"], check=True,
                    capture_output=True)
     with open(hip + "/morph/morphology.json") as f:
@@ -397,10 +406,12 @@ def test_a_plan_shows_the_resected_bone_before_and_after(hip, browser):
         assert depth.max() > 0
         browser.find_element("id", "plan-after").click()
         assert browser.find_element("id", "colour").get_attribute("value") == "resection"
-        shown = np.array(browser.execute_script(
-            "return Array.from(window.__impinge.scene && document.querySelector('canvas') && "
-            "window.__impinge.planned.femur.V)"), np.float32)
-        assert shown.size == V.size
+        shown = np.array(browser.execute_script("return window.__impinge.positions('femur')"), np.float32)
+        np.testing.assert_array_equal(shown, V)  # the geometry drawn is the resected one
+        browser.find_element("id", "plan-after").click()  # and back
+        before = np.array(browser.execute_script("return window.__impinge.positions('femur')"), np.float32)
+        assert not np.array_equal(before, V)
+        browser.find_element("id", "plan-after").click()
         rows = browser.find_element("id", "plan").text
         assert "flexion" in rows and ("met" in rows or "missed" in rows)
         colours = np.array(browser.execute_script("return window.__impinge.colours().femur"), np.uint8).reshape(-1, 3)

@@ -8,9 +8,12 @@ const token = new URLSearchParams(location.search).get('token') || '';
 const $ = (id) => document.getElementById(id);
 const withToken = (path) => path + (path.includes('?') ? '&' : '?') + 'token=' + encodeURIComponent(token);
 
+let errorShownAt = 0;
 function showError(message) {
   $('error').textContent = message;
+  errorShownAt = message ? performance.now() : 0;
 }
+const escapeHtml = (t) => String(t).replace(/[&<>"']/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;' })[c]);
 
 async function fetchChecked(path) {
   const r = await fetch(withToken(path));
@@ -249,6 +252,7 @@ async function start() {
     ].map(([k, v, u]) => `<tr><td>${k}</td><td class="v">${v}</td><td>${u}</td></tr>`).join('');
   }
 
+  let stopPlayback = () => {};  // set by a motion's timeline: a user's own pose pauses it
   function applyFrame(f) {
     last = f;
     const R = f.R, t = f.t, c = centre;
@@ -262,6 +266,9 @@ async function start() {
     showNumbers(f);
     $('status').textContent = `flexion ${f.pose[0]}, adduction ${f.pose[1]}, internal rotation ${f.pose[2]} deg`;
     hook.frame = f;
+    if (stored) {  // an exported file shows the stored pose nearest the one asked for: the controls say which
+      names.forEach((n, i) => { $(n).value = f.pose[i]; $(n + '-n').value = Number(f.pose[i].toFixed(2)); });
+    }
     for (const w of hook.waiting.splice(0)) if (w.id <= f.id) w.resolve(f); else hook.waiting.push(w);
   }
 
@@ -282,10 +289,15 @@ async function start() {
   ws.onmessage = (e) => {
     if (typeof e.data === 'string') {
       const m = JSON.parse(e.data);
-      if (m.type === 'error') showError(m.message);
+      if (m.type === 'error') {
+        showError(m.message);
+        for (const w of hook.waiting.splice(0)) {
+          if (m.id !== undefined && w.id === m.id) w.reject(new Error(m.message)); else hook.waiting.push(w);
+        }
+      }
       return;
     }
-    showError('');
+    if (errorShownAt && performance.now() - errorShownAt > 4000) showError('');  // an error stays 4 s
     applyFrame(decodeFrame(e.data, femur.n, pelvis.n));
   };
   ws.onclose = () => {
@@ -304,7 +316,7 @@ async function start() {
   const names = ['flexion', 'adduction', 'internal_rotation'];
   function currentPose() { return names.map((n) => Number($(n + '-n').value)); }
   for (const n of names) {
-    $(n).addEventListener('input', () => { $(n + '-n').value = $(n).value; sendPose(currentPose()); });
+    $(n).addEventListener('input', () => { stopPlayback(); $(n + '-n').value = $(n).value; sendPose(currentPose()); });
     $(n + '-n').addEventListener('change', () => {
       const v = Number($(n + '-n').value);
       if ($(n + '-n').value.trim() === '' || !Number.isFinite(v) || Math.abs(v) > 360) {
@@ -316,7 +328,11 @@ async function start() {
       sendPose(currentPose());
     });
   }
-  $('neutral').onclick = () => { for (const n of names) { $(n).value = 0; $(n + '-n').value = 0; } sendPose([0, 0, 0]); };
+  $('neutral').onclick = () => {
+    stopPlayback();
+    for (const n of names) { $(n).value = 0; $(n + '-n').value = 0; }
+    sendPose([0, 0, 0]);
+  };
   $('colour').onchange = recolour;
   if (!scene.distances) {  // --distances off: no Euclidean distances to colour by
     $('colour').querySelector('option[value=distance]').remove();
@@ -359,6 +375,7 @@ async function start() {
   };
   hook.colours = () => ({ femur: Array.from(femur.colour), pelvis: Array.from(pelvis.colour) });
   hook.setView = (name) => setView(name);  // anterior, lateral, medial, superior, oblique
+  hook.positions = (bone) => Array.from((bone === 'femur' ? femur : pelvis).geometry.attributes.position.array);
   // For benchmarks/viewer_latency.py: the data path of `n` poses (a slider's change to the new values in the colour
   // buffer: request, detection, transfer, decode, colouring; not the draw), and the draw alone (one colour-buffer
   // upload and one render, waited for by reading a pixel back), each in ms.
@@ -381,12 +398,14 @@ async function start() {
       gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);  // waits for the drawing to finish
       out.push(performance.now() - t0);
     }
+    hook.trianglesDrawn = renderer.info.render.triangles;  // what the last draw held (hidden or cropped parts not)
     return out;
   };
   hook.values = (bone, what) => Array.from(hook.frame[bone][what]);
 
   // A plan (--plan DIR): the resected bones, coloured by the depth removed, before and after; each target's limit.
   const planned = {};
+  let colourBefore = 'levels';
   let planDepthMax = 0.1;
   if (scene.plan) {
     $('plan-panel').hidden = false;
@@ -403,9 +422,9 @@ async function start() {
     $('colour').append(opt);
     const f = (x, d = 1) => (x === null || x === undefined ? 'n/a' : Number(x).toFixed(d));
     $('plan').innerHTML = '<tr><td>target</td><td class="v">deg</td><td class="v">before</td><td class="v">after</td><td></td></tr>' +
-      scene.plan.targets.map((t) => `<tr><td>${String(t.target).replaceAll('_', ' ')}</td><td class="v">${f(t.target_deg)}</td>` +
+      scene.plan.targets.map((t) => `<tr><td>${escapeHtml(String(t.target).replaceAll('_', ' '))}</td><td class="v">${f(t.target_deg)}</td>` +
         `<td class="v">${f(t.limit_before_deg)}</td><td class="v">${f(t.limit_after_deg)}</td><td>${t.met ? 'met' : 'missed'}</td></tr>`).join('') +
-      Object.entries(scene.plan.bones).map(([b, x]) => `<tr><td colspan="5">${b}: ${f(x.volume_mm3, 0)} mm³, deepest ` +
+      Object.entries(scene.plan.bones).map(([b, x]) => `<tr><td colspan="5">${escapeHtml(b)}: ${f(x.volume_mm3, 0)} mm³, deepest ` +
         `${f(x.deepest_cut_mm, 2)} mm</td></tr>`).join('');
     $('plan-after').onchange = () => {
       const after = $('plan-after').checked;
@@ -417,7 +436,8 @@ async function start() {
       }
       $('plan-note').textContent = after ? 'The bones after the resection, coloured by the depth removed; the ' +
           "sliders' gaps and distances are the bones' before it." : '';
-      $('colour').value = after ? 'resection' : 'levels';
+      if (after) colourBefore = $('colour').value;
+      $('colour').value = after ? 'resection' : (colourBefore === 'resection' ? 'levels' : colourBefore);
       recolour();
     };
     hook.planned = planned;
@@ -458,13 +478,16 @@ async function start() {
   let motionGeneration = 0;
   async function setupMotion(file) {
     const query = file ? `?file=${encodeURIComponent(file)}` : '';
+    const generation = ++motionGeneration;  // taken before the wait: the newest choice wins
+    stopPlayback();
     const m = await getJSON('/api/motion' + query);
-    const generation = ++motionGeneration;
+    if (generation !== motionGeneration) return;
     const n = m.time_s.length;
     $('motion-panel').hidden = false;
     $('motion-name').textContent = m.name;
     $('timeline').max = n - 1;
     let playing = false, startWall = 0, startT = 0, shown = -1;
+    stopPlayback = () => { playing = false; $('play').textContent = 'Play'; };
     const showFrame = (k) => {
       k = Math.max(0, Math.min(n - 1, k));
       $('timeline').value = k;
@@ -506,7 +529,7 @@ async function start() {
       const y = least.least_distance_mm || least.least_gap_mm;
       const finite = y.filter((v) => v !== null);
       if (!finite.length) return;
-      const lo = Math.min(0, ...finite), hi = Math.max(...finite, lo + 1);
+      const lo = finite.reduce((a, v) => Math.min(a, v), 0), hi = finite.reduce((a, v) => Math.max(a, v), lo + 1);
       const X = (k) => 4 + (cv.width - 8) * k / Math.max(1, n - 1), Y = (v) => cv.height - 4 - (cv.height - 8) * (v - lo) / (hi - lo);
       g.strokeStyle = '#bbb'; g.beginPath(); g.moveTo(0, Y(0)); g.lineTo(cv.width, Y(0)); g.stroke();
       g.strokeStyle = '#1f5fbf'; g.beginPath();
@@ -526,7 +549,7 @@ async function start() {
     const list = await getJSON('/api/motions');
     $('motion-choice').hidden = false;
     $('motion-files').innerHTML = '<option value="">choose a motion file</option>' +
-        list.files.map((f) => `<option>${f.replace(/[<&"]/g, '')}</option>`).join('');
+        list.files.map((f) => `<option value="${escapeHtml(f)}">${escapeHtml(f)}</option>`).join('');
     $('motion-files').onchange = () => { if ($('motion-files').value) setupMotion($('motion-files').value); };
     hook.chooseMotion = (f) => setupMotion(f);
   }
@@ -541,6 +564,7 @@ async function start() {
         `<button data-k="${k}" data-at="before">before</button><button data-k="${k}" data-at="at">at</button>` : ''}</td></tr>`).join('');
     for (const b of $('rom').querySelectorAll('button')) {
       b.onclick = () => {
+        stopPlayback();
         const r = rows[Number(b.dataset.k)];
         const p = r.pose_at_limit_deg, q = p.slice();
         // Just before: 2 deg short of the limit along the motion (the standard motions are straight from their start).

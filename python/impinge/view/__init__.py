@@ -188,7 +188,12 @@ class Viewer:
 
     def _rom(self):
         """The standard motions' limits (Joint.rom_limits, `impinge rom`'s defaults) with the pose at each limit and
-        where each motion starts."""
+        where each motion starts; computed once."""
+        if getattr(self, "_rom_rows", None) is None:
+            self._rom_rows = self._rom_search()
+        return self._rom_rows
+
+    def _rom_search(self):
         limits = self.joint.rom_limits()
         out = []
         for name, row in limits.items():
@@ -390,33 +395,45 @@ def export_html(viewer, path, spec, max_mb):
     if viewer.plan is not None:
         meshes.update({f"/api/plan/mesh/{bone}": b64(viewer.plan_bytes(bone)) for bone in viewer.plan["bones"]})
     first = viewer.frame_bytes(0, poses[0])
-    per_pose = len(b64(first)) + 80
-    base = len(script) + len(html) + sum(len(m) for m in meshes.values()) + 200_000  # JSON of ROM, morphology ...
+    per_pose = len(b64(first)) + 120  # a pose's values and its JSON around them
+    asked = len(poses)
+    done = lambda result: {"state": "done", "seconds": 0, "result": result}  # noqa: E731
+    # An exported page chooses no motion file (there is no server to read it) and shows --motion's, if any.
+    json_parts = {"/api/scene": dict(viewer.scene, motion_folder=False), "/api/motions": {"files": []}}
+    for route, fn in (("/api/rom", viewer._rom), ("/api/morphology", viewer._morphology)):
+        try:
+            json_parts[route] = done(fn())
+        except impinge.Error as e:  # e.g. the ROM's distance metric with --distances off: said in the page
+            json_parts[route] = {"state": "error", "message": str(e)}
+    if viewer.motion is not None:
+        json_parts["/api/motion"] = viewer.motion
+        json_parts["/api/motion/least"] = done(viewer._motion_least())
+    text_of = lambda x: json.dumps(x, allow_nan=False, default=lambda v: None)  # noqa: E731
+    base = len(script) + len(html) + sum(len(m) for m in meshes.values()) + len(text_of(json_parts)) + 4096
     room = int((max_mb * 1e6 - base) // per_pose)
     if room < 1:
         raise impinge.Error(f"--export-max-mb {max_mb:g}: the meshes and one pose need {(base + per_pose) / 1e6:.1f} MB")
-    asked = len(poses)
     if asked > room:
         keep = sorted({round(k * (asked - 1) / (room - 1)) for k in range(room)}) if room > 1 else [0]
         poses = [poses[k] for k in keep]
     frames = [{"pose": list(p), "data": b64(first if k == 0 else viewer.frame_bytes(k, p))}
               for k, p in enumerate(poses)]
-    done = lambda result: {"state": "done", "seconds": 0, "result": result}  # noqa: E731
-    json_parts = {"/api/scene": viewer.scene, "/api/rom": done(viewer._rom())}
-    try:
-        json_parts["/api/morphology"] = done(viewer._morphology())
-    except impinge.Error as e:
-        json_parts["/api/morphology"] = {"state": "error", "message": str(e)}
-    if viewer.motion is not None:
-        json_parts["/api/motion"] = viewer.motion
-        json_parts["/api/motion/least"] = done(viewer._motion_least())
-    note = (f"Exported file: {len(poses)} stored poses ({what}"
-            + (f", {asked} asked, decimated evenly to fit {max_mb:g} MB" if len(poses) < asked else "")
-            + "). Nothing is computed here: a slider or the timeline shows the stored pose nearest to it.")
-    data = {"json": json_parts, "buffers": meshes, "frames": frames, "note": note}
-    text = json.dumps(data, allow_nan=False, default=lambda x: None).replace("</", "<\\/")
-    page = html.replace('<script src="viewer.js?token=__TOKEN__"></script>',
-                        f"<script>window.__IMPINGE_EXPORT__ = {text};</script>\n<script>{script}</script>")
+
+    def build(frames):
+        note = (f"Exported file: {len(frames)} stored poses ({what}"
+                + (f", {asked} asked, decimated evenly to fit {max_mb:g} MB" if len(frames) < asked else "")
+                + "). Nothing is computed here: a slider or the timeline shows the stored pose nearest to it.")
+        data = {"json": json_parts, "buffers": meshes, "frames": frames, "note": note}
+        text = text_of(data).replace("</", "<\\/")
+        return html.replace('<script src="viewer.js?token=__TOKEN__"></script>',
+                            f"<script>window.__IMPINGE_EXPORT__ = {text};</script>\n<script>{script}</script>")
+
+    page = build(frames)
+    while len(page.encode()) > max_mb * 1e6 and len(frames) > 1:  # the estimate was short: every other pose kept
+        frames = frames[:-1:2] + frames[-1:]
+        page = build(frames)
+    if len(page.encode()) > max_mb * 1e6:
+        raise impinge.Error(f"--export-max-mb {max_mb:g}: the meshes and one pose need {len(page.encode()) / 1e6:.1f} MB")
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".impinge-export-", suffix=".html", dir=folder)
     try:
@@ -424,12 +441,15 @@ def export_html(viewer, path, spec, max_mb):
             f.write(page)
             f.flush()
             os.fsync(f.fileno())
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # as an ordinary file of the user's (mkstemp makes it 0600)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
-    return len(poses), asked, len(page.encode())
+    return len(frames), asked, len(page.encode())
 
 
 def make_app(viewer, token):
@@ -464,7 +484,8 @@ def make_app(viewer, token):
         return web.Response(body=viewer.mesh_bytes(bone), content_type="application/octet-stream")
 
     async def socket(request):
-        ws = web.WebSocketResponse(max_msg_size=1 << 20)  # larger than a pose: answered with an error, not closed
+        # Messages up to 1 MiB are read (one over 4 KB is answered with an error); a larger one closes the socket.
+        ws = web.WebSocketResponse(max_msg_size=1 << 20)
         await ws.prepare(request)
         request.app["sockets"].add(ws)
         pending = {"req": None}
@@ -566,8 +587,11 @@ async def serve(viewer, host, port, open_browser, token, ready=None):
     print(f"impinge view: {url}", flush=True)
     if ready:
         ready(url)
-    if open_browser:
-        webbrowser.open(url)
+    if open_browser:  # through a private file (0600), so the token is not on a command line other users can read
+        fd, redirect = tempfile.mkstemp(prefix="impinge-view-", suffix=".html")
+        with os.fdopen(fd, "w") as f:
+            f.write(f'<!doctype html><meta http-equiv="refresh" content="0; url={url}"><a href="{url}">{url}</a>')
+        webbrowser.open("file://" + redirect)
     try:
         await stop.wait()
     finally:
