@@ -424,7 +424,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; a usage error (unknown option, missing value, ...) exits 2 as every other error
+    // does (CLI11's own codes are 100 and up).
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
   }
   try {
     for (const Command& c : commands)

@@ -54,3 +54,18 @@ def test_meshes_in_metres_and_a_femur_far_away(generated):
     with pytest.raises(impinge.Error, match=r"t: the femur translated by 100000 mm.*at most the head radius, 22 mm"):
         j.detect(None, (1e5, 0, 0))
     assert np.isfinite(j.detect(None, (1, 0, 0))["summary"]["femur"]["min_gap_mm"])
+
+
+@pytest.mark.parametrize("args", [["distance", "--bogus"], ["distance", "--subject"], ["rom", "--precision"],
+                                  ["view", "--port", "1", "--port", "2"], ["nonsense"], []])
+def test_usage_errors_exit_2_as_every_other_error(args):
+    """A command-line usage error (unknown option or command, a missing value) exits 2, as every error of impinge does;
+    --help and --version exit 0 (CLI11's own codes are 100 and up)."""
+    r = run(args)
+    assert r.returncode == 2 and r.stderr.strip(), (args, r.returncode, r.stderr)
+
+
+@pytest.mark.parametrize("args", [["--help"], ["--version"], ["distance", "--help"], ["view", "--help"]])
+def test_help_and_version_exit_0(args):
+    r = run(args)
+    assert r.returncode == 0 and r.stdout.strip(), (args, r.returncode, r.stderr)

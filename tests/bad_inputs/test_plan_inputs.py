@@ -21,6 +21,7 @@ def cam(tmp_path_factory):
     (["--target", "flexion=200"], ["--target flexion=200: the angle must lie in (0, 150] deg"]),
     (["--target", "flexion=abc"], ["--target flexion", "abc"]),
     (["--target", "flexion"], ["'flexion' is not MOTION=DEG or 'normal'"]),
+    (["--target", "flexion=100,flexion=60"], ["--target: flexion given twice (flexion=100 and flexion=60)"]),
     ([], ["no target: give --target"]),
     (["--target-motion", "/nonexistent/walk.mot"], ["/nonexistent/walk.mot"]),
     (["--target", "flexion=60", "--clearance", "-1"], ["--clearance: -1 mm is outside the valid range"]),

@@ -49,6 +49,10 @@ std::map<std::string, double> parse_targets(const std::string& text, const std::
     const double deg = parse_number_list(item.substr(eq + 1), "--target " + name, 1)[0];
     require(std::isfinite(deg) && deg > 0 && deg <= 150,
             "--target " + name + "=" + item.substr(eq + 1) + ": the angle must lie in (0, 150] deg");
+    require(named.count(name) == 0, [&] {
+      return "--target: " + name + " given twice (" + name + "=" + shortest_decimal(named[name]) + " and " + item +
+             "): give each motion once";
+    });
     named[name] = deg;
   }
   if (normal)
