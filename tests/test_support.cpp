@@ -1,5 +1,10 @@
 #include "test_support.hpp"
 
+#include <unistd.h>
+
+#include <cstdlib>
+#include <vector>
+
 #include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
@@ -47,9 +52,20 @@ std::string error_of(const std::function<void()>& f) {
 }
 
 std::string temp_dir(const std::string& name) {
-  const auto p = std::filesystem::temp_directory_path() / ("impinge_test_" + name);
+  // One folder per process (two test runs on one machine must not clear each other's files), removed at exit.
+  static std::vector<std::filesystem::path> made;
+  static const bool cleanup = [] {
+    std::atexit([] {
+      std::error_code ec;
+      for (const auto& q : made) std::filesystem::remove_all(q, ec);
+    });
+    return true;
+  }();
+  (void)cleanup;
+  const auto p = std::filesystem::temp_directory_path() / ("impinge_test_" + name + "_" + std::to_string(getpid()));
   std::filesystem::remove_all(p);
   std::filesystem::create_directories(p);
+  made.push_back(p);
   return p.string();
 }
 

@@ -21,7 +21,8 @@ std::string error_of(const std::string& path, Side side = Side::right) {
   }
   return "";
 }
-const char* kMotHeader = "walk\nversion=1\nnRows=3\nnColumns=5\ninDegrees=yes\nendheader\n";
+// No nRows line: the files below hold various row counts (a wrong nRows is an error, tested below).
+const char* kMotHeader = "walk\nversion=1\nDataType=double\nnColumns=5\ninDegrees=yes\nendheader\n";
 }  // namespace
 
 TEST(Motion, CsvColumnsByNameInAnyOrder) {
@@ -99,5 +100,17 @@ TEST(Motion, BadFilesAreOneLineErrorsNamingFileLineAndColumn) {
   check("noend.mot", "x\ninDegrees=yes\n", "no 'endheader'");
   check("nocol.mot", std::string(kMotHeader) + "time\thip_flexion_r\thip_adduction_r\n0\t1\t2\n",
         ":7: missing column 'hip_rotation_r'");
+  // Issue 80: what a real file gets wrong is said, not read into poses.
+  check("truncated.mot", "w\nnRows=3\ninDegrees=yes\nendheader\ntime\thip_flexion_r\thip_adduction_r\thip_rotation_r\n"
+                         "0\t1\t2\t3\n0.1\t1\t2\t3\n",
+        "the header says nRows=3, the file holds 2 rows");
+  check("rows.mot", "w\nnRows=many\ninDegrees=yes\nendheader\n", ":2: 'nRows=many' is not a row count");
+  check("degrees.mot", "w\ninDegrees=no\nendheader\ntime\thip_flexion_r\thip_adduction_r\thip_rotation_r\n"
+                       "0\t0.5\t0\t0\n0.1\t30\t5\t10\n",
+        ":6: column 'hip_flexion_r': 30 rad = 1718.9 deg is beyond +-360 deg: the header says inDegrees=no");
+  check("turn.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,1,2,370\n",
+        ":2: column 'internal_rotation_deg': 370 deg is beyond +-360 deg");
+  check("twice.csv", "time_s,flexion_deg,adduction_deg,flexion_deg,internal_rotation_deg\n0,1,2,3,4\n",
+        ":1: column 'flexion_deg' appears twice (columns 2 and 4)");
   EXPECT_NE(error_of(d + "/absent.mot").find("cannot open"), std::string::npos);
 }

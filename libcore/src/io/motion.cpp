@@ -1,8 +1,11 @@
 #include "impinge/io/motion.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -68,6 +71,74 @@ double number(const std::string& cell, const std::string& where) {
 
 }  // namespace
 
+namespace {
+
+/// An OpenSim header up to "endheader": the angles' unit (degrees 1, radians kRadToDeg) and nRows (-1: not given).
+struct OpenSimHeader {
+  double scale = 1;
+  long long rows = -1;
+  bool in_degrees = true;
+};
+
+OpenSimHeader read_opensim_header(std::istream& in, const std::string& path, std::size_t& line_no) {
+  OpenSimHeader h;
+  std::string line;
+  int in_degrees = -1;
+  bool end = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string t = lower(trim(line));
+    if (t == "endheader") {
+      end = true;
+      break;
+    }
+    const std::string value = trim(t.substr(t.find('=') == std::string::npos ? t.size() : t.find('=') + 1));
+    if (t.rfind("indegrees", 0) == 0) {
+      require(value == "yes" || value == "no",
+              path + ":" + std::to_string(line_no) + ": unknown unit 'inDegrees=" + value + "' (yes or no)");
+      in_degrees = value == "yes";
+    } else if (t.rfind("nrows", 0) == 0) {
+      char* stop = nullptr;
+      h.rows = std::strtoll(value.c_str(), &stop, 10);
+      require(!value.empty() && *stop == '\0' && h.rows >= 0,
+              path + ":" + std::to_string(line_no) + ": 'nRows=" + value + "' is not a row count");
+    }
+  }
+  require(line_no > 0, path + ": empty motion file");
+  require(end, path + ": no 'endheader' line: not an OpenSim motion/storage file");
+  require(in_degrees >= 0, path + ": the header has no inDegrees=yes|no line: the angles' unit is unknown");
+  h.in_degrees = in_degrees == 1;
+  h.scale = h.in_degrees ? 1.0 : kRadToDeg;
+  return h;
+}
+
+/// The columns of time and the three angles among `labels` (the header row at `line_no`); each must appear once.
+std::array<std::size_t, 4> find_columns(const std::vector<std::string>& labels, bool opensim, Side side,
+                                        const std::string& path, std::size_t line_no) {
+  const std::string s = side == Side::right ? "_r" : "_l";
+  const std::vector<std::string> wanted =
+      opensim ? std::vector<std::string>{"time", "hip_flexion" + s, "hip_adduction" + s, "hip_rotation" + s}
+              : std::vector<std::string>{"time_s", "flexion_deg", "adduction_deg", "internal_rotation_deg"};
+  std::array<std::size_t, 4> col{};
+  for (int k = 0; k < 4; ++k) {
+    const auto matches = [&](const std::string& l) {
+      return l == wanted[k] || (opensim && (ends_with(l, "/" + wanted[k]) || ends_with(l, "/" + wanted[k] + "/value")));
+    };
+    const auto it = std::find_if(labels.begin(), labels.end(), matches);
+    require(it != labels.end(), path + ":" + std::to_string(line_no) + ": missing column '" + wanted[k] + "'");
+    const auto again = std::find_if(it + 1, labels.end(), matches);
+    require(again == labels.end(), [&] {
+      return path + ":" + std::to_string(line_no) + ": column '" + wanted[k] + "' appears twice (columns " +
+             std::to_string(it - labels.begin() + 1) + " and " + std::to_string(again - labels.begin() + 1) +
+             "): which one is meant?";
+    });
+    col[static_cast<std::size_t>(k)] = static_cast<std::size_t>(it - labels.begin());
+  }
+  return col;
+}
+
+}  // namespace
+
 Motion load_motion(const std::string& path, Side side) {
   std::ifstream in(path);
   require(in.good(), path + ": cannot open motion file");
@@ -78,29 +149,7 @@ Motion load_motion(const std::string& path, Side side) {
   m.format = opensim ? "opensim" : "csv";
   std::string line;
   std::size_t line_no = 0;
-  double scale = 1;  // to degrees
-  if (opensim) {
-    int in_degrees = -1;
-    bool end = false;
-    while (std::getline(in, line)) {
-      ++line_no;
-      const std::string t = lower(trim(line));
-      if (t == "endheader") {
-        end = true;
-        break;
-      }
-      if (t.rfind("indegrees", 0) == 0) {
-        const std::string v = trim(t.substr(t.find('=') == std::string::npos ? t.size() : t.find('=') + 1));
-        require(v == "yes" || v == "no",
-                path + ":" + std::to_string(line_no) + ": unknown unit 'inDegrees=" + v + "' (yes or no)");
-        in_degrees = v == "yes";
-      }
-    }
-    require(line_no > 0, path + ": empty motion file");
-    require(end, path + ": no 'endheader' line: not an OpenSim motion/storage file");
-    require(in_degrees >= 0, path + ": the header has no inDegrees=yes|no line: the angles' unit is unknown");
-    scale = in_degrees ? 1.0 : kRadToDeg;
-  }
+  const OpenSimHeader header = opensim ? read_opensim_header(in, path, line_no) : OpenSimHeader{};
   // Column labels.
   std::vector<std::string> labels;
   while (std::getline(in, line)) {
@@ -111,18 +160,7 @@ Motion load_motion(const std::string& path, Side side) {
     }
   }
   require(!labels.empty(), path + ": empty motion file (no header row)");
-  const std::string s = side == Side::right ? "_r" : "_l";
-  const std::vector<std::string> wanted =
-      opensim ? std::vector<std::string>{"time", "hip_flexion" + s, "hip_adduction" + s, "hip_rotation" + s}
-              : std::vector<std::string>{"time_s", "flexion_deg", "adduction_deg", "internal_rotation_deg"};
-  std::size_t col[4];
-  for (int k = 0; k < 4; ++k) {
-    const auto it = std::find_if(labels.begin(), labels.end(), [&](const std::string& l) {
-      return l == wanted[k] || (opensim && (ends_with(l, "/" + wanted[k]) || ends_with(l, "/" + wanted[k] + "/value")));
-    });
-    require(it != labels.end(), path + ":" + std::to_string(line_no) + ": missing column '" + wanted[k] + "'");
-    col[k] = static_cast<std::size_t>(it - labels.begin());
-  }
+  const std::array<std::size_t, 4> col = find_columns(labels, opensim, side, path, line_no);
   while (std::getline(in, line)) {
     ++line_no;
     if (trim(line).empty()) continue;
@@ -133,17 +171,28 @@ Motion load_motion(const std::string& path, Side side) {
              "columns";
     });
     double v[4];
-    for (int k = 0; k < 4; ++k) {
+    for (std::size_t k = 0; k < 4; ++k) {
       const std::string where = path + ":" + std::to_string(line_no) + ": column '" + labels[col[k]] + "'";
-      require(col[k] < cells.size(), where + ": the row has only " + std::to_string(cells.size()) + " cells");
       v[k] = number(cells[col[k]], where);
+      // An angle beyond a turn is not a hip's: a unit mixed up (degrees in a file that says radians), said here.
+      require(k == 0 || std::abs(v[k] * header.scale) <= 360, [&] {
+        char deg[32];
+        std::snprintf(deg, sizeof deg, "%.1f", v[k] * header.scale);
+        return where + ": " + cells[col[k]] + (header.in_degrees ? " deg" : " rad = " + std::string(deg) + " deg") +
+               " is beyond +-360 deg" +
+               (header.in_degrees ? "" : ": the header says inDegrees=no (radians); are the values degrees?");
+      });
     }
     require(m.time_s.empty() || v[0] >= m.time_s.back(),
             path + ":" + std::to_string(line_no) + ": column '" + labels[col[0]] + "': time decreases");
     m.time_s.push_back(v[0]);
-    m.angles.push_back(PoseAngles{v[1] * scale, v[2] * scale, v[3] * scale});
+    m.angles.push_back(PoseAngles{v[1] * header.scale, v[2] * header.scale, v[3] * header.scale});
   }
   require(!m.angles.empty(), path + ": the motion has no frames");
+  require(header.rows < 0 || static_cast<std::size_t>(header.rows) == m.angles.size(), [&] {
+    return path + ": the header says nRows=" + std::to_string(header.rows) + ", the file holds " +
+           std::to_string(m.angles.size()) + " rows: truncated or edited?";
+  });
   return m;
 }
 
