@@ -70,3 +70,28 @@ def test_a_killed_run_leaves_no_complete_looking_folder(generated, tmp_path):
     assert p.returncode == -signal.SIGKILL, "the motion ended before it was killed: make it longer"
     assert (out / "INCOMPLETE").exists()
     assert not (out / "summary.json").exists()
+
+
+def test_two_runs_on_one_out_the_second_refuses_and_a_killed_runs_lock_is_taken_over(generated, tmp_path):
+    """Issue 80: a run owns its --out. While one runs, another on the same folder is refused naming it (command and
+    pid); once the first is killed (its lock left behind), the next run takes the folder over and leaves no lock."""
+    out = tmp_path / "o"
+    motion = tmp_path / "m.csv"
+    with open(motion, "w") as f:
+        f.write("time_s,flexion_deg,adduction_deg,internal_rotation_deg\n")
+        for k in range(200000):
+            f.write(f"{k * 0.01},{(k % 90)},{(k % 20) - 10},{(k % 30) - 15}\n")
+    p = subprocess.Popen([CLI, "motion", "--subject", str(generated), "--precision", "1", "--motion", str(motion),
+                          "--vtp-every", "1000", "--quiet", "--out", str(out)], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    deadline = time.time() + 25
+    while time.time() < deadline and not (out / ".impinge.lock").exists():
+        time.sleep(0.02)
+    r = run(["rom", "--subject", generated, "--precision", "2", "--no-map", "--out", out])
+    one_line_error(r, str(out), f"in use by impinge motion (pid {p.pid}", "give another --out")
+    p.send_signal(signal.SIGKILL)
+    p.wait(timeout=10)
+    assert (out / ".impinge.lock").exists()  # left behind by the killed run
+    r = run(["rom", "--subject", generated, "--precision", "2", "--no-map", "--out", out])
+    assert r.returncode == 0, r.stderr
+    assert not (out / ".impinge.lock").exists() and (out / "summary.json").exists()

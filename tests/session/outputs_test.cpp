@@ -5,6 +5,8 @@
 // from the start, and a subfolder that is a symbolic link is refused.
 #include "impinge/session/outputs.hpp"
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -102,6 +104,41 @@ TEST(Outputs, FolderIsMarkedIncompleteUntilItsRunEnds) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("symbolic link"), std::string::npos) << e.what();
   }
+}
+
+// Issue 80: a run owns its --out. The lock names its holder; a live holder on this machine or any on another host is
+// refused; a lock left by a run that ended (its process gone) or an empty one (a full disk) is taken over; the run's own
+// lock goes at its end.
+TEST(Outputs, ARunLocksItsFolderAndALockLeftBehindIsTakenOver) {
+  const fs::path d = fs::temp_directory_path() / ("impinge_outputs_lock_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  begin_output_folder(d.string(), "rom");
+  std::string holder;
+  std::getline(std::ifstream(d / kOutputLock), holder);
+  EXPECT_EQ(holder.rfind(std::to_string(getpid()) + " ", 0), 0u) << holder;
+  EXPECT_NE(holder.find(" impinge rom "), std::string::npos) << holder;
+  end_output_folder(d.string());
+  EXPECT_FALSE(fs::exists(d / kOutputLock));
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  // Held by a live process of this machine (pid 1 always runs): refused, naming it.
+  write_file_atomically((d / kOutputLock).string(), std::string("1 ") + host + " impinge motion 2026-01-01T00:00:00Z\n");
+  const std::string e = test::error_of([&] { begin_output_folder(d.string(), "distance"); });
+  EXPECT_NE(e.find("in use by impinge motion (pid 1, since 2026-01-01T00:00:00Z)"), std::string::npos) << e;
+  // On another host: refused, saying how to free it.
+  write_file_atomically((d / kOutputLock).string(), "4321 elsewhere impinge plan 2026-01-01T00:00:00Z\n");
+  EXPECT_NE(test::error_of([&] { begin_output_folder(d.string(), "distance"); }).find("on elsewhere"),
+            std::string::npos);
+  // Left by a process that ended (a pid above the kernel's pid_max), or empty: taken over.
+  for (const std::string stale : {std::string("99999999 ") + host + " impinge rom 2026-01-01T00:00:00Z\n",
+                                  std::string()}) {
+    write_file_atomically((d / kOutputLock).string(), stale);
+    begin_output_folder(d.string(), "distance");
+    std::getline(std::ifstream(d / kOutputLock), holder);
+    EXPECT_EQ(holder.rfind(std::to_string(getpid()) + " ", 0), 0u) << holder;
+    end_output_folder(d.string());
+  }
+  fs::remove_all(d);
 }
 
 TEST(Outputs, AtomicWriteReplacesALinkAndLeavesItsTargetAlone) {

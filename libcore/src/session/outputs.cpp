@@ -1,11 +1,18 @@
 #include "impinge/session/outputs.hpp"
 #include "impinge/core/concurrent.hpp"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <ctime>
 #include <exception>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <sstream>
 
@@ -22,10 +29,95 @@ namespace impinge {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+std::string this_host() {
+  char name[256] = {};
+  return gethostname(name, sizeof name - 1) == 0 ? std::string(name) : std::string("unknown-host");
+}
+
+// Whether process `pid` of this machine still runs (EPERM: it runs as another user).
+bool process_alive(long pid) { return pid > 0 && (kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
+
+// Take `dir`'s lock (kOutputLock) for this process, or throw naming the run that holds it.
+void take_output_lock(const fs::path& dir, const std::string& command, const std::string& when) {
+  const fs::path lock = dir / kOutputLock;
+  const std::string host = this_host();
+  const std::string mine = std::to_string(getpid()) + " " + host + " impinge " + command + " " + when + "\n";
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const int fd = ::open(lock.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      const bool written = ::write(fd, mine.data(), mine.size()) == static_cast<ssize_t>(mine.size());
+      const bool closed = ::close(fd) == 0;
+      if (written && closed) return;
+      std::error_code ec;
+      fs::remove(lock, ec);
+      throw Error(lock.string() + ": cannot write the output folder's lock (is the disk full?)");
+    }
+    const int err = errno;
+    require(err == EEXIST, [&] { return lock.string() + ": cannot create the output folder's lock (" +
+                                         std::string(std::strerror(err)) + ")"; });
+    long pid = 0;
+    std::string holder_host, word, holder_command, started;
+    {
+      std::ifstream in(lock);
+      in >> pid >> holder_host >> word >> holder_command >> started;
+    }
+    const bool ours = pid == static_cast<long>(getpid()) && holder_host == host;
+    const bool live_here = holder_host == host && process_alive(pid) && !ours;
+    require(!live_here, [&] {
+      return dir.string() + ": in use by impinge " + holder_command + " (pid " + std::to_string(pid) + ", since " +
+             started + "): wait for it to end, or give another --out";
+    });
+    require(pid <= 0 || holder_host == host || holder_host.empty(), [&] {
+      return dir.string() + ": in use by impinge " + holder_command + " on " + holder_host + " (pid " +
+             std::to_string(pid) + ", since " + started + "); if that run has ended, remove " + lock.string();
+    });
+    std::error_code ec;  // left by a run that ended (or empty: a full disk): taken over
+    fs::remove(lock, ec);
+  }
+  throw Error(lock.string() + ": another run takes the folder at the same moment; try again");
+}
+
+// Create `subfolders`, remove a previous run's summary.json and write kIncompleteMarker (begin_output_folder).
+void prepare_output_folder(const std::string& dir, const std::string& command,
+                           const std::vector<std::string>& subfolders);
+
+void release_output_lock(const fs::path& dir) {
+  const fs::path lock = dir / kOutputLock;
+  long pid = 0;
+  std::string host;
+  {
+    std::ifstream in(lock);
+    in >> pid >> host;
+  }
+  std::error_code ec;
+  if (pid == static_cast<long>(getpid()) && host == this_host()) fs::remove(lock, ec);  // only our own
+}
+
+}  // namespace
+
 void begin_output_folder(const std::string& dir, const std::string& command, const std::vector<std::string>& subfolders) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   require(fs::is_directory(dir), [&] { return dir + ": cannot create the output folder (" + ec.message() + ")"; });
+  const std::time_t start = std::time(nullptr);
+  char started[32];
+  std::strftime(started, sizeof started, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&start));
+  take_output_lock(dir, command, started);
+  try {
+    prepare_output_folder(dir, command, subfolders);
+  } catch (...) {
+    release_output_lock(dir);
+    throw;
+  }
+}
+
+namespace {
+
+void prepare_output_folder(const std::string& dir, const std::string& command,
+                           const std::vector<std::string>& subfolders) {
+  std::error_code ec;
   for (const std::string& sub : subfolders) {
     const fs::path p = fs::path(dir) / sub;
     require(!fs::is_symlink(fs::symlink_status(p)),
@@ -43,10 +135,13 @@ void begin_output_folder(const std::string& dir, const std::string& command, con
   require(!ec, [&] { return dir + "/summary.json: cannot remove a previous run's (" + ec.message() + ")"; });
 }
 
+}  // namespace
+
 void end_output_folder(const std::string& dir) {
   std::error_code ec;
   fs::remove(fs::path(dir) / kIncompleteMarker, ec);
   require(!ec, [&] { return dir + "/" + kIncompleteMarker + ": cannot remove it (" + ec.message() + ")"; });
+  release_output_lock(dir);
 }
 
 std::vector<std::uint8_t> vertex_levels(const ScanGaps& g, const ImpingementLevels& levels, LevelQuantity levels_on) {

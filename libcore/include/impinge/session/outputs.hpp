@@ -21,12 +21,19 @@ namespace impinge {
 /// summary.json is there and this file is not.
 inline constexpr const char* kIncompleteMarker = "INCOMPLETE";
 
-/// Open `dir` for a run's outputs: create it and `subfolders` inside it (a subfolder that is a symbolic
-/// link is refused: files would be written outside `dir`), remove a previous run's summary.json, and
-/// write kIncompleteMarker (saying which command started when). Throws impinge::Error naming the folder.
+/// The lock a run holds on its output folder from begin_output_folder to end_output_folder: "PID HOST impinge COMMAND
+/// STARTED" (issue 80: two runs on one --out wrote into each other's files).
+inline constexpr const char* kOutputLock = ".impinge.lock";
+
+/// Open `dir` for a run's outputs: create it, take its lock (kOutputLock; a live run's lock on this machine, or any
+/// on another host, is refused naming the holder; one left by a run that ended, or an empty one from a full disk, is
+/// taken over), create `subfolders` inside it (a subfolder that is a symbolic link is refused: files would be written
+/// outside `dir`), remove a previous run's summary.json, and write kIncompleteMarker (saying which command started
+/// when). Throws impinge::Error naming the folder; the lock is released when it throws.
 void begin_output_folder(const std::string& dir, const std::string& command,
                          const std::vector<std::string>& subfolders = {});
-/// Mark `dir`'s outputs complete (remove kIncompleteMarker): call after its last file, summary.json.
+/// Mark `dir`'s outputs complete (remove kIncompleteMarker) and release its lock: call after its last file,
+/// summary.json. A run that ends by an error keeps its lock file, which the next run takes over (its process ended).
 void end_output_folder(const std::string& dir);
 
 /// The impingement level of every vertex of `gaps` under `levels` by quantity `levels_on` (vertex_level:
