@@ -95,3 +95,14 @@ def test_two_runs_on_one_out_the_second_refuses_and_a_killed_runs_lock_is_taken_
     r = run(["rom", "--subject", generated, "--precision", "2", "--no-map", "--out", out])
     assert r.returncode == 0, r.stderr
     assert not (out / ".impinge.lock").exists() and (out / "summary.json").exists()
+
+
+def test_a_reused_out_holds_only_the_new_runs_files(generated, tmp_path):
+    """Issue 80: `impinge rom` with its map, then with --no-map, on one folder: the second leaves no rom_map.csv of the
+    first beside its summary; a file of the user's stays."""
+    out = tmp_path / "o"
+    assert run(["rom", "--subject", generated, "--precision", "2", "--out", out]).returncode == 0
+    assert (out / "rom_map.csv").exists()
+    (out / "notes.txt").write_text("mine\n")
+    assert run(["rom", "--subject", generated, "--precision", "2", "--no-map", "--out", out]).returncode == 0
+    assert not (out / "rom_map.csv").exists() and (out / "rom_limits.csv").exists() and (out / "notes.txt").exists()

@@ -141,6 +141,30 @@ TEST(Outputs, ARunLocksItsFolderAndALockLeftBehindIsTakenOver) {
   fs::remove_all(d);
 }
 
+// Issue 80: a reused --out holds only the new run's files: a run removes its command's whole output set that an
+// earlier run left (a plan's pelvis_resected.* beside a femur-only plan, a motion's extra frames), and nothing else.
+TEST(Outputs, AReusedFolderKeepsNoFileOfTheCommandsEarlierRun) {
+  const fs::path d = fs::temp_directory_path() / ("impinge_outputs_reused_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d / "gaps");
+  for (const char* f : {"plan.json", "pelvis_resected.ply", "pelvis_resected.vtp", "plan.png", "summary.json",
+                        "notes.txt", "femur_gaps.ply", "gaps/frame_000007.vtp", "gaps/mine.txt"})
+    write_file_atomically((d / f).string(), "earlier\n");
+  begin_output_folder(d.string(), "plan");
+  for (const char* gone : {"plan.json", "pelvis_resected.ply", "pelvis_resected.vtp", "plan.png", "summary.json"})
+    EXPECT_FALSE(fs::exists(d / gone)) << gone;
+  for (const char* kept : {"notes.txt", "femur_gaps.ply", "gaps/frame_000007.vtp", "gaps/mine.txt"})
+    EXPECT_TRUE(fs::exists(d / kept)) << kept;  // not the plan's: the user's, distance's, motion's
+  end_output_folder(d.string());
+  begin_output_folder(d.string(), "motion", {"gaps"});
+  EXPECT_FALSE(fs::exists(d / "gaps/frame_000007.vtp"));
+  EXPECT_TRUE(fs::exists(d / "gaps/mine.txt"));
+  end_output_folder(d.string());
+  for (const std::string c : {"distance", "motion", "rom", "morphology", "plan"})
+    EXPECT_EQ(command_outputs(c).back(), "summary.json") << c;
+  fs::remove_all(d);
+}
+
 TEST(Outputs, AtomicWriteReplacesALinkAndLeavesItsTargetAlone) {
   const fs::path d = fs::temp_directory_path() / "impinge_outputs_atomic";
   fs::remove_all(d);

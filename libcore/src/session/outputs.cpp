@@ -79,7 +79,29 @@ void take_output_lock(const fs::path& dir, const std::string& command, const std
   throw Error(lock.string() + ": another run takes the folder at the same moment; try again");
 }
 
-// Create `subfolders`, remove a previous run's summary.json and write kIncompleteMarker (begin_output_folder).
+// Remove the files of command_outputs(command) a previous run left in `dir` (a pattern's folder must not be a link).
+void remove_previous_outputs(const std::string& dir, const std::string& command) {
+  for (const std::string& name : command_outputs(command)) {
+    const fs::path p = fs::path(dir) / name;
+    const std::string leaf = p.filename().string();
+    const std::size_t star = leaf.find('*');
+    std::error_code ec;
+    if (star == std::string::npos) {
+      if (fs::is_regular_file(fs::symlink_status(p)) || fs::is_symlink(fs::symlink_status(p))) fs::remove(p, ec);
+    } else if (fs::is_directory(fs::symlink_status(p.parent_path()))) {
+      const std::string head = leaf.substr(0, star), tail = leaf.substr(star + 1);
+      for (const auto& e : fs::directory_iterator(p.parent_path(), ec)) {
+        const std::string n = e.path().filename().string();
+        if (n.size() >= head.size() + tail.size() && n.compare(0, head.size(), head) == 0 &&
+            n.compare(n.size() - tail.size(), tail.size(), tail) == 0)
+          fs::remove(e.path(), ec);
+      }
+    }
+    require(!ec, [&] { return p.string() + ": cannot remove a previous run's file (" + ec.message() + ")"; });
+  }
+}
+
+// Create `subfolders`, remove a previous run's outputs and write kIncompleteMarker (begin_output_folder).
 void prepare_output_folder(const std::string& dir, const std::string& command,
                            const std::vector<std::string>& subfolders);
 
@@ -118,6 +140,7 @@ namespace {
 void prepare_output_folder(const std::string& dir, const std::string& command,
                            const std::vector<std::string>& subfolders) {
   std::error_code ec;
+  remove_previous_outputs(dir, command);
   for (const std::string& sub : subfolders) {
     const fs::path p = fs::path(dir) / sub;
     require(!fs::is_symlink(fs::symlink_status(p)),
@@ -136,6 +159,26 @@ void prepare_output_folder(const std::string& dir, const std::string& command,
 }
 
 }  // namespace
+
+std::vector<std::string> command_outputs(const std::string& command) {
+  std::vector<std::string> out;
+  if (command == "distance")
+    out = {"femur_gaps.ply", "pelvis_gaps.ply", "femur_map.png", "pelvis_map.png", "render.png",
+           "render_anterior.png", "render_lateral.png", "render_acetabulum_medial.png"};
+  else if (command == "motion")
+    out = {"frames.csv", "gaps.pvd", "gaps/frame_*.vtp"};
+  else if (command == "rom")
+    out = {"rom_limits.csv", "rom_map.csv", "rom_envelope.csv"};
+  else if (command == "morphology")
+    out = {"morphology.json", "femur_sphericity.ply"};
+  else if (command == "plan")
+    out = {"plan.json", "femur_resected.ply", "femur_resected.vtp", "pelvis_resected.ply", "pelvis_resected.vtp",
+           "plan.png"};
+  else
+    return out;
+  out.push_back("summary.json");
+  return out;
+}
 
 void end_output_folder(const std::string& dir) {
   std::error_code ec;

@@ -28,10 +28,15 @@ inline constexpr const char* kOutputLock = ".impinge.lock";
 /// Open `dir` for a run's outputs: create it, take its lock (kOutputLock; a live run's lock on this machine, or any
 /// on another host, is refused naming the holder; one left by a run that ended, or an empty one from a full disk, is
 /// taken over), create `subfolders` inside it (a subfolder that is a symbolic link is refused: files would be written
-/// outside `dir`), remove a previous run's summary.json, and write kIncompleteMarker (saying which command started
-/// when). Throws impinge::Error naming the folder; the lock is released when it throws.
+/// outside `dir`), remove what a previous run of `command` left (command_outputs: its whole output set, so that a
+/// reused folder holds only this run's files; other files are left alone), and write kIncompleteMarker (saying which
+/// command started when). Throws impinge::Error naming the folder; the lock is released when it throws.
 void begin_output_folder(const std::string& dir, const std::string& command,
                          const std::vector<std::string>& subfolders = {});
+/// Every file `command` ("distance", "motion", "rom", "morphology", "plan") may write in its output folder, relative
+/// to it; "*" in a last path part matches any text (gaps/frame_*.vtp). Empty for another command.
+std::vector<std::string> command_outputs(const std::string& command);
+
 /// Mark `dir`'s outputs complete (remove kIncompleteMarker) and release its lock: call after its last file,
 /// summary.json. A run that ends by an error keeps its lock file, which the next run takes over (its process ended).
 void end_output_folder(const std::string& dir);
