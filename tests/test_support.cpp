@@ -51,6 +51,15 @@ std::string error_of(const std::function<void()>& f) {
   return "(no error)";
 }
 
+bool inside_by_parity(const ExactReference& ref, const Eigen::Vector3d& q) {
+  static const Eigen::Vector3d dirs[3] = {Eigen::Vector3d(0.5377, 0.1834, -0.8229).normalized(),
+                                          Eigen::Vector3d(-0.4336, 0.8622, 0.3188).normalized(),
+                                          Eigen::Vector3d(0.3426, -0.7254, 0.5972).normalized()};
+  int votes = 0;
+  for (const auto& d : dirs) votes += ref.all_hits(q, d).size() % 2;
+  return votes >= 2;
+}
+
 std::string temp_dir(const std::string& name) {
   // One folder per process (two test runs on one machine must not clear each other's files), removed at exit.
   static std::vector<std::filesystem::path> made;

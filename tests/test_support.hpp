@@ -6,6 +6,7 @@
 #include <random>
 #include <string>
 
+#include "impinge/casters/exact_reference.hpp"
 #include "impinge/core/mesh.hpp"
 #include "impinge/session/session.hpp"
 
@@ -17,6 +18,9 @@ Eigen::Matrix3d random_rotation(std::mt19937_64& rng);
 TriangleMesh transformed(const TriangleMesh& m, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
 /// A fresh temporary directory for a test.
 std::string temp_dir(const std::string& name);
+/// Whether `q` (mm) is inside the closed mesh behind `ref` by CGAL: the majority of three fixed rays' crossing
+/// parities (ExactReference::all_hits). The ray-parity oracle of the distance and resection tests.
+bool inside_by_parity(const ExactReference& ref, const Eigen::Vector3d& q);
 /// Write text to a file.
 void write_text(const std::string& path, const std::string& text);
 /// The message of the impinge::Error that f throws, or "(no error)" when it throws none (any other exception

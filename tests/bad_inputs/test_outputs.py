@@ -48,19 +48,24 @@ def test_a_subfolder_that_is_a_link_is_refused(generated, tmp_path):
     assert os.listdir(elsewhere) == []
 
 
-def test_a_killed_run_leaves_no_complete_looking_folder(generated, tmp_path):
-    out = tmp_path / "o"
-    # A finished run first: its summary.json must not survive beside the killed run's files.
-    assert run(["rom", "--subject", generated, "--precision", "2", "--no-map", "--out", out]).returncode == 0
-    assert (out / "summary.json").exists()
+def start_long_motion(generated, tmp_path, out):
+    """`impinge motion` of 200,000 frames into `out`, started in the background (long enough to be caught running)."""
     motion = tmp_path / "m.csv"
     with open(motion, "w") as f:
         f.write("time_s,flexion_deg,adduction_deg,internal_rotation_deg\n")
         for k in range(200000):
             f.write(f"{k * 0.01},{(k % 90)},{(k % 20) - 10},{(k % 30) - 15}\n")
-    p = subprocess.Popen([CLI, "motion", "--subject", str(generated), "--precision", "1", "--motion", str(motion),
-                          "--vtp-every", "1000", "--quiet", "--out", str(out)], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE)
+    return subprocess.Popen([CLI, "motion", "--subject", str(generated), "--precision", "1", "--motion", str(motion),
+                             "--vtp-every", "1000", "--quiet", "--out", str(out)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+
+
+def test_a_killed_run_leaves_no_complete_looking_folder(generated, tmp_path):
+    out = tmp_path / "o"
+    # A finished run first: its summary.json must not survive beside the killed run's files.
+    assert run(["rom", "--subject", generated, "--precision", "2", "--no-map", "--out", out]).returncode == 0
+    assert (out / "summary.json").exists()
+    p = start_long_motion(generated, tmp_path, out)
     deadline = time.time() + 25
     while time.time() < deadline and not (out / "gaps").exists():
         time.sleep(0.02)
@@ -76,14 +81,7 @@ def test_two_runs_on_one_out_the_second_refuses_and_a_killed_runs_lock_is_taken_
     """Issue 80: a run owns its --out. While one runs, another on the same folder is refused naming it (command and
     pid); once the first is killed (its lock left behind), the next run takes the folder over and leaves no lock."""
     out = tmp_path / "o"
-    motion = tmp_path / "m.csv"
-    with open(motion, "w") as f:
-        f.write("time_s,flexion_deg,adduction_deg,internal_rotation_deg\n")
-        for k in range(200000):
-            f.write(f"{k * 0.01},{(k % 90)},{(k % 20) - 10},{(k % 30) - 15}\n")
-    p = subprocess.Popen([CLI, "motion", "--subject", str(generated), "--precision", "1", "--motion", str(motion),
-                          "--vtp-every", "1000", "--quiet", "--out", str(out)], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE)
+    p = start_long_motion(generated, tmp_path, out)
     deadline = time.time() + 25
     while time.time() < deadline and not (out / ".impinge.lock").exists():
         time.sleep(0.02)

@@ -154,14 +154,7 @@ TEST(PlanResection, TheResectedFemurKeepsTheClearanceByCgal) {
   // The oracle, in the working frame (scan neutral: the joint frame's axes, its origin the COR).
   const ExactReference pelvis(h.socket);
   const Eigen::Vector3d cor = hip.to_working(Eigen::Vector3d::Zero());
-  static const Eigen::Vector3d dirs[3] = {Eigen::Vector3d(0.5377, 0.1834, -0.8229).normalized(),
-                                          Eigen::Vector3d(-0.4336, 0.8622, 0.3188).normalized(),
-                                          Eigen::Vector3d(0.3426, -0.7254, 0.5972).normalized()};
-  auto inside = [&](const ExactReference& ref, const Eigen::Vector3d& q) {
-    int votes = 0;
-    for (const auto& d : dirs) votes += ref.all_hits(q, d).size() % 2;
-    return votes >= 2;
-  };
+  const auto inside = test::inside_by_parity;
   const double allowed = ro.clearance_mm - 2 * ro.tolerance_mm;
   double worst = std::numeric_limits<double>::infinity();
   std::vector<std::size_t> checked;  // every second pose, and always the target pose itself (the last)

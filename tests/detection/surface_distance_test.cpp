@@ -36,15 +36,7 @@ namespace {
       return ::testing::AssertionFailure() << "vertex " << i << ": " << a[i] << " against " << b[i];
   return ::testing::AssertionSuccess();
 }
-/// Inside by CGAL: the majority of three rays' crossing parities (all_hits of the closed mesh).
-bool inside_by_parity(const ExactReference& ref, const Eigen::Vector3d& q) {
-  static const Eigen::Vector3d dirs[3] = {Eigen::Vector3d(0.5377, 0.1834, -0.8229).normalized(),
-                                          Eigen::Vector3d(-0.4336, 0.8622, 0.3188).normalized(),
-                                          Eigen::Vector3d(0.3426, -0.7254, 0.5972).normalized()};
-  int votes = 0;
-  for (const auto& d : dirs) votes += ref.all_hits(q, d).size() % 2;
-  return votes >= 2;
-}
+using impinge::test::inside_by_parity;
 
 struct Checked {
   std::int64_t measured = 0, far = 0, signs = 0;
