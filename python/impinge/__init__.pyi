@@ -92,7 +92,7 @@ class Joint:
     def __init__(self, ball: Optional[Union[str, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
                  socket: Optional[Union[str, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None, *,
                  preset: str = 'clinical', subject: Optional[Union[str, os.PathLike]] = None,
-                 side: Optional[str] = None, frame: Optional[str] = None,
+                 side: Optional[str] = None, frame: Optional[str] = None, strict: bool = False,
                  landmarks: Optional[Dict[str, Sequence[float]]] = None,
                  cor: Optional[Union[str, Sequence[float]]] = None, allow_any_cor: bool = False,
                  head_region: Optional[Sequence[float]] = None, scheme: str = 'equiangular', resolution: float = 0.0,

@@ -43,6 +43,7 @@ MorphologyRun run_morphology(const SessionOptions& options) {
   run.pelvis_source = in.pelvis_source;
   run.subject = in.name;
   run.warnings = in.warnings;
+  run.meshes = meshes_record(in.femur_hygiene, in.pelvis_hygiene);
   run.femur = std::move(in.femur);
   run.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return run;
@@ -185,6 +186,7 @@ nlohmann::json morphology_record(const MorphologyRun& run) {
   j["acetabulum"] = acetabulum_measures(run);
   j["notes"] = m.notes;
   j["warnings"] = run.warnings;
+  j["meshes"] = run.meshes;
   j["ms"] = run.ms;
   return j;
 }

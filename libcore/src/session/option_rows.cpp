@@ -81,6 +81,10 @@ void add_input_rows(Rows& t) {
   t.text("frame", "frame", OptionType::choice, kInput, {"LPS", "RAS"},
          "Input frame LPS or RAS (default: the subject's, else RAS; contradicting it is an error)",
          [](auto& o) -> auto& { return o.session.input.frame; });
+  t.flag("strict", "strict", OptionType::flag, kInput,
+         "Refuse a mesh that needs a repair: a fragment apart from the bone (over 10 mm from it) or a repeated face "
+         "(a double wall); otherwise they are removed and said (docs: mesh hygiene)",
+         [](auto& o) -> auto& { return o.session.input.strict; });
   OptionRow& lm = t.add("landmarks", "landmarks", OptionType::landmarks, "mm", use_joint,
                         "Landmarks, input frame, mm, named as subject.json's (over the subject's)");
   lm.set = [](RunOptions& o, const OptionValue& v, const std::string& as) {

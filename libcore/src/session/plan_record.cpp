@@ -113,6 +113,7 @@ nlohmann::json plan_record(const PlanRun& run) {
                      {"total", run.total_ms}};
   j["notes"] = run.notes;
   j["warnings"] = run.warnings;
+  j["meshes"] = run.meshes;
   return j;
 }
 

@@ -221,6 +221,7 @@ SessionOptions plan_session_options(const SessionOptions& options, const RomOpti
 /// head centre at the scan pose (input frame, mm).
 void describe_session(PlanRun& run, const Session& s) {
   run.warnings = s.warnings();
+  run.meshes = meshes_record(s.femur_hygiene(), s.pelvis_hygiene());
   run.subject = s.subject_name();
   run.femur_source = s.ball_source();
   run.pelvis_source = s.socket_source();

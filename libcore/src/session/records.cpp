@@ -281,6 +281,29 @@ nlohmann::json frames_record(const Session& s, const HipFrames& frames) {
 
 }  // namespace
 
+nlohmann::json meshes_record(const MeshHygiene& femur, const MeshHygiene& pelvis) {
+  auto bone = [](const MeshHygiene& h) {
+    nlohmann::json fragments = nlohmann::json::array();
+    for (const MeshFragment& f : h.dropped)
+      fragments.push_back({{"triangles", f.triangles}, {"area_mm2", f.area_mm2}, {"extent_mm", f.extent_mm},
+                           {"distance_mm", number_or_null(f.distance_mm)}, {"centre_mm", vec(f.centre)}});
+    return nlohmann::json{{"parts", h.components},
+                          {"parts_kept", h.components_kept},
+                          {"fragments_removed", fragments},
+                          {"double_wall_faces_removed", h.duplicate_faces_removed},
+                          {"corners_welded", h.corners_welded},
+                          {"boundary_edges", h.boundary_edges},
+                          {"holes", h.boundary_loops},
+                          {"nonmanifold_edges", h.nonmanifold_edges}};
+  };
+  return {{"femur", bone(femur)},
+          {"pelvis", bone(pelvis)},
+          {"rule", "the bone is the largest connected part and every part within " + std::to_string(static_cast<int>(kBoneGapMm)) +
+                       " mm of it; smaller parts farther away (under " + std::to_string(static_cast<int>(100 * kFragmentAreaFraction)) +
+                       " % of its area) are fragments, removed; repeated faces removed; holes counted, and a distance "
+                       "whose sign the mesh cannot decide is flagged (docs: mesh hygiene)"}};
+}
+
 nlohmann::json setup_record(const Session& s) {
   const HipJoint& hip = s.hip();
   nlohmann::json j;
@@ -294,6 +317,7 @@ nlohmann::json setup_record(const Session& s) {
   j["neutral"] = hip.neutral() == Neutral::anatomical ? "anatomical" : "scan";
   j["pelvic_frame"] = pelvic_frame_name(s);
   j["warnings"] = s.warnings();
+  j["meshes"] = meshes_record(s.femur_hygiene(), s.pelvis_hygiene());
   j["scan_pose_min_gap_mm"] = number_or_null(s.scan_pose_min_gap_mm());
   j["overlap_at_scan_pose"] = s.scan_pose_min_gap_mm() < 0;
   j["pose_convention"] =

@@ -132,6 +132,15 @@ void orient_bones(LoadedInput& in) {
   }
 }
 
+// Mesh hygiene (mesh_hygiene.hpp): both bones' fragments, double walls and holes, each said in in.warnings and
+// kept in in.*_hygiene for the summaries. The pelvis on a second thread.
+void clean_bones(LoadedInput& in, bool strict) {
+  run_both([&] { in.femur_hygiene = clean_bone_mesh(in.femur, in.femur_source, strict); },
+           [&] { in.pelvis_hygiene = clean_bone_mesh(in.pelvis, in.pelvis_source, strict); });
+  for (const std::string& w : in.femur_hygiene.warnings(in.femur_source)) in.warnings.push_back(w);
+  for (const std::string& w : in.pelvis_hygiene.warnings(in.pelvis_source)) in.warnings.push_back(w);
+}
+
 // Units: a femur or pelvis (or a part of one holding the joint) spans tens to hundreds of millimetres; a bone
 // whose bounding box's diagonal is under 20 or over 3000 (file units) is an error naming the likely unit.
 void check_units(const LoadedInput& in) {
@@ -174,8 +183,9 @@ LoadedInput load_input(const SessionInput& input) {
   in.frame = checked_frame(input, subject_frame);
   read_bones(input, ball, socket, in);
   add_given_landmarks(input, landmarks);
-  orient_bones(in);
   check_units(in);
+  clean_bones(in, input.strict);
+  orient_bones(in);
   in.to_working = to_working_frame(in.frame);
   transform_vertices(in.femur.V, in.to_working);
   transform_vertices(in.pelvis.V, in.to_working);
@@ -339,6 +349,8 @@ Session::Session(const SessionOptions& options) : options_(options) {
   ball_source_ = in.femur_source;
   socket_source_ = in.pelvis_source;
   subject_name_ = in.name;
+  femur_hygiene_ = in.femur_hygiene;
+  pelvis_hygiene_ = in.pelvis_hygiene;
   cor_ = find_centre_of_rotation(in, options.cor);
   check_side_and_frame(in, cor_.head.centre, options.input);
   hip_options_.allow_cor_outside_ball = options.cor.allow_any;

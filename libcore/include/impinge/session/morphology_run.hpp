@@ -16,6 +16,7 @@ namespace impinge {
 
 /// A morphology run: the measures and what they were measured on.
 struct MorphologyRun {
+  nlohmann::json meshes;  ///< the bones' mesh hygiene (meshes_record)
   Morphology morphology;
   HipFrames frames;       ///< working frame (the head: the sphere the femur shows)
   Acetabulum acetabulum;  ///< working frame

@@ -67,6 +67,7 @@ struct PlanRun {
   FrameConvention input_frame = FrameConvention::RAS;
   double setup_ms = 0, before_ms = 0, plan_ms = 0, check_ms = 0, total_ms = 0;
   std::vector<std::string> warnings;
+  nlohmann::json meshes;  ///< the bones' mesh hygiene (meshes_record)
 };
 
 /// The targets of `request` for `session`'s hip (PlanRequest::target, target_motion) with the limits `before`

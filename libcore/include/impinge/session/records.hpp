@@ -56,6 +56,12 @@ nlohmann::json frame_record(const AnatomicalFrame& frame, const Eigen::Matrix3d&
 nlohmann::json acetabulum_record(const Acetabulum& acetabulum, const AnatomicalFrame& pelvis, Side side,
                                  const Eigen::Matrix3d& to_input);
 
+/// What each bone's mesh held and what was done on reading (mesh_hygiene.hpp), for summary.json's "meshes":
+/// {"femur": {...}, "pelvis": {...}, "rule": ...}: parts read and kept, fragments removed (area mm^2, size mm,
+/// distance mm, centre in the input frame, mm), double-wall faces removed, corners welded, boundary edges, holes
+/// (boundary loops), non-manifold edges.
+nlohmann::json meshes_record(const MeshHygiene& femur, const MeshHygiene& pelvis);
+
 /// What every command reports about its set-up (summary.json's common part): inputs, side and
 /// input frame, COR and how it was found, scheme and resolution, map settings, neutral, warnings,
 /// the scan-pose overlap, and with anatomical neutral the frames, the scan pose and the acetabulum.

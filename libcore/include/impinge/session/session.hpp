@@ -22,6 +22,7 @@
 #include "impinge/clinical/hip_joint.hpp"
 #include "impinge/core/range.hpp"
 #include "impinge/core/mesh.hpp"
+#include "impinge/core/mesh_hygiene.hpp"
 #include "impinge/io/subject.hpp"
 
 namespace impinge {
@@ -35,6 +36,9 @@ struct SessionInput {
   std::string side;   ///< "right" | "left"; empty: the subject's, else right. Contradicting the subject: an error
   std::string frame;  ///< "LPS" | "RAS"; empty: the subject's, else RAS. Contradicting the subject: an error
   Landmarks landmarks;  ///< given landmarks (input frame, mm; names as subject.json's), over the subject's
+  /// Refuse a mesh that needs a repair beyond the winding (a fragment apart from the bone, a double wall:
+  /// mesh_hygiene.hpp) instead of making it and saying so.
+  bool strict = false;
 };
 
 /// How the centre of rotation (COR) is found. In order: `head_region` (a sphere fit to the femur's
@@ -138,8 +142,10 @@ struct LoadedInput {
   Landmarks landmarks;     ///< working frame, mm
   std::string neutral;     ///< the subject's "neutral" (empty when none)
   std::string name;        ///< the subject's folder name (empty without a subject)
-  /// What was repaired on reading (triangles wound against their neighbours, flipped), one line each.
+  /// What was repaired on reading (triangles wound against their neighbours, flipped; fragments, double walls:
+  /// mesh_hygiene.hpp), one line each.
   std::vector<std::string> warnings;
+  MeshHygiene femur_hygiene, pelvis_hygiene;  ///< what each bone's mesh held and what was done (clean_bone_mesh)
 };
 
 /// The femoral head found on the femur of `in`: the end of its long axis that sits in the acetabulum when the
@@ -220,6 +226,9 @@ class Session {
   PoseResult detect(const FemurPose& pose) const;
   /// HipJoint's warnings and the session's (overlap at the scan pose), one line each.
   const std::vector<std::string>& warnings() const { return warnings_; }
+  /// What the femur's and the pelvis' meshes held and what was done on reading (mesh_hygiene.hpp).
+  const MeshHygiene& femur_hygiene() const { return femur_hygiene_; }
+  const MeshHygiene& pelvis_hygiene() const { return pelvis_hygiene_; }
 
   /// A working-frame point or direction (mm) in the input frame.
   Eigen::Vector3d to_input(const Eigen::Vector3d& working) const { return to_working_.transpose() * working; }
@@ -266,6 +275,7 @@ class Session {
   double scan_pose_min_gap_mm_ = 0;
   std::shared_ptr<const PoseResult> scan_result_;  ///< the scan pose's scans, kept when only_poses is set
   std::vector<std::string> warnings_;
+  MeshHygiene femur_hygiene_, pelvis_hygiene_;
 };
 
 }  // namespace impinge
