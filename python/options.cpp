@@ -8,6 +8,8 @@
 
 #include "bindings.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/session/plan_run.hpp"
+#include "impinge/session/session.hpp"
 
 namespace impinge::python {
 
@@ -46,6 +48,16 @@ const char* use_name(unsigned bit) {
     case use_view: return "view";
     default: return "?";
   }
+}
+
+// The OptionUse bit named `name` (as impinge.options() names the uses).
+unsigned use_bit(const std::string& name) {
+  std::string names;
+  for (unsigned bit = 1; bit <= use_last; bit <<= 1) {
+    if (name == use_name(bit)) return bit;
+    names += (names.empty() ? "" : ", ") + std::string(use_name(bit));
+  }
+  throw Error("check_options: use '" + name + "' is not one of " + names);
 }
 
 }  // namespace
@@ -250,6 +262,27 @@ void bind_options(py::module_& m) {
       "help says), thesis_default (the thesis preset's), help, uses (distance, motion, rom, generate: CLI "
       "commands; joint: Joint(...); rom_limits, rom_map: those methods and the study kinds rom and envelope; "
       "study: a study file's [joint] and [[task]]; generated_hip: that function).");
+  m.def(
+      "check_options",
+      [](const std::string& use, const py::kwargs& given) {
+        const unsigned bit = use_bit(use);
+        RunOptions run = RunOptions::clinical();
+        set_options(run, given, bit, use);
+        if (bit == use_joint_plan || bit == use_plan) check_plan_request(run.session, run.plan);
+        if (bit == use_joint || bit == use_study) resolved_hip_options(run.session);  // the maps' scheme, the joint's
+        py::dict d;
+        for (const OptionRow& r : option_table())
+          if (r.uses & bit) d[py::str(r.key)] = to_python(r, r.get(run));
+        return d;
+      },
+      py::arg("use"),
+      "Check keywords as the call of `use` checks them (a use of impinge.options(): joint, rom_limits, rom_map, "
+      "joint_plan, study, generated_hip, ...), building nothing: each value through its option-table row (type, "
+      "range, choice); for joint and study the settings together as a Joint resolves them (the maps' scheme at "
+      "its resolution, the joint's options), without the meshes; for joint_plan the plan's own checks (the "
+      "targets' text, the target motion file, a target at all) -> dict key -> value of every row of that use, as the call would take it (the clinical "
+      "preset's default where not given). Raises impinge.Error naming the key, the value and what is valid. "
+      "impinge.study checks every study key through it before any task runs (impinge).");
 }
 
 }  // namespace impinge::python

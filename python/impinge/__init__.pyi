@@ -58,6 +58,12 @@ def options() -> List[Dict[str, Any]]:
     study files'), type, unit, choices, min, max (the field's declared range), min_exclusive, required, default
     (the clinical preset's), thesis_default, help and uses (CLI commands, joint, rom_limits, rom_map, study)."""
 
+def check_options(use: str, **options: Any) -> Dict[str, Any]:
+    """Check keywords as the call of `use` (a use of options(): joint, rom_limits, rom_map, joint_plan, study, ...)
+    checks them, building nothing (for joint and study: the maps' scheme at its resolution too; for joint_plan: the
+    targets, the target motion, a target at all) -> every row of that use as the call would take it. Raises
+    impinge.Error naming the key, the value and what is valid."""
+
 def femoral_head_centre(ball: Optional[Union[str, os.PathLike, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
                         socket: Optional[Union[str, os.PathLike, Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
                         **options: Any) -> Dict[str, Any]:

@@ -180,20 +180,24 @@ def test_four_shards_merged_equal_one_run(serial, tmp_path):
 
 
 def test_a_task_that_raises_is_recorded_and_the_others_finish(tmp_path):
+    """A setting the table accepts but the hip cannot serve (anatomical neutral needs a whole pelvis; a generated
+    hip has only its cup) fails its task when it runs; a bad value fails the whole study before any task runs
+    (tests/bad_inputs/test_studies.py)."""
     path = write_study(str(tmp_path), """
 subjects = [{name = "g", generated = {triangles = 3000}}]
 [joint]
 resolution = 2.0
 [[task]]
 kind = "rom"
-joint_centre = ["femoral-head", "no-such-method"]
+neutral = ["scan", "anatomical"]
 """)
     r = subprocess.run([PY, "-m", "impinge.study", "run", path, "--out", str(tmp_path / "o"), "--workers", "0",
                         "--no-progress"], env=ENV, capture_output=True, text=True)
     assert r.returncode == 1, r.stderr  # the study finished, with an error to report
     rows = read(str(tmp_path / "o"))
     assert [x["status"] for x in rows] == ["ok", "error"]
-    assert "joint_centre: 'no-such-method' is not one of" in rows[1]["error"] and rows[1]["limit_flexion_deg"] == ""
+    assert "anatomical neutral needs a whole femur and pelvis" in rows[1]["error"]
+    assert rows[1]["limit_flexion_deg"] == ""
     assert float(rows[0]["limit_flexion_deg"]) > 0
 
 

@@ -184,10 +184,6 @@ std::vector<ResectionTarget> plan_targets(const Session& s, const PlanRequest& r
   return out;
 }
 
-namespace {
-
-/// Checks what can be checked before anything is built (a bad one is an error in milliseconds): the safety depth's
-/// fraction and cap (mm), the targets' text, the motion file, and that there is a target at all.
 void check_plan_request(const SessionOptions& options, const PlanRequest& request) {
   check_in_range("max-depth-fraction", request.max_depth_fraction, PlanRequest::kMaxDepthFractionRange);
   check_in_range("max-depth", request.max_depth_mm, PlanRequest::kMaxDepthRange, "mm");
@@ -196,6 +192,8 @@ void check_plan_request(const SessionOptions& options, const PlanRequest& reques
   require(!request.target.empty() || !request.target_motion.empty(),
           "plan: no target: give --target (MOTION=DEG,... or normal) or --target-motion");
 }
+
+namespace {
 
 /// `rom` asking for the ROM limits alone (no map, no envelope): the searches before and on the resected bones.
 RomRequest limits_only_request(const RomRequest& rom) {

@@ -2,6 +2,8 @@
 import argparse
 import sys
 
+import impinge
+
 from . import runner, spec
 
 
@@ -50,8 +52,12 @@ def main(argv=None):
         for task in spec.expand(spec.load_study(a.study, dict(spec.parse_override(x) for x in a.set))):
             print(task["id"], task["kind"], task["label"], task["subject_name"], task["sample"], task["group"])
         return 0
-    except spec.StudyError as e:
+    except (spec.StudyError, impinge.Error) as e:  # a user's error: one line, no traceback
         print(f"impinge.study: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:  # the file system refused (a read-only or full disk, a file where a folder should be)
+        where = f"{e.filename}: " if e.filename is not None else ""
+        print(f"impinge.study: {where}{e.strerror or e}", file=sys.stderr)
         return 2
 
 

@@ -9,7 +9,6 @@ import csv
 import json
 import os
 import shutil
-import socket
 import sys
 import time
 
@@ -18,6 +17,7 @@ import numpy as np
 import impinge
 
 from . import spec, tasks as task_mod
+from .lock import OutLock
 
 RESULTS_CSV = "results.csv"  # what a run writes in its folder
 SUMMARY_CSV = "summary.csv"
@@ -145,72 +145,47 @@ def run(study_path, out, workers=None, scheduler=None, shard=None, retry_errors=
     once the workers run (tests kill a worker through it). overrides: {dotted key: value} over the file's keys.
     Writes out/study.toml, out/study.json (the expanded tasks), out/tasks/<id>/, and, for a whole study,
     out/results.csv, out/summary.csv and out/figures/. -> dict(tasks, ran, skipped, errors, wall_s, setup_s,
-    task_s (the tasks' own time, summed), workers)."""
+    task_s (the tasks' own time, summed), workers). Raises StudyError (one line) before any task runs on a bad
+    study (every key, value and file checked: spec.load_study), an `out` that cannot be created or written, a
+    folder another runner holds (lock.py), or a scheduler file whose folder does not exist."""
     log = log or (lambda line: print(line, file=sys.stderr))
+    if scheduler and "://" not in scheduler:
+        check_scheduler_file(scheduler)
     study = spec.load_study(study_path, overrides)
     task_list = spec.expand(study)
+    out = os.fspath(out)
     tasks_dir = os.path.join(out, "tasks")
-    os.makedirs(tasks_dir, exist_ok=True)
-    with _OutLock(out, shard):
+    make_folder(out, "the study folder")
+    with OutLock(out, shard):
+        make_folder(tasks_dir, "the study's task folder")
         return _run_locked(study, task_list, out, tasks_dir, workers, scheduler, shard, retry_errors, progress, log,
                            on_start, overrides)
 
 
-class _OutLock:
-    """OUT/.lock (a whole run) or OUT/.lock-I-of-N (shard I of N), holding the runner's host and pid while it
-    writes into OUT: a second runner whose tasks overlap (a whole run and anything, or the same shard twice)
-    refuses with the first one's host and pid (it would delete the first's half-written task folders). Shards of
-    one study share the folder (their tasks are disjoint). A lock whose process is gone (same host) is taken
-    over."""
+def make_folder(folder, what):
+    """Create `folder` (and its parents) unless it is there -> None; StudyError of one line when it cannot be (a
+    file in its place, a read-only parent)."""
+    if os.path.isdir(folder):
+        return
+    if os.path.lexists(folder):
+        raise spec.StudyError(f"{folder}: not a folder ({what} must be one: give --out a new folder or one a study "
+                              "wrote)")
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as e:
+        raise spec.StudyError(f"{folder}: cannot create {what} ({e.strerror})") from None
 
-    def __init__(self, out, shard=None):
-        self.out = out
-        self.path = os.path.join(out, ".lock" if not shard else f".lock-{shard[0]}-of-{shard[1]}")
-        self.shard = shard
 
-    @staticmethod
-    def _holder(path):
-        """(host, pid) of a live lock at path; None when there is none or its process is gone (it is removed)."""
-        try:
-            with open(path) as f:
-                host, pid = f.read().split()
-        except (OSError, ValueError):
-            return None
-        if host == socket.gethostname():
-            try:
-                os.kill(int(pid), 0)
-            except (ProcessLookupError, ValueError):
-                try:
-                    os.unlink(path)  # its runner died: the folder is free
-                except OSError:
-                    pass
-                return None
-            except PermissionError:
-                pass
-        return host, pid
-
-    def __enter__(self):
-        others = [os.path.join(self.out, n) for n in os.listdir(self.out) if n.startswith(".lock")] \
-            if not self.shard else [os.path.join(self.out, ".lock"), self.path]
-        for other in others:
-            held = self._holder(other)
-            if held:
-                raise spec.StudyError(f"{self.out}: another runner ({held[0]}, pid {held[1]}) is writing here; wait "
-                                      f"for it, or remove {other} if it is gone")
-        try:
-            fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
-        except FileExistsError:
-            raise spec.StudyError(f"{self.out}: another runner took {self.path} just now") from None
-        with os.fdopen(fd, "w") as f:
-            f.write(f"{socket.gethostname()} {os.getpid()}\n")
-        return self
-
-    def __exit__(self, *exc):
-        try:
-            os.unlink(self.path)
-        except OSError:
-            pass
-        return False
+def check_scheduler_file(path):
+    """A scheduler file's folder must be there (the scheduler writes the file into it, maybe later): else a
+    StudyError at once, naming the path, instead of waiting for a file that cannot come."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if os.path.isdir(path):
+        raise spec.StudyError(f"--scheduler {path}: a folder, not a scheduler file (tcp://HOST:PORT, or the file "
+                              "`dask scheduler --scheduler-file FILE` writes)")
+    if not os.path.isdir(folder):
+        raise spec.StudyError(f"--scheduler {path}: no such folder {folder} (the scheduler file's folder must exist: "
+                              "`dask scheduler --scheduler-file FILE` writes the file into it)")
 
 
 def _run_locked(study, task_list, out, tasks_dir, workers, scheduler, shard, retry_errors, progress, log, on_start,
@@ -280,6 +255,8 @@ def _run_locked(study, task_list, out, tasks_dir, workers, scheduler, shard, ret
     missing = [t for t, r in zip(mine, records) if r is None]
     if missing:
         raise spec.StudyError(f"{out}: {len(missing)} tasks did not finish (first: {missing[0]['id']})")
+    for t, r in zip(mine, records):  # as this study names them (a motion's name depends on the study's others)
+        r["parameters"] = task_mod.task_record(t)
     if shard:
         write_results(records, os.path.join(out, "shards", f"results-{shard[0]}-of-{shard[1]}.csv"))
     else:
@@ -416,7 +393,8 @@ def merge(out, shard_dirs, log=None):
         if [t["id"] for t in p["tasks"]] != ids:
             raise spec.StudyError(f"{d}: its study.json lists other tasks than {shard_dirs[0]}'s (another study?)")
     tasks_dir = os.path.join(out, "tasks")
-    os.makedirs(tasks_dir, exist_ok=True)
+    make_folder(out, "the merged study's folder")
+    make_folder(tasks_dir, "the study's task folder")
     records = []
     for t in plans[0]["tasks"]:
         found = None
@@ -429,6 +407,7 @@ def merge(out, shard_dirs, log=None):
             raise spec.StudyError(f"merge: task {t['id']} ({t['kind']} on {t['subject_name']}, sample {t['sample']}) "
                                   f"is in none of {', '.join(shard_dirs)}: run its shard")
         d, r = found
+        r["parameters"] = task_mod.task_record(t)
         src = os.path.join(d, "tasks", t["id"])
         dst = os.path.join(tasks_dir, t["id"])
         if os.path.realpath(src) != os.path.realpath(dst) and not os.path.exists(dst):

@@ -3,8 +3,10 @@
 A study names subjects, tasks with the parameters they sweep, and perturbations of the centre of rotation
 (COR). Expanded, it is a list of Task records, each one independent computation on one hip with one set of
 settings; a task's id is a hash of its inputs' contents, its parameters and impinge's version, so a study
-run again on the same folder finds the tasks it has already done. The file's keys are documented in
-docs/studies.md; every bad key gets a StudyError of one line naming the file and the key."""
+run again on the same folder finds the tasks it has already done. Every path the study names (subjects, motion
+files, a plan's target_motion) is relative to the study file's folder, wherever the study runs from. The file's
+keys are documented in docs/studies.md; every bad key or value (checks.py: all of them, before any task runs) gets
+a StudyError of one line naming the file and the key."""
 import glob
 import hashlib
 import json
@@ -17,6 +19,8 @@ import zlib
 import numpy as np
 
 import impinge
+
+from . import checks
 
 KINDS = ("rom", "envelope", "motion", "distance", "morphology", "plan")
 
@@ -45,6 +49,12 @@ KIND_KEYS = {
 }
 KIND_TYPES = dict({o["key"]: _PY_TYPES[o["type"]] for o in _table("rom_limits") + _table("rom_map") + _table("joint_plan")},
                   motion=str, poses=list)
+# The Python call whose options a kind's keys are (impinge.check_options checks them as that call does).
+KIND_USES = {"rom": "rom_limits", "envelope": "rom_map", "plan": "joint_plan"}
+# Keys whose value is a file (the table's path rows a study may set, e.g. a plan's target_motion): read relative to
+# the study file's folder, like subjects and motions, and hashed into the ids of the tasks that read them.
+PATH_KEYS = {o["key"] for o in _table("rom_limits") + _table("rom_map") + _table("joint_plan") + _table("study")
+             if o["type"] == "path"}
 # Keys whose value is itself a list: a list of such lists sweeps them (not a plain list).
 LIST_VALUED = {o["key"] for o in impinge.options() if o["type"] in ("numbers", "region", "point")}
 # Former keys still accepted for one release (a warning names the key that replaces each).
@@ -258,52 +268,81 @@ def load_study(path, overrides=None):
     tasks = doc.get("task")
     if not isinstance(tasks, list) or not tasks or not all(isinstance(t, dict) for t in tasks):
         _fail(path, "task", "missing: give one [[task]] table per task, with kind = rom, envelope, motion or distance")
-    study["tasks"] = []
     base = os.path.dirname(os.path.abspath(path))
-    for i, t in enumerate(tasks):
-        key = f"task[{i}]"
-        kind = t.get("kind")
-        if kind not in KINDS:
-            _fail(path, f"{key}.kind", f"expected one of {', '.join(KINDS)}, got {kind!r}")
-        entry = {"kind": kind, "label": _typed(path, f"{key}.label", t.get("label", kind), str), "joint": {},
-                 "options": {}}
-        for k, v in t.items():
-            if k in ("kind", "label"):
-                continue
-            k = _current(path, key, t, k)
-            if k in JOINT_KEYS:
-                entry["joint"][k] = _values(path, f"{key}.{k}", v, JOINT_KEYS[k])
-            elif k == "poses":
-                entry["options"][k] = v  # a list of poses, not a sweep: checked below
-            elif k in KIND_KEYS[kind]:
-                entry["options"][k] = _values(path, f"{key}.{k}", v, KIND_TYPES[k])
-            else:
-                _fail(path, f"{key}.{k}", f"unknown option of a {kind} task (known: "
-                      f"{', '.join(sorted(set(KIND_KEYS[kind]) | set(JOINT_KEYS) | {'label'}))})")
-        if kind == "motion":
-            if "motion" not in entry["options"]:
-                _fail(path, f"{key}.motion", "missing: a motion file (CSV or OpenSim .mot/.sto) or a list of them")
-            files = []
-            for m in entry["options"]["motion"]:
-                f = os.path.normpath(os.path.join(base, os.path.expanduser(os.path.expandvars(m))))
-                if not os.path.isfile(f):
-                    _fail(path, f"{key}.motion", f"'{m}': no such file")
-                files.append(f)
-            entry["options"]["motion"] = files
-        if kind == "distance":
-            if "poses" not in entry["options"]:
-                _fail(path, f"{key}.poses", "missing: [[flexion, adduction, internal_rotation], ...] degrees")
-            poses = entry["options"]["poses"]
-            if not isinstance(poses, list) or not poses:
-                _fail(path, f"{key}.poses", "expected [[flexion, adduction, internal_rotation], ...] degrees")
-            checked = []
-            for p, pose in enumerate(poses):
-                if not isinstance(pose, list) or len(pose) != 3:
-                    _fail(path, f"{key}.poses[{p}]", "expected [flexion, adduction, internal_rotation] degrees")
-                checked.append([_typed(path, f"{key}.poses[{p}][{c}]", x, float) for c, x in enumerate(pose)])
-            entry["options"]["poses"] = checked
-        study["tasks"].append(entry)
+    study["tasks"] = [_task_entry(path, base, i, t) for i, t in enumerate(tasks)]
+    checks.check_settings(path, study)
+    checks.check_files(path, study)
     return study
+
+
+def _resolve(base, given):
+    """A path as the study file gives it, made absolute: relative to the study file's folder `base` (~ and $VARS
+    expanded; an absolute path stays as it is)."""
+    return os.path.normpath(os.path.join(base, os.path.expanduser(os.path.expandvars(given))))
+
+
+def _file_value(path, base, key, given):
+    """A path option's value (e.g. target_motion): {"file": the absolute path, "given": the text as given}."""
+    f = _resolve(base, given)
+    if not os.path.isfile(f):
+        _fail(path, key, f"'{given}': no such file ({f}; paths are relative to the study file's folder)")
+    return {"file": f, "given": given}
+
+
+def _is_file_value(v):
+    return isinstance(v, dict) and set(v) == {"file", "given"}
+
+
+def _task_entry(path, base, i, t):
+    """[[task]] table i, checked: dict(kind, label, joint {key: [values]}, options {key: [values]}); motion files
+    and path options resolved against the study file's folder `base`."""
+    key = f"task[{i}]"
+    kind = t.get("kind")
+    if kind not in KINDS:
+        _fail(path, f"{key}.kind", f"expected one of {', '.join(KINDS)}, got {kind!r}")
+    entry = {"kind": kind, "label": _typed(path, f"{key}.label", t.get("label", kind), str), "joint": {},
+             "options": {}}
+    for k, v in t.items():
+        if k in ("kind", "label"):
+            continue
+        k = _current(path, key, t, k)
+        if k in JOINT_KEYS:
+            entry["joint"][k] = _values(path, f"{key}.{k}", v, JOINT_KEYS[k])
+        elif k == "poses":
+            entry["options"][k] = v  # a list of poses, not a sweep: checked below
+        elif k in KIND_KEYS[kind]:
+            values = _values(path, f"{key}.{k}", v, KIND_TYPES[k])
+            if k in PATH_KEYS:
+                values = [_file_value(path, base, f"{key}.{k}" + (f"[{j}]" if len(values) > 1 else ""), x)
+                          for j, x in enumerate(values)]
+            entry["options"][k] = values
+        else:
+            _fail(path, f"{key}.{k}", f"unknown option of a {kind} task (known: "
+                  f"{', '.join(sorted(set(KIND_KEYS[kind]) | set(JOINT_KEYS) | {'label'}))})")
+    if kind == "motion":
+        if "motion" not in entry["options"]:
+            _fail(path, f"{key}.motion", "missing: a motion file (CSV or OpenSim .mot/.sto) or a list of them")
+        files = []
+        for m in entry["options"]["motion"]:
+            f = _resolve(base, m)
+            if not os.path.isfile(f):
+                _fail(path, f"{key}.motion", f"'{m}': no such file ({f}; paths are relative to the study file's "
+                      "folder)")
+            files.append(f)
+        entry["options"]["motion"] = files
+    if kind == "distance":
+        if "poses" not in entry["options"]:
+            _fail(path, f"{key}.poses", "missing: [[flexion, adduction, internal_rotation], ...] degrees")
+        poses = entry["options"]["poses"]
+        if not isinstance(poses, list) or not poses:
+            _fail(path, f"{key}.poses", "expected [[flexion, adduction, internal_rotation], ...] degrees")
+        checked = []
+        for p, pose in enumerate(poses):
+            if not isinstance(pose, list) or len(pose) != 3:
+                _fail(path, f"{key}.poses[{p}]", "expected [flexion, adduction, internal_rotation] degrees")
+            checked.append([_typed(path, f"{key}.poses[{p}][{c}]", x, float) for c, x in enumerate(pose)])
+        entry["options"]["poses"] = checked
+    return entry
 
 
 _digests = {}
@@ -352,14 +391,42 @@ def _product(choices):
     return combos
 
 
+def short_names(files):
+    """{file: name}: each file named by its last path parts, as few as keep different files apart (its basename
+    when no other file has it), so that outputs named after files never pool two of them."""
+    files = sorted(set(files))
+    parts = {f: f.split(os.sep) for f in files}
+    names = {}
+    for f in files:
+        n = 1
+        while n < len(parts[f]) and any(g != f and parts[g][-n:] == parts[f][-n:] for g in files):
+            n += 1
+        names[f] = "/".join(parts[f][-n:])
+    return names
+
+
+def _task_options(options):
+    """A task's options three ways: as its method takes them (a path option: the absolute path), as its id hashes
+    them (a path option: the text given and the file's sha256, so that editing the file changes the id) and the
+    text given for each path option (results.csv's, plan.json's target name)."""
+    run = {k: v["file"] if _is_file_value(v) else v for k, v in options.items()}
+    ident = {k: {"given": v["given"], "sha256": file_digest(v["file"])} if _is_file_value(v) else v
+             for k, v in options.items()}
+    return run, ident, {k: v["given"] for k, v in options.items() if _is_file_value(v)}
+
+
 def expand(study):
     """The study's tasks, in a fixed order (subject, task table, swept values, motion or pose, sample):
     a list of dicts with id, kind, label, subject (the entry), subject_name, side, sample, cor_offset_mm,
-    joint (Joint keywords), options (the kind's method's keywords), item (motion file or pose) and group
-    (the tasks that share one Joint: same subject, settings and COR)."""
+    joint (Joint keywords), options (the kind's method's keywords; a file's absolute path), given (the text a
+    path option was given as), item (motion file or pose), item_name (a motion file's name in the results:
+    short_names') and group (the tasks that share one Joint: same subject, settings and COR). A task's id hashes
+    the contents of every file it reads (subject.json, both meshes, the motion file, a target motion), its
+    settings and impinge's version."""
     version = impinge.__version__
     samples = study["perturb"]["samples"]
     sd = study["perturb"]["cor_sd_mm"]
+    item_names = short_names([m for t in study["tasks"] for m in t["options"].get("motion", [])])
     tasks = []
     for subject in study["subjects"]:
         sdigest = subject_digest(subject)
@@ -370,14 +437,14 @@ def expand(study):
             item_digests = {m: file_digest(m) for m in t["options"].get("motion", [])}
             for joint in _product(joint_choices):
                 for options in _product(option_choices):
-                    options = dict({k: v for k, v in KIND_KEYS[t["kind"]].items()
-                                    if k not in ("motion", "poses")}, **options)
+                    options, ident, given = _task_options(dict({k: v for k, v in KIND_KEYS[t["kind"]].items()
+                                                                if k not in ("motion", "poses")}, **options))
                     for item in items:
                         for sample in range(samples + 1):
                             offset = cor_offset(study["seed"], subject["name"], sample, sd)
                             group_key = json.dumps([sdigest, joint, offset], sort_keys=True)
                             identity = json.dumps({"subject": sdigest, "kind": t["kind"], "joint": joint,
-                                                   "options": options, "cor_offset_mm": offset,
+                                                   "options": ident, "cor_offset_mm": offset,
                                                    "item": item_digests[item] if isinstance(item, str) else item,
                                                    "version": version},
                                                   sort_keys=True)
@@ -385,13 +452,24 @@ def expand(study):
                                 "id": hashlib.sha256(identity.encode()).hexdigest()[:20], "kind": t["kind"],
                                 "label": t["label"], "subject": subject, "subject_name": subject["name"],
                                 "side": subject.get("side", "right"), "sample": sample, "cor_offset_mm": offset,
-                                "joint": joint, "options": options, "item": item,
+                                "joint": joint, "options": options, "given": given, "item": item,
+                                "item_name": item_names.get(item) if isinstance(item, str) else None,
                                 "group": hashlib.sha256(group_key.encode()).hexdigest()[:16],
                                 "threads": study["threads"]})
-    ids = [t["id"] for t in tasks]
-    if len(set(ids)) != len(ids):
-        dup = next(i for i in ids if ids.count(i) > 1)
-        t = next(t for t in tasks if t["id"] == dup)
+    _refuse_duplicates(study, tasks)
+    return tasks
+
+
+def _refuse_duplicates(study, tasks):
+    """Two tasks with one id are one computation listed twice: a StudyError naming them."""
+    first = {}
+    for t in tasks:
+        if t["id"] not in first:
+            first[t["id"]] = t
+            continue
+        a = first[t["id"]]
+        if t["kind"] == "motion" and a["item"] != t["item"]:
+            raise StudyError(f"{study['path']}: task: motion files '{a['item']}' and '{t['item']}' have the same "
+                             "contents (one motion listed twice); give it once")
         raise StudyError(f"{study['path']}: task: two tasks are the same computation ({t['kind']} on "
                          f"{t['subject_name']}, sample {t['sample']}); give each [[task]] different settings")
-    return tasks

@@ -194,6 +194,9 @@ def _run_plan(joint, task, folder):
     o = dict(task["options"])
     o["allow_partial"] = True  # a missed target is a result of the study, recorded in plan.json and its figures
     d = joint.plan(**o)
+    for t in d["targets"]:  # a target motion named as the study file gives it, not by its absolute path
+        if o.get("target_motion") and t["target"] == o["target_motion"]:
+            t["target"] = task.get("given", {}).get("target_motion", t["target"])
     meshes = {k: d.pop(k) for k in list(d) if k.endswith("_resected") or k.endswith("_resection_mm")}
     with open(os.path.join(folder, "plan.json"), "w") as f:
         json.dump(d, f, indent=1)
@@ -225,10 +228,11 @@ def task_record(task):
            "cor_offset_mm": float(np.linalg.norm(task["cor_offset_mm"]))}
     for k, v in sorted(task["joint"].items()):
         rec[k] = json.dumps(v) if isinstance(v, list) else v
+    given = task.get("given", {})  # a path option as the study file gives it
     for k, v in sorted(task["options"].items()):
-        rec[k] = json.dumps(v) if isinstance(v, list) else v
-    if task["kind"] == "motion":
-        rec["motion"] = os.path.basename(task["item"])
+        rec[k] = given[k] if k in given else json.dumps(v) if isinstance(v, list) else v
+    if task["kind"] == "motion":  # its name in the study: as much of its path as keeps it apart from the others
+        rec["motion"] = task.get("item_name") or os.path.basename(task["item"])
     if task["kind"] == "distance":
         rec["flexion_deg"], rec["adduction_deg"], rec["internal_rotation_deg"] = task["item"]
     return rec

@@ -77,6 +77,12 @@ struct PlanRun {
 /// or file.
 std::vector<ResectionTarget> plan_targets(const Session& session, const PlanRequest& request, const RomRun& before);
 
+/// Checks what can be checked before anything is built (a bad one is an error in milliseconds): the safety depth's
+/// fraction and cap (mm), the targets' text, the motion file (read for `options`' side), and that there is a target
+/// at all. Throws impinge::Error naming the option, target or file. run_plan calls it first; so does Python's
+/// impinge.check_options("joint_plan", ...) (a study's plan tasks, before any task runs).
+void check_plan_request(const SessionOptions& options, const PlanRequest& request);
+
 /// Plan and check: the session (rom_session_options of `rom.search`, distances on with a reach of at least the
 /// clearance + 1 mm), the ROM limits before, the plan (plan_resection), the resected meshes, and the ROM limits
 /// of a new session on them (the check: the same options, as `impinge rom` on the written meshes), the
