@@ -23,6 +23,9 @@ using detail::kNearbySlackMm;
 
 namespace {
 
+// A winding number within this of 1/2 cannot tell inside from outside (signed_distance.hpp, rule 3).
+constexpr double kUndecidedBand = 0.25;
+
 #ifdef IMPINGE_HAVE_EMBREE
 using detail::kGroup;
 
@@ -328,11 +331,20 @@ bool SignedDistanceQuery::signed_distance(const Eigen::Vector3d& q, double radiu
   const double along = w.dot(n), scale = w.norm() * n.norm();
   int sign = along >= 0 ? 1 : -1;
   if (s.best > 1e-6 && !(std::abs(along) >= 1e-3 * scale)) trusted = false;  // q in the tangent plane
+  const bool local = trusted;  // the pseudo-normal is sound here (a regular feature, q off its tangent plane)
   if (hint != 0 && s.best > 1e-6 && hint != sign) trusted = false;
   out.rule = SignRule::pseudo_normal;
   if (!trusted && s.best > 1e-6) {
-    sign = inside_by_winding_number(q) ? -1 : 1;
-    out.rule = SignRule::winding_number;
+    // The winding number where the pseudo-normal cannot be trusted; where it cannot tell either (the file
+    // comment, rule 3), the pseudo-normal if it is sound, else undecided.
+    const double wn = winding_number_decided(q);
+    if (std::abs(wn - 0.5) >= kUndecidedBand) {
+      sign = wn >= 0.5 ? -1 : 1;
+      out.rule = SignRule::winding_number;
+    } else if (!local) {
+      sign = 1;
+      out.rule = SignRule::undecided;
+    }
   }
   out.distance_mm = s.best;
   out.sign = sign;

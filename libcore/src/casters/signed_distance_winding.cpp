@@ -128,6 +128,12 @@ double SignedDistanceQuery::winding_number_fast(const Eigen::Vector3d& q) const 
   return m.orientation * sum / (2 * M_PI);
 }
 
+double SignedDistanceQuery::winding_number_decided(const Eigen::Vector3d& q) const {
+  if (const SignedDistanceQuery* whole = impl_->whole_query()) return whole->winding_number_decided(q);  // cropped
+  const double fast = winding_number_fast(q);
+  return std::abs(fast - 0.5) > kFastMargin ? fast : winding_number(q);
+}
+
 bool SignedDistanceQuery::inside_by_winding_number(const Eigen::Vector3d& q) const {
   if (const SignedDistanceQuery* whole = impl_->whole_query()) return whole->inside_by_winding_number(q);  // cropped
   const double fast = winding_number_fast(q);

@@ -293,6 +293,7 @@ void summarize_scan(const ScanGaps& g, const Eigen::VectorXd& area, const Imping
   s.vertices_distance = s.vertices_inside = 0;
   s.area_inside_mm2 = 0;
   s.distance_winding = g.distance_winding;
+  s.distance_undecided = g.distance_undecided;
   double min_gap = std::numeric_limits<double>::infinity();
   double min_distance = std::numeric_limits<double>::infinity();
   // One pass over the vertices (each sum still adds its terms in vertex order).

@@ -330,13 +330,16 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
     detection_ms = ms_since(t0);
     if (options_.distances) {
       t0 = std::chrono::steady_clock::now();
-      out.distance_winding = scan_distances(own.distance_set, Rq, tq, cor_, *other.distance_query, options_.reach_mm(),
-                                            out.gap_mm, out.distance_mm, mem)
-                                 .winding;
+      const DistanceScanStats ds = scan_distances(own.distance_set, Rq, tq, cor_, *other.distance_query,
+                                                  options_.reach_mm(), out.gap_mm, out.distance_mm, mem,
+                                                  &out.distance_sign_undecided);
+      out.distance_winding = ds.winding;
+      out.distance_undecided = ds.undecided;
       distance_ms = ms_since(t0);
     } else {
       out.distance_mm.clear();
-      out.distance_winding = 0;
+      out.distance_sign_undecided.clear();
+      out.distance_winding = out.distance_undecided = 0;
     }
     // On the body's own thread too: a pass over all its vertices (some 0.07 ms per body on lhdl-ct).
     summarize_scan(out, own.vertex_area, options_.levels, summary, options_.level_quantity());

@@ -139,6 +139,7 @@ struct DistanceScan {
   DistanceScanMemory* memory;
   DistanceScanStats& st;
   ClosestSurfacePoint& cp;
+  std::vector<std::uint8_t>* undecided;  // per vertex, or null
 };
 
 // The most negative radial gap (mm) of the set's vertices [b, e) below -reach, or 0 when none is (or no gaps).
@@ -258,6 +259,10 @@ void measure_cluster(DistanceScan& s, std::size_t b, std::size_t e, bool learn_v
     s.distance_mm[i] = static_cast<float>(s.cp.signed_mm());
     ++s.st.measured;
     s.st.winding += s.cp.rule == SignRule::winding_number;
+    if (s.cp.rule == SignRule::undecided) {
+      ++s.st.undecided;
+      if (s.undecided != nullptr) (*s.undecided)[i] = 1;
+    }
   }
 }
 }  // namespace
@@ -265,7 +270,7 @@ void measure_cluster(DistanceScan& s, std::size_t b, std::size_t e, bool learn_v
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
-                                 DistanceScanMemory* memory) {
+                                 DistanceScanMemory* memory, std::vector<std::uint8_t>* sign_undecided) {
   require(reach_mm > 0 && std::isfinite(reach_mm), "distance scan: the reach must be > 0 mm and finite");
   require(
       gap_mm.empty() || static_cast<std::int64_t>(gap_mm.size()) == set.vertices,
@@ -276,7 +281,8 @@ DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix
   if (memory != nullptr) fit_memory(*memory, other.id(), k_all, c_all);
   const Eigen::Vector3d shift = cor + t;
   ClosestSurfacePoint cp;
-  DistanceScan s{set, R, shift, other, reach_mm, gap_mm, distance_mm, memory, st, cp};
+  if (sign_undecided != nullptr) sign_undecided->assign(static_cast<std::size_t>(set.vertices), 0);
+  DistanceScan s{set, R, shift, other, reach_mm, gap_mm, distance_mm, memory, st, cp, sign_undecided};
   for (std::int64_t c = 0; c < set.clusters(); ++c) {
     const auto cs = static_cast<std::size_t>(c);
     const auto b = static_cast<std::size_t>(set.cluster_begin[cs]);

@@ -218,26 +218,31 @@ void write_faces(BodyWriter& out, const Faces& F) {
 void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const Eigen::VectorXf& gap_mm,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 1>& level,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor>& rgb,
-                   const Eigen::VectorXf* distance_mm) {
+                   const Eigen::VectorXf* distance_mm, const std::vector<std::uint8_t>* sign_undecided) {
+  if (distance_mm == nullptr) sign_undecided = nullptr;
   require(gap_mm.size() == V.rows() && level.size() == V.rows() && rgb.rows() == V.rows() &&
-              (distance_mm == nullptr || distance_mm->size() == V.rows()),
+              (distance_mm == nullptr || distance_mm->size() == V.rows()) &&
+              (sign_undecided == nullptr || sign_undecided->size() == static_cast<std::size_t>(V.rows())),
           path + ": per-vertex arrays do not match the vertex count");
   std::ostringstream header;
   header << "ply\nformat binary_little_endian 1.0\ncomment impinge per-vertex gap (mm)\n"
          << "element vertex " << V.rows() << "\n"
          << "property float x\nproperty float y\nproperty float z\n"
          << "property float gap_mm\nproperty float quality\n"
-         << (distance_mm != nullptr ? "property float distance_mm\n" : "") << "property uchar level\n"
+         << (distance_mm != nullptr ? "property float distance_mm\n" : "")
+         << (sign_undecided != nullptr ? "property uchar sign_undecided\n" : "") << "property uchar level\n"
          << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
          << "element face " << F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
   std::string out = header.str();
-  BodyWriter body(out, static_cast<std::size_t>(V.rows()) * (distance_mm != nullptr ? 28 : 24) +
+  BodyWriter body(out, static_cast<std::size_t>(V.rows()) * (24 + (distance_mm != nullptr ? 4 : 0) +
+                                                            (sign_undecided != nullptr ? 1 : 0)) +
                            static_cast<std::size_t>(F.rows()) * kFaceBytes);
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     for (int k = 0; k < 3; ++k) body.put<float>(static_cast<float>(V(i, k)));
     body.put<float>(gap_mm[i]);
     body.put<float>(gap_mm[i]);
     if (distance_mm != nullptr) body.put<float>((*distance_mm)[i]);
+    if (sign_undecided != nullptr) body.put<std::uint8_t>((*sign_undecided)[static_cast<std::size_t>(i)]);
     body.put<std::uint8_t>(level[i]);
     for (int k = 0; k < 3; ++k) body.put<std::uint8_t>(rgb(i, k));
   }

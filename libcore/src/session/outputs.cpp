@@ -214,7 +214,8 @@ void write_body_ply(const std::string& path, const ImpingementLevels& levels, Le
     write_gap_ply(path, V, body.mesh.F, gap, level, rgb);
   } else {
     const Eigen::VectorXf distance = Eigen::Map<const Eigen::VectorXf>(gaps.distance_mm.data(), n);
-    write_gap_ply(path, V, body.mesh.F, gap, level, rgb, &distance);
+    write_gap_ply(path, V, body.mesh.F, gap, level, rgb, &distance,
+                  gaps.distance_sign_undecided.empty() ? nullptr : &gaps.distance_sign_undecided);
   }
 }
 }  // namespace
@@ -253,7 +254,12 @@ void write_pose_vtp(const std::string& path, const Session& s, const PoseResult&
   PointArray distance{"distance_mm", {}, {}};
   distance.f32 = res.ball_gaps.distance_mm;
   distance.f32.insert(distance.f32.end(), res.socket_gaps.distance_mm.begin(), res.socket_gaps.distance_mm.end());
-  write_vtp(path, V, F, {gap, distance, level, body});
+  PointArray undecided{"sign_undecided", {}, {}};  // 1 where the other mesh cannot decide the sign
+  undecided.u8 = res.ball_gaps.distance_sign_undecided;
+  undecided.u8.insert(undecided.u8.end(), res.socket_gaps.distance_sign_undecided.begin(),
+                      res.socket_gaps.distance_sign_undecided.end());
+  if (undecided.u8.size() != distance.f32.size()) undecided.u8.assign(distance.f32.size(), 0);
+  write_vtp(path, V, F, {gap, distance, undecided, level, body});
 }
 
 void write_map_pngs(const std::string& dir, const Session& s) {

@@ -101,6 +101,7 @@ nlohmann::json scan_record(const JointBody& body, const ScanSummary& s, double d
     j["vertices_inside"] = s.vertices_inside;
     j["area_inside_mm2"] = s.area_inside_mm2;
     j["distance_signs_by_winding_number"] = s.distance_winding;
+    j["distance_signs_undecided"] = s.distance_undecided;
   }
   j["vertices_penetrating"] = s.vertices_penetrating;
   j["area_penetrating_mm2"] = s.area_penetrating_mm2;

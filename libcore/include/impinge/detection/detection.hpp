@@ -41,6 +41,10 @@ struct ScanGaps {
   /// when distances are off.
   std::vector<float> distance_mm;
   std::int64_t distance_winding = 0;  ///< distances whose sign the winding number decided
+  /// n flags (empty when distances are off): 1 where the other mesh cannot decide the sign (a hole's rim:
+  /// signed_distance.hpp, rule 3; the distance is written >= 0), else 0.
+  std::vector<std::uint8_t> distance_sign_undecided;
+  std::int64_t distance_undecided = 0;  ///< how many are 1
 };
 
 /// Which per-vertex quantity the impingement levels classify: the thesis' radial gap, or the
@@ -114,6 +118,7 @@ struct ScanSummary {
   std::int64_t vertices_inside = 0;                              ///< of them, inside the other bone (< 0)
   double area_inside_mm2 = 0;                                    ///< their vertex area
   std::int64_t distance_winding = 0;                             ///< signs decided by the winding number
+  std::int64_t distance_undecided = 0;                           ///< signs the mesh cannot decide (read >= 0)
   LevelQuantity levels_on = LevelQuantity::radial_gap;           ///< what level_vertices classify
   std::vector<std::int64_t> level_vertices;                      ///< count per impingement level
   std::vector<double> level_area_mm2;                            ///< vertex area per impingement level

@@ -52,6 +52,7 @@ struct DistanceScanStats {
   std::int64_t measured = 0;        ///< vertices given a distance
   std::int64_t clusters_pruned = 0; ///< clusters proven beyond the reach
   std::int64_t winding = 0;         ///< signs decided by the winding number
+  std::int64_t undecided = 0;       ///< signs the mesh cannot decide (SignRule::undecided; read as outside)
   std::int64_t searches = 0;        ///< closest-point searches of single vertices
   std::int64_t vertices_recalled = 0;  ///< vertices proven beyond the reach by the memory's empty balls
   std::int64_t clusters_recalled = 0;  ///< clusters so proven (counted in clusters_pruned too)
@@ -86,6 +87,9 @@ struct DistanceScanMemory {
 /// `distance_mm` and `memory` have their sizes (but for `memory`'s nearby triangles, a slot of 224 bytes
 /// added at a vertex's first search: at most k of them).
 ///
+/// `sign_undecided` (optional): resized to n, 1 where the vertex's sign the mesh cannot decide
+/// (SignRule::undecided: its distance is written >= 0), else 0.
+///
 /// `memory` (optional): what earlier scans of the set against the same surface learnt (DistanceScanMemory),
 /// used and updated. None of these facts changes an answer, only what it costs:
 /// - Seeds: each vertex's closest triangle at an earlier pose is tried first in place of the previous
@@ -113,7 +117,8 @@ struct DistanceScanMemory {
 DistanceScanStats scan_distances(const DistanceScanSet& set, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
                                  const std::vector<float>& gap_mm, std::vector<float>& distance_mm,
-                                 DistanceScanMemory* memory = nullptr);
+                                 DistanceScanMemory* memory = nullptr,
+                                 std::vector<std::uint8_t>* sign_undecided = nullptr);
 
 /// The same vertices as `set`, reordered along a Z curve over their positions (the distance scan's
 /// order), so that consecutive vertices lie close in space: for the hidden vertices, whose directions

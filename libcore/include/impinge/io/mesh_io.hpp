@@ -34,12 +34,15 @@ TriangleMesh load_mesh(const std::string& path);
 /// untested), red green blue (uchar colour of the level); then the faces.
 /// `V` (n x 3, mm) replaces mesh.V so callers can write a posed copy; `gap_mm`, `level` and
 /// `rgb` (n x 3) give one entry per vertex. With `distance_mm` (n values, or null), a property
-/// distance_mm (float, the signed Euclidean distance; NaN beyond its reach) after quality.
+/// distance_mm (float, the signed Euclidean distance; NaN beyond its reach) after quality, and with
+/// `sign_undecided` too (n flags), a property sign_undecided (uchar, 1 where the other mesh cannot decide the
+/// distance's sign: signed_distance.hpp, rule 3) after it.
 /// Throws impinge::Error if the file cannot be written or the sizes disagree.
 void write_gap_ply(const std::string& path, PointsRef V, const Faces& F, const Eigen::VectorXf& gap_mm,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 1>& level,
                    const Eigen::Matrix<unsigned char, Eigen::Dynamic, 3, Eigen::RowMajor>& rgb,
-                   const Eigen::VectorXf* distance_mm = nullptr);
+                   const Eigen::VectorXf* distance_mm = nullptr,
+                   const std::vector<std::uint8_t>* sign_undecided = nullptr);
 
 /// Write a plain mesh (x y z float, faces) as binary little-endian PLY. Throws on I/O error.
 void write_ply(const std::string& path, const TriangleMesh& mesh);
