@@ -12,19 +12,6 @@
 
 namespace impinge {
 
-namespace {
-double median_radius(const Vertices& V, const Eigen::Vector3d& c) {
-  std::vector<double> d;
-  for (Eigen::Index i = 0; i < V.rows(); ++i) {
-    const double r = (V.row(i).transpose() - c).norm();
-    if (r < 35) d.push_back(r);
-  }
-  if (d.size() < 10) return std::nan("");  // no head around the COR
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
-  return d[d.size() / 2];
-}
-}  // namespace
-
 HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const SphereFitResult& head,
                    const Landmarks& given, const HipJointOptions& options)
     : side_(side), neutral_(options.neutral.value_or(Neutral::anatomical)), cor_(head.centre) {
@@ -67,7 +54,7 @@ SphereFitResult HipJoint::head_sphere(const TriangleMesh& femur, const SphereFit
   // COR was given (then the fitted head's, so that they do not move with it).
   SphereFitResult sphere = options.head_sphere.value_or(head);
   if (!options.head_sphere) sphere.centre = cor_;
-  head_radius_ = std::isfinite(sphere.radius) ? sphere.radius : median_radius(femur.V, sphere.centre);
+  head_radius_ = std::isfinite(sphere.radius) ? sphere.radius : head_radius_about(femur.V, sphere.centre);
   require(std::isfinite(head_radius_) || neutral_ == Neutral::scan,
           femur.source + ": fewer than 10 femur vertices within 35 mm of the centre of rotation: no femoral head "
                          "there for the acetabulum and clock faces");

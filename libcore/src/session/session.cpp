@@ -167,6 +167,7 @@ LoadedInput load_input(const SessionInput& input) {
     if (ball.empty() && !input.ball_mesh) ball = info.femur_path;
     if (socket.empty() && !input.socket_mesh) socket = info.pelvis_path;
     landmarks = info.landmarks;
+    if (!info.landmarks.empty() && input.landmarks.empty()) in.landmarks_file = input.subject;
     in.neutral = info.neutral;
     in.name = info.name;
   }
@@ -194,6 +195,19 @@ SphereFitResult located_head(const LoadedInput& in) {
   return in.pelvis.V.rows() > 0 ? locate_femoral_head(in.femur, in.pelvis) : locate_femoral_head(in.femur);
 }
 
+SphereFitResult check_cor_in_head(const std::string& what, const Eigen::Vector3d& cor, const LoadedInput& in) {
+  // A given COR must lie in the femoral head: compare with the head the bone itself shows.
+  const SphereFitResult head = located_head(in);
+  const Eigen::Matrix3d& M = in.to_working;
+  const double d = (cor - head.centre).norm();
+  require(d <= head.radius, [&] {
+    return what + " " + point_text(M.transpose() * cor) + " mm is " + num(d) + " mm from the fitted femoral head " +
+           "centre " + point_text(M.transpose() * head.centre) + " mm, farther than the head radius " +
+           num(head.radius) + " mm: the COR must lie in the head (input frame, mm); allow-any-cor accepts it";
+  });
+  return head;
+}
+
 CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) {
   const Eigen::Matrix3d& M = in.to_working;
   CorResult r;
@@ -215,22 +229,15 @@ CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) 
       return "cor " + point_text(*cor.given) + " mm lies " + num(outside) + " mm outside the femur's bounding box " +
              "(input frame, mm): a COR in another frame or unit?";
     });
-    if (!cor.allow_any) {
-      // A given COR must lie in the femoral head: compare with the head the bone itself shows.
-      const SphereFitResult head = located_head(in);
-      r.fitted_head = head;
-      const double d = (r.head.centre - head.centre).norm();
-      if (d > head.radius)
-        throw Error("cor " + point_text(*cor.given) + " mm is " + num(d) + " mm from the fitted femoral head centre " +
-                    point_text(M.transpose() * head.centre) + " mm, farther than the head radius " +
-                    num(head.radius) + " mm: the COR must lie in the head (input frame, mm); allow-any-cor accepts it");
-    }
+    if (!cor.allow_any) r.fitted_head = check_cor_in_head("cor", r.head.centre, in);
     return r;
   }
   if (in.landmarks.count("hip_centre")) {
     r.head.centre = in.landmarks.at("hip_centre");
     r.head.radius = r.head.rms_residual = std::nan("");
     r.method = "given (subject.json landmark hip_centre)";
+    const std::string what = (in.landmarks_file.empty() ? "" : in.landmarks_file + ": ") + "landmark hip_centre";
+    if (!cor.allow_any) r.fitted_head = check_cor_in_head(what, r.head.centre, in);
     return r;
   }
   r.head = located_head(in);
@@ -297,23 +304,6 @@ void check_map_memory(const SessionOptions& m, const SamplingScheme& scheme) {
 }
 }  // namespace
 
-void check_side_and_frame(const LoadedInput& in, const Eigen::Vector3d& head, const SessionInput& given) {
-  if (in.pelvis.V.rows() == 0) return;
-  const double width = in.pelvis.V.col(0).maxCoeff() - in.pelvis.V.col(0).minCoeff();
-  const double lateral = head.x() - in.pelvis.V.col(0).mean();  // working frame: +x right
-  if (width < 200 || std::abs(lateral) < 30) return;
-  const bool right = in.side == Side::right;
-  require(right == (lateral > 0), [&] {
-    const char* frame = in.frame == FrameConvention::LPS ? "LPS" : "RAS";
-    return std::string("side ") + (right ? "right" : "left") + ": the femoral head lies " +
-           num(std::round(std::abs(lateral))) + " mm to the " + (lateral > 0 ? "right" : "left") +
-           " of the pelvis' centre when the meshes are read as " + frame + ": the side (" +
-           (given.side.empty() ? (given.subject.empty() ? "the default right" : "the subject's") : "--side") + ") or the frame (" +
-           (given.frame.empty() ? (given.subject.empty() ? "the default RAS" : "the subject's") : "--frame") +
-           ") is wrong";
-  });
-}
-
 Session::Session(const SessionOptions& options) : options_(options) {
   // The cheap options are checked before anything is read or built.
   hip_options_ = resolved_hip_options(options);
@@ -340,12 +330,13 @@ Session::Session(const SessionOptions& options) : options_(options) {
   socket_source_ = in.pelvis_source;
   subject_name_ = in.name;
   cor_ = find_centre_of_rotation(in, options.cor);
-  check_side_and_frame(in, cor_.head.centre, options.input);
+  check_side_and_frame(in, cor_, options.input);
   hip_options_.allow_cor_outside_ball = options.cor.allow_any;
   // A COR the user gave (--cor, cor=) is the femoral head centre the radial gaps are measured about at the
   // scan pose, whatever the joint-centre method: the maps stay about it, and the combined and equidistant
   // methods move the femur by the seat at every pose instead of sampling the seated femur.
   hip_options_.seat_before_sampling = !options.cor.given;
+  hip_options_.frames.landmarks_file = in.landmarks_file;
   hip_options_.to_report = in.to_working.transpose();
   hip_options_.report_frame_name = std::string("input frame, ") + (in.frame == FrameConvention::LPS ? "LPS" : "RAS");
   // A given COR (or the subject's hip_centre landmark): the zones, the acetabulum and the seat still
