@@ -5,6 +5,7 @@
 //   given COR outside the head is refused naming both centres (unless allow_any); a subject's
 //   hip_centre landmark is used; a given COR wins over the landmark; a hip_centre off the head is refused in the
 //   given COR's words;
+// - a femur in centimetres is named as such before anything is fitted (a whole one: by its shaft's length);
 // - bad options are refused before any file is read, naming the option;
 // - the runs equal the library calls they wrap: run_motion's rows are Joint::detect's least gaps
 //   at each pose, run_rom's limits find_rom_limits's;
@@ -472,4 +473,35 @@ TEST(Session, AHipCentreOffTheHeadIsRefusedAsTheCorIs) {
   LoadedInput inside = in;
   inside.landmarks["hip_centre"] = model(false).cor + Eigen::Vector3d(0, 0, 21);
   EXPECT_TRUE(find_centre_of_rotation(inside, {}).fitted_head);
+}
+
+// Units: a femur that shows its shaft and is 45 long (an ellipsoid 45 x 9 x 9, as a whole femur in centimetres) is
+// refused asking whether it is in centimetres, the same ten times larger is read; the generated hip in centimetres
+// (10 across) is refused as centimetres or inches, in metres as metres.
+TEST(Session, AMeshInCentimetresIsNamedBeforeAnythingIsFitted) {
+  const auto ellipsoid = [](double scale) {
+    return make_radial_surface(
+        [&](const Eigen::Vector3d& u) {
+          return scale / std::sqrt(std::pow(u.x() / 4.5, 2) + std::pow(u.y() / 4.5, 2) + std::pow(u.z() / 22.5, 2));
+        },
+        Eigen::Vector3d::Zero(), 24, 24, Eigen::Vector3d::UnitZ());
+  };
+  SessionInput input;
+  input.ball_mesh = ellipsoid(1);
+  input.socket_mesh = model().socket;
+  std::string e = error_of([&] { load_input(input); });
+  EXPECT_NE(e.find("generated radial surface: the femur is 45 long and 5 times as long as wide"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("is the mesh in centimetres (scale by 10)?"), std::string::npos) << e;
+  input.ball_mesh = ellipsoid(10);
+  EXPECT_EQ(error_of([&] { load_input(input); }), "(no error)");
+  for (const auto& [scale, unit] : {std::pair{0.1, "centimetres (scale by 10) or inches (by 25.4)?"},
+                                    std::pair{0.001, "metres (scale by 1000) or inches (by 25.4)?"}}) {
+    input.ball_mesh = model().ball;
+    input.socket_mesh = model().socket;
+    input.ball_mesh->V *= scale;
+    input.socket_mesh->V *= scale;
+    e = error_of([&] { load_input(input); });
+    EXPECT_NE(e.find(unit), std::string::npos) << e;
+  }
 }

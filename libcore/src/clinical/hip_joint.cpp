@@ -12,6 +12,13 @@
 
 namespace impinge {
 
+namespace {
+// What an anatomy error adds: the ways around it.
+constexpr const char* kAnatomyHint =
+    " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan uses the scan "
+    "pose instead]";
+}  // namespace
+
 HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const SphereFitResult& head,
                    const Landmarks& given, const HipJointOptions& options)
     : side_(side), neutral_(options.neutral.value_or(Neutral::anatomical)), cor_(head.centre) {
@@ -21,11 +28,15 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   require(method == JointCentreMethod::femoral_head || neutral_ == Neutral::anatomical,
           std::string("hip joint: the ") + to_string(method) +
               " joint centre needs anatomical neutral (the acetabulum); scan neutral allows femoral-head only");
-  SphereFitResult sphere = head_sphere(femur, head, options);
-  if (neutral_ == Neutral::anatomical)
-    build_anatomy(femur, pelvis, sphere, given, options, method);
-  else
-    femur_axes_joint_ = scan_axes();  // scan neutral: both frames are the scan axes
+  SphereFitResult sphere;
+  try {
+    sphere = head_sphere(femur, head, options);
+    if (neutral_ == Neutral::anatomical) build_anatomy(femur, pelvis, sphere, given, options, method);
+  } catch (const Error& e) {
+    if (neutral_ != Neutral::anatomical) throw;
+    throw Error(std::string(e.what()) + kAnatomyHint);  // the bones' anatomy not found: what would do without it
+  }
+  if (neutral_ != Neutral::anatomical) femur_axes_joint_ = scan_axes();  // scan neutral: both frames are the scan axes
   head_centre_joint_ = joint_to_working_.transpose() * (sphere.centre + seat_ - cor_);
   build_joint(std::move(femur), std::move(pelvis), options);
   // The acetabular centre in the joint frame: the origin once seated.

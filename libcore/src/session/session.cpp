@@ -133,17 +133,33 @@ void orient_bones(LoadedInput& in) {
 }
 
 // Units: a femur or pelvis (or a part of one holding the joint) spans tens to hundreds of millimetres; a bone
-// whose bounding box's diagonal is under 20 or over 3000 (file units) is an error naming the likely unit.
+// whose bounding box's diagonal is under 20 or over 3000 (file units) is an error naming the likely unit. A femur
+// that shows its shaft (3 or more times as long as wide: the shared femurs 4.3-5.3) is at least 100 mm long in
+// millimetres (an adult's 340-540 mm); a shorter one is a whole femur in centimetres (45 long) or inches.
 void check_units(const LoadedInput& in) {
   for (const auto& [mesh, source] : {std::pair{&in.femur, &in.femur_source}, std::pair{&in.pelvis, &in.pelvis_source}}) {
     const double span = (mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff()).norm();
     require(span >= 20 && span <= 3000, [&, span = span, source = source] {
       return *source + ": the bone spans " + num(span) + " (its bounding box's diagonal) in the file's units; a femur or "
              "pelvis in millimetres spans about 50 to 1,000: " +
-             (span < 20 ? std::string("metres (scale by 1000) or inches (by 25.4)?") : std::string("micrometres?")) +
+             (span < 5    ? std::string("metres (scale by 1000) or inches (by 25.4)?")
+              : span < 20 ? std::string("centimetres (scale by 10) or inches (by 25.4)?")
+                          : std::string("micrometres?")) +
              " impinge reads millimetres";
     });
   }
+  const Eigen::Vector3d e = principal_extents(in.femur.V);
+  require(!(e[0] >= 3 * e[1] && e[0] < 100), [&] {
+    std::string unit;
+    for (const auto& [name, scale] :
+         {std::pair{"centimetres (scale by 10)", 10.0}, std::pair{"inches (by 25.4)", 25.4}})
+      if (e[0] * scale >= 100 && e[0] * scale <= 700) unit += (unit.empty() ? "" : " or ") + std::string(name);
+    return in.femur_source + ": the femur is " + num(std::round(e[0] * 10) / 10) + " long and " +
+           num(std::round(e[0] / e[1] * 10) / 10) +
+           " times as long as wide (its shaft) in the file's units; a femur that shows its shaft is 100 to 700 mm "
+           "long in millimetres (an adult's 340-540 mm): is the mesh in " +
+           (unit.empty() ? std::string("another unit") : unit) + "? impinge reads millimetres";
+  });
 }
 
 }  // namespace
@@ -350,21 +366,15 @@ Session::Session(const SessionOptions& options) : options_(options) {
   }
   // One pose's work (SessionOptions::only_poses): the distance hierarchies cropped to it and the scan pose.
   hip_options_.joint.cropped_distance_queries = !options.only_poses.empty() && options.query_strategy == "direct";
-  try {
-    auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
-                                          hip_options_);
-    if (hip_options_.joint.cropped_distance_queries) {
-      std::vector<FemurPose> poses{hip->scan_pose()};
-      for (const PoseAngles& a : options.only_poses) poses.push_back(hip->femur_pose(a));
-      hip->crop_distance_queries(poses);
-    }
-    hip_ = std::move(hip);
-  } catch (const Error& e) {
-    if (neutral != Neutral::anatomical) throw;
-    throw Error(std::string(e.what()) +
-                " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan "
-                "uses the scan pose instead]");
+  // (With anatomical neutral, HipJoint's errors in finding the anatomy say how to do without it.)
+  auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
+                                        hip_options_);
+  if (hip_options_.joint.cropped_distance_queries) {
+    std::vector<FemurPose> poses{hip->scan_pose()};
+    for (const PoseAngles& a : options.only_poses) poses.push_back(hip->femur_pose(a));
+    hip->crop_distance_queries(poses);
   }
+  hip_ = std::move(hip);
   warnings_ = load_warnings;
   for (const std::string& w : hip_->warnings()) warnings_.push_back(w);
   // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).

@@ -205,7 +205,8 @@ class Session {
  public:
   /// Load, find the COR, build the frames and maps (HipJoint), and scan the scan pose once (a
   /// segmentation overlap there becomes a warning). Throws impinge::Error naming the file, option
-  /// or step that failed; with anatomical neutral a failure says how to use scan neutral instead.
+  /// or step that failed; with anatomical neutral a failure to find the anatomy says how to use scan neutral
+  /// instead (HipJoint).
   explicit Session(const SessionOptions& options);
 
   const HipJoint& hip() const { return *hip_; }
