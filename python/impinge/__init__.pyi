@@ -115,7 +115,7 @@ class Joint:
         ball, socket: mesh files or (V (n, 3) float mm, F (m, 3) int); or subject: a subject.json
         (meshes, side, frame, landmarks, neutral). side: 'right'/'left'; frame: 'LPS'/'RAS' (the
         meshes' frame; default the subject's, else RAS). cor: 'auto' (the femoral head fitted) or
-        (x, y, z) mm, the femoral head centre about which the radial gaps at the scan pose are measured; head_region: (x, y, z, r) mm, fit the head there; allow_any_cor: accept a COR
+        (x, y, z) mm, the femoral head centre about which the radial gaps at the scan pose are measured; head_region: (x, y, z, r) mm, fit the head there; allow_any_cor: accept a COR (or landmark hip_centre)
         outside the head. scheme and one of resolution/precision/turns/spacing_deg (0: the scheme's
         0.5 deg default); sampling; mode 'exact'/'linear'; levels: thresholds mm, decreasing;
         sparse_region_mm: mm kept around the COR (inf: any surface; 0: dense); layers: N crossings per node for

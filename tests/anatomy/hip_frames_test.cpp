@@ -7,16 +7,23 @@
 // - clinical angles move the femur as clinicians mean (tested on real femurs, both sides):
 //   +90 flexion puts the knee anterior, +30 adduction medial, +30 internal rotation turns the
 //   femoral neck posterior;
-// - given landmarks replace found ones.
+// - given landmarks replace found ones;
+// - the femoral landmarks are checked against the bone (check_femur_landmarks): a swapped pair, or posterior condyles
+//   in front of the knee, are refused naming them and the offset (analytic bounds on the generated hip; every shared
+//   hip's found landmarks pass, swapped they are refused); the neck and the acetabulum show which way they point
+//   (the generated hip's axes).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "impinge/anatomy/hip_frames.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/io/generated_models.hpp"
 #include "test_support.hpp"
 
 using namespace impinge;
+using impinge::test::error_of;
 using impinge::test::load_real_joint;
 
 namespace {
@@ -231,4 +238,131 @@ TEST(HipFrames, AHalfPelvisOrACutFemurIsAClearError) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("whole pelvis"), std::string::npos) << e.what();
   }
+}
+
+// The bones' own side, without landmarks (head_to_neck_direction, acetabular_opening_direction). Analytic oracle: the
+// generated hip's neck and cup are rotationally symmetric about their axes (make_hip_model: the neck along
+// (0.80, 0.25, -0.55) from the head centre, the cup's pole along (-0.65, -0.2, 0.73)), so the mean directions lie on
+// those axes: the neck's, and the opposite of the pole's.
+TEST(HipSide, TheGeneratedNeckAndCupGiveTheirAxes) {
+  const HipModelOptions o;
+  const HipModel h = make_hip_model(o);
+  const Eigen::Vector3d neck = Eigen::Vector3d(0.80, 0.25, -0.55).normalized();
+  const Eigen::Vector3d opening = -Eigen::Vector3d(-0.65, -0.2, 0.73).normalized();
+  const double within = std::cos(0.1 * M_PI / 180);
+  for (const double r : {o.head_radius_mm, std::nan("")}) {  // NaN: the radius from the vertices about the centre
+    const auto n = head_to_neck_direction(h.ball, h.cor, r);
+    ASSERT_TRUE(n);
+    EXPECT_GT(n->dot(neck), within) << n->transpose();
+  }
+  const auto a = acetabular_opening_direction(h.socket, h.cor, o.head_radius_mm);
+  ASSERT_TRUE(a);
+  EXPECT_GT(a->dot(opening), within) << a->transpose();
+  // The head's radius from its vertices: most of those within 35 mm lie on the sphere.
+  EXPECT_NEAR(head_radius_about(h.ball.V, h.cor), o.head_radius_mm, 1e-9);
+  // Nothing about a centre far from the bones: no direction (and no radius).
+  const Eigen::Vector3d far = h.cor + Eigen::Vector3d(500, 0, 0);
+  EXPECT_FALSE(head_to_neck_direction(h.ball, far, o.head_radius_mm));
+  EXPECT_FALSE(head_to_neck_direction(h.ball, far, std::nan("")));
+  EXPECT_FALSE(acetabular_opening_direction(h.socket, far, o.head_radius_mm));
+  EXPECT_TRUE(std::isnan(head_radius_about(h.ball.V, far)));
+}
+
+namespace {
+// Landmarks of the generated (right, RAS) femur as a whole femur would have them: the knee centre 400 mm below the
+// head and 25 mm lateral, the epicondyles 80 mm apart across it (lateral +x), the posterior condyles 44 mm apart and
+// 25 mm behind it (-y).
+FemurLandmarks generated_landmarks(const Eigen::Vector3d& head) {
+  const Eigen::Vector3d knee = head + Eigen::Vector3d(25, 0, -400);
+  FemurLandmarks L;
+  L.head_centre = head;
+  L.epicondyle_lateral = knee + Eigen::Vector3d(40, 0, 0);
+  L.epicondyle_medial = knee - Eigen::Vector3d(40, 0, 0);
+  L.posterior_condyle_lateral = knee + Eigen::Vector3d(22, -25, -5);
+  L.posterior_condyle_medial = knee + Eigen::Vector3d(-22, -25, -5);
+  return L;
+}
+
+// The offset (mm) an error of check_femur_landmarks gives: the number after `lead`, or NaN.
+double offset_after(const std::string& error, const std::string& lead) {
+  const auto at = error.find(lead);
+  return at == std::string::npos ? std::nan("") : std::stod(error.substr(at + lead.size()));
+}
+
+// The error of check_femur_landmarks on `L` (all given, from "s.json"), or "(no error)" when it passes.
+std::string femur_error(const FemurLandmarks& L, const TriangleMesh& femur, Side side) {
+  Landmarks given = L.as_map();
+  given.erase("head_centre");
+  return error_of([&] { check_femur_landmarks(L, femur, std::nan(""), side, given, "s.json"); });
+}
+}  // namespace
+
+// Swapped epicondyles or posterior condyles turn the femoral frame half a turn about its long axis (lhdl-ct's version
+// read -21.4 and 158.7 deg instead of 21.3): refused naming both and the offset, which can be no more than the pair's
+// separation (80 mm, 44 mm) and, medial lying within 20 deg of the model's -x, no less than cos 20 deg of it;
+// posterior condyles placed in front of the knee likewise. The rules use the side (a left femur is the mirror image).
+TEST(FemurLandmarks, ASwappedPairOrCondylesInFrontAreRefusedNamingThem) {
+  const HipModel h = make_hip_model(HipModelOptions{});
+  const FemurLandmarks L = generated_landmarks(h.cor);
+  EXPECT_EQ(femur_error(L, h.ball, Side::right), "(no error)");
+  FemurLandmarks e = L;
+  std::swap(e.epicondyle_lateral, e.epicondyle_medial);
+  std::string err = femur_error(e, h.ball, Side::right);
+  EXPECT_NE(err.find("s.json: landmarks epicondyle_lateral (given) and epicondyle_medial (given): "), std::string::npos)
+      << err;
+  EXPECT_NE(err.find("are they swapped?"), std::string::npos) << err;
+  double d = offset_after(err, "the lateral epicondyle lies ");
+  EXPECT_GT(d, 80 * std::cos(20 * M_PI / 180)) << err;
+  EXPECT_LE(d, 80 + 1e-9) << err;
+  FemurLandmarks p = L;
+  std::swap(p.posterior_condyle_lateral, p.posterior_condyle_medial);
+  err = femur_error(p, h.ball, Side::right);
+  EXPECT_NE(err.find("posterior_condyle_lateral (given) and posterior_condyle_medial (given)"), std::string::npos);
+  d = offset_after(err, "the lateral posterior condyle lies ");
+  EXPECT_GT(d, 44 * std::cos(20 * M_PI / 180)) << err;
+  EXPECT_LE(d, 44 + 1e-9) << err;
+  FemurLandmarks front = L;
+  front.posterior_condyle_lateral.y() += 50;  // 25 mm in front of the knee
+  front.posterior_condyle_medial.y() += 50;
+  err = femur_error(front, h.ball, Side::right);
+  d = offset_after(err, "their midpoint lies ");
+  EXPECT_GT(d, 25 * std::cos(20 * M_PI / 180)) << err;
+  EXPECT_LE(d, 25 + 1e-9) << err;
+  // A landmark found names the mesh, not the landmarks' file.
+  err = error_of([&] { check_femur_landmarks(e, h.ball, std::nan(""), Side::right, {}, "s.json"); });
+  EXPECT_EQ(err.rfind(h.ball.source + ": landmarks epicondyle_lateral (found) and epicondyle_medial (found)", 0), 0u)
+      << err;
+  // The left hip: the mirror image passes as a left femur; read as a right one its posterior condyles lie in front.
+  TriangleMesh left = h.ball;
+  mirror_to_left(left);
+  FemurLandmarks ml = L;
+  for (Eigen::Vector3d* q : {&ml.head_centre, &ml.epicondyle_lateral, &ml.epicondyle_medial,
+                             &ml.posterior_condyle_lateral, &ml.posterior_condyle_medial})
+    q->x() *= -1;
+  EXPECT_EQ(femur_error(ml, left, Side::left), "(no error)");
+  EXPECT_NE(femur_error(ml, left, Side::right).find("anterior of the epicondyles' midpoint"), std::string::npos);
+}
+
+// On every shared hip the landmarks impinge finds pass, and each swapped pair is refused.
+TEST(FemurLandmarks, FoundPassAndSwappedAreRefusedOnEverySharedHip) {
+  int hips = 0;
+  for (const char* s : {"lhdl-ct", "mc22", "mc22-left", "tlem2-mri"}) {
+    auto j = load_real_joint(s);
+    if (!j) continue;
+    ++hips;
+    SCOPED_TRACE(s);
+    const Side side = std::string(s) == "mc22-left" ? Side::left : Side::right;
+    const HipFrames h = find_hip_frames(j->femur, j->pelvis, side);  // checks the found landmarks
+    FemurLandmarks e = h.femur_landmarks;
+    std::swap(e.epicondyle_lateral, e.epicondyle_medial);
+    EXPECT_NE(error_of([&] { check_femur_landmarks(e, j->femur, h.head.radius, side, {}, ""); })
+                  .find("the lateral epicondyle lies "),
+              std::string::npos);
+    FemurLandmarks p = h.femur_landmarks;
+    std::swap(p.posterior_condyle_lateral, p.posterior_condyle_medial);
+    EXPECT_NE(error_of([&] { check_femur_landmarks(p, j->femur, h.head.radius, side, {}, ""); })
+                  .find("the lateral posterior condyle lies "),
+              std::string::npos);
+  }
+  if (hips == 0) GTEST_SKIP() << "shared data absent";
 }

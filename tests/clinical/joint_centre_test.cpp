@@ -15,7 +15,8 @@
 //   75 deg, where the bones had parted again), and once the bones press into each other they stay pressed;
 // - under the equidistant method a 1 mm move of the initial centre of rotation moves no limit of
 //   lhdl-ct by more than 3 deg (issue 29's criterion; the committed experiment covers every subject);
-// - bad input is an error naming what is missing.
+// - bad input is an error naming what is missing; too few lunate points at a coarse map name the resolution and a
+//   value that works.
 #include "impinge/clinical/joint_centre.hpp"
 
 #include <gtest/gtest.h>
@@ -256,4 +257,21 @@ TEST(JointCentre, EquidistantLimitsHoldUnderAMillimetreMoveOfTheCentre) {
     }
   }
   EXPECT_GE(compared, 3 * 7);  // at most one motion of nine left out per move
+}
+
+// Too few lunate points: with the socket map's nodes farther apart than kLunateSpacingDeg the error says the
+// resolution is too coarse, naming the scheme, its resolution and a value that works; with finer nodes, that the
+// equidistant joint centre needs the joint surface.
+TEST(JointCentre, TooFewLunatePointsNameACoarseResolution) {
+  const TriangleMesh cup = make_cup(22, 26, 100, Eigen::Vector3d::Zero(), -Eigen::Vector3d::UnitZ(), 24, 10);
+  const std::string coarse = too_few_lunate_points(JointBody(cup, make_scheme("equiangular", 10)), 0);
+  EXPECT_NE(coarse.find("generated cup: 0 points of the lunate surface sampled, fewer than 16: the maps' nodes, 10 deg "
+                        "apart (equiangular precision_deg 10), are too coarse for the lunate surface; a node spacing "
+                        "of 2 deg or finer samples it (--precision 2, or --spacing 2 with any scheme"),
+            std::string::npos)
+      << coarse;
+  const std::string fine = too_few_lunate_points(JointBody(cup, make_scheme("equiangular", kLunateSpacingDeg)), 3);
+  EXPECT_NE(fine.find("3 points of the lunate surface sampled, fewer than 16: the equidistant joint centre needs"),
+            std::string::npos)
+      << fine;
 }

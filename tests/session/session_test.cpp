@@ -3,7 +3,9 @@
 //   same hip given in RAS bit for bit, its COR and posed vertices are reported back in LPS;
 // - the COR policy: a head-region fit finds the generated head's analytic centre and radius; a
 //   given COR outside the head is refused naming both centres (unless allow_any); a subject's
-//   hip_centre landmark is used; a given COR wins over the landmark;
+//   hip_centre landmark is used; a given COR wins over the landmark; a hip_centre off the head is refused in the
+//   given COR's words;
+// - a femur in centimetres is named as such before anything is fitted (a whole one: by its shaft's length);
 // - bad options are refused before any file is read, naming the option;
 // - the runs equal the library calls they wrap: run_motion's rows are Joint::detect's least gaps
 //   at each pose, run_rom's limits find_rom_limits's;
@@ -445,5 +447,61 @@ TEST(Session, ThePivotIsTheFixedPointOfTheFemursMotion) {
     EXPECT_LT((moved - *pivot).norm(), 1e-6) << to_string(method);
     if (method == JointCentreMethod::femoral_head) EXPECT_LT((*pivot - s.head_centre_input()).norm(), 1e-12);
     if (method != JointCentreMethod::femoral_head) EXPECT_LT((*pivot - *s.acetabular_centre_input()).norm(), 1e-12);
+  }
+}
+
+// A landmark hip_centre off the head is refused as a given COR is, in the same words (check_cor_in_head): the
+// generated head (radius 22 mm) and a point 25 mm from its centre; inside the head, or with allow_any, accepted.
+TEST(Session, AHipCentreOffTheHeadIsRefusedAsTheCorIs) {
+  SessionOptions o = generated_options("RAS", false);
+  o.cor.given.reset();
+  const Eigen::Vector3d off = model(false).cor + Eigen::Vector3d(25, 0, 0);
+  o.input.landmarks["hip_centre"] = off;
+  const LoadedInput in = load_input(o.input);
+  const std::string as_landmark = error_of([&] { find_centre_of_rotation(in, {}); });
+  CorOptions as_cor;
+  as_cor.given = off;
+  const LoadedInput plain = load_input(generated_options("RAS", false).input);
+  const std::string as_given = error_of([&] { find_centre_of_rotation(plain, as_cor); });
+  const std::string lead = "landmark hip_centre (85, -20, 30) mm is 25 mm from the fitted femoral head centre";
+  ASSERT_EQ(as_landmark.rfind(lead, 0), 0u) << as_landmark;
+  EXPECT_EQ(as_landmark.substr(std::string("landmark hip_centre").size()), as_given.substr(std::string("cor").size()));
+  EXPECT_NE(as_landmark.find("farther than the head radius 22 mm"), std::string::npos) << as_landmark;
+  CorOptions any;
+  any.allow_any = true;
+  EXPECT_EQ(find_centre_of_rotation(in, any).head.centre, off);
+  LoadedInput inside = in;
+  inside.landmarks["hip_centre"] = model(false).cor + Eigen::Vector3d(0, 0, 21);
+  EXPECT_TRUE(find_centre_of_rotation(inside, {}).fitted_head);
+}
+
+// Units: a femur that shows its shaft and is 45 long (an ellipsoid 45 x 9 x 9, as a whole femur in centimetres) is
+// refused asking whether it is in centimetres, the same ten times larger is read; the generated hip in centimetres
+// (10 across) is refused as centimetres or inches, in metres as metres.
+TEST(Session, AMeshInCentimetresIsNamedBeforeAnythingIsFitted) {
+  const auto ellipsoid = [](double scale) {
+    return make_radial_surface(
+        [&](const Eigen::Vector3d& u) {
+          return scale / std::sqrt(std::pow(u.x() / 4.5, 2) + std::pow(u.y() / 4.5, 2) + std::pow(u.z() / 22.5, 2));
+        },
+        Eigen::Vector3d::Zero(), 24, 24, Eigen::Vector3d::UnitZ());
+  };
+  SessionInput input;
+  input.ball_mesh = ellipsoid(1);
+  input.socket_mesh = model().socket;
+  std::string e = error_of([&] { load_input(input); });
+  EXPECT_NE(e.find("generated radial surface: the femur is 45 long and 5 times as long as wide"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("is the mesh in centimetres (scale by 10)?"), std::string::npos) << e;
+  input.ball_mesh = ellipsoid(10);
+  EXPECT_EQ(error_of([&] { load_input(input); }), "(no error)");
+  for (const auto& [scale, unit] : {std::pair{0.1, "centimetres (scale by 10) or inches (by 25.4)?"},
+                                    std::pair{0.001, "metres (scale by 1000) or inches (by 25.4)?"}}) {
+    input.ball_mesh = model().ball;
+    input.socket_mesh = model().socket;
+    input.ball_mesh->V *= scale;
+    input.socket_mesh->V *= scale;
+    e = error_of([&] { load_input(input); });
+    EXPECT_NE(e.find(unit), std::string::npos) << e;
   }
 }

@@ -33,6 +33,16 @@ Eigen::Vector3d femur_long_axis(PointsRef V, const Eigen::Vector3d& proximal_hin
   return L;
 }
 
+Eigen::Vector3d principal_extents(PointsRef V) {
+  if (V.rows() < 4) return Eigen::Vector3d::Zero();
+  const Eigen::RowVector3d c = V.colwise().mean();
+  const Eigen::MatrixXd D = V.rowwise() - c;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(D.transpose() * D);
+  const Eigen::MatrixXd t = D * es.eigenvectors();  // columns: along the axes, smallest variance first
+  const Eigen::Vector3d e = (t.colwise().maxCoeff() - t.colwise().minCoeff()).transpose();
+  return Eigen::Vector3d(e[2], e[1], e[0]);
+}
+
 namespace {
 
 // Distance (mm) from p to the nearest vertex of `mesh`.

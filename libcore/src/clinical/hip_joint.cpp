@@ -13,16 +13,10 @@
 namespace impinge {
 
 namespace {
-double median_radius(const Vertices& V, const Eigen::Vector3d& c) {
-  std::vector<double> d;
-  for (Eigen::Index i = 0; i < V.rows(); ++i) {
-    const double r = (V.row(i).transpose() - c).norm();
-    if (r < 35) d.push_back(r);
-  }
-  if (d.size() < 10) return std::nan("");  // no head around the COR
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
-  return d[d.size() / 2];
-}
+// What an anatomy error adds: the ways around it.
+constexpr const char* kAnatomyHint =
+    " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan uses the scan "
+    "pose instead]";
 }  // namespace
 
 HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const SphereFitResult& head,
@@ -34,11 +28,15 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
   require(method == JointCentreMethod::femoral_head || neutral_ == Neutral::anatomical,
           std::string("hip joint: the ") + to_string(method) +
               " joint centre needs anatomical neutral (the acetabulum); scan neutral allows femoral-head only");
-  SphereFitResult sphere = head_sphere(femur, head, options);
-  if (neutral_ == Neutral::anatomical)
-    build_anatomy(femur, pelvis, sphere, given, options, method);
-  else
-    femur_axes_joint_ = scan_axes();  // scan neutral: both frames are the scan axes
+  SphereFitResult sphere;
+  try {
+    sphere = head_sphere(femur, head, options);
+    if (neutral_ == Neutral::anatomical) build_anatomy(femur, pelvis, sphere, given, options, method);
+  } catch (const Error& e) {
+    if (neutral_ != Neutral::anatomical) throw;
+    throw Error(std::string(e.what()) + kAnatomyHint);  // the bones' anatomy not found: what would do without it
+  }
+  if (neutral_ != Neutral::anatomical) femur_axes_joint_ = scan_axes();  // scan neutral: both frames are the scan axes
   head_centre_joint_ = joint_to_working_.transpose() * (sphere.centre + seat_ - cor_);
   build_joint(std::move(femur), std::move(pelvis), options);
   // The acetabular centre in the joint frame: the origin once seated.
@@ -67,7 +65,7 @@ SphereFitResult HipJoint::head_sphere(const TriangleMesh& femur, const SphereFit
   // COR was given (then the fitted head's, so that they do not move with it).
   SphereFitResult sphere = options.head_sphere.value_or(head);
   if (!options.head_sphere) sphere.centre = cor_;
-  head_radius_ = std::isfinite(sphere.radius) ? sphere.radius : median_radius(femur.V, sphere.centre);
+  head_radius_ = std::isfinite(sphere.radius) ? sphere.radius : head_radius_about(femur.V, sphere.centre);
   require(std::isfinite(head_radius_) || neutral_ == Neutral::scan,
           femur.source + ": fewer than 10 femur vertices within 35 mm of the centre of rotation: no femoral head "
                          "there for the acetabulum and clock faces");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <sstream>
 
 #include "impinge/core/error.hpp"
 #include "impinge/schemes/fibonacci_scheme.hpp"
@@ -49,6 +50,22 @@ ScanSet lunate_sample(const RadialDistanceMap& socket_map, const LunateSphere& L
   return set;
 }
 
+std::string too_few_lunate_points(const JointBody& socket, std::size_t points) {
+  const SamplingScheme& scheme = socket.map.scheme();
+  const double spacing_deg = scheme.max_node_spacing() * 180 / M_PI;
+  std::ostringstream o;
+  o << socket.mesh.source << ": " << points << " points of the lunate surface sampled, fewer than 16: ";
+  if (spacing_deg > kLunateSpacingDeg * (1 + 1e-9)) {
+    o << "the maps' nodes, " << spacing_deg << " deg apart (" << scheme.name() << " " << scheme.resolution_name() << " "
+      << scheme.resolution() << "), are too coarse for the lunate surface; a node spacing of " << kLunateSpacingDeg
+      << " deg or finer samples it (--precision " << kLunateSpacingDeg << ", or --spacing " << kLunateSpacingDeg
+      << " with any scheme; the default is 0.5), or --joint-centre femoral-head needs none";
+  } else {
+    o << "the equidistant joint centre needs the acetabulum's joint surface (use --joint-centre femoral-head)";
+  }
+  return o.str();
+}
+
 JointCentre::JointCentre(JointCentreMethod method, const Joint& joint, const LunateSphere& lunate,
                          const std::vector<std::uint8_t>& guard, double head_sphere_reach_mm,
                          const EquidistantOptions& o)
@@ -65,9 +82,7 @@ JointCentre::JointCentre(JointCentreMethod method, const Joint& joint, const Lun
   require(std::isfinite(lunate.radius_mm) && lunate.radius_mm > 0 && std::isfinite(lunate.band_mm) && lunate.band_mm > 0,
           "joint centre equidistant: the lunate sphere's radius and band must be > 0 mm");
   lunate_ = lunate_sample(joint.socket().map, lunate, o.max_vertices, o.mirror_x);
-  require(lunate_.size() >= 16, joint.socket().mesh.source + ": " + std::to_string(lunate_.size()) +
-                                    " points of the lunate surface sampled, fewer than 16: the equidistant joint centre "
-                                    "needs the acetabulum's joint surface (use --joint-centre femoral-head)");
+  require(lunate_.size() >= 16, [&] { return too_few_lunate_points(joint.socket(), lunate_.size()); });
   const Vertices& P = joint.socket().relative;
   require(guard.empty() || guard.size() == static_cast<std::size_t>(P.rows()),
           "joint centre equidistant: the lunate flags have " + std::to_string(guard.size()) + " entries for " +

@@ -14,11 +14,12 @@ MorphologyRun run_morphology(const SessionOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   LoadedInput in = load_input(options.input);
   const CorResult cor = find_centre_of_rotation(in, options.cor);
-  check_side_and_frame(in, cor.head.centre, options.input);
+  check_side_and_frame(in, cor, options.input);
   // The head the femur shows (a given COR moves neither the head nor what is measured about it).
   SphereFitResult head = cor.head;
   if (!std::isfinite(head.radius)) head = cor.fitted_head ? *cor.fitted_head : located_head(in);
-  const HipJointOptions hip_options = resolved_hip_options(options, in.neutral);
+  HipJointOptions hip_options = resolved_hip_options(options, in.neutral);
+  hip_options.frames.landmarks_file = in.landmarks_file;
   MorphologyRun run;
   if (hip_options.neutral.value_or(Neutral::anatomical) == Neutral::anatomical) {
     Landmarks given = in.landmarks;

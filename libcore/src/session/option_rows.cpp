@@ -121,8 +121,8 @@ void add_cor_rows(Rows& t) {
     return std::vector<double>{c.x(), c.y(), c.z()};
   };
   t.flag("allow-any-cor", "allow_any_cor", OptionType::flag, kSetting | use_morphology,
-         "Accept a --cor outside the femoral head (research; otherwise an error naming the COR and the fitted head "
-         "centre)",
+         "Accept a --cor (or subject.json's landmark hip_centre) outside the femoral head (research; otherwise an "
+         "error naming the COR and the fitted head centre)",
          [](auto& o) -> auto& { return o.session.cor.allow_any; });
   OptionRow& hr = t.add("head-region", "head_region", OptionType::region, "mm", kSetting | use_morphology,
                         "X,Y,Z,R: fit the head sphere to femur vertices within R mm of (X,Y,Z), input frame");

@@ -142,17 +142,33 @@ void clean_bones(LoadedInput& in, bool strict) {
 }
 
 // Units: a femur or pelvis (or a part of one holding the joint) spans tens to hundreds of millimetres; a bone
-// whose bounding box's diagonal is under 20 or over 3000 (file units) is an error naming the likely unit.
+// whose bounding box's diagonal is under 20 or over 3000 (file units) is an error naming the likely unit. A femur
+// that shows its shaft (3 or more times as long as wide: the shared femurs 4.3-5.3) is at least 100 mm long in
+// millimetres (an adult's 340-540 mm); a shorter one is a whole femur in centimetres (45 long) or inches.
 void check_units(const LoadedInput& in) {
   for (const auto& [mesh, source] : {std::pair{&in.femur, &in.femur_source}, std::pair{&in.pelvis, &in.pelvis_source}}) {
     const double span = (mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff()).norm();
     require(span >= 20 && span <= 3000, [&, span = span, source = source] {
       return *source + ": the bone spans " + num(span) + " (its bounding box's diagonal) in the file's units; a femur or "
              "pelvis in millimetres spans about 50 to 1,000: " +
-             (span < 20 ? std::string("metres (scale by 1000) or inches (by 25.4)?") : std::string("micrometres?")) +
+             (span < 5    ? std::string("metres (scale by 1000) or inches (by 25.4)?")
+              : span < 20 ? std::string("centimetres (scale by 10) or inches (by 25.4)?")
+                          : std::string("micrometres?")) +
              " impinge reads millimetres";
     });
   }
+  const Eigen::Vector3d e = principal_extents(in.femur.V);
+  require(!(e[0] >= 3 * e[1] && e[0] < 100), [&] {
+    std::string unit;
+    for (const auto& [name, scale] :
+         {std::pair{"centimetres (scale by 10)", 10.0}, std::pair{"inches (by 25.4)", 25.4}})
+      if (e[0] * scale >= 100 && e[0] * scale <= 700) unit += (unit.empty() ? "" : " or ") + std::string(name);
+    return in.femur_source + ": the femur is " + num(std::round(e[0] * 10) / 10) + " long and " +
+           num(std::round(e[0] / e[1] * 10) / 10) +
+           " times as long as wide (its shaft) in the file's units; a femur that shows its shaft is 100 to 700 mm "
+           "long in millimetres (an adult's 340-540 mm): is the mesh in " +
+           (unit.empty() ? std::string("another unit") : unit) + "? impinge reads millimetres";
+  });
 }
 
 }  // namespace
@@ -176,6 +192,7 @@ LoadedInput load_input(const SessionInput& input) {
     if (ball.empty() && !input.ball_mesh) ball = info.femur_path;
     if (socket.empty() && !input.socket_mesh) socket = info.pelvis_path;
     landmarks = info.landmarks;
+    if (!info.landmarks.empty() && input.landmarks.empty()) in.landmarks_file = input.subject;
     in.neutral = info.neutral;
     in.name = info.name;
   }
@@ -204,6 +221,19 @@ SphereFitResult located_head(const LoadedInput& in) {
   return in.pelvis.V.rows() > 0 ? locate_femoral_head(in.femur, in.pelvis) : locate_femoral_head(in.femur);
 }
 
+SphereFitResult check_cor_in_head(const std::string& what, const Eigen::Vector3d& cor, const LoadedInput& in) {
+  // A given COR must lie in the femoral head: compare with the head the bone itself shows.
+  const SphereFitResult head = located_head(in);
+  const Eigen::Matrix3d& M = in.to_working;
+  const double d = (cor - head.centre).norm();
+  require(d <= head.radius, [&] {
+    return what + " " + point_text(M.transpose() * cor) + " mm is " + num(d) + " mm from the fitted femoral head " +
+           "centre " + point_text(M.transpose() * head.centre) + " mm, farther than the head radius " +
+           num(head.radius) + " mm: the COR must lie in the head (input frame, mm); allow-any-cor accepts it";
+  });
+  return head;
+}
+
 CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) {
   const Eigen::Matrix3d& M = in.to_working;
   CorResult r;
@@ -225,22 +255,15 @@ CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor) 
       return "cor " + point_text(*cor.given) + " mm lies " + num(outside) + " mm outside the femur's bounding box " +
              "(input frame, mm): a COR in another frame or unit?";
     });
-    if (!cor.allow_any) {
-      // A given COR must lie in the femoral head: compare with the head the bone itself shows.
-      const SphereFitResult head = located_head(in);
-      r.fitted_head = head;
-      const double d = (r.head.centre - head.centre).norm();
-      if (d > head.radius)
-        throw Error("cor " + point_text(*cor.given) + " mm is " + num(d) + " mm from the fitted femoral head centre " +
-                    point_text(M.transpose() * head.centre) + " mm, farther than the head radius " +
-                    num(head.radius) + " mm: the COR must lie in the head (input frame, mm); allow-any-cor accepts it");
-    }
+    if (!cor.allow_any) r.fitted_head = check_cor_in_head("cor", r.head.centre, in);
     return r;
   }
   if (in.landmarks.count("hip_centre")) {
     r.head.centre = in.landmarks.at("hip_centre");
     r.head.radius = r.head.rms_residual = std::nan("");
     r.method = "given (subject.json landmark hip_centre)";
+    const std::string what = (in.landmarks_file.empty() ? "" : in.landmarks_file + ": ") + "landmark hip_centre";
+    if (!cor.allow_any) r.fitted_head = check_cor_in_head(what, r.head.centre, in);
     return r;
   }
   r.head = located_head(in);
@@ -307,23 +330,6 @@ void check_map_memory(const SessionOptions& m, const SamplingScheme& scheme) {
 }
 }  // namespace
 
-void check_side_and_frame(const LoadedInput& in, const Eigen::Vector3d& head, const SessionInput& given) {
-  if (in.pelvis.V.rows() == 0) return;
-  const double width = in.pelvis.V.col(0).maxCoeff() - in.pelvis.V.col(0).minCoeff();
-  const double lateral = head.x() - in.pelvis.V.col(0).mean();  // working frame: +x right
-  if (width < 200 || std::abs(lateral) < 30) return;
-  const bool right = in.side == Side::right;
-  require(right == (lateral > 0), [&] {
-    const char* frame = in.frame == FrameConvention::LPS ? "LPS" : "RAS";
-    return std::string("side ") + (right ? "right" : "left") + ": the femoral head lies " +
-           num(std::round(std::abs(lateral))) + " mm to the " + (lateral > 0 ? "right" : "left") +
-           " of the pelvis' centre when the meshes are read as " + frame + ": the side (" +
-           (given.side.empty() ? (given.subject.empty() ? "the default right" : "the subject's") : "--side") + ") or the frame (" +
-           (given.frame.empty() ? (given.subject.empty() ? "the default RAS" : "the subject's") : "--frame") +
-           ") is wrong";
-  });
-}
-
 Session::Session(const SessionOptions& options) : options_(options) {
   // The cheap options are checked before anything is read or built.
   hip_options_ = resolved_hip_options(options);
@@ -352,12 +358,13 @@ Session::Session(const SessionOptions& options) : options_(options) {
   femur_hygiene_ = in.femur_hygiene;
   pelvis_hygiene_ = in.pelvis_hygiene;
   cor_ = find_centre_of_rotation(in, options.cor);
-  check_side_and_frame(in, cor_.head.centre, options.input);
+  check_side_and_frame(in, cor_, options.input);
   hip_options_.allow_cor_outside_ball = options.cor.allow_any;
   // A COR the user gave (--cor, cor=) is the femoral head centre the radial gaps are measured about at the
   // scan pose, whatever the joint-centre method: the maps stay about it, and the combined and equidistant
   // methods move the femur by the seat at every pose instead of sampling the seated femur.
   hip_options_.seat_before_sampling = !options.cor.given;
+  hip_options_.frames.landmarks_file = in.landmarks_file;
   hip_options_.to_report = in.to_working.transpose();
   hip_options_.report_frame_name = std::string("input frame, ") + (in.frame == FrameConvention::LPS ? "LPS" : "RAS");
   // A given COR (or the subject's hip_centre landmark): the zones, the acetabulum and the seat still
@@ -371,21 +378,15 @@ Session::Session(const SessionOptions& options) : options_(options) {
   }
   // One pose's work (SessionOptions::only_poses): the distance hierarchies cropped to it and the scan pose.
   hip_options_.joint.cropped_distance_queries = !options.only_poses.empty() && options.query_strategy == "direct";
-  try {
-    auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
-                                          hip_options_);
-    if (hip_options_.joint.cropped_distance_queries) {
-      std::vector<FemurPose> poses{hip->scan_pose()};
-      for (const PoseAngles& a : options.only_poses) poses.push_back(hip->femur_pose(a));
-      hip->crop_distance_queries(poses);
-    }
-    hip_ = std::move(hip);
-  } catch (const Error& e) {
-    if (neutral != Neutral::anatomical) throw;
-    throw Error(std::string(e.what()) +
-                " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan "
-                "uses the scan pose instead]");
+  // (With anatomical neutral, HipJoint's errors in finding the anatomy say how to do without it.)
+  auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
+                                        hip_options_);
+  if (hip_options_.joint.cropped_distance_queries) {
+    std::vector<FemurPose> poses{hip->scan_pose()};
+    for (const PoseAngles& a : options.only_poses) poses.push_back(hip->femur_pose(a));
+    hip->crop_distance_queries(poses);
   }
+  hip_ = std::move(hip);
   warnings_ = load_warnings;
   for (const std::string& w : hip_->warnings()) warnings_.push_back(w);
   // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).

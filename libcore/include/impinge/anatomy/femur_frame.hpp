@@ -44,6 +44,11 @@ inline const char* const kFemurLandmarkNames[] = {"epicondyle_lateral", "epicond
 /// unit, pointing towards `proximal_hint` (mm; for example the head centre) when it is finite.
 Eigen::Vector3d femur_long_axis(PointsRef V, const Eigen::Vector3d& proximal_hint);
 
+/// The extents of the points `V` (n x 3) along their principal axes (the eigenvectors of their covariance), the axis
+/// of the largest variance first, in V's units: a whole femur's length and then its widths (the shared femurs:
+/// 412-456 mm long, 4.3-5.3 times their next extent). Zeros for fewer than 4 points. Source: impinge.
+Eigen::Vector3d principal_extents(PointsRef V);
+
 /// Femoral head sphere on a whole femur in any orientation: the long axis (principal axis), then
 /// fit_femoral_head with each end in turn taken as proximal; the end whose sphere has more
 /// inliers is the head. Independent of how the femur lay in the scanner. Throws impinge::Error

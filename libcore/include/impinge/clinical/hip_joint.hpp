@@ -74,8 +74,8 @@ class HipJoint {
   /// working frame (RAS, mm); `head`: the femoral head sphere (mm, working frame; its centre is
   /// the COR; a NaN radius is estimated as the median distance of the femur's vertices within
   /// 35 mm of the centre); `given`: landmarks that replace found ones (mm, working frame).
-  /// Throws impinge::Error naming the mesh and step that failed (for example
-  /// no whole pelvis with anatomical neutral: use scan neutral or give the landmarks), and naming
+  /// Throws impinge::Error naming the mesh and step that failed (with anatomical neutral, a failure to find the
+  /// head or the anatomy ends in how to do without it: scan neutral, or the landmarks given), and naming
   /// the COR when it lies outside the femur mesh (its map leaves more than 1e-4 of the directions
   /// without surface) unless options.allow_cor_outside_ball. A head radius outside 5-60 mm (metres
   /// instead of mm?) adds a warning (warnings()).

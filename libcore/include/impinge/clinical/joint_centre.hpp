@@ -103,6 +103,16 @@ struct LunateSphere {
 ScanSet lunate_sample(const RadialDistanceMap& socket_map, const LunateSphere& lunate, int max_vertices,
                       bool mirror_x = false);
 
+/// The coarsest node spacing (deg) of the socket map at which lunate_sample finds its 16 points on every shared hip
+/// (at 3 deg mc22 gives 3 points, at 4 deg tlem2-mri 3; at 10 deg lhdl-ct none).
+inline constexpr double kLunateSpacingDeg = 2.0;
+
+/// The error for a lunate sample of `points` (fewer than 16) points in `socket`'s map: with the map's nodes farther
+/// apart than kLunateSpacingDeg, that the resolution is too coarse for the lunate surface, naming the scheme, its
+/// resolution, the options that set it (--precision, --spacing) and a value that works; else that the equidistant
+/// joint centre needs the acetabulum's joint surface. Names `socket`'s mesh. Source: impinge.
+std::string too_few_lunate_points(const JointBody& socket, std::size_t points);
+
 /// The translation of the femur at each pose by one method.
 class JointCentre {
  public:
@@ -111,8 +121,8 @@ class JointCentre {
   /// points on it in `joint`'s socket map), the head sphere's reach (mm: r_h + t_h,
   /// ArticularZones::head_sphere_reach_mm) and `guard`: one flag per socket vertex of `joint`, 1 on the
   /// lunate surface (ArticularZones::pelvis), where the joint space must stay open (empty: the sample's points
-  /// only). Throws impinge::Error when what the method needs is missing, not finite or not positive, or
-  /// `guard` has another size.
+  /// only). Throws impinge::Error when what the method needs is missing, not finite or not positive (too few lunate
+  /// points: too_few_lunate_points), or `guard` has another size.
   JointCentre(JointCentreMethod method, const Joint& joint, const LunateSphere& lunate,
               const std::vector<std::uint8_t>& guard, double head_sphere_reach_mm, const EquidistantOptions& options = {});
   /// The femoral head method (t = 0 at every pose).

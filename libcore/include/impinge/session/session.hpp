@@ -49,9 +49,9 @@ struct SessionInput {
 struct CorOptions {
   std::optional<Eigen::Vector3d> given;        ///< X, Y, Z: mm, input frame
   std::optional<Eigen::Vector4d> head_region;  ///< X, Y, Z, R: fit the head to femur vertices within R mm of X, Y, Z
-  /// Accept a given COR outside the femoral head (research). Otherwise a given COR farther from the
-  /// fitted head centre than the head radius is an error naming both, and HipJoint refuses a COR
-  /// outside the femur mesh.
+  /// Accept a given COR outside the femoral head (research). Otherwise a given COR (or the subject's
+  /// landmark hip_centre) farther from the fitted head centre than the head radius is an error naming
+  /// both (check_cor_in_head), and HipJoint refuses a COR outside the femur mesh.
   bool allow_any = false;
 };
 
@@ -142,6 +142,9 @@ struct LoadedInput {
   Landmarks landmarks;     ///< working frame, mm
   std::string neutral;     ///< the subject's "neutral" (empty when none)
   std::string name;        ///< the subject's folder name (empty without a subject)
+  /// The file the given landmarks come from (the subject.json), named in their errors; empty when there are none or
+  /// some were given in SessionInput::landmarks.
+  std::string landmarks_file;
   /// What was repaired on reading (triangles wound against their neighbours, flipped; fragments, double walls:
   /// mesh_hygiene.hpp), one line each.
   std::vector<std::string> warnings;
@@ -151,12 +154,6 @@ struct LoadedInput {
 /// The femoral head found on the femur of `in`: the end of its long axis that sits in the acetabulum when the
 /// pelvis is there, else the end with the better sphere (locate_femoral_head). Throws impinge::Error as that does.
 SphereFitResult located_head(const LoadedInput& in);
-
-/// Check the side and the input frame against the bones: on a whole pelvis (over 200 mm wide) the femoral head
-/// (`head`, working frame) lies 60-100 mm to its own side of the pelvis' centroid (the shared hips: 82-94 mm); a
-/// head on the other side means the side or the frame (LPS read as RAS mirrors left and right) is wrong. Throws
-/// impinge::Error naming the option (`given`'s side or frame, or the subject's) that is wrong.
-void check_side_and_frame(const LoadedInput& in, const Eigen::Vector3d& head, const SessionInput& given);
 
 /// The side of `input` without reading its meshes (subject.json's, or `side`, else right), to
 /// read a motion file for it before the joint is built. Throws impinge::Error as load_input.
@@ -174,10 +171,28 @@ struct CorResult {
   std::optional<SphereFitResult> fitted_head;
 };
 
+/// Check a centre of rotation given as `what` ("cor", or "<subject.json>: landmark hip_centre") at `cor` (working
+/// frame, mm) against the femoral head the bone of `in` shows (located_head): it must lie within the head's radius of
+/// its centre. Returns that head. Throws impinge::Error naming `what`, both points (input frame, mm), the distance
+/// and the radius, and that allow-any-cor accepts it; or as located_head. Source: impinge.
+SphereFitResult check_cor_in_head(const std::string& what, const Eigen::Vector3d& cor, const LoadedInput& in);
+
 /// The COR of `in` by the policy of CorOptions (see there). Throws impinge::Error naming the
-/// option: a given COR outside the head without allow_any, both a given COR and a head region, a
-/// head region with too few vertices, or no femoral head found.
+/// option: a given COR or landmark hip_centre outside the head without allow_any (check_cor_in_head), both a
+/// given COR and a head region, a head region with too few vertices, or no femoral head found.
 CorResult find_centre_of_rotation(const LoadedInput& in, const CorOptions& cor);
+
+/// Check the side and the input frame against the bones (side_check.cpp). On a whole pelvis (over 200 mm wide) the
+/// femoral head (`cor`'s centre, working frame) lies 60-100 mm to its own side of the pelvis' centroid (the shared
+/// hips: 82-94 mm); a head on the other side means the side or the frame (LPS read as RAS mirrors left and right) is
+/// wrong. On a hemipelvis (narrower) the acetabulum opens laterally (acetabular_opening_direction) and the femoral
+/// neck leaves the head laterally (head_to_neck_direction), about the head sphere (`cor`'s when fitted, else its
+/// fitted_head; neither: no check): both at least 0.3 towards the other side is a wrong side or frame (the shared
+/// hips cut to their hemipelvis: 0.72-0.84 towards their own); the acetabulum opening anteriorly then blames the
+/// side, posteriorly the frame (a frame read wrongly turns anterior to posterior as well). Throws impinge::Error
+/// naming the subject (`given`'s), the side given, what the bones say and the option (`given`'s side or frame, or the
+/// subject's) that is wrong.
+void check_side_and_frame(const LoadedInput& in, const CorResult& cor, const SessionInput& given);
 
 /// The scheme a GridRequest asks for. Throws impinge::Error on two resolutions, a resolution outside its
 /// range, or an unknown scheme.
@@ -196,7 +211,8 @@ class Session {
  public:
   /// Load, find the COR, build the frames and maps (HipJoint), and scan the scan pose once (a
   /// segmentation overlap there becomes a warning). Throws impinge::Error naming the file, option
-  /// or step that failed; with anatomical neutral a failure says how to use scan neutral instead.
+  /// or step that failed; with anatomical neutral a failure to find the anatomy says how to use scan neutral
+  /// instead (HipJoint).
   explicit Session(const SessionOptions& options);
 
   const HipJoint& hip() const { return *hip_; }
