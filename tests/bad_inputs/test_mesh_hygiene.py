@@ -161,3 +161,110 @@ def test_holes_are_counted(generated, tmp_path):
     assert r.returncode == 0, r.stderr
     m = json.load(open(tmp_path / "o" / "summary.json"))["meshes"]["pelvis"]
     assert m["holes"] == 1 and m["boundary_edges"] == 3, m
+
+
+def read_gaps(path):
+    """(X: n x 3 input frame mm, distance_mm, sign_undecided) of a gaps PLY."""
+    with open(path, "rb") as f:
+        head = b""
+        while not head.endswith(b"end_header\n"):
+            head += f.readline()
+        lines = head.decode().splitlines()
+        n = int(next(x for x in lines if x.startswith("element vertex")).split()[-1])
+        types = {"float": "<f4", "uchar": "u1"}
+        dt = np.dtype([(p[2], types[p[1]]) for p in (x.split() for x in lines)
+                       if p[0] == "property" and p[1] != "list"])
+        P = np.frombuffer(f.read(n * dt.itemsize), dtype=dt)
+    return np.stack([P["x"], P["y"], P["z"]], 1).astype(float), P["distance_mm"].astype(float), P["sign_undecided"]
+
+
+def brute_force_sides(V, F, X):
+    """For points X: the unsigned distance to the mesh (V, F), the side (+1 out, -1 in) by the closest face's normal
+    (outward by the volume's sign), and whether that is unambiguous: the closest point inside a face (not on an
+    edge or corner, where a hole's rim or a crease leaves the side open) and over 0.05 mm away. Open3D's closest
+    points (an independent implementation)."""
+    o3d = pytest.importorskip("open3d")
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(V.astype(np.float32), F.astype(np.uint32))
+    q = scene.compute_closest_points(o3d.core.Tensor(X.astype(np.float32)))
+    cp, tri, uv = q["points"].numpy().astype(float), q["primitive_ids"].numpy(), q["primitive_uvs"].numpy()
+    a, b, c = V[F[tri, 0]], V[F[tri, 1]], V[F[tri, 2]]
+    volume = np.einsum("ij,ij->", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])) / 6
+    side = np.sign(np.einsum("ij,ij->i", X - cp, np.cross(b - a, c - a))) * np.sign(volume)
+    dist = np.linalg.norm(X - cp, axis=1)
+    w = np.stack([1 - uv[:, 0] - uv[:, 1], uv[:, 0], uv[:, 1]], 1)
+    return dist, side, (w > 1e-3).all(axis=1) & (dist > 0.05)
+
+
+def holed_cup(subject, tmp, count):
+    """`subject` with the `count` pelvis triangles nearest the femoral head's centre removed (a hole in the
+    acetabulum), and that centre (input frame, mm)."""
+    r = run(["distance", "--subject", subject, "--precision", "1", "--pose", "0,0,0", "--out", tmp / "c"])
+    assert r.returncode == 0, r.stderr
+    centre = np.array(json.load(open(tmp / "c" / "summary.json"))["head_centre_mm"])
+
+    def cut(V, F):
+        return V, np.delete(F, np.argsort(np.linalg.norm(V[F].mean(axis=1) - centre, axis=1))[:count], axis=0)
+    return with_bone(subject, tmp, "holed", "pelvis", cut)
+
+
+def check_signs_against_brute_force(subject, clean, tmp, poses):
+    """At each pose: no femoral vertex's sign differs from the brute-force side where that is unambiguous; every
+    vertex the mesh cannot decide is flagged, read >= 0, and counted in summary.json; and where the `clean` subject
+    has no vertex inside the pelvis, neither has the holed one (removing bone cannot make an overlap). Returns the
+    flags' total."""
+    s = json.load(open(subject))
+    V, F = read_ply(s["pelvis"])
+    flagged = 0
+    for k, pose in enumerate(poses):
+        out = tmp / f"p{k}"
+        r = run(["distance", "--subject", subject, "--precision", "0.5", "--pose", pose, "--out", out])
+        assert r.returncode == 0, r.stderr
+        X, d, undecided = read_gaps(out / "femur_gaps.ply")
+        ok = np.isfinite(d)
+        dist, side, clear = brute_force_sides(V, F, X[ok])
+        assert np.abs(dist - np.abs(d[ok])).max() < 1e-3
+        wrong = clear & (np.sign(d[ok]) != side)
+        assert not wrong.any(), (pose, d[ok][wrong][:5], (side * dist)[wrong][:5])
+        assert (d[ok][undecided[ok] == 1] >= 0).all()
+        summary = json.load(open(out / "summary.json"))
+        assert summary["femur"]["distance_signs_undecided"] == int(undecided.sum())
+        flagged += int(undecided.sum())
+        r = run(["distance", "--subject", clean, "--precision", "0.5", "--pose", pose, "--out", tmp / f"c{k}"])
+        before = json.load(open(tmp / f"c{k}" / "summary.json"))["femur"]["min_distance_mm"]
+        if before > 0:
+            assert summary["femur"]["min_distance_mm"] >= 0, (pose, before, summary["femur"]["min_distance_mm"])
+    return flagged
+
+
+@pytest.mark.skipif(not os.path.exists(SUBJECT), reason="shared data absent")
+def test_a_hole_in_the_acetabulum_flips_no_sign(tmp_path):
+    """Issue 80: 1,500 acetabular triangles removed on lhdl-ct read femoral vertices up to 3.99 mm in front of the
+    hole as 3.99 mm inside the pelvis. Now no sign differs from a brute-force closest point where that is
+    unambiguous, the vertices the mesh cannot decide are flagged, and the joint centre's warning names the hole."""
+    subject = holed_cup(SUBJECT, tmp_path, 1500)
+    assert check_signs_against_brute_force(subject, SUBJECT, tmp_path, ["60,10,20", "0,0,0", "100,0,20"]) > 0
+    r = run(["rom", "--subject", subject, "--precision", "1", "--no-map", "--out", tmp_path / "rom"])
+    assert r.returncode == 0 and "a hole in the acetabulum" in r.stderr, r.stderr
+
+
+def test_a_hole_in_the_generated_cup_flips_no_sign(generated, tmp_path):
+    subject = holed_cup(generated, tmp_path, 120)
+    check_signs_against_brute_force(subject, generated, tmp_path, ["0,0,0", "40,10,20"])
+    m = json.load(open(tmp_path / "p0" / "summary.json"))["meshes"]["pelvis"]
+    assert m["holes"] >= 1 and m["boundary_edges"] > 0, m
+
+
+def test_a_hole_in_the_femoral_head_does_not_block_the_fit(generated, tmp_path):
+    """Issue 80: a 60-triangle hole in the head was refused as 'a COR in the wrong frame or units?'. The COR is
+    inside the femur by the winding number: a warning, and the run goes on."""
+    r = run(["distance", "--subject", generated, "--precision", "1", "--pose", "0,0,0", "--out", tmp_path / "c"])
+    centre = np.array(json.load(open(tmp_path / "c" / "summary.json"))["head_centre_mm"])
+
+    def cut(V, F):
+        top = centre + [0, 0, 100]
+        return V, np.delete(F, np.argsort(np.linalg.norm(V[F].mean(axis=1) - top, axis=1))[:30], axis=0)
+    subject = with_bone(generated, tmp_path, "hh", "femur", cut)
+    r = run(["distance", "--subject", subject, "--precision", "1", "--pose", "20,0,0", "--out", tmp_path / "o"])
+    assert r.returncode == 0, r.stderr
+    assert "meet no femur surface (a hole in the femur; the COR is inside it by the winding number" in r.stderr

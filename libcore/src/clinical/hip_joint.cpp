@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "impinge/core/error.hpp"
+#include "impinge/core/mesh_hygiene.hpp"
 #include "impinge/core/timing.hpp"
 #include "impinge/maps/map_io.hpp"
 
@@ -50,6 +51,12 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     lunate.band_mm = kLunateBandMm;
     lunate.scan_head_centre = -(to_joint * seat_);
     centre_ = JointCentre(method, *joint_, lunate, articular_->pelvis, articular_->head_sphere_reach_mm, equidistant);
+    const std::int64_t rim = boundary_edges_within(joint_->socket().mesh, lunate.centre, lunate.radius_mm + lunate.band_mm);
+    if (rim > 0)  // a hole in the lunate surface: the centre is fitted to what is left of it (issue 80)
+      warnings_.push_back(joint_->socket().mesh.source + ": a hole in the acetabulum (" + std::to_string(rim) +
+                          " boundary edges within its sphere): the " + to_string(method) +
+                          " joint centre is fitted to the lunate surface left, and moves with the hole; "
+                          "--joint-centre femoral-head does not use it");
     centre_.guard_at_neutral(*joint_, femur_rotation({}));  // no head pressed into the socket at neutral
   }
   if (socket_clock_) {
@@ -144,13 +151,24 @@ void HipJoint::build_joint(TriangleMesh femur, TriangleMesh pelvis, const HipJoi
                  load(options.ball_map_file), load(options.socket_map_file));
 }
 
-void HipJoint::check_cor_inside_femur(const HipJointOptions& options) const {
+void HipJoint::check_cor_inside_femur(const HipJointOptions& options) {
   // The COR must lie inside the femur: then every ray from it meets the femur's surface.
   const RadialDistanceMap& bm = joint_->ball().map;
   // (Counted when the map was filled: a sparse map with a finite region reads "no surface" beyond it.)
   const double uncovered = 1.0 - double(joint_->ball().sampling.nodes_covered) / double(bm.num_nodes());
   const Eigen::Vector3d reported_cor = options.to_report * cor_;
-  if (uncovered > 1e-4 && !options.allow_cor_outside_ball)
+  if (uncovered <= 1e-4 || options.allow_cor_outside_ball) return;
+  // A hole in the femur (a segmentation's gap in the head): the rays through it meet no surface, but the COR is
+  // inside by the winding number (1 less the hole's solid angle / 4 pi; outside, under 1/2).
+  const double w = std::abs(winding_number(joint_->ball().mesh, Eigen::Vector3d::Zero()));
+  if (w >= 0.5) {
+    warnings_.push_back(joint_->ball().mesh.source + ": " + std::to_string(100 * uncovered) +
+                        " % of the directions from the centre of rotation meet no femur surface (a hole in the "
+                        "femur; the COR is inside it by the winding number, " + std::to_string(w) +
+                        "): pelvis vertices in those directions have no radial gap");
+    return;
+  }
+  if (uncovered > 1e-4)
     throw Error(joint_->ball().mesh.source + ": the centre of rotation (" + std::to_string(reported_cor.x()) + ", " +
                 std::to_string(reported_cor.y()) + ", " + std::to_string(reported_cor.z()) + ") mm" +
                 (options.report_frame_name.empty() ? "" : " (" + options.report_frame_name + ")") +

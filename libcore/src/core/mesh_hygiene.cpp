@@ -283,6 +283,36 @@ void count_holes(const TriangleMesh& mesh, MeshHygiene& out) {
     out.boundary_loops += on_boundary[v] != 0 && find_root(parent, static_cast<int>(v)) == static_cast<int>(v);
 }
 
+std::int64_t boundary_edges_within(const TriangleMesh& mesh, const Eigen::Vector3d& centre, double radius_mm) {
+  std::vector<std::pair<int, int>> e;
+  e.reserve(static_cast<std::size_t>(3 * mesh.F.rows()));
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
+      e.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  std::sort(e.begin(), e.end());
+  auto near = [&](int v) { return (mesh.V.row(v).transpose() - centre).norm() <= radius_mm; };
+  std::int64_t n = 0;
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    const bool once = (i == 0 || e[i - 1] != e[i]) && (i + 1 == e.size() || e[i + 1] != e[i]);
+    n += once && near(e[i].first) && near(e[i].second);
+  }
+  return n;
+}
+
+double winding_number(const TriangleMesh& mesh, const Eigen::Vector3d& q) {
+  double sum = 0;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose() - q, b = mesh.V.row(mesh.F(f, 1)).transpose() - q,
+                          c = mesh.V.row(mesh.F(f, 2)).transpose() - q;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    sum += 2 * std::atan2(a.dot(b.cross(c)), den);
+  }
+  return sum / (4 * M_PI);
+}
+
 std::vector<std::string> MeshHygiene::warnings(const std::string& source) const {
   std::vector<std::string> w;
   if (!dropped.empty()) {

@@ -167,7 +167,7 @@ class HipJoint {
                      const HipJointOptions& options, JointCentreMethod method);
   void seat_femur(TriangleMesh& femur, const SphereFitResult& sphere, const HipJointOptions& options);
   void build_joint(TriangleMesh femur, TriangleMesh pelvis, const HipJointOptions& options);
-  void check_cor_inside_femur(const HipJointOptions& options) const;
+  void check_cor_inside_femur(const HipJointOptions& options);
 
   Side side_;
   Neutral neutral_;

@@ -72,4 +72,15 @@ MeshHygiene clean_bone_mesh(TriangleMesh& mesh, const std::string& source, bool 
 /// boundary_loops. O(m log m).
 void count_holes(const TriangleMesh& mesh, MeshHygiene& out);
 
+/// The boundary edges (of one face) of `mesh` whose two ends lie within `radius_mm` of `centre` (mm, the mesh's
+/// frame): a hole there (e.g. in the lunate surface, which the acetabular and equidistant joint centres are fitted
+/// to). O(m log m).
+std::int64_t boundary_edges_within(const TriangleMesh& mesh, const Eigen::Vector3d& centre, double radius_mm);
+
+/// The generalised winding number of `mesh` at q (mm; Jacobson, Kavan & Sorkine-Hornung 2013, solid angles by van
+/// Oosterom & Strackee 1983), exact: the sum over every triangle, O(m). +-1 inside a closed surface (the sign is
+/// the winding's), 0 outside; a hole of solid angle W seen from q moves it by W / 4 pi. For a one-off test (is a
+/// point inside a bone with holes?); SignedDistanceQuery has the hierarchical one for many points.
+double winding_number(const TriangleMesh& mesh, const Eigen::Vector3d& q);
+
 }  // namespace impinge
