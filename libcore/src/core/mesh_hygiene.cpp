@@ -253,51 +253,59 @@ std::string describe(const MeshFragment& f) {
 
 }  // namespace
 
-void count_holes(const TriangleMesh& mesh, MeshHygiene& out) {
-  std::vector<std::pair<int, int>> e;
-  e.reserve(static_cast<std::size_t>(3 * mesh.F.rows()));
+namespace {
+// The undirected edges of `mesh` used by one face (boundary) and the count of those used by three or more
+// (non-manifold): the edges grouped by their lower corner (a counting sort), each group sorted (a vertex's few
+// neighbours). O(m).
+std::vector<std::pair<int, int>> boundary_edge_list(const TriangleMesh& mesh, std::int64_t* nonmanifold) {
+  const auto n = static_cast<std::size_t>(mesh.V.rows());
+  std::vector<int> start(n + 1, 0), other(static_cast<std::size_t>(3 * mesh.F.rows()));
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) ++start[static_cast<std::size_t>(std::min(mesh.F(f, k), mesh.F(f, (k + 1) % 3))) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<int> fill(start.begin(), start.end() - 1);
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
     for (int k = 0; k < 3; ++k) {
       const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
-      e.emplace_back(std::min(a, b), std::max(a, b));
+      other[static_cast<std::size_t>(fill[static_cast<std::size_t>(std::min(a, b))]++)] = std::max(a, b);
     }
-  std::sort(e.begin(), e.end());
+  std::vector<std::pair<int, int>> out;
+  if (nonmanifold != nullptr) *nonmanifold = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    const auto b = other.begin() + start[v], e = other.begin() + start[v + 1];
+    std::sort(b, e);
+    for (auto i = b; i != e;) {
+      auto j = i;
+      while (j != e && *j == *i) ++j;
+      if (j - i == 1) out.emplace_back(static_cast<int>(v), *i);
+      if (j - i >= 3 && nonmanifold != nullptr) ++*nonmanifold;
+      i = j;
+    }
+  }
+  return out;
+}
+}  // namespace
+
+void count_holes(const TriangleMesh& mesh, MeshHygiene& out) {
+  const std::vector<std::pair<int, int>> edges = boundary_edge_list(mesh, &out.nonmanifold_edges);
   std::vector<int> parent(static_cast<std::size_t>(mesh.V.rows()));
   std::iota(parent.begin(), parent.end(), 0);
   std::vector<std::uint8_t> on_boundary(parent.size(), 0);
-  out.boundary_edges = out.nonmanifold_edges = out.boundary_loops = 0;
-  for (std::size_t i = 0; i < e.size();) {
-    std::size_t j = i;
-    while (j < e.size() && e[j] == e[i]) ++j;
-    if (j - i >= 3) ++out.nonmanifold_edges;
-    if (j - i == 1) {
-      ++out.boundary_edges;
-      const auto [a, b] = e[i];
-      on_boundary[static_cast<std::size_t>(a)] = on_boundary[static_cast<std::size_t>(b)] = 1;
-      const int ra = find_root(parent, a), rb = find_root(parent, b);
-      if (ra != rb) parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-    }
-    i = j;
+  for (const auto& [a, b] : edges) {
+    on_boundary[static_cast<std::size_t>(a)] = on_boundary[static_cast<std::size_t>(b)] = 1;
+    const int ra = find_root(parent, a), rb = find_root(parent, b);
+    if (ra != rb) parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
   }
+  out.boundary_edges = static_cast<std::int64_t>(edges.size());
+  out.boundary_loops = 0;
   for (std::size_t v = 0; v < parent.size(); ++v)
     out.boundary_loops += on_boundary[v] != 0 && find_root(parent, static_cast<int>(v)) == static_cast<int>(v);
 }
 
 std::int64_t boundary_edges_within(const TriangleMesh& mesh, const Eigen::Vector3d& centre, double radius_mm) {
-  std::vector<std::pair<int, int>> e;
-  e.reserve(static_cast<std::size_t>(3 * mesh.F.rows()));
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
-      e.emplace_back(std::min(a, b), std::max(a, b));
-    }
-  std::sort(e.begin(), e.end());
   auto near = [&](int v) { return (mesh.V.row(v).transpose() - centre).norm() <= radius_mm; };
   std::int64_t n = 0;
-  for (std::size_t i = 0; i < e.size(); ++i) {
-    const bool once = (i == 0 || e[i - 1] != e[i]) && (i + 1 == e.size() || e[i + 1] != e[i]);
-    n += once && near(e[i].first) && near(e[i].second);
-  }
+  for (const auto& [a, b] : boundary_edge_list(mesh, nullptr)) n += near(a) && near(b);
   return n;
 }
 
