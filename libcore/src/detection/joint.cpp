@@ -296,6 +296,18 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
   detect(R, t, res, nullptr);
 }
 
+namespace {
+// One body's signed distances at a pose into `out` (distance_mm, the undecided signs and the counts): scan_distances.
+void measure_distances(const DistanceScanSet& set, const Eigen::Matrix3d& Rq, const Eigen::Vector3d& tq,
+                       const Eigen::Vector3d& cor, const SignedDistanceQuery& other, double reach_mm,
+                       DistanceScanMemory* mem, ScanGaps& out) {
+  const DistanceScanStats ds =
+      scan_distances(set, Rq, tq, cor, other, reach_mm, out.gap_mm, out.distance_mm, mem, &out.distance_sign_undecided);
+  out.distance_winding = ds.winding;
+  out.distance_undecided = ds.undecided;
+}
+}  // namespace
+
 void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResult& res, DetectionMemory* memory) const {
   require(!options_.needs_distance_queries() || (ball_.distance_query && socket_.distance_query),
           "joint: cropped_distance_queries is on and crop_distance_queries was not called before detect");
@@ -328,13 +340,10 @@ void Joint::detect(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, PoseResul
       expand_layered_scan(own.hidden_set, gaps.data(), out);
     }
     detection_ms = ms_since(t0);
+    distance_ms = 0;
     if (options_.distances) {
       t0 = std::chrono::steady_clock::now();
-      const DistanceScanStats ds = scan_distances(own.distance_set, Rq, tq, cor_, *other.distance_query,
-                                                  options_.reach_mm(), out.gap_mm, out.distance_mm, mem,
-                                                  &out.distance_sign_undecided);
-      out.distance_winding = ds.winding;
-      out.distance_undecided = ds.undecided;
+      measure_distances(own.distance_set, Rq, tq, cor_, *other.distance_query, options_.reach_mm(), mem, out);
       distance_ms = ms_since(t0);
     } else {
       out.distance_mm.clear();
