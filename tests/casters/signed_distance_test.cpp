@@ -290,11 +290,17 @@ TEST(SignedDistance, OpenMeshTheWindingNumberDecidesAtTheHole) {
     }
     ClosestSurfacePoint cp;
     ASSERT_TRUE(q.signed_distance(p, 100, 0, cp));
-    EXPECT_EQ(cp.sign, inside ? -1 : 1) << z;
+    // Where the winding number lies within 1/4 of 1/2 (z = 5 and 7: the hole fills 28 and 42 % of the view)
+    // and the rim is the closest feature, the mesh cannot tell: undecided, read as outside (issue 80; in front of
+    // a hole in an acetabulum the same numbers belong to points outside the bone).
+    const double w = q.winding_number(p);
+    const bool undecided = z > 3 && std::abs(w - 0.5) < 0.25;
+    EXPECT_EQ(undecided, z == 5.0 || z == 7.0) << z << " " << w;
+    EXPECT_EQ(cp.sign, inside && !undecided ? -1 : 1) << z;
     if (z > 3) {
-      // The rim is the closest feature: its pseudo-normal is not trusted, the winding number decides.
+      // The rim is the closest feature: its pseudo-normal is not trusted, the winding number decides if it can.
       EXPECT_NEAR(cp.distance_mm, std::hypot(rim_r, rim_z - z), 0.02) << z;
-      EXPECT_EQ(cp.rule, SignRule::winding_number) << z;
+      EXPECT_EQ(cp.rule, undecided ? SignRule::undecided : SignRule::winding_number) << z;
     }
   }
   // Far above the hole: outside, by the winding number.

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -170,21 +171,32 @@ TEST_P(RealSubject, ExactModeAgreesWithExactRayCastAtTenthDegree) {
 INSTANTIATE_TEST_SUITE_P(Shared, RealSubject, ::testing::Values("lhdl-ct", "mc22", "tlem2-mri"));
 
 namespace {
-/// gap_mm per vertex from a PLY written by write_gap_ply (x y z gap_mm quality level r g b).
+/// gap_mm per vertex from a PLY written by write_gap_ply, found by its name among the vertex properties (float 4
+/// bytes, uchar 1: the record's layout read from the header, whichever optional properties it has).
 std::vector<float> read_gap_ply(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   long n = -1;
-  while (std::getline(in, line) && line != "end_header")
-    if (line.rfind("element vertex ", 0) == 0) n = std::stol(line.substr(15));
-  std::vector<float> gaps;
-  for (long i = 0; i < n; ++i) {
-    float rec[5];
-    unsigned char extra[4];
-    in.read(reinterpret_cast<char*>(rec), sizeof rec);
-    in.read(reinterpret_cast<char*>(extra), sizeof extra);
-    gaps.push_back(rec[3]);
+  std::size_t record = 0, gap_at = 0;
+  bool in_vertex = false;
+  while (std::getline(in, line) && line != "end_header") {
+    std::istringstream w(line);
+    std::string kind, type, name;
+    w >> kind >> type >> name;
+    if (kind == "element") in_vertex = type == "vertex", n = in_vertex ? std::stol(name) : n;
+    if (kind != "property" || !in_vertex) continue;
+    if (name == "gap_mm") gap_at = record;
+    record += type == "float" ? 4 : 1;
   }
+  std::vector<float> gaps;
+  std::vector<char> rec(record);
+  for (long i = 0; i < n; ++i) {
+    in.read(rec.data(), static_cast<std::streamsize>(record));
+    float g;
+    std::memcpy(&g, rec.data() + gap_at, sizeof g);
+    gaps.push_back(g);
+  }
+  EXPECT_TRUE(in.good()) << path;
   return gaps;
 }
 }  // namespace

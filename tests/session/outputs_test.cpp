@@ -28,10 +28,11 @@ const Session& session() { return test::generated_session("LPS"); }
 
 struct PlyVertex {
   float x, y, z, gap, quality, distance;
-  std::uint8_t level;
+  std::uint8_t level, undecided = 0;
 };
 
-// The vertices of a PLY that write_gap_ply wrote (binary: x y z gap_mm quality [distance_mm] level r g b).
+// The vertices of a PLY that write_gap_ply wrote (binary: x y z gap_mm quality [distance_mm sign_undecided] level r
+// g b).
 std::vector<PlyVertex> read_gap_ply(const std::string& path, bool with_distance) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
@@ -43,9 +44,10 @@ std::vector<PlyVertex> read_gap_ply(const std::string& path, bool with_distance)
     float f[6];
     in.read(reinterpret_cast<char*>(f), static_cast<std::streamsize>(sizeof(float) * (with_distance ? 6 : 5)));
     p = {f[0], f[1], f[2], f[3], f[4], with_distance ? f[5] : std::nanf("")};
-    char rest[4];
-    in.read(rest, 4);
-    p.level = static_cast<std::uint8_t>(rest[0]);
+    char rest[5];
+    in.read(rest, with_distance ? 5 : 4);
+    p.undecided = with_distance ? static_cast<std::uint8_t>(rest[0]) : 0;
+    p.level = static_cast<std::uint8_t>(rest[with_distance ? 1 : 0]);
   }
   EXPECT_TRUE(in.good()) << path;
   return v;
@@ -74,6 +76,7 @@ TEST(Outputs, PosePlysHoldEveryVertexPosedWithItsGapAndLevel) {
       EXPECT_LT((p - P.row(static_cast<Eigen::Index>(i)).transpose()).norm(), 1e-4) << i;
       EXPECT_TRUE(same_float(v[i].gap, g.gap_mm[i])) << i;
       EXPECT_TRUE(same_float(v[i].distance, g.distance_mm[i])) << i;
+      EXPECT_EQ(v[i].undecided, g.distance_sign_undecided[i]) << i;
       // The level by brute force: the levels' quantity (the distance where distances are on), 255 without one.
       const float q = g.distance_mm[i];
       const std::uint8_t want = std::isnan(q) ? (std::isnan(g.gap_mm[i]) ? 255 : 0) : levels.level(q);
