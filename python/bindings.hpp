@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <functional>
 #include <memory>
 #include <typeinfo>
 #include <string>
@@ -89,6 +90,14 @@ void bind_options(py::module_& m);
 std::string keywords_doc(unsigned use);
 // A docstring kept for the module's lifetime (pybind11 keeps the pointer it is given).
 const char* keep_doc(std::string doc);
+
+// ---- interrupt.cpp: Ctrl-C in long calls (issue 80) ----
+// Runs `work` with the GIL released, the library's loops asking Python whether a signal arrived (InterruptScope,
+// core/interrupt.hpp: PyErr_CheckSignals with the GIL taken back, at most every 50 ms, on this thread). A signal's
+// exception (KeyboardInterrupt for Ctrl-C) stops the loops and is raised here, whatever `work` threw or returned
+// meanwhile; else `work`'s own error, if any. Only on Python's main thread (the one signal handlers run on);
+// elsewhere `work` runs without the GIL and without polling.
+void run_interruptible(const std::function<void()>& work);
 
 // ---- joint.cpp ----
 void bind_joint(py::module_& m);

@@ -3,7 +3,8 @@
 //
 // Arrays: vertices are float64 (or float32) n x 3 in mm, faces integer m x 3 (0-based); results
 // are numpy arrays that own the C++ buffers they were computed in (no copy). Errors are raised as
-// impinge.Error (a ValueError) with the library's one-line messages. Long calls release the GIL.
+// impinge.Error (a ValueError) with the library's one-line messages. Long calls release the GIL and stop on
+// Ctrl-C (run_interruptible: KeyboardInterrupt).
 #include <omp.h>
 
 #include "bindings.hpp"
