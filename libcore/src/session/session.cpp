@@ -314,6 +314,56 @@ void check_side_and_frame(const LoadedInput& in, const Eigen::Vector3d& head, co
   });
 }
 
+namespace {
+std::string mm1(double x) {  // x mm to 0.1 mm, rounded up (a least value to give)
+  char t[32];
+  std::snprintf(t, sizeof t, "%.1f", std::ceil(x * 10) / 10);
+  return t;
+}
+double nearest_vertex_mm(const Vertices& V, const Eigen::Vector3d& centre) {
+  return V.rows() == 0 ? 0.0 : std::sqrt((V.rowwise() - centre.transpose()).rowwise().squaredNorm().minCoeff());
+}
+
+// --max-radius and --sparse (issue 80) bound where contacts are tested: vertices within max-radius of the COR, maps
+// holding only the tiles with a surface within sparse of it. A value below either bone's nearest vertex leaves
+// that bone untested (max-radius) or its map empty (sparse): every gap untested or "no surface", every motion free.
+// An error naming the option, the value and both bones' nearest vertices, before the maps are built.
+void check_tested_region(const JointOptions& o, const LoadedInput& in, const Eigen::Vector3d& cor) {
+  const double femur = nearest_vertex_mm(in.femur.V, cor), pelvis = nearest_vertex_mm(in.pelvis.V, cor);
+  const double need = std::max(femur, pelvis);
+  auto check = [&](const std::string& option, double value, const std::string& verb, const std::string& instead) {
+    require(!(value < need), [&] {
+      const bool both = value < femur && value < pelvis;
+      const std::string bone = both || value < femur ? "femur" : "pelvis";
+      return option + " " + num(value) + " mm " + verb + " the " + bone + " (its nearest vertex is " +
+             mm1(bone == "femur" ? femur : pelvis) + " mm from the COR)" +
+             (both ? " nor of the pelvis (" + mm1(pelvis) + " mm)" : std::string()) +
+             ": no contact can be found; give at least " + mm1(need) +
+             " mm (more for the acetabular rim and beyond: cam, pincer and extra-articular contacts), " + instead;
+    });
+  };
+  if (std::isfinite(o.max_radius_mm))
+    check("--max-radius", o.max_radius_mm, "reaches no vertex of", "or 0 (every vertex)");
+  if (o.sparse_maps && std::isfinite(o.sparse_region_mm))
+    check("--sparse", o.sparse_region_mm, "keeps no surface of", "'inf' (every surface: the same gaps) or 0 (dense maps)");
+}
+
+// A value that reaches the joint surfaces but not the acetabular rim (anatomical neutral, where the rim is found):
+// contacts at the rim and beyond go untested, the gaps within it are right. A warning.
+void warn_region_inside_rim(const JointOptions& o, const HipJoint& hip, std::vector<std::string>& warnings) {
+  if (!hip.acetabulum()) return;
+  const double rim = hip.acetabulum()->rim_radius_mm;
+  const std::string where = " mm ends inside the acetabular rim (" + mm1(rim) + " mm from the centre): ";
+  if (std::isfinite(o.max_radius_mm) && o.max_radius_mm < rim)
+    warnings.push_back("--max-radius " + num(o.max_radius_mm) + where +
+                       "contacts at the rim and beyond (cam, pincer, extra-articular) are not tested; 0 tests every vertex");
+  if (o.sparse_maps && std::isfinite(o.sparse_region_mm) && o.sparse_region_mm < rim)
+    warnings.push_back("--sparse " + num(o.sparse_region_mm) + where +
+                       "the maps answer 'no surface' beyond it, so contacts at the rim and beyond (cam, pincer, "
+                       "extra-articular) may be missed; 'inf' keeps every surface");
+}
+}  // namespace
+
 Session::Session(const SessionOptions& options) : options_(options) {
   // The cheap options are checked before anything is read or built.
   hip_options_ = resolved_hip_options(options);
@@ -341,6 +391,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
   subject_name_ = in.name;
   cor_ = find_centre_of_rotation(in, options.cor);
   check_side_and_frame(in, cor_.head.centre, options.input);
+  check_tested_region(hip_options_.joint, in, cor_.head.centre);
   hip_options_.allow_cor_outside_ball = options.cor.allow_any;
   // A COR the user gave (--cor, cor=) is the femoral head centre the radial gaps are measured about at the
   // scan pose, whatever the joint-centre method: the maps stay about it, and the combined and equidistant
@@ -376,6 +427,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
   }
   warnings_ = load_warnings;
   for (const std::string& w : hip_->warnings()) warnings_.push_back(w);
+  warn_region_inside_rim(hip_options_.joint, *hip_, warnings_);
   // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).
   const FemurPose scan_pose = hip_->scan_pose();
   auto scan_result = std::make_shared<const PoseResult>(joint().detect(scan_pose.R, scan_pose.t));
