@@ -9,6 +9,7 @@
 #include <exception>
 #include <tuple>
 #include <limits>
+#include <new>
 #include <sstream>
 
 #include "impinge/anatomy/femur_frame.hpp"
@@ -364,11 +365,63 @@ void warn_region_inside_rim(const JointOptions& o, const HipJoint& hip, std::vec
 }
 }  // namespace
 
+namespace {
+// What a hip's set-up builds, for an out-of-memory error: both maps (scheme, resolution, nodes, memory), the layered
+// maps, the meshes' triangles; and how to build less.
+std::string what_is_built(const HipJointOptions& o, const LoadedInput& in) {
+  const SamplingScheme& s = *o.joint.scheme;
+  std::string t = "the maps at " + s.resolution_name() + " " + num(s.resolution()) + " (" + s.name() + ", " +
+                  std::to_string(s.num_nodes()) + " nodes each, about " +
+                  num(std::ceil(map_memory_bytes(s) / 1e8) / 10) + " GB for both) of " + in.femur_source + " (" +
+                  std::to_string(in.femur.F.rows()) + " triangles) and " + in.pelvis_source + " (" +
+                  std::to_string(in.pelvis.F.rows()) + " triangles)";
+  if (o.joint.layers > 0)
+    t += ", and layered maps of " + std::to_string(o.joint.layers) + " layers at --layered-spacing " +
+         (o.joint.layered_spacing_deg > 0 ? num(o.joint.layered_spacing_deg) + " deg" : std::string("the maps'"));
+  return t + "; coarsen --precision (or --resolution), give fewer --layers or a larger --layered-spacing, use "
+             "--query-strategy direct (no layered maps) for a few poses, or free memory";
+}
+
+// The hip built from `in` (its meshes moved in) about cor, cropped to the scan pose and `only_poses` when
+// o.joint.cropped_distance_queries. Errors: memory running out (std::bad_alloc, OutOfMemory) as OutOfMemory naming
+// what was built (what_is_built); any other Error with anatomical neutral's needs added.
+std::shared_ptr<const HipJoint> build_hip(LoadedInput& in, Side side, const CorResult& cor, const HipJointOptions& o,
+                                          const std::vector<PoseAngles>& only_poses) {
+  const std::string built = what_is_built(o, in);
+  try {
+    auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side, cor.head, in.landmarks, o);
+    if (o.joint.cropped_distance_queries) {
+      std::vector<FemurPose> poses{hip->scan_pose()};
+      for (const PoseAngles& a : only_poses) poses.push_back(hip->femur_pose(a));
+      hip->crop_distance_queries(poses);
+    }
+    return hip;
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemory("out of memory building " + built);
+  } catch (const OutOfMemory& e) {
+    throw OutOfMemory(std::string(e.what()) + " while building " + built);
+  } catch (const Error& e) {
+    if (o.neutral != Neutral::anatomical) throw;
+    throw Error(std::string(e.what()) +
+                " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan "
+                "uses the scan pose instead]");
+  }
+}
+}  // namespace
+
 Session::Session(const SessionOptions& options) : options_(options) {
   // The cheap options are checked before anything is read or built.
   hip_options_ = resolved_hip_options(options);
   check_map_memory(options, *hip_options_.joint.scheme);
-  LoadedInput in = load_input(options.input);
+  LoadedInput in;
+  try {
+    in = load_input(options.input);
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemory("out of memory reading the meshes (" +
+                      (options.input.subject.empty() ? options.input.ball + ", " + options.input.socket
+                                                     : options.input.subject) +
+                      "): they need more memory than is free; decimate them or free memory");
+  }
   const std::vector<std::string> load_warnings = in.warnings;
   // The naive ray cast tests every triangle for every node: refuse what would run for minutes.
   if (hip_options_.joint.sampling == SamplingMethod::ray_cast) {
@@ -410,21 +463,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
   }
   // One pose's work (SessionOptions::only_poses): the distance hierarchies cropped to it and the scan pose.
   hip_options_.joint.cropped_distance_queries = !options.only_poses.empty() && options.query_strategy == "direct";
-  try {
-    auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
-                                          hip_options_);
-    if (hip_options_.joint.cropped_distance_queries) {
-      std::vector<FemurPose> poses{hip->scan_pose()};
-      for (const PoseAngles& a : options.only_poses) poses.push_back(hip->femur_pose(a));
-      hip->crop_distance_queries(poses);
-    }
-    hip_ = std::move(hip);
-  } catch (const Error& e) {
-    if (neutral != Neutral::anatomical) throw;
-    throw Error(std::string(e.what()) +
-                " [anatomical neutral needs a whole femur and pelvis, or landmarks in subject.json; neutral scan "
-                "uses the scan pose instead]");
-  }
+  hip_ = build_hip(in, side_, cor_, hip_options_, options.only_poses);
   warnings_ = load_warnings;
   for (const std::string& w : hip_->warnings()) warnings_.push_back(w);
   warn_region_inside_rim(hip_options_.joint, *hip_, warnings_);
