@@ -6,7 +6,9 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <functional>
 #include <memory>
+#include <typeinfo>
 #include <string>
 #include <vector>
 
@@ -40,6 +42,14 @@ struct PyJoint {
   std::shared_ptr<const Session> session;
   const HipJoint& hip() const { return session->hip(); }
 };
+
+// ---- Uninitialised instances (issue 80) ----
+// T.__new__(T) makes an instance whose C++ value was never constructed; pybind11 would hand a method an
+// unconstructed object (a crash on first use). Throws TypeError naming the class when `src` is an instance of
+// the bound type `type` without its value (`origin`: where such objects come from, for the message); does
+// nothing for any other object. Every bound type's caster runs it (InitialisedCaster below), so every method and
+// property is guarded.
+void require_initialised(py::handle src, const std::type_info& type, const char* origin);
 
 // ---- convert.cpp: numpy and JSON ----
 // A numpy array's kind and shape checked: n x 3 (n >= min_rows); kind 'f' (float32/64) or 'i' (integers).
@@ -81,7 +91,39 @@ std::string keywords_doc(unsigned use);
 // A docstring kept for the module's lifetime (pybind11 keeps the pointer it is given).
 const char* keep_doc(std::string doc);
 
+// ---- interrupt.cpp: Ctrl-C in long calls (issue 80) ----
+// Runs `work` with the GIL released, the library's loops asking Python whether a signal arrived (InterruptScope,
+// core/interrupt.hpp: PyErr_CheckSignals with the GIL taken back, at most every 50 ms, on this thread). A signal's
+// exception (KeyboardInterrupt for Ctrl-C) stops the loops and is raised here, whatever `work` threw or returned
+// meanwhile; else `work`'s own error, if any. Only on Python's main thread (the one signal handlers run on);
+// elsewhere `work` runs without the GIL and without polling.
+void run_interruptible(const std::function<void()>& work);
+
 // ---- joint.cpp ----
 void bind_joint(py::module_& m);
 
 }  // namespace impinge::python
+
+namespace pybind11::detail {
+// The caster of a bound type that refuses an instance made by __new__ without __init__ (require_initialised)
+// before pybind11 would hand its unconstructed value to a method.
+// `origin` names where the type's objects come from.
+template <typename T, const char* origin>
+class InitialisedCaster : public type_caster_base<T> {
+ public:
+  bool load(handle src, bool convert) {
+    impinge::python::require_initialised(src, typeid(T), origin);
+    return type_caster_base<T>::load(src, convert);
+  }
+};
+// Every type the module binds (py::class_): Joint, Map, SphereFit.
+inline constexpr char kJointOrigin[] = "impinge.Joint(...)";
+inline constexpr char kMapOrigin[] = "Joint.femur_map or Joint.pelvis_map";
+inline constexpr char kSphereFitOrigin[] = "impinge.locate_femoral_head(...)";
+template <>
+class type_caster<impinge::python::PyJoint> : public InitialisedCaster<impinge::python::PyJoint, kJointOrigin> {};
+template <>
+class type_caster<impinge::python::MapView> : public InitialisedCaster<impinge::python::MapView, kMapOrigin> {};
+template <>
+class type_caster<impinge::SphereFitResult> : public InitialisedCaster<impinge::SphereFitResult, kSphereFitOrigin> {};
+}  // namespace pybind11::detail

@@ -6,6 +6,18 @@
 
 namespace impinge::python {
 
+void require_initialised(py::handle src, const std::type_info& type, const char* origin) {
+  py::detail::type_info* info = py::detail::get_type_info(type);
+  if (info == nullptr || src.ptr() == nullptr || !PyObject_TypeCheck(src.ptr(), info->type)) return;
+  auto* inst = reinterpret_cast<py::detail::instance*>(src.ptr());
+  const py::detail::value_and_holder v = inst->get_value_and_holder(info, false);
+  // Constructed: a value, and a holder wherever pybind11 owns the value (a reference it was handed has none).
+  if (v && v.value_ptr() != nullptr && (v.holder_constructed() || !inst->owned)) return;
+  const std::string name = py::str(py::handle(reinterpret_cast<PyObject*>(info->type)).attr("__name__"));
+  throw py::type_error("impinge." + name + " object is not initialised (made by " + name +
+                       ".__new__ without __init__); " + name + " objects come from " + origin);
+}
+
 py::array checked(const py::handle& obj, const std::string& what, char kind, py::ssize_t min_rows) {
   if (!py::isinstance<py::array>(obj))
     throw Error(what + ": expected a numpy array of shape (n, 3), got " + std::string(py::str(obj.get_type())));

@@ -3,7 +3,8 @@
 //
 // Arrays: vertices are float64 (or float32) n x 3 in mm, faces integer m x 3 (0-based); results
 // are numpy arrays that own the C++ buffers they were computed in (no copy). Errors are raised as
-// impinge.Error (a ValueError) with the library's one-line messages. Long calls release the GIL.
+// impinge.Error (a ValueError) with the library's one-line messages; running out of memory as MemoryError naming
+// what was being built. Long calls release the GIL and stop on Ctrl-C (run_interruptible: KeyboardInterrupt).
 #include <omp.h>
 
 #include "bindings.hpp"
@@ -227,6 +228,8 @@ PYBIND11_MODULE(_impinge, m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const OutOfMemory& e) {  // what was being built and how to build less: Python's MemoryError
+      PyErr_SetString(PyExc_MemoryError, e.what());
     } catch (const Error& e) {
       error(e.what());
     }

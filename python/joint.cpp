@@ -27,10 +27,7 @@ PyJoint make_joint(const py::object& ball, const py::object& socket, const py::k
   given["socket"] = socket;
   set_options(run, given, use_joint, "Joint");
   PyJoint j;
-  {
-    py::gil_scoped_release release;
-    j.session = std::make_shared<const Session>(run.session);
-  }
+  run_interruptible([&] { j.session = std::make_shared<const Session>(run.session); });
   for (const std::string& w : j.session->warnings())
     if (PyErr_WarnEx(PyExc_UserWarning, ("impinge: " + w).c_str(), 1) != 0) throw py::error_already_set();
   return j;
@@ -41,10 +38,7 @@ py::tuple joint_from_cli(const std::vector<std::string>& args) {
   RunOptions run = RunOptions::clinical();
   set_cli_options(run, args, use_view, "impinge view");
   PyJoint j;
-  {
-    py::gil_scoped_release release;
-    j.session = std::make_shared<const Session>(run.session);
-  }
+  run_interruptible([&] { j.session = std::make_shared<const Session>(run.session); });
   py::dict command;
   command["motion"] = run.command.motion.empty() ? py::object(py::none()) : py::object(py::str(run.command.motion));
   return py::make_tuple(j, command);
@@ -92,10 +86,8 @@ py::dict motion(const PyJoint& j, const py::handle& angles_obj) {
   Table t;
   t.columns = motion_columns(j.session->joint_options().levels);
   t.rows.reserve(poses.size());
-  {
-    py::gil_scoped_release release;
-    run_motion(*j.session, poses, {}, [&](const MotionFrame& f) { t.rows.push_back(motion_row(f)); });
-  }
+  run_interruptible(
+      [&] { run_motion(*j.session, poses, {}, [&](const MotionFrame& f) { t.rows.push_back(motion_row(f)); }); });
   py::dict d = table_columns(t);
   d["pelvis_penetrating_area_mm2"] = d["penetrating_area_mm2"];
   return d;
@@ -132,10 +124,7 @@ py::dict rom_limits(const PyJoint& j, const py::kwargs& given) {
   RomRequest q = rom_request(j, given, use_rom_limits, "rom_limits");
   q.map = false;
   RomRun run;
-  {
-    py::gil_scoped_release release;
-    run = run_rom(*j.session, q);
-  }
+  run_interruptible([&] { run = run_rom(*j.session, q); });
   const Table t = rom_limits_table(*j.session, run);
   py::dict d;
   for (std::size_t k = 0; k < t.rows.size(); ++k) {
@@ -167,10 +156,7 @@ py::dict plan(const PyJoint& j, const py::kwargs& given) {
   RunOptions run = RunOptions::clinical();
   set_options(run, given, use_joint_plan, "plan");
   PlanRun p;
-  {
-    py::gil_scoped_release release;
-    p = run_plan(j.session->options(), run.rom, run.plan);
-  }
+  run_interruptible([&] { p = run_plan(j.session->options(), run.rom, run.plan); });
   require(p.all_met || run.plan.allow_partial,
           "plan: a target is missed (give allow_partial=True to get the plan anyway): " + [&] {
             std::string s;
@@ -196,10 +182,7 @@ py::array_t<double> rom_map(const PyJoint& j, const py::kwargs& given) {
   RomRequest q = rom_request(j, given, use_rom_map, "rom_map");
   q.limits = false;
   RomRun run;
-  {
-    py::gil_scoped_release release;
-    run = run_rom(*j.session, q);
-  }
+  run_interruptible([&] { run = run_rom(*j.session, q); });
   std::vector<double> ir(run.map.size());
   for (std::size_t k = 0; k < run.map.size(); ++k) ir[k] = run.map[k].max_internal_rotation_deg;
   return own(std::move(ir), {py::ssize_t(run.map_flexion_deg.size()), py::ssize_t(run.map_adduction_deg.size())});
@@ -289,10 +272,7 @@ void add_joint_queries(py::class_<PyJoint>& c) {
           "morphology",
           [](const PyJoint& j) {
             MorphologyRun run;
-            {
-              py::gil_scoped_release release;
-              run = run_morphology(j.session->options());
-            }
+            run_interruptible([&] { run = run_morphology(j.session->options()); });
             return from_json(morphology_record(run));
           },
           "The hip's morphology (the CLI's morphology.json as a dict: femur and acetabulum, each measure's value, unit, "

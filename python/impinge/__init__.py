@@ -7,12 +7,12 @@ The package is the C++ extension `impinge._impinge` (every function and type, re
 Python: meshes from VTK files (`.vtp`, `.vtk`: OpenSim's bone geometry) through VTK's own readers, in
 `load_mesh` and wherever `Joint` takes a mesh file; and `impinge.study`, studies of many subjects, motions
 and perturbations on Dask (`/usr/bin/python3 -m impinge.study run STUDY.toml --out DIR`)."""
-import json as _json
 import os as _os
 
 from . import _impinge
 from ._impinge import *  # noqa: F401,F403 (the extension's functions and types)
 from ._impinge import Error, __version__  # noqa: F401
+from . import _json_file
 from . import vtk_meshes as _vtk_meshes
 
 VTK_SUFFIXES = (".vtp", ".vtk")
@@ -53,8 +53,7 @@ def subject_meshes(subject):
     to its folder); {} when it cannot be read (the extension then reports what is wrong with it)."""
     path = _os.fspath(subject)
     try:
-        with open(path) as f:
-            info = _json.load(f)
+        info = _json_file.load(path)
     except (OSError, ValueError):
         return {}
     folder = _os.path.dirname(_os.path.abspath(path))

@@ -3,13 +3,17 @@
 //    random directions from the COR of a generated hip socket (not star-shaped: nearest hit);
 //  - the rtcIntersect1 and 8-wide packet scans give the same gaps, equal to the exact radial gap;
 //  - fill_map equals the naive O(m n) ray cast (sample_naive) node by node;
-//  - a build without Embree throws a clear error.
+//  - a build without Embree throws a clear error;
+//  - Embree's error codes become errors naming what was being built; out of memory is OutOfMemory (issue 80).
 #include "impinge/casters/embree_ray_caster.hpp"
 #include "impinge/detection/detection.hpp"
 
 #include <gtest/gtest.h>
 
 #include <random>
+#if __has_include(<embree3/rtcore.h>)
+#include <embree3/rtcore.h>
+#endif
 
 #include "impinge/casters/exact_reference.hpp"
 #include "impinge/core/error.hpp"
@@ -102,4 +106,36 @@ TEST(EmbreeRayCaster, WithoutEmbreeTheErrorSaysSo) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("no Embree"), std::string::npos);
   }
+}
+
+// Issue 80: running out of memory inside Embree (RTC_ERROR_OUT_OF_MEMORY) was "embree: ... failed (RTCError 4)",
+// followed by the anatomical-neutral hint. It is OutOfMemory saying so and naming what was being built; any other
+// code an Error naming the code and its meaning.
+TEST(EmbreeRayCaster, ErrorCodesNameWhatWasBuiltAndOutOfMemoryIsSaidSo) {
+  const std::string what = "building the ray-casting hierarchy of femur.ply (70422 triangles)";
+  bool out_of_memory = false;
+  try {
+    throw_embree_error(4, what);
+  } catch (const OutOfMemory& e) {
+    out_of_memory = true;
+    EXPECT_EQ(std::string(e.what()), "out of memory " + what);
+  } catch (const Error& e) {
+    ADD_FAILURE() << e.what();
+  }
+  EXPECT_TRUE(out_of_memory);
+  for (const auto& [code, name] : std::vector<std::pair<int, std::string>>{
+           {1, "unknown"}, {2, "invalid argument"}, {3, "invalid operation"}, {5, "unsupported CPU"}, {6, "cancelled"},
+           {99, "not an Embree error code"}}) {
+    try {
+      throw_embree_error(code, what);
+    } catch (const OutOfMemory&) {
+      ADD_FAILURE() << code << " is not out of memory";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()),
+                "embree: " + what + " failed (RTCError " + std::to_string(code) + ": " + name + ")");
+    }
+  }
+#if __has_include(<embree3/rtcore.h>)
+  static_assert(RTC_ERROR_OUT_OF_MEMORY == 4 && RTC_ERROR_CANCELLED == 6);  // the codes the mapping names
+#endif
 }

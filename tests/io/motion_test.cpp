@@ -38,6 +38,34 @@ TEST(Motion, CsvColumnsByNameInAnyOrder) {
   EXPECT_EQ(m.angles[0].internal_rotation_deg, -3);
 }
 
+// Issue 80: a spreadsheet's CSV (a UTF-8 byte-order mark, every cell quoted, a quoted note holding commas and a
+// quote) was "missing column 'time_s'". It is the same motion as the plain file; a column truly missing is named
+// with the columns the header has; a quote left open or text after one is named with its column.
+TEST(Motion, CsvWithAByteOrderMarkAndQuotedCellsIsThePlainFile) {
+  const std::string d = temp_dir("motion_quoted");
+  write_text(d + "/plain.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg,note\n0,10,1.5,-3,a\n"
+                               "0.5,20.25,2,4,b\n");
+  write_text(d + "/sheet.csv", "\xEF\xBB\xBF\"time_s\", \"flexion_deg\",\"adduction_deg\",\"internal_rotation_deg\","
+                               "\"note\"\r\n\"0\",\"10\",\"1.5\",\"-3\",\"a, \"\"b\"\", c\"\r\n"
+                               "0.5,20.25 , 2,\"4\",\"\"\r\n");
+  const Motion plain = load_motion(d + "/plain.csv", Side::right);
+  const Motion sheet = load_motion(d + "/sheet.csv", Side::right);
+  ASSERT_EQ(sheet.frames(), 2u);
+  EXPECT_EQ(sheet.time_s, plain.time_s);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(sheet.angles[k].flexion_deg, plain.angles[k].flexion_deg);
+    EXPECT_EQ(sheet.angles[k].adduction_deg, plain.angles[k].adduction_deg);
+    EXPECT_EQ(sheet.angles[k].internal_rotation_deg, plain.angles[k].internal_rotation_deg);
+  }
+  write_text(d + "/time.csv", "\xEF\xBB\xBF\"time\",flexion_deg,adduction_deg,internal_rotation_deg\n0,1,2,3\n");
+  EXPECT_EQ(error_of(d + "/time.csv"), d + "/time.csv:1: missing column 'time_s' (the header's columns: 'time', "
+                                           "'flexion_deg', 'adduction_deg', 'internal_rotation_deg')");
+  write_text(d + "/open.csv", "time_s,flexion_deg,adduction_deg,internal_rotation_deg\n0,\"1,2,3\n");
+  EXPECT_EQ(error_of(d + "/open.csv"), d + "/open.csv:2: the quote opened at column 3 is not closed");
+  write_text(d + "/after.csv", "time_s,\"flexion\"_deg,adduction_deg,internal_rotation_deg\n0,1,2,3\n");
+  EXPECT_EQ(error_of(d + "/after.csv"), d + "/after.csv:1: text after the quoted cell at column 8: '_deg,adduction_deg,i'");
+}
+
 TEST(Motion, OpenSimDegreesRadiansSidesAndPathLabels) {
   const std::string d = temp_dir("motion_mot");
   write_text(d + "/a.mot", std::string(kMotHeader) +

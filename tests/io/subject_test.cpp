@@ -52,6 +52,41 @@ TEST(Subject, BadFilesNameFileAndKey) {
   EXPECT_THROW(load_subject(d + "/absent.json"), Error);
 }
 
+// Issue 80: nlohmann keeps the last of a key given twice, and `in >> j` stopped after the first value: both were
+// accepted without a word. A key twice (at any depth, named with the keys it sits under) and anything after the
+// object are errors naming the file and the key, or the line, column and offset.
+TEST(Subject, AKeyTwiceOrDataAfterTheObjectIsAnError) {
+  const std::string d = test::temp_dir("subject_strict");
+  auto message = [&](const std::string& body) -> std::string {
+    test::write_text(d + "/s.json", body);
+    try {
+      load_subject(d + "/s.json");
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  const std::string ok = R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p"})";
+  EXPECT_EQ(message(ok + "\n  \n"), "no error");  // white space after the object is no data
+  EXPECT_EQ(message(R"({"side": "right", "frame": "RAS", "side": "left", "femur": "f", "pelvis": "p"})"),
+            d + "/s.json: key 'side' appears twice: which value is meant?");
+  EXPECT_EQ(message(R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p",
+                       "landmarks": {"hip_centre": [1, 2, 3], "asis_left": [0, 0, 0], "hip_centre": [1, 2, 4]}})"),
+            d + "/s.json: key 'landmarks.hip_centre' appears twice: which value is meant?");
+  // The same key in two objects is no repeat.
+  EXPECT_EQ(message(R"({"side": "right", "frame": "RAS", "femur": "f", "pelvis": "p", "_a": {"side": 1},
+                       "_b": [{"side": 2}, {"side": 3}]})"),
+            "no error");
+  // Offsets counted by hand: the second object starts on line 2, column 3, 65 bytes in (62 + newline + two spaces).
+  EXPECT_EQ(message(ok + "\n  {\"side\": \"left\"}\n"),
+            d + "/s.json: line 2, column 3 (offset 65): '{\"side\": \"left\"}...' after the JSON object: a "
+                "subject file holds one object");
+  EXPECT_EQ(message(ok + " garbage"), d + "/s.json: line 1, column 64 (offset 63): 'garbage...' after the JSON "
+                                          "object: a subject file holds one object");
+  const std::string bad = message("{\n  \"side\": right}");
+  EXPECT_NE(bad.find("s.json: not valid JSON at line 2, column "), std::string::npos) << bad;
+}
+
 TEST(Subject, LandmarksAreReadInTheFilesFrame) {
   const std::string d = test::temp_dir("subject_landmarks");
   test::write_text(d + "/subject.json", R"({"side": "right", "frame": "LPS", "femur": "f.ply", "pelvis": "p.ply",

@@ -49,6 +49,30 @@ TEST(OptionTable, EveryRowCompleteAndNamedOnce) {
   EXPECT_EQ(option_table().front().name, "preset");  // applied first by every front end
 }
 
+// Issue 80: --triangles' help said it took 20 and up while the row refused below 50. A help text that states a
+// range ("[50, 20000000]", "(0, 90]") states the row's own, the one its values are checked against.
+TEST(OptionTable, ARangeInAHelpTextIsTheRowsRange) {
+  const std::regex written(R"([\[(](-?[0-9.e+]+|-?inf), (-?[0-9.e+]+|inf)\])");
+  int stated = 0;
+  for (const OptionRow& r : option_table()) {
+    if (r.type != OptionType::number && r.type != OptionType::integer) continue;
+    SCOPED_TRACE(r.name + ": " + r.help);
+    for (std::sregex_iterator m(r.help.begin(), r.help.end(), written), end; m != end; ++m, ++stated) {
+      EXPECT_EQ(std::stod((*m)[1]), r.min);
+      EXPECT_EQ(std::stod((*m)[2]), r.max);
+      EXPECT_EQ(m->str()[0] == '(', r.min_open);
+    }
+  }
+  EXPECT_GE(stated, 1);  // --triangles states its range
+  const OptionRow* triangles = find_option("triangles");
+  ASSERT_NE(triangles, nullptr);
+  EXPECT_NE(triangles->help.find("[50, 20000000]"), std::string::npos) << triangles->help;
+  RunOptions o = RunOptions::clinical();
+  EXPECT_NO_THROW(triangles->set(o, 50.0, "--triangles"));
+  EXPECT_EQ(error_of([&] { triangles->set(o, 49.0, "--triangles"); }),
+            "--triangles: 49 is outside the valid range [50, 20000000]");
+}
+
 TEST(OptionTable, NumbersReadBackAtBothEndsOfTheirRangeAndAreRefusedBeyond) {
   for (const OptionRow& r : option_table()) {
     if (r.type != OptionType::number && r.type != OptionType::integer) continue;

@@ -14,6 +14,14 @@
 
 namespace impinge {
 
+void throw_embree_error(int rtc_error, const std::string& what) {
+  if (rtc_error == 4) throw OutOfMemory("out of memory " + what);  // RTC_ERROR_OUT_OF_MEMORY
+  static const char* const names[] = {"none", "unknown", "invalid argument", "invalid operation", "out of memory",
+                                      "unsupported CPU", "cancelled"};
+  const char* name = rtc_error >= 0 && rtc_error <= 6 ? names[rtc_error] : "not an Embree error code";
+  throw Error("embree: " + what + " failed (RTCError " + std::to_string(rtc_error) + ": " + name + ")");
+}
+
 #ifdef IMPINGE_HAVE_EMBREE
 bool have_embree() { return true; }
 
@@ -27,7 +35,7 @@ struct EmbreeRayCaster::Impl {
   }
   void check(const std::string& what) const {
     const RTCError e = rtcGetDeviceError(device);
-    require(e == RTC_ERROR_NONE, "embree: " + what + " failed (RTCError " + std::to_string(int(e)) + ")");
+    if (e != RTC_ERROR_NONE) throw_embree_error(int(e), what);
   }
 };
 
@@ -38,7 +46,9 @@ EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d
   require(origin.allFinite(), "embree: origin is not finite (" + mesh.source + ")");
   impl_->device = rtcNewDevice(build == HierarchyBuild::fast ? "threads=1,tri_accel=bvh4.triangle4v,tri_builder=morton"
                                                              : "threads=1");
-  require(impl_->device != nullptr, "embree: rtcNewDevice failed");
+  // A device that could not be made (its threads, its memory): the error is the thread's (a null device's).
+  if (impl_->device == nullptr)
+    throw_embree_error(int(rtcGetDeviceError(nullptr)), "making the ray-casting device for " + mesh.source);
   impl_->scene = rtcNewScene(impl_->device);
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -58,7 +68,8 @@ EmbreeRayCaster::EmbreeRayCaster(const TriangleMesh& mesh, const Eigen::Vector3d
   impl_->filterable = robust;
 
   rtcCommitScene(impl_->scene);
-  impl_->check("building the scene of " + mesh.source);
+  impl_->check("building the ray-casting hierarchy of " + mesh.source + " (" + std::to_string(mesh.F.rows()) +
+               " triangles)");
 }
 
 EmbreeRayCaster::~EmbreeRayCaster() = default;

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "casters/signed_distance_impl.hpp"
+#include "impinge/casters/embree_ray_caster.hpp"
 #include "core/box_order.hpp"
 #include "impinge/core/error.hpp"
 
@@ -314,7 +315,8 @@ void build_embree_hierarchy(SignedDistanceQuery::Impl& m, const std::string& sou
   for (std::size_t t = 0; t < k; ++t) m.shift += (m.a[t] + m.b[t] + m.c[t]) / 3.0;
   if (k > 0) m.shift /= static_cast<double>(k);  // a crop may keep no triangle (an empty hierarchy)
   m.device = rtcNewDevice(nullptr);  // the build on every core; each query runs on its caller's thread
-  require(m.device != nullptr, "signed distance: rtcNewDevice failed (" + source + ")");
+  if (m.device == nullptr)
+    throw_embree_error(int(rtcGetDeviceError(nullptr)), "making the distance hierarchy's device for " + source);
   m.scene = rtcNewScene(m.device);
   for (std::size_t t = 0; t < k; ++t)
     for (const Eigen::Vector3d* p : {&m.a[t], &m.b[t], &m.c[t]}) m.extent = std::max(m.extent, (*p - m.shift).cwiseAbs().maxCoeff());
@@ -330,8 +332,9 @@ void build_embree_hierarchy(SignedDistanceQuery::Impl& m, const std::string& sou
   rtcReleaseGeometry(g);
   rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_MEDIUM);
   rtcCommitScene(m.scene);
-  require(rtcGetDeviceError(m.device) == RTC_ERROR_NONE,
-          "signed distance: building the hierarchy of " + source + " failed");
+  if (const RTCError e = rtcGetDeviceError(m.device); e != RTC_ERROR_NONE)
+    throw_embree_error(int(e), "building the distance hierarchy of " + source + " (" + std::to_string(k) +
+                                   " triangles)");
 }
 #elif defined(IMPINGE_HAVE_CGAL)
 // CGAL's AABB tree over the kept triangles (m.triangles: their corners, mm), with its distance queries' tree.

@@ -10,6 +10,7 @@
 #include "impinge/casters/exact_reference.hpp"
 #include "impinge/casters/signed_distance.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/interrupt.hpp"
 
 namespace impinge {
 
@@ -314,6 +315,7 @@ void plan_round(ResectionPlan& plan, const ResectionOptions& o, BoneState (&bone
   std::fill(pose_blocked.begin(), pose_blocked.end(), Blocked::no);
   plan.residual_mm = 0;
   for (int it = 0; it < o.max_iterations; ++it) {
+    interruption_point();  // a front end's stop (Ctrl-C in Python), between the iterations
     plan.iterations = it + 1;
     bone[0].rebuild_query("femur");
     bone[1].rebuild_query("pelvis");
@@ -337,10 +339,8 @@ void plan_round(ResectionPlan& plan, const ResectionOptions& o, BoneState (&bone
     }
     std::vector<double> need[2] = {std::vector<double>(bone[0].depth.size(), 0.0),
                                    std::vector<double>(bone[1].depth.size(), 0.0)};
-    const double residual = share_deficits(contacts, bone, o.tolerance_mm, need, pose_blocked);
-    plan.residual_mm = residual;
-    if (residual <= o.tolerance_mm) break;
-    if (it + 1 == o.max_iterations) break;
+    plan.residual_mm = share_deficits(contacts, bone, o.tolerance_mm, need, pose_blocked);
+    if (plan.residual_mm <= o.tolerance_mm || it + 1 == o.max_iterations) break;
     for (int b = 0; b < 2; ++b) {  // the burr (file comment, step 3) on the depths asked so far
       if (!bone[b].allowed) continue;
       for (std::size_t i = 0; i < need[b].size(); ++i) bone[b].required[i] += need[b][i];

@@ -9,6 +9,7 @@
 
 #include "clinical/rom_gap_scanner.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/interrupt.hpp"
 
 namespace impinge {
 using namespace rom_detail;
@@ -135,6 +136,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
     return std::pair{R, hip.joint_translation(R)};
   };
   auto gap_at = [&](double theta, bool exact = false) {
+    interruption_point();  // a front end's stop (Ctrl-C in Python), between the search's poses
     ++out.evaluations;
     const auto [R, t] = pose_at(theta);
     return scan(R, t, exact);

@@ -6,6 +6,7 @@
 #include "clinical/rom_gap_scanner.hpp"
 #include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/interrupt.hpp"
 
 namespace impinge {
 using namespace rom_detail;
@@ -146,6 +147,7 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
         const Eigen::Matrix3d R =
             hip.femur_rotation(PoseAngles{out.flexion_deg[i], out.adduction_deg[j], out.internal_rotation_deg[k]});
         try {
+          interruption_point();  // a front end's stop (Ctrl-C in Python)
           state[p] = scan(R, hip.joint_translation(R), false).gap > cut_of(o) ? 1 : 0;
         } catch (const std::exception& err) {
 #pragma omp critical(rom_envelope_error)

@@ -23,13 +23,51 @@ std::string trim(const std::string& s) {
   return s.substr(a, b - a);
 }
 
-std::vector<std::string> split(const std::string& line, bool csv) {
+// The cells of a CSV row (RFC 4180): comma-separated, each trimmed; a cell in double quotes may hold commas and ""
+// for a quote, and is the text inside them ("time_s" is the column time_s). Errors name `path` and `line_no`.
+std::vector<std::string> csv_cells(const std::string& line, const std::string& path, std::size_t line_no) {
+  const auto where = [&] { return path + ":" + std::to_string(line_no); };
+  std::vector<std::string> out;
+  std::size_t i = 0;
+  for (;;) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    std::string cell;
+    if (i < line.size() && line[i] == '"') {
+      const std::size_t open = i++;
+      for (;; ++i) {
+        require(i < line.size(), [&] {
+          return where() + ": the quote opened at column " + std::to_string(open + 1) + " is not closed";
+        });
+        if (line[i] == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+          cell += '"', ++i;
+        } else if (line[i] == '"') {
+          break;
+        } else {
+          cell += line[i];
+        }
+      }
+      ++i;  // past the closing quote: only blanks may come before the next comma
+      while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+      require(i == line.size() || line[i] == ',', [&] {
+        return where() + ": text after the quoted cell at column " + std::to_string(open + 1) + ": '" +
+               line.substr(i, 20) + "'";
+      });
+    } else {
+      const std::size_t comma = std::min(line.find(',', i), line.size());
+      cell = trim(line.substr(i, comma - i));
+      i = comma;
+    }
+    out.push_back(std::move(cell));
+    if (i >= line.size()) break;
+    ++i;  // past the comma: a cell follows (empty at the end of the line)
+  }
+  return out;
+}
+
+std::vector<std::string> split(const std::string& line, bool csv, const std::string& path, std::size_t line_no) {
   std::vector<std::string> out;
   if (csv) {
-    std::stringstream ss(line);
-    std::string item;
-    while (std::getline(ss, item, ',')) out.push_back(trim(item));
-    if (!line.empty() && line.back() == ',') out.emplace_back();
+    out = csv_cells(line, path, line_no);
   } else if (line.find('\t') != std::string::npos) {
     // OpenSim writes tabs: every tab separates two cells, so an empty cell stays a cell (collapsing the
     // white space would shift the row's values one column left).
@@ -125,7 +163,12 @@ std::array<std::size_t, 4> find_columns(const std::vector<std::string>& labels, 
       return l == wanted[k] || (opensim && (ends_with(l, "/" + wanted[k]) || ends_with(l, "/" + wanted[k] + "/value")));
     };
     const auto it = std::find_if(labels.begin(), labels.end(), matches);
-    require(it != labels.end(), path + ":" + std::to_string(line_no) + ": missing column '" + wanted[k] + "'");
+    require(it != labels.end(), [&] {
+      std::string found;
+      for (const std::string& l : labels) found += (found.empty() ? "'" : ", '") + l + "'";
+      return path + ":" + std::to_string(line_no) + ": missing column '" + wanted[k] + "' (the header's columns: " +
+             found + ")";
+    });
     const auto again = std::find_if(it + 1, labels.end(), matches);
     require(again == labels.end(), [&] {
       return path + ":" + std::to_string(line_no) + ": column '" + wanted[k] + "' appears twice (columns " +
@@ -147,6 +190,12 @@ Motion load_motion(const std::string& path, Side side) {
   const std::string ext = lower(path.size() >= 4 ? path.substr(path.size() - 4) : path);
   const bool opensim = ext == ".mot" || ext == ".sto";
   m.format = opensim ? "opensim" : "csv";
+  // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first line.
+  char bom[3] = {};
+  if (!in.read(bom, 3) || bom[0] != '\xEF' || bom[1] != '\xBB' || bom[2] != '\xBF') {
+    in.clear();
+    in.seekg(0);
+  }
   std::string line;
   std::size_t line_no = 0;
   const OpenSimHeader header = opensim ? read_opensim_header(in, path, line_no) : OpenSimHeader{};
@@ -155,7 +204,7 @@ Motion load_motion(const std::string& path, Side side) {
   while (std::getline(in, line)) {
     ++line_no;
     if (!trim(line).empty()) {
-      labels = split(line, !opensim);
+      labels = split(line, !opensim, path, line_no);
       break;
     }
   }
@@ -164,7 +213,7 @@ Motion load_motion(const std::string& path, Side side) {
   while (std::getline(in, line)) {
     ++line_no;
     if (trim(line).empty()) continue;
-    const std::vector<std::string> cells = split(line, !opensim);
+    const std::vector<std::string> cells = split(line, !opensim, path, line_no);
     require(cells.size() == labels.size(), [&] {
       return path + ":" + std::to_string(line_no) + ": the row has " + std::to_string(cells.size()) +
              " cells, the header " + std::to_string(labels.size()) + ": a missing or extra value would shift the "

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "impinge/anatomy/femur_frame.hpp"
@@ -33,16 +34,71 @@ const std::vector<std::string>& subject_keys() {
   return keys;
 }
 
-SubjectInfo load_subject(const std::string& json_path) {
-  namespace fs = std::filesystem;
-  std::ifstream in(json_path);
-  require(in.good(), json_path + ": cannot open subject file");
+namespace {
+// Line and column (1-based) of byte `offset` of `text`.
+std::string line_and_column(const std::string& text, std::size_t offset) {
+  offset = std::min(offset, text.size());
+  const std::size_t line = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + std::ptrdiff_t(offset), '\n'));
+  const std::size_t start = offset == 0 ? 0 : text.rfind('\n', offset - 1);
+  const std::size_t column = start == std::string::npos ? offset + 1 : offset - start;
+  return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+// The JSON value that is the whole of `text` (the file `path`): not valid JSON, data after the value, and a key
+// given twice in one object are errors naming the file and the line and column or the key.
+nlohmann::json parse_json_text(const std::string& text, const std::string& path) {
+  // A key given twice in one object (nlohmann keeps the last without a word): found by the parser's callback, the
+  // enclosing objects' keys giving its place ("landmarks.ASIS_r").
+  std::vector<std::vector<std::string>> keys;  // per open object, its keys so far
+  std::vector<std::string> place;              // per open object, the key it sits under
+  std::string twice;
+  auto seen = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using E = nlohmann::json::parse_event_t;
+    if (event == E::object_start) {
+      place.push_back(keys.empty() || keys.back().empty() ? std::string() : keys.back().back());
+      keys.emplace_back();
+    } else if (event == E::object_end && !keys.empty()) {
+      keys.pop_back(), place.pop_back();
+    } else if (event == E::key && !keys.empty()) {
+      const std::string key = parsed.get<std::string>();
+      if (twice.empty() && std::find(keys.back().begin(), keys.back().end(), key) != keys.back().end()) {
+        for (const std::string& p : place) twice += p.empty() ? "" : p + ".";
+        twice += key;
+      }
+      keys.back().push_back(key);
+    }
+    return true;
+  };
   nlohmann::json j;
   try {
-    in >> j;
-  } catch (const std::exception& e) {
-    throw Error(json_path + ": not valid JSON: " + e.what());
+    j = nlohmann::json::parse(text, seen);
+  } catch (const nlohmann::json::parse_error& e) {
+    // The whole file is one value: a second value or anything else after it ("{...} {...}", "{...} x") is refused.
+    std::size_t at = e.byte == 0 ? 0 : e.byte - 1;
+    const std::string what = e.what();
+    if (what.find("expected end of input") != std::string::npos) {
+      while (at < text.size() && std::isspace(static_cast<unsigned char>(text[at]))) ++at;
+      std::string start = text.substr(at, 20);
+      start = start.substr(0, start.find_first_of("\r\n"));
+      throw Error(path + ": " + line_and_column(text, at) + " (offset " + std::to_string(at) + "): '" + start +
+                  "...' after the JSON object: a subject file holds one object");
+    }
+    const std::size_t colon = what.find(": ", what.find("parse error"));
+    throw Error(path + ": not valid JSON at " + line_and_column(text, at) + ": " +
+                (colon == std::string::npos ? what : what.substr(colon + 2)));
   }
+  require(twice.empty(), [&] { return path + ": key '" + twice + "' appears twice: which value is meant?"; });
+  return j;
+}
+}  // namespace
+
+SubjectInfo load_subject(const std::string& json_path) {
+  namespace fs = std::filesystem;
+  std::ifstream in(json_path, std::ios::binary);
+  require(in.good(), json_path + ": cannot open subject file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  nlohmann::json j = parse_json_text(text.str(), json_path);
   auto str = [&](const char* key) -> std::string {
     require(j.contains(key), json_path + ": missing key '" + key + "'");
     require(j[key].is_string(), json_path + ": key '" + key + "' must be a string");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "impinge/core/error.hpp"
+#include "impinge/core/interrupt.hpp"
 #include "impinge/schemes/equiangular_grid.hpp"
 #include "impinge/schemes/sampling_scheme.hpp"
 
@@ -65,6 +66,7 @@ std::int64_t mark_depth_discontinuities(RadialDistanceMapT<Scalar>& map, double 
     const int rows = grid->rows(), cols = grid->columns();
 #pragma omp parallel for schedule(dynamic, 16)
     for (int r = 0; r < rows; ++r) {
+      if (interruption_requested()) continue;  // a front end's stop: the rest skipped (thrown below)
       const std::int64_t first = std::int64_t(r) * cols;
       for (int c = 0; c < cols; ++c) {
         const double d = values[first + c];
@@ -90,6 +92,7 @@ std::int64_t mark_depth_discontinuities(RadialDistanceMapT<Scalar>& map, double 
       }
     }
   }
+  interruption_point();  // a front end's stop (Ctrl-C in Python): the marks are incomplete
   std::int64_t count = 0;
   Scalar* out = map.data();
 #pragma omp parallel for reduction(+ : count) schedule(static)

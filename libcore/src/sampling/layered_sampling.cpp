@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "impinge/core/interrupt.hpp"
 #include "impinge/core/timing.hpp"
 
 namespace impinge {
@@ -21,8 +22,11 @@ LayeredSamplingReport sample_layered_map(LayeredMap& map, const FirstHitCaster& 
 #pragma omp parallel reduction(+ : covered, truncated, not_alternating) reduction(max : most)
   {
     std::vector<RayCrossing> c;
+    bool stop = false;  // a front end's stop (asked every 1024 nodes): the rest skipped, thrown below
 #pragma omp for schedule(dynamic, 4096)
     for (std::int64_t i = 0; i < nodes; ++i) {
+      if ((i & 1023) == 0) stop = interruption_requested();
+      if (stop) continue;
       caster.crossings(map.scheme().node_direction(i), c);
       covered += !c.empty();
       truncated += static_cast<int>(c.size()) > layers;
@@ -35,6 +39,7 @@ LayeredSamplingReport sample_layered_map(LayeredMap& map, const FirstHitCaster& 
       map.set(i, c);
     }
   }
+  interruption_point();  // a front end's stop (Ctrl-C in Python): the map is incomplete
   rep.nodes_covered = covered;
   rep.nodes_truncated = truncated;
   rep.nodes_not_alternating = not_alternating;

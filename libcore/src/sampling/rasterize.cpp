@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "impinge/core/error.hpp"
+#include "impinge/core/interrupt.hpp"
 #include "sampling/raster_cone_setup.hpp"
 #include "sampling/raster_exact_kernels.hpp"
 #include "sampling/raster_linear_kernels.hpp"
@@ -299,6 +300,7 @@ SamplingStats rasterize(const TriangleMesh& mesh, const Eigen::Vector3d& cor, Di
       thread_local std::vector<TriangleCone> cones;
       edge_on = 0;
       for (std::size_t first = 0; first < order.size(); first += kStreamedCones) {
+        interruption_point();  // a front end's stop (Ctrl-C in Python), between runs of cones
         cones.clear();
         edge_on += append_triangle_cones(mesh, k, order, first, std::min(order.size(), first + kStreamedCones), cones);
         for (const TriangleCone& t : cones) raster.exact_cone_in_rows(t);

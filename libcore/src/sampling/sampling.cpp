@@ -6,6 +6,7 @@
 
 #include "impinge/casters/first_hit_caster.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/interrupt.hpp"
 #include "impinge/core/spherical_frame.hpp"
 #include "impinge/core/timing.hpp"
 #include "impinge/sampling/naive_sampling.hpp"
@@ -50,6 +51,27 @@ void resample(const RadialDistanceMap& source, RadialDistanceMapT<Scalar>& targe
     }
   }
 }
+
+namespace {
+// Every node of `map` by a ray cast (all cores). Throws Interrupted on a front end's stop (core/interrupt.hpp),
+// asked every 1024 nodes, the map then incomplete.
+template <typename Scalar>
+void cast_every_node(const FirstHitCaster& caster, RadialDistanceMapT<Scalar>& map) {
+  const SamplingScheme& scheme = map.scheme();
+  Scalar* out = map.data();
+  const std::int64_t n = map.num_nodes();
+#pragma omp parallel
+  {
+    bool stop = false;
+#pragma omp for schedule(dynamic, 4096)
+    for (std::int64_t i = 0; i < n; ++i) {
+      if ((i & 1023) == 0) stop = interruption_requested();
+      if (!stop) out[i] = static_cast<Scalar>(caster.first_hit(scheme.node_direction(i)));
+    }
+  }
+  interruption_point();
+}
+}  // namespace
 
 template <typename Scalar>
 SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& cor, const SamplingOptions& o,
@@ -111,12 +133,7 @@ SamplingReport sample_surface(const TriangleMesh& mesh, const Eigen::Vector3d& c
       break;
     case SamplingMethod::ray_cast_bvh: {
       require(FirstHitCaster::available(), mesh.source + ": ray-cast-bvh sampling needs Embree or CGAL in this build");
-      const FirstHitCaster caster(mesh, cor);
-      const SamplingScheme& scheme = map.scheme();
-      Scalar* out = map.data();
-      const std::int64_t n = map.num_nodes();
-#pragma omp parallel for schedule(dynamic, 4096)
-      for (std::int64_t i = 0; i < n; ++i) out[i] = static_cast<Scalar>(caster.first_hit(scheme.node_direction(i)));
+      cast_every_node(FirstHitCaster(mesh, cor), map);
       rep.ray_cast_ms = ms_since(t0);
       break;
     }

@@ -394,7 +394,8 @@ void add_command_rows(Rows& t) {
   t.flag("quiet", "quiet", OptionType::flag, use_motion, "No progress bar or final line",
          [](auto& o) -> auto& { return o.command.quiet; });
   t.integer("triangles", "triangles", "", use_generate | use_generated_hip, HipModelOptions::kTargetTrianglesRange,
-            "Target triangles per model (at most 20 million: about 2 GB of mesh)",
+            "Target triangles per model in " + HipModelOptions::kTargetTrianglesRange.text() +
+                " (the generator's coarsest model has about 50; 20 million take about 2 GB of memory)",
             [](auto& o) -> auto& { return o.generate.target_triangles; });
   t.number("cam", "cam_mm", "mm", use_generate | use_generated_hip, HipModelOptions::kCamHeightRange, "Cam bump height",
            [](auto& o) -> auto& { return o.generate.cam_height_mm; });

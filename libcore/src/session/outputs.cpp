@@ -14,10 +14,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <new>
 #include <sstream>
 
 #include "impinge/core/atomic_file.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/range.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/subject.hpp"
 #include "impinge/io/vtk_output.hpp"
@@ -264,8 +266,16 @@ void write_pose_vtp(const std::string& path, const Session& s, const PoseResult&
 
 void write_map_pngs(const std::string& dir, const Session& s) {
   const std::filesystem::path d(dir);
-  run_both([&] { write_map_png((d / "femur_map.png").string(), s.joint().ball().map); },
-           [&] { write_map_png((d / "pelvis_map.png").string(), s.joint().socket().map); });
+  try {
+    run_both([&] { write_map_png((d / "femur_map.png").string(), s.joint().ball().map); },
+             [&] { write_map_png((d / "pelvis_map.png").string(), s.joint().socket().map); });
+  } catch (const std::bad_alloc&) {
+    const RadialDistanceMap& m = s.joint().ball().map;
+    throw OutOfMemory("out of memory drawing the maps' images (femur_map.png, pelvis_map.png in " + dir + ") of " +
+                      std::to_string(m.num_nodes()) + " nodes each (" + m.scheme().resolution_name() + " " +
+                      shortest_decimal(m.scheme().resolution()) + "): coarsen --precision (or --resolution), or "
+                      "free memory");
+  }
 }
 
 HipModel write_generated_hip(const std::string& dir, const HipModelOptions& o) {

@@ -11,6 +11,7 @@
 #include "impinge/clinical/clock_summary.hpp"
 #include "impinge/clinical/published_rom.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/interrupt.hpp"
 #include "impinge/core/parse.hpp"
 #include "impinge/io/mesh_io.hpp"
 #include "impinge/io/motion.hpp"
@@ -98,8 +99,9 @@ std::int64_t frames_in_contact(const Session& s, const RomBaseline& base, const 
     PoseResult res;
 #pragma omp for schedule(dynamic, 4)
     for (std::size_t k = 0; k < frames.size(); ++k)
-      if (counted_min_gap(s, base, search, s.hip().femur_pose(frames[k]), res) <= cut) ++n;
+      if (!interruption_requested() && counted_min_gap(s, base, search, s.hip().femur_pose(frames[k]), res) <= cut) ++n;
   }
+  interruption_point();  // a front end's stop (Ctrl-C in Python): the frames skipped above
   return n;
 }
 

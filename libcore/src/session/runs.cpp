@@ -11,6 +11,7 @@
 
 #include "impinge/clinical/published_rom.hpp"
 #include "impinge/core/error.hpp"
+#include "impinge/core/interrupt.hpp"
 #include "impinge/core/timing.hpp"
 #include "impinge/session/records.hpp"
 
@@ -57,6 +58,7 @@ namespace {
 // and the clock summaries.
 void scan_frame(const Session& s, std::size_t k, const PoseAngles& angles, double time_s, MotionFrame& f,
                 PoseResult& res) {
+  interruption_point();  // a front end's stop (Ctrl-C in Python): this frame's error, which ends the hand-overs
   f.result = &res;
   f.index = k;
   f.time_s = time_s;
@@ -117,6 +119,10 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
   {
     if (omp_get_thread_num() == 0) {
       for (std::int64_t d = 0; d < n;) {
+        if (interruption_requested()) {  // polled here too: the master may only hand frames over
+          error = std::make_exception_ptr(Interrupted());
+          break;
+        }
         const auto slot = static_cast<std::size_t>(d % ring);
         if (scanned[slot].load(std::memory_order_acquire) == d) {
           try {  // the frame's scan error, or on_frame's, ends the hand-overs

@@ -9,6 +9,7 @@
 #include <exception>
 #include <tuple>
 #include <limits>
+#include <new>
 #include <sstream>
 
 #include "impinge/anatomy/femur_frame.hpp"
@@ -330,11 +331,109 @@ void check_map_memory(const SessionOptions& m, const SamplingScheme& scheme) {
 }
 }  // namespace
 
+namespace {
+std::string mm1(double x) {  // x mm to 0.1 mm, rounded up (a least value to give)
+  char t[32];
+  std::snprintf(t, sizeof t, "%.1f", std::ceil(x * 10) / 10);
+  return t;
+}
+double nearest_vertex_mm(const Vertices& V, const Eigen::Vector3d& centre) {
+  return V.rows() == 0 ? 0.0 : std::sqrt((V.rowwise() - centre.transpose()).rowwise().squaredNorm().minCoeff());
+}
+
+// --max-radius and --sparse (issue 80) bound where contacts are tested: vertices within max-radius of the COR, maps
+// holding only the tiles with a surface within sparse of it. A value below either bone's nearest vertex leaves
+// that bone untested (max-radius) or its map empty (sparse): every gap untested or "no surface", every motion free.
+// An error naming the option, the value and both bones' nearest vertices, before the maps are built.
+void check_tested_region(const JointOptions& o, const LoadedInput& in, const Eigen::Vector3d& cor) {
+  const double femur = nearest_vertex_mm(in.femur.V, cor), pelvis = nearest_vertex_mm(in.pelvis.V, cor);
+  const double need = std::max(femur, pelvis);
+  auto check = [&](const std::string& option, double value, const std::string& verb, const std::string& instead) {
+    require(!(value < need), [&] {
+      const bool both = value < femur && value < pelvis;
+      const std::string bone = both || value < femur ? "femur" : "pelvis";
+      return option + " " + num(value) + " mm " + verb + " the " + bone + " (its nearest vertex is " +
+             mm1(bone == "femur" ? femur : pelvis) + " mm from the COR)" +
+             (both ? " nor of the pelvis (" + mm1(pelvis) + " mm)" : std::string()) +
+             ": no contact can be found; give at least " + mm1(need) +
+             " mm (more for the acetabular rim and beyond: cam, pincer and extra-articular contacts), " + instead;
+    });
+  };
+  if (std::isfinite(o.max_radius_mm))
+    check("--max-radius", o.max_radius_mm, "reaches no vertex of", "or 0 (every vertex)");
+  if (o.sparse_maps && std::isfinite(o.sparse_region_mm))
+    check("--sparse", o.sparse_region_mm, "keeps no surface of", "'inf' (every surface: the same gaps) or 0 (dense maps)");
+}
+
+// A value that reaches the joint surfaces but not the acetabular rim (anatomical neutral, where the rim is found):
+// contacts at the rim and beyond go untested, the gaps within it are right. A warning.
+void warn_region_inside_rim(const JointOptions& o, const HipJoint& hip, std::vector<std::string>& warnings) {
+  if (!hip.acetabulum()) return;
+  const double rim = hip.acetabulum()->rim_radius_mm;
+  const std::string where = " mm ends inside the acetabular rim (" + mm1(rim) + " mm from the centre): ";
+  if (std::isfinite(o.max_radius_mm) && o.max_radius_mm < rim)
+    warnings.push_back("--max-radius " + num(o.max_radius_mm) + where +
+                       "contacts at the rim and beyond (cam, pincer, extra-articular) are not tested; 0 tests every vertex");
+  if (o.sparse_maps && std::isfinite(o.sparse_region_mm) && o.sparse_region_mm < rim)
+    warnings.push_back("--sparse " + num(o.sparse_region_mm) + where +
+                       "the maps answer 'no surface' beyond it, so contacts at the rim and beyond (cam, pincer, "
+                       "extra-articular) may be missed; 'inf' keeps every surface");
+}
+}  // namespace
+
+namespace {
+// What a hip's set-up builds, for an out-of-memory error: both maps (scheme, resolution, nodes, memory), the layered
+// maps, the meshes' triangles; and how to build less.
+std::string what_is_built(const HipJointOptions& o, const LoadedInput& in) {
+  const SamplingScheme& s = *o.joint.scheme;
+  std::string t = "the maps at " + s.resolution_name() + " " + num(s.resolution()) + " (" + s.name() + ", " +
+                  std::to_string(s.num_nodes()) + " nodes each, about " +
+                  num(std::ceil(map_memory_bytes(s) / 1e8) / 10) + " GB for both) of " + in.femur_source + " (" +
+                  std::to_string(in.femur.F.rows()) + " triangles) and " + in.pelvis_source + " (" +
+                  std::to_string(in.pelvis.F.rows()) + " triangles)";
+  if (o.joint.layers > 0)
+    t += ", and layered maps of " + std::to_string(o.joint.layers) + " layers at --layered-spacing " +
+         (o.joint.layered_spacing_deg > 0 ? num(o.joint.layered_spacing_deg) + " deg" : std::string("the maps'"));
+  return t + "; coarsen --precision (or --resolution), give fewer --layers or a larger --layered-spacing, use "
+             "--query-strategy direct (no layered maps) for a few poses, or free memory";
+}
+
+// The hip built from `in` (its meshes moved in) about cor, cropped to the scan pose and `only_poses` when
+// o.joint.cropped_distance_queries. Errors: memory running out (std::bad_alloc, OutOfMemory) as OutOfMemory naming
+// what was built (what_is_built); any other Error as HipJoint throws it (with anatomical neutral's needs where the
+// anatomy was not found).
+std::shared_ptr<const HipJoint> build_hip(LoadedInput& in, Side side, const CorResult& cor, const HipJointOptions& o,
+                                          const std::vector<PoseAngles>& only_poses) {
+  const std::string built = what_is_built(o, in);
+  try {
+    auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side, cor.head, in.landmarks, o);
+    if (o.joint.cropped_distance_queries) {
+      std::vector<FemurPose> poses{hip->scan_pose()};
+      for (const PoseAngles& a : only_poses) poses.push_back(hip->femur_pose(a));
+      hip->crop_distance_queries(poses);
+    }
+    return hip;
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemory("out of memory building " + built);
+  } catch (const OutOfMemory& e) {
+    throw OutOfMemory(std::string(e.what()) + " while building " + built);
+  }
+}
+}  // namespace
+
 Session::Session(const SessionOptions& options) : options_(options) {
   // The cheap options are checked before anything is read or built.
   hip_options_ = resolved_hip_options(options);
   check_map_memory(options, *hip_options_.joint.scheme);
-  LoadedInput in = load_input(options.input);
+  LoadedInput in;
+  try {
+    in = load_input(options.input);
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemory("out of memory reading the meshes (" +
+                      (options.input.subject.empty() ? options.input.ball + ", " + options.input.socket
+                                                     : options.input.subject) +
+                      "): they need more memory than is free; decimate them or free memory");
+  }
   const std::vector<std::string> load_warnings = in.warnings;
   // The naive ray cast tests every triangle for every node: refuse what would run for minutes.
   if (hip_options_.joint.sampling == SamplingMethod::ray_cast) {
@@ -359,6 +458,7 @@ Session::Session(const SessionOptions& options) : options_(options) {
   pelvis_hygiene_ = in.pelvis_hygiene;
   cor_ = find_centre_of_rotation(in, options.cor);
   check_side_and_frame(in, cor_, options.input);
+  check_tested_region(hip_options_.joint, in, cor_.head.centre);
   hip_options_.allow_cor_outside_ball = options.cor.allow_any;
   // A COR the user gave (--cor, cor=) is the femoral head centre the radial gaps are measured about at the
   // scan pose, whatever the joint-centre method: the maps stay about it, and the combined and equidistant
@@ -379,16 +479,10 @@ Session::Session(const SessionOptions& options) : options_(options) {
   // One pose's work (SessionOptions::only_poses): the distance hierarchies cropped to it and the scan pose.
   hip_options_.joint.cropped_distance_queries = !options.only_poses.empty() && options.query_strategy == "direct";
   // (With anatomical neutral, HipJoint's errors in finding the anatomy say how to do without it.)
-  auto hip = std::make_shared<HipJoint>(std::move(in.femur), std::move(in.pelvis), side_, cor_.head, in.landmarks,
-                                        hip_options_);
-  if (hip_options_.joint.cropped_distance_queries) {
-    std::vector<FemurPose> poses{hip->scan_pose()};
-    for (const PoseAngles& a : options.only_poses) poses.push_back(hip->femur_pose(a));
-    hip->crop_distance_queries(poses);
-  }
-  hip_ = std::move(hip);
+  hip_ = build_hip(in, side_, cor_, hip_options_, options.only_poses);
   warnings_ = load_warnings;
   for (const std::string& w : hip_->warnings()) warnings_.push_back(w);
+  warn_region_inside_rim(hip_options_.joint, *hip_, warnings_);
   // Segmentations that overlap as scanned (no rotation in the joint frame is the scan pose).
   const FemurPose scan_pose = hip_->scan_pose();
   auto scan_result = std::make_shared<const PoseResult>(joint().detect(scan_pose.R, scan_pose.t));

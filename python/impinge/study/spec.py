@@ -19,6 +19,7 @@ import zlib
 import numpy as np
 
 import impinge
+from impinge import _json_file
 
 from . import checks
 
@@ -168,11 +169,10 @@ def _subject_entries(path, entries):
             if not os.path.isfile(f):
                 _fail(path, key, f"'{f}' is not a subject.json file")
             f = os.path.normpath(f)
-            with open(f) as fh:
-                try:
-                    info = json.load(fh)
-                except ValueError as err:
-                    _fail(path, key, f"{f}: not JSON ({err})")
+            try:
+                info = _json_file.load(f)  # a key given twice is an error, as the extension says it
+            except ValueError as err:
+                _fail(path, key, f"{f}: not JSON ({err})")
             name = os.path.basename(os.path.dirname(f))
             subjects.append({"name": name, "path": f, "side": info.get("side", "right") if isinstance(info, dict)
                              else "right"})

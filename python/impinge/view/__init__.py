@@ -318,8 +318,7 @@ def read_plan(folder, meshes):
     file when plan.json or a resected mesh is missing or was made for another mesh (its vertex count)."""
     path = os.path.join(folder, "plan.json")
     try:
-        with open(path, encoding="utf-8") as f:
-            p = json.load(f)
+        p = impinge._json_file.load(path)  # a key given twice is an error
     except OSError as e:
         raise impinge.Error(f"--plan {folder}: cannot read {path}: {e.strerror}") from None
     except ValueError as e:

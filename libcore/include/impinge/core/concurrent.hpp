@@ -15,6 +15,8 @@
 #include <utility>
 #include <vector>
 
+#include "impinge/core/interrupt.hpp"
+
 namespace impinge {
 
 /// Runs `second` on a new thread while `first` runs on this one, and returns after both have finished
@@ -31,7 +33,8 @@ void run_both(First&& first, Second&& second) {
   } catch (...) {
     first_error = std::current_exception();
   }
-  other.wait();
+  // Waiting, a front end's poll still runs on this thread (core/interrupt.hpp): a stop reaches `second`'s loops.
+  while (other.wait_for(InterruptScope::kPollPeriod) != std::future_status::ready) (void)interruption_requested();
   if (first_error) std::rethrow_exception(first_error);
   other.get();
 }
@@ -86,7 +89,13 @@ inline void run_task_graph(std::vector<GraphTask>& tasks, int threads = 2) {
           changed.notify_all();
           return;
         }
-        changed.wait(lock);
+        // Waiting, a front end's poll still runs on this thread (the caller's, which may hold the poll): a stop
+        // then reaches the running job's loops (core/interrupt.hpp).
+        if (changed.wait_for(lock, InterruptScope::kPollPeriod) == std::cv_status::timeout) {
+          lock.unlock();
+          (void)interruption_requested();
+          lock.lock();
+        }
         continue;
       }
       state[next] = State::running;

@@ -17,6 +17,14 @@ class Error : public std::runtime_error {
   explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
 
+/// Memory ran out building something large (maps, ray-casting hierarchies, meshes): a std::bad_alloc or Embree's
+/// RTC_ERROR_OUT_OF_MEMORY, told as what was being built, its size and how to make it smaller (issue 80). An
+/// Error, so that every front end reports it as one line; Python raises it as MemoryError.
+class OutOfMemory : public Error {
+ public:
+  explicit OutOfMemory(const std::string& message) : Error(message) {}
+};
+
 /// Throw impinge::Error(message) unless `condition` holds.
 void require(bool condition, const std::string& message);
 
