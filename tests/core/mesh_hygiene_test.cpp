@@ -126,6 +126,40 @@ TEST(MeshHygiene, DoubleWallsAndSoupsReadAsTheSurface) {
   EXPECT_EQ(triangles_of(soup), triangles_of(s));
 }
 
+TEST(MeshHygiene, PartsInsideTheBoneAndUnusedVerticesAreRemoved) {
+  // An inner cortical wall 1.5 mm inside (wound either way), a speck inside, and a vertex no face uses 200 mm off.
+  const TriangleMesh outer = make_uv_sphere(40, {0, 0, 0}, 32, 16);
+  TriangleMesh inner = make_uv_sphere(38.5, {0, 0, 0}, 32, 16);
+  inner.F.col(1).swap(inner.F.col(2));
+  const TriangleMesh speck = make_uv_sphere(1, {5, 5, 5}, 8, 4);
+  TriangleMesh m = join({inner, outer, speck});
+  m.V.conservativeResize(m.V.rows() + 1, 3);
+  m.V.row(m.V.rows() - 1) << 240, 0, 0;
+  const MeshHygiene h = clean_bone_mesh(m, "shells.ply");
+  EXPECT_EQ(h.parts_inside_removed, 2);
+  EXPECT_NEAR(h.inside_area_mm2, 4 * M_PI * 38.5 * 38.5 + 4 * M_PI, 0.05 * 4 * M_PI * 38.5 * 38.5);
+  EXPECT_EQ(h.unused_vertices_removed, 1);
+  EXPECT_EQ(triangles_of(m), triangles_of(outer));
+  EXPECT_EQ(m.V.rows(), outer.V.rows());
+  TriangleMesh strict = join({outer, speck});
+  EXPECT_THROW(clean_bone_mesh(strict, "s", true), Error);
+}
+
+TEST(MeshHygiene, ACopyMovedByAMicrometreIsADoubleWall) {
+  // Every face again, reversed, its corners moved 1e-6 and 1e-3 mm (a copy written with rounding): not the same
+  // corners, the same wall.
+  const TriangleMesh s = make_uv_sphere(20, {1, 2, 3}, 16, 8);
+  for (const double shift : {1e-6, 1e-3}) {
+    TriangleMesh copy = s;
+    copy.V.array() += shift;
+    copy.F.col(1).swap(copy.F.col(2));
+    TriangleMesh m = join({s, copy});
+    const MeshHygiene h = clean_bone_mesh(m, "d");
+    EXPECT_EQ(h.duplicate_faces_removed, s.F.rows()) << shift;
+    EXPECT_EQ(triangles_of(m), triangles_of(s)) << shift;
+  }
+}
+
 TEST(MeshHygiene, HolesAndTheirWindingNumberAreAnalytic) {
   // A UV sphere's polar fans cut out: each cap is one hole whose rim is the first ring (n_theta edges).
   const int n_theta = 64, n_phi = 32;

@@ -51,6 +51,13 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     lunate.band_mm = kLunateBandMm;
     lunate.scan_head_centre = -(to_joint * seat_);
     centre_ = JointCentre(method, *joint_, lunate, articular_->pelvis, articular_->head_sphere_reach_mm, equidistant);
+    const std::int64_t head_hole = boundary_edges_within(
+        joint_->ball().mesh, to_joint * (sphere.centre - cor_), head_radius_ + 2 + seat_.norm());
+    if (head_hole > 0)  // a hole in the head: the equidistant seat follows the head surface left (issue 80)
+      warnings_.push_back(joint_->ball().mesh.source + ": a hole in the femoral head (" + std::to_string(head_hole) +
+                          " boundary edges within its sphere): the " + to_string(method) +
+                          " joint centre is fitted to the head surface left, and moves with the hole; "
+                          "--joint-centre femoral-head does not use it");
     const std::int64_t rim = boundary_edges_within(joint_->socket().mesh, lunate.centre, lunate.radius_mm + lunate.band_mm);
     if (rim > 0)  // a hole in the lunate surface: the centre is fitted to what is left of it (issue 80)
       warnings_.push_back(joint_->socket().mesh.source + ": a hole in the acetabulum (" + std::to_string(rim) +

@@ -8,9 +8,14 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "core/mesh_parts.hpp"
 #include "impinge/core/error.hpp"
 
 namespace impinge {
+namespace {
+using detail::Part;
+}  // namespace
+using detail::find_root;
 namespace {
 
 std::string fixed(double v, int digits) {
@@ -72,141 +77,68 @@ std::int64_t remove_duplicate_faces(TriangleMesh& mesh) {
   return removed;
 }
 
-int find_root(std::vector<int>& parent, int v) {
-  while (parent[static_cast<std::size_t>(v)] != v) {
-    parent[static_cast<std::size_t>(v)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(v)])];
-    v = parent[static_cast<std::size_t>(v)];
-  }
-  return v;
-}
-
-// The mesh's connected parts (across shared corners): each face's part (0..parts-1, numbered by first face).
-std::vector<int> face_parts(const TriangleMesh& mesh, int& parts) {
-  std::vector<int> parent(static_cast<std::size_t>(mesh.V.rows()));
-  std::iota(parent.begin(), parent.end(), 0);
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
-    for (int k = 1; k < 3; ++k) {
-      const int a = find_root(parent, mesh.F(f, 0)), b = find_root(parent, mesh.F(f, k));
-      if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
-    }
-  std::unordered_map<int, int> number;
-  std::vector<int> part(static_cast<std::size_t>(mesh.F.rows()));
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-    const auto [it, added] = number.try_emplace(find_root(parent, mesh.F(f, 0)), static_cast<int>(number.size()));
-    part[static_cast<std::size_t>(f)] = it->second;
-  }
-  parts = static_cast<int>(number.size());
-  return part;
-}
-
-// The parts' geometry: area, bounding box and vertices.
-struct Part {
-  double area = 0;
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = Eigen::Vector3d::Constant(-INFINITY);
-  std::vector<int> vertices;
-  std::int64_t triangles = 0;
-  bool kept = false;
-};
-
-std::vector<Part> describe_parts(const TriangleMesh& mesh, const std::vector<int>& part, int parts) {
-  std::vector<Part> p(static_cast<std::size_t>(parts));
-  std::vector<int> seen(static_cast<std::size_t>(mesh.V.rows()), -1);
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-    Part& q = p[static_cast<std::size_t>(part[static_cast<std::size_t>(f)])];
-    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
-    q.area += 0.5 * (b - a).cross(c - a).norm();
-    ++q.triangles;
-    for (int k = 0; k < 3; ++k) {
-      const int v = mesh.F(f, k);
-      if (seen[static_cast<std::size_t>(v)] >= 0) continue;
-      seen[static_cast<std::size_t>(v)] = 1;
-      q.vertices.push_back(v);
-      q.lo = q.lo.cwiseMin(mesh.V.row(v).transpose()), q.hi = q.hi.cwiseMax(mesh.V.row(v).transpose());
-    }
-  }
-  return p;
-}
-
-// The largest part by area; of equal areas the one whose box's lowest corner comes first (not the file's order).
-std::size_t largest_part(const std::vector<Part>& p) {
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < p.size(); ++i) {
-    const bool lower = std::lexicographical_compare(p[i].lo.data(), p[i].lo.data() + 3, p[best].lo.data(),
-                                                    p[best].lo.data() + 3);
-    if (p[i].area > p[best].area || (p[i].area == p[best].area && lower)) best = i;
-  }
-  return best;
-}
-
-// Cells of kBoneGapMm over the kept parts' vertices, to find the parts within that gap of them.
-struct KeptGrid {
+// Step 2 within a tolerance: a face (its longest edge at least 10 kNearFaceMm: a speck's slivers are not judged)
+// whose centroid lies within kNearFaceMm of an earlier such face's of another connected part (a copy; a flat
+// speck's two sides share corners and stay), in a parallel plane
+// (|cos| > 0.99) and of nearly the same area (1 %), is the same wall stored twice with its corners moved a little
+// (a copy written with rounding, or reversed and offset by a micrometre). Removed. Centroids in cells of
+// kNearFaceMm (O(m)). Returns the faces removed.
+constexpr double kNearFaceMm = 0.01;  // mm
+std::int64_t remove_near_duplicate_faces(TriangleMesh& mesh) {
+  const auto m = static_cast<std::size_t>(mesh.F.rows());
+  int parts = 0;
+  const std::vector<int> part = detail::face_parts(mesh, parts);
+  std::vector<Eigen::Vector3d> centre(m), normal(m);
+  std::vector<double> area(m);
   std::unordered_map<std::int64_t, std::vector<int>> cells;
-  static std::array<std::int64_t, 3> cell_of(const Eigen::Vector3d& x) {
-    return {static_cast<std::int64_t>(std::floor(x.x() / kBoneGapMm)),
-            static_cast<std::int64_t>(std::floor(x.y() / kBoneGapMm)),
-            static_cast<std::int64_t>(std::floor(x.z() / kBoneGapMm))};
-  }
-  static std::int64_t key(std::int64_t i, std::int64_t j, std::int64_t k) {
-    return ((i & 0x1fffff) << 42) | ((j & 0x1fffff) << 21) | (k & 0x1fffff);
-  }
-  void add(const TriangleMesh& mesh, const Part& p) {
-    for (int v : p.vertices) {
-      const auto c = cell_of(mesh.V.row(v).transpose());
-      cells[key(c[0], c[1], c[2])].push_back(v);
-    }
-  }
-  // Whether any kept vertex lies within kBoneGapMm of one of p's vertices.
-  bool near(const TriangleMesh& mesh, const Part& p) const {
-    for (int v : p.vertices) {
-      const Eigen::Vector3d x = mesh.V.row(v).transpose();
-      const auto c = cell_of(x);
-      for (std::int64_t di = -1; di <= 1; ++di)
-        for (std::int64_t dj = -1; dj <= 1; ++dj)
-          for (std::int64_t dk = -1; dk <= 1; ++dk) {
-            const auto it = cells.find(key(c[0] + di, c[1] + dj, c[2] + dk));
-            if (it == cells.end()) continue;
-            for (int w : it->second)
-              if ((mesh.V.row(w).transpose() - x).squaredNorm() <= kBoneGapMm * kBoneGapMm) return true;
+  auto key = [](const Eigen::Vector3d& x, int di, int dj, int dk) {
+    const auto c = [](double v, int d) { return (static_cast<std::int64_t>(std::floor(v / kNearFaceMm)) + d) & 0x1fffff; };
+    return (c(x.x(), di) << 42) | (c(x.y(), dj) << 21) | c(x.z(), dk);
+  };
+  std::vector<std::uint8_t> keep(m, 1);
+  std::int64_t removed = 0;
+  for (std::size_t f = 0; f < m; ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(Eigen::Index(f), 0)), b = mesh.V.row(mesh.F(Eigen::Index(f), 1)),
+                          c = mesh.V.row(mesh.F(Eigen::Index(f), 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    centre[f] = (a + b + c) / 3, area[f] = n.norm(), normal[f] = n / std::max(area[f], 1e-300);
+    if (std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()}) < 10 * kNearFaceMm) continue;  // a speck's
+    bool repeat = false;
+    for (int di = -1; di <= 1 && !repeat; ++di)
+      for (int dj = -1; dj <= 1 && !repeat; ++dj)
+        for (int dk = -1; dk <= 1 && !repeat; ++dk) {
+          const auto it = cells.find(key(centre[f], di, dj, dk));
+          if (it == cells.end()) continue;
+          for (int g : it->second) {
+            const auto k = static_cast<std::size_t>(g);
+            if (part[k] != part[f] && (centre[k] - centre[f]).norm() <= kNearFaceMm &&
+                std::abs(normal[k].dot(normal[f])) > 0.99 &&
+                std::abs(area[k] - area[f]) <= 0.01 * std::max(area[k], area[f])) {
+              repeat = true;
+              break;
+            }
           }
+        }
+    if (repeat) {
+      keep[f] = 0, ++removed;
+    } else {
+      cells[key(centre[f], 0, 0, 0)].push_back(static_cast<int>(f));
     }
-    return false;
   }
-};
-
-// Step 3: mark the bone's parts kept (the largest, then every part within kBoneGapMm of a kept one, repeatedly).
-void keep_bone_parts(const TriangleMesh& mesh, std::vector<Part>& p) {
-  KeptGrid grid;
-  const std::size_t first = largest_part(p);
-  p[first].kept = true;
-  grid.add(mesh, p[first]);
-  for (bool grew = true; grew;) {
-    grew = false;
-    for (Part& q : p)
-      if (!q.kept && grid.near(mesh, q)) q.kept = true, grid.add(mesh, q), grew = true;
-  }
+  if (removed > 0) keep_faces(mesh, keep);
+  return removed;
 }
 
-// The least distance (mm) from a left-out part's vertices to the kept parts' vertices (brute force: fragments
-// are small, and only the largest kMaxDescribed are measured).
-double distance_to_kept(const TriangleMesh& mesh, const std::vector<Part>& p, const Part& q) {
-  double best = INFINITY;
-  for (const Part& k : p) {
-    if (!k.kept) continue;
-    for (int v : q.vertices)
-      for (int w : k.vertices) best = std::min(best, (mesh.V.row(v) - mesh.V.row(w)).squaredNorm());
-  }
-  return std::sqrt(best);
-}
-
-constexpr std::size_t kMaxDescribed = 20;  // fragments whose distance is measured and listed
+constexpr std::size_t kMaxDescribed = 20;       // fragments whose distance is measured and listed
+constexpr std::size_t kMaxEnclosureTests = 256;  // parts tested for lying inside another (largest first)
 
 // Step 4: the parts left out as fragments (largest first; the first kMaxDescribed with their distance), or an
 // error for another bone's worth of surface.
 std::vector<MeshFragment> left_out(const TriangleMesh& mesh, const std::vector<Part>& p, const std::string& source) {
-  const double largest = p[largest_part(p)].area;
+  const double largest = p[detail::largest_part(p)].area;
   std::vector<const Part*> out;
   for (const Part& q : p)
-    if (!q.kept) out.push_back(&q);
+    if (!q.kept && !q.inside) out.push_back(&q);
   std::sort(out.begin(), out.end(), [](const Part* a, const Part* b) {
     return a->area != b->area ? a->area > b->area
                               : std::lexicographical_compare(a->lo.data(), a->lo.data() + 3, b->lo.data(), b->lo.data() + 3);
@@ -216,38 +148,46 @@ std::vector<MeshFragment> left_out(const TriangleMesh& mesh, const std::vector<P
     MeshFragment f;
     f.triangles = q->triangles, f.area_mm2 = q->area, f.extent_mm = (q->hi - q->lo).maxCoeff();
     f.centre = (q->lo + q->hi) / 2;
-    f.distance_mm = frags.size() < kMaxDescribed ? distance_to_kept(mesh, p, *q) : NAN;
+    f.distance_mm = frags.size() < kMaxDescribed ? detail::distance_to_kept(mesh, p, *q) : NAN;
     require(q->area < kFragmentAreaFraction * largest, [&] {
       return source + ": two bones in one file? a part of " + fixed(q->area, 0) + " mm^2 lies " +
              fixed(f.distance_mm, 1) + " mm from the largest (" + fixed(largest, 0) +
              " mm^2), more than " + fixed(kBoneGapMm, 0) + " mm apart and over " +
-             fixed(100 * kFragmentAreaFraction, 0) + " % of its area; give one bone per file";
+             fixed(100 * kFragmentAreaFraction, 0) + " % of its area; give one bone per file (the parts of one bone lie "
+             "within " + fixed(kBoneGapMm, 0) + " mm of each other)";
     });
     frags.push_back(f);
   }
   return frags;
 }
 
-// Remove the fragments' faces and the vertices only they used (the others keep their order).
-void remove_parts(TriangleMesh& mesh, const std::vector<Part>& p, const std::vector<int>& part) {
+// Remove the faces of the parts not kept, then every vertex no face uses (the others keep their order). Returns
+// the vertices removed.
+std::int64_t remove_parts(TriangleMesh& mesh, const std::vector<Part>& p, const std::vector<int>& part) {
   std::vector<std::uint8_t> keep(static_cast<std::size_t>(mesh.F.rows()));
   for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = p[static_cast<std::size_t>(part[f])].kept ? 1 : 0;
-  std::vector<std::uint8_t> drop_vertex(static_cast<std::size_t>(mesh.V.rows()), 0);
-  for (const Part& q : p)
-    if (!q.kept)
-      for (int v : q.vertices) drop_vertex[static_cast<std::size_t>(v)] = 1;
   keep_faces(mesh, keep);
-  std::vector<int> to(drop_vertex.size(), -1);
+  std::vector<int> to(static_cast<std::size_t>(mesh.V.rows()), -1);
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) to[static_cast<std::size_t>(mesh.F(f, k))] = 0;
   Eigen::Index n = 0;
-  for (std::size_t v = 0; v < drop_vertex.size(); ++v)
-    if (drop_vertex[v] == 0) mesh.V.row(n) = mesh.V.row(Eigen::Index(v)), to[v] = static_cast<int>(n++);
+  for (std::size_t v = 0; v < to.size(); ++v)
+    if (to[v] == 0) mesh.V.row(n) = mesh.V.row(Eigen::Index(v)), to[v] = static_cast<int>(n++);
+  const std::int64_t removed = mesh.V.rows() - n;
   mesh.V.conservativeResize(n, 3);
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
     for (int k = 0; k < 3; ++k) mesh.F(f, k) = to[static_cast<std::size_t>(mesh.F(f, k))];
+  return removed;
+}
+
+std::string short_num(double v) {  // three significant digits: 12.9, 0.00064, 200
+  char b[64];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
 }
 
 std::string describe(const MeshFragment& f) {
-  return fixed(f.area_mm2, 1) + " mm^2 (" + fixed(f.extent_mm, 1) + " mm across) " +
+  return short_num(f.area_mm2) + " mm^2 (" + short_num(f.extent_mm) + " mm across) " +
          (std::isnan(f.distance_mm) ? std::string("far") : fixed(f.distance_mm, 1) + " mm") + " from the bone";
 }
 
@@ -309,6 +249,20 @@ std::int64_t boundary_edges_within(const TriangleMesh& mesh, const Eigen::Vector
   return n;
 }
 
+double central_span(const Vertices& V) {
+  Eigen::Vector3d lo, hi;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> x(static_cast<std::size_t>(V.rows()));
+    for (Eigen::Index i = 0; i < V.rows(); ++i) x[static_cast<std::size_t>(i)] = V(i, k);
+    const auto cut = static_cast<std::ptrdiff_t>(x.size() / 1000);
+    std::nth_element(x.begin(), x.begin() + cut, x.end());
+    lo[k] = x[static_cast<std::size_t>(cut)];
+    std::nth_element(x.begin(), x.end() - 1 - cut, x.end());
+    hi[k] = x[x.size() - 1 - static_cast<std::size_t>(cut)];
+  }
+  return (hi - lo).norm();
+}
+
 double winding_number(const TriangleMesh& mesh, const Eigen::Vector3d& q) {
   double sum = 0;
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
@@ -331,14 +285,56 @@ std::vector<std::string> MeshHygiene::warnings(const std::string& source) const 
     if (dropped.size() > 3) s += "; and " + std::to_string(dropped.size() - 3) + " smaller";
     w.push_back(s + " (--strict refuses them)");
   }
+  if (parts_inside_removed > 0)
+    w.push_back(source + ": " + std::to_string(parts_inside_removed) + " part" + (parts_inside_removed > 1 ? "s" : "") +
+                " inside the bone removed (" + short_num(inside_area_mm2) +
+                " mm^2: an inner wall, a cyst or a speck within it); the bone's outer surface is what meets the other "
+                "bone (--strict refuses them)");
   if (duplicate_faces_removed > 0)
     w.push_back(source + ": " + std::to_string(duplicate_faces_removed) +
-                " faces repeat another face's corners (a double wall); the repeats removed");
+                " faces repeat another face (a double wall: the same corners, or within " + short_num(kNearFaceMm) +
+                " mm in a parallel plane); the repeats removed");
   if (corners_welded > 0)
     w.push_back(source + ": " + std::to_string(corners_welded) +
                 " face corners share a position with another vertex; joined to it");
+  if (unused_vertices_removed > 0)
+    w.push_back(source + ": " + std::to_string(unused_vertices_removed) +
+                " vertices no face uses removed (per-vertex outputs list the vertices kept, in the file's order)");
   return w;
 }
+
+namespace {
+// Steps 3-4 (mesh_hygiene.hpp): the bone's parts kept, parts inside it and fragments apart from it removed (or
+// refused with `strict`), into h.
+void keep_the_bone(TriangleMesh& mesh, const std::string& source, bool strict, MeshHygiene& h) {
+  int parts = 0;
+  const std::vector<int> part = detail::face_parts(mesh, parts);
+  std::vector<Part> p = detail::describe_parts(mesh, part, parts);
+  detail::keep_bone_parts(mesh, p, kBoneGapMm);
+  h.components = parts;
+  std::vector<int> vertex_part(static_cast<std::size_t>(mesh.V.rows()), -1);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int v : p[i].vertices) vertex_part[static_cast<std::size_t>(v)] = static_cast<int>(i);
+  std::vector<std::uint8_t> closed(p.size(), 1);
+  for (const auto& [a, b] : boundary_edge_list(mesh, nullptr)) closed[static_cast<std::size_t>(vertex_part[a])] = 0;
+  h.parts_inside_removed = detail::mark_enclosed_parts(mesh, part, p, closed, kMaxEnclosureTests);
+  h.dropped = left_out(mesh, p, source);
+  for (const Part& q : p) h.inside_area_mm2 += q.inside ? q.area : 0.0;
+  h.components_kept = std::count_if(p.begin(), p.end(), [](const Part& q) { return q.kept; });
+  require(!strict || h.dropped.empty(), [&] {
+    return source + ": " + std::to_string(h.dropped.size()) + " fragment(s) apart from the bone, the largest " +
+           describe(h.dropped.front()) + "; --strict refuses them (without it they are removed)";
+  });
+  require(!strict || h.parts_inside_removed == 0, [&] {
+    return source + ": " + std::to_string(h.parts_inside_removed) +
+           " part(s) inside the bone (an inner wall, a cyst); --strict refuses them (without it they are removed)";
+  });
+  const std::int64_t unused = remove_parts(mesh, p, part);
+  std::int64_t fragment_vertices = 0;
+  for (const Part& q : p) fragment_vertices += q.kept ? 0 : static_cast<std::int64_t>(q.vertices.size());
+  h.unused_vertices_removed = unused - fragment_vertices;
+}
+}  // namespace
 
 MeshHygiene clean_bone_mesh(TriangleMesh& mesh, const std::string& source, bool strict) {
   validate_mesh(mesh);
@@ -346,22 +342,12 @@ MeshHygiene clean_bone_mesh(TriangleMesh& mesh, const std::string& source, bool 
   h.corners_welded = weld_corners(mesh);
   if (h.corners_welded > 0) remove_degenerate_faces(mesh);  // corners welded together: no area
   h.duplicate_faces_removed = remove_duplicate_faces(mesh);
+  h.duplicate_faces_removed += remove_near_duplicate_faces(mesh);
   require(!strict || h.duplicate_faces_removed == 0, [&] {
     return source + ": " + std::to_string(h.duplicate_faces_removed) +
-           " faces repeat another face's corners (a double wall); --strict refuses it";
+           " faces repeat another face (a double wall); --strict refuses it";
   });
-  int parts = 0;
-  const std::vector<int> part = face_parts(mesh, parts);
-  std::vector<Part> p = describe_parts(mesh, part, parts);
-  keep_bone_parts(mesh, p);
-  h.components = parts;
-  h.components_kept = std::count_if(p.begin(), p.end(), [](const Part& q) { return q.kept; });
-  h.dropped = left_out(mesh, p, source);
-  require(!strict || h.dropped.empty(), [&] {
-    return source + ": " + std::to_string(h.dropped.size()) + " fragment(s) apart from the bone, the largest " +
-           describe(h.dropped.front()) + "; --strict refuses them (without it they are removed)";
-  });
-  if (!h.dropped.empty()) remove_parts(mesh, p, part);
+  keep_the_bone(mesh, source, strict, h);
   count_holes(mesh, h);
   return h;
 }

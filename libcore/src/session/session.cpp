@@ -148,7 +148,7 @@ void clean_bones(LoadedInput& in, bool strict) {
 // millimetres (an adult's 340-540 mm); a shorter one is a whole femur in centimetres (45 long) or inches.
 void check_units(const LoadedInput& in) {
   for (const auto& [mesh, source] : {std::pair{&in.femur, &in.femur_source}, std::pair{&in.pelvis, &in.pelvis_source}}) {
-    const double span = (mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff()).norm();
+    const double span = central_span(mesh->V);
     require(span >= 20 && span <= 3000, [&, span = span, source = source] {
       return *source + ": the bone spans " + num(span) + " (its bounding box's diagonal) in the file's units; a femur or "
              "pelvis in millimetres spans about 50 to 1,000: " +
