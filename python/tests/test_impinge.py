@@ -313,8 +313,9 @@ def test_real_subject_anatomical_frames():
     in_app = app.rom_limits(contact_depth_mm=0)
     assert in_app["flexion"]["pelvic_frame"] == "app"
     # Both pelvic frames in every row: limit_deg is the session frame's; the other frame's is the motion about that
-    # frame's axes on the same joint, which a Joint set up in that frame (its own maps, joint surfaces and joint
-    # centre) finds too, within the maps' resolution.
+    # frame's axes on the same joint, which a Joint set up in that frame (its own maps, sampled about other axes,
+    # joint surfaces and joint centre) finds too, within the 0.5 deg maps' resolution (measured: at most 0.5 deg).
+    APP_TOLERANCE_DEG = 0.75
     same = lambda a, b: (np.isnan(a) and np.isnan(b)) or a == b
     close = lambda a, b: (np.isnan(a) and np.isnan(b)) or abs(a - b) <= APP_TOLERANCE_DEG
     for m, r in lim.items():
