@@ -3,7 +3,8 @@
 //   (20 random rigid motions, rotations up to 180 deg about any axis, of both meshes together),
 //   within 0.05 mm, on every shared subject and a mirrored (left) copy of one;
 // - scan neutral is the plain Joint posed by pose_rotation, bit for bit;
-// - posed_femur places the femur where femur_rotation says, in the working frame;
+// - posed_femur places the femur where femur_rotation says, in the working frame; scan neutral has no pelvic
+//   frame to pose in, and says so;
 // - both pelvic frames (issue 81): with pelvic landmarks built so that the ISB frame is the anterior pelvic
 //   plane (APP) frame turned by a known angle theta about their common Z, APP angles (f, a, r) pose the femur
 //   as ISB angles (f + theta, a, r) (both joint coordinate systems turn about Z first), so every limit in the
@@ -98,6 +99,11 @@ TEST(HipJoint, ScanNeutralIsThePlainJointPosedByPoseRotation) {
       }
     EXPECT_EQ(r.socket.min_gap_mm, q.socket.min_gap_mm);
   }
+  // Scan neutral has no pelvic frame to pose in: asked for one, it says so.
+  EXPECT_FALSE(hip.pelvis_frame_kind());
+  EXPECT_FALSE(hip.has_pelvis_frame(PelvisFrameKind::isb) || hip.has_pelvis_frame(PelvisFrameKind::anterior_pelvic_plane));
+  EXPECT_EQ(test::error_of([&] { hip.femur_rotation({}, PelvisFrameKind::anterior_pelvic_plane); }),
+            "hip joint: no app pelvic frame to pose in (scan neutral: no pelvic frame)");
   // The generated model is a proximal femur and a cup: anatomical neutral is refused clearly.
   HipJointOptions anat = options(1.0);
   EXPECT_THROW(HipJoint(h.ball, h.socket, Side::right, head, {}, anat), Error);
