@@ -259,6 +259,7 @@ int run_rom(const RunOptions& o) {
                      {"femur_sampling", s.joint().ball().sampling_ms},
                      {"pelvis_sampling", s.joint().socket().sampling_ms},
                      {"limits", run.limits_ms},
+                     {"limits_other_frame", run.other_limits_ms},
                      {"rom_map", run.map_ms},
                      {"envelope", run.envelope_ms},
                      {"total", ms_since(t_start)}};

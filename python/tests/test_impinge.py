@@ -310,7 +310,27 @@ def test_real_subject_anatomical_frames():
     assert row["status"] == "limited" and row["pelvic_frame"] == "isb" and row["normal_deg"] == pytest.approx(37.9)
     assert bool(row["soft_tissue_first"]) == (fl > 37.9)
     app = impinge.Joint(ball, socket, resolution=0.5, pelvis_frame="app")
-    assert app.rom_limits(contact_depth_mm=0)["flexion"]["pelvic_frame"] == "app"
+    in_app = app.rom_limits(contact_depth_mm=0)
+    assert in_app["flexion"]["pelvic_frame"] == "app"
+    # Both pelvic frames in every row: limit_deg is the session frame's; the other frame's is the motion about that
+    # frame's axes on the same joint, which a Joint set up in that frame (its own maps, sampled about other axes,
+    # joint surfaces and joint centre) finds too, within the 0.5 deg maps' resolution (measured: at most 0.5 deg).
+    APP_TOLERANCE_DEG = 0.75
+    same = lambda a, b: (np.isnan(a) and np.isnan(b)) or a == b
+    close = lambda a, b: (np.isnan(a) and np.isnan(b)) or abs(a - b) <= APP_TOLERANCE_DEG
+    for m, r in lim.items():
+        if not isinstance(r, dict):
+            continue
+        a = in_app[m]
+        assert same(r["limit_isb_deg"], r["limit_deg"]) and r["status_isb"] == r["status"], m
+        assert same(a["limit_app_deg"], a["limit_deg"]) and a["status_app"] == a["status"], m
+        assert close(r["limit_app_deg"], a["limit_app_deg"]) and close(r["limit_isb_deg"], a["limit_isb_deg"]), m
+    # The tilt between the frames moves flexion: the APP and ISB flexion limits differ.
+    assert abs(lim["flexion"]["limit_app_deg"] - lim["flexion"]["limit_isb_deg"]) > 1
+    # Active ranges of living subjects and simulated bony ranges, each with its own source.
+    assert lim["flexion"]["normal_source"].startswith("AAOS") and np.isnan(lim["flexion"]["bony_normal_deg"])
+    assert lim["fadir"]["bony_normal_deg"] == pytest.approx(27.9)
+    assert lim["fadir"]["bony_normal_source"].startswith("Audenaert") and np.isnan(lim["fadir"]["normal_deg"])
 
 
 def test_a_joint_set_up_without_layered_maps_refuses_rom_searches(generated):

@@ -3,13 +3,22 @@
 //   (20 random rigid motions, rotations up to 180 deg about any axis, of both meshes together),
 //   within 0.05 mm, on every shared subject and a mirrored (left) copy of one;
 // - scan neutral is the plain Joint posed by pose_rotation, bit for bit;
-// - posed_femur places the femur where femur_rotation says, in the working frame.
+// - posed_femur places the femur where femur_rotation says, in the working frame; scan neutral has no pelvic
+//   frame to pose in, and says so;
+// - both pelvic frames (issue 81): with pelvic landmarks built so that the ISB frame is the anterior pelvic
+//   plane (APP) frame turned by a known angle theta about their common Z, APP angles (f, a, r) pose the femur
+//   as ISB angles (f + theta, a, r) (both joint coordinate systems turn about Z first), so every limit in the
+//   APP is the ISB search along the motion with its flexion shifted by theta (flexion's limit the ISB one less
+//   theta, extension's the ISB one plus theta); with theta = 0 both frames give the same limits.
 #include "impinge/clinical/hip_joint.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
 #include <random>
 
+#include "impinge/clinical/rom.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/io/generated_models.hpp"
 #include "test_support.hpp"
@@ -90,6 +99,11 @@ TEST(HipJoint, ScanNeutralIsThePlainJointPosedByPoseRotation) {
       }
     EXPECT_EQ(r.socket.min_gap_mm, q.socket.min_gap_mm);
   }
+  // Scan neutral has no pelvic frame to pose in: asked for one, it says so.
+  EXPECT_FALSE(hip.pelvis_frame_kind());
+  EXPECT_FALSE(hip.has_pelvis_frame(PelvisFrameKind::isb) || hip.has_pelvis_frame(PelvisFrameKind::anterior_pelvic_plane));
+  EXPECT_EQ(test::error_of([&] { hip.femur_rotation({}, PelvisFrameKind::anterior_pelvic_plane); }),
+            "hip joint: no app pelvic frame to pose in (scan neutral: no pelvic frame)");
   // The generated model is a proximal femur and a cup: anatomical neutral is refused clearly.
   HipJointOptions anat = options(1.0);
   EXPECT_THROW(HipJoint(h.ball, h.socket, Side::right, head, {}, anat), Error);
@@ -152,4 +166,85 @@ TEST(HipJoint, CorOutsideTheFemurIsAnErrorUnlessAllowedAndWrongUnitsWarn) {
   head.centre = h.cor;
   head.radius = mo.head_radius_mm;
   EXPECT_TRUE(HipJoint(h.ball, h.socket, Side::right, head, {}, o).warnings().empty());
+}
+
+namespace {
+// lhdl-ct's pelvic landmarks with both PSIS moved so that the ISB frame is the APP frame turned by theta_deg about
+// their common Z (the ASIS line): X_isb = cos(theta) X_app - sin(theta) Y_app, i.e. P_app = P_isb Rz(theta). The APP
+// axes come from the landmarks here (Y along the ASIS midpoint less the pubic tubercles' midpoint, normal to Z).
+Landmarks landmarks_tilted(const PelvisLandmarks& L, double theta_deg) {
+  const Eigen::Vector3d z = (L.asis_right - L.asis_left).normalized();
+  const Eigen::Vector3d mid_asis = 0.5 * (L.asis_right + L.asis_left);
+  Eigen::Vector3d y = mid_asis - 0.5 * (L.pubic_tubercle_right + L.pubic_tubercle_left);
+  y = (y - y.dot(z) * z).normalized();
+  const Eigen::Vector3d x = y.cross(z);
+  const double t = theta_deg * M_PI / 180;
+  const Eigen::Vector3d x_isb = std::cos(t) * x - std::sin(t) * y;
+  Landmarks given = L.as_map();
+  given["psis_right"] = mid_asis - 150 * x_isb + 45 * z;
+  given["psis_left"] = mid_asis - 150 * x_isb - 45 * z;
+  return given;
+}
+}  // namespace
+
+TEST(HipJoint, LimitsInTheAnteriorPelvicPlaneAreTheMotionsAboutItsAxes) {
+  auto j = test::load_real_joint("lhdl-ct");
+  if (!j) GTEST_SKIP() << "shared data absent";
+  const PelvisLandmarks found = find_pelvis_landmarks(j->pelvis, j->cor, Side::right);
+  const std::vector<StandardMotion> motions = standard_motions();
+  RomOptions ro;
+  ro.tolerance_deg = 0.02;
+  for (const double theta : {0.0, 12.0}) {
+    SCOPED_TRACE(theta);
+    const HipJoint hip(j->femur, j->pelvis, Side::right, fit_femoral_head(j->femur), landmarks_tilted(found, theta),
+                       options(0.5));
+    ASSERT_EQ(hip.pelvis_frame_kind(), PelvisFrameKind::isb);
+    ASSERT_TRUE(hip.has_pelvis_frame(PelvisFrameKind::anterior_pelvic_plane)) << hip.other_pelvis_frame_note();
+    const PoseRotation app = [&hip](const PoseAngles& a) {
+      return hip.femur_rotation(a, PelvisFrameKind::anterior_pelvic_plane);
+    };
+    for (const PoseAngles& a : kClinicalPoses)
+      EXPECT_LT((app(a) - hip.femur_rotation({a.flexion_deg + theta, a.adduction_deg, a.internal_rotation_deg})).norm(),
+                1e-9);
+    const std::vector<RomLimit> in_isb = find_rom_limits(hip, motions, ro, rom_baseline(hip, hip.femur_rotation({}), ro));
+    const std::vector<RomLimit> in_app = find_rom_limits(hip, motions, ro, rom_baseline(hip, app({}), ro), app);
+    // The oracle: the ISB search along each motion with its flexion shifted, from the shifted neutral.
+    const RomBaseline shifted_base = rom_baseline(hip, hip.femur_rotation({theta, 0, 0}), ro);
+    int compared = 0;
+    for (std::size_t k = 0; k < motions.size(); ++k) {
+      SCOPED_TRACE(motions[k].name);
+      const RomLimit& l = in_app[k];
+      if (theta == 0) {
+        EXPECT_EQ(l.status, in_isb[k].status);
+        EXPECT_TRUE(l.limit_deg == in_isb[k].limit_deg || (std::isnan(l.limit_deg) && std::isnan(in_isb[k].limit_deg)));
+        continue;
+      }
+      if (l.status == RomLimitStatus::not_reachable) continue;
+      const auto& m = motions[k];
+      const RomLimit oracle = find_rom_limit(
+          hip,
+          std::function<PoseAngles(double)>([&m, theta](double t) {
+            PoseAngles p = m.angles(t);
+            p.flexion_deg += theta;
+            return p;
+          }),
+          ro, shifted_base);
+      EXPECT_EQ(std::isnan(l.limit_deg), std::isnan(oracle.limit_deg));
+      if (std::isfinite(oracle.limit_deg)) {
+        EXPECT_NEAR(l.limit_deg, oracle.limit_deg, 2 * ro.tolerance_deg);
+        ++compared;
+      }
+    }
+    if (theta == 0) continue;
+    EXPECT_GE(compared, 6);
+    // Flexion and extension turn about the shared Z: the APP limits are the ISB ones moved by theta.
+    ASSERT_EQ(motions[0].name, "flexion");
+    ASSERT_EQ(motions[1].name, "extension");
+    if (std::isfinite(in_isb[0].limit_deg)) {
+      EXPECT_NEAR(in_app[0].limit_deg, in_isb[0].limit_deg - theta, 0.1);
+    }
+    if (std::isfinite(in_isb[1].limit_deg)) {
+      EXPECT_NEAR(in_app[1].limit_deg, in_isb[1].limit_deg + theta, 0.1);
+    }
+  }
 }

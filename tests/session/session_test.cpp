@@ -336,6 +336,24 @@ TEST(Session, RomRunEqualsTheLibraryCalls) {
     else
       EXPECT_EQ(limit[k].get<double>(), direct[k].limit_deg);
   }
+  // Scan neutral has no pelvic frame: no limit in either, and the run says why; the published ranges are there,
+  // each with its source, the active (living subjects) and the simulated bony ones in their own columns.
+  EXPECT_TRUE(run.other_limits.empty());
+  EXPECT_FALSE(run.other_frame_note.empty());
+  const auto isb = t.column("limit_isb_deg"), app = t.column("limit_app_deg"), status_app = t.column("status_app");
+  const auto normal = t.column("normal_deg"), normal_source = t.column("normal_source");
+  const auto bony = t.column("bony_normal_deg"), bony_source = t.column("bony_normal_source");
+  for (std::size_t k = 0; k < direct.size(); ++k) {
+    EXPECT_TRUE(isb[k].is_null() && app[k].is_null() && status_app[k].is_null());
+    EXPECT_EQ(normal[k].is_null(), normal_source[k].get<std::string>().empty());
+    EXPECT_EQ(bony[k].is_null(), bony_source[k].get<std::string>().empty());
+    if (!bony[k].is_null()) {
+      EXPECT_NE(bony_source[k], normal_source[k]);
+    }
+  }
+  EXPECT_FALSE(normal[0].is_null());  // flexion: AAOS
+  EXPECT_EQ(run.motions[8].name, "fadir");
+  EXPECT_FALSE(bony[8].is_null());
   EXPECT_EQ(run.map.size(), 4u);
   EXPECT_EQ(rom_map_table(run).rows.size(), 4u);
   EXPECT_TRUE(rom_envelope_table(run).rows.empty());

@@ -37,7 +37,10 @@ HipJoint::HipJoint(TriangleMesh femur, TriangleMesh pelvis, Side side, const Sph
     if (neutral_ != Neutral::anatomical) throw;
     throw Error(std::string(e.what()) + kAnatomyHint);  // the bones' anatomy not found: what would do without it
   }
-  if (neutral_ != Neutral::anatomical) femur_axes_joint_ = scan_axes();  // scan neutral: both frames are the scan axes
+  if (neutral_ != Neutral::anatomical) {
+    femur_axes_joint_ = scan_axes();  // scan neutral: both frames are the scan axes
+    other_frame_note_ = "scan neutral: no pelvic frame";
+  }
   head_centre_joint_ = joint_to_working_.transpose() * (sphere.centre + seat_ - cor_);
   build_joint(std::move(femur), std::move(pelvis), options);
   // The acetabular centre in the joint frame: the origin once seated.
@@ -108,6 +111,19 @@ void HipJoint::build_anatomy(TriangleMesh& femur, const TriangleMesh& pelvis, Sp
   // Joint frame: pelvic axes arranged as the scan frame, p_joint = S P^T (p - cor).
   joint_to_working_ = frames_->pelvis.axes * scan_axes().transpose();
   femur_axes_joint_ = joint_to_working_.transpose() * frames_->femur.axes;
+  // Both pelvic frames' axes in the joint frame: the session's is the joint frame's arrangement itself; the
+  // other is built from the same landmarks (both share Z through the ASIS).
+  pelvis_kind_ = options.frames.pelvis;
+  pelvic_axes_joint_[static_cast<std::size_t>(*pelvis_kind_)] = scan_axes();
+  const PelvisFrameKind other =
+      *pelvis_kind_ == PelvisFrameKind::isb ? PelvisFrameKind::anterior_pelvic_plane : PelvisFrameKind::isb;
+  try {
+    require(!frames_->pelvis_landmarks.source.empty(), "no pelvic landmarks");
+    pelvic_axes_joint_[static_cast<std::size_t>(other)] =
+        joint_to_working_.transpose() * pelvis_frame(frames_->pelvis_landmarks, cor_, other).axes;
+  } catch (const Error& e) {
+    other_frame_note_ = std::string("the ") + to_string(other) + " pelvic frame could not be built: " + e.what();
+  }
   const Eigen::Matrix3d A = joint_to_working_.transpose();
   socket_clock_ = acetabulum_->clock.transformed(A, -A * cor_);
   ball_clock_ = femoral.transformed(A, A * (seat_ - cor_));
@@ -217,6 +233,14 @@ void HipJoint::clocks(const PoseResult& res, ClockSummary& ball, ClockSummary& s
 Eigen::Matrix3d HipJoint::femur_rotation(const PoseAngles& angles) const {
   // Pelvic axes in the joint frame are S; R = S Rjcs F_joint^T (femur_rotation of pose.hpp).
   return scan_axes() * jcs_rotation(angles, side_) * femur_axes_joint_.transpose();
+}
+
+Eigen::Matrix3d HipJoint::femur_rotation(const PoseAngles& angles, PelvisFrameKind frame) const {
+  const auto& P = pelvic_axes_joint_[static_cast<std::size_t>(frame)];
+  if (!P)
+    throw Error(std::string("hip joint: no ") + to_string(frame) + " pelvic frame to pose in (" +
+                (other_frame_note_.empty() ? "anatomical neutral needed" : other_frame_note_) + ")");
+  return *P * jcs_rotation(angles, side_) * femur_axes_joint_.transpose();
 }
 
 void HipJoint::detect(const PoseAngles& angles, PoseResult& out) const {

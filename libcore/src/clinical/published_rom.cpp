@@ -19,6 +19,14 @@ PublishedRange published_normal_range(const std::string& m) {
   return {std::numeric_limits<double>::quiet_NaN(), ""};
 }
 
+BonyRange published_bony_range(const std::string& m) {
+  if (m == "fadir")
+    return {27.9, "not stated",
+            "Audenaert et al. 2012, Am J Sports Med 40:1329-1336: 10 healthy controls, 3-D computational simulation "
+            "of the impingement test (flexion, adduction, internal rotation), mean internal rotation"};
+  return {std::numeric_limits<double>::quiet_NaN(), "", ""};
+}
+
 bool soft_tissue_first(const std::string& motion, double limit_deg) {
   const PublishedRange r = published_normal_range(motion);
   if (std::isnan(r.normal_deg)) return false;

@@ -214,6 +214,11 @@ RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(doub
 
 std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
                                       const RomOptions& o, const RomBaseline& base) {
+  return find_rom_limits(hip, motions, o, base, [&hip](const PoseAngles& a) { return hip.femur_rotation(a); });
+}
+
+std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
+                                      const RomOptions& o, const RomBaseline& base, const PoseRotation& rotation) {
   check(o);
   const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(hip.joint(), o, base);
   std::vector<RomLimit> out(motions.size());
@@ -234,7 +239,7 @@ std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<Sta
         const RomLimit on_the_way = search(
             hip, std::function<Eigen::Matrix3d(double)>([&](double t) {
               const double f = t / way;
-              return hip.femur_rotation({f * s.flexion_deg, f * s.adduction_deg, f * s.internal_rotation_deg});
+              return rotation({f * s.flexion_deg, f * s.adduction_deg, f * s.internal_rotation_deg});
             }),
             lead, base, bounds.get(), true);
         if (on_the_way.status != RomLimitStatus::free) {
@@ -255,8 +260,8 @@ std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<Sta
         }
       }
       limit = search(
-          hip, std::function<Eigen::Matrix3d(double)>([&](double t) { return hip.femur_rotation(m.angles(t)); }), o,
-          base, bounds.get());
+          hip, std::function<Eigen::Matrix3d(double)>([&](double t) { return rotation(m.angles(t)); }), o, base,
+          bounds.get());
     } catch (const std::exception& e) {
       errors[static_cast<std::size_t>(k)] = e.what();
     }

@@ -203,6 +203,7 @@ RomRequest limits_only_request(const RomRequest& rom) {
   limits_only.map = false;
   limits_only.envelope = false;
   limits_only.limits = true;
+  limits_only.both_frames = false;  // the plan targets the session frame's limits only
   return limits_only;
 }
 

@@ -160,6 +160,32 @@ double run_motion(const Session& s, const std::vector<PoseAngles>& angles, const
   return detect_ms;
 }
 
+namespace {
+// The standard motions' limits with their angles in the other pelvic frame than the session's (RomRun::
+// other_limits): the same joint, the motions about that frame's axes from its neutral, whose own scan is their
+// baseline (its overlap excluded, as the session frame's neutral is for the limits).
+void other_frame_limits(const Session& s, const RomRequest& q, RomRun& run) {
+  const HipJoint& hip = s.hip();
+  if (!hip.pelvis_frame_kind()) {
+    run.other_frame_note = hip.other_pelvis_frame_note();
+    return;
+  }
+  const PelvisFrameKind other = *hip.pelvis_frame_kind() == PelvisFrameKind::isb
+                                    ? PelvisFrameKind::anterior_pelvic_plane
+                                    : PelvisFrameKind::isb;
+  if (!hip.has_pelvis_frame(other)) {
+    run.other_frame_note = hip.other_pelvis_frame_note();
+    return;
+  }
+  const auto t0 = Clock::now();
+  const PoseRotation rotation = [&hip, other](const PoseAngles& a) { return hip.femur_rotation(a, other); };
+  const RomBaseline base = rom_baseline(hip, rotation({}), q.search);
+  run.other_limits = find_rom_limits(hip, run.motions, q.search, base, rotation);
+  run.other_frame = other;
+  run.other_limits_ms = ms_since(t0);
+}
+}  // namespace
+
 RomRun run_rom(const Session& s, const RomRequest& q) {
   // Only the articular zones tell the joint surfaces apart; without them (scan neutral) 'articular' would
   // count every vertex under its name.
@@ -172,12 +198,14 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
   // Pre-existing overlap at neutral (a segmentation's) is excluded, not taken for a limit. The
   // baseline's scan and the search bounds it builds count with the limits' time.
   auto t0 = Clock::now();
+  run.frame = hip.pelvis_frame_kind();
   run.baseline = rom_baseline(hip, hip.femur_rotation({}), q.search);  // with its joint translation
   if (q.limits) {
     run.motions = standard_motions();
     run.limits = find_rom_limits(hip, run.motions, q.search, run.baseline);
   }
   run.limits_ms = ms_since(t0);
+  if (q.limits && q.both_frames) other_frame_limits(s, q, run);
   auto count = [&run](const auto& x) {  // a limit's, a cell's or the envelope's look-ups
     run.vertices_looked_up += x.vertices_looked_up;
     run.vertices_skipped += x.vertices_skipped;
@@ -212,24 +240,42 @@ bool soft_tissue_ends_first(const std::string& motion, const RomLimit& l) {
 }
 }  // namespace
 
+namespace {
+// The limit of motion k with its angles in pelvic frame `frame` (the run's limits or the other frame's), or
+// nullptr when the run has none there (scan neutral, or the other frame not searched).
+const RomLimit* limit_in_frame(const RomRun& run, std::size_t k, PelvisFrameKind frame) {
+  if (run.frame == frame && k < run.limits.size()) return &run.limits[k];
+  if (run.other_frame == frame && k < run.other_limits.size()) return &run.other_limits[k];
+  return nullptr;
+}
+nlohmann::json limit_of(const RomLimit* x) { return x ? number_or_null(x->limit_deg) : nlohmann::json(); }
+nlohmann::json status_of(const RomLimit* x) { return x ? nlohmann::json(to_string(x->status)) : nlohmann::json(); }
+}  // namespace
+
 Table rom_limits_table(const Session& s, const RomRun& run) {
   Table t;
   t.columns = {"motion",      "limit_deg",        "status",       "limited_by",     "contact_class", "pelvis_clock_h",
                "femur_clock_h", "min_gap_at_limit_mm", "monotone", "contact_at_start", "contact_x_mm", "contact_y_mm",
                "contact_z_mm", "joint_translation_x_mm", "joint_translation_y_mm", "joint_translation_z_mm",
-               "evaluations", "normal_deg", "soft_tissue_first", "pelvic_frame", "note"};
+               "evaluations", "normal_deg", "normal_source", "soft_tissue_first", "pelvic_frame", "limit_isb_deg",
+               "status_isb", "limit_app_deg", "status_app", "bony_normal_deg", "bony_normal_frame",
+               "bony_normal_source", "note"};
   const std::string frame = pelvic_frame_name(s);
   for (std::size_t k = 0; k < run.motions.size(); ++k) {
     const RomLimit& l = run.limits[k];
     const std::string& name = run.motions[k].name;
     const Eigen::Vector3d c = s.to_input(l.contact_mm), tr = s.to_input(l.joint_translation_mm);
+    const PublishedRange normal = published_normal_range(name);
+    const BonyRange bony = published_bony_range(name);
+    const RomLimit* isb = limit_in_frame(run, k, PelvisFrameKind::isb);
+    const RomLimit* app = limit_in_frame(run, k, PelvisFrameKind::anterior_pelvic_plane);
     t.add({name, number_or_null(l.limit_deg), to_string(l.status), to_string(l.limited_by), to_string(l.contact_class),
            number_or_null(l.socket_clock_h),
            number_or_null(l.femur_clock_h), number_or_null(l.min_gap_at_limit_mm), l.monotone, l.contact_at_start,
            number_or_null(c.x()), number_or_null(c.y()), number_or_null(c.z()), number_or_null(tr.x()),
-           number_or_null(tr.y()), number_or_null(tr.z()), l.evaluations,
-           number_or_null(published_normal_range(name).normal_deg), soft_tissue_ends_first(name, l),
-           frame, l.note});
+           number_or_null(tr.y()), number_or_null(tr.z()), l.evaluations, number_or_null(normal.normal_deg),
+           normal.source, soft_tissue_ends_first(name, l), frame, limit_of(isb), status_of(isb), limit_of(app),
+           status_of(app), number_or_null(bony.bony_deg), bony.frame, bony.source, l.note});
   }
   return t;
 }
@@ -292,17 +338,29 @@ nlohmann::json rom_record(const RomRun& run) {
     const RomLimit& l = run.limits[k];
     const std::string& name = run.motions[k].name;
     const PublishedRange normal = published_normal_range(name);
+    const BonyRange bony = published_bony_range(name);
+    const RomLimit* isb = limit_in_frame(run, k, PelvisFrameKind::isb);
+    const RomLimit* app = limit_in_frame(run, k, PelvisFrameKind::anterior_pelvic_plane);
     limits.push_back({{"motion", name},
                       {"limit_deg", number_or_null(l.limit_deg)},
                       {"status", to_string(l.status)},
                       {"limited_by", to_string(l.limited_by)},
                       {"monotone", l.monotone},
+                      {"limit_isb_deg", limit_of(isb)},
+                      {"status_isb", status_of(isb)},
+                      {"limit_app_deg", limit_of(app)},
+                      {"status_app", status_of(app)},
                       {"normal_deg", number_or_null(normal.normal_deg)},
                       {"normal_source", normal.source},
+                      {"bony_normal_deg", number_or_null(bony.bony_deg)},
+                      {"bony_normal_frame", bony.frame},
+                      {"bony_normal_source", bony.source},
                       {"soft_tissue_first", soft_tissue_ends_first(name, l)},
                       {"note", l.note}});
   }
   j["limits"] = limits;
+  j["other_pelvic_frame"] = run.other_frame ? nlohmann::json(to_string(*run.other_frame)) : nlohmann::json();
+  j["other_pelvic_frame_note"] = run.other_frame_note;
   if (run.envelope) {
     const RomEnvelope& env = *run.envelope;
     const RomEnvelopeOptions& eo = run.envelope_options;

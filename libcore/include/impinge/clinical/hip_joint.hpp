@@ -5,6 +5,7 @@
 /// and the results do not depend on how the subject lay in the scanner.
 
 #include <Eigen/Core>
+#include <array>
 #include <optional>
 
 #include "impinge/anatomy/articular_zones.hpp"
@@ -84,6 +85,22 @@ class HipJoint {
 
   /// Rotation (3 x 3, joint frame) of the femur about the COR at `angles` (degrees, ISB signs).
   Eigen::Matrix3d femur_rotation(const PoseAngles& angles) const;
+  /// The same with `angles` measured in the pelvic frame `frame` (anatomical neutral): zero angles put the
+  /// femoral frame parallel to that frame's axes, and flexion turns about its Z. With the other frame than
+  /// pelvis_frame_kind() it is the motion performed about that frame's axes, on the same joint (maps, zones,
+  /// clocks); R = A^T P_frame Rjcs F^T (pose.hpp's femur_rotation with that frame's axes P_frame). Both
+  /// frames share Z (through both ASIS), so the other frame's angles are the session frame's with the
+  /// flexion offset by the angle between their X axes. Throws impinge::Error with scan neutral, or when that
+  /// frame could not be built from the landmarks (other_pelvis_frame_note()). Source: impinge.
+  Eigen::Matrix3d femur_rotation(const PoseAngles& angles, PelvisFrameKind frame) const;
+  /// The pelvic frame the angles are measured in (HipJointOptions::frames.pelvis); empty with scan neutral.
+  std::optional<PelvisFrameKind> pelvis_frame_kind() const { return pelvis_kind_; }
+  /// Whether femur_rotation(angles, frame) can pose in `frame` (anatomical neutral, its landmarks usable).
+  bool has_pelvis_frame(PelvisFrameKind frame) const {
+    return pelvic_axes_joint_[static_cast<std::size_t>(frame)].has_value();
+  }
+  /// Why the other pelvic frame is not available (scan neutral, or the landmarks' error), else empty.
+  const std::string& other_pelvis_frame_note() const { return other_frame_note_; }
 
   /// The femur's translation (mm, joint frame) at rotation R by the joint-centre method: a femur
   /// point p (joint frame, unposed) is posed at R p + t (JointCentre::translation; a function of R
@@ -174,6 +191,9 @@ class HipJoint {
   Eigen::Vector3d cor_;
   Eigen::Matrix3d joint_to_working_ = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d femur_axes_joint_ = Eigen::Matrix3d::Identity();  // femoral frame axes in the joint frame
+  std::optional<PelvisFrameKind> pelvis_kind_;                        // anatomical neutral only
+  std::array<std::optional<Eigen::Matrix3d>, 2> pelvic_axes_joint_;   // each pelvic frame's axes, joint frame
+  std::string other_frame_note_;                                      // why the other frame is missing
   std::optional<HipFrames> frames_;
   std::optional<Acetabulum> acetabulum_;
   std::optional<ClockFace> socket_clock_, ball_clock_;

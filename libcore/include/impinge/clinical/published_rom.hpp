@@ -30,6 +30,26 @@ struct PublishedRange {
 /// normal_deg NaN and an empty source for any other name. Never throws.
 PublishedRange published_normal_range(const std::string& motion);
 
+/// A published simulated bony range of one motion in normal hips: the angle at which the bones of CT or MRI
+/// models meet in a computer simulation, without soft tissue, averaged over a cohort: what impinge computes, kept
+/// apart from PublishedRange's ranges of living subjects (which the capsule, ligaments and muscles end).
+struct BonyRange {
+  double bony_deg = 0;     ///< the cohort's mean, deg (NaN: no such range found for the motion)
+  const char* frame = "";  ///< the pelvic frame of the published angles: "app" (anterior pelvic plane), or
+                           ///< "not stated" where the source does not say
+  const char* source = "";  ///< the citation, with the cohort and what exactly was simulated
+};
+
+/// The published simulated bony range of `motion` in normal hips (standard_motions' names). Only what could be
+/// read in the source itself is given: Audenaert et al. 2012 (Am J Sports Med 40:1329, abstract: 10 healthy
+/// controls, 3-D computational simulation): internal rotation on impingement testing 27.9 deg (the flexion-
+/// adduction-internal rotation test; impinge's fadir: 90 deg flexion, 10 deg adduction). The Bern studies in the
+/// anterior pelvic plane (Tannast et al. 2007, J Orthop Res 25:122; Kubiak-Langer et al. 2007, Clin Orthop
+/// 458:117: flexion about 122 deg, internal rotation at 90 deg flexion about 35 deg) are not given here: their
+/// tables could not be read to cite their values exactly. bony_deg NaN and an empty source for any other motion.
+/// Never throws.
+BonyRange published_bony_range(const std::string& motion);
+
 /// Whether soft tissue usually ends `motion` before the bones meet: the bony limit `limit_deg` (NaN: the bones
 /// do not meet within the search, RomLimitStatus::free; a motion that is not reached has no limit to judge and
 /// is not passed here) lies beyond the published normal range. False where no range is published. Never throws.

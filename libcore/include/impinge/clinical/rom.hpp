@@ -233,6 +233,18 @@ RomLimit find_rom_limit(const HipJoint& hip, const std::function<Eigen::Matrix3d
 std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
                                       const RomOptions& options, const RomBaseline& baseline);
 
+/// How clinical angles pose the femur: its rotation (3 x 3, joint frame) at `angles` (deg), e.g.
+/// HipJoint::femur_rotation with a pelvic frame.
+using PoseRotation = std::function<Eigen::Matrix3d(const PoseAngles&)>;
+
+/// The same with the motions' angles turned into femur rotations by `rotation` (e.g. the angles measured in
+/// the other pelvic frame: [&](const PoseAngles& a) { return hip.femur_rotation(a, PelvisFrameKind::
+/// anterior_pelvic_plane); }, with a baseline at that frame's neutral). The overload above passes
+/// HipJoint::femur_rotation.
+std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
+                                      const RomOptions& options, const RomBaseline& baseline,
+                                      const PoseRotation& rotation);
+
 /// One cell of a ROM map: the largest internal rotation at (flexion, adduction).
 /// The outcome of one ROM map cell's search.
 enum class RomMapStatus {

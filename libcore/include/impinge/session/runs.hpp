@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "impinge/clinical/rom.hpp"
@@ -73,6 +74,9 @@ struct RomRequest {
   }
   bool envelope = false;                  ///< the ROM envelope (rom_envelope)
   RomEnvelopeOptions envelope_options;
+  /// With the limits and anatomical neutral, the limits of the same motions in the other pelvic frame too
+  /// (RomRun::other_limits: the ISB and the anterior pelvic plane frames side by side in rom_limits.csv).
+  bool both_frames = true;
 };
 
 /// The results of a ROM run and their cost.
@@ -81,6 +85,14 @@ struct RomRun {
   RomBaseline baseline;                  ///< the neutral scan (vertices in contact there are excluded)
   std::vector<StandardMotion> motions;   ///< standard_motions()
   std::vector<RomLimit> limits;          ///< one per motion
+  /// The same motions with their angles in the other pelvic frame (HipJoint::femur_rotation(angles, frame):
+  /// about that frame's axes, from its neutral, with its own baseline there), one per motion; empty with scan
+  /// neutral, without RomRequest::both_frames, or when that frame cannot be built (other_frame_note).
+  std::vector<RomLimit> other_limits;
+  std::optional<PelvisFrameKind> frame;        ///< the pelvic frame of limits' angles (empty: scan neutral)
+  std::optional<PelvisFrameKind> other_frame;  ///< the frame of other_limits
+  std::string other_frame_note;                ///< why other_limits is empty, else empty
+  double other_limits_ms = 0;                  ///< their wall time, ms (baseline included)
   std::vector<double> map_flexion_deg, map_adduction_deg;
   std::vector<RomMapCell> map;           ///< flexion-major; empty without a map
   std::optional<RomEnvelope> envelope;
@@ -102,7 +114,12 @@ RomRun run_rom(const Session& session, const RomRequest& request);
 
 /// rom_limits.csv: motion, limit_deg, limited_by, contact_class, pelvis_clock_h, femur_clock_h,
 /// min_gap_at_limit_mm, monotone, contact_at_start, contact_x/y/z_mm (input frame),
-/// joint_translation_x/y/z_mm (the femur's translation at the limit, input-frame axes), evaluations.
+/// joint_translation_x/y/z_mm (the femur's translation at the limit, input-frame axes), evaluations,
+/// normal_deg and normal_source (the active range of living subjects, published_normal_range),
+/// soft_tissue_first, pelvic_frame (the frame of limit_deg), limit_isb_deg, status_isb, limit_app_deg and
+/// status_app (the motion's limit with its angles in each pelvic frame: one is limit_deg, the other
+/// RomRun::other_limits; null with scan neutral), bony_normal_deg, bony_normal_frame and bony_normal_source
+/// (published simulated bony ROM of normal hips, published_bony_range), note.
 Table rom_limits_table(const Session& session, const RomRun& run);
 /// rom_map.csv: flexion_deg, adduction_deg, max_internal_rotation_deg, status.
 Table rom_map_table(const RomRun& run);
