@@ -19,14 +19,10 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // The unit vector of v's component across unit n.
 Eigen::Vector3d across(const Eigen::Vector3d& v, const Eigen::Vector3d& n) { return (v - v.dot(n) * n).normalized(); }
 
-// The femoral version (deg): the neck axis `neck` (towards the head) against the condylar axis from `medial` to
-// `lateral`, both across the long axis `y`, positive when the neck points towards `anterior`.
+// femoral_version_deg under its old name here.
 double version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& medial, const Eigen::Vector3d& lateral,
                    const Eigen::Vector3d& y, const Eigen::Vector3d& anterior) {
-  const Eigen::Vector3d to_medial = across(medial - lateral, y);
-  const Eigen::Vector3d ant = across(across(anterior, y) - across(anterior, y).dot(to_medial) * to_medial, y);
-  const Eigen::Vector3d n = across(neck, y);
-  return std::atan2(n.dot(ant), n.dot(to_medial)) * kDeg;
+  return femoral_version_deg(neck, medial, lateral, y, anterior);
 }
 
 // The femoral versions (deg) of `n` (the neck axis, towards the head) against the posterior condylar and the
@@ -191,6 +187,15 @@ void measure_coverage(const Acetabulum& A, const Eigen::Vector3d& c, Morphology&
   for (std::size_t k = 0; k < 12; ++k) m.coverage_deg[k] = count[k] > 0 ? sum[k] / count[k] : kNaN;
 }
 }  // namespace
+
+double femoral_version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& medial, const Eigen::Vector3d& lateral,
+                           const Eigen::Vector3d& axis, const Eigen::Vector3d& anterior) {
+  const Eigen::Vector3d y = axis.normalized();
+  const Eigen::Vector3d to_medial = across(medial - lateral, y);
+  const Eigen::Vector3d ant = across(across(anterior, y) - across(anterior, y).dot(to_medial) * to_medial, y);
+  const Eigen::Vector3d n = across(neck, y);
+  return std::atan2(n.dot(ant), n.dot(to_medial)) * kDeg;
+}
 
 Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pelvis, Side side, const HipFrames& frames,
                               const Acetabulum& A) {

@@ -99,6 +99,14 @@ struct Morphology {
   std::vector<std::string> notes;         ///< what could not be measured, and why
 };
 
+/// The femoral version (deg, in (-180, 180]) of the neck axis `neck` (towards the head) against the condylar axis from
+/// `lateral` to `medial` (points, mm; the posterior condyles or the epicondyles), both projected on the plane normal to
+/// `axis` (the shaft axis: the CT convention, Reikeras et al. 1983, Murphy et al. 1987; or the mechanical axis: the
+/// ISB femoral y); positive (anteversion) when the projected neck leans towards `anterior` (any vector on the
+/// anterior side of the condylar axis across `axis`). Source: those papers, in 3D (impinge).
+double femoral_version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& medial, const Eigen::Vector3d& lateral,
+                           const Eigen::Vector3d& axis, const Eigen::Vector3d& anterior);
+
 /// Measure the morphology of a hip from its whole femur and its pelvis (working frame, mm) on `side`, its frames
 /// (find_hip_frames: head sphere, landmarks, ISB frames) and its acetabulum (find_acetabulum on the pelvis). The
 /// anterior pelvic plane frame is built from the same landmarks. The centre-edge angles are Wiberg's edge found by
