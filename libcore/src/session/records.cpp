@@ -341,6 +341,11 @@ nlohmann::json setup_record(const Session& s) {
       "ISB joint coordinate system (Wu et al. 2002): flexion about the pelvic Z axis, adduction about the floating "
       "axis, internal rotation about the femoral y axis; flexion, adduction and internal rotation positive; left "
       "hips mirrored";
+  // Which frame each kind of value is in (issue 81): the pose angles above, every point and axis here.
+  j["coordinates_note"] =
+      "points (*_mm: centres, contacts, translations) and axes in the input files' frame (input_frame), mm; pose and "
+      "limit angles in the pelvic frame named by pelvic_frame (pose_convention); the head centre fitted or given as "
+      "cor_method says";
   if (const auto& frames = hip.frames()) j["frames"] = frames_record(s, *frames);
   return j;
 }
