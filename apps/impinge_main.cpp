@@ -288,8 +288,10 @@ int run_morphology(const RunOptions& o) {
   const Morphology& m = run.morphology;
   std::cout << std::fixed << std::setprecision(1) << "morphology: head radius " << m.head_radius_mm
             << " mm, alpha max " << m.alpha_max_deg << " deg at " << std::setprecision(0) << m.alpha_max_hour
-            << " o'clock, femoral version " << std::setprecision(1) << m.version_posterior_condylar_deg
-            << " deg, acetabular anteversion " << m.orientation_app.anteversion_deg << " deg, LCE "
+            << " o'clock, femoral version " << std::setprecision(1) << m.version_posterior_condylar_shaft_deg
+            << " deg (posterior condylar, across the shaft; " << m.version_posterior_condylar_deg
+            << " across the mechanical axis), acetabular anteversion " << m.orientation_app.anteversion_deg
+            << " deg (anterior pelvic plane), LCE "
             << m.lateral_centre_edge_deg << " deg; written to " << out << "\n";
   return 0;
 }

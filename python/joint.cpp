@@ -279,8 +279,8 @@ void add_joint_queries(py::class_<PyJoint>& c) {
             return from_json(morphology_record(run));
           },
           "The hip's morphology (the CLI's morphology.json as a dict: femur and acetabulum, each measure's value, unit, "
-          "definition and source; notes): head radius and sphericity, neck-shaft angle, femoral version, alpha "
-          "angle per clock hour, head-neck offset; acetabular sphere, version and inclination (Murray 1993, "
+          "definition, source, frame and where it was obtained; notes): head radius and sphericity, neck-shaft "
+          "angle, femoral version (across the shaft and across the mechanical axis), alpha angle per clock hour, head-neck offset; acetabular sphere, version and inclination (Murray 1993, "
           "anterior pelvic plane), lateral and anterior centre-edge angles, coverage. Measured on this Joint's inputs "
           "and frames, without its maps.")
       .def(

@@ -48,6 +48,26 @@ TEST(MorphologyRun, AGeneratedHipHasItsAnalyticAlphaAngleAndOffset) {
   EXPECT_TRUE(said) << j["notes"].dump();
 }
 
+// Issue 81: every measure of morphology.json names the frame of its angles, points or axes and where it came from;
+// the fitted head's residual is written (it was null in the femoral frame), and without a knee neither version
+// convention is measured.
+TEST(MorphologyRun, EveryMeasureNamesItsFrameAndWhereItCameFrom) {
+  const MorphologyRun run = morphology_of(0);
+  const nlohmann::json j = morphology_record(run);
+  for (const char* part : {"femur", "acetabulum"})
+    for (const auto& [name, v] : j[part].items()) {
+      if (!v.is_object() || !v.contains("value")) continue;
+      EXPECT_FALSE(v.value("frame", std::string()).empty()) << part << "." << name;
+      EXPECT_FALSE(v.value("obtained", std::string()).empty()) << part << "." << name;
+    }
+  EXPECT_EQ(j["femur"]["head_centre_mm"]["obtained"].get<std::string>().rfind("fitted", 0), 0u);
+  ASSERT_TRUE(j["femur"]["head_fit_rms_mm"]["value"].is_number());
+  EXPECT_EQ(j["femur"]["frame"]["head_fit_rms_mm"], j["femur"]["head_fit_rms_mm"]["value"]);
+  EXPECT_TRUE(j["femur"]["version_posterior_condylar_shaft_deg"]["value"].is_null());
+  EXPECT_TRUE(j["femur"]["version_transepicondylar_shaft_deg"]["value"].is_null());
+  EXPECT_EQ(j["acetabulum"]["radiographic_anteversion_deg"]["frame"].get<std::string>().rfind("scan", 0), 0u);
+}
+
 TEST(MorphologyRun, ACamRaisesTheAlphaAngleWhereItSits) {
   const MorphologyRun plain = morphology_of(0), cam = morphology_of(2);
   const auto& a0 = plain.morphology.alpha_deg;

@@ -19,14 +19,28 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // The unit vector of v's component across unit n.
 Eigen::Vector3d across(const Eigen::Vector3d& v, const Eigen::Vector3d& n) { return (v - v.dot(n) * n).normalized(); }
 
-// The femoral version (deg): the neck axis `neck` (towards the head) against the condylar axis from `medial` to
-// `lateral`, both across the long axis `y`, positive when the neck points towards `anterior`.
+// femoral_version_deg under its old name here.
 double version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& medial, const Eigen::Vector3d& lateral,
                    const Eigen::Vector3d& y, const Eigen::Vector3d& anterior) {
-  const Eigen::Vector3d to_medial = across(medial - lateral, y);
-  const Eigen::Vector3d ant = across(across(anterior, y) - across(anterior, y).dot(to_medial) * to_medial, y);
-  const Eigen::Vector3d n = across(neck, y);
-  return std::atan2(n.dot(ant), n.dot(to_medial)) * kDeg;
+  return femoral_version_deg(neck, medial, lateral, y, anterior);
+}
+
+// The femoral versions (deg) of `n` (the neck axis, towards the head) against the posterior condylar and the
+// transepicondylar axes of L, across the mechanical axis fy (knee centre to head centre) and across the shaft axis
+// (m.shaft_axis, when measure_neck_shaft found it; else NaN, with a note); fx: the femoral frame's anterior.
+void measure_versions(const Eigen::Vector3d& n, const FemurLandmarks& L, const Eigen::Vector3d& fy,
+                      const Eigen::Vector3d& fx, Morphology& m) {
+  m.version_posterior_condylar_deg = version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, fy, fx);
+  m.version_transepicondylar_deg = version_deg(n, L.epicondyle_medial, L.epicondyle_lateral, fy, fx);
+  const Eigen::Vector3d s = m.shaft_axis;
+  if (s.norm() > 0.5) {
+    m.version_posterior_condylar_shaft_deg =
+        version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, s, fx);
+    m.version_transepicondylar_shaft_deg = version_deg(n, L.epicondyle_medial, L.epicondyle_lateral, s, fx);
+  } else {
+    m.version_posterior_condylar_shaft_deg = m.version_transepicondylar_shaft_deg = kNaN;
+    m.notes.push_back("femoral version across the shaft: no shaft axis (see the neck-shaft angle's note)");
+  }
 }
 
 // The centre-edge angle (deg): rays from the head centre c (mm) in the plane normal to `normal` swept from `up`
@@ -174,6 +188,15 @@ void measure_coverage(const Acetabulum& A, const Eigen::Vector3d& c, Morphology&
 }
 }  // namespace
 
+double femoral_version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& medial, const Eigen::Vector3d& lateral,
+                           const Eigen::Vector3d& axis, const Eigen::Vector3d& anterior) {
+  const Eigen::Vector3d y = axis.normalized();
+  const Eigen::Vector3d to_medial = across(medial - lateral, y);
+  const Eigen::Vector3d ant = across(across(anterior, y) - across(anterior, y).dot(to_medial) * to_medial, y);
+  const Eigen::Vector3d n = across(neck, y);
+  return std::atan2(n.dot(ant), n.dot(to_medial)) * kDeg;
+}
+
 Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pelvis, Side side, const HipFrames& frames,
                               const Acetabulum& A) {
   Morphology m;
@@ -200,16 +223,14 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
   const bool landmarks = !L.source.empty();
   if (!landmarks) {
     m.neck_shaft_angle_deg = m.version_posterior_condylar_deg = m.version_transepicondylar_deg = kNaN;
+    m.version_posterior_condylar_shaft_deg = m.version_transepicondylar_shaft_deg = kNaN;
     m.notes.push_back(
         "no femoral landmarks (scan neutral): no neck-shaft angle or femoral version; the input frame's "
         "axes stand for the femoral and pelvic frames");
   }
   measure_neck_shaft(femur, c, fy, n, L, landmarks, m);
-  // Femoral version against both condylar axes, across the long axis (ISB y).
-  if (landmarks) {
-    m.version_posterior_condylar_deg = version_deg(n, L.posterior_condyle_medial, L.posterior_condyle_lateral, fy, fx);
-    m.version_transepicondylar_deg = version_deg(n, L.epicondyle_medial, L.epicondyle_lateral, fy, fx);
-  }
+  // Femoral version against both condylar axes, across the mechanical axis (ISB y) and across the shaft axis.
+  if (landmarks) measure_versions(n, L, fy, fx, m);
 
   // Alpha angle per clock hour and the anterior head-neck offset, by exact rays from inside the femur.
   const ExactReference ref(femur);
@@ -222,11 +243,14 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
   m.acetabular_radius_mm = A.sphere.radius;
   m.acetabular_fit_rms_mm = A.sphere.rms_residual;
   m.lunate_area_mm2 = A.lunate_area_mm2;
-  const AnatomicalFrame app = frames.pelvis_landmarks.source.empty()
-                                  ? frames.pelvis
-                                  : pelvis_frame(frames.pelvis_landmarks, c, PelvisFrameKind::anterior_pelvic_plane);
+  // The anterior pelvic plane and the ISB frames from the same landmarks, whichever frames.pelvis is.
+  const bool pelvic_landmarks = !frames.pelvis_landmarks.source.empty();
+  const auto pelvic = [&](PelvisFrameKind kind) {
+    return pelvic_landmarks ? pelvis_frame(frames.pelvis_landmarks, c, kind) : frames.pelvis;
+  };
+  const AnatomicalFrame app = pelvic(PelvisFrameKind::anterior_pelvic_plane);
   m.orientation_app = radiographic_orientation(A, app, side);
-  m.orientation_isb = radiographic_orientation(A, frames.pelvis, side);
+  m.orientation_isb = radiographic_orientation(A, pelvic(PelvisFrameKind::isb), side);
   const Eigen::Vector3d X = app.axes.col(0), Y = app.axes.col(1), lateral = lateral_sign * app.axes.col(2);
   // Lateral: in the coronal plane (normal X) from superior towards lateral; anterior: in the sagittal plane (normal:
   // lateral) from superior towards anterior.

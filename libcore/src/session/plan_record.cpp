@@ -82,6 +82,13 @@ nlohmann::json plan_record(const PlanRun& run) {
   j["pelvis"] = run.pelvis_source;
   j["head_centre_mm"] = {run.head_centre_mm.x(), run.head_centre_mm.y(), run.head_centre_mm.z()};
   j["input_frame"] = run.input_frame == FrameConvention::LPS ? "LPS" : "RAS";
+  // The frames of the angles and where the head centre came from (issue 81): the targets' and limits' angles are
+  // joint angles in the pelvic frame named here, as rom_limits.csv's pelvic_frame.
+  j["pelvic_frame"] = run.pelvic_frame;
+  j["pose_convention"] =
+      "ISB joint coordinate system (Wu et al. 2002) in the pelvic frame pelvic_frame: flexion, adduction and internal "
+      "rotation positive; left hips mirrored";
+  j["head_centre_obtained"] = run.cor_method;
   j["method"] =
       "least removal: per vertex, the depth that keeps every target pose's counted contacts at least the clearance "
       "apart (exact signed distances, iterated on the resected bones), widened to what a spherical burr cuts, "

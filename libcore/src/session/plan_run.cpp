@@ -228,6 +228,8 @@ void describe_session(PlanRun& run, const Session& s) {
   run.pelvis_source = s.socket_source();
   run.input_frame = s.input_frame();
   run.head_centre_mm = s.head_centre_input();
+  run.pelvic_frame = pelvic_frame_name(s);
+  run.cor_method = s.cor_method();
 }
 
 /// The morphology before (on `options`' inputs; a note when it cannot be measured), the neck's least diameter

@@ -140,7 +140,8 @@ nlohmann::json scan_record(const JointBody& body, const ScanSummary& s, double d
   return j;
 }
 
-nlohmann::json frame_record(const AnatomicalFrame& f, const Eigen::Matrix3d& to_input, const char* quality_name) {
+nlohmann::json frame_record(const AnatomicalFrame& f, const Eigen::Matrix3d& to_input, const char* quality_name,
+                            const std::string& landmarks_file) {
   nlohmann::json j;
   j["definition"] = f.definition;
   j["origin_mm"] = vec(to_input * f.origin);
@@ -148,11 +149,19 @@ nlohmann::json frame_record(const AnatomicalFrame& f, const Eigen::Matrix3d& to_
   j["y_axis"] = vec(to_input * f.axes.col(1));
   j["z_axis"] = vec(to_input * f.axes.col(2));
   nlohmann::json lm = nlohmann::json::object();
-  for (const auto& [name, p] : f.landmarks)
-    lm[name] = {{"position_mm", vec(to_input * p)},
-                {"source", f.landmark_source.count(name) ? f.landmark_source.at(name) : "found"}};
+  for (const auto& [name, p] : f.landmarks) {
+    const std::string source = f.landmark_source.count(name) ? f.landmark_source.at(name) : "found";
+    lm[name] = {{"position_mm", vec(to_input * p)}, {"source", source}};
+    if (source == "given" && !landmarks_file.empty()) lm[name]["file"] = landmarks_file;
+  }
   j["landmarks"] = lm;
   j[quality_name] = number_or_null(f.quality_mm);
+  if (!std::isfinite(f.quality_mm))
+    j[std::string(quality_name) + "_reason"] =
+        f.landmarks.empty()                          ? "no landmarks: the scan axes stand for the frame"
+        : std::string(quality_name) == "head_fit_rms_mm" ? "the head centre was given (a COR or landmark hip_centre), "
+                                                           "not fitted: no fit residual"
+                                                         : "not computed for this frame";
   return j;
 }
 
@@ -267,8 +276,15 @@ nlohmann::json frames_record(const Session& s, const HipFrames& frames) {
   nlohmann::json f;
   AnatomicalFrame femur = frames.femur;
   femur.quality_mm = s.head().rms_residual;
-  f["pelvis"] = frame_record(frames.pelvis, to_input, "app_out_of_plane_mm");
-  f["femur"] = frame_record(femur, to_input, "head_fit_rms_mm");
+  // The head centre is the COR: given (the option or subject.json's hip_centre) or fitted (CorResult::method).
+  // A COR given as an option is named so (a given landmark's file is subject.json's).
+  const std::string& cor = s.cor_method();
+  femur.landmark_source["head_centre"] = cor.rfind("given (subject.json", 0) == 0 ? "given"
+                                         : cor.rfind("given", 0) == 0             ? "given: the cor option"
+                                                                                  : "fitted";
+  const std::string& file = s.hip_options().frames.landmarks_file;
+  f["pelvis"] = frame_record(frames.pelvis, to_input, "app_out_of_plane_mm", file);
+  f["femur"] = frame_record(femur, to_input, "head_fit_rms_mm", file);
   f["scan_pose_deg"] = {{"flexion", frames.scan_pose.flexion_deg},
                         {"adduction", frames.scan_pose.adduction_deg},
                         {"internal_rotation", frames.scan_pose.internal_rotation_deg}};
@@ -325,6 +341,11 @@ nlohmann::json setup_record(const Session& s) {
       "ISB joint coordinate system (Wu et al. 2002): flexion about the pelvic Z axis, adduction about the floating "
       "axis, internal rotation about the femoral y axis; flexion, adduction and internal rotation positive; left "
       "hips mirrored";
+  // Which frame each kind of value is in (issue 81): the pose angles above, every point and axis here.
+  j["coordinates_note"] =
+      "points (*_mm: centres, contacts, translations) and axes in the input files' frame (input_frame), mm; pose and "
+      "limit angles in the pelvic frame named by pelvic_frame (pose_convention); the head centre fitted or given as "
+      "cor_method says";
   if (const auto& frames = hip.frames()) j["frames"] = frames_record(s, *frames);
   return j;
 }

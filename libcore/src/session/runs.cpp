@@ -326,6 +326,18 @@ nlohmann::json rom_record(const RomRun& run) {
   j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
   j["neutral_min_gap_mm"] = number_or_null(run.baseline.min_gap_mm);
   j["neutral_joint_space_min_mm"] = number_or_null(run.baseline.joint_space_min_mm);
+  // Null values say why (issue 81): the metric's values are NaN beyond the distance's reach.
+  const bool by_distance = o.metric == RomMetric::distance;
+  if (!std::isfinite(run.baseline.min_gap_mm))
+    j["neutral_min_gap_reason"] = by_distance ? "no vertex of either bone lies within the distance reach "
+                                                "(distance_reach_mm) of the other at neutral: the bones are farther apart"
+                                              : "no vertex's ray meets the other bone at neutral";
+  if (!std::isfinite(run.baseline.joint_space_min_mm))
+    j["neutral_joint_space_min_reason"] =
+        by_distance ? "no lunate vertex lies within the distance reach (distance_reach_mm) of the femur at neutral: "
+                      "the joint space is wider than the reach (--distance-reach widens it); or no articular zones "
+                      "(scan neutral)"
+                    : "no lunate vertex's ray meets the femur at neutral, or no articular zones (scan neutral)";
   j["excluded_vertices"] = run.baseline.excluded_vertices;
   j["contacts_counted"] = run.baseline.articular_vertices == 0 && o.contacts != RomContacts::all
                               ? "all (no articular zones: scan neutral)"

@@ -29,7 +29,9 @@ struct HipFrameOptions {
 /// Both frames of a hip, in the working frame (mm).
 struct HipFrames {
   SphereFitResult head;     ///< the femoral head sphere: its centre is the centre of rotation and both frames' origin
-  std::string head_source;  ///< "found" (locate_femoral_head) or "given" (landmark "hip_centre")
+  /// "found" (locate_femoral_head) or "given" (landmark "hip_centre"); run_morphology sets "fitted" for the head
+  /// sphere it fitted and gave as hip_centre.
+  std::string head_source;
   PelvisLandmarks pelvis_landmarks;
   FemurLandmarks femur_landmarks;
   AnatomicalFrame pelvis, femur;

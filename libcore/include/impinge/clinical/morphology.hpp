@@ -11,15 +11,22 @@
 /// - head: the sphere fitted to the femoral head (HipFrames::head, thesis sec. 3.4); sphericity: rms and largest
 ///   |distance - r| of the femur's vertices on the head's cap away from the neck (angle from the neck axis over
 ///   100 deg), where cartilage-bearing bone lies;
-/// - neck axis: from the centroid of the femur's surface 4-12 mm outside the head sphere (the neck) to the head
-///   centre (femoral_clock_face); shaft axis: the principal axis of the femur's surface between 35 % and 65 % of
+/// - neck axis: through the head centre and the centre of the neck's narrowest cross-section, the sections normal to
+///   the axis (Reikeras et al. 1983; femoral_neck_axis, seeded at the centroid of the femur's surface 4-12 mm outside
+///   the head sphere: femoral_clock_face); shaft axis: the principal axis of the femur's surface between 35 % and 65 % of
 ///   the head-to-knee length (the diaphysis), pointing proximal; neck-shaft angle: between the neck axis and the
 ///   shaft axis pointing distal (normal 125-135 deg);
-/// - femoral version: the angle between the neck axis and a condylar axis, both projected on the plane normal to
-///   the femur's long axis (the ISB femur frame's y: knee centre to head centre), positive when the neck points
-///   anterior (anteversion): against the posterior condylar axis (Murphy et al. 1987, J Bone Joint Surg Am
-///   69:1169) and against the transepicondylar axis (Reikeras et al. 1983, Acta Orthop Scand 54:18); normal
-///   10-20 deg;
+/// - femoral version: the angle between the neck axis and a condylar axis (the line through the two posterior
+///   condyle landmarks, or through the two epicondyles), both projected on a plane, positive when the neck points
+///   anterior (anteversion), in two conventions:
+///   - across the shaft (version_*_shaft_deg): the plane normal to the shaft axis, as on the axial slices of a CT
+///     of a femur lying along the scanner's axis: the CT convention of Reikeras et al. 1983 (Acta Orthop Scand
+///     54:18; their neck axis: the head centre and the neck's centre, as impinge's) and Murphy et al. 1987 (J Bone
+///     Joint Surg Am 69:1169; the posterior condylar tangent as the distal reference); normal 10-20 deg against
+///     the posterior condylar axis;
+///   - across the mechanical axis (version_posterior_condylar_deg, version_transepicondylar_deg): the plane normal
+///     to the femur's mechanical axis (the ISB femur frame's y: the epicondyles' midpoint to the head centre; Wu
+///     et al. 2002), as 3D studies in the femoral frame take it;
 /// - alpha angle (Noetzli et al. 2002, J Bone Joint Surg Br 84:556, measured radially as 3D CT studies do):
 ///   in the plane through the neck axis at each clock hour of the head-neck clock (12 superior, 3 anterior on
 ///   both sides), the angle at the head centre between the neck axis and the first point, coming from the head,
@@ -41,7 +48,8 @@
 ///   cap inside the rim: 0.5 is a hemisphere), and the rim's angle from the acetabular pole per acetabular clock
 ///   hour (deg).
 /// Without landmarks (`frames` from scan neutral: a generated hip, a proximal femur in a cup) the frames' axes stand
-/// for the anatomical ones and the neck-shaft angle and femoral version are NaN, with a note.
+/// for the anatomical ones and the neck-shaft angle and femoral versions are NaN, with a note; without a shaft axis
+/// (fewer than 30 vertices on the diaphysis: a proximal femur) the versions across the shaft are NaN, with a note.
 /// Every direction is taken from the bone's own axes and its side (lateral is right for a right hip, left for a
 /// left one), so a mirrored hip gives the same values and a rigidly moved hip the same values.
 
@@ -70,8 +78,13 @@ struct Morphology {
   Eigen::Vector3d neck_axis = Eigen::Vector3d::Zero();   ///< unit, from the neck towards the head centre
   Eigen::Vector3d shaft_axis = Eigen::Vector3d::Zero();  ///< unit, distal to proximal
   double neck_shaft_angle_deg = 0;
-  double version_posterior_condylar_deg = 0;  ///< femoral anteversion against the posterior condylar axis
-  double version_transepicondylar_deg = 0;    ///< and against the transepicondylar axis
+  /// Femoral anteversion against the posterior condylar axis, across the mechanical axis (knee centre to head centre).
+  double version_posterior_condylar_deg = 0;
+  double version_transepicondylar_deg = 0;  ///< and against the transepicondylar axis, across the mechanical axis
+  /// Femoral anteversion against the posterior condylar axis, across the shaft axis (the CT convention: Reikeras et al.
+  /// 1983, Murphy et al. 1987); NaN without a shaft axis.
+  double version_posterior_condylar_shaft_deg = 0;
+  double version_transepicondylar_shaft_deg = 0;  ///< and against the transepicondylar axis, across the shaft axis
   // Head-neck junction.
   std::array<double, 12> alpha_deg{};  ///< alpha angle at clock hours 1 ... 12 (index hour - 1)
   double alpha_max_deg = 0, alpha_max_hour = 0;
@@ -85,6 +98,14 @@ struct Morphology {
   std::array<double, 12> coverage_deg{};  ///< rim angle from the acetabular pole per acetabular clock hour
   std::vector<std::string> notes;         ///< what could not be measured, and why
 };
+
+/// The femoral version (deg, in (-180, 180]) of the neck axis `neck` (towards the head) against the condylar axis from
+/// `lateral` to `medial` (points, mm; the posterior condyles or the epicondyles), both projected on the plane normal to
+/// `axis` (the shaft axis: the CT convention, Reikeras et al. 1983, Murphy et al. 1987; or the mechanical axis: the
+/// ISB femoral y); positive (anteversion) when the projected neck leans towards `anterior` (any vector on the
+/// anterior side of the condylar axis across `axis`). Source: those papers, in 3D (impinge).
+double femoral_version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& medial, const Eigen::Vector3d& lateral,
+                           const Eigen::Vector3d& axis, const Eigen::Vector3d& anterior);
 
 /// Measure the morphology of a hip from its whole femur and its pelvis (working frame, mm) on `side`, its frames
 /// (find_hip_frames: head sphere, landmarks, ISB frames) and its acetabulum (find_acetabulum on the pelvis). The

@@ -19,6 +19,8 @@ struct MorphologyRun {
   nlohmann::json meshes;  ///< the bones' mesh hygiene (meshes_record)
   Morphology morphology;
   HipFrames frames;       ///< working frame (the head: the sphere the femur shows)
+  std::string head_method;     ///< how the head sphere was fitted (CorResult::method, or the automatic fit's)
+  std::string landmarks_file;  ///< the file the given landmarks came from (subject.json); empty: none given
   Acetabulum acetabulum;  ///< working frame
   TriangleMesh femur;     ///< working frame
   Side side = Side::right;

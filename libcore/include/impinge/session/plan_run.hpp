@@ -65,6 +65,8 @@ struct PlanRun {
   std::string subject, femur_source, pelvis_source;
   Eigen::Vector3d head_centre_mm = Eigen::Vector3d::Zero();  ///< the femoral head centre at the scan pose, input frame
   FrameConvention input_frame = FrameConvention::RAS;
+  std::string pelvic_frame;  ///< the frame of the targets' and limits' angles (pelvic_frame_name: isb, app or scan)
+  std::string cor_method;    ///< how the head centre (the COR) was obtained (Session::cor_method)
   double setup_ms = 0, before_ms = 0, plan_ms = 0, check_ms = 0, total_ms = 0;
   std::vector<std::string> warnings;
   nlohmann::json meshes;  ///< the bones' mesh hygiene (meshes_record)

@@ -47,9 +47,11 @@ nlohmann::json scan_record(const JointBody& body, const ScanSummary& summary, do
                            const ImpingementLevels& levels, const ClockSummary* clock);
 
 /// An anatomical frame: definition, origin, axes (ISB: x anterior, y superior, z right), landmarks
-/// with their source, and its quality (mm) under `quality_name`; in the input frame by `to_input`
-/// (3 x 3, working -> input).
-nlohmann::json frame_record(const AnatomicalFrame& frame, const Eigen::Matrix3d& to_input, const char* quality_name);
+/// with their source ("found" on the mesh, "given", or "fitted": a sphere's centre) and, for a given one, the file it
+/// was given in (`landmarks_file`, when not empty), and its quality (mm) under `quality_name` (null with a
+/// `quality_name`_reason beside it when not finite); in the input frame by `to_input` (3 x 3, working -> input).
+nlohmann::json frame_record(const AnatomicalFrame& frame, const Eigen::Matrix3d& to_input, const char* quality_name,
+                           const std::string& landmarks_file = "");
 
 /// The acetabulum: sphere, rim, opening, radiographic inclination and anteversion
 /// (radiographic_orientation), clock axes and coverage; in the input frame by `to_input`.
