@@ -115,27 +115,29 @@ struct BoneQueries {
   explicit BoneQueries(const Session& s) : femur(mesh(s.joint().ball())), pelvis(mesh(s.joint().socket())) {}
 };
 
-/// The least counted signed distance (mm) at pose P of session `s`, over the vertices the plan follows (RomBaseline
-/// `base`'s, as find_contacts in resection.cpp): each vertex's Euclidean distance to the other bone where the joint
-/// gives one (within its reach), the exact signed distance (`q`) where it gives none but the radial gap says the
-/// vertex lies inside the other bone (farther inside than the reach, or the radial gap's error); +inf when none is
-/// within the reach.
-double counted_clearance(const Session& s, const RomBaseline& base, const BoneQueries& q, const FemurPose& P,
-                         PoseResult& res) {
+/// A pose's least signed distances (mm): over the vertices the plan follows, and over every vertex (the joint
+/// surfaces too).
+struct PoseClearance {
+  double counted = std::numeric_limits<double>::infinity(), any = std::numeric_limits<double>::infinity();
+};
+
+/// The least signed distances (mm) at pose P of session `s`: over the vertices the plan follows (RomBaseline `base`'s,
+/// as find_contacts in resection.cpp) and over every vertex; each vertex's Euclidean distance to the other bone where
+/// the joint gives one (within its reach), the exact signed distance (`q`) where it gives none but the radial gap
+/// says the vertex lies inside the other bone (farther inside than the reach, or the radial gap's error); +inf when
+/// none is within the reach.
+PoseClearance pose_clearance(const Session& s, const RomBaseline& base, const BoneQueries& q, const FemurPose& P,
+                             PoseResult& res) {
   s.joint().detect(P.R, P.t, res);
-  double m = std::numeric_limits<double>::infinity();
+  PoseClearance m;
   for (int b = 0; b < 2; ++b) {
     const ScanGaps& g = b == 0 ? res.ball_gaps : res.socket_gaps;
     const std::vector<std::uint8_t>& skip = b == 0 ? base.skip_ball : base.skip_socket;
     const Vertices& own = b == 0 ? s.joint().ball().relative : s.joint().socket().relative;
     for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
-      if (!skip.empty() && skip[i]) continue;
       double v = g.distance_mm.empty() ? std::nan("") : double(g.distance_mm[i]);
       if (std::isnan(v) && !(g.gap_mm[i] < 0)) continue;
       const Eigen::Vector3d x = own.row(static_cast<Eigen::Index>(i)).transpose();
-      if (b == 1 && std::isfinite(base.head_sphere_reach_mm) &&
-          (P.R.transpose() * (x - P.t) - base.head_centre).norm() <= base.head_sphere_reach_mm)
-        continue;
       if (std::isnan(v)) {
         ClosestSurfacePoint cp;
         const bool found = b == 0 ? q.pelvis.signed_distance(P.R * x + P.t, kInfMm, 0, cp)
@@ -143,18 +145,23 @@ double counted_clearance(const Session& s, const RomBaseline& base, const BoneQu
         if (!found) continue;
         v = cp.signed_mm();
       }
-      m = std::min(m, v);
+      m.any = std::min(m.any, v);
+      if ((!skip.empty() && skip[i]) || !(v < m.counted)) continue;
+      if (b == 1 && std::isfinite(base.head_sphere_reach_mm) &&
+          (P.R.transpose() * (x - P.t) - base.head_centre).norm() <= base.head_sphere_reach_mm)
+        continue;
+      m.counted = v;
     }
   }
   return m;
 }
 
-/// Each pose's clearance in session `s`'s placement (counted_clearance) at pose `which[p]` (target, pose) of
+/// Each pose's clearance in session `s`'s placement (pose_clearance) at pose `which[p]` (target, pose) of
 /// `planned`, in parallel. Throws impinge::Error with the first pose's error.
-std::vector<double> pose_clearances(const Session& s, const RomBaseline& base,
+std::vector<PoseClearance> pose_clearances(const Session& s, const RomBaseline& base,
                                     const std::vector<ResectionTarget>& planned,
                                     const std::vector<std::pair<std::size_t, std::size_t>>& which) {
-  std::vector<double> d(which.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<PoseClearance> d(which.size());
   if (which.empty()) return d;
   const BoneQueries q(s);
   std::string error;
@@ -166,7 +173,7 @@ std::vector<double> pose_clearances(const Session& s, const RomBaseline& base,
       if (interruption_requested()) continue;
       try {
         const PoseAngles& a = planned[which[p].first].poses[which[p].second];
-        d[p] = counted_clearance(s, base, q, s.hip().femur_pose(a), res);
+        d[p] = pose_clearance(s, base, q, s.hip().femur_pose(a), res);
       } catch (const std::exception& e) {
 #pragma omp critical(plan_clearance_error)
         if (error.empty()) error = e.what();
@@ -191,20 +198,21 @@ void check_clearance(PlanRun& run, const PlanCheck& c, const Session& s_after, c
     const auto cleared = static_cast<std::size_t>(std::max<std::int64_t>(0, run.plan.targets[k].poses_cleared));
     for (std::size_t i = 0; i < std::min(cleared, planned[k].poses.size()); ++i) which.emplace_back(k, i);
   }
-  const std::vector<double> d = pose_clearances(s_after, base, planned, which);
+  const std::vector<PoseClearance> d = pose_clearances(s_after, base, planned, which);
   run.clearance_met = true;
   run.all_met = true;
   for (std::size_t k = 0; k < run.targets.size(); ++k) {
     PlanTargetCheck& t = run.targets[k];
-    t.clearance_least_mm = t.clearance_least_at = t.clearance_at_target_mm = std::nan("");
+    t.clearance_least_mm = t.clearance_least_at = t.clearance_at_target_mm = t.clearance_least_any_mm = std::nan("");
     t.clearance_poses = 0;
     for (std::size_t p = 0; p < which.size(); ++p) {
       if (which[p].first != k) continue;
       ++t.clearance_poses;
       const ResectionTarget& tg = planned[k];
-      if (!(d[p] >= t.clearance_least_mm))
-        t.clearance_least_mm = d[p], t.clearance_least_at = tg.theta_deg[which[p].second];
-      if (which[p].second + 1 == tg.poses.size()) t.clearance_at_target_mm = d[p];
+      if (!(d[p].counted >= t.clearance_least_mm))
+        t.clearance_least_mm = d[p].counted, t.clearance_least_at = tg.theta_deg[which[p].second];
+      if (!(d[p].any >= t.clearance_least_any_mm)) t.clearance_least_any_mm = d[p].any;
+      if (which[p].second + 1 == tg.poses.size()) t.clearance_at_target_mm = d[p].counted;
     }
     t.clearance_met = !(t.clearance_least_mm < c.ro.clearance_mm - kRoundingMm);
     t.met = t.limit_met && t.clearance_met;

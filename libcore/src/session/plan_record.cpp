@@ -38,7 +38,13 @@ nlohmann::json clearance_record(const PlanRun& run, const PlanTargetCheck& c) {
           {"least_at", number_or_null(c.clearance_least_at)},
           {"at_target_mm", number_or_null(c.clearance_at_target_mm)},
           {"poses", c.clearance_poses},
-          {"met", c.clearance_met}};
+          {"met", c.clearance_met},
+          {"least_any_mm", number_or_null(c.clearance_least_any_mm)},
+          {"definition",
+           "in the final placement, over the poses the plan cleared: the least signed distance between the vertices "
+           "the plan follows (the ROM search's, joint surfaces left out) and the other bone (least_mm, where: "
+           "least_at, deg or frame; at the target's own pose: at_target_mm); least_any_mm: over every vertex, the "
+           "joint surfaces too (the plan does not follow these: a contact classed articular shows there)"}};
 }
 
 /// The femur's alpha angles (deg) before and after the resection, per head-neck clock hour 1..12 and the largest;

@@ -52,6 +52,9 @@ struct PlanTargetCheck {
   double clearance_least_mm = std::numeric_limits<double>::quiet_NaN();
   double clearance_least_at = std::numeric_limits<double>::quiet_NaN();
   double clearance_at_target_mm = std::numeric_limits<double>::quiet_NaN();
+  /// The least signed distance over the same poses and every vertex, the joint surfaces too (which the plan does
+  /// not follow: a contact classed articular shows here), mm.
+  double clearance_least_any_mm = std::numeric_limits<double>::quiet_NaN();
   std::int64_t clearance_poses = 0;  ///< the poses checked
   bool clearance_met = true;         ///< clearance_least_mm at least the clearance (less 1e-4 mm of rounding)
   double shortfall_deg = 0;  ///< target less the limit after, when not met
