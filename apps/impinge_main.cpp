@@ -324,7 +324,9 @@ int run_plan(const RunOptions& o) {
       std::cout << " " << (std::isnan(c.before.limit_deg) ? std::string(to_string(c.before.status)) : std::to_string(static_cast<double>(std::lround(c.before.limit_deg * 10)) / 10.0).substr(0, 5))
                 << "->" << (std::isnan(c.after.limit_deg) ? std::string(to_string(c.after.status)) : std::to_string(static_cast<double>(std::lround(c.after.limit_deg * 10)) / 10.0).substr(0, 5))
                 << "/" << c.target_deg;
-    std::cout << (c.met ? " met" : " MISSED") << ";";
+    if (c.clearance_poses > 0)
+      std::cout << " clearance " << std::setprecision(2) << c.clearance_least_mm << std::setprecision(1) << " mm";
+    std::cout << (c.met ? " met" : c.limit_met ? " MISSED (clearance)" : " MISSED") << ";";
   }
   std::cout << " " << std::setprecision(0) << run.total_ms << " ms; written to " << out << "\n";
   if (!run.all_met && !o.plan.allow_partial) {

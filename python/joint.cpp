@@ -261,7 +261,8 @@ void add_joint_queries(py::class_<PyJoint>& c) {
                     "that the "
            "targets run free of impingement (target: 'MOTION=DEG,...' and/or 'normal'; target_motion: a motion "
            "file), shaped for a spherical burr, within the safety depth, never the head inside the labrum line or "
-           "the lunate surface; checked by the ROM search on the resected bones. Adds femur_resected (V, F: input "
+           "the lunate surface; checked on the resected bones in their own placement (the ROM search and the "
+           "clearance at every target pose; further passes where one is missed). Adds femur_resected (V, F: input "
            "frame, the input's faces) and femur_resection_mm (per vertex), and the pelvis' with resect 'pelvis' or "
            "'both'. Raises impinge.Error when a target is missed, unless allow_partial. Keywords and defaults: the "
             "option table's (impinge.options()). " + keywords_doc(use_joint_plan)))

@@ -162,9 +162,10 @@ class Joint:
         """Resection plan (`impinge plan`'s plan.json as a dict): the least bone to remove so that the targets
         ('MOTION=DEG,...' and/or 'normal'; target_motion: a motion file) run free of impingement, shaped for a
         spherical burr (burr_radius_mm), within the safety depth (max_depth_fraction of the neck's least diameter,
-        or max_depth_mm), never the head inside the labrum line or the lunate surface; checked by the ROM search on
-        the resected bones. Adds femur_resected (V, F: input frame, mm) and femur_resection_mm (per vertex, mm),
-        and the pelvis' with resect 'pelvis' or 'both'. Raises impinge.Error when a target is missed unless
+        or max_depth_mm), never the head inside the labrum line or the lunate surface; checked on the resected
+        bones in their own placement (the ROM search and the clearance at every target pose). Adds femur_resected
+        (V, F: input frame, mm) and femur_resection_mm (per vertex, mm), and the pelvis' with resect 'pelvis' or
+        'both'. Raises impinge.Error when a target is missed unless
         allow_partial."""
     def rom_map(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
                 flexion: Sequence[float] = [0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0,

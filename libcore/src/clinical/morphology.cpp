@@ -198,7 +198,7 @@ double femoral_version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& m
 }
 
 Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pelvis, Side side, const HipFrames& frames,
-                              const Acetabulum& A) {
+                              const Acetabulum& A, const ClockFace* head_neck_clock) {
   Morphology m;
   const SphereFitResult& head = frames.head;
   const Eigen::Vector3d c = head.centre;
@@ -213,9 +213,10 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
   const Eigen::Vector3d fx = F.axes.col(0), fy = F.axes.col(1);
 
   // Neck axis (towards the head) and the head-neck clock.
-  const ClockFace clock = femoral_clock_face(femur, c, r, F);
+  const ClockFace clock = head_neck_clock ? *head_neck_clock : femoral_clock_face(femur, c, r, F);
   const Eigen::Vector3d n = clock.axis, down_neck = -n;
   m.neck_axis = n;
+  m.head_neck_clock = clock;
   measure_sphericity(femur, c, r, down_neck, m);
 
   // Without femoral landmarks (scan neutral: a generated hip, a proximal femur) there is no knee: no shaft, no version.

@@ -332,7 +332,7 @@ void plan_round(ResectionPlan& plan, const ResectionOptions& o, BoneState (&bone
       if (other.query->signed_distance(q, kInf, 0, cp, ct.seed)) {
         ct.seed = cp.triangle;
         ct.triangle = cp.triangle;
-        ct.deficit = o.clearance_mm - cp.signed_mm();
+        ct.deficit = o.clearance_mm + o.tolerance_mm - cp.signed_mm();  // met at c (header, step 4)
       } else {
         ct.deficit = 0;
       }

@@ -29,19 +29,16 @@ void mark_fitted_head(MorphologyRun& run, const std::string& method, const Loade
   }
   run.landmarks_file = in.landmarks.empty() ? "" : in.landmarks_file;
 }
-}  // namespace
 
-MorphologyRun run_morphology(const SessionOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  LoadedInput in = load_input(options.input);
+/// The head sphere the femur shows (a given COR moves neither the head nor what is measured about it) and both frames
+/// (find_hip_frames; scan neutral: the input frame's axes) of the loaded input `in` into `run`.
+void find_head_and_frames(const SessionOptions& options, const LoadedInput& in, MorphologyRun& run) {
   const CorResult cor = find_centre_of_rotation(in, options.cor);
   check_side_and_frame(in, cor, options.input);
-  // The head the femur shows (a given COR moves neither the head nor what is measured about it).
   SphereFitResult head = cor.head;
   if (!std::isfinite(head.radius)) head = cor.fitted_head ? *cor.fitted_head : located_head(in);
   HipJointOptions hip_options = resolved_hip_options(options, in.neutral);
   hip_options.frames.landmarks_file = in.landmarks_file;
-  MorphologyRun run;
   if (hip_options.neutral.value_or(Neutral::anatomical) == Neutral::anatomical) {
     Landmarks given = in.landmarks;
     given["hip_centre"] = head.centre;
@@ -57,8 +54,24 @@ MorphologyRun run_morphology(const SessionOptions& options) {
   }
   run.frames.head = head;
   mark_fitted_head(run, std::isfinite(cor.head.radius) ? cor.method : kAutomaticHeadFit, in);
+}
+}  // namespace
+
+MorphologyRun run_morphology(const SessionOptions& options, const MorphologyRun* reference) {
+  const auto t0 = std::chrono::steady_clock::now();
+  LoadedInput in = load_input(options.input);
+  MorphologyRun run;
+  if (reference) {  // the head sphere and frames before the resection, and where they came from
+    run.frames = reference->frames;
+    run.head_method = reference->head_method;
+    run.landmarks_file = reference->landmarks_file;
+  } else {
+    find_head_and_frames(options, in, run);
+  }
+  const SphereFitResult& head = run.frames.head;
   run.acetabulum = find_acetabulum(in.pelvis, head.centre, head.radius, run.frames.pelvis);
-  run.morphology = measure_morphology(in.femur, in.pelvis, in.side, run.frames, run.acetabulum);
+  run.morphology = measure_morphology(in.femur, in.pelvis, in.side, run.frames, run.acetabulum,
+                                      reference ? &reference->morphology.head_neck_clock : nullptr);
   run.side = in.side;
   run.to_input = in.to_working.transpose();
   run.input_frame = in.frame;

@@ -26,6 +26,27 @@ nlohmann::json bone_record(const PlanRun& run, const BoneResection& b, int k) {
   return r;
 }
 
+/// A point or vector (input frame), NaN entries as null.
+nlohmann::json point(const Eigen::Vector3d& v) {
+  return {number_or_null(v.x()), number_or_null(v.y()), number_or_null(v.z())};
+}
+
+/// A target's clearance in the final placement (PlanTargetCheck's clearance_*; mm, and deg or frame).
+nlohmann::json clearance_record(const PlanRun& run, const PlanTargetCheck& c) {
+  return {{"required_mm", run.plan.options.clearance_mm},
+          {"least_mm", number_or_null(c.clearance_least_mm)},
+          {"least_at", number_or_null(c.clearance_least_at)},
+          {"at_target_mm", number_or_null(c.clearance_at_target_mm)},
+          {"poses", c.clearance_poses},
+          {"met", c.clearance_met},
+          {"least_any_mm", number_or_null(c.clearance_least_any_mm)},
+          {"definition",
+           "in the final placement, over the poses the plan cleared: the least signed distance between the vertices "
+           "the plan follows (the ROM search's, joint surfaces left out) and the other bone (least_mm, where: "
+           "least_at, deg or frame; at the target's own pose: at_target_mm); least_any_mm: over every vertex, the "
+           "joint surfaces too (the plan does not follow these: a contact classed articular shows there)"}};
+}
+
 /// The femur's alpha angles (deg) before and after the resection, per head-neck clock hour 1..12 and the largest;
 /// after: null when not measured. Needs run.before.
 nlohmann::json alpha_record(const PlanRun& run) {
@@ -39,11 +60,20 @@ nlohmann::json alpha_record(const PlanRun& run) {
   a["max_before_deg"] = number_or_null(run.before->alpha_max_deg);
   a["max_after_deg"] = run.after ? number_or_null(run.after->alpha_max_deg) : nullptr;
   a["definition"] = "alpha angle per head-neck clock hour 1..12 (Notzli et al. 2002; impinge morphology)";
+  a["axes"] = {{"frame", "femur before the resection"},
+               {"head_centre_mm", point(run.reference_head_centre_mm)},
+               {"head_radius_mm", number_or_null(run.reference_head_radius_mm)},
+               {"neck_axis", point(run.reference_neck_axis)},
+               {"definition",
+                "before and after measured about the same head sphere, neck axis (head-neck clock) and frames, those "
+                "of the femur before the resection (impinge morphology on the input, input frame): the resected "
+                "femur's own are not fitted again, so only the cut changes an angle"}};
   return a;
 }
 
-/// plan.json's targets: each one's angle (deg), whether met, what the plan reached and its note; a standard
-/// motion's limits (deg) and statuses before and after and its shortfall (deg), a motion file's frames in contact.
+/// plan.json's targets: each one's angle (deg), whether met (its limit, its clearance in the final placement: mm),
+/// what the plan reached and its note; a standard motion's limits (deg) and statuses before and after and its
+/// shortfall (deg), a motion file's frames in contact.
 nlohmann::json targets_record(const PlanRun& run) {
   nlohmann::json targets = nlohmann::json::array();
   for (std::size_t k = 0; k < run.targets.size(); ++k) {
@@ -52,6 +82,8 @@ nlohmann::json targets_record(const PlanRun& run) {
     nlohmann::json t = {{"target", c.name},
                         {"target_deg", number_or_null(c.target_deg)},
                         {"met", c.met},
+                        {"limit_met", c.limit_met},
+                        {"clearance", clearance_record(run, c)},
                         {"planned_reachable", r.reachable},
                         {"planned_reachable_deg", number_or_null(r.reachable_deg)},
                         {"poses", r.poses},
@@ -107,6 +139,15 @@ nlohmann::json plan_record(const PlanRun& run) {
   if (run.before) j["femur_resection"]["alpha"] = alpha_record(run);
   j["targets"] = targets_record(run);
   j["all_targets_met"] = run.all_met;
+  j["clearance_met"] = run.clearance_met;
+  j["placement"] = {
+      {"head_centre_before_mm", point(run.head_centre_mm)},
+      {"head_centre_final_mm", point(run.final_head_centre_mm)},
+      {"head_centre_shift_mm", number_or_null((run.final_head_centre_mm - run.head_centre_mm).norm())},
+      {"definition",
+       "the check's placement (the last check): a new session on the resected bones, as `impinge rom` on the written "
+       "meshes, its femoral head, equidistant joint centre, acetabulum and joint surfaces found on them; each target's "
+       "limit and clearance are checked there (input frame, mm)"}};
   j["plan"] = {{"iterations", run.plan.iterations},
                {"rounds", run.plan.rounds},
                {"passes", run.plan.passes},

@@ -76,6 +76,7 @@ struct Morphology {
   std::vector<double> head_deviation_mm;
   // Neck and shaft.
   Eigen::Vector3d neck_axis = Eigen::Vector3d::Zero();   ///< unit, from the neck towards the head centre
+  ClockFace head_neck_clock;  ///< the head-neck clock the alpha angles and offset were measured on (axis: neck_axis)
   Eigen::Vector3d shaft_axis = Eigen::Vector3d::Zero();  ///< unit, distal to proximal
   double neck_shaft_angle_deg = 0;
   /// Femoral anteversion against the posterior condylar axis, across the mechanical axis (knee centre to head centre).
@@ -113,7 +114,10 @@ double femoral_version_deg(const Eigen::Vector3d& neck, const Eigen::Vector3d& m
 /// rays from the head centre (where the roof's bone ends, the median of five parallel planes 2 mm apart). Costs about
 /// a thousand exact ray casts on the femur and up to 9,000 on the pelvis (CGAL AABB trees; ExactReference). Throws
 /// impinge::Error naming the femur mesh when no neck is found (femoral_clock_face) or CGAL is missing from this build.
+/// `head_neck_clock` (working frame; its axis the neck axis): measure about it instead of the femur's own
+/// (femoral_clock_face): a femur after a resection measured about its neck axis before (plan_run.hpp), so that only
+/// the cut changes a value, not an axis refitted on the cut bone.
 Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pelvis, Side side, const HipFrames& frames,
-                              const Acetabulum& acetabulum);
+                              const Acetabulum& acetabulum, const ClockFace* head_neck_clock = nullptr);
 
 }  // namespace impinge

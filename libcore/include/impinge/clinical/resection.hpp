@@ -28,9 +28,10 @@
 ///    rim's plane with the femur at neutral; the head-neck junction outside it, where an osteochondroplasty
 ///    restores the offset, may go) and the lunate surface; with scan neutral, the head sphere's surface within
 ///    0.5 mm and the cup's surface facing the centre within the head radius + 3 mm;
-/// 4. the vertices moved, steps 2-3 are repeated on the resected bones (exact distances again) until no contact
-///    asks for more than `tolerance_mm` or `max_iterations` pass: moving along n_i clears a tilted contact by
-///    less than its depth, so a few rounds are needed.
+/// 4. the vertices moved, steps 2-3 are repeated on the resected bones (exact distances again) until every contact
+///    is at least c apart or `max_iterations` pass: moving along n_i clears a tilted contact by less than its
+///    depth, so a few rounds are needed; a contact closer than c asks (in step 2) for `tolerance_mm` more than
+///    c - s, so that the rounds end with every contact at least c apart, not within a tolerance of it.
 /// A contact whose depth cannot be taken (every vertex that could take it is protected or at the safety depth)
 /// makes its pose unreachable: the target is planned up to the last pose before it, and the plan is made again
 /// without the unreachable poses, so no bone is removed for a motion it cannot restore.
@@ -90,7 +91,7 @@ struct ResectionOptions {
   double safety_depth_mm = std::numeric_limits<double>::infinity();
   double burr_radius_mm = 2.5;     ///< b: the spherical burr's radius, mm (0: no widening)
   static constexpr Range kBurrRadiusRange{0, 10};  ///< of burr_radius_mm, mm
-  double tolerance_mm = 0.02;      ///< a contact asking for less than this more is met, mm
+  double tolerance_mm = 0.02;      ///< a contact closer than c asks for this more than it misses, mm (step 4)
   int max_iterations = 16;         ///< rounds of step 4
   double candidate_margin_mm = 1;  ///< contacts: vertices within c + this of the other bone, mm
   /// Per vertex of the femur and of the pelvis (or empty: none), the depth an earlier plan already removed, mm
@@ -142,7 +143,7 @@ struct ResectionPlan {
   int rounds = 0;                        ///< plans made (1 + one per round of dropping unreachable poses)
   /// Plans on the resected bones (run_plan: 1, plus one per further round after a check that missed a target)
   int passes = 1;
-  double residual_mm = 0;                ///< the largest depth a kept contact still asks for, mm
+  double residual_mm = 0;                ///< the largest depth a kept contact still asks for (c + tolerance - s), mm
   std::int64_t poses = 0, contacts = 0;  ///< poses scanned; (pose, vertex) contacts followed
   double ms = 0;                         ///< wall time, ms
 };

@@ -35,7 +35,10 @@ struct MorphologyRun {
 /// femoral head (the sphere the femur shows, also when a COR is given), both frames (find_hip_frames) and the
 /// acetabulum (find_acetabulum), and measure the morphology (measure_morphology). No maps are built. Throws
 /// impinge::Error as Session's constructor does for the same inputs (naming the file, landmark or step).
-MorphologyRun run_morphology(const SessionOptions& options);
+/// With `reference` (a run on the same hip before a resection, its input frame the same): its head sphere, frames and
+/// head-neck clock (neck axis) are taken as they are, not found again on these bones, and the acetabulum is found on
+/// this pelvis about that head: a before/after comparison in which only the cut changes a value (plan_run.hpp).
+MorphologyRun run_morphology(const SessionOptions& options, const MorphologyRun* reference = nullptr);
 
 /// morphology.json: per quantity its value (points and axes in the input frame), unit, definition and source; the
 /// landmarks and frames used; the notes of what could not be measured. Never throws.

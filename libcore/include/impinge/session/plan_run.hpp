@@ -40,8 +40,23 @@ struct PlanTargetCheck {
   std::string name;
   double target_deg = std::numeric_limits<double>::quiet_NaN();  ///< NaN for a motion file
   RomLimit before, after;    ///< the ROM search's limit on the input and on the resected bones (standard motions)
-  bool met = false;          ///< after: limited at or beyond the target (within 0.1 deg, the search's tolerance),
+  bool met = false;          ///< limit_met and clearance_met
+  bool limit_met = false;    ///< after: limited at or beyond the target (within 0.1 deg, the search's tolerance),
                              ///< or free; a motion file: no frame in contact after
+  /// The clearance (ResectionOptions::clearance_mm, what the plan promises) in the final placement: the check's
+  /// session on the resected bones, whose equidistant joint centre, acetabulum and joint surfaces are found again
+  /// on them. Over the poses the plan cleared (its last pass's: the whole target when it was reachable), the least
+  /// counted signed distance (the vertices the plan follows, RomBaseline's; mm) and where (the motion's angle,
+  /// deg, or a motion file's frame; NaN on the way to a motion's start), and at the target's own pose (its angle or
+  /// last frame; NaN when not cleared). NaN and met when there was no pose to plan (a target met before the plan).
+  double clearance_least_mm = std::numeric_limits<double>::quiet_NaN();
+  double clearance_least_at = std::numeric_limits<double>::quiet_NaN();
+  double clearance_at_target_mm = std::numeric_limits<double>::quiet_NaN();
+  /// The least signed distance over the same poses and every vertex, the joint surfaces too (which the plan does
+  /// not follow: a contact classed articular shows here), mm.
+  double clearance_least_any_mm = std::numeric_limits<double>::quiet_NaN();
+  std::int64_t clearance_poses = 0;  ///< the poses checked
+  bool clearance_met = true;         ///< clearance_least_mm at least the clearance (less 1e-4 mm of rounding)
   double shortfall_deg = 0;  ///< target less the limit after, when not met
   /// Motion files: frames in contact before and after (the ROM search's criterion), else 0.
   std::int64_t frames_in_contact_before = 0, frames_in_contact_after = 0;
@@ -52,11 +67,22 @@ struct PlanRun {
   ResectionPlan plan;
   std::vector<PlanTargetCheck> targets;
   bool all_met = false;
+  bool clearance_met = false;  ///< every target's clearance_met
+  /// The head centre (COR) of the final placement (the last check's session, fitted on the resected femur) and of the
+  /// plan's first session (head_centre_mm), input frame, mm.
+  Eigen::Vector3d final_head_centre_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// The axes the morphology before and after share (input frame; NaN when the morphology before was not measured):
+  /// the femoral head sphere and neck axis (unit, towards the head) of the femur before the resection.
+  Eigen::Vector3d reference_head_centre_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Vector3d reference_neck_axis = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  double reference_head_radius_mm = std::numeric_limits<double>::quiet_NaN();
   RomOptions search;  ///< the ROM search's options (the check's)
   double neck_diameter_mm = std::numeric_limits<double>::quiet_NaN();
   PlanRequest request;                            ///< what was asked
   double safety_depth_mm = 0;                     ///< the safety depth used (from request's cap or fraction), mm
-  std::optional<Morphology> before, after;        ///< morphology of the input and of the resected femur
+  /// Morphology of the input and of the resected femur, the latter about the former's head sphere, neck axis and
+  /// frames (run_morphology's reference): only the cut changes a value.
+  std::optional<Morphology> before, after;
   std::vector<std::string> notes;                 ///< what could not be measured or checked
   TriangleMesh femur_resected, pelvis_resected;   ///< input frame, mm (the input's faces and vertex order)
   std::vector<double> femur_hours, pelvis_hours;  ///< per vertex: head-neck and acetabular clock hours (empty
@@ -87,8 +113,10 @@ void check_plan_request(const SessionOptions& options, const PlanRequest& reques
 
 /// Plan and check: the session (rom_session_options of `rom.search`, distances on with a reach of at least the
 /// clearance + 1 mm), the ROM limits before, the plan (plan_resection), the resected meshes, and the ROM limits
-/// of a new session on them (the check: the same options, as `impinge rom` on the written meshes), the
-/// morphology before and after where it can be measured. Throws impinge::Error naming the option, target or
+/// of a new session on them (the check: the same options, as `impinge rom` on the written meshes) with the
+/// clearance at every pose the plan cleared in that session's placement; where a limit or a clearance is missed,
+/// further passes on the resected bones (at most four passes in all); the morphology before and after (about the
+/// same head sphere and neck axis) where it can be measured. Throws impinge::Error naming the option, target or
 /// file; a target missed is not an error here (the CLI's exit status follows PlanRequest::allow_partial).
 PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const PlanRequest& request);
 
