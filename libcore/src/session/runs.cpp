@@ -317,16 +317,10 @@ SessionOptions rom_session_options(SessionOptions so, const RomOptions& search) 
   return so;
 }
 
-nlohmann::json rom_record(const RomRun& run) {
-  nlohmann::json j;
+namespace {
+// Null neutral values say why (issue 81): the metric's values are NaN beyond the distance's reach.
+void add_null_reasons(const RomRun& run, nlohmann::json& j) {
   const RomOptions& o = run.search;
-  j["threshold_mm"] = o.threshold_mm;
-  j["contact_depth_mm"] = o.contact_depth_mm;
-  j["metric"] = to_string(o.metric);
-  j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
-  j["neutral_min_gap_mm"] = number_or_null(run.baseline.min_gap_mm);
-  j["neutral_joint_space_min_mm"] = number_or_null(run.baseline.joint_space_min_mm);
-  // Null values say why (issue 81): the metric's values are NaN beyond the distance's reach.
   const bool by_distance = o.metric == RomMetric::distance;
   if (!std::isfinite(run.baseline.min_gap_mm))
     j["neutral_min_gap_reason"] = by_distance ? "no vertex of either bone lies within the distance reach "
@@ -338,6 +332,19 @@ nlohmann::json rom_record(const RomRun& run) {
                       "the joint space is wider than the reach (--distance-reach widens it); or no articular zones "
                       "(scan neutral)"
                     : "no lunate vertex's ray meets the femur at neutral, or no articular zones (scan neutral)";
+}
+}  // namespace
+
+nlohmann::json rom_record(const RomRun& run) {
+  nlohmann::json j;
+  const RomOptions& o = run.search;
+  j["threshold_mm"] = o.threshold_mm;
+  j["contact_depth_mm"] = o.contact_depth_mm;
+  j["metric"] = to_string(o.metric);
+  j["search"] = {{"step_deg", o.step_deg}, {"max_deg", o.max_deg}, {"tolerance_deg", o.tolerance_deg}};
+  j["neutral_min_gap_mm"] = number_or_null(run.baseline.min_gap_mm);
+  j["neutral_joint_space_min_mm"] = number_or_null(run.baseline.joint_space_min_mm);
+  add_null_reasons(run, j);
   j["excluded_vertices"] = run.baseline.excluded_vertices;
   j["contacts_counted"] = run.baseline.articular_vertices == 0 && o.contacts != RomContacts::all
                               ? "all (no articular zones: scan neutral)"
