@@ -115,6 +115,10 @@ def main():
         ball = options.pop("femur", None)
         socket = options.pop("pelvis", None)
         j = impinge.Joint(ball, socket, resolution=resolution, distances=True, **options)
+        # The peers get the Joint's own meshes: those read, less what the reading removed (a speck inside a bone:
+        # mesh hygiene), so that per-vertex indices agree.
+        (femur_V, femur_F), (pelvis_V, pelvis_F) = (tuple(np.asarray(a) for a in j.meshes[b])
+                                                    for b in ("femur", "pelvis"))
         pelvis_scene, femur_scene = o3d_scene(pelvis_V, pelvis_F), o3d_scene(femur_V, femur_F)
         pelvis_vtk, femur_vtk = vtk_distance(pelvis_V, pelvis_F), vtk_distance(femur_V, femur_F)
         cor = np.asarray(j.cor)

@@ -59,6 +59,15 @@ def limits_of(joint):
     return {m: r for m, r in joint.rom_limits().items() if isinstance(r, dict)}
 
 
+def in_file_order(p, bone, n):
+    """A plan's per-vertex resection depth (mm) of `bone` in the file's n vertices: the vertices the reading removed
+    (meshes.<bone>.vertices_removed: a speck inside the bone, a fragment) cut by 0."""
+    removed = p["meshes"][bone]["vertices_removed"]
+    depth = np.zeros(n)
+    depth[np.setdiff1d(np.arange(n), removed)] = np.asarray(p[f"{bone}_resection_mm"])
+    return depth
+
+
 def on_cam_share(V_cam, V_free, F, depth):
     """The share of the removal (depth x area) on the vertices the cam moved."""
     w = vertex_areas(V_cam, F) * depth
@@ -120,7 +129,7 @@ def main():
             r = p["femur_resection"]
             cam_volume = volume(h["femur"][0], h["femur"][1]) - volume(free_hip["femur"][0], free_hip["femur"][1])
             share = on_cam_share(np.asarray(h["femur"][0]), np.asarray(free_hip["femur"][0]), np.asarray(h["femur"][1]),
-                                 np.asarray(p["femur_resection_mm"]))
+                                 in_file_order(p, "femur", len(h["femur"][0])))
             after = {t["target"]: t for t in p["targets"]}
             for m in GENERATED_TARGETS:
                 t = after.get(m)
@@ -178,7 +187,7 @@ def main():
             Vr, Fr = p["femur_resected"]
             checked = limits_of(impinge.Joint((np.asarray(Vr), np.asarray(Fr)), pelvis, subject=subject,
                                               precision=precision))
-            share = on_cam_share(Vc, V, F, np.asarray(p["femur_resection_mm"]))
+            share = on_cam_share(Vc, V, F, in_file_order(p, "femur", len(V)))
             r = p["femur_resection"]
             after = {t["target"]: t for t in p["targets"]}
             for k in lowered:

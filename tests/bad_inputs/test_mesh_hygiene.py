@@ -107,6 +107,7 @@ def test_an_island_200_mm_from_the_pelvis_changes_nothing_and_is_named(tmp_path)
     s = json.load(open(tmp_path / "dirty" / "distance" / "summary.json"))
     (f,) = s["meshes"]["pelvis"]["fragments_removed"]
     assert f["triangles"] == 20 and abs(f["distance_mm"] - 200) < 0.01 and abs(f["extent_mm"] - 4) < 1e-6, f
+    assert s["meshes"]["pelvis"]["vertices_removed"] == list(range(12))  # the island's, stored first
     r = run(COMMANDS["distance"] + ["--subject", noisy, "--strict", "--out", tmp_path / "strict"])
     one_line_error(r, "pelvis.ply", "1 fragment(s) apart from the bone", "--strict refuses them")
 

@@ -161,9 +161,10 @@ std::vector<MeshFragment> left_out(const TriangleMesh& mesh, const std::vector<P
   return frags;
 }
 
-// Remove the faces of the parts not kept, then every vertex no face uses (the others keep their order). Returns
-// the vertices removed.
-std::int64_t remove_parts(TriangleMesh& mesh, const std::vector<Part>& p, const std::vector<int>& part) {
+// Remove the faces of the parts not kept, then every vertex no face uses (the others keep their order), their
+// indices into `removed`. Returns how many.
+std::int64_t remove_parts(TriangleMesh& mesh, const std::vector<Part>& p, const std::vector<int>& part,
+                          std::vector<std::int64_t>& removed) {
   std::vector<std::uint8_t> keep(static_cast<std::size_t>(mesh.F.rows()));
   for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = p[static_cast<std::size_t>(part[f])].kept ? 1 : 0;
   keep_faces(mesh, keep);
@@ -171,13 +172,18 @@ std::int64_t remove_parts(TriangleMesh& mesh, const std::vector<Part>& p, const 
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
     for (int k = 0; k < 3; ++k) to[static_cast<std::size_t>(mesh.F(f, k))] = 0;
   Eigen::Index n = 0;
-  for (std::size_t v = 0; v < to.size(); ++v)
-    if (to[v] == 0) mesh.V.row(n) = mesh.V.row(Eigen::Index(v)), to[v] = static_cast<int>(n++);
-  const std::int64_t removed = mesh.V.rows() - n;
+  for (std::size_t v = 0; v < to.size(); ++v) {
+    if (to[v] == 0) {
+      mesh.V.row(n) = mesh.V.row(Eigen::Index(v)), to[v] = static_cast<int>(n++);
+    } else {
+      removed.push_back(static_cast<std::int64_t>(v));
+    }
+  }
+  const std::int64_t count = mesh.V.rows() - n;
   mesh.V.conservativeResize(n, 3);
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
     for (int k = 0; k < 3; ++k) mesh.F(f, k) = to[static_cast<std::size_t>(mesh.F(f, k))];
-  return removed;
+  return count;
 }
 
 std::string short_num(double v) {  // three significant digits: 12.9, 0.00064, 200
@@ -329,7 +335,7 @@ void keep_the_bone(TriangleMesh& mesh, const std::string& source, bool strict, M
     return source + ": " + std::to_string(h.parts_inside_removed) +
            " part(s) inside the bone (an inner wall, a cyst); --strict refuses them (without it they are removed)";
   });
-  const std::int64_t unused = remove_parts(mesh, p, part);
+  const std::int64_t unused = remove_parts(mesh, p, part, h.removed_vertices);
   std::int64_t fragment_vertices = 0;
   for (const Part& q : p) fragment_vertices += q.kept ? 0 : static_cast<std::int64_t>(q.vertices.size());
   h.unused_vertices_removed = unused - fragment_vertices;

@@ -311,7 +311,8 @@ nlohmann::json meshes_record(const MeshHygiene& femur, const MeshHygiene& pelvis
                           {"corners_welded", h.corners_welded},
                           {"boundary_edges", h.boundary_edges},
                           {"holes", h.boundary_loops},
-                          {"nonmanifold_edges", h.nonmanifold_edges}};
+                          {"nonmanifold_edges", h.nonmanifold_edges},
+                          {"vertices_removed", h.removed_vertices}};
   };
   return {{"femur", bone(femur)},
           {"pelvis", bone(pelvis)},

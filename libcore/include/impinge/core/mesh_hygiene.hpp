@@ -64,6 +64,9 @@ struct MeshHygiene {
   std::int64_t parts_inside_removed = 0;    ///< kept parts enclosed by another (step 4b), removed
   double inside_area_mm2 = 0;               ///< their area, mm^2
   std::int64_t unused_vertices_removed = 0; ///< vertices no face used (besides the removed parts' own)
+  /// Every vertex removed (the removed parts' and the unused), as indices into the mesh as read, ascending: the
+  /// per-vertex outputs hold the others, in order (np.delete(range(n), removed) maps them back to the file).
+  std::vector<std::int64_t> removed_vertices;
   std::int64_t boundary_edges = 0;          ///< edges of exactly one face (after the clean-up)
   std::int64_t nonmanifold_edges = 0;       ///< edges of three or more faces
   std::int64_t boundary_loops = 0;          ///< holes: connected sets of boundary edges

@@ -61,7 +61,8 @@ nlohmann::json acetabulum_record(const Acetabulum& acetabulum, const AnatomicalF
 /// What each bone's mesh held and what was done on reading (mesh_hygiene.hpp), for summary.json's "meshes":
 /// {"femur": {...}, "pelvis": {...}, "rule": ...}: parts read and kept, fragments removed (area mm^2, size mm,
 /// distance mm, centre in the input frame, mm), double-wall faces removed, corners welded, boundary edges, holes
-/// (boundary loops), non-manifold edges.
+/// (boundary loops), non-manifold edges, and `vertices_removed` (indices into the file, ascending: the per-vertex
+/// outputs hold the file's other vertices in order).
 nlohmann::json meshes_record(const MeshHygiene& femur, const MeshHygiene& pelvis);
 
 /// What every command reports about its set-up (summary.json's common part): inputs, side and
