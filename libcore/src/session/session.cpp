@@ -26,11 +26,7 @@
 namespace impinge {
 
 namespace {
-std::string num(double x) {
-  std::ostringstream o;
-  o << x;
-  return o.str();
-}
+std::string num(double x) { return number_text(x); }
 std::string point_text(const Eigen::Vector3d& p) {
   return "(" + num(p.x()) + ", " + num(p.y()) + ", " + num(p.z()) + ")";
 }

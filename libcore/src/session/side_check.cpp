@@ -11,11 +11,7 @@ namespace impinge {
 
 namespace {
 
-std::string num(double x) {
-  std::ostringstream o;
-  o << x;
-  return o.str();
-}
+std::string num(double x) { return number_text(x); }
 
 // A unit direction (working frame) as "(x, y, z)" to two decimals.
 std::string direction_text(const Eigen::Vector3d& d) {

@@ -28,6 +28,9 @@ class OutOfMemory : public Error {
 /// Throw impinge::Error(message) unless `condition` holds.
 void require(bool condition, const std::string& message);
 
+/// x as a message shows it: the shortest of six significant digits (std::ostream's default: 23.0448, 1e+06).
+std::string number_text(double x);
+
 /// Throw impinge::Error(message) unless `condition` holds: a fixed message (a string literal), which becomes a
 /// std::string only then. Without it every call with a literal built and freed a string, held or not (issue 52:
 /// checks inside loops).
