@@ -19,8 +19,11 @@ LHDL = os.path.join(DATA, "lhdl-ct", "subject.json")
 def limited(args, limit=LIMIT, **kw):
     def cap():
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    # One OpenMP thread: under the cap, whether libgomp's thread stacks or the maps run out first depends on the
+    # machine's state ('libgomp: Thread creation failed' aborts the run before impinge can say anything).
+    env = dict(kw.pop("env", os.environ), OMP_NUM_THREADS="1")
     return subprocess.run([str(a) for a in args], capture_output=True, text=True, timeout=CASE_SECONDS,
-                          preexec_fn=cap, **kw)
+                          preexec_fn=cap, env=env, **kw)
 
 
 @pytest.fixture(scope="module")
