@@ -154,10 +154,20 @@ class HipJoint {
   /// The joint surfaces per vertex (the femoral head's, the lunate's), to tell the joint space
   /// closing from impingement (anatomical neutral only: they need the acetabulum; else empty).
   const std::optional<ArticularZones>& articular() const { return articular_; }
+  /// The femoral head up to its head-neck junction (ArticularZones::head) in the joint frame, unposed femur
+  /// (a femur point x of the posed femur R x + t); empty with scan neutral.
+  const std::optional<FemoralHeadZone>& head_zone_joint() const { return head_zone_joint_; }
+  /// Where on the femur the point p (joint frame, unposed femur: R^T (q - t) for a posed point q) lies
+  /// (femoral_zone; articular_zones.hpp); none with scan neutral.
+  FemoralZone femoral_zone(const Eigen::Vector3d& p) const;
+  /// Where on the pelvis the point p_joint (joint frame) lies (pelvic_zone; articular_zones.hpp); none with scan
+  /// neutral.
+  PelvicZone pelvic_zone(const Eigen::Vector3d& p_joint) const;
   /// The class of a contact at vertex `vertex` of the femur (`ball`) or the pelvis with the femur at
   /// `pose`: articular when the vertex is on its joint surface (articular()), or is a pelvis vertex
-  /// within ArticularZones::head_sphere_reach_mm of the posed head centre (it meets the head's joint
-  /// surface); else intra-articular impingement within the acetabular rim radius (head radius + 5 mm
+  /// within ArticularZones::head_sphere_reach_mm of the posed head centre on the head side of the head-neck
+  /// junction (it meets the head's joint surface: head_zone_joint()->contains); else intra-articular
+  /// impingement within the acetabular rim radius (head radius + 5 mm
   /// without an acetabulum) plus `intra_margin_mm` of the COR, else extra-articular.
   ContactClass contact_class(bool ball, std::int64_t vertex, const FemurPose& pose, double intra_margin_mm) const;
   /// Save both maps (map_io.hpp) with the working-frame COR, for options.ball_map_file and
@@ -199,6 +209,7 @@ class HipJoint {
   std::optional<ClockFace> socket_clock_, ball_clock_;
   std::vector<double> socket_hours_, ball_hours_;  ///< every vertex's clock hour (clock_hours), once
   std::optional<ArticularZones> articular_;
+  std::optional<FemoralHeadZone> head_zone_joint_;
   double head_radius_ = 0;
   std::vector<std::string> warnings_;
   std::optional<Joint> joint_;

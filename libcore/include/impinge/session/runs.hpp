@@ -89,6 +89,10 @@ struct RomRun {
   /// about that frame's axes, from its neutral, with its own baseline there), one per motion; empty with scan
   /// neutral, without RomRequest::both_frames, or when that frame cannot be built (other_frame_note).
   std::vector<RomLimit> other_limits;
+  /// With RomContacts::impingement and articular zones: the same motions searched with RomContacts::all (every
+  /// contact counts), so that a contact the limit set aside as the joint surfaces meeting is said, with where
+  /// (rom_limits_table's set_aside_* columns; issue 81); else empty.
+  std::vector<RomLimit> all_contact_limits;
   std::optional<PelvisFrameKind> frame;        ///< the pelvic frame of limits' angles (empty: scan neutral)
   std::optional<PelvisFrameKind> other_frame;  ///< the frame of other_limits
   std::string other_frame_note;                ///< why other_limits is empty, else empty
@@ -119,7 +123,11 @@ RomRun run_rom(const Session& session, const RomRequest& request);
 /// soft_tissue_first, pelvic_frame (the frame of limit_deg), limit_isb_deg, status_isb, limit_app_deg and
 /// status_app (the motion's limit with its angles in each pelvic frame: one is limit_deg, the other
 /// RomRun::other_limits; null with scan neutral), bony_normal_deg, bony_normal_frame and bony_normal_source
-/// (published simulated bony ROM of normal hips, published_bony_range), note.
+/// (published simulated bony ROM of normal hips, published_bony_range), femoral_zone and pelvic_zone (where the
+/// limit's contact lies on each bone: RomLimit), set_aside_contact_deg, set_aside_contact_class,
+/// set_aside_femoral_zone, set_aside_pelvic_zone (the first contact of every vertex, RomRun::all_contact_limits,
+/// when it comes before the limit: the joint surfaces meeting, which the limit does not count; null/empty
+/// otherwise), note.
 Table rom_limits_table(const Session& session, const RomRun& run);
 /// rom_map.csv: flexion_deg, adduction_deg, max_internal_rotation_deg, status.
 Table rom_map_table(const RomRun& run);
