@@ -14,6 +14,7 @@
 #include "impinge/core/interrupt.hpp"
 #include "impinge/core/timing.hpp"
 #include "impinge/session/records.hpp"
+#include "labrum_run.hpp"
 
 namespace impinge {
 
@@ -206,6 +207,7 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
   }
   run.limits_ms = ms_since(t0);
   if (q.limits && q.both_frames) other_frame_limits(s, q, run);
+  if (q.limits && q.labrum.enabled) detail::run_labrum(s, q, run);
   auto count = [&run](const auto& x) {  // a limit's, a cell's or the envelope's look-ups
     run.vertices_looked_up += x.vertices_looked_up;
     run.vertices_skipped += x.vertices_skipped;
@@ -277,6 +279,7 @@ Table rom_limits_table(const Session& s, const RomRun& run) {
            normal.source, soft_tissue_ends_first(name, l), frame, limit_of(isb), status_of(isb), limit_of(app),
            status_of(app), number_or_null(bony.bony_deg), bony.frame, bony.source, l.note});
   }
+  if (run.labrum) detail::add_labral_columns(t, run);
   return t;
 }
 
@@ -405,6 +408,7 @@ nlohmann::json rom_record(const RomRun& run) {
   j["vertices_skipped_by_bounds"] = run.vertices_skipped;
   const std::int64_t all = run.vertices_looked_up + run.vertices_skipped;
   j["share_skipped"] = all > 0 ? double(run.vertices_skipped) / double(all) : 0.0;
+  if (run.labrum) j["labrum"] = detail::labrum_record(run);
   return j;
 }
 
