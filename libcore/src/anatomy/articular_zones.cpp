@@ -11,6 +11,7 @@ const char* to_string(ContactClass c) {
     case ContactClass::articular: return "articular";
     case ContactClass::intra_articular_impingement: return "intra_articular_impingement";
     case ContactClass::extra_articular_impingement: return "extra_articular_impingement";
+    case ContactClass::labral: return "labral";
     case ContactClass::none: break;
   }
   return "";

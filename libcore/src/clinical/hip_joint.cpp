@@ -158,7 +158,7 @@ void HipJoint::build_joint(TriangleMesh femur, TriangleMesh pelvis, const HipJoi
   if (options.ball_map_file.empty() != options.socket_map_file.empty())
     throw Error("hip joint: give both map files (ball and socket) or neither");
   if (options.ball_map_file.empty()) {
-    joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint);
+    joint_ = std::make_shared<Joint>(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint);
     return;
   }
   auto load = [&](const std::string& path) {
@@ -171,7 +171,7 @@ void HipJoint::build_joint(TriangleMesh femur, TriangleMesh pelvis, const HipJoi
                                            "): another subject or COR");
     return m;
   };
-  joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint,
+  joint_ = std::make_shared<Joint>(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint,
                  load(options.ball_map_file), load(options.socket_map_file));
 }
 
@@ -211,6 +211,7 @@ ContactClass HipJoint::contact_class(bool ball, std::int64_t vertex, const Femur
     if (ball && articular_->femur[static_cast<std::size_t>(vertex)]) return ContactClass::articular;
     if (!ball && head_zone_joint_->contains(pose.R.transpose() * (v - pose.t))) return ContactClass::articular;
   }
+  if (labral_) return ContactClass::labral;
   const double rim = acetabulum_ ? acetabulum_->rim_radius_mm : head_radius_ + 5;
   return p_joint.norm() <= rim + intra_margin_mm ? ContactClass::intra_articular_impingement
                                                  : ContactClass::extra_articular_impingement;

@@ -14,6 +14,7 @@
 #include "impinge/core/interrupt.hpp"
 #include "impinge/core/timing.hpp"
 #include "impinge/session/records.hpp"
+#include "labrum_run.hpp"
 
 namespace impinge {
 
@@ -186,6 +187,17 @@ void other_frame_limits(const Session& s, const RomRequest& q, RomRun& run) {
 }
 }  // namespace
 
+namespace {
+// With impingement contacts and articular zones, the motions again counting every contact: the contact each limit
+// set aside (RomRun::all_contact_limits; issue 81).
+void every_contact_limits(const HipJoint& hip, const RomRequest& q, RomRun& run) {
+  if (q.search.contacts != RomContacts::impingement || !hip.articular()) return;
+  RomOptions every = q.search;
+  every.contacts = RomContacts::all;
+  run.all_contact_limits = find_rom_limits(hip, run.motions, every, rom_baseline(hip, hip.femur_rotation({}), every));
+}
+}  // namespace
+
 RomRun run_rom(const Session& s, const RomRequest& q) {
   // Only the articular zones tell the joint surfaces apart; without them (scan neutral) 'articular' would
   // count every vertex under its name.
@@ -206,11 +218,8 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
   }
   run.limits_ms = ms_since(t0);
   if (q.limits && q.both_frames) other_frame_limits(s, q, run);
-  if (q.limits && q.search.contacts == RomContacts::impingement && hip.articular()) {
-    RomOptions every = q.search;
-    every.contacts = RomContacts::all;
-    run.all_contact_limits = find_rom_limits(hip, run.motions, every, rom_baseline(hip, hip.femur_rotation({}), every));
-  }
+  if (q.limits) every_contact_limits(hip, q, run);
+  if (q.limits && q.labrum.enabled) detail::run_labrum(s, q, run);
   auto count = [&run](const auto& x) {  // a limit's, a cell's or the envelope's look-ups
     run.vertices_looked_up += x.vertices_looked_up;
     run.vertices_skipped += x.vertices_skipped;
@@ -304,6 +313,7 @@ Table rom_limits_table(const Session& s, const RomRun& run) {
            set_aside ? to_string(set_aside->contact_class) : "", set_aside ? to_string(set_aside->femoral_zone) : "", set_aside ? to_string(set_aside->pelvic_zone) : "",
            l.note});
   }
+  if (run.labrum) detail::add_labral_columns(t, run);
   return t;
 }
 
@@ -435,6 +445,7 @@ nlohmann::json rom_record(const RomRun& run) {
   j["vertices_skipped_by_bounds"] = run.vertices_skipped;
   const std::int64_t all = run.vertices_looked_up + run.vertices_skipped;
   j["share_skipped"] = all > 0 ? double(run.vertices_skipped) / double(all) : 0.0;
+  if (run.labrum) j["labrum"] = detail::labrum_record(run);
   return j;
 }
 

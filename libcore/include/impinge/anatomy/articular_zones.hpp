@@ -47,8 +47,9 @@ enum class ContactClass {
   articular,                    ///< the head's joint surface against the lunate surface: the joint space closing
   intra_articular_impingement,  ///< head-neck junction or neck against the acetabular rim
   extra_articular_impingement,  ///< trochanters or neck against the ilium, AIIS or ischium
+  labral,                       ///< the femur against the acetabular labrum (labrum.hpp), off the head's joint surface
 };
-/// "", "articular", "intra_articular_impingement", "extra_articular_impingement".
+/// "", "articular", "intra_articular_impingement", "extra_articular_impingement", "labral".
 const char* to_string(ContactClass c);
 
 /// Azimuth bins of the head-neck junction about the neck axis (5 deg each).
