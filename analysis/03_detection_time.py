@@ -68,7 +68,7 @@ for s in ["generated-300", "generated-1k", "generated-3k", "generated-12k"]:
                  spread(g, "embree_radial"), spread(g, "cgal_radial")])
 write_table(d, "table4_9", ["level", "triangles", "pair-wise thesis", "pair-wise ours", "RAPID thesis", "FCL ours",
                             "RSID thesis", "RSID ours", "USID thesis", "USID ours", "Embree", "CGAL"], rows,
-            align="lrrrrrrrrrrr")
+            align="lrrrrrrrrrrr", stack=True)
 
 # Real subjects, both poses: every method; per pose ms and ns per vertex.
 rows = []
@@ -80,7 +80,7 @@ for (s, pose), g in t[~t.generated.astype(bool)].groupby(["subject", "pose"], so
                  spread(g, "fcl_distance"), fmt(get(g, "pairwise")), f"{get(g, 'rsid', 0.1, 'result'):.2f}"])
 write_table(d, "table_real", ["subject", "pose", "vertices", "RSID 0.5", "RSID 0.1", "USID", "Embree", "Embree x8",
                               "CGAL", "FCL collide", "contacts", "FCL distance", "pair-wise", "RSID min gap (mm)"], rows,
-            align="llrrrrrrrrrrrr")
+            align="llrrrrrrrrrrrr", stack=True)
 
 rows = []
 for (s, m, r), g in thr[thr.method.isin(["rsid", "usid"])].groupby(["subject", "method", "resolution"], sort=False):
