@@ -7,7 +7,7 @@ table_throughput.tex, table_schemes.tex (every registered scheme), detection_tim
 import numpy as np
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, median_quartiles, read_csv, save, write_macros, write_table
+from common import experiment_dir, median_quartiles, read_csv, save, timing_text, write_macros, write_table
 
 d = experiment_dir("03_detection_time")
 t = read_csv(d, "detection.csv")
@@ -29,9 +29,7 @@ def fmt(ms):
 def spread(g, method, res=None):
     """A time cell with its spread: 'median (lower quartile-upper quartile)' ms over the alternated rounds."""
     med, lo, hi = (get(g, method, res, c) for c in ("time_ms", "time_q25_ms", "time_q75_ms"))
-    if not np.isfinite(med):
-        return "--"
-    return fmt(med) if not np.isfinite(lo) or lo == hi else f"{fmt(med)} ({fmt(lo)}-{fmt(hi)})"
+    return timing_text(med, lo, hi, get(g, method, res, "runs"), fmt)
 
 
 def paired(subject, pose, num, den, num_res=None, den_res=None):
@@ -61,7 +59,7 @@ for s in ["generated-300", "generated-1k", "generated-3k", "generated-12k"]:
     if not len(g):
         continue
     rows.append([s.replace("generated-", ""), f"{int(g.femur_triangles.iloc[0]):,}",
-                 fmt(get(g, "pairwise", col="thesis_ms")), fmt(get(g, "pairwise")),
+                 fmt(get(g, "pairwise", col="thesis_ms")), spread(g, "pairwise"),
                  fmt(get(g, "fcl_collide", col="thesis_ms")), spread(g, "fcl_collide"),
                  fmt(get(g, "rsid", col="thesis_ms")), spread(g, "rsid", p_table),
                  fmt(get(g, "usid", col="thesis_ms")), spread(g, "usid", k_table),
@@ -77,9 +75,9 @@ for (s, pose), g in t[~t.generated.astype(bool)].groupby(["subject", "pose"], so
     rows.append([s, pose.replace("_", " "), f"{nv:,}", spread(g, "rsid", 0.5), spread(g, "rsid", 0.1),
                  spread(g, "usid", k_table), spread(g, "embree_radial"), spread(g, "embree_radial_packet8"),
                  spread(g, "cgal_radial"), spread(g, "fcl_collide"), f"{get(g, 'fcl_collide', col='result'):.0f}",
-                 spread(g, "fcl_distance"), fmt(get(g, "pairwise")), f"{get(g, 'rsid', 0.1, 'result'):.2f}"])
+                 spread(g, "fcl_distance"), spread(g, "pairwise"), f"{get(g, 'rsid', 0.1, 'result'):.2f}"])
 write_table(d, "table_real", ["subject", "pose", "vertices", "RSID 0.5", "RSID 0.1", "USID", "Embree", "Embree x8",
-                              "CGAL", "FCL collide", "contacts", "FCL distance", "pair-wise", "RSID min gap (mm)"], rows,
+                              "CGAL", "FCL collide", "contacts", "FCL distance", "pair-wise", "min gap (mm)"], rows,
             align="llrrrrrrrrrrrr", stack=True)
 
 rows = []

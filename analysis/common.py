@@ -102,6 +102,22 @@ def median_quartiles(values):
     return (v.median(), v.quantile(0.25), v.quantile(0.75)) if len(v) else (float("nan"),) * 3
 
 
+ONE_RUN = "one run"  # how a table marks a time measured once; its caption says why (issue 82)
+
+
+def timing_text(median, q25, q75, runs, fmt, sep="-", unit=""):
+    """A time cell: 'median (q25-q75)' over its alternated rounds, or 'median (one run)' for a time measured once
+    (runs <= 1: its quartiles would repeat the median, "0.531 (0.531-0.531)", as if it had a spread); '--' when
+    not measured. fmt formats one number; unit (e.g. " s") follows the median of a single run, the quartiles
+    otherwise."""
+    import math
+    if median is None or not math.isfinite(median) or (runs is not None and runs < 1):
+        return "--"
+    if runs is not None and runs <= 1 or q25 is None or not math.isfinite(q25):
+        return f"{fmt(median)}{unit} ({ONE_RUN})"
+    return f"{fmt(median)} ({fmt(q25)}{sep}{fmt(q75)}){unit}"
+
+
 def density_uniformity(g, within=0.1):
     """Thesis Fig. 47's uniformity of a scheme's nodes, from experiment 01's density.csv rows of one scheme (nodes and
     band_sr per band of the polar angle): the share of the sphere's area whose node density lies within `within` of
