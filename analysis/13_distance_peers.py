@@ -89,7 +89,7 @@ if wp is not None and len(wp):
 
         def span(r):
             if r.runs == 0:
-                return "left out (over 300 s)"
+                return "left out (over 60 s)"
             return timing_text(scale * r.median_s, scale * r.q1_s, scale * r.q3_s, r.runs, lambda x: f"{x:.3g}",
                                sep="--", unit=f" {unit}")
         rows.append([mesh.replace("_", " "), what, span(a), span(b),
