@@ -106,8 +106,12 @@ for s_, g in real.groupby("subject", sort=False):
         r = r.iloc[0]
         tp = thr[(thr.subject == s_) & (thr.method == m) & np.isclose(thr.spacing_deg, 0.1) & (thr.threads == 1)]
         res = f"{int(r.resolution):,}" if float(r.resolution).is_integer() else f"{r.resolution:.4g}"
-        rows.append([s_, labels.get(m, m), res, fmt(r.time_ms), f"{r.ns_per_vertex:.1f}",
-                     f"{r.time_ms / base:.2f}" if np.isfinite(base) and base > 0 else "--",
+        # The time with its quartiles, and its ratio to RSID's round by round (paired: the same rounds).
+        q = paired(s_, r.pose, m, "rsid", r.resolution, 0.1)
+        rows.append([s_, labels.get(m, m), res, timing_text(r.time_ms, r.time_q25_ms, r.time_q75_ms, r.runs, fmt),
+                     f"{r.ns_per_vertex:.1f}",
+                     "1 (itself)" if m == "rsid" else timing_text(q[0], q[1], q[2], None, lambda x: f"{x:.2f}")
+                     if np.isfinite(base) and base > 0 else "--",
                      f"{tp.poses_per_s.iloc[0]:,.0f}" if len(tp) else "--"])
 write_table(d, "table_schemes", ["subject", "scheme", "resolution", "ms per pose", "ns/vertex", "/ RSID",
                                  "poses/s (random)"], rows, align="llrrrrr")
