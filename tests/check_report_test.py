@@ -52,6 +52,9 @@ def write_run(d, commits, claims_rows, log="", leave_out=(), drop_field=None):
     with open(os.path.join(d, "paper", "impinge.log"), "w") as f:
         f.write(log)
     write_paper(d, [(100, 700, 10, 1, False)], [("table", 1, 750, 650)])
+    with open(os.path.join(d, "reproduce_times.csv"), "w") as f:
+        f.write("step,driver_s,analysis_s,wall_s,share\nbuild,900,,900,0.3\n01_x,2000,100,2100,0.7\n"
+                "total,,,3000,1.0\n")
 
 
 def write_pdf(path, texts):
@@ -263,6 +266,21 @@ def test_table_text_printed_under_seven_points_is_found_in_the_pdf():
         findings = check.check_text_size(d)
         assert len(findings) == 2 and "Table 2 prints text at 5.0 pt" in findings[0] and "Figure 1" in findings[1], \
             findings
+
+
+def test_a_full_run_over_an_hour_after_its_build_and_a_run_without_its_time_table_are_found():
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc"], every_item_row())
+        metas = check.read_metas(d)
+        for m in metas.values():
+            m["quick"] = False
+        assert check.check_run_time(d, metas) == []  # 35 min after a 15 min build
+        with open(os.path.join(d, "reproduce_times.csv"), "a") as f:
+            f.write("02_y,1600,,1600,0.3\n")
+        findings = check.check_run_time(d, metas)
+        assert len(findings) == 1 and "took 62 min after its build" in findings[0], findings
+        os.remove(os.path.join(d, "reproduce_times.csv"))
+        assert "reproduce_times.csv missing" in check.check_run_time(d, metas)[0]
 
 
 def test_a_line_is_sized_by_its_text_not_its_superscripts():
