@@ -6,7 +6,8 @@ thesis' level), table_real.tex (real bones, every method), sampling_time.pdf/png
 import numpy as np
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, median_quartiles, read_csv, save, session_figures, write_macros, write_table
+from common import (ONE_RUN, experiment_dir, median_quartiles, read_csv, save, session_figures, timing_text, write_macros,
+                    write_table)
 
 d = experiment_dir("02_sampling_time")
 t = read_csv(d, "sampling_time.csv")
@@ -33,12 +34,10 @@ def cell(g, method, body, col="time_ms"):
 
 
 def spread(g, method, body):
-    """A time cell with its spread: 'median (lower quartile-upper quartile)' ms over the alternated rounds (one
-    value where the method ran once: pair-wise)."""
+    """A time cell with its spread: 'median (lower quartile-upper quartile)' ms over the alternated rounds (marked
+    'one run' where the method ran once: pair-wise)."""
     med, lo, hi = (cell(g, method, body, c) for c in ("time_ms", "time_q25_ms", "time_q75_ms"))
-    if not np.isfinite(med):
-        return "--"
-    return fmt(med) if not np.isfinite(lo) or cell(g, method, body, "runs") <= 1 else f"{fmt(med)} ({fmt(lo)}-{fmt(hi)})"
+    return timing_text(med, lo, hi, cell(g, method, body, "runs"), fmt)
 
 
 def paired(subject, body, p, num, den):
@@ -55,7 +54,7 @@ for p in sorted(gen.precision_deg.unique(), reverse=True):
     th = {m: g[g.method == m].thesis_ms.iloc[0] if len(g[g.method == m]) else np.nan
           for m in ("pairwise", "rsid_linear", "usid_accelerated")}
     pw = cell(g, "pairwise", "pelvis")
-    rows.append([f"{p:g}", fmt(th["pairwise"]), fmt(pw) + "*", fmt(th["rsid_linear"]), spread(g, "rsid_linear", "pelvis"),
+    rows.append([f"{p:g}", fmt(th["pairwise"]), fmt(pw) + "* (" + ONE_RUN + ")", fmt(th["rsid_linear"]), spread(g, "rsid_linear", "pelvis"),
                  spread(g, "rsid_exact_culled", "pelvis"), fmt(th["usid_accelerated"]),
                  spread(g, "usid_accelerated", "pelvis"), spread(g, "embree_node_cast", "pelvis"),
                  spread(g, "fill", "pelvis")])

@@ -7,7 +7,7 @@ table_throughput.tex, table_schemes.tex (every registered scheme), detection_tim
 import numpy as np
 import matplotlib.pyplot as plt
 
-from common import experiment_dir, median_quartiles, read_csv, save, write_macros, write_table
+from common import experiment_dir, median_quartiles, read_csv, save, timing_text, write_macros, write_table
 
 d = experiment_dir("03_detection_time")
 t = read_csv(d, "detection.csv")
@@ -29,9 +29,7 @@ def fmt(ms):
 def spread(g, method, res=None):
     """A time cell with its spread: 'median (lower quartile-upper quartile)' ms over the alternated rounds."""
     med, lo, hi = (get(g, method, res, c) for c in ("time_ms", "time_q25_ms", "time_q75_ms"))
-    if not np.isfinite(med):
-        return "--"
-    return fmt(med) if not np.isfinite(lo) or lo == hi else f"{fmt(med)} ({fmt(lo)}-{fmt(hi)})"
+    return timing_text(med, lo, hi, get(g, method, res, "runs"), fmt)
 
 
 def paired(subject, pose, num, den, num_res=None, den_res=None):
@@ -61,14 +59,14 @@ for s in ["generated-300", "generated-1k", "generated-3k", "generated-12k"]:
     if not len(g):
         continue
     rows.append([s.replace("generated-", ""), f"{int(g.femur_triangles.iloc[0]):,}",
-                 fmt(get(g, "pairwise", col="thesis_ms")), fmt(get(g, "pairwise")),
+                 fmt(get(g, "pairwise", col="thesis_ms")), spread(g, "pairwise"),
                  fmt(get(g, "fcl_collide", col="thesis_ms")), spread(g, "fcl_collide"),
                  fmt(get(g, "rsid", col="thesis_ms")), spread(g, "rsid", p_table),
                  fmt(get(g, "usid", col="thesis_ms")), spread(g, "usid", k_table),
                  spread(g, "embree_radial"), spread(g, "cgal_radial")])
 write_table(d, "table4_9", ["level", "triangles", "pair-wise thesis", "pair-wise ours", "RAPID thesis", "FCL ours",
                             "RSID thesis", "RSID ours", "USID thesis", "USID ours", "Embree", "CGAL"], rows,
-            align="lrrrrrrrrrrr")
+            align="lrrrrrrrrrrr", stack=True)
 
 # Real subjects, both poses: every method; per pose ms and ns per vertex.
 rows = []
@@ -77,10 +75,10 @@ for (s, pose), g in t[~t.generated.astype(bool)].groupby(["subject", "pose"], so
     rows.append([s, pose.replace("_", " "), f"{nv:,}", spread(g, "rsid", 0.5), spread(g, "rsid", 0.1),
                  spread(g, "usid", k_table), spread(g, "embree_radial"), spread(g, "embree_radial_packet8"),
                  spread(g, "cgal_radial"), spread(g, "fcl_collide"), f"{get(g, 'fcl_collide', col='result'):.0f}",
-                 spread(g, "fcl_distance"), fmt(get(g, "pairwise")), f"{get(g, 'rsid', 0.1, 'result'):.2f}"])
+                 spread(g, "fcl_distance"), spread(g, "pairwise"), f"{get(g, 'rsid', 0.1, 'result'):.2f}"])
 write_table(d, "table_real", ["subject", "pose", "vertices", "RSID 0.5", "RSID 0.1", "USID", "Embree", "Embree x8",
-                              "CGAL", "FCL collide", "contacts", "FCL distance", "pair-wise", "RSID min gap (mm)"], rows,
-            align="llrrrrrrrrrrrr")
+                              "CGAL", "FCL collide", "contacts", "FCL distance", "pair-wise", "min gap (mm)"], rows,
+            align="llrrrrrrrrrrrr", stack=True)
 
 rows = []
 for (s, m, r), g in thr[thr.method.isin(["rsid", "usid"])].groupby(["subject", "method", "resolution"], sort=False):
@@ -108,8 +106,12 @@ for s_, g in real.groupby("subject", sort=False):
         r = r.iloc[0]
         tp = thr[(thr.subject == s_) & (thr.method == m) & np.isclose(thr.spacing_deg, 0.1) & (thr.threads == 1)]
         res = f"{int(r.resolution):,}" if float(r.resolution).is_integer() else f"{r.resolution:.4g}"
-        rows.append([s_, labels.get(m, m), res, fmt(r.time_ms), f"{r.ns_per_vertex:.1f}",
-                     f"{r.time_ms / base:.2f}" if np.isfinite(base) and base > 0 else "--",
+        # The time with its quartiles, and its ratio to RSID's round by round (paired: the same rounds).
+        q = paired(s_, r.pose, m, "rsid", r.resolution, 0.1)
+        rows.append([s_, labels.get(m, m), res, timing_text(r.time_ms, r.time_q25_ms, r.time_q75_ms, r.runs, fmt),
+                     f"{r.ns_per_vertex:.1f}",
+                     "1 (itself)" if m == "rsid" else timing_text(q[0], q[1], q[2], None, lambda x: f"{x:.2f}")
+                     if np.isfinite(base) and base > 0 else "--",
                      f"{tp.poses_per_s.iloc[0]:,.0f}" if len(tp) else "--"])
 write_table(d, "table_schemes", ["subject", "scheme", "resolution", "ms per pose", "ns/vertex", "/ RSID",
                                  "poses/s (random)"], rows, align="llrrrrr")

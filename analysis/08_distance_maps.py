@@ -221,13 +221,12 @@ if os.path.exists(os.path.join(d, "poses.csv")) and len(read_csv(d, "poses.csv")
 rows = []
 def versus(eb, es, ob, os_):
     """Columns comparing another scheme's ball and socket rows (ob, os_) with the equiangular grid's
-    (eb, es): both min gaps, the ball gaps' p95 and max difference, sampling ms of both bones, ns per
-    look-up (medians of alternated rounds; their quartiles in gap_statistics.csv and table_convergence), and the
+    (eb, es): both min gaps, the ball gaps' p95 and max difference, sampling ms of both bones (the sum of their
+    medians), ns per look-up of the ball scan (median and quartiles of the alternated rounds, ns_spread), and the
     bytes ratio of both maps."""
     return [f"{eb.min_gap_mm:.3f}", f"{ob.min_gap_mm:.3f}", f"{ob.vs_equiangular_p95_abs_mm:.4f}",
             f"{ob.vs_equiangular_max_abs_mm:.2f}", f"{(eb.sampling_ms + es.sampling_ms):.0f}",
-            f"{(ob.sampling_ms + os_.sampling_ms):.0f}", f"{eb.detection_ns_per_lookup:.0f}",
-            f"{ob.detection_ns_per_lookup:.0f}", f"{(ob.map_bytes + os_.map_bytes) / (eb.map_bytes + es.map_bytes):.3f}"]
+            f"{(ob.sampling_ms + os_.sampling_ms):.0f}", ns_spread(eb), ns_spread(ob), f"{(ob.map_bytes + os_.map_bytes) / (eb.map_bytes + es.map_bytes):.3f}"]
 
 
 def row_of(t, s_, scan, p, mode):
@@ -243,7 +242,7 @@ for s_ in subjects:
                            row_of(hx, s_, "socket", p, mode)))
 write_table(d, "table_usid", ["subject", "$p$ / $k$", "mode", "RSID min", "USID min", "p95 $|\\Delta|$",
                               "max $|\\Delta|$", "RSID ms", "USID ms", "RSID ns", "USID ns", "bytes ratio"], rows,
-            align="llrrrrrrrrrr")
+            align="llrrrrrrrrrr", stack=True)
 
 fig, ax = plt.subplots(figsize=(5.5, 3.4))
 for s_ in subjects:
@@ -273,7 +272,7 @@ for s_ in subjects:
                            row_of(g, s_, "ball", other_p, "exact"), row_of(g, s_, "socket", other_p, "exact")))
 write_table(d, "table_schemes", ["subject", "scheme", "resolution", "equiang. min", "min gap", "p95 $|\\Delta|$",
                                  "max $|\\Delta|$", "equiang. ms", "ms", "equiang. ns", "ns", "bytes ratio"], rows,
-            align="llrrrrrrrrrr")
+            align="llrrrrrrrrrr", stack=True)
 others = ot[(ot.precision_deg == other_p) & (ot.scan == "ball")]
 
 # The radial gap of the thesis against the Euclidean distance (issue 26): table and scatter.

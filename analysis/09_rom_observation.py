@@ -16,7 +16,8 @@ import matplotlib.colors
 import matplotlib.patches
 import matplotlib.pyplot as plt
 
-from common import THESIS_ROM_ZONES, experiment_dir, in_clock_zones, read_csv, save, write_macros, write_table
+from common import (THESIS_ROM_ZONES, experiment_dir, in_clock_zones, read_csv, save, timing_text, write_macros,
+                    write_table)
 from render import draw, level_key, level_rgb, plot_coordinates, read_gap_ply
 
 d = experiment_dir("09_rom_observation")
@@ -349,10 +350,11 @@ for r in env.itertuples():
     rows.append([r.subject, f"{int(r.poses):,}", f(100 * r.poses_scanned / r.poses), f(100 * r.poses_valid / r.poses),
                  f"{f(r.envelope_ms / 1000, 2)} ({f(r.envelope_q25_ms / 1000, 2)}--{f(r.envelope_q75_ms / 1000, 2)})",
                  f"{r.poses_per_core_second / 1000:.0f}k",
-                 f"{f(r.brute_force_ms / 1000, 1)} ({f(r.brute_force_q25_ms / 1000, 1)}--{f(r.brute_force_q75_ms / 1000, 1)})",
+                 timing_text(r.brute_force_ms / 1000, r.brute_force_q25_ms / 1000, r.brute_force_q75_ms / 1000,
+                             getattr(r, "brute_force_runs", r.timing_runs), lambda x: f(x, 1), sep="--"),
                  f(100 * r.poses_differ / r.poses, 2)])
 write_table(d, "table_envelope", ["subject", "poses", "scanned \\%", "valid \\%", "time s (quartiles)", "poses/core-s",
-                                  "every pose s (quartiles)", "differ \\%"], rows, align="lrrrrrrr")
+                                  "every pose s", "differ \\%"], rows, align="lrrrrrrr")
 # Kawasaki et al. 2007: 360 x 360 x 180 poses with adaptive refinement in 20 s on 64 PCs.
 KAWASAKI_POSES_PER_PC_SECOND = 360 * 360 * 180 / (20 * 64)
 e0 = env.iloc[0]

@@ -90,10 +90,15 @@ if os.path.exists(os.path.join(d, "cases.csv")):
         # beside an error larger than the bound.
         refused = bool(w["pass"]) and w.max_abs > w.bound
         error = f"{w.max_abs:.2g}" + (" (refused)" if refused else "")
-        rows.append([case.split(" ", 1)[1] if case[0].isdigit() else case, variant, f"{len(g)}", f"{int(g['pass'].sum())}",
-                     f"{int(g.holes.sum())}", error, f"{w.bound:.2g}", w.unit, what])
+        name = case.split(" ", 1)[1] if case[0].isdigit() else case
+        # The case named once, on its first variant's row, in a column that wraps: the table then fits the page
+        # at a readable size (issue 82) instead of being shrunk to it.
+        shown = "" if rows and rows[-1][-1] == case else name
+        rows.append([shown, variant, f"{len(g)}", f"{int(g['pass'].sum())}",
+                     f"{int(g.holes.sum())}", error, f"{w.bound:.2g}", w.unit, what, case])
     write_table(d, "table_cases", ["case", "variant", "rows", "pass", "holes", "largest error", "its bound", "unit",
-                                   "where (scheme, mode, storage)"], rows, align="llrrrrrll")
+                                   "where (scheme, mode, storage)"], [r[:-1] for r in rows],
+                align=r">{\raggedright\arraybackslash}p{3.2cm}lrrrrrll")
     geo = c[c.case.str[0].isin(["2", "3", "4"])]
     touch = c[c.case.str.startswith("5")]
     fits = c[c.case.str.contains("sphere fit")]

@@ -9,7 +9,7 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
-from common import experiment_dir, read_csv, save, write_macros, write_table
+from common import experiment_dir, read_csv, save, timing_text, write_macros, write_table
 
 d = experiment_dir("13_distance_peers")
 t = read_csv(d, "distance_peers.csv")
@@ -89,8 +89,9 @@ if wp is not None and len(wp):
 
         def span(r):
             if r.runs == 0:
-                return "left out (over 300 s)"
-            return f"{scale * r.median_s:.3g} ({scale * r.q1_s:.3g}--{scale * r.q3_s:.3g}) {unit}"
+                return "left out (over 60 s)"
+            return timing_text(scale * r.median_s, scale * r.q1_s, scale * r.q3_s, r.runs, lambda x: f"{x:.3g}",
+                               sep="--", unit=f" {unit}")
         rows.append([mesh.replace("_", " "), what, span(a), span(b),
                      f"{b.median_s / a.median_s:.1f}" if b.runs > 0 else "--"])
     write_table(d, "table_whole_process", ["mesh", "job", "impinge, median (quartiles)", "Open3D", "Open3D / impinge"],

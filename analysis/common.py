@@ -102,6 +102,22 @@ def median_quartiles(values):
     return (v.median(), v.quantile(0.25), v.quantile(0.75)) if len(v) else (float("nan"),) * 3
 
 
+ONE_RUN = "one run"  # how a table marks a time measured once; its caption says why (issue 82)
+
+
+def timing_text(median, q25, q75, runs, fmt, sep="-", unit=""):
+    """A time cell: 'median (q25-q75)' over its alternated rounds, or 'median (one run)' for a time measured once
+    (runs <= 1: its quartiles would repeat the median, "0.531 (0.531-0.531)", as if it had a spread); '--' when
+    not measured. fmt formats one number; unit (e.g. " s") follows the median of a single run, the quartiles
+    otherwise."""
+    import math
+    if median is None or not math.isfinite(median) or (runs is not None and runs < 1):
+        return "--"
+    if runs is not None and runs <= 1 or q25 is None or not math.isfinite(q25):
+        return f"{fmt(median)}{unit} ({ONE_RUN})"
+    return f"{fmt(median)} ({fmt(q25)}{sep}{fmt(q75)}){unit}"
+
+
 def density_uniformity(g, within=0.1):
     """Thesis Fig. 47's uniformity of a scheme's nodes, from experiment 01's density.csv rows of one scheme (nodes and
     band_sr per band of the polar angle): the share of the sphere's area whose node density lies within `within` of
@@ -121,10 +137,21 @@ def latex_escape(s):
             .replace("&", r"\&").replace("^", r"\textasciicircum{}").replace("#", r"\#"))
 
 
-def write_table(d, stem, header, rows, align=None, caption=None, label=None):
+def stacked_cell(text):
+    """A cell "median (q1-q3)" as two lines, the quartiles under the median (a LaTeX cell, already escaped): a table
+    of many timings then fits the page at a readable size (issue 82) instead of being shrunk."""
+    import re
+    m = re.fullmatch(r"(.+?) (\(.+\).*)", text)
+    if not m:
+        return text
+    return r"\begin{tabular}[t]{@{}r@{}}" + m.group(1) + r"\\ " + m.group(2) + r"\end{tabular}"
+
+
+def write_table(d, stem, header, rows, align=None, caption=None, label=None, stack=False):
     """A booktabs tabular in d/stem.tex. header: list of str; rows: list of lists of str. With a caption, a
     longtable instead (caption and label inside, the header repeated on every page), for a table too long
-    for one page: input it outside a table float."""
+    for one page: input it outside a table float. stack: every cell "median (q1-q3)" prints its quartiles
+    under its median (stacked_cell), for a table too wide for the page otherwise."""
     align = align or "l" + "r" * (len(header) - 1)
     head = " & ".join(header) + r" \\"
     if caption is None:
@@ -134,7 +161,8 @@ def write_table(d, stem, header, rows, align=None, caption=None, label=None):
                  r"\caption{" + caption + "}" + (r"\label{" + label + "}" if label else "") + r" \\",
                  r"\toprule", head, r"\midrule", r"\endfirsthead", r"\toprule", head, r"\midrule", r"\endhead",
                  r"\bottomrule", r"\endfoot"]
-    lines += [" & ".join(latex_escape(c) for c in r) + r" \\" for r in rows]
+    cell = (lambda c: stacked_cell(latex_escape(c))) if stack else latex_escape
+    lines += [" & ".join(cell(c) for c in r) + r" \\" for r in rows]
     lines += [r"\bottomrule", r"\end{tabular}"] if caption is None else [r"\end{longtable}"]
     with open(os.path.join(d, stem + ".tex"), "w") as f:
         f.write("\n".join(lines) + "\n")

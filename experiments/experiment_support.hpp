@@ -100,7 +100,8 @@ std::string experiment_dir(const Args& args, const std::string& name);
 /// experiment_support.py writes the same; tools/check-report checks it): experiment (DIR's name),
 /// git_commit (with "-dirty" when tracked files outside results/ differ), date (UTC), quick,
 /// repetitions, timing, data_folder, parameters (`params`), versions, compiler, kernels, cores and
-/// machine (machine_description(): CPU model, family, clock, caches, memory, hypervisor, kernel).
+/// machine (machine_description(): CPU model, family, clock, caches, topology (sockets, cores, SMT siblings),
+/// memory, hypervisor, kernel).
 void write_meta(const std::string& dir, const Args& args, nlohmann::json params);
 
 /// Minimal CSV writer: header once, then rows of already-formatted cells.

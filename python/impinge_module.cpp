@@ -89,7 +89,8 @@ void bind_functions(py::module_& m) {
         return d;
       },
       "What this machine exposes about itself -> dict of str: cpu_model, cpu_family, cpu_model_number, "
-      "cpu_stepping, cpu_mhz, l2_cache, l3_cache, logical_cpus, memory_gib, hypervisor, os_kernel ('unknown' "
+      "cpu_stepping, cpu_mhz, l2_cache, l3_cache, logical_cpus, sockets, physical_cores, smt ('yes' when a core "
+      "runs two logical CPUs), thread_siblings, memory_gib, hypervisor, os_kernel ('unknown' "
       "where the machine does not say; provenance.hpp).");
 
   m.def(

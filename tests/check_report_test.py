@@ -51,6 +51,47 @@ def write_run(d, commits, claims_rows, log="", leave_out=(), drop_field=None):
     os.makedirs(os.path.join(d, "paper"), exist_ok=True)
     with open(os.path.join(d, "paper", "impinge.log"), "w") as f:
         f.write(log)
+    write_paper(d, [(100, 700, 10, 1, False)], [("table", 1, 750, 650)])
+    with open(os.path.join(d, "reproduce_times.csv"), "w") as f:
+        f.write("step,driver_s,analysis_s,wall_s,share\nbuild,900,,900,0.3\n01_x,2000,100,2100,0.7\n"
+                "total,,,3000,1.0\n")
+
+
+def write_pdf(path, texts):
+    """A one-page A4 PDF, written by hand, drawing "Table text" in Helvetica for each (x, y, font size, scale,
+    turned) of `texts`: at (x, y) PDF points, the font size scaled by `scale` through the page's transformation
+    (as \\resizebox does), turned a quarter when `turned`. Its printed size is font size x scale."""
+    ops = []
+    for x, y, size, scale, turned in texts:
+        m = f"0 {scale} {-scale} 0" if turned else f"{scale} 0 0 {scale}"
+        ops.append(f"q {m} {x} {y} cm BT /F1 {size} Tf 0 0 Td (Table text) Tj ET Q")
+    content = "\n".join(ops).encode()
+    objects = [b"<< /Type /Catalog /Pages 2 0 R >>", b"<< /Type /Pages /Kids [3 0 R] /Count 1 >>",
+               b"<< /Type /Page /Parent 2 0 R /MediaBox [0 0 595 842] /Contents 4 0 R "
+               b"/Resources << /Font << /F1 5 0 R >> >> >>",
+               b"<< /Length %d >>\nstream\n" % len(content) + content + b"\nendstream",
+               b"<< /Type /Font /Subtype /Type1 /BaseFont /Helvetica >>"]
+    out, offsets = bytearray(b"%PDF-1.4\n"), []
+    for k, body in enumerate(objects, start=1):
+        offsets.append(len(out))
+        out += b"%d 0 obj\n" % k + body + b"\nendobj\n"
+    xref = len(out)
+    out += b"xref\n0 %d\n0000000000 65535 f \n" % (len(objects) + 1)
+    out += b"".join(b"%010d 00000 n \n" % o for o in offsets)
+    out += b"trailer\n<< /Size %d /Root 1 0 R >>\nstartxref\n%d\n%%%%EOF\n" % (len(objects) + 1, xref)
+    with open(path, "wb") as f:
+        f.write(bytes(out))
+
+
+def write_paper(d, texts, floats):
+    """RESULTS d's built paper: impinge.pdf drawing `texts` (write_pdf) and the position file paper/impinge.tex
+    writes, with each (kind, number, top, bottom) of `floats` (PDF points from the page's bottom) on page 1."""
+    write_pdf(os.path.join(d, "paper", "impinge.pdf"), texts)
+    sp = 65536 * 72.27 / 72
+    with open(os.path.join(d, "paper", "impinge.pos"), "w") as f:
+        for k, (kind, number, top, bottom) in enumerate(floats, start=1):
+            f.write(f"begin {kind} {k} {number - 1} 0 0 {round(top * sp)}\n")
+            f.write(f"end {kind} {k} {number} 0 0 {round(bottom * sp)}\n")
 
 
 def every_item_row(verdict="holds"):
@@ -207,6 +248,45 @@ def test_the_analysis_draws_figure_text_at_eight_points_where_the_paper_prints_i
             recorded = json.load(f)["fig"]
         assert recorded["min_font_pt"] >= 8 * 6.5 / (0.5 * check.TEXT_WIDTH_IN) - 1e-9, recorded
         assert check.check_figure_text(results, paper) == []
+
+
+def test_table_text_printed_under_seven_points_is_found_in_the_pdf():
+    # Table 1 at 10 pt; Table 2 at 10 pt shrunk by half (5 pt, as \\resizebox prints a wide table); Table 3 at 8 pt
+    # turned on its page; Figure 1 at 9 pt scaled to 0.75 (6.75 pt). Text outside every float (a 4 pt line at the
+    # page's foot) is not a table's.
+    with tempfile.TemporaryDirectory() as d:
+        os.makedirs(os.path.join(d, "paper"))
+        write_paper(d, [(100, 700, 10, 1, False), (100, 600, 10, 0.5, False), (300, 420, 8, 1, True),
+                        (100, 300, 9, 0.75, False), (100, 50, 4, 1, False)],
+                    [("table", 1, 750, 650), ("table", 2, 640, 560), ("table", 3, 540, 360), ("figure", 1, 340, 250)])
+        sizes = check.table_text_sizes(d)
+        assert set(sizes) == {"Table 1", "Table 2", "Table 3", "Figure 1"}, sizes
+        for name, expected in (("Table 1", 10), ("Table 2", 5), ("Table 3", 8), ("Figure 1", 6.75)):
+            assert abs(sizes[name][0] - expected) < 0.06 and abs(sizes[name][1] - expected) < 0.06, (name, sizes)
+        findings = check.check_text_size(d)
+        assert len(findings) == 2 and "Table 2 prints text at 5.0 pt" in findings[0] and "Figure 1" in findings[1], \
+            findings
+
+
+def test_a_full_run_over_an_hour_after_its_build_and_a_run_without_its_time_table_are_found():
+    with tempfile.TemporaryDirectory() as d:
+        write_run(d, ["abc"], every_item_row())
+        metas = check.read_metas(d)
+        for m in metas.values():
+            m["quick"] = False
+        assert check.check_run_time(d, metas) == []  # 35 min after a 15 min build
+        with open(os.path.join(d, "reproduce_times.csv"), "a") as f:
+            f.write("02_y,1600,,1600,0.3\n")
+        findings = check.check_run_time(d, metas)
+        assert len(findings) == 1 and "took 62 min after its build" in findings[0], findings
+        os.remove(os.path.join(d, "reproduce_times.csv"))
+        assert "reproduce_times.csv missing" in check.check_run_time(d, metas)[0]
+
+
+def test_a_line_is_sized_by_its_text_not_its_superscripts():
+    # Three glyphs at 7 pt and one at 5 pt on one line: a superscript; alone on its own line, 5 pt counts.
+    assert check.line_sizes([(100, 7), (100.5, 7), (99.8, 7), (102, 5)]) == [7]
+    assert check.line_sizes([(100, 7), (100.5, 7), (80, 5)]) == [7, 5]
 
 
 def test_a_page_that_runs_over_is_found():

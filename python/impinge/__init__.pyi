@@ -35,7 +35,8 @@ def build_info() -> Dict[str, str]:
 
 def machine_info() -> Dict[str, str]:
     """What this machine exposes -> dict(cpu_model, cpu_family, cpu_model_number, cpu_stepping, cpu_mhz, l2_cache,
-    l3_cache, logical_cpus, memory_gib, hypervisor, os_kernel); 'unknown' where it does not say."""
+    l3_cache, logical_cpus, sockets, physical_cores, smt ("yes" when a core runs two logical CPUs), thread_siblings,
+    memory_gib, hypervisor, os_kernel); 'unknown' where it does not say."""
 
 def load_motion(path: str, side: str = "right") -> Dict[str, Any]:
     """A motion file as impinge motion reads it (CSV or OpenSim .mot/.sto) -> dict(time_s (k,) s,

@@ -5,7 +5,7 @@ import os
 import impinge
 
 KEYS = ["cpu_model", "cpu_family", "cpu_model_number", "cpu_stepping", "cpu_mhz", "l2_cache", "l3_cache",
-        "logical_cpus", "memory_gib", "hypervisor", "os_kernel"]
+        "logical_cpus", "sockets", "physical_cores", "smt", "thread_siblings", "memory_gib", "hypervisor", "os_kernel"]
 
 
 def cpuinfo(key):
@@ -40,3 +40,31 @@ def test_machine_info_has_every_key_in_order_and_agrees_with_the_machines_files(
         kib = next(float(line.split()[1]) for line in f if line.startswith("MemTotal:"))
     assert m["memory_gib"] == f"{kib / 1024 ** 2:.1f}"
     assert m["os_kernel"] == f"{os.uname().sysname} {os.uname().release}"
+
+
+def test_machine_info_gives_the_cpu_topology_as_sysfs_and_lscpu_do():
+    # Read here independently: every online CPU's topology files; lscpu -p (when present) agrees on the core count.
+    import glob
+    import re
+    import shutil
+    import subprocess
+    m = impinge.machine_info()
+    dirs = [d for d in glob.glob("/sys/devices/system/cpu/cpu*") if re.fullmatch(r"cpu\d+", os.path.basename(d))
+            and os.path.exists(os.path.join(d, "topology", "thread_siblings_list"))]
+    if not dirs:
+        assert m["smt"] == "unknown"
+        return
+
+    def read(d, f):
+        with open(os.path.join(d, "topology", f)) as fh:
+            return fh.read().strip()
+    cores = {(read(d, "physical_package_id"), read(d, "core_id")) for d in dirs}
+    groups = {read(d, "thread_siblings_list") for d in dirs}
+    assert m["physical_cores"] == str(len(cores))
+    assert m["sockets"] == str(len({c[0] for c in cores}))
+    assert m["smt"] == ("yes" if len(cores) < len(dirs) else "no")
+    assert sorted(m["thread_siblings"].split(" | ")) == sorted(groups)
+    if shutil.which("lscpu"):
+        rows = [line.split(",") for line in subprocess.run(["lscpu", "-p=CORE,SOCKET"], capture_output=True,
+                                                             text=True).stdout.splitlines() if line[:1].isdigit()]
+        assert len({tuple(r) for r in rows}) == len(cores)

@@ -4,8 +4,10 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 
 #ifndef IMPINGE_COMPILER
 #define IMPINGE_COMPILER "unknown"
@@ -57,6 +59,45 @@ std::string cache_size(int level) {
   return {};
 }
 
+// The CPU topology from sysfs (/sys/devices/system/cpu/cpuN/topology): the sockets (distinct physical_package_id),
+// the physical cores (distinct package and core_id pairs), whether any core runs more than one logical CPU (SMT:
+// a thread_siblings_list of more than one CPU) and the sibling groups themselves ("0 | 1": two cores of one
+// thread each; "0-1": one core of two threads). Empty values where sysfs does not say.
+struct Topology {
+  std::string sockets, cores, smt, siblings;
+};
+
+Topology cpu_topology() {
+  namespace fs = std::filesystem;
+  std::set<std::string> packages, groups;
+  std::set<std::pair<std::string, std::string>> cores;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator("/sys/devices/system/cpu", ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() < 4 || name.compare(0, 3, "cpu") != 0 ||
+        name.find_first_not_of("0123456789", 3) != std::string::npos)
+      continue;
+    const std::string dir = entry.path().string() + "/topology/";
+    const std::string package = first_line(dir + "physical_package_id"), core = first_line(dir + "core_id");
+    const std::string group = first_line(dir + "thread_siblings_list");
+    if (package.empty() || core.empty() || group.empty()) continue;  // offline, or no topology exposed
+    packages.insert(package);
+    cores.emplace(package, core);
+    groups.insert(group);
+  }
+  Topology t;
+  if (groups.empty()) return t;
+  t.sockets = std::to_string(packages.size());
+  t.cores = std::to_string(cores.size());
+  bool smt = false;
+  for (const auto& g : groups) {
+    smt = smt || g.find_first_of(",-") != std::string::npos;
+    t.siblings += (t.siblings.empty() ? "" : " | ") + g;
+  }
+  t.smt = smt ? "yes" : "no";
+  return t;
+}
+
 }  // namespace
 
 std::string compiler_description() { return IMPINGE_COMPILER; }
@@ -73,6 +114,11 @@ std::vector<std::pair<std::string, std::string>> machine_description() {
   m.emplace_back("l3_cache", or_unknown(cache_size(3)));
   const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
   m.emplace_back("logical_cpus", cpus > 0 ? std::to_string(cpus) : std::string("unknown"));
+  const Topology topology = cpu_topology();
+  m.emplace_back("sockets", or_unknown(topology.sockets));
+  m.emplace_back("physical_cores", or_unknown(topology.cores));
+  m.emplace_back("smt", or_unknown(topology.smt));
+  m.emplace_back("thread_siblings", or_unknown(topology.siblings));
   std::string memory = "unknown";
   const std::string kb = field(proc_fields("/proc/meminfo"), "MemTotal");  // "24684100 kB"
   double kib = 0;
