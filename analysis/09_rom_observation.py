@@ -4,7 +4,7 @@ ROM maps, published values beside ours, sensitivity and cost.
 Reads RESULTS/09_rom_observation/*.csv (and the observation_*.ply cup meshes); writes
 table_observation.tex, table_limits.tex, table_published.tex, table_sensitivity.tex, table_extra.tex,
 table_layered.tex, table_envelope.tex, table_methods.tex, table_method_sensitivity.tex,
-rom_map.pdf, limits_vs_normal.pdf (every limit beside the published normal range), medial_<subject>_<patient>.pdf
+rom_map.pdf, limits_vs_normal.pdf (every limit in the anterior pelvic plane beside the published bony and living ranges), medial_<subject>_<patient>.pdf
 (Tables 12-13's panels), macros.tex."""
 import os
 import warnings
@@ -70,11 +70,15 @@ for p in pub.itertuples():
 write_table(d, "table_published", ["group (published)", "IR deg", "subject", "ours deg", "source"], rows,
             align="lrlrl")
 
-# Every limit beside the published normal range of its motion in living subjects (normal_deg, from the
-# driver's table: AAOS 1965, Kouyoumdjian et al. 2012), in the pelvic frame the limits are measured in; a motion
-# whose start is not reached is drawn at the foot, one the soft tissue usually ends first (the bony limit past
-# the normal range) hollow.
+# Every limit beside the published ranges of its motion (issue 81): in the anterior pelvic plane, the frame of
+# clinical tools and of published simulated bony ROM (limit_app_deg; the limits' own frame where the APP could
+# not be built), against the published simulated *bony* range of normal hips where one could be cited
+# (bony_normal_deg: dashed) kept apart from the active range of living subjects (normal_deg, AAOS 1965,
+# Kouyoumdjian et al. 2012: solid). A motion whose start is not reached is drawn at the foot, one past the
+# living range (the capsule and ligaments usually end it first) hollow.
 if "normal_deg" in lim.columns:
+    app = "limit_app_deg" in lim.columns and lim.limit_app_deg.notna().any()
+    value, status = ("limit_app_deg", "status_app") if app else ("limit_deg", "status")
     motions = list(dict.fromkeys(lim.motion))
     fig, ax = plt.subplots(figsize=(7.5, 3.6))
     markers = "osD^v<>"
@@ -82,27 +86,31 @@ if "normal_deg" in lim.columns:
         normal = lim[lim.motion == m].normal_deg.iloc[0]
         if not np.isnan(normal):
             ax.plot([k - 0.35, k + 0.35], [normal, normal], color="black", lw=2.5, zorder=1)
+        bony_range = lim[lim.motion == m].bony_normal_deg.iloc[0] if "bony_normal_deg" in lim.columns else np.nan
+        if not np.isnan(bony_range):
+            ax.plot([k - 0.35, k + 0.35], [bony_range, bony_range], color="black", lw=1.5, ls="--", zorder=1)
         for i, s in enumerate(subjects):
             r = lim[(lim.subject == s) & (lim.motion == m)].iloc[0]
             x = k + (i - (len(subjects) - 1) / 2) * 0.15
-            if r.status == "not_reachable":
+            if getattr(r, status) == "not_reachable":
                 ax.plot(x, 2, marker="x", color=f"C{i}", ms=7, zorder=2)
                 continue
-            y = r.limit_deg if r.status != "free" else 150
-            hollow = bool(r.soft_tissue_first)
+            y = getattr(r, value) if getattr(r, status) != "free" else 150
+            hollow = not np.isnan(normal) and (getattr(r, status) == "free" or y > normal)
             ax.plot(x, y, marker=markers[i % len(markers)], ms=6, zorder=2, color=f"C{i}",
                     markerfacecolor="none" if hollow else f"C{i}")
     ax.set_xticks(range(len(motions)))
     ax.set_xticklabels([m.replace("_90_flexion", " 90").replace("_", " ") for m in motions], rotation=30, ha="right",
                        fontsize=8)
-    frames = ", ".join(sorted(set(lim.pelvic_frame)))
-    ax.set_ylabel(f"bony limit, deg (pelvic frame: {frames})")
+    ax.set_ylabel("bony limit, deg (" + ("anterior pelvic plane" if app else
+                                         "pelvic frame: " + ", ".join(sorted(set(lim.pelvic_frame)))) + ")")
     ax.set_ylim(0, 155)
     for i, s in enumerate(subjects):
         ax.plot([], [], marker=markers[i % len(markers)], ls="none", color=f"C{i}", label=s)
-    ax.plot([], [], color="black", lw=2.5, label="published normal (living)")
+    ax.plot([], [], color="black", lw=2.5, label="published normal (living, active)")
+    ax.plot([], [], color="black", lw=1.5, ls="--", label="published bony (simulated, normal hips)")
     ax.plot([], [], marker="x", ls="none", color="gray", label="start not reached")
-    ax.plot([], [], marker="o", ls="none", color="gray", markerfacecolor="none", label="soft tissue first")
+    ax.plot([], [], marker="o", ls="none", color="gray", markerfacecolor="none", label="past the living range")
     ax.legend(fontsize=7, ncol=2, loc="upper right")
     save(fig, d, "limits_vs_normal")
 
