@@ -8,6 +8,7 @@ radial_vs_distance.pdf (the radial gap against the Euclidean distance, issue 26)
 table_acetabulum.tex, table_usid.tex, table_schemes.tex, min_gap.pdf, levels.pdf, maps_<subject>.pdf (map images with colour bars), render_<subject>.pdf (shaded, with the clock face), macros.tex."""
 import json
 import os
+import re
 
 import numpy as np
 import pandas as pd
@@ -315,6 +316,22 @@ save(fig, d, "radial_vs_distance")
 both = rv.vertices_both.sum()
 
 pen = st[(st.precision_deg == finest) & (st["mode"] == "exact") & (st.scan == "ball")]
+
+def pose_words(pose):
+    """A pose's name as words: "extension20" -> "20 deg extension", "scan" -> "the scan pose"."""
+    m = re.fullmatch(r"([a-z]+?)(\d+)", pose)
+    return f"{m.group(2)} deg {m.group(1)}" if m else f"the {pose} pose"
+
+
+# The README's example of the two parting (issue 81, item 7): on a shared hip, the vertex inside the other bone (by
+# the distance) whose radial gap reads deepest past its distance.
+inner = rvv[~rvv.subject.str.startswith("generated") & (rvv.distance_mm < 0) & np.isfinite(rvv.gap_mm)]
+deep = inner.loc[(inner.gap_mm - inner.distance_mm).idxmin()] if len(inner) else None
+deep_macros = ({"RDdeepWhere": f"{deep.subject} at {pose_words(deep.pose)}",
+                "RDdeepBone": "femur" if deep.scan == "ball" else "pelvis",
+                "RDdeepDistance": f"{-deep.distance_mm:.2f}", "RDdeepGap": f"{deep.gap_mm:.1f}"} if deep is not None
+               else {k: "--" for k in ("RDdeepWhere", "RDdeepBone", "RDdeepDistance", "RDdeepGap")})
+
 # USID beside RSID (thesis Fig. 50): the largest per-vertex difference of the matched helix, any mode, and exact.
 usid = allst[(allst.scheme == "helix") & (allst.vs_equiangular_compared > 0)]
 write_macros(d, "macros", {
@@ -337,4 +354,5 @@ write_macros(d, "macros", {
     "DMinclinationRange": (f"{anat.inclination_deg.min():.0f}--{anat.inclination_deg.max():.0f}" if len(anat) else "n/a"),
     "DMrimRmsRange": (f"{anat.rim_plane_rms_mm.min():.1f}--{anat.rim_plane_rms_mm.max():.1f}" if len(anat) else "n/a"),
     "DManteversionRange": (f"{anat.anteversion_deg.min():.0f}--{anat.anteversion_deg.max():.0f}" if len(anat) else "n/a"),
+    **deep_macros,
 })

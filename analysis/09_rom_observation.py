@@ -150,7 +150,8 @@ write_table(d, "table_sensitivity", ["subject", "method", "perturbation", "media
 # Without the shared hips (no methods.csv, no mc22 pair) the prose's numbers read "--".
 method_macros = {k: "--" for k in ["ROMeqSensMax", "ROMeqSensWorstSubject", "ROMeqSensWithinThree", "ROMmethodSubjects",
                                    "ROMfhSensMax", "ROMfhSensVanish", "ROMeqSensMedian", "ROMeqSensOverThree",
-                                   "ROMeqSensLimits", "ROMeqSensOverThreeList"]}
+                                   "ROMeqSensLimits", "ROMeqSensOverThreeList", "ROMfhSensMedian",
+                                   "ROMeqSensWithinThreeLimits"]}
 if meth is not None:
     order = ["femoral-head", "acetabular", "combined", "equidistant"]
     msubjects = list(dict.fromkeys(meth.subject))
@@ -178,12 +179,14 @@ if meth is not None:
         "ROMfhSensMax": f(changes(fh)[np.isfinite(changes(fh))].max()),
         "ROMfhSensVanish": str(int(np.isinf(changes(fh)).sum())),
         "ROMeqSensMedian": f(changes(eq).median(), 2),
+        "ROMfhSensMedian": f(changes(fh).median()),
     })
     # The limits a 1 mm move changes by more than 3 deg, by subject (the prose names them).
     worst = eq.assign(change=changes(eq)).groupby(["subject", "motion"], sort=False).change.max()
     over = worst[worst > 3]
     method_macros.update({
         "ROMeqSensOverThree": str(len(over)), "ROMeqSensLimits": str(len(worst)),
+        "ROMeqSensWithinThreeLimits": str(len(worst) - len(over)),
         "ROMeqSensOverThreeList": "; ".join(
             f"\\texttt{{{s}}}: " + ", ".join(m.replace("_", " ") for m in over[s].index)
             for s in dict.fromkeys(over.index.get_level_values(0))) or "none",

@@ -245,6 +245,7 @@ if len(rf):
     macros.update({
         "RefMapsMaxMax": e(ex[real[ex.index]].max_abs_mm.max()),
         "RefMaxMax": e(rf.max_abs_mm.max()),
+        "RefRealMaxMax": e(rf[real[rf.index]].max_abs_mm.max()),  # the shared hips alone (the README quotes it)
         "RefRatioMin": f"{ratio.min():.2f}", "RefRatioMax": f"{ratio.max():.2f}",
         "RefMismatchedMaps": f"{int(ex.mismatched.sum())}", "RefMismatchedRefined": f"{int(rf.mismatched.sum())}",
     })
