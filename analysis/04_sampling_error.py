@@ -123,9 +123,9 @@ ex_heads = heads[(heads["mode"] == "exact") & (heads.precision_deg == fine)]
 ex_local = rad[rad["shape"].str.startswith("head_") & (rad.scheme == "equiangular") & (rad["mode"] == "exact")]
 hx_cov = cov[cov.scheme == "helix"]
 write_macros(d, "macros", {
-    # Shares rounded down to a tenth, so that the range never claims more than the data.
-    "SElocalExact": (f"{np.floor(1000 * ex_local.fraction_within_local_bound.min()) / 10:.1f}--"
-                     f"{np.floor(1000 * ex_local.fraction_within_local_bound.max()) / 10:.1f}" if len(ex_local) else "n/a"),
+    # Rounded as the appendix table prints each row (issue 82: the floor gave 99.7 where the table shows 99.8).
+    "SElocalExact": (f"{100 * ex_local.fraction_within_local_bound.min():.1f}--"
+                     f"{100 * ex_local.fraction_within_local_bound.max():.1f}" if len(ex_local) else "n/a"),
     "SEhelixCov": f"{(hx_cov.max_nearest_mm / hx_cov.eq7_mm).min():.2f}--{(hx_cov.max_nearest_mm / hx_cov.eq7_mm).max():.2f}",
     "SEsphereMax": f"{sph.max_mm.max():.1e}",
     "SEcovRatioMax": f"{(cov.max_nearest_mm / cov.eq7_mm).max():.2f}",

@@ -107,10 +107,19 @@ if "normal_deg" in lim.columns:
 
 # Sensitivity: largest |change| of a limit per subject, method and perturbation kind. A limit that
 # appears or disappears (found in one run, none within the search range in the other) counts as an
-# unbounded change.
+# unbounded change. delta_deg is empty on both counts, so a limit that vanishes under the perturbation is told
+# from one that is absent in both runs by the unperturbed run's limit (rom_limits.csv for the thesis' method,
+# methods.csv for Puls et al.'s; issue 82: the tables dropped the vanishing ones).
+BASE = {(r.subject, "femoral-head (thesis)", r.motion): r.limit_deg for r in lim.itertuples()}
+if meth is not None:
+    BASE.update({(r.subject, r.method, r.motion): r.limit_deg for r in meth.itertuples()})
+
+
 def changes(g):
     v = g.delta_deg.abs().copy()
     v[g.limit_deg.isna() != g.delta_deg.isna()] = np.inf
+    base = np.array([BASE.get((r.subject, r.method, r.motion), np.nan) for r in g.itertuples()], dtype=float)
+    v[g.limit_deg.isna().to_numpy() & np.isfinite(base)] = np.inf
     return v
 
 
@@ -290,9 +299,13 @@ for s in clk.subject:
             # width); the socket's closest point, marked, and the least gap in the title are what changes.
             finite = np.where(np.isfinite(gap))[0]
             closest = finite[np.argmin(gap[finite])] if len(finite) else None
+            # The title gives the least gap of both scans, as Table 28 (table_observation) does (issue 82: it gave
+            # the socket scan's alone); the star marks the socket's closest point.
+            o = obs[(obs.subject == s) & (obs.patient == patient) & (obs.motion == m)]
+            least = float(np.fmin(o.ball_min_gap_mm, o.socket_min_gap_mm).iloc[0]) if len(o) else np.nan
             draw(ax, [(V, F, rgb)], "acetabulum_medial", row.side, clock, radius=row.rim_radius_mm + 3,
                  title=f"{m.replace('_', ' ')} {ang:g} deg" +
-                 (f"\nleast gap {gap[closest]:.2f} mm" if closest is not None else ""))
+                 (f"\nleast gap {least:.2f} mm" if np.isfinite(least) else ""))
             if closest is not None:
                 p = plot_coordinates(V[closest][None])[0]
                 ax.computed_zorder = False  # the star above the surface, not sorted behind it

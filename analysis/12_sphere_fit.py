@@ -6,7 +6,7 @@ table_synthetic.tex, table_real.tex, residuals_<subject>.pdf/png, macros.tex."""
 import matplotlib.pyplot as plt
 import numpy as np
 
-from common import experiment_dir, read_csv, save, write_macros, write_table
+from common import experiment_dir, latex_escape, read_csv, save, write_macros, write_table
 
 d = experiment_dir("12_sphere_fit")
 syn = read_csv(d, "synthetic.csv")
@@ -62,4 +62,7 @@ write_macros(d, "macros", {
     "SFautoCam": f"{np.ceil(cam4[cam4.method == 'automatic'].centre_error_mm.max() * 1000) / 1000:.3f}",
     "SFgeoCam": f"{cam4[cam4.method == 'geometric'].centre_error_mm.max():.3f}",
     "SFrealShift": (f"{realsubs.shift_from_default_mm.max():.2f}" if len(realsubs) else "n/a"),
+    # The subject of that largest shift, from the same rows (issue 82: the prose named mc22 where it is mc22-left).
+    "SFrealShiftSubject": (latex_escape(realsubs.loc[realsubs.shift_from_default_mm.idxmax(), "subject"])
+                           if len(realsubs) else "n/a"),
 })

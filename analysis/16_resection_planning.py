@@ -89,6 +89,11 @@ macros["RPirMsHigh"] = f(ir.plan_ms.max(), 0) if len(ir) else "--"
 macros["RPlhdlMs"], macros["RPlhdlMsQlow"], macros["RPlhdlMsQhigh"], _, _ = timed("shared", 1000, 2)
 vol = pub[pub.quantity == "arthroscopic_resection_volume_mm3"].iloc[0]
 macros["RPpubVolumeLow"], macros["RPpubVolumeHigh"] = f(vol.low, 0), f(vol.high, 0)
+# How many of the ir90 plans' volumes lie in the published range (issue 82: the prose said all, where one removes more).
+ir_vol = ir.femur_volume_mm3 + ir.pelvis_volume_mm3
+macros["RPirPlans"] = str(len(ir))
+macros["RPirInRange"] = str(int(((ir_vol >= vol.low) & (ir_vol <= vol.high)).sum()))
+macros["RPirVolumeMax"] = f(ir_vol.max(), 0) if len(ir) else "--"
 write_macros(d, "macros", macros)
 
 # The table: every plan on a real hip.

@@ -23,6 +23,7 @@
 #include "impinge/core/concurrent.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/timing.hpp"
+#include "impinge/io/mesh_io.hpp"
 #include "impinge/session/option_table.hpp"
 #include "impinge/session/morphology_run.hpp"
 #include "impinge/session/plan_run.hpp"
@@ -253,6 +254,7 @@ int run_rom(const RunOptions& o) {
   write_csv(in_dir(out, "rom_limits.csv"), rom_limits_table(s, run));
   if (q.map) write_csv(in_dir(out, "rom_map.csv"), rom_map_table(run));
   if (q.envelope) write_csv(in_dir(out, "rom_envelope.csv"), rom_envelope_table(run));
+  if (run.labrum) write_ply(in_dir(out, "labrum.ply"), labrum_input(s, run));
   nlohmann::json j = run_record(s);
   j.update(rom_record(run));
   j["timings_ms"] = {{"setup_total", setup_ms},

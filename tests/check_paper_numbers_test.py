@@ -45,3 +45,30 @@ kernels, the 95th percentile, (1)~first. \includegraphics[width=0.48\textwidth]{
 def test_the_paper_passes():
     r = subprocess.run([sys.executable, TOOL], capture_output=True, text=True)
     assert r.returncode == 0, r.stdout
+
+
+def run_named(name, text, tmp_path):
+    path = tmp_path / name
+    path.write_text(text)
+    return subprocess.run([sys.executable, TOOL, str(path)], capture_output=True, text=True)
+
+
+def test_summary_number_words_are_flagged(tmp_path):
+    """Issue 82, item 4: in the abstract and the conclusion a number written as a word is a number."""
+    for text, word in [("faster than FCL by one to two orders of\nmagnitude on the real hips", "one"),
+                       ("Three findings are refuted", "Three"),
+                       ("the saving of about a fifth of the nodes", "a fifth"),
+                       ("samples orders of magnitude faster", "orders of magnitude"),
+                       ("it is twice as fast", "twice")]:
+        for name in ("99_conclusion.tex", "00_abstract.tex"):
+            r = run_named(name, text, tmp_path)
+            assert r.returncode == 1, (name, text)
+            assert f": {word}\t" in r.stdout, (name, text, r.stdout)
+
+
+def test_summary_number_words_pass_from_macros_and_elsewhere(tmp_path):
+    ok = (r"\ClaimsNot{} findings do not hold; one of the hips; \thesis{two} detectors; FCL takes "
+          r"\ConclFclAllLow--\ConclFclAllHigh{} times as long.")
+    assert run_named("99_conclusion.tex", ok, tmp_path).returncode == 0
+    # Outside the abstract and the conclusion, words are prose (digits are still checked).
+    assert run_named("05_slices.tex", "Three findings, one to two orders of magnitude.", tmp_path).returncode == 0

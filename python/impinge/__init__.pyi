@@ -147,7 +147,8 @@ class Joint:
         """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each. Frames
         are scanned in blocks on impinge.get_threads() threads; rows come back in order."""
     def rom_limits(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.0, metric: str = 'distance',
-                   contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0) -> Dict[str, Any]:
+                   contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0, labrum: bool = False,
+                   labrum_width_mm: float = 5.3, labrum_height_mm: float = 7.0) -> Dict[str, Any]:
         """ROM limits from neutral for the standard motions -> dict motion -> the CLI's rom_limits.csv row
         (limit_deg, first_contact_deg, limited_by, contact_class, ...). The keywords and defaults are `impinge
         rom`'s (the option table). contacts: 'impingement' (the joint surfaces meeting is left out), 'articular'

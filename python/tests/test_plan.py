@@ -191,8 +191,8 @@ def test_internal_rotation_in_flexion_ten_degrees_more_on_a_real_hip(tmp_path):
 def test_a_cam_added_to_a_real_femur_is_planned_away(tmp_path):
     """tlem2-mri's femur with a 3 mm bump at its antero-superior head-neck junction (the input frame's femur axes from
     impinge morphology): targets = the limits without the bump that it lowers; `impinge rom` on the written
-    femur_resected.ply restores each within 0.5 deg, the plan removing at most 1.5 times the bump's volume (1.2 before
-    issue 81 kept the clearance in the final placement), most of
+    femur_resected.ply restores each within 0.5 deg, the plan removing at most twice the bump's volume (1.2 before
+    issue 81 kept the clearance in the final placement and counted the lunate surface against the junction), most of
     it on the bump (issue 50's first done-when item; experiment 16 does every shared hip)."""
     subject = os.path.join(DATA, "tlem2-mri", "subject.json")
     meshes = impinge.subject_meshes(subject)
@@ -232,9 +232,11 @@ def test_a_cam_added_to_a_real_femur_is_planned_away(tmp_path):
     Vr = np.column_stack([props["x"], props["y"], props["z"]])
     assert np.array_equal(Fr, F)
     removed = volume(Vc, F) - volume(Vr, F)
-    # At most 1.5 times the bump's volume: the clearance is kept in the placement the resected femur gets (its
+    # At most twice the bump's volume: the clearance is kept in the placement the resected femur gets (its
     # equidistant joint centre found again, issue 81), which took 1.43 times here (245 mm^3 in the first pass,
-    # whose check found the bones 0.21 mm inside each other there; 360 after four), 0.96 times before.
-    assert 0 < removed <= 1.5 * cam_volume, (removed, cam_volume)
+    # whose check found the bones 0.21 mm inside each other there; 360 after four), 0.96 times before; and the
+    # lunate surface meeting the head-neck junction below the head counts since issue 81 (it was taken for the
+    # joint space closing), so the plan clears it too at the targets: 473 mm^3, 1.88 times.
+    assert 0 < removed <= 2.0 * cam_volume, (removed, cam_volume)
     w = props["resection_mm"] * np.bincount(F.ravel(), minlength=len(V))  # depth x (a proxy of) area
     assert w[bump > 0.05].sum() > 0.5 * w.sum()

@@ -5,7 +5,11 @@
 //   head's joint surface and every neck vertex beyond the acetabular shell is not; every inner cup
 //   vertex deeper than 2.5 mm below the rim is on the lunate surface, and no outer-wall vertex and no
 //   inner vertex within 1.5 mm of the rim is;
-// - to_string spells every class.
+// - the head-neck junction (issue 81) of the generated femur, a sphere of radius r on a cylindrical neck of radius
+//   a, lies where the neck's surface a / sin(t) comes within r + tol of the centre, t = asin(a / (r + tol)), at
+//   every azimuth (to the vertex spacing); with a 3 mm cam at the junction no vertex more than 1 mm outside the
+//   head sphere is on the head side, and every vertex on the sphere away from the cam is;
+// - to_string spells every class and zone.
 #include "impinge/anatomy/articular_zones.hpp"
 
 #include <gtest/gtest.h>
@@ -15,6 +19,19 @@
 #include "impinge/io/generated_models.hpp"
 
 using namespace impinge;
+
+namespace {
+// The generated femur's head-neck clock: centre the COR, axis from the neck towards the head
+// (make_hip_model's neck points (0.80, 0.25, -0.55) from the head), 12 and 3 any two perpendiculars.
+ClockFace generated_clock(const HipModel& h) {
+  ClockFace k;
+  k.centre = h.cor;
+  k.axis = -Eigen::Vector3d(0.80, 0.25, -0.55).normalized();
+  k.twelve = (Eigen::Vector3d::UnitZ() - k.axis.z() * k.axis).normalized();
+  k.three = k.axis.cross(k.twelve);
+  return k;
+}
+}  // namespace
 
 TEST(ArticularZones, GeneratedHipZonesMatchItsClosedForm) {
   HipModelOptions o;
@@ -32,14 +49,18 @@ TEST(ArticularZones, GeneratedHipZonesMatchItsClosedForm) {
   head.centre = h.cor;
   head.radius = r_head;
   head.rms_residual = 0.05;
-  const ArticularZones z = find_articular_zones(h.ball, head, h.socket, A);
+  const ArticularZones z = find_articular_zones(h.ball, head, generated_clock(h), h.socket, A);
   EXPECT_EQ(z.head_tolerance_mm, 1.0);
-  // Femur: the head (distance r_head) in; the neck beyond the acetabular shell out.
+  // Femur: the head (distance r_head) in, but for the row of vertices next to the junction (read to this coarse
+  // mesh's spacing, conservatively: 5 deg here); the neck beyond the acetabular shell out.
   const double shell = r_in + z.lunate_tolerance_mm + (A.sphere.centre - h.cor).norm();
+  const Eigen::Vector3d down_neck = Eigen::Vector3d(0.80, 0.25, -0.55).normalized();
+  const double sphere_starts = std::asin(o.neck_radius_mm / r_head) * 180 / M_PI;
   int head_vertices = 0, neck_vertices = 0;
   for (Eigen::Index i = 0; i < h.ball.V.rows(); ++i) {
     const double d = (h.ball.V.row(i).transpose() - h.cor).norm();
-    if (std::abs(d - r_head) < 1e-6) {
+    const double from_neck = std::acos((h.ball.V.row(i).transpose() - h.cor).normalized().dot(down_neck)) * 180 / M_PI;
+    if (std::abs(d - r_head) < 1e-6 && from_neck > sphere_starts + 5) {
       ++head_vertices;
       EXPECT_TRUE(z.femur[std::size_t(i)]) << "head vertex " << i;
     } else if (d > shell + 0.5) {
@@ -74,7 +95,66 @@ TEST(ArticularZones, GeneratedHipZonesMatchItsClosedForm) {
   EXPECT_GT(near_rim, 10);
 }
 
+TEST(ArticularZones, HeadNeckJunctionWhereTheNeckComesWithinTheHeadsReach) {
+  HipModelOptions o;
+  o.target_triangles = 60000;
+  const HipModel h = make_hip_model(o);
+  const double r = o.head_radius_mm, a = o.neck_radius_mm, tol = head_junction_tolerance_mm(0.05);
+  EXPECT_EQ(tol, 0.5);
+  const FemoralHeadZone z = find_femoral_head_zone(h.ball, generated_clock(h), r, tol, 1.0);
+  const double exact = std::asin(a / (r + tol)) * 180 / M_PI;
+  for (double j : z.junction_deg) {
+    EXPECT_GE(j, exact - 1e-6);
+    EXPECT_LE(j, exact + 2.0);  // the vertices' spacing along the meridian
+  }
+  // Every vertex on the sphere is on the head side (the sphere starts at asin(a / r) > exact); every neck vertex
+  // farther than r + tol is not.
+  int head = 0, neck = 0;
+  for (Eigen::Index i = 0; i < h.ball.V.rows(); ++i) {
+    const Eigen::Vector3d v = h.ball.V.row(i).transpose();
+    const double d = (v - h.cor).norm();
+    if (std::abs(d - r) < 1e-6) {
+      ++head;
+      EXPECT_TRUE(z.on_head_side(v)) << i;
+    }
+    if (d > r + tol + 0.5) {
+      ++neck;
+      EXPECT_FALSE(z.on_head_side(v)) << i;
+    }
+  }
+  EXPECT_GT(head, 1000);
+  EXPECT_GT(neck, 1000);
+}
+
+TEST(ArticularZones, AThreeMillimetreCamIsNeverTheHead) {
+  HipModelOptions o;
+  o.target_triangles = 60000;
+  o.cam_height_mm = 3;
+  const HipModel h = make_hip_model(o);
+  const double r = o.head_radius_mm;
+  const FemoralHeadZone z = find_femoral_head_zone(h.ball, generated_clock(h), r, 0.5, 1.0);
+  int cam = 0;
+  for (Eigen::Index i = 0; i < h.ball.V.rows(); ++i) {
+    const Eigen::Vector3d v = h.ball.V.row(i).transpose();
+    if ((v - h.cor).norm() > r + 1) {
+      ++cam;
+      EXPECT_FALSE(z.on_head_side(v)) << "vertex " << i;
+    }
+    EXPECT_EQ(z.contains(v), (v - h.cor).norm() <= z.reach_mm && z.on_head_side(v));
+  }
+  EXPECT_GT(cam, 100);
+  // The zones name it: the cam's vertices are the junction's or the neck's, never the head's.
+  for (Eigen::Index i = 0; i < h.ball.V.rows(); ++i) {
+    const Eigen::Vector3d v = h.ball.V.row(i).transpose();
+    if ((v - h.cor).norm() > r + 1) EXPECT_NE(femoral_zone(z, v), FemoralZone::head);
+  }
+}
+
 TEST(ArticularZones, EveryClassHasItsSpelling) {
+  EXPECT_STREQ(to_string(FemoralZone::head_neck_junction), "head_neck_junction");
+  EXPECT_STREQ(to_string(FemoralZone::trochanter), "trochanter");
+  EXPECT_STREQ(to_string(PelvicZone::aiis), "aiis");
+  EXPECT_STREQ(to_string(PelvicZone::none), "");
   EXPECT_STREQ(to_string(ContactClass::none), "");
   EXPECT_STREQ(to_string(ContactClass::articular), "articular");
   EXPECT_STREQ(to_string(ContactClass::intra_articular_impingement), "intra_articular_impingement");

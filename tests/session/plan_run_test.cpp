@@ -134,9 +134,7 @@ double cgal_least(const Session& s, const RomBaseline& base, const FemurPose& po
     if (!base.skip_socket.empty() && base.skip_socket[std::size_t(i)]) continue;
     if ((pelvis.V.row(i).transpose() - head).norm() > near_mm) continue;
     const Eigen::Vector3d u = socket.row(i).transpose();
-    if (std::isfinite(base.head_sphere_reach_mm) &&
-        (pose.R.transpose() * (u - pose.t) - base.head_centre).norm() <= base.head_sphere_reach_mm)
-      continue;
+    if (base.meets_head(pose.R.transpose() * (u - pose.t))) continue;  // the head's joint surface, as the plan
     least = std::min(least, signed_distance(f, pelvis.V.row(i).transpose()));
   }
   return least;

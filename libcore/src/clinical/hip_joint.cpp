@@ -102,8 +102,8 @@ void HipJoint::build_anatomy(TriangleMesh& femur, const TriangleMesh& pelvis, Sp
   frames_ = find_hip_frames(femur, pelvis, side_, g, options.frames);
   acetabulum_ = find_acetabulum(pelvis, sphere.centre, head_radius_, frames_->pelvis);
   sphere.radius = head_radius_;
-  articular_ = find_articular_zones(femur, sphere, pelvis, *acetabulum_, options.articular);
   const ClockFace femoral = femoral_clock_face(femur, sphere.centre, head_radius_, frames_->femur);
+  articular_ = find_articular_zones(femur, sphere, femoral, pelvis, *acetabulum_, options.articular);
   if (options.seat_before_sampling &&
       (method == JointCentreMethod::combined || method == JointCentreMethod::equidistant))
     seat_femur(femur, sphere, options);
@@ -127,6 +127,7 @@ void HipJoint::build_anatomy(TriangleMesh& femur, const TriangleMesh& pelvis, Sp
   const Eigen::Matrix3d A = joint_to_working_.transpose();
   socket_clock_ = acetabulum_->clock.transformed(A, -A * cor_);
   ball_clock_ = femoral.transformed(A, A * (seat_ - cor_));
+  head_zone_joint_ = articular_->head.transformed(A, A * (seat_ - cor_));
 }
 
 void HipJoint::seat_femur(TriangleMesh& femur, const SphereFitResult& sphere, const HipJointOptions& options) {
@@ -157,7 +158,7 @@ void HipJoint::build_joint(TriangleMesh femur, TriangleMesh pelvis, const HipJoi
   if (options.ball_map_file.empty() != options.socket_map_file.empty())
     throw Error("hip joint: give both map files (ball and socket) or neither");
   if (options.ball_map_file.empty()) {
-    joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint);
+    joint_ = std::make_shared<Joint>(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint);
     return;
   }
   auto load = [&](const std::string& path) {
@@ -170,7 +171,7 @@ void HipJoint::build_joint(TriangleMesh femur, TriangleMesh pelvis, const HipJoi
                                            "): another subject or COR");
     return m;
   };
-  joint_.emplace(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint,
+  joint_ = std::make_shared<Joint>(std::move(femur), std::move(pelvis), Eigen::Vector3d::Zero(), options.joint,
                  load(options.ball_map_file), load(options.socket_map_file));
 }
 
@@ -206,15 +207,23 @@ ContactClass HipJoint::contact_class(bool ball, std::int64_t vertex, const Femur
   require(vertex >= 0 && vertex < V.rows(), "contact class: vertex " + std::to_string(vertex) + " out of range");
   const Eigen::Vector3d v = V.row(static_cast<Eigen::Index>(vertex)).transpose();
   const Eigen::Vector3d p_joint = ball ? Eigen::Vector3d(pose.R * v + pose.t) : v;
-  if (articular_) {
-    const std::vector<std::uint8_t>& zone = ball ? articular_->femur : articular_->pelvis;
-    if (zone[static_cast<std::size_t>(vertex)]) return ContactClass::articular;
-    if (!ball && (pose.R.transpose() * (v - pose.t) - head_centre_joint_).norm() <= articular_->head_sphere_reach_mm)
-      return ContactClass::articular;
+  if (articular_) {  // the head against the acetabulum, the lunate surface against the neck not (issue 81)
+    if (ball && articular_->femur[static_cast<std::size_t>(vertex)]) return ContactClass::articular;
+    if (!ball && head_zone_joint_->contains(pose.R.transpose() * (v - pose.t))) return ContactClass::articular;
   }
+  if (labral_) return ContactClass::labral;
   const double rim = acetabulum_ ? acetabulum_->rim_radius_mm : head_radius_ + 5;
   return p_joint.norm() <= rim + intra_margin_mm ? ContactClass::intra_articular_impingement
                                                  : ContactClass::extra_articular_impingement;
+}
+
+FemoralZone HipJoint::femoral_zone(const Eigen::Vector3d& p) const {
+  return head_zone_joint_ ? impinge::femoral_zone(*head_zone_joint_, p) : FemoralZone::none;
+}
+
+PelvicZone HipJoint::pelvic_zone(const Eigen::Vector3d& p_joint) const {
+  return articular_ && acetabulum_ ? impinge::pelvic_zone(*acetabulum_, *articular_, to_working(p_joint))
+                                   : PelvicZone::none;
 }
 
 void HipJoint::save_maps(const std::string& ball_path, const std::string& socket_path) const {

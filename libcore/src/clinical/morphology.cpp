@@ -1,5 +1,7 @@
 #include "impinge/clinical/morphology.hpp"
 
+#include "impinge/anatomy/articular_zones.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -235,7 +237,7 @@ Morphology measure_morphology(const TriangleMesh& femur, const TriangleMesh& pel
 
   // Alpha angle per clock hour and the anterior head-neck offset, by exact rays from inside the femur.
   const ExactReference ref(femur);
-  const double tol = std::max(0.5, std::isfinite(head.rms_residual) ? 2 * head.rms_residual : 0.0);
+  const double tol = head_junction_tolerance_mm(head.rms_residual);  // the head-neck junction's (articular_zones.hpp)
   measure_alpha_angles(ref, c, r, tol, clock, down_neck, m);
   measure_head_neck_offset(ref, c, r, clock, down_neck, m);
 

@@ -225,7 +225,6 @@ std::vector<std::vector<Contact>> find_contacts(const HipJoint& hip, const std::
                                                 const RomBaseline& baseline, const ResectionOptions& o,
                                                 const BoneState (&bone)[2], std::vector<PoseRef>& poses) {
   std::vector<std::vector<Contact>> per_pose(poses.size());
-  const double reach_head = baseline.head_sphere_reach_mm;
   std::string pose_error;
 #pragma omp parallel
   {
@@ -245,9 +244,9 @@ std::vector<std::vector<Contact>> find_contacts(const HipJoint& hip, const std::
             const float d = g.distance_mm.empty() ? std::nanf("") : g.distance_mm[i];
             const bool near = std::isfinite(d) ? d < o.clearance_mm + o.candidate_margin_mm : (g.gap_mm[i] < 0);
             if (!near) continue;
-            if (b == 1 && std::isfinite(reach_head)) {
+            if (b == 1) {  // a pelvis vertex meeting the head's joint surface (issue 81: never the neck)
               const Eigen::Vector3d u = bone[1].V->row(static_cast<Eigen::Index>(i)).transpose();
-              if ((P.R.transpose() * (u - P.t) - baseline.head_centre).norm() <= reach_head) continue;
+              if (baseline.meets_head(P.R.transpose() * (u - P.t))) continue;
             }
             per_pose[p].push_back({static_cast<std::int32_t>(p), b == 0, static_cast<std::int64_t>(i), -1, 0, -1});
           }

@@ -89,20 +89,16 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
   for (std::size_t i = 0; i < b.skip_socket.size(); ++i) b.skip_socket[i] = socket_values[i] <= o.threshold_mm;
   for (auto s : b.skip_ball) b.excluded_vertices += s;
   for (auto s : b.skip_socket) b.excluded_vertices += s;
-  // The joint surfaces: left out of impingement searches, the only ones counted where the joint space closes.
-  // The pelvis' other contacts are classed at each pose by the scanner: those that meet the head's
-  // joint surface are articular too (head_sphere_reach_mm).
+  // The femoral head's joint surface: left out of impingement searches, the only one counted where the joint
+  // space closes. The pelvis' contacts are classed at each pose by the scanner: those that meet the head up to
+  // its head-neck junction are articular (RomBaseline::meets_head), wherever on the acetabulum they lie; the
+  // lunate surface meeting the neck or a cam is not (issue 81), so it is not left out as a whole.
   if (const auto& z = hip.articular(); z && o.contacts != RomContacts::all) {
     const bool keep_articular = o.contacts == RomContacts::articular;
     for (std::size_t i = 0; i < b.skip_ball.size(); ++i)
       if (!b.skip_ball[i] && ((z->femur[i] != 0) != keep_articular)) b.skip_ball[i] = 1, ++b.articular_vertices;
-    if (!keep_articular)
-      for (std::size_t i = 0; i < b.skip_socket.size(); ++i)
-        if (!b.skip_socket[i] && z->pelvis[i]) b.skip_socket[i] = 1, ++b.articular_vertices;
-    b.head_sphere_reach_mm = z->head_sphere_reach_mm;
-    b.head_centre = hip.head_centre_joint();
+    b.head_zone = hip.head_zone_joint();
     b.contacts = o.contacts;
-    if (keep_articular) b.lunate = z->pelvis;
   }
   if (const auto& z = hip.articular())
     for (std::size_t i = 0; i < z->pelvis.size(); ++i)
@@ -141,6 +137,7 @@ void describe_contact(RomLimit& out, const HipJoint& hip, const Least& l, const 
                                                                       : ImpingementSite::extra_articular;
   out.limited_by_hidden_vertex = l.hidden;
   out.contact_class = hip.contact_class(l.ball, static_cast<std::int64_t>(l.vertex), {R, t}, o.intra_articular_margin_mm);
+  out.femoral_zone = hip.femoral_zone(R.transpose() * (p_joint - t)), out.pelvic_zone = hip.pelvic_zone(p_joint);
   if (hip.socket_clock()) {
     // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.
     out.socket_clock_h = hip.socket_clock()->hour(p_joint);

@@ -47,7 +47,7 @@ MeshContact::Query ExactScanner::query_at(const Eigen::Matrix3d& R, const Eigen:
       const auto v = static_cast<std::size_t>(F(static_cast<Eigen::Index>(f), c));
       if (base_.skip_socket[v]) continue;
       const Eigen::Vector3d y = Rt * (joint_.socket().relative.row(static_cast<Eigen::Index>(v)).transpose() - t);
-      if (pelvis_.counts(y, pelvis_.articular_only && base_.lunate[v])) return true;
+      if (pelvis_.counts(y)) return true;
     }
     return false;
   };
@@ -71,7 +71,7 @@ Least ExactScanner::operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& 
     if (ball) return base_.skip_ball[v] == 0;
     const Eigen::Vector3d y = Rt * (V.row(static_cast<Eigen::Index>(v)).transpose() - t);
     return base_.skip_socket[v] == 0 &&
-           (!pelvis_.classed() || pelvis_.counts(y, pelvis_.articular_only && base_.lunate[v]));
+           (!pelvis_.classed() || pelvis_.counts(y));
   };
   double best = std::numeric_limits<double>::infinity();
   for (int pass = 0; pass < 2 && !std::isfinite(best); ++pass)  // a counted corner; failing that, any

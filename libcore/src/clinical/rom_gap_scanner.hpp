@@ -62,7 +62,7 @@ class DistanceScanner {
       if (skip[k] || !(d < l.gap)) continue;
       if (classed) {
         const Eigen::Vector3d y = R.transpose() * (rel.row(static_cast<Eigen::Index>(k)).transpose() - t);
-        if (!pelvis_.counts(y, pelvis_.articular_only && base_.lunate[k])) continue;
+        if (!pelvis_.counts(y)) continue;
       }
       l.gap = d, l.ball = ball, l.hidden = g.status[k] == ScanGaps::tested_layered, l.vertex = k;
     }

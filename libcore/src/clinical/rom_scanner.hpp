@@ -15,24 +15,17 @@ struct Candidate {
   std::size_t vertex;
 };
 
-// How the pelvis' contacts are counted at each pose (RomBaseline::head_sphere_reach_mm, contacts): a
-// pelvis vertex meeting the femur within the head sphere's reach meets its joint surface (articular), as
-// does a lunate vertex when only the joint surfaces are counted.
+// How the pelvis' contacts are counted at each pose (RomBaseline::head_zone, contacts): a pelvis vertex
+// meeting the femur's head up to its head-neck junction meets its joint surface (articular), wherever on the
+// acetabulum it lies; the lunate surface meeting the neck or a cam does not (issue 81).
 struct PelvisContacts {
   explicit PelvisContacts(const RomBaseline& base)
-      : reach2(std::isnan(base.head_sphere_reach_mm) ? -1 : base.head_sphere_reach_mm * base.head_sphere_reach_mm),
-        articular_only(base.contacts == RomContacts::articular),
-        head_centre(base.head_centre) {}
-  bool classed() const { return reach2 >= 0; }
-  // Whether a pelvis vertex at y (femur frame, unposed: relative to the COR) counts; lunate: it is on the
-  // lunate surface.
-  bool counts(const Eigen::Vector3d& y, bool lunate) const {
-    const bool articular = (y - head_centre).squaredNorm() <= reach2 || (articular_only && lunate);
-    return articular == articular_only;
-  }
-  double reach2;        // head_sphere_reach_mm^2 (< 0: pelvis contacts not classed per pose)
-  bool articular_only;  // count the joint surfaces only (RomContacts::articular)
-  Eigen::Vector3d head_centre;  // the femur's head centre, joint frame (unposed)
+      : base_(&base), articular_only(base.contacts == RomContacts::articular) {}
+  bool classed() const { return base_->head_zone.has_value(); }
+  // Whether a pelvis vertex at y (femur frame, unposed: relative to the COR) counts.
+  bool counts(const Eigen::Vector3d& y) const { return base_->meets_head(y) == articular_only; }
+  const RomBaseline* base_;  // its head zone (joint frame; empty: pelvis contacts not classed per pose)
+  bool articular_only;       // count the joint surfaces only (RomContacts::articular)
 };
 
 class CompactScanner {
@@ -59,11 +52,6 @@ class CompactScanner {
     skip_ball_hidden_ = skips(*ball_hidden_set_, base.skip_ball);
     skip_socket_hidden_ = skips(*socket_hidden_set_, base.skip_socket);
     if (bounds_ != nullptr) skip_ball_reachable_ = skips(bounds_->ball_reachable, base.skip_ball);
-    // The pelvis' contacts with the head's joint surface, classed at each pose (take()).
-    if (pelvis_.articular_only) {
-      lunate_socket_ = skips(*socket_set_, base.lunate);
-      lunate_socket_hidden_ = skips(*socket_hidden_set_, base.lunate);
-    }
     buf_.resize(static_cast<std::size_t>(std::max({joint.ball().scan_set.size(), joint.socket().scan_set.size(),
                                                    joint.ball().hidden_set.size(), joint.socket().hidden_set.size()})));
   }
@@ -391,10 +379,9 @@ class CompactScanner {
       const bool listed = collect_ != nullptr && buf_[k] <= threshold_;
       if (skip[k] || !(buf_[k] < l.gap || listed)) continue;
       if (classed) {
-        // A pelvis vertex meeting the femur within the head sphere's reach meets its joint surface.
+        // A pelvis vertex meeting the femur's head up to its junction meets its joint surface.
         const Eigen::Vector3d y = socket_pose_.M * Eigen::Vector3d(set.x[k], set.y[k], set.z[k]) + socket_pose_.s;
-        const bool lunate = pelvis_.articular_only && (hidden ? lunate_socket_hidden_ : lunate_socket_)[k];
-        if (!pelvis_.counts(y, lunate)) continue;
+        if (!pelvis_.counts(y)) continue;
       }
       if (listed) collect_->push_back({buf_[k], ball, hidden, static_cast<std::size_t>(set.index[j])});
       if (buf_[k] < l.gap) l.gap = buf_[k], l.ball = ball, l.hidden = hidden, l.vertex = static_cast<std::size_t>(set.index[j]);
@@ -409,7 +396,6 @@ class CompactScanner {
   bool exact_ = true;
   std::vector<Candidate>* collect_ = nullptr;  // the listed gaps of the current scan (null: none)
   Rigid ball_pose_, socket_pose_;
-  std::vector<std::uint8_t> lunate_socket_, lunate_socket_hidden_;  // scan-set order
   double shift_mm_ = 0;  // |t|
   // A group's bound at an earlier pose (M, s) over the cap of the poses near it (valid: it was above
   // the cut), or that its bound failed at the last pose (failed: try the plain cap first next time).

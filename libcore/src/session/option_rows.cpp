@@ -324,6 +324,24 @@ void add_frame_rows(Rows& t) {
          [](auto& o) -> auto& { return o.session.hip.frames.femur; });
 }
 
+// The labrum's rows (labrum.hpp): on or off, its base width and height (defaults from cadaveric measurements).
+void add_labrum_rows(Rows& t) {
+  const unsigned uses = use_rom | use_rom_limits;
+  t.flag("labrum", "labrum", OptionType::flag, uses,
+         "Also the acetabular labrum, a soft-tissue ring of triangular cross-section on the rim continuing the "
+         "socket's sphere, with its own map: each limit's labral limit beside the bony one (rom_limits.csv's labral_* "
+         "columns, labrum.ply); the ROM map stays bony",
+         [](auto& o) -> auto& { return o.rom.labrum.enabled; });
+  t.number("labrum-width", "labrum_width_mm", "mm", uses, LabrumOptions::kWidthRange,
+           "The labrum's base width on the rim (default: the mean width of 55 cadaveric labra, Tan et al. 2001, "
+           "Am J Orthop 30:809)",
+           [](auto& o) -> auto& { return o.rom.labrum.width_mm; });
+  t.number("labrum-height", "labrum_height_mm", "mm", uses, LabrumOptions::kHeightRange,
+           "The labrum's height from its base to its free margin (default: the anterior labrum's mean height in 54 "
+           "cadaveric labra, Won et al. 2003, Yonsei Med J 44:855; 4.0-6.8 mm elsewhere on the rim)",
+           [](auto& o) -> auto& { return o.rom.labrum.height_mm; });
+}
+
 void add_rom_rows(Rows& t) {
   const unsigned both = use_rom | use_rom_limits | use_rom_map | use_plan | use_joint_plan;
   t.number("threshold", "threshold_mm", "mm", both, RomOptions::kThresholdRange,
@@ -368,6 +386,7 @@ void add_rom_rows(Rows& t) {
             "Steps between the envelope's first poses (1: scan every pose; larger is faster and can miss a region of "
             "contact smaller than a cell)",
             [](auto& o) -> auto& { return o.rom.envelope_options.coarse_steps; });
+  add_labrum_rows(t);
 }
 
 void add_command_rows(Rows& t) {

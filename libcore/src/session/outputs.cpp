@@ -170,7 +170,7 @@ std::vector<std::string> command_outputs(const std::string& command) {
   else if (command == "motion")
     out = {"frames.csv", "gaps.pvd", "gaps/frame_*.vtp"};
   else if (command == "rom")
-    out = {"rom_limits.csv", "rom_map.csv", "rom_envelope.csv"};
+    out = {"rom_limits.csv", "rom_map.csv", "rom_envelope.csv", "labrum.ply"};
   else if (command == "morphology")
     out = {"morphology.json", "femur_sphericity.ply"};
   else if (command == "plan")

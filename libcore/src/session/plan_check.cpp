@@ -34,10 +34,8 @@ double counted_min_gap(const Session& s, const RomBaseline& base, const RomOptio
       double v = search.metric == RomMetric::distance && !g.distance_mm.empty() ? g.distance_mm[i] : g.gap_mm[i];
       if (std::isnan(v) && search.metric == RomMetric::distance && g.gap_mm[i] < 0) v = g.gap_mm[i];
       if (!(v < m)) continue;
-      if (b == 1 && std::isfinite(base.head_sphere_reach_mm)) {
-        const Eigen::Vector3d u = socket.row(static_cast<Eigen::Index>(i)).transpose();
-        if ((P.R.transpose() * (u - P.t) - base.head_centre).norm() <= base.head_sphere_reach_mm) continue;
-      }
+      if (b == 1 && base.meets_head(P.R.transpose() * (socket.row(static_cast<Eigen::Index>(i)).transpose() - P.t)))
+        continue;
       m = v;
     }
   }
@@ -147,9 +145,7 @@ PoseClearance pose_clearance(const Session& s, const RomBaseline& base, const Bo
       }
       m.any = std::min(m.any, v);
       if ((!skip.empty() && skip[i]) || !(v < m.counted)) continue;
-      if (b == 1 && std::isfinite(base.head_sphere_reach_mm) &&
-          (P.R.transpose() * (x - P.t) - base.head_centre).norm() <= base.head_sphere_reach_mm)
-        continue;
+      if (b == 1 && base.meets_head(P.R.transpose() * (x - P.t))) continue;
       m.counted = v;
     }
   }

@@ -14,6 +14,7 @@
 #include "impinge/core/interrupt.hpp"
 #include "impinge/core/timing.hpp"
 #include "impinge/session/records.hpp"
+#include "labrum_run.hpp"
 
 namespace impinge {
 
@@ -186,6 +187,17 @@ void other_frame_limits(const Session& s, const RomRequest& q, RomRun& run) {
 }
 }  // namespace
 
+namespace {
+// With impingement contacts and articular zones, the motions again counting every contact: the contact each limit
+// set aside (RomRun::all_contact_limits; issue 81).
+void every_contact_limits(const HipJoint& hip, const RomRequest& q, RomRun& run) {
+  if (q.search.contacts != RomContacts::impingement || !hip.articular()) return;
+  RomOptions every = q.search;
+  every.contacts = RomContacts::all;
+  run.all_contact_limits = find_rom_limits(hip, run.motions, every, rom_baseline(hip, hip.femur_rotation({}), every));
+}
+}  // namespace
+
 RomRun run_rom(const Session& s, const RomRequest& q) {
   // Only the articular zones tell the joint surfaces apart; without them (scan neutral) 'articular' would
   // count every vertex under its name.
@@ -206,6 +218,8 @@ RomRun run_rom(const Session& s, const RomRequest& q) {
   }
   run.limits_ms = ms_since(t0);
   if (q.limits && q.both_frames) other_frame_limits(s, q, run);
+  if (q.limits) every_contact_limits(hip, q, run);
+  if (q.limits && q.labrum.enabled) detail::run_labrum(s, q, run);
   auto count = [&run](const auto& x) {  // a limit's, a cell's or the envelope's look-ups
     run.vertices_looked_up += x.vertices_looked_up;
     run.vertices_skipped += x.vertices_skipped;
@@ -248,6 +262,23 @@ const RomLimit* limit_in_frame(const RomRun& run, std::size_t k, PelvisFrameKind
   if (run.other_frame == frame && k < run.other_limits.size()) return &run.other_limits[k];
   return nullptr;
 }
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The contact the every-contact search (RomRun::all_contact_limits) met before motion k's limit (or where the
+// motion is free), or nullptr: a contact the limit set aside, the joint surfaces meeting (issue 81, item 1).
+const RomLimit* contact_set_aside(const RomRun& run, std::size_t k) {
+  if (k >= run.all_contact_limits.size()) return nullptr;
+  const RomLimit& a = run.all_contact_limits[k];
+  const RomLimit& l = run.limits[k];
+  return std::isfinite(a.limit_deg) && !(l.limit_deg <= a.limit_deg) ? &a : nullptr;
+}
+nlohmann::json set_aside_record(const RomLimit* a) {
+  if (!a) return nullptr;
+  return {{"angle_deg", number_or_null(a->limit_deg)}, {"contact_class", to_string(a->contact_class)},
+          {"femoral_zone", to_string(a->femoral_zone)}, {"pelvic_zone", to_string(a->pelvic_zone)},
+          {"pelvis_clock_h", number_or_null(a->socket_clock_h)}, {"femur_clock_h", number_or_null(a->femur_clock_h)},
+          {"why", "the first contact of every vertex (--contacts all) comes before the limit: the head's joint "
+                  "surface meeting the lunate surface, not counted as impingement"}};
+}
 nlohmann::json limit_of(const RomLimit* x) { return x ? number_or_null(x->limit_deg) : nlohmann::json(); }
 nlohmann::json status_of(const RomLimit* x) { return x ? nlohmann::json(to_string(x->status)) : nlohmann::json(); }
 }  // namespace
@@ -259,7 +290,8 @@ Table rom_limits_table(const Session& s, const RomRun& run) {
                "contact_z_mm", "joint_translation_x_mm", "joint_translation_y_mm", "joint_translation_z_mm",
                "evaluations", "normal_deg", "normal_source", "soft_tissue_first", "pelvic_frame", "limit_isb_deg",
                "status_isb", "limit_app_deg", "status_app", "bony_normal_deg", "bony_normal_frame",
-               "bony_normal_source", "note"};
+               "bony_normal_source", "femoral_zone", "pelvic_zone", "set_aside_contact_deg",
+               "set_aside_contact_class", "set_aside_femoral_zone", "set_aside_pelvic_zone", "note"};
   const std::string frame = pelvic_frame_name(s);
   for (std::size_t k = 0; k < run.motions.size(); ++k) {
     const RomLimit& l = run.limits[k];
@@ -269,14 +301,19 @@ Table rom_limits_table(const Session& s, const RomRun& run) {
     const BonyRange bony = published_bony_range(name);
     const RomLimit* isb = limit_in_frame(run, k, PelvisFrameKind::isb);
     const RomLimit* app = limit_in_frame(run, k, PelvisFrameKind::anterior_pelvic_plane);
+    const RomLimit* set_aside = contact_set_aside(run, k);
     t.add({name, number_or_null(l.limit_deg), number_or_null(l.first_contact_deg), to_string(l.status), to_string(l.limited_by), to_string(l.contact_class),
            number_or_null(l.socket_clock_h),
            number_or_null(l.femur_clock_h), number_or_null(l.min_gap_at_limit_mm), l.monotone, l.contact_at_start,
            number_or_null(c.x()), number_or_null(c.y()), number_or_null(c.z()), number_or_null(tr.x()),
            number_or_null(tr.y()), number_or_null(tr.z()), l.evaluations, number_or_null(normal.normal_deg),
            normal.source, soft_tissue_ends_first(name, l), frame, limit_of(isb), status_of(isb), limit_of(app),
-           status_of(app), number_or_null(bony.bony_deg), bony.frame, bony.source, l.note});
+           status_of(app), number_or_null(bony.bony_deg), bony.frame, bony.source, to_string(l.femoral_zone),
+           to_string(l.pelvic_zone), number_or_null(set_aside ? set_aside->limit_deg : kNaN),
+           set_aside ? to_string(set_aside->contact_class) : "", set_aside ? to_string(set_aside->femoral_zone) : "", set_aside ? to_string(set_aside->pelvic_zone) : "",
+           l.note});
   }
+  if (run.labrum) detail::add_labral_columns(t, run);
   return t;
 }
 
@@ -376,6 +413,9 @@ nlohmann::json rom_record(const RomRun& run) {
                       {"bony_normal_frame", bony.frame},
                       {"bony_normal_source", bony.source},
                       {"soft_tissue_first", soft_tissue_ends_first(name, l)},
+                      {"femoral_zone", to_string(l.femoral_zone)},
+                      {"pelvic_zone", to_string(l.pelvic_zone)},
+                      {"set_aside_contact", set_aside_record(contact_set_aside(run, k))},
                       {"note", l.note}});
   }
   j["limits"] = limits;
@@ -406,6 +446,7 @@ nlohmann::json rom_record(const RomRun& run) {
   j["vertices_skipped_by_bounds"] = run.vertices_skipped;
   const std::int64_t all = run.vertices_looked_up + run.vertices_skipped;
   j["share_skipped"] = all > 0 ? double(run.vertices_skipped) / double(all) : 0.0;
+  if (run.labrum) j["labrum"] = detail::labrum_record(run);
   return j;
 }
 

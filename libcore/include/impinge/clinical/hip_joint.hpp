@@ -6,11 +6,13 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <memory>
 #include <optional>
 
 #include "impinge/anatomy/articular_zones.hpp"
 #include "impinge/anatomy/clock_face.hpp"
 #include "impinge/anatomy/hip_frames.hpp"
+#include "impinge/anatomy/labrum.hpp"
 #include "impinge/anatomy/pose.hpp"
 #include "impinge/clinical/clock_summary.hpp"
 #include "impinge/clinical/joint_centre.hpp"
@@ -105,7 +107,9 @@ class HipJoint {
   /// The femur's translation (mm, joint frame) at rotation R by the joint-centre method: a femur
   /// point p (joint frame, unposed) is posed at R p + t (JointCentre::translation; a function of R
   /// alone). Throws impinge::Error as that does.
-  Eigen::Vector3d joint_translation(const Eigen::Matrix3d& R) const { return centre_.translation(*joint_, R); }
+  Eigen::Vector3d joint_translation(const Eigen::Matrix3d& R) const {
+    return centre_.translation(centre_joint_ ? *centre_joint_ : *joint_, R);
+  }
   /// femur_rotation(angles) with its joint_translation.
   FemurPose femur_pose(const PoseAngles& angles) const {
     const Eigen::Matrix3d R = femur_rotation(angles);
@@ -154,12 +158,35 @@ class HipJoint {
   /// The joint surfaces per vertex (the femoral head's, the lunate's), to tell the joint space
   /// closing from impingement (anatomical neutral only: they need the acetabulum; else empty).
   const std::optional<ArticularZones>& articular() const { return articular_; }
+  /// The femoral head up to its head-neck junction (ArticularZones::head) in the joint frame, unposed femur
+  /// (a femur point x of the posed femur R x + t); empty with scan neutral.
+  const std::optional<FemoralHeadZone>& head_zone_joint() const { return head_zone_joint_; }
+  /// Where on the femur the point p (joint frame, unposed femur: R^T (q - t) for a posed point q) lies
+  /// (femoral_zone; articular_zones.hpp); none with scan neutral.
+  FemoralZone femoral_zone(const Eigen::Vector3d& p) const;
+  /// Where on the pelvis the point p_joint (joint frame) lies (pelvic_zone; articular_zones.hpp); none with scan
+  /// neutral.
+  PelvicZone pelvic_zone(const Eigen::Vector3d& p_joint) const;
   /// The class of a contact at vertex `vertex` of the femur (`ball`) or the pelvis with the femur at
   /// `pose`: articular when the vertex is on its joint surface (articular()), or is a pelvis vertex
-  /// within ArticularZones::head_sphere_reach_mm of the posed head centre (it meets the head's joint
-  /// surface); else intra-articular impingement within the acetabular rim radius (head radius + 5 mm
+  /// within ArticularZones::head_sphere_reach_mm of the posed head centre on the head side of the head-neck
+  /// junction (it meets the head's joint surface: head_zone_joint()->contains); else intra-articular
+  /// impingement within the acetabular rim radius (head radius + 5 mm
   /// without an acetabulum) plus `intra_margin_mm` of the COR, else extra-articular.
   ContactClass contact_class(bool ball, std::int64_t vertex, const FemurPose& pose, double intra_margin_mm) const;
+  /// The same hip with the acetabular labrum (make_labrum, `width_mm` x `height_mm`) as its socket in place of the
+  /// pelvis: a Joint of the femur against the labrum alone, with maps of the same scheme and options, in the same
+  /// joint frame about the same COR; the frames, clocks, articular zones of the femur and the joint-centre method
+  /// are this hip's (its translations come from this hip's Joint, so that the femur moves exactly as here). Its
+  /// searches (find_rom_limit) find the femur's first contact with the labrum; a contact off the head's joint
+  /// surface is ContactClass::labral. The rim: acetabulum(), or with scan neutral find_acetabulum about the head
+  /// sphere with the joint frame's axes (only the clock's orientation, unused here, depends on them). Throws
+  /// impinge::Error as make_labrum, find_acetabulum and Joint do. Source: impinge (issue 81).
+  std::shared_ptr<const HipJoint> with_labrum(double width_mm, double height_mm) const;
+  /// Whether this is a labral hip (with_labrum): its socket is the labrum.
+  bool labral() const { return labral_; }
+  /// The acetabulum the labrum is built on, joint frame (with_labrum's rim). Throws as find_acetabulum.
+  Acetabulum acetabulum_joint() const;
   /// Save both maps (map_io.hpp) with the working-frame COR, for options.ball_map_file and
   /// socket_map_file of a later HipJoint. Throws impinge::Error on I/O errors.
   void save_maps(const std::string& ball_path, const std::string& socket_path) const;
@@ -199,9 +226,12 @@ class HipJoint {
   std::optional<ClockFace> socket_clock_, ball_clock_;
   std::vector<double> socket_hours_, ball_hours_;  ///< every vertex's clock hour (clock_hours), once
   std::optional<ArticularZones> articular_;
+  std::optional<FemoralHeadZone> head_zone_joint_;
   double head_radius_ = 0;
   std::vector<std::string> warnings_;
-  std::optional<Joint> joint_;
+  std::shared_ptr<Joint> joint_;
+  std::shared_ptr<const Joint> centre_joint_;  ///< a labral hip's: the bony hip's Joint, whose translations it takes
+  bool labral_ = false;
   JointCentre centre_;
   Eigen::Vector3d seat_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d head_centre_joint_ = Eigen::Vector3d::Zero();

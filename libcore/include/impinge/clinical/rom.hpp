@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,8 +31,9 @@ enum class RomVertices {
 /// Which contacts end a ROM search (the articular zones of HipJoint::articular(); with scan neutral
 /// there are none and every option counts every vertex).
 enum class RomContacts {
-  impingement,  ///< impingement only: the joint surfaces (head against lunate) are not counted (the limit)
-  articular,    ///< the joint surfaces only: where the joint space closes, reported apart
+  impingement,  ///< impingement only: the femoral head up to its head-neck junction against the acetabulum (the
+                ///< joint space closing) is not counted; the neck or a cam against the lunate surface is (the limit)
+  articular,    ///< the head against the acetabulum only: where the joint space closes, reported apart
   all,          ///< every vertex: where the bones first meet (the thesis' criterion)
 };
 /// The names of RomContacts (the option table's choices of --contacts).
@@ -178,6 +180,11 @@ struct RomLimit {
   /// from its scan position, after its rotation about its head centre), working-frame axes, mm; NaN
   /// without a limit.
   Eigen::Vector3d joint_translation_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  /// Where on each bone the limit's contact lies (HipJoint::femoral_zone of the contact carried onto the
+  /// femur, HipJoint::pelvic_zone of it on the pelvis; articular_zones.hpp); none without a limit or with scan
+  /// neutral (issue 81, item 1).
+  FemoralZone femoral_zone = FemoralZone::none;
+  PelvicZone pelvic_zone = PelvicZone::none;
   double socket_clock_h = std::numeric_limits<double>::quiet_NaN();  ///< contact on the acetabular clock
   double femur_clock_h = std::numeric_limits<double>::quiet_NaN();   ///< contact on the femoral head-neck clock
   std::int64_t excluded_vertices = 0;  ///< vertices within the threshold at the baseline pose (pre-existing
@@ -201,13 +208,14 @@ struct RomBaseline {
   std::vector<std::uint8_t> skip_ball, skip_socket;  ///< 1 = not counted (per vertex of each body)
   std::int64_t excluded_vertices = 0;
   std::int64_t articular_vertices = 0;  ///< not counted for RomOptions::contacts (on, or off, the joint surfaces)
-  /// How the pelvis' contacts are classed at each pose (HipJoint::contact_class): a pelvis vertex
-  /// within this of the posed head centre meets the head's joint surface (ArticularZones::
-  /// head_sphere_reach_mm). NaN: not applied (scan neutral, or RomContacts::all).
-  double head_sphere_reach_mm = std::numeric_limits<double>::quiet_NaN();
-  RomContacts contacts = RomContacts::all;  ///< the options' (with head_sphere_reach_mm)
-  Eigen::Vector3d head_centre = Eigen::Vector3d::Zero();  ///< HipJoint::head_centre_joint()
-  std::vector<std::uint8_t> lunate;         ///< per pelvis vertex, 1 on the lunate surface (RomContacts::articular)
+  RomContacts contacts = RomContacts::all;  ///< the options' (with head_zone)
+  /// How the pelvis' contacts are classed at each pose (HipJoint::contact_class): the head up to its head-neck
+  /// junction, joint frame (HipJoint::head_zone_joint()); empty: not applied (scan neutral, or RomContacts::all).
+  std::optional<FemoralHeadZone> head_zone;
+  /// Whether a pelvis point at y (joint frame, carried onto the unposed femur: R^T (p - t)) meets the head's
+  /// joint surface: within head_zone->reach_mm of the head centre and on the head side of the head-neck
+  /// junction (issue 81: the neck below the junction is never the joint). False when not classed.
+  bool meets_head(const Eigen::Vector3d& y) const { return head_zone && head_zone->contains(y); }
   double min_gap_mm = std::numeric_limits<double>::quiet_NaN();  ///< least gap of all vertices at the baseline
   /// The joint space at the baseline: the least gap (the metric's) of the lunate surface's vertices to the femur,
   /// mm; NaN without articular zones (scan neutral) or when every lunate vertex is beyond the distance's reach.

@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,6 +79,30 @@ struct RomRequest {
   /// With the limits and anatomical neutral, the limits of the same motions in the other pelvic frame too
   /// (RomRun::other_limits: the ISB and the anterior pelvic plane frames side by side in rom_limits.csv).
   bool both_frames = true;
+  /// With the limits and `labrum.enabled`: the acetabular labrum (HipJoint::with_labrum) and each motion's labral
+  /// limit beside its bony one (RomRun::labrum; rom_limits.csv's labral columns). The ROM map and envelope stay bony.
+  LabrumOptions labrum;
+};
+
+/// A ROM run's labrum (RomRequest::labrum): the labral hip and each standard motion's first contact of the femur
+/// with the labrum alone (searched as the bony limits, with its own baseline at neutral).
+struct LabrumRun {
+  LabrumOptions options;                 ///< width and height asked for, mm
+  std::shared_ptr<const HipJoint> hip;   ///< HipJoint::with_labrum of the session's hip
+  RomBaseline baseline;                  ///< the labrum at neutral (labrum vertices in contact there are excluded)
+  std::vector<RomLimit> contacts;        ///< one per motion: the femur's first contact with the labrum
+  double ms = 0;                         ///< building the labral hip and its searches, ms
+};
+
+/// A motion's limit with the labrum: the first of its bony limit and its first labral contact (labral_limit).
+struct LabralLimit {
+  double limit_deg = std::numeric_limits<double>::quiet_NaN();  ///< NaN when free or not reachable
+  RomLimitStatus status = RomLimitStatus::free;
+  ContactClass contact_class = ContactClass::none;  ///< labral when the labrum is met first, else the bony limit's
+  double labrum_contact_deg = std::numeric_limits<double>::quiet_NaN();  ///< first contact with the labrum alone
+  /// How much the labrum lowers the limit: bony limit less labral limit, deg (0 when the bone is met first); NaN
+  /// unless both are numbers (a motion free of bone but stopped by the labrum reads NaN: see the statuses).
+  double lowering_deg = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The results of a ROM run and their cost.
@@ -89,6 +115,10 @@ struct RomRun {
   /// about that frame's axes, from its neutral, with its own baseline there), one per motion; empty with scan
   /// neutral, without RomRequest::both_frames, or when that frame cannot be built (other_frame_note).
   std::vector<RomLimit> other_limits;
+  /// With RomContacts::impingement and articular zones: the same motions searched with RomContacts::all (every
+  /// contact counts), so that a contact the limit set aside as the joint surfaces meeting is said, with where
+  /// (rom_limits_table's set_aside_* columns; issue 81); else empty.
+  std::vector<RomLimit> all_contact_limits;
   std::optional<PelvisFrameKind> frame;        ///< the pelvic frame of limits' angles (empty: scan neutral)
   std::optional<PelvisFrameKind> other_frame;  ///< the frame of other_limits
   std::string other_frame_note;                ///< why other_limits is empty, else empty
@@ -97,6 +127,7 @@ struct RomRun {
   std::vector<RomMapCell> map;           ///< flexion-major; empty without a map
   std::optional<RomEnvelope> envelope;
   RomEnvelopeOptions envelope_options;
+  std::optional<LabrumRun> labrum;       ///< with RomRequest::labrum (and the limits)
   double limits_ms = 0, map_ms = 0, envelope_ms = 0;  ///< wall time, ms (the baseline counts with the limits)
   std::int64_t limit_evaluations = 0, map_evaluations = 0;
   std::int64_t vertices_looked_up = 0, vertices_skipped = 0;  ///< over limits, map and envelope
@@ -120,13 +151,29 @@ RomRun run_rom(const Session& session, const RomRequest& request);
 /// soft_tissue_first, pelvic_frame (the frame of limit_deg), limit_isb_deg, status_isb, limit_app_deg and
 /// status_app (the motion's limit with its angles in each pelvic frame: one is limit_deg, the other
 /// RomRun::other_limits; null with scan neutral), bony_normal_deg, bony_normal_frame and bony_normal_source
-/// (published simulated bony ROM of normal hips, published_bony_range), note.
+/// (published simulated bony ROM of normal hips, published_bony_range), femoral_zone and pelvic_zone (where the
+/// limit's contact lies on each bone: RomLimit), set_aside_contact_deg, set_aside_contact_class,
+/// set_aside_femoral_zone, set_aside_pelvic_zone (the first contact of every vertex, RomRun::all_contact_limits,
+/// when it comes before the limit: the joint surfaces meeting, which the limit does not count; null/empty
+/// otherwise), note; with RomRun::labrum also labral_limit_deg, labral_status, labral_contact_class,
+/// labrum_contact_deg and labral_lowering_deg (labral_limit), last.
 Table rom_limits_table(const Session& session, const RomRun& run);
+/// The limit of motion `k` of `run` with its labrum (run.labrum set, k < run.motions.size()): not reachable when
+/// either the bony search or the labral one cannot reach the motion's start; else the lesser of the bony limit
+/// and the first labral contact (a contact at the start counting as 0 deg, a free motion as none), its status and
+/// class with it (the bone's on a tie); free when neither is met. Throws impinge::Error without a labrum or with
+/// k out of range. Source: impinge (issue 81).
+LabralLimit labral_limit(const RomRun& run, std::size_t k);
+/// The labrum of `run` (run.labrum) in the input frame of `session`, mm: the mesh `impinge rom --labrum` writes
+/// (labrum.ply). Throws impinge::Error without a labrum.
+TriangleMesh labrum_input(const Session& session, const RomRun& run);
+
 /// rom_map.csv: flexion_deg, adduction_deg, max_internal_rotation_deg, status.
 Table rom_map_table(const RomRun& run);
 /// rom_envelope.csv: the valid runs of internal rotation per flexion and adduction (from, to).
 Table rom_envelope_table(const RomRun& run);
-/// The ROM part of summary.json: threshold, search, limits, envelope figures, counts, timings.
+/// The ROM part of summary.json: threshold, search, limits, envelope figures, counts, timings; with RomRun::labrum
+/// a "labrum" object (its dimensions and their sources, mesh size, neutral clearance, each motion's labral limit).
 nlohmann::json rom_record(const RomRun& run);
 
 }  // namespace impinge
