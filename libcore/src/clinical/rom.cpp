@@ -93,6 +93,7 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
   // space closes. The pelvis' contacts are classed at each pose by the scanner: those that meet the head up to
   // its head-neck junction are articular (RomBaseline::meets_head), wherever on the acetabulum they lie; the
   // lunate surface meeting the neck or a cam is not (issue 81), so it is not left out as a whole.
+  const std::vector<std::uint8_t> skip_ball_pre = b.skip_ball;  // the exact test's: before any articular class
   if (const auto& z = hip.articular(); z && o.contacts != RomContacts::all) {
     const bool keep_articular = o.contacts == RomContacts::articular;
     for (std::size_t i = 0; i < b.skip_ball.size(); ++i)
@@ -108,7 +109,7 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
   if (o.use_bounds && screened_or_radial(o))
     b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), scan_cut_of(o), &b.skip_ball, &b.skip_socket);
   // The exact test's meshes, whenever it applies at depth 0 (the first contact is always searched).
-  if (exact_at(o, o.threshold_mm)) b.contact = baseline_contact(hip.joint(), b, R, hip.joint_translation(R), o.threshold_mm);
+  if (exact_at(o, o.threshold_mm)) b.contact = baseline_contact(hip.joint(), b, skip_ball_pre, R, hip.joint_translation(R), o.threshold_mm);
   return b;
 }
 
@@ -136,7 +137,10 @@ void describe_contact(RomLimit& out, const HipJoint& hip, const Least& l, const 
   out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? ImpingementSite::intra_articular
                                                                       : ImpingementSite::extra_articular;
   out.limited_by_hidden_vertex = l.hidden;
-  out.contact_class = hip.contact_class(l.ball, static_cast<std::int64_t>(l.vertex), {R, t}, o.intra_articular_margin_mm);
+  // An exact contact is classed by its point (as the exact search classed it), a vertex by the vertex.
+  out.contact_class = std::isfinite(l.point.x())
+                          ? hip.contact_class_at(p_joint, {R, t}, o.intra_articular_margin_mm)
+                          : hip.contact_class(l.ball, static_cast<std::int64_t>(l.vertex), {R, t}, o.intra_articular_margin_mm);
   out.femoral_zone = hip.femoral_zone(R.transpose() * (p_joint - t)), out.pelvic_zone = hip.pelvic_zone(p_joint);
   if (hip.socket_clock()) {
     // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.

@@ -4,7 +4,9 @@
 // triangles (MeshContact: vertex against face and edge against edge), not a vertex's gap, so that a limit
 // does not depend on where the vertices lie. Included by rom.cpp and rom_exact.cpp only.
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "clinical/rom_scanner.hpp"
 #include "impinge/detection/mesh_contact.hpp"
@@ -26,21 +28,34 @@ inline bool exact_search(const RomOptions& o, const RomBaseline& base) {
 }
 
 // The baseline's contact meshes (RomBaseline::contact): the femur's and the pelvis' triangles about the
-// COR (the femur moves), a triangle counted when any of its corners is (not in base's skip lists), less
-// both triangles of every pair (counted or not) within `threshold` (mm) at the baseline pose (R, t): a
+// COR (the femur moves). A pair of triangles is classed by where it comes nearest: by the femur's closest
+// point, unposed, against the head up to its head-neck junction (base.meets_head; at a touch the pelvis'
+// point carried onto the femur is the same point), so that a triangle across the junction counts on its
+// neck side only and the class does not depend on where the vertices lie (issue 81). A femur triangle wholly
+// on one side (head_side_of_face) is decided once; one the junction or the head's reach may cross is classed
+// pair by pair (MeshContact's 2). With RomContacts::all or no head zone (scan neutral) every pair counts.
+// Left out: every femur triangle with a corner in `skip_ball_pre` (the vertices within the threshold at the
+// baseline, before any articular class) or in a pair within `threshold` (mm) at the baseline pose (R, t): a
 // pre-existing overlap, as the skip lists leave out its vertices.
 std::shared_ptr<const MeshContact> baseline_contact(const Joint& joint, const RomBaseline& base,
+                                                    const std::vector<std::uint8_t>& skip_ball_pre,
                                                     const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                                     double threshold);
 
-// The exact test at a pose, with the pelvis' contacts classed at the pose as CompactScanner::take does
-// (a pelvis triangle counts at a pose when one of its corners counts there).
+// Where the triangle (a, b, c) (mm, the zone's frame) lies against `zone`: 1 wholly inside it (FemoralHeadZone::
+// contains at every point), 0 wholly outside, -1 either (the junction or the reach may cross it). Conservative:
+// the triangle's angular extent seen from the head centre widens its range of angles from the neck and of
+// azimuths, and the junction's least and largest angle over those azimuths decide.
+int head_side_of_face(const FemoralHeadZone& zone, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                      const Eigen::Vector3d& c);
+
+// The exact test at a pose, each pair classed at the pose by where it comes nearest (baseline_contact).
 class ExactScanner {
  public:
   ExactScanner(const Joint& joint, const RomBaseline& base, double cut);
   // full = false: a Least with gap <= the cut when a counted pair lies within it (the first found), else
   // gap = +inf. full: the least distance over every counted pair and where (Least::point), with the
-  // counted corner nearest it as the vertex (the femur's when the femur's triangle counts).
+  // femur's corner nearest it as the vertex.
   Least operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, bool full) const;
 
  private:

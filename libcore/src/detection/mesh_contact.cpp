@@ -259,6 +259,7 @@ MeshContact::Closest MeshContact::least(const Eigen::Matrix3d& R, const Eigen::V
   walk(R, t, q, bound, [&](std::int32_t fa, std::int32_t fb, const Vector3d* pa, const Vector3d* pb) {
     const double d = triangle_distance(pa, pb, on_a, on_b);
     if (d > bound || !before(d)) return false;
+    if (a_counted_[static_cast<std::size_t>(fa)] == 2 && q.pair_counts && !q.pair_counts(fa, on_a, on_b)) return false;
     out = {d, fa, fb, on_a, on_b};
     bound = d;
     return q.first;
@@ -273,7 +274,9 @@ std::vector<std::pair<std::int64_t, std::int64_t>> MeshContact::pairs_within(con
   double bound = reach;
   Vector3d on_a, on_b;
   walk(R, t, q, bound, [&](std::int32_t fa, std::int32_t fb, const Vector3d* pa, const Vector3d* pb) {
-    if (triangle_distance(pa, pb, on_a, on_b) <= reach) out.emplace_back(fa, fb);
+    if (triangle_distance(pa, pb, on_a, on_b) <= reach &&
+        !(a_counted_[static_cast<std::size_t>(fa)] == 2 && q.pair_counts && !q.pair_counts(fa, on_a, on_b)))
+      out.emplace_back(fa, fb);
     return false;
   });
   return out;

@@ -106,11 +106,12 @@ struct RomOptions {
   /// is counted (RomVertices::all), whether the bones meet at a pose is the exact least distance between
   /// the meshes (MeshContact: vertex against face and edge against edge, every triangle of either bone)
   /// at or below the cut, not a vertex's gap; so a limit does not depend on where the vertices lie. A
-  /// triangle counts when any of its corners is counted (at the border of an articular zone or of a
-  /// pre-existing overlap), a pair of triangles when either counts (as a vertex counts whatever it meets),
-  /// and the triangles within the threshold at the baseline are left out (RomBaseline::contact). false:
-  /// the per-vertex test throughout (the thesis' Algorithm 2; for comparisons). Not an option of the
-  /// CLI or Python: they always find contacts exactly.
+  /// pair of triangles is classed by where it comes nearest, not by its corners: it is articular when the
+  /// femur's closest point lies on the head up to its head-neck junction (RomBaseline::meets_head), so that
+  /// a triangle across the junction counts on its neck side (RomContacts), and the femur's triangles within
+  /// the threshold at the baseline are left out (RomBaseline::contact). false: the per-vertex test
+  /// throughout (the thesis' Algorithm 2; for comparisons). Not an option of the CLI or Python: their ROM
+  /// limits are always exact (the envelope is not: rom_envelope).
   bool exact_contact = true;
 };
 
@@ -226,8 +227,9 @@ struct RomBaseline {
   /// threshold; a search with another threshold builds its own.
   std::shared_ptr<const RomSearchBounds> bounds;
   /// The meshes of the exact contact test (RomOptions::exact_contact; null when it cannot apply at depth 0:
-  /// a negative threshold, the radial metric above 0, or not every vertex counted): which triangles count,
-  /// by the skip lists above, less the triangles within the threshold at the baseline pose.
+  /// a negative threshold, the radial metric above 0, or not every vertex counted): which femur triangles
+  /// count, wholly or pair by pair at their closest points (by head_zone and contacts, not by the per-vertex
+  /// articular flags), less those within the threshold at the baseline pose.
   std::shared_ptr<const MeshContact> contact;
 };
 
@@ -334,7 +336,11 @@ struct RomEnvelope {
 /// the envelope's boundary are scanned. Assumption (the price of the refinement): a region of contact
 /// (or of freedom) smaller than a cell and touching none of its corners is missed; coarse_steps = 1
 /// scans every pose. Each scan stops at the first contact (RomOptions, `baseline` as for
-/// find_rom_limit). All cores (OpenMP). Throws impinge::Error on an empty or uneven grid. Source:
+/// find_rom_limit), by the per-vertex test: RomOptions::exact_contact does not apply here. A grid pose is
+/// valid or not; the exact test (vertex-face and edge-edge, issue 81) moves where the bones meet by a
+/// fraction of a degree, well within the grid's step, and cost some 350 times as much per envelope (the
+/// tests' generated cam hip: 156 s against 0.44 s), so the envelope's boundary is the per-vertex one while
+/// the ROM limits are exact. All cores (OpenMP). Throws impinge::Error on an empty or uneven grid. Source:
 /// impinge (not in the thesis); the refinement of Kawasaki et al. 2007 in spirit.
 RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& envelope, const RomOptions& options,
                          const RomBaseline& baseline);

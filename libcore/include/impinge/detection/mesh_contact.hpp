@@ -30,7 +30,9 @@ double triangle_distance(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3],
 
 /// Two meshes for exact contact queries: A moves (a point p of A goes to R p + t), B stays. Which
 /// triangles count is given per face (1 = counted); a pair of triangles counts when either of its two
-/// triangles counts (as a per-vertex test counts a vertex, whatever it meets).
+/// triangles counts (as a per-vertex test counts a vertex, whatever it meets). A face of A may instead be
+/// counted pair by pair (2): such a pair counts when Query::pair_counts says so at its closest points (a
+/// class that depends on where on the face the pair comes nearest, e.g. a boundary crossing the face).
 class MeshContact {
  public:
   /// Build both trees. a, b: n x 3 vertices (mm); fa, fb: m x 3 faces (0-based). a_counted, b_counted:
@@ -56,8 +58,12 @@ class MeshContact {
     /// A further test of B's faces at this pose (e.g. a classification that moves with A): a B face
     /// counts only when it is counted and this returns true for it. Null: none.
     std::function<bool(std::int64_t face_b)> b_counts_now;
+    /// For a pair whose A face is counted pair by pair (2): whether it counts, from its closest points (on_a:
+    /// posed, B's frame; on_b), mm. Null: such a pair counts.
+    std::function<bool(std::int64_t face_a, const Eigen::Vector3d& on_a, const Eigen::Vector3d& on_b)> pair_counts;
   };
-  /// The least distance over the counted pairs with A posed by (R, t), or +inf beyond the reach. Ties
+  /// The least distance over the counted pairs with A posed by (R, t), or +inf beyond the reach (a pair
+  /// counted pair by pair is tested at its closest points: Query::pair_counts). Ties
   /// (several pairs crossing, distance 0) are broken by the closest points' coordinates, so that the
   /// answer does not depend on the order of faces or vertices.
   Closest least(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Query& query) const;
@@ -66,7 +72,7 @@ class MeshContact {
   std::vector<std::pair<std::int64_t, std::int64_t>> pairs_within(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                                                   double reach, const Query& query) const;
 
-  /// Whether face f of A (of B) is counted (set_counted).
+  /// Whether face f of A (of B) is counted (set_counted; for A also pair by pair).
   bool counted_a(std::int64_t f) const { return a_counted_[static_cast<std::size_t>(f)] != 0; }
   bool counted_b(std::int64_t f) const { return b_counted_[static_cast<std::size_t>(f)] != 0; }
   std::int64_t faces_a() const { return static_cast<std::int64_t>(fa_.rows()); }
