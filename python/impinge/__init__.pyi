@@ -147,15 +147,17 @@ class Joint:
     def motion(self, angles: npt.ArrayLike) -> Dict[str, npt.NDArray[np.float64]]:
         """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each. Frames
         are scanned in blocks on impinge.get_threads() threads; rows come back in order."""
-    def rom_limits(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
+    def rom_limits(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.0, metric: str = 'distance',
                    contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0, labrum: bool = False,
                    labrum_width_mm: float = 5.3, labrum_height_mm: float = 7.0) -> Dict[str, Any]:
         """ROM limits from neutral for the standard motions -> dict motion -> the CLI's rom_limits.csv row
-        (limit_deg, limited_by, contact_class, ...). The keywords and defaults are `impinge rom`'s (the option
-        table). contacts: 'impingement' (the joint surfaces meeting is left out), 'articular' (only that: the
-        joint space closing) or 'all'. contact_depth_mm: how far past the threshold a contact must reach to end a
-        search (0: the first touch). metric: 'distance' (needs the Joint's distances) or 'radial'."""
-    def plan(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
+        (limit_deg, first_contact_deg, limited_by, contact_class, ...). The keywords and defaults are `impinge
+        rom`'s (the option table). contacts: 'impingement' (the joint surfaces meeting is left out), 'articular'
+        (only that: the joint space closing) or 'all'. contact_depth_mm: how far past the threshold a contact must
+        reach to end a search (default 0: the first touch, exact between vertices; > 0 for noisy meshes, when
+        first_contact_deg still gives the first touch). metric: 'distance' (needs the Joint's distances) or
+        'radial'."""
+    def plan(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.0, metric: str = 'distance',
              contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0,
              target: Optional[str] = None, target_motion: Optional[Union[str, os.PathLike]] = None,
              resect: str = 'femur', clearance_mm: float = 0.3, max_depth_fraction: float = 0.3,
@@ -169,7 +171,7 @@ class Joint:
         (V, F: input frame, mm) and femur_resection_mm (per vertex, mm), and the pelvis' with resect 'pelvis' or
         'both'. Raises impinge.Error when a target is missed unless
         allow_partial."""
-    def rom_map(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.25, metric: str = 'distance',
+    def rom_map(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.0, metric: str = 'distance',
                 flexion: Sequence[float] = [0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0,
                                             60.0, 65.0, 70.0, 75.0, 80.0, 85.0, 90.0, 95.0, 100.0, 105.0, 110.0,
                                             115.0, 120.0],

@@ -265,6 +265,7 @@ TEST(Rom, ClusterBoundsGiveTheFullScansResults) {
       SCOPED_TRACE(threshold);
       RomOptions with, without;
       with.threshold_mm = without.threshold_mm = threshold;
+      with.exact_contact = without.exact_contact = false;  // the per-vertex scans' bounds
       without.use_bounds = false;
       const RomBaseline base = rom_baseline(*hip, hip->femur_rotation({}), with);
       const auto a = find_rom_limits(*hip, standard_motions(), with, base);
@@ -325,6 +326,7 @@ TEST(Rom, TrochanterMeetsTheIliacPlateWhereTheClosedFormSays) {
   RomOptions ro;
   ro.step_deg = 1;
   ro.contact_depth_mm = 0;  // the first touch: the closed form's
+  ro.exact_contact = false;  // the per-vertex scans (the exact test sees the block with any maps: below)
   for (const int layers : {0, 4}) {
     SCOPED_TRACE(layers);
     HipJointOptions o = scan_options(0.25);
@@ -362,6 +364,7 @@ TEST(Rom, LayeredClusterBoundsGiveTheFullScansResults) {
   o.joint.layers = 4;
   const HipJoint hip(j->femur, j->pelvis, Side::right, locate_femoral_head(j->femur), {}, o);
   RomOptions with, without;
+  with.exact_contact = without.exact_contact = false;  // the per-vertex scans' bounds
   without.use_bounds = false;
   const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), with);
   const auto a = find_rom_limits(hip, standard_motions(), with, base);
@@ -467,7 +470,10 @@ TEST(Rom, TheDistanceMetricMeetsAClearanceWhereTheClosedFormSays) {
   // At the limit the least distance has just reached the clearance, from above.
   EXPECT_LE(distance.min_gap_at_limit_mm, clearance);
   EXPECT_GT(distance.min_gap_at_limit_mm, clearance - 0.05);
-  EXPECT_NEAR((distance.contact_mm - h.cor).norm(), inner, 0.3);
+  // The contact: on the rim's inner edge, or (exact contacts: the femur's closest point) on the neck within
+  // the clearance of it.
+  EXPECT_GT((distance.contact_mm - h.cor).norm(), inner - clearance - 0.3);
+  EXPECT_LT((distance.contact_mm - h.cor).norm(), inner + 0.3);
   // The joint must be able to give the metric its distances.
   EXPECT_THROW(rom_baseline(*joint_of(h, mo, scan_options(0.5)), Eigen::Matrix3d::Identity(), ro), Error);
   ro.threshold_mm = 2;  // beyond the reach of 1.5 mm
@@ -490,7 +496,8 @@ TEST(Rom, TheScreenedDistanceSearchEndsWhereWholeScansFirstMeet) {
   const std::unique_ptr<HipJoint> cam = cam_hip(0.25, &jo);
   const HipJoint& hip = *cam;
   RomOptions ro;
-  ro.metric = RomMetric::distance;  // contact depth 0.25 mm: the cut is -0.25 mm
+  ro.metric = RomMetric::distance;
+  ro.contact_depth_mm = 0.25;  // the cut is -0.25 mm: the per-vertex screened search
   const RomBaseline base = rom_baseline(hip, hip.femur_rotation({}), ro);
   const double cut = ro.threshold_mm - ro.contact_depth_mm;
   auto least = [&](double theta, const StandardMotion& m) {

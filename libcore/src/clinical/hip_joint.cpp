@@ -217,6 +217,15 @@ ContactClass HipJoint::contact_class(bool ball, std::int64_t vertex, const Femur
                                                  : ContactClass::extra_articular_impingement;
 }
 
+ContactClass HipJoint::contact_class_at(const Eigen::Vector3d& p_joint, const FemurPose& pose,
+                                        double intra_margin_mm) const {
+  if (articular_ && head_zone_joint_->contains(pose.R.transpose() * (p_joint - pose.t))) return ContactClass::articular;
+  if (labral_) return ContactClass::labral;
+  const double rim = acetabulum_ ? acetabulum_->rim_radius_mm : head_radius_ + 5;
+  return p_joint.norm() <= rim + intra_margin_mm ? ContactClass::intra_articular_impingement
+                                                 : ContactClass::extra_articular_impingement;
+}
+
 FemoralZone HipJoint::femoral_zone(const Eigen::Vector3d& p) const {
   return head_zone_joint_ ? impinge::femoral_zone(*head_zone_joint_, p) : FemoralZone::none;
 }

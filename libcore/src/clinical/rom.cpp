@@ -93,6 +93,7 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
   // space closes. The pelvis' contacts are classed at each pose by the scanner: those that meet the head up to
   // its head-neck junction are articular (RomBaseline::meets_head), wherever on the acetabulum they lie; the
   // lunate surface meeting the neck or a cam is not (issue 81), so it is not left out as a whole.
+  const std::vector<std::uint8_t> skip_ball_pre = b.skip_ball;  // the exact test's: before any articular class
   if (const auto& z = hip.articular(); z && o.contacts != RomContacts::all) {
     const bool keep_articular = o.contacts == RomContacts::articular;
     for (std::size_t i = 0; i < b.skip_ball.size(); ++i)
@@ -107,10 +108,47 @@ RomBaseline rom_baseline(const HipJoint& hip, const Eigen::Matrix3d& R, const Ro
                              : std::fmin(r.ball.min_gap_mm, r.socket.min_gap_mm);
   if (o.use_bounds && screened_or_radial(o))
     b.bounds = std::make_shared<const RomSearchBounds>(hip.joint(), scan_cut_of(o), &b.skip_ball, &b.skip_socket);
+  // The exact test's meshes, whenever it applies at depth 0 (the first contact is always searched).
+  if (exact_at(o, o.threshold_mm)) b.contact = baseline_contact(hip.joint(), b, skip_ball_pre, R, hip.joint_translation(R), o.threshold_mm);
   return b;
 }
 
 namespace {
+// The first touch of a search at depth 0 (RomLimit::first_contact_deg): its limit, 0 with contact at the
+// start, NaN when free; NaN at a depth > 0 (a search of its own gives it: with_first_contact).
+double first_contact_of(const RomLimit& l, const RomOptions& o) {
+  if (o.contact_depth_mm > 0 || l.status == RomLimitStatus::free) return std::numeric_limits<double>::quiet_NaN();
+  return l.contact_at_start ? 0.0 : l.limit_deg;
+}
+
+// Where the limit's contact lies and what it is, from the least `l` at the pose (R, t): the exact contact
+// point (Least::point) or the vertex, in the working frame, its site, class and clock hours.
+void describe_contact(RomLimit& out, const HipJoint& hip, const Least& l, const Eigen::Matrix3d& R,
+                      const Eigen::Vector3d& t, const RomOptions& o) {
+  const Joint& joint = hip.joint();
+  out.limited_by_ball = l.ball;
+  // The contact point in the joint frame (the pelvis does not move): the exact one, or the vertex, posed.
+  const Eigen::Vector3d p_joint =
+      std::isfinite(l.point.x()) ? l.point
+      : l.ball ? Eigen::Vector3d(R * joint.ball().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose() + t)
+               : Eigen::Vector3d(joint.socket().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose());
+  out.contact_mm = hip.to_working(p_joint);
+  const double rim = hip.acetabulum() ? hip.acetabulum()->rim_radius_mm : hip.head_radius_mm() + 5;
+  out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? ImpingementSite::intra_articular
+                                                                      : ImpingementSite::extra_articular;
+  out.limited_by_hidden_vertex = l.hidden;
+  // An exact contact is classed by its point (as the exact search classed it), a vertex by the vertex.
+  out.contact_class = std::isfinite(l.point.x())
+                          ? hip.contact_class_at(p_joint, {R, t}, o.intra_articular_margin_mm)
+                          : hip.contact_class(l.ball, static_cast<std::int64_t>(l.vertex), {R, t}, o.intra_articular_margin_mm);
+  out.femoral_zone = hip.femoral_zone(R.transpose() * (p_joint - t)), out.pelvic_zone = hip.pelvic_zone(p_joint);
+  if (hip.socket_clock()) {
+    // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.
+    out.socket_clock_h = hip.socket_clock()->hour(p_joint);
+    out.femur_clock_h = hip.ball_clock()->hour(R.transpose() * (p_joint - t));
+  }
+}
+
 // limit_only: only limit_deg, contact_at_start and the counts are wanted (a ROM map's cell), so
 // neither end is scanned for the exact least gap and the monotony is not checked.
 RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation, const RomOptions& o,
@@ -162,6 +200,7 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
     out.vertices_looked_up = scan.vertices_looked_up();
     out.vertices_skipped = scan.vertices_skipped();
     out.limit_deg = hi;
+    out.first_contact_deg = first_contact_of(out, o);
     return out;
   }
   const auto [R, t] = pose_at(hi);
@@ -169,38 +208,51 @@ RomLimit search(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)
   const Least l = scan(R, t, true);  // the least gap and where, not only whether they meet
   // A transient touch: the bones part again one step farther.
   if (hi + o.step_deg <= o.max_deg) out.monotone = gap_at(hi + o.step_deg).gap <= cut;
+  out.limit_deg = hi;
+  out.first_contact_deg = first_contact_of(out, o);
+  out.min_gap_at_limit_mm = l.gap;
+  out.joint_translation_mm = hip.femur_translation(t);
+  if (std::isfinite(l.point.x()) && !out.contact_at_start) {
+    // Exact contacts: at the limit the surfaces cross along a curve; they first touch where they come
+    // nearest at the bracket's lower end.
+    const auto [R_lo, t_lo] = pose_at(lo);
+    ++out.evaluations;
+    describe_contact(out, hip, scan(R_lo, t_lo, true), R_lo, t_lo, o);
+  } else {
+    describe_contact(out, hip, l, R, t, o);
+  }
   out.vertices_looked_up = scan.vertices_looked_up();
   out.vertices_skipped = scan.vertices_skipped();
-  out.limit_deg = hi;
-  out.min_gap_at_limit_mm = l.gap;
-  out.limited_by_ball = l.ball;
-  out.joint_translation_mm = hip.femur_translation(t);
-  // The contact point: the vertex, posed, in the joint frame (the pelvis does not move).
-  const Eigen::Vector3d p_joint =
-      l.ball ? Eigen::Vector3d(R * joint.ball().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose() + t)
-             : Eigen::Vector3d(joint.socket().relative.row(static_cast<Eigen::Index>(l.vertex)).transpose());
-  out.contact_mm = hip.to_working(p_joint);
-  const double rim = hip.acetabulum() ? hip.acetabulum()->rim_radius_mm : hip.head_radius_mm() + 5;
-  out.limited_by = p_joint.norm() <= rim + o.intra_articular_margin_mm ? ImpingementSite::intra_articular
-                                                                      : ImpingementSite::extra_articular;
-  out.limited_by_hidden_vertex = l.hidden;
-  out.contact_class = hip.contact_class(l.ball, static_cast<std::int64_t>(l.vertex), {R, t}, o.intra_articular_margin_mm);
-  out.femoral_zone = hip.femoral_zone(R.transpose() * (p_joint - t)), out.pelvic_zone = hip.pelvic_zone(p_joint);
-  if (hip.socket_clock()) {
-    // On the socket the contact point itself; on the femur the point carried back onto the unposed femur.
-    out.socket_clock_h = hip.socket_clock()->hour(p_joint);
-    out.femur_clock_h = hip.ball_clock()->hour(R.transpose() * (p_joint - t));
-  }
   return out;
 }
 
+// The bounds of a search's per-vertex scans (none where it finds contacts exactly).
+std::shared_ptr<const RomSearchBounds> search_bounds(const Joint& joint, const RomOptions& o, const RomBaseline& base) {
+  return exact_search(o, base) ? nullptr : bounds_for(joint, o, base);
+}
+RomOptions at_first_touch(RomOptions o) {
+  o.contact_depth_mm = 0;
+  return o;
+}
+// The search of one motion with its first touch (RomLimit::first_contact_deg): at a contact depth > 0, a
+// search of its own at depth 0 (first_bounds: search_bounds of at_first_touch(o)).
+RomLimit with_first_contact(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation,
+                            const RomOptions& o, const RomBaseline& base, const RomSearchBounds* bounds,
+                            const RomSearchBounds* first_bounds) {
+  RomLimit l = search(hip, rotation, o, base, bounds);
+  if (o.contact_depth_mm > 0)
+    l.first_contact_deg = search(hip, rotation, at_first_touch(o), base, first_bounds, true).first_contact_deg;
+  return l;
+}
 }  // namespace
 
 RomLimit find_rom_limit(const HipJoint& hip, const std::function<Eigen::Matrix3d(double)>& rotation,
                         const RomOptions& o, const RomBaseline& base) {
   check(o);
-  const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(hip.joint(), o, base);
-  return search(hip, rotation, o, base, bounds.get());
+  const std::shared_ptr<const RomSearchBounds> bounds = search_bounds(hip.joint(), o, base);
+  const std::shared_ptr<const RomSearchBounds> first =
+      o.contact_depth_mm > 0 ? search_bounds(hip.joint(), at_first_touch(o), base) : nullptr;
+  return with_first_contact(hip, rotation, o, base, bounds.get(), first.get());
 }
 
 RomLimit find_rom_limit(const HipJoint& hip, const std::function<PoseAngles(double)>& motion, const RomOptions& o,
@@ -217,7 +269,9 @@ std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<Sta
 std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<StandardMotion>& motions,
                                       const RomOptions& o, const RomBaseline& base, const PoseRotation& rotation) {
   check(o);
-  const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(hip.joint(), o, base);
+  const std::shared_ptr<const RomSearchBounds> bounds = search_bounds(hip.joint(), o, base);
+  const std::shared_ptr<const RomSearchBounds> first =
+      o.contact_depth_mm > 0 ? search_bounds(hip.joint(), at_first_touch(o), base) : nullptr;
   std::vector<RomLimit> out(motions.size());
   std::vector<std::string> errors(motions.size());
   const auto n = static_cast<std::int64_t>(motions.size());
@@ -256,9 +310,9 @@ std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<Sta
           continue;
         }
       }
-      limit = search(
+      limit = with_first_contact(
           hip, std::function<Eigen::Matrix3d(double)>([&](double t) { return rotation(m.angles(t)); }), o, base,
-          bounds.get());
+          bounds.get(), first.get());
     } catch (const std::exception& e) {
       errors[static_cast<std::size_t>(k)] = e.what();
     }
@@ -270,7 +324,7 @@ std::vector<RomLimit> find_rom_limits(const HipJoint& hip, const std::vector<Sta
 std::vector<RomMapCell> rom_map(const HipJoint& hip, const std::vector<double>& flexion,
                                 const std::vector<double>& adduction, const RomOptions& o, const RomBaseline& base) {
   check(o);
-  const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(hip.joint(), o, base);
+  const std::shared_ptr<const RomSearchBounds> bounds = search_bounds(hip.joint(), o, base);
   std::vector<RomMapCell> cells;
   for (double f : flexion)
     for (double a : adduction) cells.push_back({f, a, std::numeric_limits<double>::quiet_NaN(), RomMapStatus::free});

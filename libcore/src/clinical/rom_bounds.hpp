@@ -306,6 +306,9 @@ struct Least {
   bool ball = false;
   bool hidden = false;  ///< a hidden vertex, tested by the other body's layered map
   std::size_t vertex = 0;
+  /// With exact contacts (rom_exact.hpp): where the two surfaces come nearest (the closest point on the
+  /// surface of the vertex's bone), joint frame, mm; NaN from a per-vertex scan (the vertex is the place).
+  Eigen::Vector3d point = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 // The ball's first-surface vertices that can meet the socket at some pose: a vertex at radius r
 // has gap >= (least finite node of the socket map) - (r + |t|) at every rotation and translation t

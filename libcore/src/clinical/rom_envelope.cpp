@@ -130,7 +130,11 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
   out.poses = std::int64_t(n[0]) * n[1] * n[2];
   std::vector<std::int8_t> state(static_cast<std::size_t>(out.poses), -1);  // -1 unknown, 0 contact, 1 valid
   const Joint& joint = hip.joint();
-  const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(joint, o, base);
+  // The per-vertex test at every pose (rom.hpp: the exact test would cost some 300 times as much here and move
+  // the envelope's boundary by a fraction of a degree, well within its step).
+  RomOptions per_vertex = o;
+  per_vertex.exact_contact = false;
+  const std::shared_ptr<const RomSearchBounds> bounds = bounds_for(joint, per_vertex, base);
 
   // Scan the listed poses on all cores; each thread keeps its scanner.
   std::int64_t looked = 0, skipped = 0;
@@ -139,7 +143,7 @@ RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& e, const
     std::string error;  // the first error of any thread, thrown after the parallel region
 #pragma omp parallel reduction(+ : looked, skipped)
     {
-      GapScanner scan(joint, base, bounds.get(), o);
+      GapScanner scan(joint, base, bounds.get(), per_vertex);
 #pragma omp for schedule(dynamic, 64)
       for (std::int64_t q = 0; q < m; ++q) {
         const std::size_t p = poses[static_cast<std::size_t>(q)];

@@ -5,7 +5,7 @@
 
 #include <optional>
 
-#include "clinical/rom_scanner.hpp"
+#include "clinical/rom_exact.hpp"
 
 namespace impinge {
 namespace rom_detail {
@@ -82,14 +82,20 @@ class DistanceScanner {
 // where none is listed, no distance reaches the cut. Where the ray runs inside the other bone (issue
 // 26) the radial gap is far below the distance, and the distance decides. Above a cut of 0 the radial
 // gap bounds an outside vertex's distance from above, not below: every pose is a whole distance scan.
-// `exact` poses (a search's start and limit) are whole distance scans too.
+// `exact` poses (a search's start and limit) are whole distance scans too. Where the search finds its
+// contacts exactly (exact_search), ExactScanner alone serves every pose.
 class GapScanner {
  public:
   GapScanner(const Joint& joint, const RomBaseline& base, const RomSearchBounds* bounds, const RomOptions& o) {
+    if (exact_search(o, base)) {  // the exact test throughout (rom_exact.hpp)
+      exact_.emplace(joint, base, cut_of(o));
+      return;
+    }
     if (o.metric == RomMetric::distance) distance_.emplace(joint, base);
     if (screened_or_radial(o)) compact_.emplace(joint, base, bounds, scan_cut_of(o), o.vertices);
   }
   Least operator()(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, bool exact) {
+    if (exact_) return (*exact_)(R, t, exact);
     if (!distance_) return (*compact_)(R, t, exact);
     if (!compact_ || exact) return (*distance_)(R, t);
     const Least radial = (*compact_)(R, t, false, &listed_);
@@ -105,6 +111,7 @@ class GapScanner {
   std::vector<Candidate> listed_;
   std::optional<CompactScanner> compact_;
   std::optional<DistanceScanner> distance_;
+  std::optional<ExactScanner> exact_;
 };
 
 }  // namespace rom_detail

@@ -349,8 +349,10 @@ void add_rom_rows(Rows& t) {
            "cartilage offset > 0)",
            [](auto& o) -> auto& { return o.rom.search.threshold_mm; });
   t.number("contact-depth", "contact_depth_mm", "mm", both, RomOptions::kContactDepthRange,
-           "A contact must reach this far past the threshold to end a search; a shallower graze is within the "
-           "data's error (map interpolation, an MRI surface's roughness) and the joint's play (0: the first touch)",
+           "A contact must reach this far past the threshold to end a search. 0 (default): the limit is the first "
+           "touch (the least exact surface-to-surface distance reaches the threshold). For noisy meshes (an MRI "
+           "surface's roughness, 0.4-0.8 mm rms) a depth > 0 lets a graze shallower than the data's error pass; "
+           "the limit is then a depth of overlap by the per-vertex test, and first_contact_deg still the first touch",
            [](auto& o) -> auto& { return o.rom.search.contact_depth_mm; });
   t.choice("metric", "metric", both, kRomMetricNames,
            "What --threshold is compared with: the signed Euclidean distance to the other bone (what a depth or a "

@@ -285,7 +285,7 @@ nlohmann::json status_of(const RomLimit* x) { return x ? nlohmann::json(to_strin
 
 Table rom_limits_table(const Session& s, const RomRun& run) {
   Table t;
-  t.columns = {"motion",      "limit_deg",        "status",       "limited_by",     "contact_class", "pelvis_clock_h",
+  t.columns = {"motion",      "limit_deg",        "first_contact_deg", "status",       "limited_by",     "contact_class", "pelvis_clock_h",
                "femur_clock_h", "min_gap_at_limit_mm", "monotone", "contact_at_start", "contact_x_mm", "contact_y_mm",
                "contact_z_mm", "joint_translation_x_mm", "joint_translation_y_mm", "joint_translation_z_mm",
                "evaluations", "normal_deg", "normal_source", "soft_tissue_first", "pelvic_frame", "limit_isb_deg",
@@ -302,7 +302,7 @@ Table rom_limits_table(const Session& s, const RomRun& run) {
     const RomLimit* isb = limit_in_frame(run, k, PelvisFrameKind::isb);
     const RomLimit* app = limit_in_frame(run, k, PelvisFrameKind::anterior_pelvic_plane);
     const RomLimit* set_aside = contact_set_aside(run, k);
-    t.add({name, number_or_null(l.limit_deg), to_string(l.status), to_string(l.limited_by), to_string(l.contact_class),
+    t.add({name, number_or_null(l.limit_deg), number_or_null(l.first_contact_deg), to_string(l.status), to_string(l.limited_by), to_string(l.contact_class),
            number_or_null(l.socket_clock_h),
            number_or_null(l.femur_clock_h), number_or_null(l.min_gap_at_limit_mm), l.monotone, l.contact_at_start,
            number_or_null(c.x()), number_or_null(c.y()), number_or_null(c.z()), number_or_null(tr.x()),
@@ -399,6 +399,7 @@ nlohmann::json rom_record(const RomRun& run) {
     const RomLimit* app = limit_in_frame(run, k, PelvisFrameKind::anterior_pelvic_plane);
     limits.push_back({{"motion", name},
                       {"limit_deg", number_or_null(l.limit_deg)},
+                      {"first_contact_deg", number_or_null(l.first_contact_deg)},
                       {"status", to_string(l.status)},
                       {"limited_by", to_string(l.limited_by)},
                       {"monotone", l.monotone},

@@ -174,6 +174,11 @@ class HipJoint {
   /// impingement within the acetabular rim radius (head radius + 5 mm
   /// without an acetabulum) plus `intra_margin_mm` of the COR, else extra-articular.
   ContactClass contact_class(bool ball, std::int64_t vertex, const FemurPose& pose, double intra_margin_mm) const;
+  /// The class of a contact at the point p_joint (joint frame, mm; e.g. an exact contact between vertices) with the
+  /// femur at `pose`: articular when the point carried onto the unposed femur (R^T (p - t)) lies in the head up to
+  /// its head-neck junction (head_zone_joint()->contains), labral on a labral hip, else as contact_class by the
+  /// point's distance from the COR. Source: impinge (issue 81).
+  ContactClass contact_class_at(const Eigen::Vector3d& p_joint, const FemurPose& pose, double intra_margin_mm) const;
   /// The same hip with the acetabular labrum (make_labrum, `width_mm` x `height_mm`) as its socket in place of the
   /// pelvis: a Joint of the femur against the labrum alone, with maps of the same scheme and options, in the same
   /// joint frame about the same COR; the frames, clocks, articular zones of the femur and the joint-centre method

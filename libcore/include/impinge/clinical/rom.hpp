@@ -68,14 +68,14 @@ struct RomOptions {
   double threshold_mm = 0;       ///< contact when the minimum gap <= this less contact_depth_mm (0: bone contact;
                                  ///< a cartilage offset > 0)
   static constexpr Range kThresholdRange{-100, 100};  ///< of threshold_mm, mm
-  /// A contact must reach this far past the threshold to end a search, mm: a graze shallower than
-  /// the data's own error (the maps' interpolation, about 0.05 mm at 0.1 deg; an MRI surface's
-  /// roughness about its fitted sphere, 0.4-0.8 mm rms) does not stop a motion, whose femur the
-  /// joint's play lets slide past it. Without it a graze along a motion makes the limit jump by tens
-  /// of degrees under a 1 mm change of the centre of rotation (measured: tlem2-mri's flexion 118 ->
-  /// 27 deg at 0 mm, mc22's external rotation 52 -> 4 deg at 0.1 mm; at 0.25 mm every limit of
-  /// lhdl-ct, tlem2-mri and mc22 moves by at most 2 deg). 0: the first touch.
-  double contact_depth_mm = 0.25;
+  /// A contact must reach this far past the threshold to end a search, mm. 0 (the default): the limit is
+  /// where the bones first touch (the least exact surface-to-surface distance reaches the threshold;
+  /// published simulated ROM is at first bony contact). > 0 is for noisy meshes: a graze shallower than the
+  /// data's own error (an MRI surface's roughness about its fitted sphere, 0.4-0.8 mm rms) does not stop a
+  /// motion, whose femur the joint's play lets slide past it (measured before issue 81: tlem2-mri's flexion
+  /// 118 -> 27 deg at 0 mm against 0.1 mm); such a limit is a depth of overlap, found by the per-vertex
+  /// test, and RomLimit::first_contact_deg still gives the first touch.
+  double contact_depth_mm = 0;
   static constexpr Range kContactDepthRange{0, 100};  ///< of contact_depth_mm, mm
   /// What is compared with the threshold: the radial gap, or the Euclidean distance (which needs the
   /// joint's JointOptions::distances on, with a reach of at least max(threshold_mm, 0), and counts every
@@ -101,6 +101,18 @@ struct RomOptions {
   /// Contacts within the acetabular rim radius plus this (mm) of the COR are intra-articular,
   /// farther ones extra-articular.
   double intra_articular_margin_mm = kIntraArticularMarginMm;
+  /// Contacts found exactly between vertices (issue 81): where the cut (threshold less contact depth) is
+  /// >= 0 and, with the radial metric, 0 (where the bones meet, the two metrics agree), and every vertex
+  /// is counted (RomVertices::all), whether the bones meet at a pose is the exact least distance between
+  /// the meshes (MeshContact: vertex against face and edge against edge, every triangle of either bone)
+  /// at or below the cut, not a vertex's gap; so a limit does not depend on where the vertices lie. A
+  /// pair of triangles is classed by where it comes nearest, not by its corners: it is articular when the
+  /// femur's closest point lies on the head up to its head-neck junction (RomBaseline::meets_head), so that
+  /// a triangle across the junction counts on its neck side (RomContacts), and the femur's triangles within
+  /// the threshold at the baseline are left out (RomBaseline::contact). false: the per-vertex test
+  /// throughout (the thesis' Algorithm 2; for comparisons). Not an option of the CLI or Python: their ROM
+  /// limits are always exact (the envelope is not: rom_envelope).
+  bool exact_contact = true;
 };
 
 /// A standard motion: angles(theta) for theta >= 0 from its start (degrees), angles(0) = start.
@@ -138,7 +150,13 @@ const char* to_string(ImpingementSite site);
 struct RomLimit {
   double limit_deg = std::numeric_limits<double>::quiet_NaN();  ///< first contact angle (upper end of the final
                                                                  ///< bracket), NaN when none within max_deg
-  /// The least counted gap (RomOptions::metric: radial gap or distance) at the limit, mm.
+  /// Where the bones first touch along the motion (contact depth 0: the least exact distance reaches
+  /// the threshold), deg: limit_deg when RomOptions::contact_depth_mm is 0, else a search of its own at
+  /// depth 0; 0 with contact at the start, NaN when free within max_deg or not reachable.
+  double first_contact_deg = std::numeric_limits<double>::quiet_NaN();
+  /// The least counted gap (RomOptions::metric: radial gap or distance) at the limit, mm; with exact
+  /// contacts (RomOptions::exact_contact) the exact least distance between the counted triangles, 0 where
+  /// they cross.
   double min_gap_at_limit_mm = std::numeric_limits<double>::quiet_NaN();
   /// The same at the start, mm; with the distance metric, NaN when every vertex is beyond the reach.
   double min_gap_at_start_mm = std::numeric_limits<double>::quiet_NaN();
@@ -154,7 +172,11 @@ struct RomLimit {
                                    ///< RomOptions::intra_articular_margin_mm from the COR (a hidden vertex
                                    ///< near the joint, such as the far side of the rim, is intra-articular)
   Eigen::Vector3d contact_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-                                   ///< the contact vertex at the limit, working frame (pelvis fixed), mm
+                                   ///< the contact vertex at the limit, working frame (pelvis fixed), mm; with
+                                   ///< exact contacts the point where the bones first touch (the closest point,
+                                   ///< at the bracket's lower end, on the counted triangle: the femur's when it
+                                   ///< counts), and limited_by_ball and the class name that triangle's counted
+                                   ///< corner nearest it
   /// The femur's translation at the limit by the joint-centre method (HipJoint::femur_translation:
   /// from its scan position, after its rotation about its head centre), working-frame axes, mm; NaN
   /// without a limit.
@@ -177,6 +199,7 @@ struct RomLimit {
   std::int64_t vertices_skipped = 0;    ///< first-surface vertices skipped by the cluster bounds
 };
 
+class MeshContact;      ///< detection/mesh_contact.hpp
 struct RomSearchBounds;  ///< opaque: a joint's bound pyramids and vertex clusters for ROM searches
 
 /// The vertices not counted in ROM searches: those within the threshold at a baseline pose
@@ -203,6 +226,11 @@ struct RomBaseline {
   /// 10 ms for 0.1 deg maps) and shared by every search given this baseline with the same joint and
   /// threshold; a search with another threshold builds its own.
   std::shared_ptr<const RomSearchBounds> bounds;
+  /// The meshes of the exact contact test (RomOptions::exact_contact; null when it cannot apply at depth 0:
+  /// a negative threshold, the radial metric above 0, or not every vertex counted): which femur triangles
+  /// count, wholly or pair by pair at their closest points (by head_zone and contacts, not by the per-vertex
+  /// articular flags), less those within the threshold at the baseline pose.
+  std::shared_ptr<const MeshContact> contact;
 };
 
 /// The baseline at the femur rotation R (joint frame), e.g. hip.femur_rotation({}) for neutral,
@@ -308,7 +336,11 @@ struct RomEnvelope {
 /// the envelope's boundary are scanned. Assumption (the price of the refinement): a region of contact
 /// (or of freedom) smaller than a cell and touching none of its corners is missed; coarse_steps = 1
 /// scans every pose. Each scan stops at the first contact (RomOptions, `baseline` as for
-/// find_rom_limit). All cores (OpenMP). Throws impinge::Error on an empty or uneven grid. Source:
+/// find_rom_limit), by the per-vertex test: RomOptions::exact_contact does not apply here. A grid pose is
+/// valid or not; the exact test (vertex-face and edge-edge, issue 81) moves where the bones meet by a
+/// fraction of a degree, well within the grid's step, and cost some 350 times as much per envelope (the
+/// tests' generated cam hip: 156 s against 0.44 s), so the envelope's boundary is the per-vertex one while
+/// the ROM limits are exact. All cores (OpenMP). Throws impinge::Error on an empty or uneven grid. Source:
 /// impinge (not in the thesis); the refinement of Kawasaki et al. 2007 in spirit.
 RomEnvelope rom_envelope(const HipJoint& hip, const RomEnvelopeOptions& envelope, const RomOptions& options,
                          const RomBaseline& baseline);

@@ -143,7 +143,8 @@ SessionOptions rom_session_options(SessionOptions options, const RomOptions& sea
 /// envelope as requested. Throws impinge::Error on bad options (RomOptions, RomEnvelopeOptions).
 RomRun run_rom(const Session& session, const RomRequest& request);
 
-/// rom_limits.csv: motion, limit_deg, limited_by, contact_class, pelvis_clock_h, femur_clock_h,
+/// rom_limits.csv: motion, limit_deg, first_contact_deg (where the bones first touch: limit_deg at contact
+/// depth 0, else the depth-0 search's; RomLimit::first_contact_deg), status, limited_by, contact_class, pelvis_clock_h, femur_clock_h,
 /// min_gap_at_limit_mm, monotone, contact_at_start, contact_x/y/z_mm (input frame),
 /// joint_translation_x/y/z_mm (the femur's translation at the limit, input-frame axes), evaluations,
 /// normal_deg and normal_source (the active range of living subjects, published_normal_range),
