@@ -80,7 +80,7 @@ if "normal_deg" in lim.columns:
     app = "limit_app_deg" in lim.columns and lim.limit_app_deg.notna().any()
     value, status = ("limit_app_deg", "status_app") if app else ("limit_deg", "status")
     motions = list(dict.fromkeys(lim.motion))
-    fig, ax = plt.subplots(figsize=(7.5, 3.6))
+    fig, ax = plt.subplots(figsize=(7.5, 4.6))
     markers = "osD^v<>"
     for k, m in enumerate(motions):
         normal = lim[lim.motion == m].normal_deg.iloc[0]
@@ -102,8 +102,8 @@ if "normal_deg" in lim.columns:
     ax.set_xticks(range(len(motions)))
     ax.set_xticklabels([m.replace("_90_flexion", " 90").replace("_", " ") for m in motions], rotation=30, ha="right",
                        fontsize=8)
-    ax.set_ylabel("bony limit, deg (" + ("anterior pelvic plane" if app else
-                                         "pelvic frame: " + ", ".join(sorted(set(lim.pelvic_frame)))) + ")")
+    ax.set_ylabel("bony limit, deg\n(" + ("anterior pelvic plane" if app else
+                                           "pelvic frame: " + ", ".join(sorted(set(lim.pelvic_frame)))) + ")")
     ax.set_ylim(0, 155)
     for i, s in enumerate(subjects):
         ax.plot([], [], marker=markers[i % len(markers)], ls="none", color=f"C{i}", label=s)
@@ -111,7 +111,8 @@ if "normal_deg" in lim.columns:
     ax.plot([], [], color="black", lw=1.5, ls="--", label="published bony (simulated, normal hips)")
     ax.plot([], [], marker="x", ls="none", color="gray", label="start not reached")
     ax.plot([], [], marker="o", ls="none", color="gray", markerfacecolor="none", label="past the living range")
-    ax.legend(fontsize=7, ncol=2, loc="upper right")
+    ax.legend(fontsize=8, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.32))
+    fig.tight_layout()
     save(fig, d, "limits_vs_normal")
 
 # Sensitivity: largest |change| of a limit per subject, method and perturbation kind. A limit that
