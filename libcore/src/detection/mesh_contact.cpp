@@ -13,6 +13,9 @@ namespace impinge {
 using Eigen::Vector3d;
 
 namespace {
+// The slack of the faces' sphere test (MeshContact::walk), mm: far above the rounding of either distance.
+constexpr double kSphereMarginMm = 1e-6;
+
 // The closest point of triangle (a, b, c) to p (Ericson 2005, sec. 5.1.5: Voronoi regions).
 Vector3d closest_on_triangle(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
   const Vector3d ab = b - a, ac = c - a, ap = p - a;
@@ -120,8 +123,14 @@ MeshContact::Tree MeshContact::build(const Vertices& v, const Faces& f) {
   tree.order.resize(static_cast<std::size_t>(m));
   std::iota(tree.order.begin(), tree.order.end(), 0);
   std::vector<Vector3d> centroid(static_cast<std::size_t>(m));
-  for (std::int32_t k = 0; k < m; ++k)
-    centroid[static_cast<std::size_t>(k)] = (v.row(f(k, 0)) + v.row(f(k, 1)) + v.row(f(k, 2))).transpose() / 3.0;
+  tree.spheres.resize(static_cast<std::size_t>(m));
+  for (std::int32_t k = 0; k < m; ++k) {
+    const Vector3d c = (v.row(f(k, 0)) + v.row(f(k, 1)) + v.row(f(k, 2))).transpose() / 3.0;
+    double r = 0;
+    for (int j = 0; j < 3; ++j) r = std::max(r, (v.row(f(k, j)).transpose() - c).norm());
+    centroid[static_cast<std::size_t>(k)] = c;
+    tree.spheres[static_cast<std::size_t>(k)] = Eigen::Vector4d(c.x(), c.y(), c.z(), r);
+  }
   if (m == 0) return tree;
   struct Span {
     std::int32_t node, first, count;
@@ -225,9 +234,15 @@ void MeshContact::walk(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const
         const std::int32_t fa = ta_.order[static_cast<std::size_t>(i)];
         const bool ca = a_counted_[static_cast<std::size_t>(fa)] != 0;
         for (int c = 0; c < 3; ++c) pa[c] = R * a_.row(fa_(fa, c)).transpose() + t;
+        const Eigen::Vector4d& sa = ta_.spheres[static_cast<std::size_t>(fa)];
+        const Vector3d ca_posed = R * sa.head<3>() + t;
         for (std::int32_t j = nb.first; j < nb.first + nb.count; ++j) {
           const std::int32_t fb = tb_.order[static_cast<std::size_t>(j)];
           if (!ca && !(b_counted_[static_cast<std::size_t>(fb)] && (!q.b_counts_now || q.b_counts_now(fb)))) continue;
+          // The faces' spheres apart by more than the bound (with a rounding margin): so are the faces, and a
+          // pair farther than the bound changes no answer.
+          const Eigen::Vector4d& sb = tb_.spheres[static_cast<std::size_t>(fb)];
+          if ((ca_posed - sb.head<3>()).norm() - sa.w() - sb.w() > bound + kSphereMarginMm) continue;
           for (int c = 0; c < 3; ++c) pb[c] = b_.row(fb_(fb, c)).transpose();
           if (visit(fa, fb, pa, pb)) return;
         }

@@ -92,6 +92,9 @@ class MeshContact {
   struct Tree {
     std::vector<Node> nodes;
     std::vector<std::int32_t> order;  ///< faces, leaf by leaf
+    /// Per face: a sphere holding it (x, y, z: its centroid; w: the centroid's largest distance to a corner),
+    /// so that a pair of faces whose spheres lie farther apart than the bound is passed over untested.
+    std::vector<Eigen::Vector4d> spheres;
   };
   static Tree build(const Vertices& v, const Faces& f);
   static void mark(Tree& tree, const std::vector<std::uint8_t>& counted);
