@@ -88,6 +88,16 @@ bool segment_crosses(const Vector3d& p, const Vector3d& q, const Vector3d& a, co
   // Inside (boundary included): the three edge cross products agree with the normal.
   return n.dot((b - a).cross(x - a)) >= 0 && n.dot((c - b).cross(x - b)) >= 0 && n.dot((a - c).cross(x - c)) >= 0;
 }
+// Whether triangles a and b (unit normals na, nb; zero for no area) lie farther apart than `bound` (>= 0) by a
+// plane: every corner of one farther than `bound` from the other's plane on one side. Every point of the one
+// is then that far from the plane (the corners' convex hull), which holds the other.
+bool planes_apart(const Vector3d a[3], const Vector3d& na, const Vector3d b[3], const Vector3d& nb, double bound) {
+  auto beyond = [bound](const Vector3d p[3], const Vector3d& n, const Vector3d& on) {
+    const double s0 = n.dot(p[0] - on), s1 = n.dot(p[1] - on), s2 = n.dot(p[2] - on);
+    return std::min({s0, s1, s2}) > bound || std::max({s0, s1, s2}) < -bound;
+  };
+  return beyond(b, na, a[0]) || beyond(a, nb, b[0]);
+}
 }  // namespace
 
 double triangle_distance(const Vector3d a[3], const Vector3d b[3], Vector3d& pa, Vector3d& pb) {
@@ -130,6 +140,9 @@ MeshContact::Tree MeshContact::build(const Vertices& v, const Faces& f) {
     for (int j = 0; j < 3; ++j) r = std::max(r, (v.row(f(k, j)).transpose() - c).norm());
     centroid[static_cast<std::size_t>(k)] = c;
     tree.spheres[static_cast<std::size_t>(k)] = Eigen::Vector4d(c.x(), c.y(), c.z(), r);
+    const Vector3d n = (v.row(f(k, 1)) - v.row(f(k, 0))).transpose().cross((v.row(f(k, 2)) - v.row(f(k, 0))).transpose());
+    const double len = n.norm();
+    tree.normals.push_back(len > 0 ? Vector3d(n / len) : Vector3d::Zero());
   }
   if (m == 0) return tree;
   struct Span {
@@ -235,7 +248,7 @@ void MeshContact::walk(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const
         const bool ca = a_counted_[static_cast<std::size_t>(fa)] != 0;
         for (int c = 0; c < 3; ++c) pa[c] = R * a_.row(fa_(fa, c)).transpose() + t;
         const Eigen::Vector4d& sa = ta_.spheres[static_cast<std::size_t>(fa)];
-        const Vector3d ca_posed = R * sa.head<3>() + t;
+        const Vector3d ca_posed = R * sa.head<3>() + t, na_posed = R * ta_.normals[static_cast<std::size_t>(fa)];
         for (std::int32_t j = nb.first; j < nb.first + nb.count; ++j) {
           const std::int32_t fb = tb_.order[static_cast<std::size_t>(j)];
           if (!ca && !(b_counted_[static_cast<std::size_t>(fb)] && (!q.b_counts_now || q.b_counts_now(fb)))) continue;
@@ -244,6 +257,7 @@ void MeshContact::walk(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const
           const Eigen::Vector4d& sb = tb_.spheres[static_cast<std::size_t>(fb)];
           if ((ca_posed - sb.head<3>()).norm() - sa.w() - sb.w() > bound + kSphereMarginMm) continue;
           for (int c = 0; c < 3; ++c) pb[c] = b_.row(fb_(fb, c)).transpose();
+          if (planes_apart(pa, na_posed, pb, tb_.normals[static_cast<std::size_t>(fb)], bound + kSphereMarginMm)) continue;
           if (visit(fa, fb, pa, pb)) return;
         }
       }

@@ -95,6 +95,8 @@ class MeshContact {
     /// Per face: a sphere holding it (x, y, z: its centroid; w: the centroid's largest distance to a corner),
     /// so that a pair of faces whose spheres lie farther apart than the bound is passed over untested.
     std::vector<Eigen::Vector4d> spheres;
+    /// Per face: its unit normal (zero for a face of no area), for the planes' test of a pair.
+    std::vector<Eigen::Vector3d> normals;
   };
   static Tree build(const Vertices& v, const Faces& f);
   static void mark(Tree& tree, const std::vector<std::uint8_t>& counted);
