@@ -98,6 +98,19 @@ bool planes_apart(const Vector3d a[3], const Vector3d& na, const Vector3d b[3], 
   };
   return beyond(b, na, a[0]) || beyond(a, nb, b[0]);
 }
+// A lower bound of the distance between box A (a_lo, a_hi; posed by R, t; Rabs = |R|, Rt = R^T, back = -R^T t)
+// and box B: A's sphere against B's box, and the two boxes apart along B's axes (A's box posed, within its
+// axis-aligned hull) or along A's (B's carried back), less a rounding margin.
+double boxes_apart(const Eigen::Matrix3d& R, const Eigen::Matrix3d& Rabs, const Eigen::Matrix3d& Rt, const Vector3d& t,
+                   const Vector3d& back, const Vector3d& a_lo, const Vector3d& a_hi, const Vector3d& b_lo,
+                   const Vector3d& b_hi) {
+  const Vector3d ha = 0.5 * (a_hi - a_lo), hb = 0.5 * (b_hi - b_lo), ca = 0.5 * (a_lo + a_hi), cb = 0.5 * (b_lo + b_hi);
+  const Vector3d c = R * ca + t;
+  const double sphere = (c - c.cwiseMax(b_lo).cwiseMin(b_hi)).norm() - ha.norm();
+  const double in_b = ((c - cb).cwiseAbs() - Rabs * ha - hb).cwiseMax(0.0).norm();
+  const double in_a = ((Rt * cb + back - ca).cwiseAbs() - Rabs.transpose() * hb - ha).cwiseMax(0.0).norm();
+  return std::max(sphere, std::max(in_b, in_a)) - kSphereMarginMm;
+}
 }  // namespace
 
 double triangle_distance(const Vector3d a[3], const Vector3d b[3], Vector3d& pa, Vector3d& pb) {
@@ -184,17 +197,28 @@ MeshContact::Tree MeshContact::build(const Vertices& v, const Faces& f) {
   return tree;
 }
 
-void MeshContact::mark(Tree& tree, const std::vector<std::uint8_t>& counted) {
-  // Children are stored after their parents: from the back, a parent holds a counted face when a child does.
+void MeshContact::mark(Tree& tree, const std::vector<std::uint8_t>& counted, const Vertices& v, const Faces& f) {
+  // Children are stored after their parents: from the back, a parent holds a counted face when a child does,
+  // and the box of its counted faces is its children's.
   for (auto k = tree.nodes.size(); k-- > 0;) {
     Node& n = tree.nodes[k];
+    n.counted_lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), n.counted_hi = -n.counted_lo;
     if (n.left < 0) {
-      n.counted = false;
-      for (std::int32_t j = n.first; j < n.first + n.count && !n.counted; ++j)
-        n.counted = counted[static_cast<std::size_t>(tree.order[static_cast<std::size_t>(j)])] != 0;
+      for (std::int32_t j = n.first; j < n.first + n.count; ++j) {
+        const std::int32_t face = tree.order[static_cast<std::size_t>(j)];
+        if (counted[static_cast<std::size_t>(face)] == 0) continue;
+        for (int c = 0; c < 3; ++c) {
+          const Vector3d p = v.row(f(face, c)).transpose();
+          n.counted_lo = n.counted_lo.cwiseMin(p), n.counted_hi = n.counted_hi.cwiseMax(p);
+        }
+      }
     } else {
-      n.counted = tree.nodes[static_cast<std::size_t>(n.left)].counted || tree.nodes[static_cast<std::size_t>(n.right)].counted;
+      for (const std::int32_t child : {n.left, n.right}) {
+        const Node& c = tree.nodes[static_cast<std::size_t>(child)];
+        n.counted_lo = n.counted_lo.cwiseMin(c.counted_lo), n.counted_hi = n.counted_hi.cwiseMax(c.counted_hi);
+      }
     }
+    n.counted = (n.counted_lo.array() <= n.counted_hi.array()).all();
   }
 }
 
@@ -218,8 +242,8 @@ void MeshContact::set_counted(std::vector<std::uint8_t> a_counted, std::vector<s
   require(a_counted.size() == static_cast<std::size_t>(fa_.rows()) && b_counted.size() == static_cast<std::size_t>(fb_.rows()),
           "mesh contact: a counted-face mask's length is not the mesh's face count");
   a_counted_ = std::move(a_counted), b_counted_ = std::move(b_counted);
-  mark(ta_, a_counted_);
-  mark(tb_, b_counted_);
+  mark(ta_, a_counted_, a_, fa_);
+  mark(tb_, b_counted_, b_, fb_);
 }
 
 // Both trees together: visit(face_a, face_b, posed corners of A's face, B's corners) for every counted pair
@@ -228,11 +252,14 @@ template <typename Visit>
 void MeshContact::walk(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Query& q, double& bound,
                        Visit visit) const {
   if (ta_.nodes.empty() || tb_.nodes.empty()) return;
-  // A lower bound of the distance between A's node (posed) and B's: A's sphere against B's box and sphere.
+  // A lower bound of the distance between the counted pairs of A's node (posed) and B's: a counted face of
+  // either against any face of the other (boxes; none counted: +inf).
+  const Eigen::Matrix3d Rabs = R.cwiseAbs(), Rt = R.transpose();
+  const Vector3d back = -(Rt * t);
   auto apart = [&](const Node& na, const Node& nb) {
-    const Vector3d c = R * na.centre + t;
-    const double to_box = (c - c.cwiseMax(nb.lo).cwiseMin(nb.hi)).norm();
-    return std::max(to_box, (c - nb.centre).norm() - nb.radius) - na.radius;
+    const double far = std::numeric_limits<double>::infinity();
+    return std::min(na.counted ? boxes_apart(R, Rabs, Rt, t, back, na.counted_lo, na.counted_hi, nb.lo, nb.hi) : far,
+                    nb.counted ? boxes_apart(R, Rabs, Rt, t, back, na.lo, na.hi, nb.counted_lo, nb.counted_hi) : far);
   };
   std::vector<std::pair<std::int32_t, std::int32_t>> stack{{0, 0}};
   Vector3d pa[3], pb[3];

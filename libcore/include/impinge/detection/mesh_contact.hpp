@@ -86,6 +86,7 @@ class MeshContact {
     std::int32_t left = -1, right = -1;  ///< children (-1: a leaf)
     std::int32_t first = 0, count = 0;   ///< leaf: faces order[first, first + count)
     bool counted = false;                ///< holds a counted face
+    Eigen::Vector3d counted_lo = Eigen::Vector3d::Zero(), counted_hi = Eigen::Vector3d::Zero();  ///< the box of its counted faces (when counted)
   };
 
  private:
@@ -99,7 +100,7 @@ class MeshContact {
     std::vector<Eigen::Vector3d> normals;
   };
   static Tree build(const Vertices& v, const Faces& f);
-  static void mark(Tree& tree, const std::vector<std::uint8_t>& counted);
+  static void mark(Tree& tree, const std::vector<std::uint8_t>& counted, const Vertices& v, const Faces& f);
   template <typename Visit>
   void walk(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Query& q, double& bound, Visit visit) const;
   Vertices a_, b_;
