@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 #include <random>
+#include <set>
 
 #include "impinge/casters/fcl_collision.hpp"
 #include "impinge/core/error.hpp"
@@ -138,4 +139,45 @@ TEST(MeshContact, AgreesWithFclOnSeparatedPoses) {
     EXPECT_NEAR(d, fcl.distance(R, t), 1e-6) << trial;
   }
   EXPECT_GT(compared, 10);
+}
+
+// The walk passes over pairs of nodes and of faces by lower bounds (counted boxes, faces' spheres and planes):
+// at every reach, whether a counted pair lies within it and which pairs do are brute force's.
+TEST(MeshContact, WithinAReachTheSamePairsAsBruteForce) {
+  const TriangleMesh a = make_uv_sphere(10, Vector3d::Zero(), 16, 9);
+  const TriangleMesh b = make_cup(11, 14, 100, Vector3d(0.5, 0, 0), Vector3d::UnitZ(), 18, 6);
+  std::mt19937 rng(7);
+  std::bernoulli_distribution half(0.5);
+  std::vector<std::uint8_t> ca(a.F.rows()), cb(b.F.rows(), 0);
+  for (auto& c : ca) c = half(rng);
+  const MeshContact some(a.V, a.F, b.V, b.F, ca, cb);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI), shift(-3, 3);
+  int met = 0, apart = 0;  // reaches with some pair within, with none: the test sees both
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(angle(rng), Vector3d(shift(rng), shift(rng), 1).normalized()).toRotationMatrix();
+    const Vector3d t(shift(rng), shift(rng), shift(rng));
+    for (const double reach : {0.0, 0.3, 1.0, 2.5}) {
+      std::set<std::pair<std::int64_t, std::int64_t>> expected;  // counted pairs within the reach
+      for (Eigen::Index i = 0; i < a.F.rows(); ++i) {
+        if (!ca[static_cast<std::size_t>(i)]) continue;
+        Vector3d pa[3], pb[3], x, y;
+        for (int c = 0; c < 3; ++c) pa[c] = R * a.V.row(a.F(i, c)).transpose() + t;
+        for (Eigen::Index j = 0; j < b.F.rows(); ++j) {
+          for (int c = 0; c < 3; ++c) pb[c] = b.V.row(b.F(j, c)).transpose();
+          if (triangle_distance(pa, pb, x, y) <= reach) expected.emplace(i, j);
+        }
+      }
+      using Pairs = std::set<std::pair<std::int64_t, std::int64_t>>;
+      const auto found = some.pairs_within(R, t, reach, {});
+      EXPECT_EQ(Pairs(found.begin(), found.end()), expected)
+          << trial << " " << reach;
+      MeshContact::Query q;
+      q.reach = reach, q.first = true;
+      EXPECT_EQ(some.least(R, t, q).distance <= reach, !expected.empty()) << trial << " " << reach;
+      ++(expected.empty() ? apart : met);
+    }
+  }
+  EXPECT_GT(met, 0);
+  EXPECT_GT(apart, 0);
 }

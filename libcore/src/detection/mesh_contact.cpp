@@ -13,6 +13,9 @@ namespace impinge {
 using Eigen::Vector3d;
 
 namespace {
+// The slack of the faces' sphere test (MeshContact::walk), mm: far above the rounding of either distance.
+constexpr double kSphereMarginMm = 1e-6;
+
 // The closest point of triangle (a, b, c) to p (Ericson 2005, sec. 5.1.5: Voronoi regions).
 Vector3d closest_on_triangle(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
   const Vector3d ab = b - a, ac = c - a, ap = p - a;
@@ -85,6 +88,29 @@ bool segment_crosses(const Vector3d& p, const Vector3d& q, const Vector3d& a, co
   // Inside (boundary included): the three edge cross products agree with the normal.
   return n.dot((b - a).cross(x - a)) >= 0 && n.dot((c - b).cross(x - b)) >= 0 && n.dot((a - c).cross(x - c)) >= 0;
 }
+// Whether triangles a and b (unit normals na, nb; zero for no area) lie farther apart than `bound` (>= 0) by a
+// plane: every corner of one farther than `bound` from the other's plane on one side. Every point of the one
+// is then that far from the plane (the corners' convex hull), which holds the other.
+bool planes_apart(const Vector3d a[3], const Vector3d& na, const Vector3d b[3], const Vector3d& nb, double bound) {
+  auto beyond = [bound](const Vector3d p[3], const Vector3d& n, const Vector3d& on) {
+    const double s0 = n.dot(p[0] - on), s1 = n.dot(p[1] - on), s2 = n.dot(p[2] - on);
+    return std::min({s0, s1, s2}) > bound || std::max({s0, s1, s2}) < -bound;
+  };
+  return beyond(b, na, a[0]) || beyond(a, nb, b[0]);
+}
+// A lower bound of the distance between box A (a_lo, a_hi; posed by R, t; Rabs = |R|, Rt = R^T, back = -R^T t)
+// and box B: A's sphere against B's box, and the two boxes apart along B's axes (A's box posed, within its
+// axis-aligned hull) or along A's (B's carried back), less a rounding margin.
+double boxes_apart(const Eigen::Matrix3d& R, const Eigen::Matrix3d& Rabs, const Eigen::Matrix3d& Rt, const Vector3d& t,
+                   const Vector3d& back, const Vector3d& a_lo, const Vector3d& a_hi, const Vector3d& b_lo,
+                   const Vector3d& b_hi) {
+  const Vector3d ha = 0.5 * (a_hi - a_lo), hb = 0.5 * (b_hi - b_lo), ca = 0.5 * (a_lo + a_hi), cb = 0.5 * (b_lo + b_hi);
+  const Vector3d c = R * ca + t;
+  const double sphere = (c - c.cwiseMax(b_lo).cwiseMin(b_hi)).norm() - ha.norm();
+  const double in_b = ((c - cb).cwiseAbs() - Rabs * ha - hb).cwiseMax(0.0).norm();
+  const double in_a = ((Rt * cb + back - ca).cwiseAbs() - Rabs.transpose() * hb - ha).cwiseMax(0.0).norm();
+  return std::max(sphere, std::max(in_b, in_a)) - kSphereMarginMm;
+}
 }  // namespace
 
 double triangle_distance(const Vector3d a[3], const Vector3d b[3], Vector3d& pa, Vector3d& pb) {
@@ -120,8 +146,17 @@ MeshContact::Tree MeshContact::build(const Vertices& v, const Faces& f) {
   tree.order.resize(static_cast<std::size_t>(m));
   std::iota(tree.order.begin(), tree.order.end(), 0);
   std::vector<Vector3d> centroid(static_cast<std::size_t>(m));
-  for (std::int32_t k = 0; k < m; ++k)
-    centroid[static_cast<std::size_t>(k)] = (v.row(f(k, 0)) + v.row(f(k, 1)) + v.row(f(k, 2))).transpose() / 3.0;
+  tree.spheres.resize(static_cast<std::size_t>(m));
+  for (std::int32_t k = 0; k < m; ++k) {
+    const Vector3d c = (v.row(f(k, 0)) + v.row(f(k, 1)) + v.row(f(k, 2))).transpose() / 3.0;
+    double r = 0;
+    for (int j = 0; j < 3; ++j) r = std::max(r, (v.row(f(k, j)).transpose() - c).norm());
+    centroid[static_cast<std::size_t>(k)] = c;
+    tree.spheres[static_cast<std::size_t>(k)] = Eigen::Vector4d(c.x(), c.y(), c.z(), r);
+    const Vector3d n = (v.row(f(k, 1)) - v.row(f(k, 0))).transpose().cross((v.row(f(k, 2)) - v.row(f(k, 0))).transpose());
+    const double len = n.norm();
+    tree.normals.push_back(len > 0 ? Vector3d(n / len) : Vector3d::Zero());
+  }
   if (m == 0) return tree;
   struct Span {
     std::int32_t node, first, count;
@@ -162,17 +197,28 @@ MeshContact::Tree MeshContact::build(const Vertices& v, const Faces& f) {
   return tree;
 }
 
-void MeshContact::mark(Tree& tree, const std::vector<std::uint8_t>& counted) {
-  // Children are stored after their parents: from the back, a parent holds a counted face when a child does.
+void MeshContact::mark(Tree& tree, const std::vector<std::uint8_t>& counted, const Vertices& v, const Faces& f) {
+  // Children are stored after their parents: from the back, a parent holds a counted face when a child does,
+  // and the box of its counted faces is its children's.
   for (auto k = tree.nodes.size(); k-- > 0;) {
     Node& n = tree.nodes[k];
+    n.counted_lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), n.counted_hi = -n.counted_lo;
     if (n.left < 0) {
-      n.counted = false;
-      for (std::int32_t j = n.first; j < n.first + n.count && !n.counted; ++j)
-        n.counted = counted[static_cast<std::size_t>(tree.order[static_cast<std::size_t>(j)])] != 0;
+      for (std::int32_t j = n.first; j < n.first + n.count; ++j) {
+        const std::int32_t face = tree.order[static_cast<std::size_t>(j)];
+        if (counted[static_cast<std::size_t>(face)] == 0) continue;
+        for (int c = 0; c < 3; ++c) {
+          const Vector3d p = v.row(f(face, c)).transpose();
+          n.counted_lo = n.counted_lo.cwiseMin(p), n.counted_hi = n.counted_hi.cwiseMax(p);
+        }
+      }
     } else {
-      n.counted = tree.nodes[static_cast<std::size_t>(n.left)].counted || tree.nodes[static_cast<std::size_t>(n.right)].counted;
+      for (const std::int32_t child : {n.left, n.right}) {
+        const Node& c = tree.nodes[static_cast<std::size_t>(child)];
+        n.counted_lo = n.counted_lo.cwiseMin(c.counted_lo), n.counted_hi = n.counted_hi.cwiseMax(c.counted_hi);
+      }
     }
+    n.counted = (n.counted_lo.array() <= n.counted_hi.array()).all();
   }
 }
 
@@ -196,8 +242,8 @@ void MeshContact::set_counted(std::vector<std::uint8_t> a_counted, std::vector<s
   require(a_counted.size() == static_cast<std::size_t>(fa_.rows()) && b_counted.size() == static_cast<std::size_t>(fb_.rows()),
           "mesh contact: a counted-face mask's length is not the mesh's face count");
   a_counted_ = std::move(a_counted), b_counted_ = std::move(b_counted);
-  mark(ta_, a_counted_);
-  mark(tb_, b_counted_);
+  mark(ta_, a_counted_, a_, fa_);
+  mark(tb_, b_counted_, b_, fb_);
 }
 
 // Both trees together: visit(face_a, face_b, posed corners of A's face, B's corners) for every counted pair
@@ -206,11 +252,14 @@ template <typename Visit>
 void MeshContact::walk(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Query& q, double& bound,
                        Visit visit) const {
   if (ta_.nodes.empty() || tb_.nodes.empty()) return;
-  // A lower bound of the distance between A's node (posed) and B's: A's sphere against B's box and sphere.
+  // A lower bound of the distance between the counted pairs of A's node (posed) and B's: a counted face of
+  // either against any face of the other (boxes; none counted: +inf).
+  const Eigen::Matrix3d Rabs = R.cwiseAbs(), Rt = R.transpose();
+  const Vector3d back = -(Rt * t);
   auto apart = [&](const Node& na, const Node& nb) {
-    const Vector3d c = R * na.centre + t;
-    const double to_box = (c - c.cwiseMax(nb.lo).cwiseMin(nb.hi)).norm();
-    return std::max(to_box, (c - nb.centre).norm() - nb.radius) - na.radius;
+    const double far = std::numeric_limits<double>::infinity();
+    return std::min(na.counted ? boxes_apart(R, Rabs, Rt, t, back, na.counted_lo, na.counted_hi, nb.lo, nb.hi) : far,
+                    nb.counted ? boxes_apart(R, Rabs, Rt, t, back, na.lo, na.hi, nb.counted_lo, nb.counted_hi) : far);
   };
   std::vector<std::pair<std::int32_t, std::int32_t>> stack{{0, 0}};
   Vector3d pa[3], pb[3];
@@ -225,10 +274,17 @@ void MeshContact::walk(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const
         const std::int32_t fa = ta_.order[static_cast<std::size_t>(i)];
         const bool ca = a_counted_[static_cast<std::size_t>(fa)] != 0;
         for (int c = 0; c < 3; ++c) pa[c] = R * a_.row(fa_(fa, c)).transpose() + t;
+        const Eigen::Vector4d& sa = ta_.spheres[static_cast<std::size_t>(fa)];
+        const Vector3d ca_posed = R * sa.head<3>() + t, na_posed = R * ta_.normals[static_cast<std::size_t>(fa)];
         for (std::int32_t j = nb.first; j < nb.first + nb.count; ++j) {
           const std::int32_t fb = tb_.order[static_cast<std::size_t>(j)];
           if (!ca && !(b_counted_[static_cast<std::size_t>(fb)] && (!q.b_counts_now || q.b_counts_now(fb)))) continue;
+          // The faces' spheres apart by more than the bound (with a rounding margin): so are the faces, and a
+          // pair farther than the bound changes no answer.
+          const Eigen::Vector4d& sb = tb_.spheres[static_cast<std::size_t>(fb)];
+          if ((ca_posed - sb.head<3>()).norm() - sa.w() - sb.w() > bound + kSphereMarginMm) continue;
           for (int c = 0; c < 3; ++c) pb[c] = b_.row(fb_(fb, c)).transpose();
+          if (planes_apart(pa, na_posed, pb, tb_.normals[static_cast<std::size_t>(fb)], bound + kSphereMarginMm)) continue;
           if (visit(fa, fb, pa, pb)) return;
         }
       }

@@ -8,8 +8,10 @@
 /// Source: impinge; the closest points of Ericson, Real-Time Collision Detection (2005), sec. 5.1.
 ///
 /// Each mesh is held in a tree of axis-aligned boxes (median splits, up to 4 triangles a leaf), built
-/// once; a query walks both trees together and prunes a pair of nodes whose bounds lie farther apart
-/// than the reach or the least distance found so far.
+/// once; a query walks both trees together and prunes a pair of nodes whose bounds (the box of either's
+/// counted faces against the other's box) lie farther apart than the reach or the least distance found so
+/// far, and a pair of faces whose bounding spheres, or one of which beyond the other's plane, lie so far
+/// apart (true lower bounds less 1e-6 mm: no answer changes, only the time).
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -86,15 +88,21 @@ class MeshContact {
     std::int32_t left = -1, right = -1;  ///< children (-1: a leaf)
     std::int32_t first = 0, count = 0;   ///< leaf: faces order[first, first + count)
     bool counted = false;                ///< holds a counted face
+    Eigen::Vector3d counted_lo = Eigen::Vector3d::Zero(), counted_hi = Eigen::Vector3d::Zero();  ///< the box of its counted faces (when counted)
   };
 
  private:
   struct Tree {
     std::vector<Node> nodes;
     std::vector<std::int32_t> order;  ///< faces, leaf by leaf
+    /// Per face: a sphere holding it (x, y, z: its centroid; w: the centroid's largest distance to a corner),
+    /// so that a pair of faces whose spheres lie farther apart than the bound is passed over untested.
+    std::vector<Eigen::Vector4d> spheres;
+    /// Per face: its unit normal (zero for a face of no area), for the planes' test of a pair.
+    std::vector<Eigen::Vector3d> normals;
   };
   static Tree build(const Vertices& v, const Faces& f);
-  static void mark(Tree& tree, const std::vector<std::uint8_t>& counted);
+  static void mark(Tree& tree, const std::vector<std::uint8_t>& counted, const Vertices& v, const Faces& f);
   template <typename Visit>
   void walk(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Query& q, double& bound, Visit visit) const;
   Vertices a_, b_;
