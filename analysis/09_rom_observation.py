@@ -80,7 +80,7 @@ if "normal_deg" in lim.columns:
     app = "limit_app_deg" in lim.columns and lim.limit_app_deg.notna().any()
     value, status = ("limit_app_deg", "status_app") if app else ("limit_deg", "status")
     motions = list(dict.fromkeys(lim.motion))
-    fig, ax = plt.subplots(figsize=(7.5, 4.6))
+    fig, ax = plt.subplots(figsize=(6.3, 4.4))  # printed at the text width: its 8 pt text stays 8 pt
     markers = "osD^v<>"
     for k, m in enumerate(motions):
         normal = lim[lim.motion == m].normal_deg.iloc[0]
