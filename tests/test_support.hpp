@@ -43,4 +43,12 @@ const Session& generated_session(const std::string& frame);
 /// Analytic oracle: distance from origin o along unit u to the sphere (c, r), far root.
 double ray_sphere_far(const Eigen::Vector3d& o, const Eigen::Vector3d& u, const Eigen::Vector3d& c, double r);
 
+/// Hip joint options of scan neutral on equiangular maps of `precision_deg` (deg): the generated hips' ROM tests.
+inline HipJointOptions scan_options(double precision_deg) {
+  HipJointOptions o;
+  o.neutral = Neutral::scan;
+  o.joint.scheme = make_scheme("equiangular", precision_deg);
+  return o;
+}
+
 }  // namespace impinge::test

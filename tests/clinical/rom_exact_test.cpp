@@ -25,12 +25,7 @@ using namespace impinge;
 using Eigen::Vector3d;
 
 namespace {
-HipJointOptions scan_options(double precision_deg) {
-  HipJointOptions o;
-  o.neutral = Neutral::scan;
-  o.joint.scheme = make_scheme("equiangular", precision_deg);
-  return o;
-}
+using test::scan_options;
 // A closed prism: the triangle (p0, p1, p2) swept by e; faces wound outward.
 TriangleMesh make_prism(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2, const Vector3d& e) {
   TriangleMesh m;

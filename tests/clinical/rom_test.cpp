@@ -36,12 +36,7 @@
 using namespace impinge;
 
 namespace {
-HipJointOptions scan_options(double precision_deg) {
-  HipJointOptions o;
-  o.neutral = Neutral::scan;
-  o.joint.scheme = make_scheme("equiangular", precision_deg);
-  return o;
-}
+using test::scan_options;
 // The right hip of generated model `h` (made with `mo`), its true head as the COR.
 std::unique_ptr<HipJoint> joint_of(const HipModel& h, const HipModelOptions& mo, const HipJointOptions& o) {
   SphereFitResult head;
