@@ -7,13 +7,17 @@ import signal
 import subprocess
 import time
 
-from conftest import CLI, one_line_error, run
+from conftest import CASE_SECONDS, CLI, one_line_error, run
+
+# The per-vertex search (a contact depth): the exact first-contact map of `impinge rom` takes over 30 s under the
+# sanitizers, and the files are what is tested here.
+FAST = ["--precision", "2", "--contact-depth", "0.25"]
 
 
 def test_a_full_device_is_an_error_naming_the_file(generated, tmp_path):
     out = tmp_path / "o"
     r = subprocess.run(["bash", "-c", f"trap '' XFSZ; ulimit -f 4; exec {CLI} rom --subject {generated} "
-                        f"--precision 2 --out {out}"], capture_output=True, text=True, timeout=30)
+                        f"{' '.join(FAST)} --out {out}"], capture_output=True, text=True, timeout=CASE_SECONDS)
     line = one_line_error(r, "rom_map.csv", "File too large")
     assert "summary.json" not in line
     assert (out / "INCOMPLETE").exists() and not (out / "summary.json").exists()
@@ -27,7 +31,7 @@ def test_a_planted_symlink_is_replaced_not_followed(generated, tmp_path):
     out.mkdir()
     for name in ("rom_limits.csv", "summary.json", "rom_map.csv"):
         os.symlink(victim, out / name)
-    r = run(["rom", "--subject", generated, "--precision", "2", "--out", out])
+    r = run(["rom", "--subject", generated, "--out", out] + FAST)
     assert r.returncode == 0, r.stderr
     assert victim.read_text() == "precious\n"
     for name in ("rom_limits.csv", "summary.json", "rom_map.csv"):
@@ -99,9 +103,7 @@ def test_a_reused_out_holds_only_the_new_runs_files(generated, tmp_path):
     """Issue 80: `impinge rom` with its map, then with --no-map, on one folder: the second leaves no rom_map.csv of the
     first beside its summary; a file of the user's stays."""
     out = tmp_path / "o"
-    # The per-vertex search (a contact depth): the exact first-contact map takes over 30 s under the sanitizers, and
-    # the files are what is tested here.
-    fast = ["--precision", "2", "--contact-depth", "0.25"]
+    fast = FAST
     assert run(["rom", "--subject", generated, "--out", out] + fast).returncode == 0
     assert (out / "rom_map.csv").exists()
     (out / "notes.txt").write_text("mine\n")
