@@ -148,8 +148,9 @@ class Joint:
         """Both scans at every row of angles (k, 3) -> the columns of the CLI's frames.csv, (k,) each. Frames
         are scanned in blocks on impinge.get_threads() threads; rows come back in order."""
     def rom_limits(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.0, metric: str = 'distance',
-                   contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0, labrum: bool = False,
-                   labrum_width_mm: float = 5.3, labrum_height_mm: float = 7.0) -> Dict[str, Any]:
+                   contacts: str = 'impingement', step_deg: float = 2.0, tolerance_deg: float = 0.1,
+                   max_deg: float = 150.0, labrum: bool = False, labrum_width_mm: float = 5.3,
+                   labrum_height_mm: float = 7.0) -> Dict[str, Any]:
         """ROM limits from neutral for the standard motions -> dict motion -> the CLI's rom_limits.csv row
         (limit_deg, first_contact_deg, limited_by, contact_class, ...). The keywords and defaults are `impinge
         rom`'s (the option table). contacts: 'impingement' (the joint surfaces meeting is left out), 'articular'
@@ -158,7 +159,7 @@ class Joint:
         first_contact_deg still gives the first touch). metric: 'distance' (needs the Joint's distances) or
         'radial'."""
     def plan(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.0, metric: str = 'distance',
-             contacts: str = 'impingement', step_deg: float = 2.0, max_deg: float = 150.0,
+             contacts: str = 'impingement', step_deg: float = 2.0, tolerance_deg: float = 0.1, max_deg: float = 150.0,
              target: Optional[str] = None, target_motion: Optional[Union[str, os.PathLike]] = None,
              resect: str = 'femur', clearance_mm: float = 0.3, max_depth_fraction: float = 0.3,
              max_depth_mm: float = 0.0, burr_radius_mm: float = 2.5, plan_step_deg: float = 0.5,

@@ -367,7 +367,13 @@ void add_rom_rows(Rows& t) {
            "criterion). Anatomical neutral only (the zones need the acetabulum)",
            [](auto& o) -> auto& { return o.rom.search.contacts; });
   t.number("step", "step_deg", "deg", use_rom | use_rom_limits | use_plan | use_joint_plan, RomOptions::kStepRange,
-           "Coarse search step (then bisection to 0.1 deg)", [](auto& o) -> auto& { return o.rom.search.step_deg; });
+           "Coarse search step (then bisection to --search-tolerance)",
+           [](auto& o) -> auto& { return o.rom.search.step_deg; });
+  t.number("search-tolerance", "tolerance_deg", "deg", use_rom | use_rom_limits | use_plan | use_joint_plan,
+           RomOptions::kToleranceRange,
+           "Bisect each limit's last step until the bracket is this narrow (at most --step; the default 0.1 ends "
+           "at 0.0625 from the 2 deg step)",
+           [](auto& o) -> auto& { return o.rom.search.tolerance_deg; });
   t.number("max", "max_deg", "deg", use_rom | use_rom_limits | use_plan | use_joint_plan, RomOptions::kMaxRange,
            "Search no farther than this from the start",
            [](auto& o) -> auto& { return o.rom.search.max_deg; });

@@ -38,6 +38,36 @@ SphereFitResult fit_sphere_geometric(PointsRef P);
 /// rms. Throws impinge::Error on a weight count other than k, a negative or non-finite weight.
 SphereFitResult fit_sphere_geometric(PointsRef P, const std::vector<double>& weights);
 
+/// Which way a surface fitted by fit_sphere_to_surface faces its sphere: its outward normal towards the centre
+/// (a socket, the lunate surface) or away from it (a ball, the femoral head).
+enum class SurfaceSide { concave, convex };
+
+/// A sphere fitted to a surface (fit_sphere_to_surface).
+struct SurfaceSphereFit {
+  SphereFitResult sphere;        ///< the sphere (mm); iterations: the reweighting steps; rms: the weighted rms
+  double area_in_band_mm2 = 0;   ///< the surface within band_mm of the sphere and facing it (cosine >= facing_cos)
+};
+
+/// A sphere fitted to the surface of `mesh` (mm; its triangles' outward normals, by the sign of its volume) rather
+/// than to its vertices: an iteratively reweighted geometric fit (Tukey's biweight of each point's distance from
+/// the sphere, (1 - (s / band_mm)^2)^2, 0 beyond band_mm; times a smooth step of the cosine between the outward
+/// normal and the direction to the centre (concave) or from it (convex), 0 at facing_cos - 0.1, 1 at
+/// facing_cos + 0.1; times the area each point stands for), from the sphere (centre, radius), a Gauss-Newton step
+/// per reweighting until a step moves the sphere less than 1e-6 mm (at most 2,000), then GSL's weighted geometric
+/// fit with the last weights (fit_sphere_geometric) as the result. The points: each triangle within band_mm + 3 mm
+/// of the sphere cut into k x k congruent triangles (k the least power of two that makes them at most 0.5 mm long,
+/// at most 64), their centroids. The weights change continuously with the sphere and the points do not depend on
+/// the vertices' order, so that one surface gives one sphere: a file with every triangle split in four at its
+/// edges' midpoints is cut into the same points. Throws impinge::Error (naming mesh.source and `what`) when no
+/// point weighs anything or a step is not finite. Source: impinge (issue 81, item 2); the biweight: Beaton and
+/// Tukey 1974.
+SurfaceSphereFit fit_sphere_to_surface(const TriangleMesh& mesh, const Eigen::Vector3d& centre, double radius,
+                                       double band_mm, double facing_cos, SurfaceSide side, const std::string& what);
+
+/// The femoral head's surface faces away from its centre within acos(kHeadFacing) = 45.6 deg where the head fit
+/// (fit_femoral_head) weighs it fully (the neck's, across the head-neck junction, does not).
+inline constexpr double kHeadFacing = 0.7;
+
 /// Options of the automatic femoral-head fit.
 struct HeadFitOptions {
   double proximal_extent_mm = 70;  ///< candidates: vertices within this height of the most
@@ -52,7 +82,9 @@ struct HeadFitOptions {
 
 /// Automatic centre of rotation of a femur: RANSAC sphere detection on the proximal femur
 /// (4-point minimal spheres with radius in range, most inliers wins), then geometric fits on
-/// the re-selected inliers. `femur`: vertices in the working frame (RAS, +z superior), mm.
+/// the re-selected inliers until they no longer change, and last the sphere of the head's surface from there
+/// (fit_sphere_to_surface, convex, band 4.685 / 3 of the last inlier band, kHeadFacing; points_used: the last
+/// inliers, vertices). `femur`: vertices in the working frame (RAS, +z superior), mm.
 /// Throws impinge::Error naming the mesh when no plausible sphere is found.
 SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions& options = {});
 

@@ -93,6 +93,7 @@ struct RomOptions {
   double max_deg = 150;          ///< search no farther than this from neutral, deg
   static constexpr Range kMaxRange{0.1, 360};   ///< of max_deg, deg
   double tolerance_deg = 0.1;    ///< bisection until the bracket is this narrow, deg
+  static constexpr Range kToleranceRange{1e-4, 90};  ///< of tolerance_deg, deg (and at most step_deg)
   bool use_bounds = true;        ///< skip vertex clusters whose bound cannot reach the threshold (same results,
                                  ///< fewer look-ups; equiangular maps)
   RomVertices vertices = RomVertices::all;  ///< which vertices are counted (hidden ones need JointOptions::layers)
