@@ -628,6 +628,33 @@ else:
             "20 %; 30 %", "segments.csv", S06,
       kind="arithmetic", tolerance="--", conditions="--", same_subjects=True)
 
+# Fig. 57: Table 10's rays on the conchoid, original and adjusted by Eq. 16; the figure holds when this run drew it
+# and the adjusted rays cut the hip curve into more nearly equal segments than the original ones (Eq. 12's length
+# between the rays, Menschik's a and b as the experiment's meta.json gives them).
+if t10 is not None:
+    meta06 = json.load(open(os.path.join(ROOT, S06, "meta.json")))["parameters"]
+    a_, b_ = meta06["a_mm"], meta06["b_mm"]
+
+    def cut(angles):
+        out = []
+        for p0, p1 in zip(angles[:-1], angles[1:]):
+            p = np.linspace(np.radians(p0), np.radians(p1), 2001)
+            f = np.sqrt(a_ ** 2 + b_ ** 2 + 2 * a_ * b_ * np.cos(p))
+            out.append(float(np.sum((f[1:] + f[:-1]) / 2 * np.diff(p))))
+        return np.array(out)
+    so, sa = cut(list(t10.original_deg)), cut(list(t10.eq16_deg))
+    k57, v57 = drawn(f"{S06}/fig57.pdf")
+    claim("Fig. 57", "sampling rays: original (dashed) and adjusted (solid)", "the adjusted rays",
+          f"segments {', '.join(f'{x:.1f}' for x in so)} mm (original) and {', '.join(f'{x:.1f}' for x in sa)} mm "
+          f"(Eq. 16) ({k57} figure)", v57 if np.ptp(sa) < np.ptp(so) else "does_not_hold",
+          "Table 10's rays drawn on r = a + b cos(phi); the adjusted rays' segments more nearly equal", S06,
+          kind="qualitative", tolerance="the figure drawn from the same quantity; the adjusted segments' spread below "
+          "the original's", conditions="Table 10 (30 deg, 4 rays), Menschik's a and b", same_subjects=True,
+          data=f"{S06}/table10.csv; {S06}/meta.json; {S06}/fig57.pdf")
+else:
+    missing("Fig. 57", "sampling rays: original and adjusted", "the adjusted rays", "table10.csv", S06,
+            kind="qualitative", tolerance="--", conditions="--", same_subjects=True)
+
 # --- 07: helix traveled distance (Eq. 10) -------------------------------------------------------------------
 ie, selfc = csv_of("07_helix_arc_length", "index_errors.csv"), csv_of("07_helix_arc_length", "self_consistent.csv")
 S07 = "07_helix_arc_length"
@@ -652,6 +679,49 @@ if ie is not None:
           kind="measured", tolerance="the nearest nodes' stencil (direction: within one node)",
           conditions="k = 10-4584, 50,000 directions; nodes at equal exact arc length (self-consistent reading beside)",
           same_subjects=True, data="07_helix_arc_length/index_errors.csv; 07_helix_arc_length/self_consistent.csv")
+
+# Figs. 47-48: the helix drawn from the scheme's own nodes (helix_nodes.csv) and one direction's look-up on the k = 10
+# helix (helix_locate.csv): the figure holds when this run drew it from the same quantity and, for Fig. 47, the node
+# counts are the thesis' w = k^2; for Fig. 48, when the stencil is two nodes on each turn around P_a and P_b (the
+# thesis' three steps) by the exact and the Eq. 10 locator.
+hn, hl = csv_of(S07, "helix_nodes.csv"), csv_of(S07, "helix_locate.csv")
+if hn is not None and len(hn):
+    counts = hn.groupby("turns").size()
+    k47, v47 = drawn(f"{S07}/fig47.pdf")
+    square = bool(all(int(c) == int(k) ** 2 for k, c in counts.items()))
+    claim("Fig. 47", "k-turn spherical helices on the unit sphere: k = 10, 20, 40 with w = 100, 400, 1600 points",
+          "w = k^2: 100, 400, 1600", "w = " + ", ".join(f"{int(c):,}" for c in counts) + f" nodes of the helix scheme "
+          f"at k = " + ", ".join(str(int(k)) for k in counts.index) + f" on Eq. 9's curve ({k47} figure)",
+          v47 if square else "does_not_hold", "the scheme's node_direction for each node, drawn on the sphere", S07,
+          kind="qualitative", tolerance="the figure drawn from the same quantity; the counts equal k^2",
+          conditions="the helix scheme (exact arc length) at k = 10, 20, 40", same_subjects=True,
+          data=f"{S07}/helix_nodes.csv; {S07}/fig47.pdf")
+else:
+    missing("Fig. 47", "k-turn spherical helices with w = k^2 points", "100, 400, 1600", "helix_nodes.csv", S07,
+            kind="qualitative", tolerance="--", conditions="--", same_subjects=True)
+if hl is not None and len(hl):
+    pts = hl.set_index("point")
+    k48, v48 = drawn(f"{S07}/fig48.pdf")
+
+    def brackets(g):
+        g = g.sort_values("steps")
+        return bool(g.steps.iloc[0] <= pts.loc["P_a", "steps"] <= g.steps.iloc[1]
+                    and g.steps.iloc[2] <= pts.loc["P_b", "steps"] <= g.steps.iloc[3])
+    ok = {loc: brackets(g) for loc, g in hl[hl.locator != "--"].groupby("locator")}
+    claim("Fig. 48", "a direction's four neighbouring helix points: two on the turn above (around P_a) and two on the "
+          "turn below (around P_b), found by their traveled distances", "P_0, P_1 around P_a; P_2, P_3 around P_b",
+          f"k = 10, v at phi = {pts.loc['v', 'phi_deg']:.0f}, theta = {pts.loc['v', 'theta_deg']:.0f} deg: P_a at "
+          f"{pts.loc['P_a', 'steps']:.2f} and P_b at {pts.loc['P_b', 'steps']:.2f} node steps; stencil "
+          + "; ".join(f"{loc} " + ", ".join(str(int(x)) for x in g.node) for loc, g in hl[hl.locator != "--"]
+                      .groupby("locator")) + f" ({k48} figure)",
+          v48 if all(ok.values()) else "does_not_hold",
+          "the scheme's stencil for v (interpolate) against the traveled distances of P_a and P_b", S07,
+          kind="qualitative", tolerance="the figure drawn from the same quantity; the stencil brackets P_a and P_b",
+          conditions="the helix scheme at k = 10, one direction; exact and Eq. 10 locators", same_subjects=True,
+          data=f"{S07}/helix_locate.csv; {S07}/fig48.pdf")
+else:
+    missing("Fig. 48", "a direction's four neighbouring helix points", "P_0-P_3", "helix_locate.csv", S07,
+            kind="qualitative", tolerance="--", conditions="--", same_subjects=True)
 
 # --- 08: distance maps (Fig. 31, 40-42, 50) -----------------------------------------------------------------
 gs = csv_of("08_distance_maps", "gap_statistics.csv")
