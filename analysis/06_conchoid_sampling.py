@@ -2,8 +2,13 @@
 and weighted vs equiangular vs helix sampling at equal node count on a conchoid joint.
 
 Reads RESULTS/06_conchoid_sampling/{length,table10,angles,equal_nodes}.csv; writes
-table_length.tex, table10.tex, angles.pdf/png, table_equal.tex, equal.pdf/png, macros.tex."""
+table_length.tex, table10.tex, angles.pdf/png, table_equal.tex, equal.pdf/png, fig57.pdf/png (the thesis' Fig. 57:
+Table 10's four rays on the conchoid, original dashed and adjusted solid, from the experiment's a and b), macros.tex."""
+import json
+import os
+
 import matplotlib.pyplot as plt
+import numpy as np
 
 from common import experiment_dir, read_csv, save, write_macros, write_table
 
@@ -72,8 +77,47 @@ ax.set_ylabel("segment length / shortest")
 ax.grid(True, alpha=0.3)
 ax.legend()
 save(fig, d, "segments")
+# Thesis Fig. 57: the 30 deg rays of Table 10 on the conchoid r = a + b cos(phi) (Eq. 11), original (dashed) and
+# adjusted by Eq. 16 (solid), from the conchoid's origin; the segments each pair of rays cuts from the hip curve.
+meta = json.load(open(os.path.join(d, "meta.json")))
+a_mm, b_mm = meta["parameters"]["a_mm"], meta["parameters"]["b_mm"]
+
+
+def on_curve(phi_deg):
+    p = np.radians(phi_deg)
+    r = a_mm + b_mm * np.cos(p)
+    return r * np.sin(p), r * np.cos(p)
+
+
+def arc(p0_deg, p1_deg):
+    p = np.linspace(np.radians(p0_deg), np.radians(p1_deg), 2001)
+    return np.trapz(np.sqrt(a_mm ** 2 + b_mm ** 2 + 2 * a_mm * b_mm * np.cos(p)), p)
+
+
+fig, ax = plt.subplots(figsize=(4.6, 3.0))
+x, y = on_curve(np.linspace(0, 180, 721))
+ax.plot(x, y, color="0.75", lw=0.8)
+x, y = on_curve(np.linspace(0, 90, 361))
+ax.plot(x, y, color="k", lw=1.4, label="hip curve ($\\phi \\leq 90^\\circ$)")
+for r in t10.itertuples():
+    for angle, style, colour in ((r.original_deg, "--", "C0"), (r.eq16_deg, "-", "C3")):
+        px, py = on_curve(angle)
+        ax.plot([0, px], [0, py], style, color=colour, lw=1.0)
+        ax.plot([px], [py], "o", color=colour, ms=3)
+ax.plot([], [], "--", color="C0", label="original (30$^\\circ$ apart)")
+ax.plot([], [], "-", color="C3", label="adjusted (Eq. 16)")
+ax.plot([0], [0], "k+", ms=6)
+ax.set_aspect("equal")
+ax.set_xlabel("mm")
+ax.set_ylabel("mm")
+ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1), fontsize=7)
+ax.grid(True, alpha=0.3)
+save(fig, d, "fig57")
+seg_orig = [arc(p0, p1) for p0, p1 in zip(t10.original_deg[:-1], t10.original_deg[1:])]
+seg_adj = [arc(p0, p1) for p0, p1 in zip(t10.eq16_deg[:-1], t10.eq16_deg[1:])]
 exact_len = ln.iloc[0]
 write_macros(d, "macros", {
+    "CSfigOrig": ", ".join(f"{x:.1f}" for x in seg_orig), "CSfigAdj": ", ".join(f"{x:.1f}" for x in seg_adj),
     "CSsegOrigin": f"{longer['conchoid_origin']:.0f}", "CSsegCentroid": f"{longer['object_centroid']:.0f}",
     "CSsegExtent": f"{longer['object_extent_middle']:.0f}",
     "CSlenOverB": f"{exact_len.length_over_b:.3f}", "CSlen": f"{exact_len.length_mm:.2f}",

@@ -3,8 +3,11 @@
 Reads RESULTS/17_viewer/{images,latency}.csv and the PNGs images.csv names; writes fig44.pdf/png (three display modes
 x three views, the thesis' Figure 44), fig36.pdf/png (the page, Figure 36), fig42.pdf/png (per hip: both bones from
 anterior and lateral, the acetabulum from medial, at the scan pose), extremities.pdf/png (the acetabulum at each
-motion's ROM limit, Tables 12-13) and macros.tex (the first hip's data path, draw, first frame and export)."""
+motion's ROM limit, Tables 12-13), fig41.pdf/png (the levels on both bones past the first hip's first ROM limit, with
+the page's legend: the thesis' Figure 41, from levels.csv) and macros.tex (the first hip's data path, draw, first
+frame and export; Figure 41's pose and levels)."""
 import os
+import re
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -72,6 +75,36 @@ ext = images[images.figure == "Tables 12-13"]
 grid([[file_of(figure="Tables 12-13", hip=h, file=f"extremity_{h}_{m}.png") for m in motions] for h in hips], hips,
      ["flexion", "abduction", "IR at 90 flexion", "external rotation"], "extremities")
 
+# Figure 41: the acetabulum and the femur, each coloured by the levels at a pose past the ROM limit, and the page's
+# legend below them.
+levels = read_csv(d, "levels.csv") if os.path.exists(os.path.join(d, "levels.csv")) else None
+f41 = {k: "--" for k in ("VWfOneMotion", "VWfOneHip", "VWfOnePose", "VWfOneRanges", "VWfOnePelvisLevels",
+                          "VWfOneFemurLevels", "VWfOneLevels")}  # this run drew no Figure 41 (no ROM limit)
+if levels is not None and len(levels) and file_of(figure="Fig. 41", file="fig41_legend.png"):
+    fig = plt.figure(figsize=(6.0, 3.6))
+    gs = fig.add_gridspec(2, 2, height_ratios=[4, 1.1])
+    for j, (bone, title) in enumerate((("pelvis", "acetabulum, lateral (femur hidden)"),
+                                       ("femur", "femur, anterior (pelvis hidden)"))):
+        ax = fig.add_subplot(gs[0, j])
+        ax.imshow(crop(f"fig41_{bone}.png"))
+        ax.set_title(title, fontsize=8)
+        ax.axis("off")
+    ax = fig.add_subplot(gs[1, :])
+    ax.imshow(np.asarray(Image.open(os.path.join(d, "fig41_legend.png")).convert("RGB")))
+    ax.axis("off")
+    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.93, hspace=0.05, wspace=0.05)
+    save(fig, d, "fig41", rect=(0, 0, 1, 1))
+    lv = levels[levels.level != 255]
+    first41 = levels.iloc[0]
+    ranges = [re.sub(r"\d+\.\d+", lambda m: f"{float(m.group()):.3g}", r).replace("-", "--")
+              for r in dict.fromkeys(lv.sort_values("level").range_mm)]
+    shown = {b: sorted(g[g.vertices > 0].level.unique()) for b, g in lv.groupby("bone")}
+    f41 = {"VWfOneMotion": str(first41.motion).replace("_", " "), "VWfOneHip": str(first41.hip).replace("_", r"\_"),
+           "VWfOnePose": f"{first41.flexion_deg:g}, {first41.adduction_deg:g}, {first41.internal_rotation_deg:g}",
+           "VWfOneRanges": ", ".join(ranges).replace("<=", r"$\le$").replace(">", "$>$"),
+           "VWfOnePelvisLevels": str(len(shown.get("pelvis", []))), "VWfOneFemurLevels": str(len(shown.get("femur", []))),
+           "VWfOneLevels": str(lv.level.nunique())}
+
 first = latency.iloc[0]
 macros = {
     "VWhip": str(first.hip).replace("_", r"\_"), "VWresolution": f"{first.resolution_deg:g}",
@@ -86,4 +119,5 @@ macros = {
     "VWmedianLow": f"{latency.data_path_median_ms.min():.1f}", "VWmedianHigh": f"{latency.data_path_median_ms.max():.1f}",
     "VWbareShareLow": f"{100 * images.bone_share.min():.0f}",
 }
+macros.update(f41)
 write_macros(d, "macros", macros)

@@ -20,6 +20,7 @@ usage: /usr/bin/python3 analysis/claims.py [RESULTS]"""
 import csv
 import json
 import os
+import re
 import sys
 
 import numpy as np
@@ -628,6 +629,33 @@ else:
             "20 %; 30 %", "segments.csv", S06,
       kind="arithmetic", tolerance="--", conditions="--", same_subjects=True)
 
+# Fig. 57: Table 10's rays on the conchoid, original and adjusted by Eq. 16; the figure holds when this run drew it
+# and the adjusted rays cut the hip curve into more nearly equal segments than the original ones (Eq. 12's length
+# between the rays, Menschik's a and b as the experiment's meta.json gives them).
+if t10 is not None:
+    meta06 = json.load(open(os.path.join(ROOT, S06, "meta.json")))["parameters"]
+    a_, b_ = meta06["a_mm"], meta06["b_mm"]
+
+    def cut(angles):
+        out = []
+        for p0, p1 in zip(angles[:-1], angles[1:]):
+            p = np.linspace(np.radians(p0), np.radians(p1), 2001)
+            f = np.sqrt(a_ ** 2 + b_ ** 2 + 2 * a_ * b_ * np.cos(p))
+            out.append(float(np.sum((f[1:] + f[:-1]) / 2 * np.diff(p))))
+        return np.array(out)
+    so, sa = cut(list(t10.original_deg)), cut(list(t10.eq16_deg))
+    k57, v57 = drawn(f"{S06}/fig57.pdf")
+    claim("Fig. 57", "sampling rays: original (dashed) and adjusted (solid)", "the adjusted rays",
+          f"segments {', '.join(f'{x:.1f}' for x in so)} mm (original) and {', '.join(f'{x:.1f}' for x in sa)} mm "
+          f"(Eq. 16) ({k57} figure)", v57 if np.ptp(sa) < np.ptp(so) else "does_not_hold",
+          "Table 10's rays drawn on r = a + b cos(phi); the adjusted rays' segments more nearly equal", S06,
+          kind="qualitative", tolerance="the figure drawn from the same quantity; the adjusted segments' spread below "
+          "the original's", conditions="Table 10 (30 deg, 4 rays), Menschik's a and b", same_subjects=True,
+          data=f"{S06}/table10.csv; {S06}/meta.json; {S06}/fig57.pdf")
+else:
+    missing("Fig. 57", "sampling rays: original and adjusted", "the adjusted rays", "table10.csv", S06,
+            kind="qualitative", tolerance="--", conditions="--", same_subjects=True)
+
 # --- 07: helix traveled distance (Eq. 10) -------------------------------------------------------------------
 ie, selfc = csv_of("07_helix_arc_length", "index_errors.csv"), csv_of("07_helix_arc_length", "self_consistent.csv")
 S07 = "07_helix_arc_length"
@@ -653,6 +681,49 @@ if ie is not None:
           conditions="k = 10-4584, 50,000 directions; nodes at equal exact arc length (self-consistent reading beside)",
           same_subjects=True, data="07_helix_arc_length/index_errors.csv; 07_helix_arc_length/self_consistent.csv")
 
+# Figs. 47-48: the helix drawn from the scheme's own nodes (helix_nodes.csv) and one direction's look-up on the k = 10
+# helix (helix_locate.csv): the figure holds when this run drew it from the same quantity and, for Fig. 47, the node
+# counts are the thesis' w = k^2; for Fig. 48, when the stencil is two nodes on each turn around P_a and P_b (the
+# thesis' three steps) by the exact and the Eq. 10 locator.
+hn, hl = csv_of(S07, "helix_nodes.csv"), csv_of(S07, "helix_locate.csv")
+if hn is not None and len(hn):
+    counts = hn.groupby("turns").size()
+    k47, v47 = drawn(f"{S07}/fig47.pdf")
+    square = bool(all(int(c) == int(k) ** 2 for k, c in counts.items()))
+    claim("Fig. 47", "k-turn spherical helices on the unit sphere: k = 10, 20, 40 with w = 100, 400, 1600 points",
+          "w = k^2: 100, 400, 1600", "w = " + ", ".join(f"{int(c):,}" for c in counts) + f" nodes of the helix scheme "
+          f"at k = " + ", ".join(str(int(k)) for k in counts.index) + f" on Eq. 9's curve ({k47} figure)",
+          v47 if square else "does_not_hold", "the scheme's node_direction for each node, drawn on the sphere", S07,
+          kind="qualitative", tolerance="the figure drawn from the same quantity; the counts equal k^2",
+          conditions="the helix scheme (exact arc length) at k = 10, 20, 40", same_subjects=True,
+          data=f"{S07}/helix_nodes.csv; {S07}/fig47.pdf")
+else:
+    missing("Fig. 47", "k-turn spherical helices with w = k^2 points", "100, 400, 1600", "helix_nodes.csv", S07,
+            kind="qualitative", tolerance="--", conditions="--", same_subjects=True)
+if hl is not None and len(hl):
+    pts = hl.set_index("point")
+    k48, v48 = drawn(f"{S07}/fig48.pdf")
+
+    def brackets(g):
+        g = g.sort_values("steps")
+        return bool(g.steps.iloc[0] <= pts.loc["P_a", "steps"] <= g.steps.iloc[1]
+                    and g.steps.iloc[2] <= pts.loc["P_b", "steps"] <= g.steps.iloc[3])
+    ok = {loc: brackets(g) for loc, g in hl[hl.locator != "--"].groupby("locator")}
+    claim("Fig. 48", "a direction's four neighbouring helix points: two on the turn above (around P_a) and two on the "
+          "turn below (around P_b), found by their traveled distances", "P_0, P_1 around P_a; P_2, P_3 around P_b",
+          f"k = 10, v at phi = {pts.loc['v', 'phi_deg']:.0f}, theta = {pts.loc['v', 'theta_deg']:.0f} deg: P_a at "
+          f"{pts.loc['P_a', 'steps']:.2f} and P_b at {pts.loc['P_b', 'steps']:.2f} node steps; stencil "
+          + "; ".join(f"{loc} " + ", ".join(str(int(x)) for x in g.node) for loc, g in hl[hl.locator != "--"]
+                      .groupby("locator")) + f" ({k48} figure)",
+          v48 if all(ok.values()) else "does_not_hold",
+          "the scheme's stencil for v (interpolate) against the traveled distances of P_a and P_b", S07,
+          kind="qualitative", tolerance="the figure drawn from the same quantity; the stencil brackets P_a and P_b",
+          conditions="the helix scheme at k = 10, one direction; exact and Eq. 10 locators", same_subjects=True,
+          data=f"{S07}/helix_locate.csv; {S07}/fig48.pdf")
+else:
+    missing("Fig. 48", "a direction's four neighbouring helix points", "P_0-P_3", "helix_locate.csv", S07,
+            kind="qualitative", tolerance="--", conditions="--", same_subjects=True)
+
 # --- 08: distance maps (Fig. 31, 40-42, 50) -----------------------------------------------------------------
 gs = csv_of("08_distance_maps", "gap_statistics.csv")
 S08 = "08_distance_maps"
@@ -673,12 +744,6 @@ if gs is not None:
           f"{n(hx.vs_equiangular_p95_abs_mm.max())} mm)", "holds" if hx.vs_equiangular_p95_abs_mm.max() < 0.1 else "partly",
           "the same vertices looked up in both maps at matched precision (exact mode)", S08,
       kind="measured", tolerance="95th percentile under 0.1 mm", conditions="exact mode, matched precision, the same vertices", same_subjects=True)
-    k_lv, v_lv = drawn("08_distance_maps/levels.pdf")
-    claim("Fig. 41", "five colour levels after a 4 mm cartilage offset show the impingement level", "levels",
-          "levels per vertex in every output (summary.json, PLY, VTP); the levels figure of section 08", v_lv,
-          "the thresholds are parameters (--levels); this report uses 6, 4, 2 and 0 mm throughout", S08,
-      kind="qualitative", tolerance="the figure drawn from the same quantity", conditions="thresholds 6, 4, 2, 0 mm",
-      same_subjects=True, data="08_distance_maps/gap_statistics.csv; 08_distance_maps/levels.pdf")
 clock = csv_of("08_distance_maps", "red_clock_hours.csv")
 clock = clock[(clock.red_vertices > 0) & ~clock.subject.isin(list(ROM_EXCLUDED))] if clock is not None else None
 morph = csv_of("15_morphology", "morphology.csv")
@@ -950,29 +1015,88 @@ claim("Ch. 6", "the systems extend to deformable models such as cartilage, becau
       "sampling, whose cost per map is in experiment 02 (Table 3's row)", S02,
       kind="qualitative", tolerance="--", conditions="--", same_subjects=True)
 
-# --- 17: Joint3D in the browser (Sec. 3.4, Fig. 36, 44) ---------------------------------------------------------
+# --- 17: Joint3D in the browser (Sec. 3.4, Fig. 36, 41, 42, 44) ---------------------------------------------
+# The thesis' Joint3D figures reproduced from impinge view's page: each figure row holds when this run drew the same
+# quantity (the file named in data); Fig. 41's also needs every level of the page's legend on the bones it shows.
 S17 = "17_viewer"
-vw_images, vw_latency = csv_of(S17, "images.csv"), csv_of(S17, "latency.csv")
-if vw_images is not None and len(vw_images) and vw_latency is not None and len(vw_latency):
+vw_images, vw_latency, vw_levels = csv_of(S17, "images.csv"), csv_of(S17, "latency.csv"), csv_of(S17, "levels.csv")
+if vw_latency is not None and len(vw_latency):
     first = vw_latency.iloc[0]
-    claim("Fig. 36", "Joint3D lets the user control the hip's motion and watch the impingement detected and the "
+    claim("Sec. 3.4", "Joint3D lets the user control the hip's motion and watch the impingement detected and the "
           "distances on the joint surfaces", "interactive system",
           f"impinge view: a page where sliders pose the hip and both bones are coloured by the library's detection; "
           f"{n(first.data_path_median_ms)} ms median from a pose to its values ({first.hip}, "
           f"{int(first.triangles):,} triangles)", "holds" if first.data_path_median_ms <= 30 else "partly",
           "the page's values at a pose equal impinge distance's files (tests/viewer); the draw is the browser's",
           S17, kind="measured", tolerance="a pose's values in the page within a frame of a slider's move (30 ms)",
-          conditions=f"{first.resolution_deg:g} deg, distances on, 2 cores, headless Chromium", same_subjects=False)
-    f44 = vw_images[vw_images.figure == "Fig. 44"]
-    claim("Fig. 44", "three visualisation options (filled polygons, lines, blending) in three views (anterior, medial, "
-          "oblique)", "3 x 3 views", f"{len(f44)} pictures, the same modes and views, from the page", "holds",
-          "the page's display modes and view presets, photographed", S17,
-          kind="qualitative", tolerance="--", conditions="headless Chromium, SwiftShader", same_subjects=False)
+          conditions=f"{first.resolution_deg:g} deg, distances on, 2 cores, headless Chromium", same_subjects=False,
+          data=f"{S17}/latency.csv")
 else:
-    missing("Fig. 36", "Joint3D: control the motion, watch the impingement", "interactive system", "images.csv", S17,
-            kind="measured", tolerance="--", conditions="--", same_subjects=False)
-    missing("Fig. 44", "filled, lines, blending in three views", "3 x 3 views", "images.csv", S17,
-            kind="qualitative", tolerance="--", conditions="--", same_subjects=False)
+    missing("Sec. 3.4", "Joint3D: control the motion, watch the impingement", "interactive system", "latency.csv",
+            S17, kind="measured", tolerance="--", conditions="--", same_subjects=False)
+VW_COND = "impinge view in headless Chromium (SwiftShader); our hips, not the thesis' patient"
+if vw_images is not None and len(vw_images):
+    def shots(figure):
+        return vw_images[vw_images.figure == figure]
+    k36, v36 = drawn(f"{S17}/fig36.pdf")
+    f36 = shots("Fig. 36")
+    claim("Fig. 36", "Joint3D: a right hip joint displayed from anterior view", "the hip from anterior",
+          f"the page with {', '.join(sorted(set(f36.hip)))} from anterior, coloured by the levels ({k36} figure)",
+          v36, "the page photographed at a pose", S17, kind="qualitative",
+          tolerance="the figure drawn from the same quantity", conditions=VW_COND, same_subjects=False,
+          data=f"{S17}/images.csv; {S17}/fig36.pdf")
+    k42, v42 = drawn(f"{S17}/fig42.pdf")
+    f42 = shots("Fig. 42")
+    claim("Fig. 42", "the impingement result (the strain distribution) drawn on both models: the joint from anterior, "
+          "the socket from the side, the femur", "three views", f"{len(f42)} pictures of {f42.hip.nunique()} hips at "
+          f"the scan pose: both bones from anterior and lateral, the acetabulum from medial ({k42} figure)", v42,
+          "the page's levels on both bones, photographed in three views; where the impinged regions lie is the "
+          "clock-hour row (Fig. 42; Fig. 43)", S17, kind="qualitative",
+          tolerance="the figure drawn from the same quantity", conditions=VW_COND, same_subjects=False,
+          data=f"{S17}/images.csv; {S17}/fig42.pdf")
+    k44, v44 = drawn(f"{S17}/fig44.pdf")
+    f44 = shots("Fig. 44")
+    claim("Fig. 44", "three visualisation options (filled polygons, lines, blending) in three views (anterior, medial, "
+          "oblique)", "3 x 3 views", f"{len(f44)} pictures, {f44.display.nunique()} modes x {f44.view.nunique()} "
+          f"views, from the page ({k44} figure)", v44 if len(f44) == 9 else "partly",
+          "the page's display modes and view presets, photographed", S17,
+          kind="qualitative", tolerance="the figure drawn from the same quantity (3 x 3 pictures)",
+          conditions=VW_COND, same_subjects=False, data=f"{S17}/images.csv; {S17}/fig44.pdf")
+else:
+    for item, text in (("Fig. 36", "a right hip joint from anterior"), ("Fig. 42", "the result on both models"),
+                       ("Fig. 44", "filled, lines, blending in three views")):
+        missing(item, text, "figure", "images.csv", S17, kind="qualitative", tolerance="--", conditions="--",
+                same_subjects=False)
+k_lv, _ = drawn("08_distance_maps/levels.pdf")
+k41, v41 = drawn(f"{S17}/fig41.pdf")
+if vw_levels is not None and len(vw_levels) and k41:
+    lv = vw_levels[vw_levels.level != 255]
+    shown = {b: int((g.vertices > 0).sum()) for b, g in lv.groupby("bone")}
+    every = lv.groupby("bone").size().max()
+    r41 = vw_levels.iloc[0]
+    FIG41_PAST = json.load(open(os.path.join(ROOT, S17, "meta.json")))["parameters"].get("fig41_past_limit_deg", "--")
+    claim("Fig. 41", "five colour levels (none; four levels within the 4 mm cartilage offset, purple at contact) show "
+          "the impingement level; the head moved into the socket to show them", "5 levels",
+          f"{every} levels ({', '.join(re.sub(r'[0-9]+[.][0-9]+', lambda m: f'{float(m.group()):.3g}', x) for x in dict.fromkeys(lv.sort_values('level').range_mm))} mm) in the page's legend; "
+          + ", ".join(f"{k} of {every} on the {b}" for b, k in shown.items())
+          + f" of {r41.hip} at {r41.motion.replace('_', ' ')} {r41.flexion_deg:g}, {r41.adduction_deg:g}, "
+          f"{r41.internal_rotation_deg:g} deg (past its ROM limit); the levels figure of section 08 beside "
+          f"({k41 + k_lv} figures)",
+          v41 if all(k == every for k in shown.values()) else "partly",
+          "the page's levels (the library's, as every output gives them) photographed with its legend; the "
+          "thresholds are parameters (--levels): the page's clinical preset splits 4 mm in thirds, section 08 uses "
+          "6, 4, 2 and 0 mm", S17, kind="qualitative",
+          tolerance="the figure drawn from the same quantity; every level of the legend on both bones",
+          conditions=VW_COND + f"; {FIG41_PAST} deg past the first ROM limit", same_subjects=False,
+          data=f"{S17}/levels.csv; {S17}/fig41.pdf; 08_distance_maps/levels.pdf")
+else:
+    claim("Fig. 41", "five colour levels after a 4 mm cartilage offset show the impingement level", "levels",
+          "levels per vertex in every output (summary.json, PLY, VTP); the levels figure of section 08" if k_lv
+          else "--", "holds" if k_lv else "not_testable",
+          "the thresholds are parameters (--levels); section 08 uses 6, 4, 2 and 0 mm (the viewer's figure: not in "
+          "this run)", "08_distance_maps", kind="qualitative", tolerance="the figure drawn from the same quantity",
+          conditions="thresholds 6, 4, 2, 0 mm", same_subjects=True,
+          data="08_distance_maps/gap_statistics.csv; 08_distance_maps/levels.pdf")
 
 # --- write -------------------------------------------------------------------------------------------------
 out = os.path.join(ROOT, "claims.csv")

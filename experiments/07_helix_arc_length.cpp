@@ -13,12 +13,19 @@
 //                     spacing along the curve against the exact helix's equal spacing (smallest and largest
 //                     ratio, where the largest lies, and the share of intervals within 10 % of it) -- the
 //                     sensitivity check of a self-consistent Eq. 10 helix (issue 51)
+//   helix_nodes.csv   thesis Fig. 47: every node of the k = 10, 20 and 40 helices (w = k^2 nodes), as the scheme
+//                     places them (node_angles, node_direction)
+//   helix_locate.csv  thesis Fig. 48: one direction v on the k = 10 helix, the points P_a and P_b where its
+//                     meridian crosses the turns above and below, the four nodes of its stencil (both locators),
+//                     each with its traveled distance (exact arc length from the start, unit sphere) in node steps
 //   meta.json
 // Command: build/experiments/exp_07_helix_arc_length --out results [--quick]
 #include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "experiment_support.hpp"
 #include "impinge/core/spherical_frame.hpp"
@@ -26,6 +33,52 @@
 
 using namespace impinge;
 using namespace impinge::experiment;
+
+namespace {
+
+// Thesis Figs. 47-48 drawn from the scheme's own geometry: the nodes of three helices, and the look-up of one
+// direction on the k = 10 helix (the turns bracketing it, its stencil by the exact and the Eq. 10 locator).
+void write_figure_geometry(const std::string& dir) {
+  CsvWriter nodes(dir + "/helix_nodes.csv", {"turns", "node", "phi_deg", "theta_deg", "x", "y", "z"});
+  for (double k : {10.0, 20.0, 40.0}) {
+    const HelixScheme h(k);
+    std::vector<double> phi(static_cast<std::size_t>(h.num_nodes())), theta(phi.size());
+    h.node_angles(0, h.num_nodes(), phi.data(), theta.data());
+    for (std::int64_t i = 0; i < h.num_nodes(); ++i) {
+      const Eigen::Vector3d u = h.node_direction(i);
+      nodes.row(k, i, phi[std::size_t(i)] * kRadToDeg, theta[std::size_t(i)] * kRadToDeg, u.x(), u.y(), u.z());
+    }
+  }
+  CsvWriter loc(dir + "/helix_locate.csv",
+                {"turns", "point", "locator", "node", "phi_deg", "theta_deg", "x", "y", "z", "steps", "weight"});
+  const double k = 10, phi_v = 64 * kDegToRad, theta_v = 235 * kDegToRad;
+  const HelixScheme exact(k), fitted(k, TraveledDistance::fitted);
+  const double dx = exact.node_spacing();
+  const Eigen::Vector3d v = direction(phi_v, theta_v);
+  auto point = [&](const char* name, const char* locator, std::int64_t node, double phi, double theta, double w) {
+    const Eigen::Vector3d u = direction(phi, theta);
+    loc.row(k, name, locator, node, phi * kRadToDeg, theta * kRadToDeg, u.x(), u.y(), u.z(),
+            exact.arc_length()(phi) / dx, w);
+  };
+  point("v", "--", -1, phi_v, theta_v, 1.0);
+  // The turns (theta = 2 k phi, Eq. 9) cross v's meridian at phi_j = (theta_v + 2 pi j) / (2 k): the last such phi
+  // before phi_v (the turn above, P_a) and the next (the turn below, P_b).
+  const double j = std::floor((2 * k * phi_v - theta_v) / (2 * kPi));
+  const double phi_a = (theta_v + 2 * kPi * j) / (2 * k), phi_b = phi_a + kPi / k;
+  point("P_a", "--", -1, phi_a, theta_v, 0.0);
+  point("P_b", "--", -1, phi_b, theta_v, 0.0);
+  for (const HelixScheme* h : {&exact, &fitted}) {
+    const Stencil st = h->interpolate(v);
+    for (int n = 0; n < 4; ++n) {
+      std::vector<double> phi(1), theta(1);
+      exact.node_angles(st.nodes[std::size_t(n)], 1, phi.data(), theta.data());
+      point(("stencil_" + std::to_string(n)).c_str(), h == &exact ? "exact" : "eq10", st.nodes[std::size_t(n)],
+            phi[0], theta[0], st.weights[std::size_t(n)]);
+    }
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   const Args args = parse_args(argc, argv, "07_helix_arc_length: thesis Eq. 10 against the exact arc length");
@@ -42,6 +95,7 @@ int main(int argc, char** argv) {
        "eq10_ns_per_locate", "eq10_ns_q25", "eq10_ns_q75", "runs"});
   CsvWriter self(dir + "/self_consistent.csv", {"turns", "nodes", "exact_spacing_deg", "min_spacing_ratio",
                                                  "max_spacing_ratio", "phi_of_max_deg", "share_within_10pct"});
+  write_figure_geometry(dir);
   int step = 0;
   for (double k : turns) {
     progress("07_helix_arc_length", ++step, int(turns.size()), "k=" + std::to_string(int(k)));

@@ -8,7 +8,10 @@ drives its page in Debian's headless Chromium (SwiftShader). Writes to OUT/17_vi
   in a level's colour) and the PNGs it names: Figure 36 (the page: a right hip from anterior), Figure 44 (filled,
   lines and blending x anterior, medial and oblique views at a pose, the first hip), Figure 42's three views
   (anterior and lateral with both bones, the acetabulum from medial) and Tables 12-13's extremity images (the
-  acetabulum from medial at each of four motions' ROM limits) per hip;
+  acetabulum from medial at each of four motions' ROM limits) per hip, and Figure 41 (the first hip pushed past its
+  first ROM limit, as the thesis pushed the head into the socket to show the colours: the acetabulum from medial, the
+  femur from anterior, and the page's legend of the levels);
+- levels.csv: Figure 41's pose and, per bone and level (the page's levels: 255 not tested), its vertices;
 - latency.csv per hip: the data path (a pose asked to its values in the page's colour buffer: request, detection,
   transfer, decode, colouring) over many poses, the draw (one colour upload and one render of the page as it opens:
   both bones, the pelvis cropped to the acetabulum; triangles_drawn; waited for by reading a pixel back), the first coloured frame after the command starts, and the size, poses, writing time and load time
@@ -28,6 +31,7 @@ import impinge
 
 CLI = os.path.join(ROOT, "build", "impinge")
 EXTREMITY_MOTIONS = ("flexion", "abduction", "internal_rotation_90_flexion", "external_rotation")
+FIG41_PAST_DEG = 10.0  # Figure 41's pose: this far past the first ROM limit along its motion
 
 
 def quantile(xs, q):
@@ -102,6 +106,40 @@ def shoot(d, folder, name, rows, hip, figure, view, display, pose, whole_page=Fa
     rows.append([hip, figure, view, display, *pose, name, round(bone, 4), round(coloured, 4)])
 
 
+def fig41(d, folder, rows, levels, hip, rom):
+    """Thesis Figure 41: the levels' colours on both bones at a pose past the first ROM limit (the bones overlap, so
+    every level shows), and the page's legend of them (cropped from the whole page)."""
+    motion = next((m for m in EXTREMITY_MOTIONS if rom.get(m, {}).get("pose_at_limit_deg")), None)
+    if motion is None:
+        return
+    r = rom[motion]
+    start, at, limit = r.get("start_deg") or [0.0, 0.0, 0.0], r["pose_at_limit_deg"], r["limit_deg"]
+    scale = (limit + FIG41_PAST_DEG) / limit if limit else 1.0
+    pose = tuple(round(s_ + (a - s_) * scale, 2) for s_, a in zip(start, at))
+    set_pose(d, pose)
+    t = [float(x) for x in d.execute_script("return window.__impinge.scene.levels_thresholds_mm")]
+    ranges = [f">{t[0]:.3g}"] + [f"{a:.3g}-{b:.3g}" for a, b in zip(t[:-1], t[1:])] + [f"<={t[-1]:.3g}"]
+    for bone, femur, pelvis, view in (("pelvis", False, True, "lateral"), ("femur", True, False, "anterior")):
+        page_state(d, femur=femur, pelvis=pelvis, clock=False)
+        shoot(d, folder, f"fig41_{bone}.png", rows, hip, "Fig. 41", view, "filled", pose)
+        counts = d.execute_script("const c = {}; for (const x of window.__impinge.frame[arguments[0]].level) "
+                                  "c[x] = (c[x] || 0) + 1; return c;", bone)
+        for lv in [*range(len(ranges)), 255]:  # every level, shown or not (255: not tested)
+            levels.append([hip, motion, *pose, bone, lv, ranges[lv] if lv < len(ranges) else "not tested",
+                           int(counts.get(str(lv), 0))])
+    page_state(d)
+    png = d.get_screenshot_as_png()
+    box = d.execute_script("const r = ['legend', 'legend-labels', 'legend-note'].map(i => "
+                           "document.getElementById(i).getBoundingClientRect()); const dpr = window.devicePixelRatio;"
+                           "return [Math.min(...r.map(b => b.left)) * dpr, r[0].top * dpr, "
+                           "Math.max(...r.map(b => b.right)) * dpr, r[2].bottom * dpr];")
+    import io
+
+    from PIL import Image
+    Image.open(io.BytesIO(png)).crop(tuple(int(round(x)) for x in box)).save(os.path.join(folder, "fig41_legend.png"))
+    rows.append([hip, "Fig. 41", "legend", "levels", *pose, "fig41_legend.png", 0.0, 0.0])
+
+
 def set_pose(d, pose):
     d.execute_async_script("window.__impinge.setPose(arguments[0], arguments[1], arguments[2]).then(arguments[3])",
                            *pose)
@@ -119,7 +157,7 @@ def main():
                    capture_output=True)
     subjects = [(h, os.path.join(data, h, "subject.json")) for h in hips] + [("generated", os.path.join(gen,
                                                                                                        "subject.json"))]
-    images, latency = [], []
+    images, latency, levels = [], [], []
     d = browser()
     try:
         for k, (hip, subject) in enumerate(subjects):
@@ -151,6 +189,8 @@ def main():
                 rom = wait(d, "return window.__impinge.rom || (document.getElementById('rom-state').textContent"
                               ".startsWith('computing') ? null : [])")  # [] when the ROM search failed (said)
                 rom = {r["motion"]: r for r in rom}
+                if k == 0:
+                    fig41(d, d_out, images, levels, hip, rom)
                 for motion in EXTREMITY_MOTIONS:
                     at = rom.get(motion, {}).get("pose_at_limit_deg")
                     if not at:
@@ -196,6 +236,11 @@ def main():
         w.writerow(["hip", "figure", "view", "display", "flexion_deg", "adduction_deg", "internal_rotation_deg",
                     "file", "bone_share", "coloured_share"])
         w.writerows(images)
+    with open(os.path.join(d_out, "levels.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["hip", "motion", "flexion_deg", "adduction_deg", "internal_rotation_deg", "bone", "level",
+                    "range_mm", "vertices"])
+        w.writerows(levels)
     with open(os.path.join(d_out, "latency.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["hip", "resolution_deg", "vertices", "triangles", "poses", "data_path_median_ms",
@@ -206,7 +251,7 @@ def main():
     write_meta(d_out, "17_viewer", quick=quick, data_folder=data if hips else None,
                timing="wall clock in the page (performance.now) and of the command; each hip once: medians and 95th "
                       "percentiles over its poses and draws",
-               parameters={"resolution_deg": resolution, "subjects": hips + ["generated (12k triangles, 2 mm cam)"],
+               parameters={"resolution_deg": resolution, "fig41_past_limit_deg": FIG41_PAST_DEG, "subjects": hips + ["generated (12k triangles, 2 mm cam)"],
                            "renderer": "headless Chromium, SwiftShader (software WebGL2)", "window": "1280x860"},
                versions={"chromium": subprocess.run(["chromium", "--version"], capture_output=True,
                                                     text=True).stdout.strip()})
