@@ -45,10 +45,18 @@ import os
 import statistics
 import time
 
-import numpy as np
-from experiment_support import experiment_args, write_meta
+# OpenMP threads that wait between parallel regions sleep instead of spinning (read when libgomp loads, so before
+# impinge and Open3D, which share it; the subprocesses inherit it; OMP_WAIT_POLICY set outside wins). On a 2-core
+# machine that another job shares, spinning made a second thread wait for a core: on 2026-11-29 impinge's pose at
+# 2 threads took 8.0 ms spinning against 2.6 ms sleeping, and Open3D's signed distance of 245 points 48 ms against
+# 0.6 ms (its sign step, compute_occupancy; count_intersections alone did not stall), in steps of a scheduler tick:
+# the ratios followed the machine's load, not the tools.
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
-import impinge
+import numpy as np  # noqa: E402
+from experiment_support import experiment_args, write_meta  # noqa: E402
+
+import impinge  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -202,7 +210,7 @@ def three_ways(j, pose, scenes, culler, threads, rounds, impinge_set):
     before = impinge.get_threads()
     impinge.set_threads(threads)
     try:
-        for f in fns:  # warm-up
+        for f in fns[:1] + fns[2:]:  # warm-up ((a) queries the scenes that (b) and (c) warm: its run would cost most)
             f()
         times = paired_rounds(fns, rounds)
         r = j.detect_pose(*pose)
@@ -345,7 +353,8 @@ def main():
     write_meta(d, "13_distance_peers", quick=quick, data_folder=data if data and os.path.isdir(data) else None,
                repetitions=reps,
                timing="median wall time after one warm-up run, one thread each (impinge's scans, Open3D nthreads=1, "
-                      "VTK); whole processes: median and quartiles of alternated runs",
+                      "VTK); whole processes: median and quartiles of alternated runs; OMP_WAIT_POLICY="
+                      f"{os.environ.get('OMP_WAIT_POLICY')} (the file comment)",
                parameters={"resolution_deg": resolution, "scheme": "equiangular",
                            "distance_reach_mm": "the largest --levels threshold (three_ways.csv: reach_mm)",
                            "poses_deg": poses,
