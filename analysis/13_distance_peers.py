@@ -184,6 +184,28 @@ if tw is not None and len(tw):
                         "vertices of the opposite sign (Open3D's sign by one ray's crossings, on the MRI surfaces "
                         "that are not closed).")
 
+    # The three ways' ratios per hip (medians over the poses of each pose's paired median), one panel per thread count.
+    counts = sorted(tw.threads.unique())
+    fig, axes = plt.subplots(1, len(counts), figsize=(3.6 * len(counts) + 1.6, 3.2), squeeze=False, sharey=True)
+    most = tw.groupby("threads").subject.nunique().max()
+    for ax, threads in zip(axes[0], counts):
+        g = tw[tw.threads == threads]
+        hips = list(dict.fromkeys(g.subject))
+        x = np.arange(len(hips))
+        for k, (way, label) in enumerate(WAYS):
+            m = g.groupby("subject")[f"ratio_{way}_median"].median().reindex(hips)
+            lo = g.groupby("subject")[f"ratio_{way}_q25"].median().reindex(hips)
+            hi = g.groupby("subject")[f"ratio_{way}_q75"].median().reindex(hips)
+            ax.bar(x + (k - 1) * 0.27, m, 0.27, yerr=[m - lo, hi - m], capsize=2, label=f"({'abc'[k]}) {label}")
+        ax.axhline(1, color="k", lw=0.8)
+        ax.set_xticks(x, hips, rotation=20)
+        ax.set_xlim(-0.6, most - 0.4)  # the same bar width in every panel
+        ax.set_yscale("log")
+        ax.set_title(f"{threads} thread{'s' if threads > 1 else ''}")
+    axes[0][0].set_ylabel("Open3D time / impinge time")
+    fig.legend(*axes[0][0].get_legend_handles_labels(), loc="center right", frameon=False)
+    save(fig, d, "peers_three_ways", rect=(0, 0, 0.76, 1))
+
     def per_hip(way, threads):
         """The per-hip medians (over the poses) of the paired ratio's medians at `threads` threads."""
         g = tw[tw.threads == threads]
