@@ -2,7 +2,9 @@
 poses, one thread each (issue 26, item 4).
 
 Reads RESULTS/13_distance_peers/distance_peers.csv; writes table_peers.tex (per subject, medians over poses),
-peers_time.pdf (time per pose per tool and subject), macros.tex."""
+peers_time.pdf (time per pose per tool and subject), macros.tex; from three_ways.csv (issue 82, item 3)
+table_three_ways.tex (per hip, pose and thread count: Open3D on every vertex, after a KD-tree cull and on impinge's
+own vertex set, each over impinge) and its macros (PEERthree*)."""
 import json
 import os
 
@@ -145,4 +147,113 @@ else:
     wp_macros["WPaims"] = "the aims were not measured in this run"
 with open(os.path.join(d, "macros.tex"), "a") as f:
     for k, v in wp_macros.items():
+        f.write("\\newcommand{\\%s}{%s}\n" % (k, v))
+
+
+# Open3D three ways against impinge, paired round by round (experiments/13_distance_peers.py, three_ways.csv): a
+# naive user's (every vertex), a competent user's (a KD-tree cull, then the exact query) and impinge's own vertex set.
+tw_path = os.path.join(d, "three_ways.csv")
+tw = read_csv(d, "three_ways.csv") if os.path.exists(tw_path) else None
+WAYS = (("every", "every vertex"), ("culled", "KD-tree cull"), ("own", "impinge's set"))
+tw_macros = {}
+if tw is not None and len(tw):
+    def cell(r, name, fmt, unit=""):
+        return timing_text(r[f"{name}_median{unit}"], r[f"{name}_q25{unit}"], r[f"{name}_q75{unit}"], r.rounds, fmt)
+
+    def short(x):
+        """A ratio to two or three digits: 141, 14.7, 0.83."""
+        return f"{x:.0f}" if x >= 100 else f"{x:.1f}" if x >= 1 else f"{x:.2f}"
+
+    rows = []
+    for _, r in tw.iterrows():
+        pose = f"{r.flexion_deg:g}/{r.adduction_deg:g}/{r.internal_rotation_deg:g}"
+        rows.append([r.subject, pose, str(int(r.threads)), f"{int(r.vertices_every):,}", f"{int(r.vertices_culled):,}",
+                     f"{int(r.vertices_impinge):,}", cell(r, "impinge", lambda x: f"{x:.2f}", "_ms"),
+                     *(cell(r, f"ratio_{w}", short) for w, _ in WAYS),
+                     str(int(r.culled_lost)), f"{r.culled_max_diff_mm:.1g}", str(int(r.culled_sign_disagreements))])
+    rounds = int(tw.rounds.min())
+    write_table(d, "table_three_ways", ["hip", "pose (deg)", "thr.", "every", "kept", "impinge's", "impinge ms",
+                                        "(a) every", "(b) cull", "(c) own", "lost", "diff mm", "signs"],
+                rows, align="llrrrrrrrrrrr", stack=True, label="tab:peers-three-ways",
+                caption="Open3D three ways against impinge per hip, pose (flexion/adduction/internal rotation) and "
+                        "thread count (thr.), in one run: the vertices of both bones Open3D is given (a) every vertex, "
+                        "(b) those a KD-tree cull keeps (kept), (c) impinge's own vertex set (impinge's); impinge's "
+                        "time per pose (ms: the detect\\_pose call that returns both bones' distances); Open3D's time over impinge's in each way, paired round by round "
+                        f"(median and quartiles over {rounds} alternated rounds); the cull's check against "
+                        "impinge's distances: impinge's vertices it lost, the largest |difference| (mm) and the "
+                        "vertices of the opposite sign (Open3D's sign by one ray's crossings, on the MRI surfaces "
+                        "that are not closed).")
+
+    # The three ways' ratios per hip (medians over the poses of each pose's paired median), one panel per thread count.
+    counts = sorted(tw.threads.unique())
+    fig, axes = plt.subplots(1, len(counts), figsize=(3.6 * len(counts) + 1.6, 3.2), squeeze=False, sharey=True)
+    most = tw.groupby("threads").subject.nunique().max()
+    for ax, threads in zip(axes[0], counts):
+        g = tw[tw.threads == threads]
+        hips = list(dict.fromkeys(g.subject))
+        x = np.arange(len(hips))
+        for k, (way, label) in enumerate(WAYS):
+            m = g.groupby("subject")[f"ratio_{way}_median"].median().reindex(hips)
+            lo = g.groupby("subject")[f"ratio_{way}_q25"].median().reindex(hips)
+            hi = g.groupby("subject")[f"ratio_{way}_q75"].median().reindex(hips)
+            ax.bar(x + (k - 1) * 0.27, m, 0.27, yerr=[m - lo, hi - m], capsize=2, label=f"({'abc'[k]}) {label}")
+        ax.axhline(1, color="k", lw=0.8)
+        ax.set_xticks(x, hips, rotation=20)
+        ax.set_xlim(-0.6, most - 0.4)  # the same bar width in every panel
+        ax.set_yscale("log")
+        ax.set_title(f"{threads} thread{'s' if threads > 1 else ''}")
+    axes[0][0].set_ylabel("Open3D time / impinge time")
+    fig.legend(*axes[0][0].get_legend_handles_labels(), loc="center right", frameon=False)
+    save(fig, d, "peers_three_ways", rect=(0, 0, 0.76, 1))
+
+    def per_hip(way, threads):
+        """The per-hip medians (over the poses) of the paired ratio's medians at `threads` threads."""
+        g = tw[tw.threads == threads]
+        return g.groupby("subject")[f"ratio_{way}_median"].median()
+
+    def hip_span(v, digits=1):
+        """The range of per-hip values as the text prints it ("--" when none)."""
+        if not len(v):
+            return "--"
+        lo, hi = f"{v.min():.{digits}f}", f"{v.max():.{digits}f}"
+        return lo if lo == hi else f"{lo}--{hi}"
+
+    def hip_range(way, threads, digits=1):
+        return hip_span(per_hip(way, threads), digits)
+
+    names = {"every": "Every", "culled": "Culled", "own": "Own"}
+    for w, _ in WAYS:
+        for threads, word in ((1, "One"), (2, "Two")):
+            tw_macros[f"PEERthree{names[w]}{word}"] = hip_range(w, threads, 0 if w == "every" else 1)
+    two = tw[tw.threads == 2]
+    tw_macros.update({
+        "PEERthreeHips": str(tw.subject.nunique()),
+        "PEERthreeOverstate": hip_span(per_hip("every", 1) / per_hip("culled", 1)),
+        "PEERthreeTwoHips": ", ".join(dict.fromkeys(two.subject)) if len(two) else "none",
+        "PEERthreeRows": str(len(tw)),
+        "PEERthreeRounds": str(int(tw.rounds.min())),
+        "PEERthreeLost": str(int(tw.culled_lost.sum())),
+        "PEERthreeMaxDiff": f"{tw.culled_max_diff_mm.max():.1g}",
+        "PEERthreeSigns": str(int(tw.culled_sign_disagreements.sum())),
+        "PEERthreeMaxDiffSame": power_of_ten(tw.culled_max_diff_same_sign_mm.max()),
+        "PEERthreeBoundRange": f"{tw[['cull_bound_femur_tree_mm', 'cull_bound_pelvis_tree_mm']].min().min():.1f}--"
+                               f"{tw[['cull_bound_femur_tree_mm', 'cull_bound_pelvis_tree_mm']].max().max():.1f}",
+        "PEERthreeKeptShare": f"{100 * (tw.vertices_culled / tw.vertices_every).min():.0f}--"
+                              f"{100 * (tw.vertices_culled / tw.vertices_every).max():.0f}",
+        "PEERthreeKeptOverOwn": f"{(tw.vertices_culled / tw.vertices_impinge).min():.1f}--"
+                                f"{(tw.vertices_culled / tw.vertices_impinge).max():.1f}",
+        "PEERthreeBuildMs": f"{tw.kdtree_build_ms.min():.0f}--{tw.kdtree_build_ms.max():.0f}",
+        # impinge faster than the competent user in every paired round; Open3D on impinge's set faster in every one.
+        "PEERthreeCulledLeadRows": str(int((tw.ratio_culled_min > 1).sum())),
+        "PEERthreeOwnBehindRows": str(int((tw.ratio_own_max < 1).sum())),
+    })
+else:
+    tw_macros = {f"PEERthree{w}{t}": "--" for w in ("Every", "Culled", "Own") for t in ("One", "Two")}
+    tw_macros.update({k: "--" for k in ("PEERthreeHips", "PEERthreeTwoHips", "PEERthreeRows", "PEERthreeRounds",
+                                        "PEERthreeLost", "PEERthreeMaxDiff", "PEERthreeSigns", "PEERthreeKeptShare",
+                                        "PEERthreeMaxDiffSame", "PEERthreeBoundRange", "PEERthreeOverstate",
+                                        "PEERthreeKeptOverOwn", "PEERthreeBuildMs", "PEERthreeCulledLeadRows",
+                                        "PEERthreeOwnBehindRows")})
+with open(os.path.join(d, "macros.tex"), "a") as f:
+    for k, v in tw_macros.items():
         f.write("\\newcommand{\\%s}{%s}\n" % (k, v))

@@ -351,6 +351,9 @@ if det is not None:
     tri = det[det.subject.isin(real)].femur_triangles
     lo_hi("FclAll", fr_all, 2)
     lo_hi("FclFirst", fr_first, 2)
+    # At the pushed pose alone, where the bones touch (issue 82, item 3: section 13 cites them beside the peers).
+    lo_hi("FclAllPushed", [t(s, "fcl_collide", pose=PUSHED) / t(s, "rsid", 0.1, PUSHED) for s in real], 2)
+    lo_hi("FclFirstPushed", [t(s, "fcl_first_contact", pose=PUSHED) / t(s, "rsid", 0.1, PUSHED) for s in real], 2)
     facts.update(FclFirstTwelveKMs=n(f12first), RsidTwelveKMs=n(r12), FclTwelveKRounds=str(k12),
                  TwelveKRounds=str(m12), RealRoundsRsid=str(sum(k for k, _ in real_wins)),
                  RealRounds=str(sum(m for _, m in real_wins)))
@@ -965,23 +968,55 @@ if syn is not None:
 
 # --- 13: the radial gap against closest-point distance (Sec. 3.6.1, Ch. 6) ----------------------------------
 peers = csv_of("13_distance_peers", "distance_peers.csv")
+ways = csv_of("13_distance_peers", "three_ways.csv")
 rvd = csv_of("08_distance_maps", "radial_vs_distance.csv")
-if peers is not None and len(peers):
-    ratio = peers.open3d_ms / peers.impinge_radial_ms
+if ways is not None and len(ways):
+    # Judged against a competent Open3D user (issue 82, item 3): a KD-tree cull to the vertices that can be within
+    # reach, then Open3D's exact signed distance of those only, against impinge's detect_pose, paired round by round.
+    # The naive way (every vertex: the whole-process table's per-pose rows) and impinge's own vertex set (which a user
+    # cannot know beforehand) stand beside it; neither is the fair comparison.
+    def per_hip(way, threads):
+        g = ways[ways.threads == threads]
+        return g.groupby("subject")[f"ratio_{way}_median"].median().tolist()
+    one, two = ways[ways.threads == 1], ways[ways.threads == 2]
+    lead = int((ways.ratio_culled_min > 1).sum())  # impinge faster in every paired round (the measured rule)
+    lo_hi("CompetentOne", per_hip("culled", 1), 2)
+    lo_hi("NaiveOne", per_hip("every", 1), 2)
+    lo_hi("OwnOne", per_hip("own", 1), 2)
+    if len(two):
+        lo_hi("CompetentTwo", per_hip("culled", 2), 2)
+    else:
+        facts["CompetentTwoLow"] = facts["CompetentTwoHigh"] = "--"
+    facts.update(CompetentHips=str(ways.subject.nunique()), CompetentLost=str(int(ways.culled_lost.sum())))
     agree = rvd[rvd.pose == "scan"].p95_abs_diff_mm if rvd is not None else pd.Series(dtype=float)
-    claim("Sec. 3.6.1; Ch. 6", "the map gives the surface-to-surface distance without extra cost, where a BVH "
-          "must search its tree for every point", "O(n) against O(n log n)",
-          f"per pose, Open3D's closest points for the vertices within reach take {span(ratio, 2)}x both radial scans "
-          f"of every vertex (layered maps included; faster on {int((ratio > 1).sum())} of {len(ratio)} poses); the "
-          f"radial gap against the closest-point distance: p95 |difference| {span(agree, 2, ' mm')} per scan at the "
-          "scan pose",
-          measured_verdict(bool((ratio > 1).all() and (agree <= 0.1).all()), bool(ratio.median() > 1)),
-          "the look-up is faster on most poses, but the radial gap is a distance along the ray, not the closest "
-          "point's: they part where the ray grazes a bone (section 08)", "13_distance_peers",
-          kind="measured", tolerance="faster than Open3D on every pose, and the radial gap within 0.1 mm of the "
-          "closest-point distance (p95); direction: faster on the median pose",
-          conditions="per pose, one thread, layered maps; every real hip", same_subjects=True,
-          data="13_distance_peers/distance_peers.csv; 08_distance_maps/radial_vs_distance.csv")
+    two_text = (f", {span(per_hip('culled', 2), 2)}x at two threads ({', '.join(dict.fromkeys(two.subject))})"
+                if len(two) else "")
+    claim("Sec. 3.6.1; Ch. 6", "the map gives the surface-to-surface distance without extra cost, where a "
+          "BVH must search its tree for every point", "O(n) against O(n log n)",
+          f"per pose, a competent Open3D user (a KD-tree cull to the vertices within reach plus the longest edge, then "
+          f"Open3D's exact signed distance of those; {int(ways.culled_lost.sum())} of impinge's vertices lost) takes "
+          f"{span(per_hip('culled', 1), 2)}x impinge's time at one thread (per-hip medians of the paired ratios)"
+          f"{two_text}; impinge faster in every paired round on {lead} of {len(ways)} hip-pose rows; beside it, "
+          f"Open3D on every vertex {span(per_hip('every', 1), 2)}x and on impinge's own vertex set "
+          f"{span(per_hip('own', 1), 2)}x; the radial gap against the closest-point distance: p95 |difference| "
+          f"{span(agree, 2, ' mm')} per scan at the scan pose",
+          measured_verdict(bool((ways.ratio_culled_min > 1).all() and (agree <= 0.1).all()),
+                           bool(ways.ratio_culled_median.median() > 1)),
+          "judged against a competent user's pipeline, the same answer side by side (issue 82): the naive ratio of "
+          "the whole-process table's per-pose rows (section 13) sets Open3D on every vertex against impinge on the vertices within reach, and "
+          "Open3D on impinge's own vertex set needs what only impinge's bounds know; the look-up is faster, but the "
+          "radial gap is a distance along the ray, not the closest point's: they part where the ray grazes a bone "
+          "(section 08)", "13_distance_peers",
+          kind="measured", tolerance="faster than a competent Open3D user in every paired round of every hip-pose "
+          "row, and the radial gap within 0.1 mm of the closest-point distance (p95); direction: "
+          "faster on the median row",
+          conditions="per pose, detect_pose against Open3D after a KD-tree cull, 1 and 2 threads, 5 alternated "
+          "rounds; every real hip", same_subjects=True,
+          data="13_distance_peers/three_ways.csv; 08_distance_maps/radial_vs_distance.csv")
+elif peers is not None and len(peers):
+    missing("Sec. 3.6.1; Ch. 6", "the map gives the surface-to-surface distance without extra cost",
+            "O(n) against O(n log n)", "three_ways.csv (Open3D three ways)", "13_distance_peers", kind="measured",
+            tolerance="--", conditions="--", same_subjects=True)
 # Ch. 6 / sec. 3.6.2: an order of magnitude less computation and memory than a distance field on a 3D Cartesian grid,
 # settled by arithmetic (issue 82): a grid over a cube just enclosing the joint (the 22 mm head's 44 mm and 8 mm of
 # socket either side) at the spacing the map resolves on the head at 0.1 deg, against the map's nodes; any fill

@@ -8,7 +8,9 @@ each pose of a motion. Measured as a new user runs it:
            a Python process that imports Open3D, loads both meshes, builds both RaycastingScenes and queries every
            vertex at every pose (RaycastingScene.compute_signed_distance), and writes the distances;
   pose     per pose in one process, at 1 and 2 threads: impinge.Joint.detect_pose (OMP_NUM_THREADS) against Open3D's
-           two queries (RaycastingScene(nthreads=...)).
+           two queries of every vertex (compute_signed_distance(nthreads=...): the scene's nthreads sets its build
+           only). This is the naive user's way; experiment 13's three_ways.csv sets it beside a competent user's
+           KD-tree cull and beside impinge's own vertex set (issue 82, item 3).
 Medians and quartiles over --repeats runs, on the native meshes and on the same meshes subdivided 4x (Open3D's
 midpoint subdivision); --quick: 1 and 10 poses, native meshes only. Experiment 13 runs it (run()).
 
@@ -162,8 +164,8 @@ sf, sp = scene(V["f"], F["f"]), scene(V["p"], F["p"])
 to = []
 for i in range({repeats}):
     t0 = time.perf_counter()
-    sp.compute_signed_distance(o3d.core.Tensor(V["f"].astype(np.float32)))
-    sf.compute_signed_distance(o3d.core.Tensor(V["p"].astype(np.float32)))
+    sp.compute_signed_distance(o3d.core.Tensor(V["f"].astype(np.float32)), nthreads={threads})
+    sf.compute_signed_distance(o3d.core.Tensor(V["p"].astype(np.float32)), nthreads={threads})
     to.append(time.perf_counter() - t0)
 print(json.dumps({{"impinge": ts, "open3d": to}}))
 '''

@@ -2,9 +2,9 @@
 user compares with, on the same vertices and poses, one thread each, in one run:
 - impinge: both radial scans and both distance scans of a pose (Joint.detect_pose; the times from its summary,
   each scan single-threaded);
-- Open3D (Debian python3-open3d 0.16): RaycastingScene(nthreads=1).compute_signed_distance (closest point by
+- Open3D (Debian python3-open3d 0.16): RaycastingScene.compute_signed_distance(nthreads=1) (closest point by
   Embree, sign by one ray's crossings), the scene built once per bone and the other bone's vertices moved
-  into its frame;
+  into its frame (a query's nthreads, not the scene's, sets the query's threads: its default takes every core);
 - VTK 9 (Debian python3-vtk9): vtkImplicitPolyDataDistance.FunctionValue over the same points.
 The vertices are those impinge gives a distance at that pose (within the reach of the other bone: every
 vertex that the bounds cannot prove farther). Agreement: the largest |difference| from impinge's distance and
@@ -19,9 +19,23 @@ Outputs (OUT/13_distance_peers/):
                       alternated, one run of each per round, and Open3D's time over impinge's distance scans
                       paired round by round: median and quartiles) and VTK's on the same vertices, their largest
                       difference from impinge's distances (mm) and their sign disagreements
+  three_ways.csv      subject x pose x threads (1, 2): Open3D three ways against impinge (issue 82, item 3), in
+                      5 paired rounds, the order rotated round by round: impinge.Joint.detect_pose (set_threads; the
+                      wall time of the call that returns the distances) against Open3D (a) on every vertex of both
+                      bones (a naive user), (b) on the vertices a scipy cKDTree on the other bone's vertices keeps
+                      within the reach plus that bone's longest edge (a competent user: the trees built once per bone,
+                      kdtree_build_ms, outside the per-pose time like the scenes and impinge's maps; the posing, the
+                      query and Open3D's distances of the kept vertices in it), (c) on impinge's own vertex set
+                      (which a user cannot know beforehand); each posing the vertices in its time; median and
+                      quartiles of each time and of each ratio Open3D / impinge round by round (its least and
+                      largest too: impinge faster in every round when ratio_*_min > 1); the cull checked
+                      against impinge: culled_lost (impinge's vertices the cull dropped), culled_max_diff_mm (and
+                      culled_max_diff_same_sign_mm, where the signs agree) and culled_sign_disagreements (Open3D's
+                      distances of the kept vertices against impinge's)
   meta.json
 Every shared hip with a subject.json under --data, or (without it) the generated hip with a 2 mm cam.
-Poses: rest and 10 poses up to 110 deg flexion (issue 26's); --quick: rest and 2 poses at 0.5 deg maps.
+Poses: rest and 10 poses up to 110 deg flexion (issue 26's); --quick: rest and 2 poses at 0.5 deg maps, the three
+ways at the first of the 2 (both thread counts on the first hip, one thread on the others).
 
 usage: exp_13_distance_peers --out DIR [--data DIR] [--quick]
 (build/experiments/exp_13_distance_peers runs this file with the module on PYTHONPATH)"""
@@ -31,10 +45,18 @@ import os
 import statistics
 import time
 
-import numpy as np
-from experiment_support import experiment_args, write_meta
+# OpenMP threads that wait between parallel regions sleep instead of spinning (read when libgomp loads, so before
+# impinge and Open3D, which share it; the subprocesses inherit it; OMP_WAIT_POLICY set outside wins). On a 2-core
+# machine that another job shares, spinning made a second thread wait for a core: on 2026-11-29 impinge's pose at
+# 2 threads took 8.0 ms spinning against 2.6 ms sleeping, and Open3D's signed distance of 245 points 48 ms against
+# 0.6 ms (its sign step, compute_occupancy; count_intersections alone did not stall), in steps of a scheduler tick:
+# the ratios followed the machine's load, not the tools.
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
-import impinge
+import numpy as np  # noqa: E402
+from experiment_support import experiment_args, write_meta  # noqa: E402
+
+import impinge  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -102,6 +124,124 @@ def disagreements(a, b):
     return int(np.count_nonzero(np.sign(a) != np.sign(b)))
 
 
+THREE_WAY_THREADS = (1, 2)  # impinge's and Open3D's threads in the three-way comparison (issue 82, item 3)
+THREE_WAY_ROUNDS = 5        # its paired rounds per pose and thread count (--quick too: a ratio needs its spread)
+
+
+def paired_rounds(fns, rounds):
+    """Wall times (ms) of each of `fns`, one run of each per round for `rounds` rounds, the order rotated round by
+    round (so that no tool always runs first after another's caches): times[k][i] is fns[k]'s run in round i, and
+    times[a][i] / times[b][i] is a ratio paired round by round."""
+    times = [[0.0] * rounds for _ in fns]
+    for i in range(rounds):
+        for k in [(i + m) % len(fns) for m in range(len(fns))]:
+            t0 = time.perf_counter()
+            fns[k]()
+            times[k][i] = (time.perf_counter() - t0) * 1e3
+    return times
+
+
+def quartiles(xs, name, unit="", extremes=False):
+    """{name_median, name_q25, name_q75}: the median and quartiles of xs (with extremes: name_min, name_max too)."""
+    out = {f"{name}_median{unit}": float(np.median(xs)), f"{name}_q25{unit}": float(np.quantile(xs, 0.25)),
+           f"{name}_q75{unit}": float(np.quantile(xs, 0.75))}
+    if extremes:
+        out.update({f"{name}_min{unit}": float(np.min(xs)), f"{name}_max{unit}": float(np.max(xs))})
+    return out
+
+
+def longest_edge(V, F):
+    """The longest edge (mm) of the mesh (V: n x 3, F: m x 3)."""
+    e = np.concatenate([V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 1]], V[F[:, 0]] - V[F[:, 2]]])
+    return float(np.sqrt((e * e).sum(axis=1).max()))
+
+
+class Culler:
+    """A competent Open3D user's pipeline (issue 82, item 3): a scipy cKDTree on each bone's vertices, built once per
+    bone (build_ms), and per pose a query that keeps the other bone's vertices with a vertex of this bone within
+    reach + this bone's longest edge: every vertex within the reach of the surface (its closest point lies on a
+    triangle, whose nearest corner is at most one edge farther), so that none of impinge's vertices is lost."""
+
+    def __init__(self, femur_V, femur_F, pelvis_V, pelvis_F, reach):
+        from scipy.spatial import cKDTree
+        t0 = time.perf_counter()
+        self.femur_tree, self.pelvis_tree = cKDTree(femur_V), cKDTree(pelvis_V)
+        self.build_ms = (time.perf_counter() - t0) * 1e3
+        self.femur_bound = reach + longest_edge(femur_V, femur_F)
+        self.pelvis_bound = reach + longest_edge(pelvis_V, pelvis_F)
+
+    def keep(self, femur_in_pelvis, pelvis_in_femur, threads):
+        """(femur vertices, pelvis vertices) that can be within reach: indices into the posed vertices given."""
+        db, _ = self.pelvis_tree.query(femur_in_pelvis, k=1, distance_upper_bound=self.pelvis_bound, workers=threads)
+        ds, _ = self.femur_tree.query(pelvis_in_femur, k=1, distance_upper_bound=self.femur_bound, workers=threads)
+        return np.flatnonzero(np.isfinite(db)), np.flatnonzero(np.isfinite(ds))
+
+
+def three_ways(j, pose, scenes, culler, threads, rounds, impinge_set):
+    """One row of three_ways.csv (the file comment): at `threads` threads, impinge's detect_pose against Open3D
+    (a) on every vertex, (b) on the vertices a KD-tree cull keeps, (c) on impinge's own vertex set, in paired,
+    rotated rounds; the ratios Open3D / impinge round by round; the cull checked against impinge's distances.
+    scenes: (pelvis scene, femur scene); impinge_set: (femur indices, pelvis indices) with a distance at the pose."""
+    import open3d as o3d
+    femur_V, pelvis_V = (np.asarray(j.meshes[b][0]) for b in ("femur", "pelvis"))
+    R, t = j.femur_pose(*pose)
+    cor = np.asarray(j.cor)
+    pelvis_scene, femur_scene = scenes
+    bi, si = impinge_set
+
+    def posed(fi, pi):
+        # The femur's vertices into the pelvis' frame, the pelvis' into the femur's (each scene stays put).
+        return (femur_V[fi] - cor) @ R.T + cor + t, (pelvis_V[pi] - cor - t) @ R + cor
+
+    def open3d(qb, qs):
+        return (pelvis_scene.compute_signed_distance(o3d.core.Tensor(qb.astype(np.float32)), nthreads=threads).numpy(),
+                femur_scene.compute_signed_distance(o3d.core.Tensor(qs.astype(np.float32)), nthreads=threads).numpy())
+
+    every = slice(None)
+    out = {}
+
+    def competent():
+        qb, qs = posed(every, every)
+        kb, ks = culler.keep(qb, qs, threads)
+        out["culled"] = (kb, ks, *open3d(qb[kb], qs[ks]))
+
+    fns = [lambda: j.detect_pose(*pose), lambda: open3d(*posed(every, every)), competent,
+           lambda: open3d(*posed(bi, si))]
+    before = impinge.get_threads()
+    impinge.set_threads(threads)
+    try:
+        for f in fns[:1] + fns[2:]:  # warm-up ((a) queries the scenes that (b) and (c) warm: its run would cost most)
+            f()
+        times = paired_rounds(fns, rounds)
+        r = j.detect_pose(*pose)
+    finally:
+        impinge.set_threads(before)
+    kb, ks, ob, os_ = out["culled"]
+    lost, worst, worst_same, signs = 0, 0.0, 0.0, 0
+    for ours, kept, theirs in ((r["femur_distance_mm"], kb, ob), (r["pelvis_distance_mm"], ks, os_)):
+        have = np.flatnonzero(np.isfinite(ours))
+        at = np.searchsorted(kept, have)
+        found = (at < len(kept)) & (kept[np.minimum(at, len(kept) - 1)] == have)
+        lost += int((~found).sum())
+        a, b = ours[have[found]], theirs[at[found]]
+        worst = max(worst, float(np.max(np.abs(a - b), initial=0)))
+        same = np.sign(a) == np.sign(b)
+        worst_same = max(worst_same, float(np.max(np.abs(a[same] - b[same]), initial=0)))
+        signs += disagreements(a, b)
+    imp = np.asarray(times[0])
+    row = {"threads": threads, "rounds": rounds, "vertices_every": len(femur_V) + len(pelvis_V),
+           "vertices_culled": len(kb) + len(ks), "vertices_impinge": len(bi) + len(si),
+           "reach_mm": float(j.setup["distance_reach_mm"]), "cull_bound_femur_tree_mm": culler.femur_bound,
+           "cull_bound_pelvis_tree_mm": culler.pelvis_bound, "kdtree_build_ms": culler.build_ms,
+           **quartiles(imp, "impinge", "_ms")}
+    for k, way in ((1, "every"), (2, "culled"), (3, "own")):
+        row.update(quartiles(times[k], f"open3d_{way}", "_ms"))
+        row.update(quartiles(np.asarray(times[k]) / imp, f"ratio_{way}", extremes=True))
+    row.update({"culled_lost": lost, "culled_max_diff_mm": worst, "culled_max_diff_same_sign_mm": worst_same,
+                "culled_sign_disagreements": signs})
+    return row
+
+
 def main():
     d, data, quick = experiment_args("13_distance_peers", __doc__)
     resolution = 0.5 if quick else 0.1
@@ -109,7 +249,7 @@ def main():
     poses = [(0, 0, 0)] + [(-10 + 12 * k, (k % 3 - 1) * 10, (k % 4 - 1.5) * 10) for k in range(10)]
     if quick:
         poses = poses[:1] + poses[5:7]
-    rows = []
+    rows, ways, three_way_s = [], [], 0.0
     for name, options, (femur_V, femur_F), (pelvis_V, pelvis_F) in subjects(data):
         print(f"[13_distance_peers] {name}", flush=True)
         ball = options.pop("femur", None)
@@ -123,6 +263,8 @@ def main():
         pelvis_vtk, femur_vtk = vtk_distance(pelvis_V, pelvis_F), vtk_distance(femur_V, femur_F)
         cor = np.asarray(j.cor)
         import open3d as o3d
+        # The three ways' scenes (the same meshes) and the competent user's KD-trees, built once per bone.
+        culler = Culler(femur_V, femur_F, pelvis_V, pelvis_F, float(j.setup["distance_reach_mm"]))
         for pose in poses:
             R, t = j.femur_pose(*pose)
             r = j.detect_pose(*pose)  # warm-up, and the vertices within reach that the peers are given
@@ -134,7 +276,9 @@ def main():
             tb, ts = o3d.core.Tensor(qb.astype(np.float32)), o3d.core.Tensor(qs.astype(np.float32))
 
             def run_open3d():
-                return pelvis_scene.compute_signed_distance(tb).numpy(), femur_scene.compute_signed_distance(ts).numpy()
+                # nthreads=1: the scene's nthreads sets its build only; a query's own default (0) takes every core.
+                return (pelvis_scene.compute_signed_distance(tb, nthreads=1).numpy(),
+                        femur_scene.compute_signed_distance(ts, nthreads=1).numpy())
             run_open3d()
             # impinge and Open3D alternated, one run of each per round, so that their ratio is paired round by round.
             radial, distance, o3d_runs = [], [], []
@@ -170,10 +314,25 @@ def main():
                 "open3d_sign_disagreements": disagreements(ob, bd[bi]) + disagreements(os_, sd[si]),
                 "vtk_sign_disagreements": disagreements(vb, bd[bi]) + disagreements(vs, sd[si]),
             })
-    with open(os.path.join(d, "distance_peers.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+            # --quick: one pose per hip, two threads on the first hip only (the three ways cost about 4 s a pose and
+            # thread count on lhdl-ct, most of it Open3D on every vertex).
+            first_hip = not ways or ways[0]["subject"] == name
+            for threads in (THREE_WAY_THREADS if not quick else () if pose != poses[1] else
+                            THREE_WAY_THREADS if first_hip else THREE_WAY_THREADS[:1]):
+                t0 = time.perf_counter()
+                ways.append({"subject": name, "flexion_deg": pose[0], "adduction_deg": pose[1],
+                             "internal_rotation_deg": pose[2],
+                             **three_ways(j, pose, (pelvis_scene, femur_scene), culler, threads, THREE_WAY_ROUNDS,
+                                          (bi, si))})
+                three_way_s += time.perf_counter() - t0
+    print(f"[13_distance_peers] Open3D three ways: {len(ways)} poses and thread counts, {three_way_s:.1f} s", flush=True)
+    for file, table in (("distance_peers.csv", rows), ("three_ways.csv", ways)):
+        tmp = os.path.join(d, f".{file}.{os.getpid()}.tmp")
+        with open(tmp, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(table[0]))
+            w.writeheader()
+            w.writerows(table)
+        os.replace(tmp, os.path.join(d, file))
     # Whole processes and single poses at 1 and 2 threads beside Open3D (benchmarks/whole_process.py): lhdl-ct, or
     # without the shared data a generated hip of 100,000 triangles.
     import subprocess
@@ -194,9 +353,16 @@ def main():
     write_meta(d, "13_distance_peers", quick=quick, data_folder=data if data and os.path.isdir(data) else None,
                repetitions=reps,
                timing="median wall time after one warm-up run, one thread each (impinge's scans, Open3D nthreads=1, "
-                      "VTK); whole processes: median and quartiles of alternated runs",
+                      "VTK); whole processes: median and quartiles of alternated runs; OMP_WAIT_POLICY="
+                      f"{os.environ.get('OMP_WAIT_POLICY')} (the file comment)",
                parameters={"resolution_deg": resolution, "scheme": "equiangular",
-                           "distance_reach_mm": "6 (the largest --levels threshold)", "poses_deg": poses,
+                           "distance_reach_mm": "the largest --levels threshold (three_ways.csv: reach_mm)",
+                           "poses_deg": poses,
+                           "three_ways": {"threads": list(THREE_WAY_THREADS), "rounds": THREE_WAY_ROUNDS,
+                                          "cull": "scipy.spatial.cKDTree on the other bone's vertices, query k=1 "
+                                                  "with distance_upper_bound = reach + that bone's longest edge",
+                                          "impinge": "Joint.detect_pose wall time (impinge.set_threads)",
+                                          "open3d": "compute_signed_distance(nthreads=threads)"},
                            "whole_process": {
                                "subject": subject, "repetitions": 3 if quick else 5,
                                "impinge": "impinge distance (1 pose) / impinge motion (N poses), CLI defaults, "
@@ -204,7 +370,8 @@ def main():
                                           "OMP_NUM_THREADS 1, 2",
                                "open3d": "a Python process: import, load both meshes, build both RaycastingScenes, "
                                          "compute_signed_distance of every vertex at every pose, write"}},
-               versions={"open3d": __import__("open3d").__version__, "vtk": vtk.vtkVersion.GetVTKVersion()})
+               versions={"open3d": __import__("open3d").__version__, "vtk": vtk.vtkVersion.GetVTKVersion(),
+                         "scipy": __import__("scipy").__version__})
 
 
 if __name__ == "__main__":
