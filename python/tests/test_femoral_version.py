@@ -165,14 +165,16 @@ def test_morphology_labels_are_true_on_a_shared_hip(tmp_path):
     assert f["version_posterior_condylar_shaft_deg"]["value"] != f["version_posterior_condylar_deg"]["value"]
     # With the session's pelvic frame the APP, the *_isb angles stay in the ISB frame (they were the APP's before, 5.5
     # deg apart on mc22) and the APP angles stay as they are (the acetabulum's rim, found in the session's frame,
-    # moves them by under 0.1 deg).
+    # moves them by under 0.3 deg).
     app = morphology(os.path.join(DATA, "mc22", "subject.json"), str(tmp_path / "app"), "--pelvis-frame", "app")
     b = app["acetabulum"]
     assert b["pelvic_frame"]["definition"] == a["anterior_pelvic_plane_frame"]["definition"]
     assert abs(a["radiographic_anteversion_isb_deg"]["value"] - a["radiographic_anteversion_deg"]["value"]) > 2
     for k in ("radiographic_anteversion_isb_deg", "radiographic_inclination_isb_deg", "radiographic_anteversion_deg",
               "radiographic_inclination_deg"):
-        assert b[k]["value"] == pytest.approx(a[k]["value"], abs=0.2), k
+        # (the rim's 5 deg azimuth bins start at the frame's superior axis: 0.23 deg on mc22's ISB anteversion since
+        # the lunate sphere is fitted to the surface, issue 81; 0.1 before)
+        assert b[k]["value"] == pytest.approx(a[k]["value"], abs=0.3), k
 
 
 def test_morphology_labels_are_true_on_a_generated_hip(tmp_path):

@@ -219,14 +219,22 @@ def test_a_cam_added_to_a_real_femur_is_planned_away(tmp_path):
     free, cam = limits(tmp_path / "free"), limits(tmp_path / "cam")
     lowered = [k for k in free if free[k] == free[k] and cam[k] == cam[k] and cam[k] < free[k] - 1]
     assert "internal_rotation_90_flexion" in lowered, (free, cam)
-    r = run(["plan", "--ball", tmp_path / "femur_cam.ply", "--out", tmp_path / "plan", "--target",
+    # --allow-partial: a target whose contact lies deeper than the safety depth is reported, not planned (since the head
+    # is fitted to its surface, issue 81, the cam lowers internal rotation at neutral from 94.9 to 57.2 deg, and
+    # beyond 80.2 deg restoring it would cut the head-neck junction deeper than the safety depth: plan.json says so).
+    r = run(["plan", "--ball", tmp_path / "femur_cam.ply", "--out", tmp_path / "plan", "--allow-partial", "--target",
              ",".join(f"{k}={free[k]:.3f}" for k in lowered)] + common)
     assert r.returncode == 0, r.stderr + r.stdout
+    targets = {t["target"]: t for t in json.load(open(tmp_path / "plan" / "plan.json"))["targets"]}
+    reachable = [k for k in lowered if targets[k]["planned_reachable"]]
+    assert "internal_rotation_90_flexion" in reachable, targets
+    for k in set(lowered) - set(reachable):
+        assert not targets[k]["met"] and "safety depth" in targets[k]["note"], targets[k]
     r = run(["rom", "--ball", tmp_path / "plan" / "femur_resected.ply", "--out", tmp_path / "after", "--no-map"]
             + common)
     assert r.returncode == 0, r.stderr
     after = limits(tmp_path / "after")
-    for k in lowered:
+    for k in reachable:
         assert after[k] >= free[k] - 0.5, (k, after[k], free[k])
     props, Fr = read_ply_properties(tmp_path / "plan" / "femur_resected.ply")
     Vr = np.column_stack([props["x"], props["y"], props["z"]])
