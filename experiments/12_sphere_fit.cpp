@@ -71,6 +71,7 @@ void synthetic_table(const std::string& dir, int seeds) {
           try {
             HeadFitOptions o;
             o.seed = 99 + seed;
+            o.surface_stage = false;  // a point set: no surface to fit (the vertices' fixed point is the result)
             fits.push_back({"automatic", fit_femoral_head(pts, o)});
           } catch (const Error&) {
           }

@@ -191,7 +191,8 @@ def test_internal_rotation_in_flexion_ten_degrees_more_on_a_real_hip(tmp_path):
 def test_a_cam_added_to_a_real_femur_is_planned_away(tmp_path):
     """tlem2-mri's femur with a 3 mm bump at its antero-superior head-neck junction (the input frame's femur axes from
     impinge morphology): targets = the limits without the bump that it lowers; `impinge rom` on the written
-    femur_resected.ply restores each within 0.5 deg, the plan removing at most twice the bump's volume (1.2 before
+    femur_resected.ply restores each the plan calls reachable within 0.5 deg (the others lie beyond the safety depth,
+    and plan.json says so), the plan removing at most twice the bump's volume (1.2 before
     issue 81 kept the clearance in the final placement and counted the lunate surface against the junction), most of
     it on the bump (issue 50's first done-when item; experiment 16 does every shared hip)."""
     subject = os.path.join(DATA, "tlem2-mri", "subject.json")

@@ -1,11 +1,14 @@
 """The ROM limits belong to the surfaces, not to their tessellation (issue 81, item 2's done-when). On the shared
-MRI hip whose limits moved most when its pelvis was split (tlem2-mri: 0.09-0.38 deg through the acetabular sphere's
-triangle selection and the equidistant guard's vertices), `tools/tessellation-check` runs `impinge rom` on the
+MRI hip whose limits moved most when its pelvis was split (mc22-left: its extension by 6.9 deg, through the
+acetabular sphere's triangle selection, before the spheres were fitted to the surfaces), `tools/tessellation-check`
+(which runs the repository's build/impinge) runs `impinge rom` on the
 original meshes, on the pelvis and on the femur with every triangle split in four at its edges' midpoints (the same
 surface), and on both renumbered, with the bisection carried to 0.01 deg: no limit or first contact moves more than
 0.05 deg, no least distance more than 0.01 mm, and renumbering moves nothing. The oracle is the original meshes' own
 run; the split meshes are written by the tool in double precision. The other shared hips:
-`tools/tessellation-check -- --search-tolerance 0.01` (the closing note of issue 81 gives its figures)."""
+`tools/tessellation-check -- --search-tolerance 0.01` (lhdl-ct holds too; mc22's and tlem2-mri's pelvis split moves
+limits by up to 0.28 deg through the equidistant joint centre's guard, which keeps the joint space open at the
+lunate vertices: issue 81's closing note)."""
 import os
 import re
 import subprocess
@@ -29,7 +32,7 @@ def test_splitting_or_renumbering_a_real_hip_moves_no_limit():
     assert r.returncode == 0, r.stderr
     largest = {}
     summary = r.stdout.split("largest moves")[-1]
-    for kind, column, value in re.findall(r"^\s+(split|renumbered)\s+(\w+)\s+([0-9.einf]+)\s", summary, re.M):
+    for kind, column, value in re.findall(r"^\s+(split|renumbered)\s+(\w+)\s+(\S+)\s", summary, re.M):
         largest[(kind, column)] = float(value)
     assert len(largest) == 6, r.stdout
     assert largest[("split", "limit_deg")] <= 0.05, r.stdout

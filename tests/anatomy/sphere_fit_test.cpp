@@ -6,11 +6,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
 #include <random>
 
 #include "impinge/core/error.hpp"
 #include "impinge/core/spherical_frame.hpp"
 #include "impinge/io/generated_models.hpp"
+#include "test_support.hpp"
 
 using namespace impinge;
 using PointMatrix = Eigen::Matrix<double, Eigen::Dynamic, 3>;
@@ -102,4 +105,65 @@ TEST(SphereFit, RegionFitAndErrors) {
   PointMatrix flat(10, 3);
   for (int i = 0; i < 10; ++i) flat.row(i) << i, i * i, 0;
   EXPECT_THROW(fit_sphere_algebraic(flat), Error);
+}
+
+// fit_sphere_to_surface (issue 81): the sphere of a surface, not of its vertices. Oracles: the analytic sphere of a
+// finely tessellated UV sphere and cup (whose flat triangles lie within h^2 / (8 r) of it), and the same mesh split
+// in four or renumbered (the same surface: the same points, so the same sphere to rounding).
+TEST(SurfaceSphereFit, ABallAndACupGiveTheirSpheres) {
+  const Eigen::Vector3d c(10, -20, 30);
+  // 0.25 deg-ish facets: 360 x 180 on r = 22 mm, chords 0.38 mm, sagitta < 0.001 mm.
+  const TriangleMesh ball = make_uv_sphere(22, c, 360, 180, Eigen::Vector3d(0.2, 0.3, 0.93).normalized());
+  const SurfaceSphereFit b = fit_sphere_to_surface(ball, c + Eigen::Vector3d(0.8, -0.5, 0.3), 21.2, 1.5, 0.7,
+                                                   SurfaceSide::convex, "test ball");
+  EXPECT_LT((b.sphere.centre - c).norm(), 1e-3);
+  EXPECT_NEAR(b.sphere.radius, 22, 2e-3);
+  EXPECT_NEAR(b.area_in_band_mm2, 4 * M_PI * 22 * 22, 0.01 * 4 * M_PI * 22 * 22);
+  // A cup (inner 25, outer 30 mm, 80 deg): the inner surface faces the centre; the outer one, 5 mm out, weighs nothing.
+  const TriangleMesh cup = make_cup(25, 30, 80, c, Eigen::Vector3d::UnitZ(), 360, 120);
+  const SurfaceSphereFit k =
+      fit_sphere_to_surface(cup, c + Eigen::Vector3d(-0.6, 0.4, 0.9), 24.3, 1.5, 0.7, SurfaceSide::concave, "test cup");
+  EXPECT_LT((k.sphere.centre - c).norm(), 2e-3);
+  EXPECT_NEAR(k.sphere.radius, 25, 2e-3);
+  // The wrong side: the ball seen as a socket has no surface facing its centre.
+  EXPECT_THROW(fit_sphere_to_surface(ball, c, 22, 1.5, 0.7, SurfaceSide::concave, "test ball"), Error);
+}
+
+TEST(SurfaceSphereFit, SplittingRenumberingOrTurningTheMeshInsideOutMovesNothing) {
+  // A bumpy, coarse head (1.2-2.5 mm facets, edges in (0.5, 32] mm where the quadrature points coincide exactly).
+  const Eigen::Vector3d c(60, -20, 30);
+  const TriangleMesh head = make_radial_surface(
+      [](const Eigen::Vector3d& u) { return 22 + 0.4 * u.x() * u.y() + 0.3 * u.z() * u.z(); }, c, 96, 48);
+  const auto fit = [&](const TriangleMesh& m) {
+    return fit_sphere_to_surface(m, c + Eigen::Vector3d(0.5, 0.2, -0.4), 21.5, 1.0, 0.7, SurfaceSide::convex, "head")
+        .sphere;
+  };
+  const SphereFitResult a = fit(head);
+  TriangleMesh inside_out = head;
+  inside_out.F.col(1).swap(inside_out.F.col(2));
+  for (const TriangleMesh& m : {test::split_in_four(head), test::renumbered(head, 7), inside_out}) {
+    const SphereFitResult b = fit(m);
+    EXPECT_LT((b.centre - a.centre).norm(), 1e-6) << m.source;
+    EXPECT_NEAR(b.radius, a.radius, 1e-6) << m.source;
+  }
+  // The vertices' fit moves when the mesh is split (its midpoints lie inside the surface's curvature).
+  const SphereFitResult v = fit_sphere_geometric(head.V), vs = fit_sphere_geometric(test::split_in_four(head).V);
+  EXPECT_GT(std::abs(vs.radius - v.radius), 1e-3);
+}
+
+TEST(SurfaceSphereFit, BadInputsAreErrorsNamingTheMesh) {
+  const TriangleMesh ball = make_uv_sphere(22, Eigen::Vector3d::Zero(), 48, 24);
+  auto message = [](const std::function<void()>& f) { return test::error_of(f); };
+  // Far from any surface, a radius that is not positive, a start that is not finite, no triangles.
+  EXPECT_NE(message([&] { fit_sphere_to_surface(ball, Eigen::Vector3d(500, 0, 0), 5, 1, 0.7, SurfaceSide::convex, "x"); })
+                .find("no surface within 1 mm of the sphere faces it"),
+            std::string::npos);
+  for (const double r : {0.0, -3.0, std::nan("")})
+    EXPECT_THROW(fit_sphere_to_surface(ball, Eigen::Vector3d::Zero(), r, 1, 0.7, SurfaceSide::convex, "x"), Error);
+  TriangleMesh none = ball;
+  none.F.resize(0, 3);
+  none.source = "empty.ply";
+  EXPECT_NE(message([&] { fit_sphere_to_surface(none, Eigen::Vector3d::Zero(), 22, 1, 0.7, SurfaceSide::convex, "x"); })
+                .find("empty.ply: x: no surface"),
+            std::string::npos);
 }

@@ -71,3 +71,9 @@ def test_usage_errors_exit_2_as_every_other_error(args):
 def test_help_and_version_exit_0(args):
     r = run(args)
     assert r.returncode == 0 and r.stdout.strip(), (args, r.returncode, r.stderr)
+
+
+def test_a_search_tolerance_beyond_the_step_names_both(generated, tmp_path):
+    r = run(["rom", "--subject", generated, "--precision", "2", "--no-map", "--step", "2", "--search-tolerance", "5",
+             "--out", tmp_path / "o"])
+    one_line_error(r, "--search-tolerance 5 deg is more than --step 2 deg")

@@ -25,7 +25,9 @@ using namespace impinge;
 using Eigen::Vector3d;
 
 namespace {
+using test::renumbered;
 using test::scan_options;
+using test::split_in_four;
 // A closed prism: the triangle (p0, p1, p2) swept by e; faces wound outward.
 TriangleMesh make_prism(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2, const Vector3d& e) {
   TriangleMesh m;
@@ -41,50 +43,6 @@ TriangleMesh make_prism(const Vector3d& p0, const Vector3d& p1, const Vector3d& 
   }
   m.source = "prism";
   return m;
-}
-// Every triangle split in four at its edges' midpoints (shared between neighbours): the same surface.
-TriangleMesh split_in_four(const TriangleMesh& m) {
-  std::vector<Vector3d> v;
-  for (Eigen::Index i = 0; i < m.V.rows(); ++i) v.push_back(m.V.row(i).transpose());
-  std::map<std::pair<int, int>, int> mid;
-  auto midpoint = [&](int a, int b) {
-    const auto key = std::minmax(a, b);
-    const auto it = mid.find(key);
-    if (it != mid.end()) return it->second;
-    v.push_back(0.5 * (v[static_cast<std::size_t>(a)] + v[static_cast<std::size_t>(b)]));
-    return mid[key] = static_cast<int>(v.size()) - 1;
-  };
-  TriangleMesh out;
-  out.F.resize(4 * m.F.rows(), 3);
-  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
-    const int a = m.F(f, 0), b = m.F(f, 1), c = m.F(f, 2);
-    const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-    out.F.row(4 * f) << a, ab, ca;
-    out.F.row(4 * f + 1) << ab, b, bc;
-    out.F.row(4 * f + 2) << ca, bc, c;
-    out.F.row(4 * f + 3) << ab, bc, ca;
-  }
-  out.V.resize(static_cast<Eigen::Index>(v.size()), 3);
-  for (std::size_t i = 0; i < v.size(); ++i) out.V.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
-  out.source = m.source + " split in four";
-  return out;
-}
-// The same mesh with its vertices and faces in a random order and each face's corners turned.
-TriangleMesh renumbered(const TriangleMesh& m, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::vector<int> to(static_cast<std::size_t>(m.V.rows())), faces(static_cast<std::size_t>(m.F.rows()));
-  std::iota(to.begin(), to.end(), 0), std::iota(faces.begin(), faces.end(), 0);
-  std::shuffle(to.begin(), to.end(), rng), std::shuffle(faces.begin(), faces.end(), rng);
-  TriangleMesh out;
-  out.V.resize(m.V.rows(), 3), out.F.resize(m.F.rows(), 3);
-  for (Eigen::Index i = 0; i < m.V.rows(); ++i) out.V.row(to[static_cast<std::size_t>(i)]) = m.V.row(i);
-  for (std::size_t k = 0; k < faces.size(); ++k) {
-    const auto f = static_cast<Eigen::Index>(faces[k]);
-    const int turn = static_cast<int>(k % 3);
-    for (int c = 0; c < 3; ++c) out.F(static_cast<Eigen::Index>(k), c) = to[static_cast<std::size_t>(m.F(f, (c + turn) % 3))];
-  }
-  out.source = m.source + " renumbered";
-  return out;
 }
 std::vector<RomLimit> limits_of(const TriangleMesh& femur, const TriangleMesh& pelvis, const HipModel& h,
                                 const HipModelOptions& mo, const RomOptions& ro) {

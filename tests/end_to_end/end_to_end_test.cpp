@@ -403,7 +403,7 @@ TEST(EndToEnd, DistancesMatchTheOracleAtMc22LeftsDeepestExtension) {
     EXPECT_EQ(j["femur"]["vertices_inside"], 97) << layers;
     EXPECT_EQ(j["pelvis"]["vertices_inside"], 32) << layers;
     // The radial gap parts from the distance here (at the earlier head fit it read -27 mm; at this one the rays miss
-    // the 1.7 mm penetration and it reads +0.9 mm): the artefact stays visible.
+    // the penetration and it reads +0.9 mm; at the surface fit -27 mm again): the artefact stays visible.
     EXPECT_GT(std::abs(j["pelvis"]["min_gap_mm"].get<double>() - j["pelvis"]["min_distance_mm"].get<double>()), 1.0)
         << layers;
     // The levels classify the distance by default: the last level (<= 0 mm) holds the vertices inside.

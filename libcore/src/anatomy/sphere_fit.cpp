@@ -146,6 +146,7 @@ struct SurfacePoint {
 };
 
 constexpr double kQuadratureEdgeMm = 0.5;  // the quadrature's sub-triangles are at most this long
+constexpr int kSurfaceFitSteps = 2000;      // the reweighted Gauss-Newton steps at most
 
 // The triangles of `mesh` whose centroid lies within reach_mm (plus the triangle's longest edge) of the sphere
 // (c, r) (fit_sphere_to_surface): their indices. The points are made from them on each pass (for_each_point), not
@@ -200,21 +201,34 @@ double surface_weight(const SurfacePoint& x, const Eigen::Vector3d& c, double r,
 }
 }  // namespace
 
-SurfaceSphereFit fit_sphere_to_surface(const TriangleMesh& mesh, const Eigen::Vector3d& start, double start_radius,
+SurfaceSphereFit fit_sphere_to_surface(const TriangleMesh& mesh, const Eigen::Vector3d& centre, double radius,
                                        double band_mm, double facing_cos, SurfaceSide side, const std::string& what) {
-  double volume6 = 0;  // six times the signed volume: > 0 when the normals point out
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
-    volume6 += mesh.V.row(mesh.F(f, 0)).dot(mesh.V.row(mesh.F(f, 1)).cross(mesh.V.row(mesh.F(f, 2))));
+  std::ostringstream band_text;
+  band_text << band_mm;
+  const std::string failure = mesh.source + ": " + what + ": no surface within " + band_text.str() +
+                              " mm of the sphere faces it";
+  require(centre.allFinite() && std::isfinite(radius) && radius > 0 && std::isfinite(band_mm) && band_mm > 0, failure);
+  // Six times the signed volume about the start centre: > 0 when the normals point out. About a point inside the
+  // ball or the socket's sphere, so that an open cut far away (a proximal femur) weighs little in the sign.
+  double volume6 = 0;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)).transpose() - centre,
+                          b = mesh.V.row(mesh.F(f, 1)).transpose() - centre,
+                          e = mesh.V.row(mesh.F(f, 2)).transpose() - centre;
+    volume6 += a.dot(b.cross(e));
+  }
   const double flip = volume6 < 0 ? -1.0 : 1.0, towards = side == SurfaceSide::concave ? 1.0 : -1.0;
   const double reach = band_mm + 3;  // the shell: the sphere may move 2.5 mm before its triangles are found again
-  Eigen::Vector3d c = start, drawn_at = start;
-  double r = start_radius;
+  Eigen::Vector3d c = centre, drawn_c = centre;
+  double r = radius, drawn_r = radius;
   std::vector<Eigen::Index> T = shell_triangles(mesh, c, r, reach);
-  const std::string failure = mesh.source + ": " + what + ": no surface within " + std::to_string(band_mm) +
-                              " mm of the sphere faces it";
+  auto redraw = [&] {  // the shell holds every triangle within band_mm of (c, r) while |dc| + |dr| <= reach - band
+    if ((c - drawn_c).norm() + std::abs(r - drawn_r) > reach - band_mm - 0.5)
+      T = shell_triangles(mesh, c, r, reach), drawn_c = c, drawn_r = r;
+  };
   int steps = 0;
-  for (; steps < 2000; ++steps) {
-    if ((c - drawn_at).norm() > reach - band_mm - 0.5) T = shell_triangles(mesh, c, r, reach), drawn_at = c;
+  for (; steps < kSurfaceFitSteps; ++steps) {
+    redraw();
     Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
     Eigen::Vector4d g = Eigen::Vector4d::Zero();
     for_each_point(mesh, T, flip, [&](const SurfacePoint& x) {  // a Gauss-Newton step of sum w (|p - c| - r)^2
@@ -228,11 +242,14 @@ SurfaceSphereFit fit_sphere_to_surface(const TriangleMesh& mesh, const Eigen::Ve
       g.noalias() += w * (n - r) * J;
     });
     require(H(3, 3) > 0, failure);
-    const Eigen::Vector4d step = -H.ldlt().solve(g);
+    Eigen::Vector4d step = -H.ldlt().solve(g);
     require(step.allFinite(), failure);
+    if (step.norm() > band_mm) step *= band_mm / step.norm();  // a nearly flat patch: no leap past the band
     c += step.head<3>(), r += step[3];
+    require(r > 0, [&] { return failure + " (the fitted radius fell to " + std::to_string(r) + " mm)"; });
     if (step.norm() < 1e-6) break;
   }
+  redraw();
   std::vector<double> w, xyz;
   SurfaceSphereFit out;
   for_each_point(mesh, T, flip, [&](const SurfacePoint& x) {
@@ -247,8 +264,13 @@ SurfaceSphereFit fit_sphere_to_surface(const TriangleMesh& mesh, const Eigen::Ve
   for (std::size_t k = 0; k < w.size(); ++k)
     P.row(static_cast<Eigen::Index>(k)) = Eigen::RowVector3d(xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]);
   xyz = {};
-  out.sphere = fit_sphere_geometric(P, w);
+  try {
+    out.sphere = fit_sphere_geometric(P, w);
+  } catch (const Error& e) {
+    throw Error(mesh.source + ": " + what + ": " + e.what());
+  }
   out.sphere.iterations = steps + 1;
+  out.sphere.converged = out.sphere.converged && steps < kSurfaceFitSteps;
   return out;
 }
 
@@ -399,7 +421,11 @@ SphereFitResult fit_femoral_head(const TriangleMesh& femur, const HeadFitOptions
   // Then the sphere of the surface (fit_sphere_to_surface) from there, with Tukey's biweight at 4.685 sigma of the
   // last band (3 sigma): the vertices' fixed point moves when a file splits its triangles (0.012-0.05 mm on the
   // shared MRI heads split in four, and their ROM limits by up to 0.69 deg); the surface's does not.
-  const std::int64_t inliers = static_cast<std::int64_t>(last.size());
+  if (!o.surface_stage) {
+    res.iterations = o.refinement_rounds;
+    return res;
+  }
+  const std::int64_t inliers = last.empty() ? res.points_used : static_cast<std::int64_t>(last.size());
   res = fit_sphere_to_surface(femur, c, r, threshold * 4.685 / 3, kHeadFacing, SurfaceSide::convex, "femoral head").sphere;
   res.points_used = inliers;
   res.iterations = o.refinement_rounds;

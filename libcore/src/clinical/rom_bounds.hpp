@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <sstream>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -45,7 +46,12 @@ inline void check(const RomOptions& o) {
   check_in_range("RomOptions::contact_depth_mm", o.contact_depth_mm, RomOptions::kContactDepthRange, "mm");
   check_in_range("RomOptions::step_deg", o.step_deg, RomOptions::kStepRange, "deg");
   check_in_range("RomOptions::max_deg", o.max_deg, RomOptions::kMaxRange, "deg");
-  require(o.tolerance_deg > 0 && o.tolerance_deg <= o.step_deg, "rom: need 0 < tolerance <= step (degrees)");
+  require(o.tolerance_deg > 0 && o.tolerance_deg <= o.step_deg, [&] {
+    std::ostringstream m;
+    m << "--search-tolerance " << o.tolerance_deg << " deg is more than --step " << o.step_deg
+      << " deg: the bisection halves the last step until its bracket is this narrow, so give at most the step";
+    return m.str();
+  });
   require(o.metric == RomMetric::radial || o.vertices == RomVertices::all,
           "rom: the distance metric counts every vertex (RomVertices::all)");
 }

@@ -143,7 +143,7 @@ void femur_head_measures(const MorphologyRun& run, nlohmann::json& f) {
                                 input_frame(run), fitted);
   f["head_radius_mm"] =
       measure(number_or_null(m.head_radius_mm), "mm", "radius of that sphere", "thesis sec. 3.4", kNoFrame, fitted);
-  f["head_fit_rms_mm"] = measure(number_or_null(m.head_fit_rms_mm), "mm", "rms distance of the fitted vertices from it",
+  f["head_fit_rms_mm"] = measure(number_or_null(m.head_fit_rms_mm), "mm", "weighted rms distance of the head's surface from it (fit_sphere_to_surface: biweight x facing x area)",
                                  "thesis sec. 3.4", kNoFrame, fitted);
   f["sphericity_rms_mm"] =
       measure(number_or_null(m.sphericity_rms_mm), "mm",
@@ -252,7 +252,7 @@ void acetabular_sphere_measures(const MorphologyRun& run, nlohmann::json& a) {
                            input_frame(run), fitted);
   a["radius_mm"] = measure(number_or_null(m.acetabular_radius_mm), "mm", "its radius", "impinge", kNoFrame, fitted);
   a["fit_rms_mm"] = measure(number_or_null(m.acetabular_fit_rms_mm), "mm",
-                            "area-weighted rms of the lunate surface about it", "impinge", kNoFrame, fitted);
+                            "weighted rms of the lunate surface about it (fit_sphere_to_surface: biweight x facing x area)", "impinge", kNoFrame, fitted);
   a["lunate_area_mm2"] = measure(number_or_null(m.lunate_area_mm2), "mm^2", "area the sphere is fitted on",
                                  "impinge (find_acetabulum)", kNoFrame, "measured on the mesh");
 }

@@ -36,8 +36,8 @@ struct ClockFace {
 
 /// The acetabulum of a pelvis: its sphere, rim and clock face.
 struct Acetabulum {
-  SphereFitResult sphere;                 ///< area-weighted geometric sphere fit of the lunate surface, mm
-                                          ///< (iterations: refits until the lunate triangles no longer changed)
+  SphereFitResult sphere;                 ///< the lunate surface's sphere (fit_sphere_to_surface), mm
+                                          ///< (iterations: its reweighting steps; rms: weighted)
   double joint_space_mode_mm = 0;         ///< the commonest distance of the socket from the head sphere at the scan pose
   double lunate_area_mm2 = 0;             ///< area of the lunate surface the sphere is fitted on
   std::int64_t lunate_triangles = 0;      ///< its triangles
@@ -65,12 +65,12 @@ inline constexpr double kLunateBandMm = 1.5;
 /// (for superior and anterior):
 /// 1. joint space: the mode of the head-facing triangles' distance from the head sphere (area-weighted,
 ///    within [-3, 12] mm; 2-6 mm on the shared hips' CT and MRI);
-/// 2. sphere: from the head-centred sphere at that distance, an area-weighted geometric fit of the
-///    triangles on the sphere (kLunateBandMm, facing its centre, kLunateFacing), refitted until they no
-///    longer change: the lunate surface whole, whatever the joint space, without the deeper fossa or the
+/// 2. sphere: from the head-centred sphere at that distance, the sphere of the surface facing its centre
+///    within kLunateBandMm (Tukey's biweight, kLunateFacing; reweighted to its fixed point): the lunate surface whole, whatever the joint space, without the deeper fossa or the
 ///    rim's flare; the acetabular centre onto which Puls et al. 2010's equidistant method seats the head.
 ///    (Until 2026-11 the fit took the vertices within the head radius + 4 mm, which left out 40-97 % of
-///    an MRI socket whose joint space is 3.5-6 mm.) Triangles, not vertices: a file that renumbers,
+///    an MRI socket whose joint space is 3.5-6 mm.) The surface, not its vertices or triangles
+///    (fit_sphere_to_surface, concave, band kLunateBandMm, facing kLunateFacing): a file that renumbers,
 ///    duplicates or splits them gives the same sphere;
 /// 3. cup: pelvis vertices within the sphere's radius + `cup_margin_mm` of its centre;
 /// 4. rim: in each 5-degree azimuth bin about the cup's axis, the cup vertex farthest from the

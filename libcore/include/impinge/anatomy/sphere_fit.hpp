@@ -54,18 +54,22 @@ struct SurfaceSphereFit {
 /// normal and the direction to the centre (concave) or from it (convex), 0 at facing_cos - 0.1, 1 at
 /// facing_cos + 0.1; times the area each point stands for), from the sphere (centre, radius), a Gauss-Newton step
 /// per reweighting until a step moves the sphere less than 1e-6 mm (at most 2,000), then GSL's weighted geometric
-/// fit with the last weights (fit_sphere_geometric) as the result. The points: each triangle within band_mm + 3 mm
-/// of the sphere cut into k x k congruent triangles (k the least power of two that makes them at most 0.5 mm long,
-/// at most 64), their centroids. The weights change continuously with the sphere and the points do not depend on
-/// the vertices' order, so that one surface gives one sphere: a file with every triangle split in four at its
-/// edges' midpoints is cut into the same points. Throws impinge::Error (naming mesh.source and `what`) when no
-/// point weighs anything or a step is not finite. Source: impinge (issue 81, item 2); the biweight: Beaton and
-/// Tukey 1974.
+/// fit with the last weights (fit_sphere_geometric) as the result (converged false when the steps ran out). A step
+/// is at most band_mm long. The points: each triangle whose centroid lies within band_mm + 3 mm + its longest edge
+/// of the sphere, cut into k x k congruent triangles (k the least power of two that makes them at most 0.5 mm long,
+/// at most 64), their centroids. The outward side: the sign of the mesh's volume about `centre`. The weights change
+/// continuously with the sphere and the points do not depend on the vertices' order, so that one surface gives one
+/// sphere: a file with every triangle split in four at its edges' midpoints is cut into the same points where its
+/// triangles' longest edges lie in (0.5, 32] mm (elsewhere into nearly the same: a finer or a coarser quadrature of
+/// the same surface). Throws impinge::Error (naming mesh.source and `what`) when the start is not finite or its
+/// radius or band not > 0, no point weighs anything, a step is not finite, the radius falls to 0 or the last fit
+/// fails. Source: impinge (issue 81, item 2); the biweight: Beaton and Tukey 1974.
 SurfaceSphereFit fit_sphere_to_surface(const TriangleMesh& mesh, const Eigen::Vector3d& centre, double radius,
                                        double band_mm, double facing_cos, SurfaceSide side, const std::string& what);
 
-/// The femoral head's surface faces away from its centre within acos(kHeadFacing) = 45.6 deg where the head fit
-/// (fit_femoral_head) weighs it fully (the neck's, across the head-neck junction, does not).
+/// The head fit's facing cosine (fit_femoral_head's surface stage): the head's surface weighs fully where it faces
+/// away from the centre within acos(kHeadFacing + 0.1) = 36.9 deg, half at 45.6 deg, nothing beyond 53.1 deg (the
+/// neck's, across the head-neck junction, does not count).
 inline constexpr double kHeadFacing = 0.7;
 
 /// Options of the automatic femoral-head fit.
@@ -77,6 +81,9 @@ struct HeadFitOptions {
   double inlier_threshold_mm = 1.0;  ///< |distance - r| below this counts as an inlier
   int ransac_iterations = 3000;
   int refinement_rounds = 4;   ///< geometric refit on re-selected inliers
+  /// The last stage, the sphere of the head's surface (fit_sphere_to_surface): needs the femur's triangles; off for a
+  /// point set with no surface (experiment 12's vertex clouds).
+  bool surface_stage = true;
   std::uint64_t seed = 12345;  ///< RNG seed: results are reproducible
 };
 
