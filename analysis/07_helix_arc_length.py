@@ -100,7 +100,7 @@ ax.plot(np.where(f, x, np.nan), np.where(f, y, np.nan), np.where(f, z, np.nan), 
 fn = front(k10.x, k10.y, k10.z, el, az)
 ax.scatter(k10.x[fn], k10.y[fn], k10.z[fn], s=4, color="C3", depthshade=False)
 ax.scatter([v.x], [v.y], [v.z], s=18, color="blue", depthshade=False)
-ax.set_title("a) k = 10, v in blue", fontsize=8, y=0.96)
+ax.set_title("a) k = 10, v in blue", fontsize=11, y=0.96)
 # b) the local view in (theta, phi): the two turns bracketing v, P_a and P_b, the stencil of each locator.
 ax = fig.add_subplot(1, 3, 2)
 phi = np.linspace(np.radians(pa.phi_deg) - 0.08, np.radians(pb.phi_deg) + 0.08, 2000)
@@ -116,16 +116,17 @@ ax.axvline(v.theta_deg, color="0.6", lw=0.6, ls="--")
 ax.scatter([v.theta_deg], [v.phi_deg], s=22, color="blue", zorder=5, label="v")
 for name, p_ in (("P_a", pa), ("P_b", pb)):
     ax.scatter([p_.theta_deg], [p_.phi_deg], s=14, marker="s", color="0.3", zorder=4)
-    ax.annotate(f"$P_{name[-1]}$", (p_.theta_deg, p_.phi_deg), xytext=(3, -11), textcoords="offset points", fontsize=8)
+    ax.annotate(f"$P_{name[-1]}$", (p_.theta_deg, p_.phi_deg), xytext=(3, -13), textcoords="offset points",
+                fontsize=11)  # its subscript at 0.7 of that: 7.2 pt printed at the text width
 for r in ex.itertuples():
     ax.annotate(f"$P_{r.point[-1]}$", (r.theta_deg, r.phi_deg), xytext=(-4, 8), textcoords="offset points",
-                fontsize=8)
+                fontsize=11)
 ax.set_xlim(v.theta_deg - 25, v.theta_deg + 25)
 ax.set_ylim(pb.phi_deg + 9, pa.phi_deg - 9)  # north up
 ax.set_xlabel("theta (deg)")
 ax.set_ylabel("phi (deg)")
-ax.set_title("b) local view", fontsize=8)
-ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=3, handlelength=1, borderpad=0.3,
+ax.set_title("b) local view", fontsize=11)
+ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=3, handlelength=1, borderpad=0.3,
           labelspacing=0.2, columnspacing=0.6)
 # c) the traveled distance of P_b: the curve from the start (the north pole) to P_b, in black.
 ax = fig.add_subplot(1, 3, 3, projection="3d")
@@ -137,7 +138,7 @@ x, y, z = curve(10, np.radians(pb.phi_deg))
 f = front(x, y, z, el, az)
 ax.plot(np.where(f, x, np.nan), np.where(f, y, np.nan), np.where(f, z, np.nan), color="k", lw=1.0)
 ax.scatter([pb.x], [pb.y], [pb.z], s=14, marker="s", color="0.3", depthshade=False)
-ax.set_title(f"c) $P_b$'s traveled distance:\n{pb.steps:.2f} node steps", fontsize=8, y=0.96)
+ax.set_title(f"c) $P_b$'s traveled distance:\n{pb.steps:.2f} node steps", fontsize=11, y=0.96)
 fig.subplots_adjust(left=0.0, right=0.99, bottom=0.3, top=0.88, wspace=0.25)
 save(fig, d, "fig48", rect=(0, 0, 1, 1))
 
