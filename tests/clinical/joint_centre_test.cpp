@@ -24,6 +24,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "impinge/anatomy/femur_frame.hpp"
 #include "impinge/clinical/rom.hpp"
@@ -59,6 +60,30 @@ const std::vector<Eigen::Matrix3d>& rotations() {
       Eigen::AngleAxisd(2.0, Eigen::Vector3d(0, 0.4, 1).normalized()).toRotationMatrix()};
   return r;
 }
+// A cup of inner radius 20.5 mm about kBumpCupCentre whose inner surface carries a bump 0.9 mm high (a cosine cap of
+// 4 deg radius, 30 deg from the pole); `around`, `along`: make_cup's segments.
+const Eigen::Vector3d kBumpCupCentre(0.3, -0.2, 0.1);
+TriangleMesh bump_cup(int around, int along) {
+  TriangleMesh cup = make_cup(20.5, 25, 100, kBumpCupCentre, -Eigen::Vector3d::UnitZ(), around, along);
+  const Eigen::Vector3d bump_dir = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitX()) * -Eigen::Vector3d::UnitZ();
+  for (Eigen::Index i = 0; i < cup.V.rows(); ++i) {
+    const Eigen::Vector3d d = cup.V.row(i).transpose() - kBumpCupCentre;
+    if (std::abs(d.norm() - 20.5) > 1e-6) continue;
+    const double angle = std::acos(std::clamp(d.normalized().dot(bump_dir), -1.0, 1.0));
+    const double width = 4 * M_PI / 180;
+    if (angle < width)
+      cup.V.row(i) = (kBumpCupCentre + d.normalized() * (20.5 - 0.45 * (1 + std::cos(M_PI * angle / width)))).transpose();
+  }
+  return cup;
+}
+// 1 at the vertices of the bump cup's inner surface (within 20.5 mm of its centre: the bump's and, once split, the
+// midpoints of the inner chords).
+std::vector<std::uint8_t> inner_flags(const TriangleMesh& cup) {
+  std::vector<std::uint8_t> f(static_cast<std::size_t>(cup.V.rows()), 0);
+  for (Eigen::Index i = 0; i < cup.V.rows(); ++i)
+    f[static_cast<std::size_t>(i)] = (cup.V.row(i).transpose() - kBumpCupCentre).norm() < 20.5 + 1e-6;
+  return f;
+}
 }  // namespace
 
 TEST(JointCentre, EquidistantSeatsASphericalHeadOnTheCupCentre) {
@@ -86,19 +111,10 @@ TEST(JointCentre, EquidistantSeatsASphericalHeadOnTheCupCentre) {
 TEST(JointCentre, EquidistantNeverPressesTheHeadIntoTheSocket) {
   JointOptions o;
   o.scheme = make_scheme("equiangular", 0.25);
-  const Eigen::Vector3d cup_centre(0.3, -0.2, 0.1);
+  const Eigen::Vector3d cup_centre = kBumpCupCentre;
   TriangleMesh head = make_uv_sphere(20, Eigen::Vector3d::Zero(), 240, 120);
-  TriangleMesh cup = make_cup(20.5, 25, 100, cup_centre, -Eigen::Vector3d::UnitZ(), 360, 150);
-  const Eigen::Vector3d bump_dir = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitX()) * -Eigen::Vector3d::UnitZ();
-  std::vector<std::uint8_t> inner(static_cast<std::size_t>(cup.V.rows()), 0);
-  for (Eigen::Index i = 0; i < cup.V.rows(); ++i) {
-    const Eigen::Vector3d d = cup.V.row(i).transpose() - cup_centre;
-    if (std::abs(d.norm() - 20.5) > 1e-6) continue;
-    inner[static_cast<std::size_t>(i)] = 1;
-    const double angle = std::acos(std::clamp(d.normalized().dot(bump_dir), -1.0, 1.0));
-    const double width = 4 * M_PI / 180;
-    if (angle < width) cup.V.row(i) = (cup_centre + d.normalized() * (20.5 - 0.45 * (1 + std::cos(M_PI * angle / width)))).transpose();
-  }
+  TriangleMesh cup = bump_cup(360, 150);
+  const std::vector<std::uint8_t> inner = inner_flags(cup);
   const Joint joint(std::move(head), std::move(cup), Eigen::Vector3d::Zero(), o);
   LunateSphere lunate;
   lunate.centre = cup_centre;
@@ -114,6 +130,52 @@ TEST(JointCentre, EquidistantNeverPressesTheHeadIntoTheSocket) {
   };
   EXPECT_LT(least_inner_gap(sample_only, Eigen::Matrix3d::Identity()), -0.2);
   for (const Eigen::Matrix3d& R : rotations()) EXPECT_GE(least_inner_gap(guarded, R), -0.02);
+}
+
+// The guard's points are the surface's, not the file's: the bump cup's inner triangles split in four at their edges'
+// midpoints (the same surface) give the same points (as a set, to 1e-9 mm: brute force over both sets), and so the
+// same equidistant translation at every rotation. The old guard, the lunate vertices, changed under the split (the
+// midpoints lie on the chords, nearer the head): splitting mc22's pelvis moved its IR limit 0.25 deg.
+TEST(JointCentre, TheGuardIsTheSameForASplitSurface) {
+  const TriangleMesh cup = bump_cup(120, 50), split = test::split_in_four(cup);
+  const ScanSet a = guard_points(cup.V, cup.F, inner_flags(cup)), b = guard_points(split.V, split.F, inner_flags(split));
+  ASSERT_GT(a.size(), 1000);
+  auto covered = [](const ScanSet& from, const ScanSet& in) {  // every point of `from` is a point of `in` (to 1e-9 mm)
+    std::vector<std::int64_t> order(static_cast<std::size_t>(in.size()));
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](std::int64_t p, std::int64_t q) { return in.x[p] < in.x[q]; });
+    for (std::int64_t i = 0; i < from.size(); ++i) {
+      auto j = std::lower_bound(order.begin(), order.end(), from.x[i] - 1e-9,
+                                [&](std::int64_t k, double x) { return in.x[k] < x; });
+      bool found = false;
+      for (; j != order.end() && in.x[*j] <= from.x[i] + 1e-9 && !found; ++j)
+        found = std::hypot(from.x[i] - in.x[*j], from.y[i] - in.y[*j], from.z[i] - in.z[*j]) <= 1e-9;
+      if (!found) return false;
+    }
+    return true;
+  };
+  EXPECT_TRUE(covered(a, b));
+  EXPECT_TRUE(covered(b, a));
+  // The old guard, the vertices alone, was not the same: the split's midpoints are not vertices of the cup.
+  const ScanSet va = make_scan_set(cup.V, inner_flags(cup)), vb = make_scan_set(split.V, inner_flags(split));
+  EXPECT_FALSE(covered(vb, va));
+  // And so the same translation, where the guard binds (the bump, as in EquidistantNeverPressesTheHeadIntoTheSocket).
+  JointOptions o;
+  o.scheme = make_scheme("equiangular", 0.25);
+  LunateSphere lunate;
+  lunate.centre = kBumpCupCentre;
+  lunate.radius_mm = 20.5;
+  const TriangleMesh head = make_uv_sphere(20, Eigen::Vector3d::Zero(), 240, 120);
+  const Joint whole(head, cup, Eigen::Vector3d::Zero(), o), halves(head, split, Eigen::Vector3d::Zero(), o);
+  const JointCentre jw(JointCentreMethod::equidistant, whole, lunate, inner_flags(cup), 21.0);
+  const JointCentre jh(JointCentreMethod::equidistant, halves, lunate, inner_flags(split), 21.0);
+  const JointCentre unguarded(JointCentreMethod::equidistant, whole, lunate, {}, 21.0);
+  for (const Eigen::Matrix3d& R : rotations()) {
+    const Eigen::Vector3d t = jw.translation(whole, R);
+    EXPECT_LT((jh.translation(halves, R) - t).norm(), 1e-6) << t.transpose();
+  }
+  // The guard binds at neutral (without it the head sits elsewhere): the comparison above could fail.
+  EXPECT_GT((unguarded.translation(whole, Eigen::Matrix3d::Identity()) - jw.translation(whole, Eigen::Matrix3d::Identity())).norm(), 0.05);
 }
 
 TEST(JointCentre, CombinedAndAcetabularKeepTheirCentres) {

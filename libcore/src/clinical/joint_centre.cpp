@@ -87,7 +87,30 @@ JointCentre::JointCentre(JointCentreMethod method, const Joint& joint, const Lun
   require(guard.empty() || guard.size() == static_cast<std::size_t>(P.rows()),
           "joint centre equidistant: the lunate flags have " + std::to_string(guard.size()) + " entries for " +
               std::to_string(P.rows()) + " pelvis vertices");
-  if (!guard.empty()) guard_ = make_scan_set(P, guard);
+  if (!guard.empty()) guard_ = guard_points(P, joint.socket().mesh.F, guard);
+}
+
+ScanSet guard_points(const Vertices& P, const Faces& F, const std::vector<std::uint8_t>& flags) {
+  ScanSet set;
+  set.vertices = P.rows();
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const std::int32_t i0 = F(f, 0), i1 = F(f, 1), i2 = F(f, 2);
+    if (!(flags[static_cast<std::size_t>(i0)] && flags[static_cast<std::size_t>(i1)] && flags[static_cast<std::size_t>(i2)]))
+      continue;
+    const Eigen::Vector3d a = P.row(i0).transpose(), b = P.row(i1).transpose(), c = P.row(i2).transpose();
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    int k = 1;
+    while (k < kGuardMaxCuts && longest / k > kGuardSpacingMm) k *= 2;
+    const Eigen::Vector3d u = (b - a) / k, v = (c - a) / k;
+    for (int p = 0; p <= k; ++p)
+      for (int q = 0; p + q <= k; ++q) {
+        // The corners as given (not a + k u: the same point to the last bit wherever a corner is shared).
+        const Eigen::Vector3d x = p == k ? b : q == k ? c : Eigen::Vector3d(a + p * u + q * v);
+        set.index.push_back(static_cast<std::int32_t>(f));
+        set.x.push_back(x.x()), set.y.push_back(x.y()), set.z.push_back(x.z());
+      }
+  }
+  return set;
 }
 
 void JointCentre::gaps(const Joint& joint, const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float* out) const {
@@ -273,8 +296,9 @@ struct GuardTest {
   }
 };
 
-/// Watches the guard vertices closing at t: those not yet watched whose guarded gap (guard_gap, mm) is below 0.25 mm
-/// are marked in is_watched (and closed_out, if given) and appended to `watched`, their guard indices to watched_k.
+/// Watches the guard points closing at t: those not yet watched whose guarded gap (guard_gap, mm) is below 0.25 mm
+/// are marked in is_watched (and in closed_out, if given, where the femur's surface closing them is not the head's)
+/// and appended to `watched`, their guard indices to watched_k.
 void watch_closing(const ScanSet& guard, const float* guard_gap, const GuardTest& test, const Eigen::Vector3d& t,
                    std::vector<std::uint8_t>& is_watched, std::vector<std::int64_t>& watched_k, ScanSet& watched,
                    std::vector<std::uint8_t>* closed_out) {
@@ -284,7 +308,11 @@ void watch_closing(const ScanSet& guard, const float* guard_gap, const GuardTest
     if (is_watched[i] || !(guard_gap[i] < kNearMm) || !test.guarded(k, guard, k, t, guard_gap[i])) continue;
     is_watched[i] = 1;
     watched_k.push_back(k);
-    if (closed_out) (*closed_out)[i] = 1;
+    // Recorded as closed at neutral only where what closes it is not the head's joint surface (a head past its sphere, a
+    // segmentation overlap): a closure by the head is guarded at every pose anyway, and a point recorded here is kept
+    // open against anything of the femur, a neck or cam too (1,106 points of tlem2-mri's lunate surface lie within
+    // 0.25 mm of its head at neutral: recording them all held its femur off a cam's contact).
+    if (closed_out && !test.faces_head(guard, k, t, guard_gap[i])) (*closed_out)[i] = 1;
     watched.index.push_back(guard.index[i]);
     watched.x.push_back(guard.x[k]), watched.y.push_back(guard.y[k]), watched.z.push_back(guard.z[k]);
   }

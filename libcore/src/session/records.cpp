@@ -211,7 +211,7 @@ namespace {
 
 // summary.json's centres (input frame, mm): the femoral head centre, the acetabular centre (when found), the maps'
 // centre, how the COR was found, the head radius (mm), the joint-centre method and its pivot (null for
-// equidistant), and with the equidistant joint centre the lunate vertices guarded at neutral.
+// equidistant), and with the equidistant joint centre the guard points closed at neutral.
 void add_centres(nlohmann::json& j, const Session& s) {
   const HipJoint& hip = s.hip();
   // Three centres, each with its own name: the femoral head centre (the COR the femur rotates about: given or
@@ -228,8 +228,8 @@ void add_centres(nlohmann::json& j, const Session& s) {
   // equidistant, whose centre moves with each pose (a pose's joint_translation_mm).
   j["pivot_mm"] = nullptr;
   if (const auto pivot = pivot_input(s)) j["pivot_mm"] = vec(*pivot);
-  // The lunate vertices the equidistant placement keeps open at every pose because something of the femur closed
-  // them at neutral (a head past its sphere, a segmentation overlap): 0 on a clean hip.
+  // The guard points of the lunate surface (JointCentre's guard_points, 0.5 mm apart) the equidistant placement keeps
+  // open at every pose because something of the femur closed them at neutral (a head past its sphere, a segmentation overlap): 0 on a clean hip.
   if (hip.joint_centre().method() == JointCentreMethod::equidistant)
     j["equidistant_guarded_at_neutral"] = hip.joint_centre().guarded_at_neutral();
 }

@@ -22,12 +22,12 @@
 ///   the ray from the head centre through q leaves through the head-neck junction or the fovea's
 ///   rim); t is found by Gauss-Newton from the head centre's scan position (LunateSphere::scan_head_centre;
 ///   the exact Jacobian for a spherical head), to within EquidistantOptions::tolerance_mm, each step constrained so that the joint
-///   space stays open (>= 0 mm, up to the tolerance) at every point sampled and at every lunate vertex facing
-///   the head's joint surface (those found closed at a converged t join the constraints and the iteration goes
+///   space stays open (>= 0 mm, up to the tolerance) at every point sampled and at every guard point facing
+///   the head's joint surface (the lunate triangles' points at most 0.5 mm apart, guard_points) (those found closed at a converged t join the constraints and the iteration goes
 ///   on): the head is never pressed into the socket to even the joint space out (an MRI socket whose sphere is
 ///   barely larger than the head's, tlem2-mri's, had it pressed 1-2.5 mm in and its abduction ended at 8 deg).
-///   Only a closure by the head's joint surface is guarded (the femur's surface facing the lunate vertex within
-///   the head sphere's reach), and at the lunate vertices anything closes at neutral (guard_at_neutral: a head
+///   Only a closure by the head's joint surface is guarded (the femur's surface facing the guard point within
+///   the head sphere's reach), and at the guard points anything closes at neutral (guard_at_neutral: a head
 ///   bulging past its sphere, a segmentation overlap): a neck or cam meeting the rim is an impingement, the ROM's
 ///   to find. Guarding it too levered the femur out of the socket past the first contact (lhdl-ct: 6 mm at 70 deg
 ///   of extension, 23-60 mm beyond 75 deg, where the bones parted again and extension ended at 138 deg instead of
@@ -113,6 +113,22 @@ inline constexpr double kLunateSpacingDeg = 2.0;
 /// joint centre needs the acetabulum's joint surface. Names `socket`'s mesh. Source: impinge.
 std::string too_few_lunate_points(const JointBody& socket, std::size_t points);
 
+/// The guard's points are at most this far apart on each lunate triangle (guard_points), mm.
+inline constexpr double kGuardSpacingMm = 0.5;
+/// A lunate triangle is cut at most this many times along an edge (guard_points).
+inline constexpr int kGuardMaxCuts = 64;
+
+/// The points of the lunate surface where the equidistant method keeps the joint space open: every triangle of
+/// F (m x 3) whose three corners are flagged (`flags`: one per row of P, n x 3, mm) cut into k x k congruent
+/// triangles, k the least power of two (at most kGuardMaxCuts) that makes their edges at most kGuardSpacingMm
+/// long, and the corners of those (the triangle's own corners among them). A triangle split in four at its edges'
+/// midpoints is cut into the same triangles, so the points are the same for either tessellation of one surface
+/// (the mesh's vertices alone were not: an edge's midpoint lies on the chord, nearer the head than the corners,
+/// and splitting mc22's or tlem2-mri's pelvis moved limits 0.1-0.28 deg). `index`: the face of each point
+/// (points on a shared edge repeat); `vertices`: n. Never throws (the flags' length is the caller's to check).
+/// Source: impinge (issue 81).
+ScanSet guard_points(const Vertices& P, const Faces& F, const std::vector<std::uint8_t>& flags);
+
 /// The translation of the femur at each pose by one method.
 class JointCentre {
  public:
@@ -120,8 +136,8 @@ class JointCentre {
   /// joint frame, mm); equidistant also needs the rest of `lunate` (lunate_sample must find at least 16
   /// points on it in `joint`'s socket map), the head sphere's reach (mm: r_h + t_h,
   /// ArticularZones::head_sphere_reach_mm) and `guard`: one flag per socket vertex of `joint`, 1 on the
-  /// lunate surface (ArticularZones::pelvis), where the joint space must stay open (empty: the sample's points
-  /// only). Throws impinge::Error when what the method needs is missing, not finite or not positive (too few lunate
+  /// lunate surface (ArticularZones::pelvis): the joint space must stay open at its triangles' guard_points (empty: the
+  /// sample's points only). Throws impinge::Error when what the method needs is missing, not finite or not positive (too few lunate
   /// points: too_few_lunate_points), or `guard` has another size.
   JointCentre(JointCentreMethod method, const Joint& joint, const LunateSphere& lunate,
               const std::vector<std::uint8_t>& guard, double head_sphere_reach_mm, const EquidistantOptions& options = {});
@@ -136,14 +152,14 @@ class JointCentre {
   /// fewer than 16 lunate vertices face the head's joint surface or the iteration diverges.
   Eigen::Vector3d translation(const Joint& joint, const Eigen::Matrix3d& R) const;
 
-  /// Equidistant: the lunate vertices that whatever of the femur closes at the neutral rotation R0 (3 x 3, joint
+  /// Equidistant: the guard points that whatever of the femur closes at the neutral rotation R0 (3 x 3, joint
   /// frame) stay guarded at every pose, however far the closing surface lies from the head sphere (a head that
   /// bulges past its sphere, or a segmentation overlap: mc22's head was pressed 0.59 mm into its socket at neutral
   /// without it). Elsewhere only a closure by the head's joint surface is guarded. Call once, before the first
   /// translation (HipJoint does, with the anatomical neutral). No-op for the other methods.
   void guard_at_neutral(const Joint& joint, const Eigen::Matrix3d& R0);
 
-  /// Equidistant: the lunate vertices guarded at every pose by guard_at_neutral (0 before it).
+  /// Equidistant: the guard points (guard_points) guarded at every pose by guard_at_neutral (0 before it).
   std::int64_t guarded_at_neutral() const;
 
   /// The joint space's standard deviation (mm) over the lunate vertices used, at pose (R, t): what
@@ -173,8 +189,8 @@ class JointCentre {
   Eigen::Vector3d start_ = Eigen::Vector3d::Zero();  // where the equidistant iteration starts
   double reach_mm_ = 0;
   ScanSet lunate_;  // the lunate sample, joint frame (relative to the COR)
-  ScanSet guard_;   // the lunate vertices whose joint space must stay open
-  std::vector<std::uint8_t> neutral_closed_;  // per guard_ vertex: closed at neutral (guard_at_neutral), guarded always
+  ScanSet guard_;   // the guard points: where the lunate surface's joint space must stay open (guard_points)
+  std::vector<std::uint8_t> neutral_closed_;  // per guard_ point: closed at neutral (guard_at_neutral), guarded always
   // translation's iteration; guard_all: every closure guarded (not only the head's); closed_out (guard_.size(), or
   // null): set to 1 at every guard vertex watched
   Eigen::Vector3d solve(const Joint& joint, const Eigen::Matrix3d& R, bool guard_all,
