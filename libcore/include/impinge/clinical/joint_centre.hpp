@@ -124,7 +124,8 @@ inline constexpr int kGuardMaxCuts = 64;
 /// long, and the corners of those (the triangle's own corners among them). A triangle split in four at its edges'
 /// midpoints is cut into the same triangles, so the points are the same for either tessellation of one surface
 /// (where a triangle's edges are all shorter than kGuardSpacingMm it is its corners alone, and a split adds its
-/// edges' midpoints: within 0.0013 mm of the surface's chord on a 25 mm socket, below the iteration's tolerance)
+/// edges' midpoints, which a 0.5 mm chord of a 25 mm socket brings 0.0013 mm nearer the head: below the
+/// iteration's 0.02 mm tolerance)
 /// (the mesh's vertices alone were not: an edge's midpoint lies on the chord, nearer the head than the corners,
 /// and splitting mc22's or tlem2-mri's pelvis moved limits 0.1-0.28 deg). `index`: the face of each point
 /// (points on a shared edge repeat); `vertices`: n. Never throws (the flags' length is the caller's to check).
