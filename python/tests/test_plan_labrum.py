@@ -9,8 +9,9 @@ resected volume by numpy's divergence theorem on the input and written meshes; t
 Invariants: a target beyond the labral limit but within the bony limit needs no cut without --labrum (the femur
 written unmoved) and a femoral cut with it (volume > 0), after which the labral limit reaches the target (within the
 check's 0.1 deg) and the bony limit is not lowered; the labrum is the same before, in the plan and after (1e-4 mm:
-float coordinates); only the femur is written; plan.json says the labral limit was targeted. Bad input (--labrum with
---resect pelvis): tests/bad_inputs/test_plan_inputs.py."""
+float coordinates); only the femur is written; plan.json says the labral limit was targeted; where the labrum blocks
+the way to a motion's start (tlem2-mri) the plan frees it, the clearance kept by the exact distance. Bad input
+(--labrum with --resect pelvis): tests/bad_inputs/test_plan_inputs.py."""
 import csv
 import json
 import os
@@ -97,6 +98,28 @@ def test_a_plan_with_the_labrum_cuts_the_femur_to_the_labral_target_on_a_real_hi
     subject = os.path.join(DATA, "lhdl-ct", "subject.json")
     check_labral_plan(tmp_path, subject, "internal_rotation_90_flexion", ["--precision", 0.5],
                       impinge.subject_meshes(subject)["femur"])
+
+
+@pytest.mark.skipif(not os.path.isdir(os.path.join(DATA, "tlem2-mri")), reason="shared data absent")
+def test_a_motion_the_labrum_blocks_on_its_way_is_freed_with_the_clearance_kept_exactly(tmp_path):
+    """tlem2-mri: the labrum meets the femur on the way to 90 deg flexion, so internal rotation there is not reachable
+    (bony limit 23.8 deg). A plan for 5 deg frees the way and the motion, keeping the clearance by the exact distance
+    (the labrum's margin between its vertices: the per-vertex plan alone left 0.295 mm of the 0.3), as a separate
+    `impinge rom --labrum` on the written femur confirms."""
+    subject = os.path.join(DATA, "tlem2-mri", "subject.json")
+    r = run(["rom", "--subject", subject, "--out", tmp_path / "before", "--no-map", "--labrum"])
+    assert r.returncode == 0, r.stderr
+    assert rom_rows(tmp_path / "before")["internal_rotation_90_flexion"]["labral_status"] == "not_reachable"
+    r = run(["plan", "--subject", subject, "--out", tmp_path / "lab", "--target", "internal_rotation_90_flexion=5",
+             "--labrum"])
+    assert r.returncode == 0, r.stderr + r.stdout
+    t = json.load(open(tmp_path / "lab" / "plan.json"))["targets"][0]
+    assert t["met"] and t["clearance"]["least_labrum_mm"] >= 0.3 - 1e-4, t
+    r = run(["rom", "--subject", subject, "--ball", tmp_path / "lab" / "femur_resected.ply", "--out",
+             tmp_path / "after", "--no-map", "--labrum"])
+    assert r.returncode == 0, r.stderr
+    after = rom_rows(tmp_path / "after")["internal_rotation_90_flexion"]
+    assert after["labral_status"] == "limited" and num(after["labral_limit_deg"]) >= 5 - 0.1, after
 
 
 def test_joint_plan_takes_the_labrum_and_refuses_it_with_a_pelvis_only_trim(tmp_path):

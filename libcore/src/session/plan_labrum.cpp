@@ -80,6 +80,74 @@ ResectionPlan combined(const HipJoint& hip, const std::vector<ResectionTarget>& 
   return bony;
 }
 
+/// The exact query of the ROM search at pose P within `reach` (mm): a pair across the head-neck junction classed by
+/// the femur's closest point, as rom_exact.cpp's ExactScanner classes it.
+MeshContact::Query exact_query(const RomBaseline& base, const FemurPose& P, double reach) {
+  MeshContact::Query q;
+  q.reach = reach;
+  if (base.head_zone)
+    q.pair_counts = [&base, Rt = Eigen::Matrix3d(P.R.transpose()), t = P.t](
+                        std::int64_t, const Eigen::Vector3d& on_a, const Eigen::Vector3d&) {
+      return base.meets_head(Rt * (on_a - t)) == (base.contacts == RomContacts::articular);
+    };
+  return q;
+}
+
+/// What the femur resected by `plan` (its femur, joint frame) still lacks of `clearance_mm` against the labrum by the
+/// exact mesh-to-mesh distance (the baseline's counted triangles, each classed pair by pair), at its worst pose of
+/// those the plan cleared (the first poses_cleared of each target), mm; 0 when no pair is within the clearance or
+/// without the exact meshes (RomBaseline::contact). The plan's contacts are per vertex: the labrum's free margin, a
+/// sharp edge, may still come nearer the femur between its vertices.
+double exact_shortfall_mm(const PlanLabrum& labrum, const ResectionPlan& plan,
+                          const std::vector<ResectionTarget>& targets, double clearance_mm) {
+  const RomBaseline& base = labrum.baseline;
+  if (!base.contact) return 0;
+  std::vector<std::uint8_t> counted(static_cast<std::size_t>(base.contact->faces_a()));
+  for (std::size_t f = 0; f < counted.size(); ++f)
+    counted[f] = base.contact->counted_a(static_cast<std::int64_t>(f)) ? 2 : 0;
+  const JointBody& lab = labrum.hip->joint().socket();
+  const MeshContact contact(plan.femur.resected, labrum.hip->joint().ball().mesh.F, lab.relative, lab.mesh.F,
+                            std::move(counted),
+                            std::vector<std::uint8_t>(static_cast<std::size_t>(lab.mesh.F.rows()), 0));
+  std::vector<PoseAngles> poses;
+  for (std::size_t k = 0; k < targets.size(); ++k)
+    for (std::int64_t i = 0; i < plan.targets[k].poses_cleared; ++i)
+      poses.push_back(targets[k].poses[static_cast<std::size_t>(i)]);
+  double worst = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(max : worst)
+  for (std::size_t p = 0; p < poses.size(); ++p) {
+    const FemurPose P = labrum.hip->femur_pose(poses[p]);
+    const double d = contact.least(P.R, P.t, exact_query(base, P, clearance_mm)).distance;
+    if (std::isfinite(d)) worst = std::max(worst, clearance_mm - d);
+  }
+  return worst;
+}
+
+/// The labral plan (plan_resection of the labral hip for `targets`, `options`), asked again, at most twice, while
+/// the exact distance falls short of the clearance somewhere (exact_shortfall_mm > 0), for the clearance plus that
+/// shortfall and the plan's tolerance more (the per-vertex contacts' error there, made up); the candidates' margin
+/// less as much, so that the same contacts are followed within the same distance reach (the increase at most what
+/// the margin and the clearance's range leave).
+ResectionPlan labral_plan(const PlanLabrum& labrum, const std::vector<ResectionTarget>& targets,
+                          ResectionOptions options) {
+  const double clearance = options.clearance_mm;
+  ResectionPlan plan = plan_resection(*labrum.hip, targets, labrum.baseline, options);
+  for (int again = 0; again < 2; ++again) {
+    const double shortfall = exact_shortfall_mm(labrum, plan, targets, clearance);
+    if (shortfall <= 0) break;
+    const double more = std::min({shortfall + options.tolerance_mm, options.candidate_margin_mm,
+                                  ResectionOptions::kClearanceRange.max - options.clearance_mm});
+    if (more <= 0) break;
+    options.clearance_mm += more;
+    options.candidate_margin_mm -= more;
+    const double ms = plan.ms;
+    const int rounds = plan.rounds;
+    plan = plan_resection(*labrum.hip, targets, labrum.baseline, options);
+    plan.ms += ms, plan.rounds += rounds;
+  }
+  return plan;
+}
+
 }  // namespace
 
 RomRun targeted_limits(const RomRun& run) {
@@ -109,14 +177,7 @@ PlanLabrum plan_labrum(const HipJoint& hip, const LabrumOptions& labrum, const R
 double labrum_exact_distance(const PlanLabrum& labrum, const FemurPose& P, double reach) {
   const RomBaseline& base = labrum.baseline;
   if (!base.contact) return std::numeric_limits<double>::infinity();
-  MeshContact::Query q;
-  q.reach = reach;
-  if (base.head_zone)  // a pair across the junction is classed by the femur's closest point, as the search classes it
-    q.pair_counts = [&base, Rt = Eigen::Matrix3d(P.R.transpose()), t = P.t](
-                        std::int64_t, const Eigen::Vector3d& on_a, const Eigen::Vector3d&) {
-      return base.meets_head(Rt * (on_a - t)) == (base.contacts == RomContacts::articular);
-    };
-  return base.contact->least(P.R, P.t, q).distance;
+  return base.contact->least(P.R, P.t, exact_query(base, P, reach)).distance;
 }
 
 ResectionPlan plan_targeted(const HipJoint& hip, const RomBaseline& baseline, const PlanLabrum* labrum,
@@ -125,7 +186,7 @@ ResectionPlan plan_targeted(const HipJoint& hip, const RomBaseline& baseline, co
   ResectionOptions femur_only = options;
   femur_only.bones = ResectBones::femur;
   femur_only.pelvis_removed_mm.clear();  // the labral hip's socket is the labrum: nothing was removed from it
-  ResectionPlan labral = plan_resection(*labrum->hip, targets, labrum->baseline, femur_only);
+  ResectionPlan labral = labral_plan(*labrum, targets, femur_only);
   std::vector<ResectionTarget> planned = cut_back(targets, cleared(labral));
   const ResectionPlan bony = plan_resection(hip, planned, baseline, options);
   if (clears_fewer(bony, cleared(labral))) {
@@ -133,7 +194,7 @@ ResectionPlan plan_targeted(const HipJoint& hip, const RomBaseline& baseline, co
     // the bony plan cleared (a subset of those it cleared, so it clears them all).
     planned = cut_back(planned, cleared(bony));
     const ResectionPlan first = std::move(labral);
-    labral = plan_resection(*labrum->hip, planned, labrum->baseline, femur_only);
+    labral = labral_plan(*labrum, planned, femur_only);
     labral.targets = first.targets;  // what the labrum allows: the first labral plan's (poses cleared, notes)
     labral.ms += first.ms, labral.rounds += first.rounds, labral.poses += first.poses;
   }
