@@ -320,11 +320,20 @@ int run_plan(const RunOptions& o) {
   if (f.allowed && p.allowed) std::cout << ", ";
   if (p.allowed) std::cout << "pelvis " << p.volume_mm3 << " mm^3 (deepest cut " << p.deepest_cut_mm << " mm)";
   std::cout << "; targets:";
+  // A limit as the summary prints it: its angle to 0.1 deg, or its status.
+  auto limit = [](double deg, RomLimitStatus status) {
+    return std::isnan(deg) ? std::string(to_string(status))
+                           : std::to_string(static_cast<double>(std::lround(deg * 10)) / 10.0).substr(0, 5);
+  };
   for (const PlanTargetCheck& c : run.targets) {
     std::cout << " " << c.name;
-    if (!std::isnan(c.target_deg))
-      std::cout << " " << (std::isnan(c.before.limit_deg) ? std::string(to_string(c.before.status)) : std::to_string(static_cast<double>(std::lround(c.before.limit_deg * 10)) / 10.0).substr(0, 5))
-                << "->" << (std::isnan(c.after.limit_deg) ? std::string(to_string(c.after.status)) : std::to_string(static_cast<double>(std::lround(c.after.limit_deg * 10)) / 10.0).substr(0, 5))
+    if (!std::isnan(c.target_deg) && c.labral_before && c.labral_after)  // --labrum: both, the labral one targeted
+      std::cout << " bony " << limit(c.before.limit_deg, c.before.status) << "->"
+                << limit(c.after.limit_deg, c.after.status) << ", labral (targeted) "
+                << limit(c.labral_before->limit_deg, c.labral_before->status) << "->"
+                << limit(c.labral_after->limit_deg, c.labral_after->status) << "/" << c.target_deg;
+    else if (!std::isnan(c.target_deg))
+      std::cout << " " << limit(c.before.limit_deg, c.before.status) << "->" << limit(c.after.limit_deg, c.after.status)
                 << "/" << c.target_deg;
     if (c.clearance_poses > 0)
       std::cout << " clearance " << std::setprecision(2) << c.clearance_least_mm << std::setprecision(1) << " mm";
@@ -415,8 +424,9 @@ int main(int argc, char** argv) {
        use_morphology, run_morphology},
       {app.add_subcommand("plan",
                           "Resection plan: the least bone to remove (the cam, a rim) so that target motions run free "
-                          "of impingement, checked by the ROM search on the resected bones. Writes plan.json, "
-                          "femur_resected.ply/.vtp (per-vertex resection_mm) and summary.json"),
+                          "of impingement, checked by the ROM search on the resected bones (--labrum: the labral "
+                          "limits targeted, the femur cut to clear the labrum too). Writes plan.json, "
+                          "femur_resected.ply/.vtp (per-vertex resection_mm), labrum.ply (--labrum) and summary.json"),
        use_plan, run_plan},
       {app.add_subcommand("generate", "Write a generated hip model (femur_r.ply, pelvis.ply, subject.json)"),
        use_generate, run_generate},

@@ -265,7 +265,9 @@ void add_joint_queries(py::class_<PyJoint>& c) {
            "the lunate surface; checked on the resected bones in their own placement (the ROM search and the "
            "clearance at every target pose; further passes where one is missed). Adds femur_resected (V, F: input "
            "frame, the input's faces) and femur_resection_mm (per vertex), and the pelvis' with resect 'pelvis' or "
-           "'both'. Raises impinge.Error when a target is missed, unless allow_partial. Keywords and defaults: the "
+           "'both'. labrum=True targets the labral limits: the femur is cut to clear the pelvis and the labrum (never "
+           "cut; not with resect 'pelvis'). Raises impinge.Error when a target is missed, unless allow_partial. "
+           "Keywords and defaults: the "
             "option table's (impinge.options()). " + keywords_doc(use_joint_plan)))
       .def("rom_map", &rom_map,
            keep_doc("ROM map: the largest internal rotation (deg) before contact for every flexion x adduction "

@@ -268,7 +268,7 @@ void bind_options(py::module_& m) {
         const unsigned bit = use_bit(use);
         RunOptions run = RunOptions::clinical();
         set_options(run, given, bit, use);
-        if (bit == use_joint_plan || bit == use_plan) check_plan_request(run.session, run.plan);
+        if (bit == use_joint_plan || bit == use_plan) check_plan_request(run.session, run.plan, run.rom.labrum);
         if (bit == use_joint || bit == use_study) resolved_hip_options(run.session);  // the maps' scheme, the joint's
         py::dict d;
         for (const OptionRow& r : option_table())

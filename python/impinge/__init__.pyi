@@ -160,6 +160,7 @@ class Joint:
         'radial'."""
     def plan(self, *, threshold_mm: float = 0.0, contact_depth_mm: float = 0.0, metric: str = 'distance',
              contacts: str = 'impingement', step_deg: float = 2.0, tolerance_deg: float = 0.1, max_deg: float = 150.0,
+             labrum: bool = False, labrum_width_mm: float = 5.3, labrum_height_mm: float = 7.0,
              target: Optional[str] = None, target_motion: Optional[Union[str, os.PathLike]] = None,
              resect: str = 'femur', clearance_mm: float = 0.3, max_depth_fraction: float = 0.3,
              max_depth_mm: float = 0.0, burr_radius_mm: float = 2.5, plan_step_deg: float = 0.5,

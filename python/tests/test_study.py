@@ -361,3 +361,26 @@ target = "flexion=50"
     assert rows[0]["met_flexion"] == "true" and float(rows[0]["limit_after_flexion_deg"]) >= 50 - 0.1
     folder = os.path.join(out, "tasks", rows[0]["task_id"])
     assert os.path.exists(os.path.join(folder, "plan.json")) and os.path.exists(os.path.join(folder, "resection.npz"))
+
+
+def test_a_plan_task_with_the_labrum_records_the_labral_limit(tmp_path):
+    """labrum = true in a plan task (issue 81): the plan targets the labral limit; results.csv gives it after the plan,
+    as a separate Joint.rom_limits(labrum=True) on the written resected femur measures it (the generated hip's cup
+    covering 80 deg: abduction's labral limit 35 deg, its bony 50 deg)."""
+    path = write_study(str(tmp_path), """name = "labral plans"
+subjects = [{name = "cup80", generated = {cam_mm = 0.0, triangles = 6000, coverage_deg = 80.0}}]
+[joint]
+precision = 1.0
+neutral = "scan"
+[[task]]
+kind = "plan"
+target = "abduction=40"
+labrum = true
+""")
+    out = str(tmp_path / "out")
+    study.run(path, out, workers=0, progress=False, log=lambda _: None)
+    rows = read(out)
+    assert len(rows) == 1 and rows[0]["status"] == "ok", rows
+    assert rows[0]["met_abduction"] == "true" and float(rows[0]["femur_volume_mm3"]) > 0
+    assert float(rows[0]["labral_limit_after_abduction_deg"]) >= 40 - 0.1
+    assert float(rows[0]["limit_after_abduction_deg"]) > float(rows[0]["labral_limit_after_abduction_deg"])

@@ -1,5 +1,6 @@
-"""`impinge plan`'s inputs (issue 50): a bad target, motion file or option is one line naming it, before anything is
-written; a motion file as a target is read as `impinge motion` reads it, and the plan frees its frames.
+"""`impinge plan`'s inputs (issue 50): a bad target, motion file or option (--labrum with --resect pelvis, issue 81)
+is one line naming it, before anything is written; a motion file as a target is read as `impinge motion` reads it,
+and the plan frees its frames.
 Invariant: no plan.json is written when the inputs are refused."""
 import json
 
@@ -32,6 +33,10 @@ def cam(tmp_path_factory):
     (["--target", "flexion=60", "--max-depth", "-2"], ["--max-depth: -2 mm is outside the valid range [0, 100] mm"]),
     (["--target", "flexion=60", "--clearance", "0.3", "--clearance-mm", "0.3"],
      ["give --clearance or --clearance-mm (its former name), not both"]),
+    # The labrum is soft tissue, never cut: a labral contact can be cleared only on the femur (issue 81).
+    (["--target", "flexion=60", "--labrum", "--resect", "pelvis"],
+     ["--labrum with --resect pelvis", "can be cleared only on the femur", "give --resect femur or both"]),
+    (["--target", "flexion=60", "--labrum", "--labrum-height", "20"], ["--labrum-height", "20 mm", "(0, 15] mm"]),
 ])
 def test_bad_plan_inputs_are_one_line_errors_naming_them(cam, tmp_path, args, fragments):
     r = run(["plan", "--subject", cam, "--out", tmp_path / "p", "--precision", 2] + args)

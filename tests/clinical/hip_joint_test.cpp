@@ -9,7 +9,11 @@
 //   plane (APP) frame turned by a known angle theta about their common Z, APP angles (f, a, r) pose the femur
 //   as ISB angles (f + theta, a, r) (both joint coordinate systems turn about Z first), so every limit in the
 //   APP is the ISB search along the motion with its flexion shifted by theta (flexion's limit the ISB one less
-//   theta, extension's the ISB one plus theta); with theta = 0 both frames give the same limits.
+//   theta, extension's the ISB one plus theta); with theta = 0 both frames give the same limits;
+// - the labrum split in four (with_labrum's splits, issue 81: the plan's labrum) is the same surface: 4^splits the
+//   triangles, every vertex on a triangle of the labrum unsplit (brute force over its triangles, 1e-9 mm), the
+//   labral limits within 0.05 deg of the unsplit labrum's (the exact search's tessellation tolerance); splits
+//   outside 0..5 are an error naming them.
 #include "impinge/clinical/hip_joint.hpp"
 
 #include <gtest/gtest.h>
@@ -247,4 +251,52 @@ TEST(HipJoint, LimitsInTheAnteriorPelvicPlaneAreTheMotionsAboutItsAxes) {
       EXPECT_NEAR(in_app[1].limit_deg, in_isb[1].limit_deg + theta, 0.1);
     }
   }
+}
+
+TEST(HipJoint, ALabrumSplitInFourIsTheSameSurfaceAndMovesNoLabralLimit) {
+  HipModelOptions mo;
+  mo.target_triangles = 3000;
+  mo.cup_coverage_deg = 80;  // the labrum clear of the neck at neutral
+  const HipModel h = make_hip_model(mo);
+  HipJointOptions o = test::scan_options(0.5);
+  o.joint.distances = true;
+  SphereFitResult head;
+  head.centre = h.cor;
+  head.radius = mo.head_radius_mm;
+  const HipJoint hip(h.ball, h.socket, Side::right, head, {}, o);
+  const auto coarse = hip.with_labrum(5.3, 7), fine = hip.with_labrum(5.3, 7, 2);
+  const Vertices &Vc = coarse->joint().socket().relative, &Vf = fine->joint().socket().relative;
+  const Faces &Fc = coarse->joint().socket().mesh.F, &Ff = fine->joint().socket().mesh.F;
+  ASSERT_EQ(Ff.rows(), 16 * Fc.rows());
+  // Every vertex of the split labrum lies on a triangle of the unsplit one: in its plane, barycentrics >= 0.
+  for (Eigen::Index i = 0; i < Vf.rows(); ++i) {
+    const Eigen::Vector3d p = Vf.row(i).transpose();
+    bool on = false;
+    for (Eigen::Index f = 0; f < Fc.rows() && !on; ++f) {
+      const Eigen::Vector3d a = Vc.row(Fc(f, 0)), b = Vc.row(Fc(f, 1)), c = Vc.row(Fc(f, 2));
+      const Eigen::Vector3d n = (b - a).cross(c - a);
+      if (std::abs(n.normalized().dot(p - a)) > 1e-9) continue;
+      const double u = (c - b).cross(p - b).dot(n), v = (a - c).cross(p - c).dot(n), w = (b - a).cross(p - a).dot(n);
+      on = u >= -1e-9 * n.squaredNorm() && v >= -1e-9 * n.squaredNorm() && w >= -1e-9 * n.squaredNorm();
+    }
+    ASSERT_TRUE(on) << "vertex " << i << " of the split labrum off the labrum";
+  }
+  RomOptions ro;
+  ro.metric = RomMetric::distance;
+  auto limits = [&](const HipJoint& lh) {
+    return find_rom_limits(lh, standard_motions(), ro, rom_baseline(lh, lh.femur_rotation({}), ro));
+  };
+  const auto a = limits(*coarse), b = limits(*fine);
+  int limited = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    SCOPED_TRACE(standard_motions()[k].name);
+    EXPECT_EQ(a[k].status, b[k].status);
+    if (a[k].status != RomLimitStatus::limited) continue;
+    ++limited;
+    EXPECT_NEAR(a[k].limit_deg, b[k].limit_deg, 0.05);
+  }
+  EXPECT_GE(limited, 4);
+  for (int bad : {-1, 6})
+    EXPECT_EQ(test::error_of([&] { hip.with_labrum(5.3, 7, bad); }),
+              "labrum: " + std::to_string(bad) + " splits of its triangles; valid: 0..5");
 }

@@ -263,6 +263,14 @@ TEST(PlanRun, BadRequestsNameTheOption) {
   EXPECT_NE(test::error_of([&] { run_plan(options_of(h.ball, h.socket, h.cor), limits_only(), request); })
                 .find("pirouette"),
             std::string::npos);
+  // The labrum is never cut: a plan against it may not trim the pelvis alone (issue 81), refused before any set-up.
+  request.target = "flexion=100";
+  request.resection.bones = ResectBones::pelvis;
+  RomRequest labral = limits_only();
+  labral.labrum.enabled = true;
+  EXPECT_EQ(test::error_of([&] { run_plan(options_of(h.ball, h.socket, h.cor), labral, request); }),
+            "plan: --labrum with --resect pelvis: a contact with the labrum can be cleared only on the femur (the "
+            "labrum is soft tissue and is never cut); give --resect femur or both, or leave out --labrum");
 }
 
 }  // namespace

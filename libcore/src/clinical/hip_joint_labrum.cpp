@@ -1,11 +1,46 @@
 // HipJoint's labrum (issue 81): the hip with the acetabular labrum as its socket (hip_joint.hpp, labrum.hpp).
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <utility>
+#include <vector>
 
 #include "impinge/clinical/hip_joint.hpp"
 #include "impinge/core/error.hpp"
 
 namespace impinge {
+
+namespace {
+
+/// Every triangle of `m` split in four at its edges' midpoints (shared between neighbours): the same surface.
+TriangleMesh split_in_four(const TriangleMesh& m) {
+  std::vector<Eigen::Vector3d> v;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) v.push_back(m.V.row(i).transpose());
+  std::map<std::pair<int, int>, int> mid;
+  auto midpoint = [&](int a, int b) {
+    const auto key = std::minmax(a, b);
+    const auto it = mid.find(key);
+    if (it != mid.end()) return it->second;
+    v.push_back(0.5 * (v[static_cast<std::size_t>(a)] + v[static_cast<std::size_t>(b)]));
+    return mid[key] = static_cast<int>(v.size()) - 1;
+  };
+  TriangleMesh out;
+  out.F.resize(4 * m.F.rows(), 3);
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    const int a = m.F(f, 0), b = m.F(f, 1), c = m.F(f, 2);
+    const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+    out.F.row(4 * f) << a, ab, ca;
+    out.F.row(4 * f + 1) << ab, b, bc;
+    out.F.row(4 * f + 2) << ca, bc, c;
+    out.F.row(4 * f + 3) << ab, bc, ca;
+  }
+  out.V.resize(static_cast<Eigen::Index>(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) out.V.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
+  out.source = m.source;
+  return out;
+}
+
+}  // namespace
 
 Acetabulum HipJoint::acetabulum_joint() const {
   require(!labral_, "hip joint: the acetabulum of a labral hip's socket (the labrum) is its bony hip's");
@@ -28,8 +63,12 @@ Acetabulum HipJoint::acetabulum_joint() const {
   return find_acetabulum(joint_->socket().mesh, head_centre_joint_, head_radius_, axes);
 }
 
-std::shared_ptr<const HipJoint> HipJoint::with_labrum(double width_mm, double height_mm) const {
+std::shared_ptr<const HipJoint> HipJoint::with_labrum(double width_mm, double height_mm, int splits) const {
+  require(splits >= 0 && splits <= kMaxLabrumSplits, "labrum: " + std::to_string(splits) +
+                                                         " splits of its triangles; valid: 0.." +
+                                                         std::to_string(kMaxLabrumSplits));
   TriangleMesh labrum = make_labrum(acetabulum_joint(), width_mm, height_mm, joint_->socket().mesh.source);
+  for (int k = 0; k < splits; ++k) labrum = split_in_four(labrum);
   const auto n = static_cast<std::size_t>(labrum.V.rows());
   auto out = std::make_shared<HipJoint>(*this);  // shares this Joint until its own replaces it below
   out->centre_joint_ = joint_;                    // the femur moves as in this hip

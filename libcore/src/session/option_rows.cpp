@@ -326,11 +326,12 @@ void add_frame_rows(Rows& t) {
 
 // The labrum's rows (labrum.hpp): on or off, its base width and height (defaults from cadaveric measurements).
 void add_labrum_rows(Rows& t) {
-  const unsigned uses = use_rom | use_rom_limits;
+  const unsigned uses = use_rom | use_rom_limits | use_plan | use_joint_plan;
   t.flag("labrum", "labrum", OptionType::flag, uses,
          "Also the acetabular labrum, a soft-tissue ring of triangular cross-section on the rim continuing the "
          "socket's sphere, with its own map: each limit's labral limit beside the bony one (rom_limits.csv's labral_* "
-         "columns, labrum.ply); the ROM map stays bony",
+         "columns, labrum.ply); the ROM map stays bony. plan: target the labral limits, the femur cut to clear the "
+         "pelvis and the labrum (never cut; not with --resect pelvis)",
          [](auto& o) -> auto& { return o.rom.labrum.enabled; });
   t.number("labrum-width", "labrum_width_mm", "mm", uses, LabrumOptions::kWidthRange,
            "The labrum's base width on the rim (default: the mean width of 55 cadaveric labra, Tan et al. 2001, "

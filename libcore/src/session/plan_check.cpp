@@ -6,12 +6,14 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
 #include "impinge/casters/signed_distance.hpp"
 #include "impinge/core/error.hpp"
 #include "impinge/core/interrupt.hpp"
+#include "session/plan_labrum.hpp"
 
 namespace impinge::plan_detail {
 
@@ -19,13 +21,13 @@ namespace {
 
 constexpr double kInfMm = std::numeric_limits<double>::infinity();
 
-/// The least counted gap at a pose (the ROM search's criterion: distance with the distance metric, else the
+/// The least counted gap of `hip` at a pose (the ROM search's criterion: distance with the distance metric, else the
 /// radial gap), over the vertices the baseline counts; +inf when none is near.
-double counted_min_gap(const Session& s, const RomBaseline& base, const RomOptions& search, const FemurPose& P,
+double counted_min_gap(const HipJoint& hip, const RomBaseline& base, const RomOptions& search, const FemurPose& P,
                        PoseResult& res) {
-  s.joint().detect(P.R, P.t, res);
+  hip.joint().detect(P.R, P.t, res);
   double m = std::numeric_limits<double>::infinity();
-  const Vertices& socket = s.joint().socket().relative;
+  const Vertices& socket = hip.joint().socket().relative;
   for (int b = 0; b < 2; ++b) {
     const ScanGaps& g = b == 0 ? res.ball_gaps : res.socket_gaps;
     const std::vector<std::uint8_t>& skip = b == 0 ? base.skip_ball : base.skip_socket;
@@ -42,16 +44,27 @@ double counted_min_gap(const Session& s, const RomBaseline& base, const RomOptio
   return m;
 }
 
-std::int64_t frames_in_contact(const Session& s, const RomBaseline& base, const RomOptions& search,
-                               const std::vector<PoseAngles>& frames) {
+/// The frames of a motion file in contact in session `s` with baseline `base`: the bones' counted least gap at most
+/// the threshold less the contact depth (the cut, mm), or with `labrum` (plan_labrum of s's hip) the femur and the
+/// labrum within the cut: their exact least distance where the search's is exact (a cut >= 0 and the baseline's
+/// contact meshes), else their counted least gap (the labrum split fine).
+std::int64_t frames_in_contact(const Session& s, const RomBaseline& base, const PlanLabrum* labrum,
+                               const RomOptions& search, const std::vector<PoseAngles>& frames) {
   std::int64_t n = 0;
   const double cut = search.threshold_mm - search.contact_depth_mm;
+  const bool exact = labrum && labrum->baseline.contact && cut >= 0;
 #pragma omp parallel reduction(+ : n)
   {
     PoseResult res;
 #pragma omp for schedule(dynamic, 4)
-    for (std::size_t k = 0; k < frames.size(); ++k)
-      if (!interruption_requested() && counted_min_gap(s, base, search, s.hip().femur_pose(frames[k]), res) <= cut) ++n;
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      if (interruption_requested()) continue;
+      const FemurPose P = s.hip().femur_pose(frames[k]);
+      if (counted_min_gap(s.hip(), base, search, P, res) <= cut ||
+          (labrum && (exact ? labrum_exact_distance(*labrum, P, cut) <= cut
+                            : counted_min_gap(*labrum->hip, labrum->baseline, search, P, res) <= cut)))
+        ++n;
+    }
   }
   interruption_point();  // a front end's stop (Ctrl-C in Python): the frames skipped above
   return n;
@@ -72,10 +85,13 @@ std::unique_ptr<Session> check_session(const PlanRun& run, const PlanCheck& c) {
 }
 
 /// Each target before and after (run.targets, run.all_met): a standard motion's limits (deg) before and on the
-/// resected bones (`after`, of session `s_after`), its limit met when free or limited within 0.1 deg of the target,
-/// else its shortfall (deg); a motion file's frames in contact before and after, met when none is after. `met`
-/// and all_met here: the limits alone (check_clearance adds the clearance).
-void check_targets(PlanRun& run, const PlanCheck& c, const Session& s_after, const RomRun& after) {
+/// resected bones (`after`, of session `s_after`), with the labrum its labral limits too (labral_limit), its
+/// targeted limit (the labral one with the labrum, else the bony one) met when free or limited within 0.1 deg of
+/// the target, else its shortfall (deg); a motion file's frames in contact before and after (with the labrum: with
+/// the bones or the labrum, c.labrum and `labrum_after`: plan_labrum of each session's hip), met when none is
+/// after. `met` and all_met here: the limits alone (check_clearance adds the clearance).
+void check_targets(PlanRun& run, const PlanCheck& c, const Session& s_after, const RomRun& after,
+                   const PlanLabrum* labrum_after) {
   const RomRun& before = c.before;
   run.all_met = true;
   run.targets.clear();
@@ -85,15 +101,20 @@ void check_targets(PlanRun& run, const PlanCheck& c, const Session& s_after, con
     t.target_deg = target.angle_deg;
     if (!std::isnan(target.angle_deg)) {
       for (std::size_t m = 0; m < before.motions.size(); ++m)
-        if (before.motions[m].name == target.name) t.before = before.limits[m], t.after = after.limits[m];
-      t.met = t.after.status == RomLimitStatus::free ||
-              (t.after.status == RomLimitStatus::limited && t.after.limit_deg >= target.angle_deg - 0.1);
-      if (!t.met)
-        t.shortfall_deg =
-            t.after.status == RomLimitStatus::limited ? target.angle_deg - t.after.limit_deg : target.angle_deg;
+        if (before.motions[m].name == target.name) {
+          t.before = before.limits[m], t.after = after.limits[m];
+          if (before.labrum && after.labrum)
+            t.labral_before = labral_limit(before, m), t.labral_after = labral_limit(after, m);
+        }
+      const RomLimitStatus status = t.labral_after ? t.labral_after->status : t.after.status;
+      const double reached = t.labral_after ? t.labral_after->limit_deg : t.after.limit_deg;
+      t.met = status == RomLimitStatus::free ||
+              (status == RomLimitStatus::limited && reached >= target.angle_deg - 0.1);
+      if (!t.met) t.shortfall_deg = status == RomLimitStatus::limited ? target.angle_deg - reached : target.angle_deg;
     } else {
-      t.frames_in_contact_before = frames_in_contact(c.s, before.baseline, c.rom.search, target.poses);
-      t.frames_in_contact_after = frames_in_contact(s_after, after.baseline, c.rom.search, target.poses);
+      t.frames_in_contact_before = frames_in_contact(c.s, before.baseline, c.labrum, c.rom.search, target.poses);
+      t.frames_in_contact_after =
+          frames_in_contact(s_after, after.baseline, labrum_after, c.rom.search, target.poses);
       t.met = t.frames_in_contact_after == 0;
     }
     t.limit_met = t.met;
@@ -102,7 +123,8 @@ void check_targets(PlanRun& run, const PlanCheck& c, const Session& s_after, con
   }
 }
 
-/// Both bones of session `s` for exact signed distances (joint frame, unposed: JointBody::relative).
+/// Both bodies of `hip` (the femur and the pelvis, or a labral hip's labrum) for exact signed distances (joint frame,
+/// unposed: JointBody::relative).
 struct BoneQueries {
   SignedDistanceQuery femur, pelvis;
   static TriangleMesh mesh(const JointBody& b) {
@@ -110,7 +132,7 @@ struct BoneQueries {
     m.V = b.relative, m.F = b.mesh.F, m.source = b.mesh.source;
     return m;
   }
-  explicit BoneQueries(const Session& s) : femur(mesh(s.joint().ball())), pelvis(mesh(s.joint().socket())) {}
+  explicit BoneQueries(const HipJoint& hip) : femur(mesh(hip.joint().ball())), pelvis(mesh(hip.joint().socket())) {}
 };
 
 /// A pose's least signed distances (mm): over the vertices the plan follows, and over every vertex (the joint
@@ -119,19 +141,19 @@ struct PoseClearance {
   double counted = std::numeric_limits<double>::infinity(), any = std::numeric_limits<double>::infinity();
 };
 
-/// The least signed distances (mm) at pose P of session `s`: over the vertices the plan follows (RomBaseline `base`'s,
-/// as find_contacts in resection.cpp) and over every vertex; each vertex's Euclidean distance to the other bone where
-/// the joint gives one (within its reach), the exact signed distance (`q`) where it gives none but the radial gap
-/// says the vertex lies inside the other bone (farther inside than the reach, or the radial gap's error); +inf when
-/// none is within the reach.
-PoseClearance pose_clearance(const Session& s, const RomBaseline& base, const BoneQueries& q, const FemurPose& P,
+/// The least signed distances (mm) at pose P of `hip` (a session's, or its labral hip: the femur and the labrum): over
+/// the vertices the plan follows (RomBaseline `base`'s, as find_contacts in resection.cpp) and over every vertex; each
+/// vertex's Euclidean distance to the other bone where the joint gives one (within its reach), the exact signed
+/// distance (`q`) where it gives none but the radial gap says the vertex lies inside the other bone (farther inside
+/// than the reach, or the radial gap's error); +inf when none is within the reach.
+PoseClearance pose_clearance(const HipJoint& hip, const RomBaseline& base, const BoneQueries& q, const FemurPose& P,
                              PoseResult& res) {
-  s.joint().detect(P.R, P.t, res);
+  hip.joint().detect(P.R, P.t, res);
   PoseClearance m;
   for (int b = 0; b < 2; ++b) {
     const ScanGaps& g = b == 0 ? res.ball_gaps : res.socket_gaps;
     const std::vector<std::uint8_t>& skip = b == 0 ? base.skip_ball : base.skip_socket;
-    const Vertices& own = b == 0 ? s.joint().ball().relative : s.joint().socket().relative;
+    const Vertices& own = b == 0 ? hip.joint().ball().relative : hip.joint().socket().relative;
     for (std::size_t i = 0; i < g.gap_mm.size(); ++i) {
       double v = g.distance_mm.empty() ? std::nan("") : double(g.distance_mm[i]);
       if (std::isnan(v) && !(g.gap_mm[i] < 0)) continue;
@@ -152,14 +174,14 @@ PoseClearance pose_clearance(const Session& s, const RomBaseline& base, const Bo
   return m;
 }
 
-/// Each pose's clearance in session `s`'s placement (pose_clearance) at pose `which[p]` (target, pose) of
-/// `planned`, in parallel. Throws impinge::Error with the first pose's error.
-std::vector<PoseClearance> pose_clearances(const Session& s, const RomBaseline& base,
+/// Each pose's clearance in `hip`'s placement (pose_clearance) at pose `which[p]` (target, pose) of `planned`, in
+/// parallel. Throws impinge::Error with the first pose's error.
+std::vector<PoseClearance> pose_clearances(const HipJoint& hip, const RomBaseline& base,
                                     const std::vector<ResectionTarget>& planned,
                                     const std::vector<std::pair<std::size_t, std::size_t>>& which) {
   std::vector<PoseClearance> d(which.size());
   if (which.empty()) return d;
-  const BoneQueries q(s);
+  const BoneQueries q(hip);
   std::string error;
 #pragma omp parallel
   {
@@ -169,7 +191,7 @@ std::vector<PoseClearance> pose_clearances(const Session& s, const RomBaseline& 
       if (interruption_requested()) continue;
       try {
         const PoseAngles& a = planned[which[p].first].poses[which[p].second];
-        d[p] = pose_clearance(s, base, q, s.hip().femur_pose(a), res);
+        d[p] = pose_clearance(hip, base, q, hip.femur_pose(a), res);
       } catch (const std::exception& e) {
 #pragma omp critical(plan_clearance_error)
         if (error.empty()) error = e.what();
@@ -181,25 +203,49 @@ std::vector<PoseClearance> pose_clearances(const Session& s, const RomBaseline& 
   return d;
 }
 
+/// pose_clearances of the femur against the labrum (`labrum`: the femur and its labrum split fine), each pose's least
+/// counted distance also at most the exact least distance there (labrum_exact_distance within `reach`, mm): the
+/// labrum's free margin may cross the femur between vertices. Throws impinge::Error as pose_clearances does.
+std::vector<PoseClearance> labrum_clearances(const PlanLabrum& labrum, const std::vector<ResectionTarget>& planned,
+                                             const std::vector<std::pair<std::size_t, std::size_t>>& which,
+                                             double reach) {
+  std::vector<PoseClearance> d = pose_clearances(*labrum.hip, labrum.baseline, planned, which);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t p = 0; p < which.size(); ++p) {
+    if (interruption_requested()) continue;
+    const FemurPose P = labrum.hip->femur_pose(planned[which[p].first].poses[which[p].second]);
+    d[p].counted = std::min(d[p].counted, labrum_exact_distance(labrum, P, reach));
+  }
+  interruption_point();
+  return d;
+}
+
 /// The clearance each target keeps in session `s_after`'s placement (the final one when this is the last check):
 /// over the poses the plan cleared (the first run.plan.targets[k].poses_cleared of `planned[k]`, the poses of the
 /// last pass), the least counted signed distance (mm) and its motion angle or frame, and at the target's own pose
-/// (its last, when the plan cleared it); met when the least is at least the clearance (less 1e-4 mm of rounding).
-/// A target is met when its limit and its clearance are; sets run.clearance_met and run.all_met.
+/// (its last, when the plan cleared it); with `labrum` (plan_labrum of s_after's hip) each pose's the lesser of the
+/// bones' and the femur's to the labrum (labrum_clearances; that one alone also: clearance_least_labrum_mm); met
+/// when the least is at least the clearance (less 1e-4 mm of rounding). A target is met when its limit and its
+/// clearance are; sets run.clearance_met and run.all_met.
 void check_clearance(PlanRun& run, const PlanCheck& c, const Session& s_after, const RomBaseline& base,
-                     const std::vector<ResectionTarget>& planned) {
+                     const PlanLabrum* labrum, const std::vector<ResectionTarget>& planned) {
   constexpr double kRoundingMm = 1e-4;
   std::vector<std::pair<std::size_t, std::size_t>> which;
   for (std::size_t k = 0; k < planned.size() && k < run.plan.targets.size(); ++k) {
     const auto cleared = static_cast<std::size_t>(std::max<std::int64_t>(0, run.plan.targets[k].poses_cleared));
     for (std::size_t i = 0; i < std::min(cleared, planned[k].poses.size()); ++i) which.emplace_back(k, i);
   }
-  const std::vector<PoseClearance> d = pose_clearances(s_after, base, planned, which);
+  std::vector<PoseClearance> d = pose_clearances(s_after.hip(), base, planned, which);
+  std::vector<PoseClearance> labral;
+  if (labrum) labral = labrum_clearances(*labrum, planned, which, c.distance_reach_mm);
+  for (std::size_t p = 0; p < labral.size(); ++p)
+    d[p].counted = std::min(d[p].counted, labral[p].counted), d[p].any = std::min(d[p].any, labral[p].any);
   run.clearance_met = true;
   run.all_met = true;
   for (std::size_t k = 0; k < run.targets.size(); ++k) {
     PlanTargetCheck& t = run.targets[k];
     t.clearance_least_mm = t.clearance_least_at = t.clearance_at_target_mm = t.clearance_least_any_mm = std::nan("");
+    t.clearance_least_labrum_mm = std::nan("");
     t.clearance_poses = 0;
     for (std::size_t p = 0; p < which.size(); ++p) {
       if (which[p].first != k) continue;
@@ -208,6 +254,8 @@ void check_clearance(PlanRun& run, const PlanCheck& c, const Session& s_after, c
       if (!(d[p].counted >= t.clearance_least_mm))
         t.clearance_least_mm = d[p].counted, t.clearance_least_at = tg.theta_deg[which[p].second];
       if (!(d[p].any >= t.clearance_least_any_mm)) t.clearance_least_any_mm = d[p].any;
+      if (!labral.empty() && !(labral[p].counted >= t.clearance_least_labrum_mm))
+        t.clearance_least_labrum_mm = labral[p].counted;
       if (which[p].second + 1 == tg.poses.size()) t.clearance_at_target_mm = d[p].counted;
     }
     t.clearance_met = !(t.clearance_least_mm < c.ro.clearance_mm - kRoundingMm);
@@ -215,6 +263,13 @@ void check_clearance(PlanRun& run, const PlanCheck& c, const Session& s_after, c
     run.clearance_met = run.clearance_met && t.clearance_met;
     run.all_met = run.all_met && t.met;
   }
+}
+
+/// The largest distance (mm) between the vertices of the labrum `before` and `after` (input frame), NaN when their
+/// vertex counts differ.
+double labrum_moved_mm(const TriangleMesh& before, const TriangleMesh& after) {
+  if (before.V.rows() != after.V.rows()) return std::nan("");
+  return before.V.rows() ? (before.V - after.V).rowwise().norm().maxCoeff() : 0.0;
 }
 
 /// Adds a further pass's removal of one bone to the plan's `total` (when that bone may be resected): `mesh` (input
@@ -283,17 +338,22 @@ double check_plan(PlanRun& run, const PlanCheck& c) {
   for (int pass = 1;; ++pass) {
     const std::unique_ptr<Session> s_after = check_session(run, c);
     const RomRun after = run_rom(*s_after, c.limits_only);
-    check_targets(run, c, *s_after, after);
-    check_clearance(run, c, *s_after, after.baseline, planned);
+    std::optional<PlanLabrum> labrum;  // with --labrum: the labrum, split fine, on the bones after
+    if (after.labrum) labrum = plan_labrum(s_after->hip(), c.rom.labrum, c.rom.search);
+    check_targets(run, c, *s_after, after, labrum ? &*labrum : nullptr);
+    check_clearance(run, c, *s_after, after.baseline, labrum ? &*labrum : nullptr, planned);
     run.final_head_centre_mm = s_after->head_centre_input();
+    if (after.labrum) run.labrum_moved_mm = labrum_moved_mm(run.labrum_mesh, labrum_input(*s_after, after));
     if (run.all_met || pass >= kPlanPasses) break;
     // A further pass on the resected bones in their own placement, its depths added to the earlier passes'.
     const auto t_pass = Clock::now();
     ResectionOptions more = c.ro;
     more.femur_removed_mm = run.plan.femur.depth_mm;
     more.pelvis_removed_mm = run.plan.pelvis.depth_mm;
-    std::vector<ResectionTarget> targets = further_targets(c.targets, plan_targets(*s_after, c.request, after));
-    const ResectionPlan next = plan_resection(s_after->hip(), targets, after.baseline, more);
+    std::vector<ResectionTarget> targets =
+        further_targets(c.targets, plan_targets(*s_after, c.request, targeted_limits(after)));
+    const ResectionPlan next =
+        plan_targeted(s_after->hip(), after.baseline, labrum ? &*labrum : nullptr, targets, more);
     extra_plan_ms += ms_since(t_pass);
     if (next.femur.deepest_cut_mm <= kResectedDepthMm && next.pelvis.deepest_cut_mm <= kResectedDepthMm) break;
     add_pass(run, c, *s_after, next, joint_to_input, pass);

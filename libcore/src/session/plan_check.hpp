@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "impinge/session/plan_run.hpp"
+#include "session/plan_labrum.hpp"
 
 namespace impinge::plan_detail {
 
@@ -22,7 +23,8 @@ TriangleMesh resected_mesh(const Session& session, const BoneResection& b, const
 
 /// What the check's passes share: the call's options and ROM request, the limits-only request, the first session's
 /// distance reach (mm), the first session (the plan's joint frame) with its limits before, the targets, the
-/// resection's options and the bones' scan-pose vertices (input frame, mm).
+/// resection's options and the bones' scan-pose vertices (input frame, mm); with --labrum the first session's
+/// labrum (plan_labrum; else null).
 struct PlanCheck {
   const SessionOptions& options;
   const RomRequest& rom;
@@ -35,6 +37,7 @@ struct PlanCheck {
   const ResectionOptions& ro;
   const Vertices& femur_scan;
   const Vertices& pelvis_scan;
+  const PlanLabrum* labrum;
 };
 
 /// The check: a new session on the resected meshes, as `impinge rom` on the written files, its ROM limits and the

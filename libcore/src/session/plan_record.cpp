@@ -31,9 +31,10 @@ nlohmann::json point(const Eigen::Vector3d& v) {
   return {number_or_null(v.x()), number_or_null(v.y()), number_or_null(v.z())};
 }
 
-/// A target's clearance in the final placement (PlanTargetCheck's clearance_*; mm, and deg or frame).
+/// A target's clearance in the final placement (PlanTargetCheck's clearance_*; mm, and deg or frame); with the labrum
+/// also least_labrum_mm.
 nlohmann::json clearance_record(const PlanRun& run, const PlanTargetCheck& c) {
-  return {{"required_mm", run.plan.options.clearance_mm},
+  nlohmann::json r = {{"required_mm", run.plan.options.clearance_mm},
           {"least_mm", number_or_null(c.clearance_least_mm)},
           {"least_at", number_or_null(c.clearance_least_at)},
           {"at_target_mm", number_or_null(c.clearance_at_target_mm)},
@@ -45,6 +46,43 @@ nlohmann::json clearance_record(const PlanRun& run, const PlanTargetCheck& c) {
            "the plan follows (the ROM search's, joint surfaces left out) and the other bone (least_mm, where: "
            "least_at, deg or frame; at the target's own pose: at_target_mm); least_any_mm: over every vertex, the "
            "joint surfaces too (the plan does not follow these: a contact classed articular shows there)"}};
+  if (run.labrum) {
+    r["least_labrum_mm"] = number_or_null(c.clearance_least_labrum_mm);
+    r["labrum"] = "with the labrum the femur is also kept the clearance from the labrum: least_mm, at_target_mm and "
+                  "least_any_mm are the lesser of the bones' and the femur's to the labrum (least_labrum_mm: that "
+                  "one alone)";
+  }
+  return r;
+}
+
+/// A standard motion's labral limits before and after (PlanTargetCheck::labral_*), into target record `t`, and which
+/// limit the plan targeted.
+void add_labral_limits(nlohmann::json& t, const PlanTargetCheck& c) {
+  t["limit_targeted"] = "labral";
+  t["labral_limit_before_deg"] = number_or_null(c.labral_before->limit_deg);
+  t["labral_status_before"] = to_string(c.labral_before->status);
+  t["labral_contact_class_before"] = to_string(c.labral_before->contact_class);
+  t["labral_limit_after_deg"] = number_or_null(c.labral_after->limit_deg);
+  t["labral_status_after"] = to_string(c.labral_after->status);
+  t["labral_contact_class_after"] = to_string(c.labral_after->contact_class);
+}
+
+/// plan.json's "labrum" (with the labrum): its dimensions, what the plan targets, and the labrum's displacement
+/// between the plan's session and the last check's (mm).
+nlohmann::json labrum_plan_record(const PlanRun& run) {
+  return {{"width_mm", run.labrum->width_mm},
+          {"height_mm", run.labrum->height_mm},
+          {"vertices", run.labrum_mesh.V.rows()},
+          {"moved_mm", number_or_null(run.labrum_moved_mm)},
+          {"targeted", "labral limits"},
+          {"definition",
+           "the acetabular labrum (impinge rom --labrum; labrum.ply, input frame) is a soft-tissue body: the plan "
+           "targets each motion's labral limit (the first of the bony limit and the femur's first contact with the "
+           "labrum: labral_limit_*), cutting the femur so that at every target pose it clears both the pelvis and "
+           "the labrum by the clearance. The labrum is never cut, and a contact with it is cleared on the femur "
+           "alone (with --resect both the rim is trimmed for bony contacts only). limit_before_deg and "
+           "limit_after_deg stay the bony limits. moved_mm: the largest distance between the labrum's vertices here "
+           "and the labrum the last check built again on the bones after (impinge, issue 81)"}};
 }
 
 /// The femur's alpha angles (deg) before and after the resection, per head-neck clock hour 1..12 and the largest;
@@ -95,6 +133,7 @@ nlohmann::json targets_record(const PlanRun& run) {
       t["limit_after_deg"] = number_or_null(c.after.limit_deg);
       t["status_after"] = to_string(c.after.status);
       t["shortfall_deg"] = c.shortfall_deg;
+      if (c.labral_before && c.labral_after) add_labral_limits(t, c);
     } else {
       t["frames_in_contact_before"] = c.frames_in_contact_before;
       t["frames_in_contact_after"] = c.frames_in_contact_after;
@@ -138,6 +177,7 @@ nlohmann::json plan_record(const PlanRun& run) {
   j["pelvis_resection"] = bone_record(run, run.plan.pelvis, 1);
   if (run.before) j["femur_resection"]["alpha"] = alpha_record(run);
   j["targets"] = targets_record(run);
+  if (run.labrum) j["labrum"] = labrum_plan_record(run);
   j["all_targets_met"] = run.all_met;
   j["clearance_met"] = run.clearance_met;
   j["placement"] = {
@@ -181,6 +221,7 @@ void write_plan_meshes(const std::string& dir, const PlanRun& run) {
   };
   if (run.plan.femur.allowed) one(run.femur_resected, run.plan.femur, run.femur_hours, "femur_resected");
   if (run.plan.pelvis.allowed) one(run.pelvis_resected, run.plan.pelvis, run.pelvis_hours, "pelvis_resected");
+  if (run.labrum) write_ply(dir + "/labrum.ply", run.labrum_mesh);
 }
 
 }  // namespace impinge

@@ -18,6 +18,7 @@
 #include "impinge/session/morphology_run.hpp"
 #include "impinge/session/records.hpp"
 #include "session/plan_check.hpp"
+#include "session/plan_labrum.hpp"
 
 namespace impinge {
 
@@ -150,13 +151,16 @@ std::vector<ResectionTarget> plan_targets(const Session& s, const PlanRequest& r
   return out;
 }
 
-void check_plan_request(const SessionOptions& options, const PlanRequest& request) {
+void check_plan_request(const SessionOptions& options, const PlanRequest& request, const LabrumOptions& labrum) {
   check_in_range("max-depth-fraction", request.max_depth_fraction, PlanRequest::kMaxDepthFractionRange);
   check_in_range("max-depth", request.max_depth_mm, PlanRequest::kMaxDepthRange, "mm");
   parse_targets(request.target, standard_motions());
   if (!request.target_motion.empty()) load_motion(request.target_motion, input_side(options.input));
   require(!request.target.empty() || !request.target_motion.empty(),
           "plan: no target: give --target (MOTION=DEG,... or normal) or --target-motion");
+  require(!labrum.enabled || request.resection.bones != ResectBones::pelvis,
+          "plan: --labrum with --resect pelvis: a contact with the labrum can be cleared only on the femur (the "
+          "labrum is soft tissue and is never cut); give --resect femur or both, or leave out --labrum");
 }
 
 namespace {
@@ -258,10 +262,11 @@ void measure_after(PlanRun& run, const SessionOptions& options, const std::optio
 PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const PlanRequest& request) {
   const auto t_start = Clock::now();
   PlanRun run;
-  check_plan_request(options, request);
+  check_plan_request(options, request, rom.labrum);
   const RomRequest limits_only = limits_only_request(rom);
   run.search = rom.search;
   run.request = request;
+  if (rom.labrum.enabled) run.labrum = rom.labrum;
   const SessionOptions so = plan_session_options(options, rom.search, request);
   const Session s(so);
   run.setup_ms = ms_since(t_start);
@@ -270,7 +275,8 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   auto t = Clock::now();
   const RomRun before = run_rom(s, limits_only);
   run.before_ms = ms_since(t);
-  const std::vector<ResectionTarget> targets = plan_targets(s, request, before);
+  if (before.labrum) run.labrum_mesh = labrum_input(s, before);
+  const std::vector<ResectionTarget> targets = plan_targets(s, request, plan_detail::targeted_limits(before));
 
   // The safety depth: given, or a fraction of the neck's least diameter (Mardones et al. 2005).
   const std::optional<MorphologyRun> morphology_before = try_morphology(options, run.notes, "before");
@@ -279,7 +285,9 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   ResectionOptions ro = request.resection;
   ro.safety_depth_mm = run.safety_depth_mm;
   t = Clock::now();
-  run.plan = plan_resection(hip, targets, before.baseline, ro);
+  std::optional<plan_detail::PlanLabrum> labrum;  // with --labrum: the femur cut to clear the labrum too
+  if (before.labrum) labrum = plan_detail::plan_labrum(hip, rom.labrum, rom.search);
+  run.plan = plan_detail::plan_targeted(hip, before.baseline, labrum ? &*labrum : nullptr, targets, ro);
   run.plan_ms = ms_since(t);
 
   // The resected meshes in the input frame: the scan-pose vertices moved by the plan's (joint-frame) displacement.
@@ -290,7 +298,7 @@ PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const Pla
   // The check on the resected bones, with further passes where it misses a target (check_plan).
   t = Clock::now();
   const plan_detail::PlanCheck check{options, rom, request,    limits_only, so.hip.joint.distance_reach_mm, s, before,
-                        targets, ro,  femur_scan, pelvis_scan};
+                        targets, ro,  femur_scan, pelvis_scan, labrum ? &*labrum : nullptr};
   const double extra_plan_ms = plan_detail::check_plan(run, check);
   run.plan_ms += extra_plan_ms;
   set_clock_extents(run, s);

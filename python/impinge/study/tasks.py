@@ -213,6 +213,9 @@ def _run_plan(joint, task, folder):
             out[f"limit_after_{t['target']}_deg"] = float("nan") if t["limit_after_deg"] is None else float(
                 t["limit_after_deg"])
             out[f"met_{t['target']}"] = bool(t["met"])
+        if "labral_limit_after_deg" in t:  # labrum = true: the labral limit, the one the plan targeted
+            out[f"labral_limit_after_{t['target']}_deg"] = float("nan") if t["labral_limit_after_deg"] is None \
+                else float(t["labral_limit_after_deg"])
     return out
 
 

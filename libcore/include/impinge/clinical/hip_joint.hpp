@@ -185,9 +185,15 @@ class HipJoint {
   /// are this hip's (its translations come from this hip's Joint, so that the femur moves exactly as here). Its
   /// searches (find_rom_limit) find the femur's first contact with the labrum; a contact off the head's joint
   /// surface is ContactClass::labral. The rim: acetabulum(), or with scan neutral find_acetabulum about the head
-  /// sphere with the joint frame's axes (only the clock's orientation, unused here, depends on them). Throws
-  /// impinge::Error as make_labrum, find_acetabulum and Joint do. Source: impinge (issue 81).
-  std::shared_ptr<const HipJoint> with_labrum(double width_mm, double height_mm) const;
+  /// sphere with the joint frame's axes (only the clock's orientation, unused here, depends on them). With
+  /// `splits` > 0 each of the labrum's triangles is split in four at its edges' midpoints (shared between
+  /// neighbours) that many times: the same surface, with 4^splits times the triangles and vertices dense enough
+  /// for a per-vertex test (the plan's contacts: the free margin, a sharp edge with a vertex per rim point, 2-3 mm
+  /// apart, is otherwise seen only at those). Throws impinge::Error as make_labrum, find_acetabulum and Joint do,
+  /// and naming the splits outside 0..kMaxLabrumSplits. Source: impinge (issue 81).
+  std::shared_ptr<const HipJoint> with_labrum(double width_mm, double height_mm, int splits = 0) const;
+  /// The most splits with_labrum takes (4^5 = 1024 times the labrum's 432 triangles).
+  static constexpr int kMaxLabrumSplits = 5;
   /// Whether this is a labral hip (with_labrum): its socket is the labrum.
   bool labral() const { return labral_; }
   /// The acetabulum the labrum is built on, joint frame (with_labrum's rim). Throws as find_acetabulum.

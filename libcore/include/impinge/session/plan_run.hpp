@@ -39,10 +39,16 @@ struct PlanRequest {
 struct PlanTargetCheck {
   std::string name;
   double target_deg = std::numeric_limits<double>::quiet_NaN();  ///< NaN for a motion file
-  RomLimit before, after;    ///< the ROM search's limit on the input and on the resected bones (standard motions)
+  RomLimit before, after;    ///< the ROM search's (bony) limit on the input and on the resected bones (standard
+                             ///< motions)
+  /// With the labrum (PlanRun::labrum; standard motions): the labral limits (labral_limit: the first of the bony
+  /// limit and the femur's first contact with the labrum) on the input and on the resected bones; the plan targets
+  /// these. Empty without.
+  std::optional<LabralLimit> labral_before, labral_after;
   bool met = false;          ///< limit_met and clearance_met
-  bool limit_met = false;    ///< after: limited at or beyond the target (within 0.1 deg, the search's tolerance),
-                             ///< or free; a motion file: no frame in contact after
+  bool limit_met = false;    ///< after: the targeted limit (labral_after with the labrum, else after) limited at or
+                             ///< beyond the target (within 0.1 deg, the search's tolerance), or free; a motion
+                             ///< file: no frame in contact after (with the labrum: with the bones or the labrum)
   /// The clearance (ResectionOptions::clearance_mm, what the plan promises) in the final placement: the check's
   /// session on the resected bones, whose equidistant joint centre, acetabulum and joint surfaces are found again
   /// on them. Over the poses the plan cleared (its last pass's: the whole target when it was reachable), the least
@@ -55,9 +61,12 @@ struct PlanTargetCheck {
   /// The least signed distance over the same poses and every vertex, the joint surfaces too (which the plan does
   /// not follow: a contact classed articular shows here), mm.
   double clearance_least_any_mm = std::numeric_limits<double>::quiet_NaN();
+  /// With the labrum: the least counted signed distance between the femur and the labrum over the same poses, mm
+  /// (clearance_least_mm is the lesser of this and the bones'); NaN without.
+  double clearance_least_labrum_mm = std::numeric_limits<double>::quiet_NaN();
   std::int64_t clearance_poses = 0;  ///< the poses checked
   bool clearance_met = true;         ///< clearance_least_mm at least the clearance (less 1e-4 mm of rounding)
-  double shortfall_deg = 0;  ///< target less the limit after, when not met
+  double shortfall_deg = 0;  ///< target less the targeted limit after, when not met
   /// Motion files: frames in contact before and after (the ROM search's criterion), else 0.
   std::int64_t frames_in_contact_before = 0, frames_in_contact_after = 0;
 };
@@ -77,6 +86,15 @@ struct PlanRun {
   Eigen::Vector3d reference_neck_axis = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   double reference_head_radius_mm = std::numeric_limits<double>::quiet_NaN();
   RomOptions search;  ///< the ROM search's options (the check's)
+  /// With RomRequest::labrum (`impinge plan --labrum`): its width and height (mm). The plan then targets the labral
+  /// limits, cutting the femur so that at every target pose it clears the pelvis and the labrum by the clearance;
+  /// the labrum is never cut (plan_detail::plan_targeted). Empty: the bony limits (the plan as before issue 81).
+  std::optional<LabrumOptions> labrum;
+  /// With the labrum: the labrum of the plan's first session (input frame, mm; labrum.ply), and the largest distance
+  /// (mm) of its vertices from those of the labrum the last check built again on the bones after (the same
+  /// construction on the resected bones in their refitted placement; NaN when their vertex counts differ).
+  TriangleMesh labrum_mesh;
+  double labrum_moved_mm = std::numeric_limits<double>::quiet_NaN();
   double neck_diameter_mm = std::numeric_limits<double>::quiet_NaN();
   PlanRequest request;                            ///< what was asked
   double safety_depth_mm = 0;                     ///< the safety depth used (from request's cap or fraction), mm
@@ -106,13 +124,16 @@ struct PlanRun {
 std::vector<ResectionTarget> plan_targets(const Session& session, const PlanRequest& request, const RomRun& before);
 
 /// Checks what can be checked before anything is built (a bad one is an error in milliseconds): the safety depth's
-/// fraction and cap (mm), the targets' text, the motion file (read for `options`' side), and that there is a target
-/// at all. Throws impinge::Error naming the option, target or file. run_plan calls it first; so does Python's
-/// impinge.check_options("joint_plan", ...) (a study's plan tasks, before any task runs).
-void check_plan_request(const SessionOptions& options, const PlanRequest& request);
+/// fraction and cap (mm), the targets' text, the motion file (read for `options`' side), that there is a target
+/// at all, and that a plan with the labrum (`labrum`.enabled) may cut the femur (a labral contact can be cleared
+/// only on the femur: --labrum with --resect pelvis is refused). Throws impinge::Error naming the option, target or
+/// file. run_plan calls it first; so does Python's impinge.check_options("joint_plan", ...) (a study's plan tasks,
+/// before any task runs).
+void check_plan_request(const SessionOptions& options, const PlanRequest& request, const LabrumOptions& labrum = {});
 
 /// Plan and check: the session (rom_session_options of `rom.search`, distances on with a reach of at least the
-/// clearance + 1 mm), the ROM limits before, the plan (plan_resection), the resected meshes, and the ROM limits
+/// clearance + 1 mm), the ROM limits before, the plan (plan_resection; with `rom.labrum` the labral limits targeted,
+/// the femur cut to clear the labrum too: PlanRun::labrum), the resected meshes, and the ROM limits
 /// of a new session on them (the check: the same options, as `impinge rom` on the written meshes) with the
 /// clearance at every pose the plan cleared in that session's placement; where a limit or a clearance is missed,
 /// further passes on the resected bones (at most four passes in all); the morphology before and after (about the
@@ -121,12 +142,14 @@ void check_plan_request(const SessionOptions& options, const PlanRequest& reques
 PlanRun run_plan(const SessionOptions& options, const RomRequest& rom, const PlanRequest& request);
 
 /// plan.json: per bone the volume (mm^3), area (mm^2), largest and mean depth (mm), vertices, clock extent (from-
-/// to hours), alpha angles before and after; per target the limit before, after, met, shortfall; the safety
-/// depth and neck diameter; method and options; notes. Never throws.
+/// to hours), alpha angles before and after; per target the limit before, after, met, shortfall (with the labrum
+/// also the labral limits before and after, limit_targeted "labral", and a "labrum" object); the safety depth and
+/// neck diameter; method and options; notes. Never throws.
 nlohmann::json plan_record(const PlanRun& run);
 
-/// Write femur_resected.ply / .vtp (and pelvis_resected.* when the pelvis was resected) into `dir`: input frame,
-/// the input's faces, per-vertex resection_mm (and clock_hour). Atomic; throws impinge::Error naming the file.
+/// Write femur_resected.ply / .vtp (and pelvis_resected.* when the pelvis was resected; labrum.ply with the labrum,
+/// PlanRun::labrum_mesh, uncut) into `dir`: input frame, the input's faces, per-vertex resection_mm (and
+/// clock_hour). Atomic; throws impinge::Error naming the file.
 void write_plan_meshes(const std::string& dir, const PlanRun& run);
 
 }  // namespace impinge
