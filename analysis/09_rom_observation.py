@@ -163,20 +163,22 @@ if meth is not None:
             rows.append([s, motion.replace("_", " ")] + [f(g.limit_deg.get(m, np.nan), 0) for m in order])
     write_table(d, "table_methods", ["subject", "motion"] + order, rows, align="llrrrr")
     cor = sens[sens.variant.str.startswith("cor") & sens.method.isin(order)]
+    # The subjects whose COR was moved (--quick: the first alone; the full run: every subject of methods.csv).
+    csubjects = [s for s in msubjects if s in set(cor.subject)]
     rows = []
-    for s in msubjects:
+    for s in csubjects:
         worst = [changes(cor[(cor.subject == s) & (cor.method == m)]).max() for m in order]
         rows.append([s] + [f(w) for w in worst])
     write_table(d, "table_method_sensitivity", ["subject"] + [m + " max $|\\Delta|$ deg" for m in order], rows,
                 align="lrrrr")
     eq = cor[cor.method == "equidistant"]
     fh = cor[cor.method == "femoral-head"]
-    per_subject = {s: changes(eq[eq.subject == s]).max() for s in msubjects}
+    per_subject = {s: changes(eq[eq.subject == s]).max() for s in csubjects}
     method_macros.update({
         "ROMeqSensMax": f(max(per_subject.values())),
         "ROMeqSensWorstSubject": max(per_subject, key=per_subject.get),
         "ROMeqSensWithinThree": str(sum(1 for v in per_subject.values() if v <= 3)),
-        "ROMmethodSubjects": str(len(msubjects)),
+        "ROMmethodSubjects": str(len(csubjects)),
         "ROMfhSensMax": f(changes(fh)[np.isfinite(changes(fh))].max()),
         "ROMfhSensVanish": str(int(np.isinf(changes(fh)).sum())),
         "ROMeqSensMedian": f(changes(eq).median(), 2),
