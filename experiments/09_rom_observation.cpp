@@ -47,8 +47,9 @@
 //   meta.json
 // --quick (CI's budget, issue 82 item 7): maps at 0.25 deg (sensitivity: 0.5), the envelope at 5 deg (the coarsest
 // step dividing every range); on every subject but the first, timing.csv's sampling and search are the subject's
-// first run's (sampling_runs, search_runs 1) and the joint-centre methods' COR moves are left out (their limits and
-// maps stay: methods.csv, methods_map.csv). The rounds the paper gives as "at least 5" stay at 5.
+// first run's (sampling_runs, search_runs 1), layered.csv's sampling and limits are not timed (empty, timing_runs
+// 0), and the joint-centre methods' maps and COR moves are left out (their limits stay: methods.csv). The rounds
+// the paper gives as "at least 5" stay at 5 where they run.
 // Command: build/experiments/exp_09_rom_observation --out results --data ../shared/data/hips [--quick]
 #include <omp.h>
 
@@ -323,8 +324,10 @@ void record_limits(const SubjectRun& r, const Settings& st, Outputs& out) {
 
 // Extra-articular impingement (issue 14): layered maps of 4 crossings per node; the standard motions
 // and two with external rotation, counting every vertex (the limit) and the hidden ones only (the
-// first extra-articular contact), each checked exactly 0.5 deg either side.
-void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
+// first extra-articular contact), each checked exactly 0.5 deg either side. Without `timed` (--quick, every
+// subject but the first) the layered maps' sampling and the limits are not timed (layered.csv: empty times,
+// timing_runs 0).
+void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out, bool timed) {
   SessionOptions lo = r.options;
   lo.hip.joint.layers = 4;
   const Session lsession(lo);
@@ -334,11 +337,12 @@ void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
   const std::vector<StandardMotion> xm = extra_articular_motions();
   // The nine limits without and with the layers, timed alternately (medians and quartiles of --repetitions rounds).
   const HipJoint& hip = r.session.hip();
-  const int reps = std::max(5, st.reps);
+  const int reps = timed ? std::max(5, st.reps) : 0;
   const std::vector<std::vector<double>> lim_runs =
-      run_alternated({[&] { find_rom_limits(hip, r.run.motions, st.ro, r.run.baseline); },
-                      [&] { find_rom_limits(lhip, r.run.motions, st.ro, lbase); }},
-                     reps);
+      timed ? run_alternated({[&] { find_rom_limits(hip, r.run.motions, st.ro, r.run.baseline); },
+                              [&] { find_rom_limits(lhip, r.run.motions, st.ro, lbase); }},
+                             reps)
+            : std::vector<std::vector<double>>(2);
   const Timing lim_single = summarize(lim_runs[0]), lim_layered = summarize(lim_runs[1]);
   // The layered maps' sampling, again `reps` times (each a new session of the same options): its spread.
   std::vector<double> layered_ms[2];
@@ -478,12 +482,13 @@ void add_prefixed(Table& into, const Table& t, const std::string& subject, const
 }
 
 // Puls et al. 2010's four joint-centre methods side by side (issue 29), as `impinge rom` runs them by
-// default (layered maps, contact depth): limits and maps, and (with `moves`; --quick: the first subject only)
-// each method's limits with the initial COR moved 1 mm along each pelvic axis.
-void methods(const SubjectRun& r, Outputs& out, bool moves) {
+// default (layered maps, contact depth): limits, and with `whole` (--quick: the first subject only) the maps
+// (methods_map.csv) and each method's limits with the initial COR moved 1 mm along each pelvic axis.
+void methods(const SubjectRun& r, Outputs& out, bool whole) {
   if (!r.session.hip().acetabulum()) return;  // scan neutral (the generated model): femoral-head only
   const std::vector<StandardMotion> motions = standard_motions();
-  const RomRequest q = RunOptions::clinical().rom;  // the CLI's defaults: the distance metric
+  RomRequest q = RunOptions::clinical().rom;  // the CLI's defaults: the distance metric
+  q.map = q.map && whole;
   const Eigen::Vector3d centre = r.session.head().centre;
   const Eigen::Matrix3d axes = r.session.hip().frames()->pelvis.axes;
   const char* axis_name[3] = {"x", "y", "z"};
@@ -507,7 +512,7 @@ void methods(const SubjectRun& r, Outputs& out, bool moves) {
     }
     add_prefixed(out.meth, rom_limits_table(s, run), r.subject.name, method);
     add_prefixed(out.meth_map, rom_map_table(run), r.subject.name, method);
-    for (int a = 0; a < 3 && moves; ++a)
+    for (int a = 0; a < 3 && whole; ++a)
       for (const double sign : {1.0, -1.0}) {
         SessionOptions m = o;
         m.cor.given = centre + sign * axes.col(a);  // the working frame is the subject's (RAS)
@@ -629,8 +634,9 @@ void write_meta_of(const Args& args, const Settings& st, const std::vector<Subje
       {"subjects", subj}};
   if (st.quick)
     params["quick"] =
-        "maps at 0.25 deg, the envelope at 5 deg; the repeated sampling and search timings (timing.csv) "
-        "and the joint-centre methods' COR moves (sensitivity.csv) on the first subject only";
+        "maps at 0.25 deg, the envelope at 5 deg; the repeated sampling and search timings (timing.csv), the layered "
+        "maps' timings (layered.csv) and the joint-centre methods' maps (methods_map.csv) and COR moves "
+        "(sensitivity.csv) on the first subject only";
   write_meta(st.dir, args, params);
 }
 
@@ -659,11 +665,11 @@ int main(int argc, char** argv) {
   int done = 0;
   for (const Subject& s : subjects) {
     progress("09_rom_observation", ++done, static_cast<int>(subjects.size()), s.name);
-    const bool first = done == 1;  // --quick: the repeated timings and the methods' COR moves on the first subject only
+    const bool first = done == 1;  // --quick: the repeated timings and the methods' COR moves and maps: this one only
     const SubjectRun r(s, st);
     if (!s.generated) observe_table11(r, st, out);
     record_limits(r, st, out);
-    extra_articular(r, st, out);
+    extra_articular(r, st, out, !st.quick || first);
     envelope(r, st, out);
     timing(r, st, out, !st.quick || first);
     sensitivity(r, st, out);
