@@ -344,7 +344,9 @@ write_table(d, "table_extra", ["subject", "motion", "limit", "where", "hidden", 
 rows = []
 for r in lay.itertuples():
     rows.append([r.subject, r.body, str(int(r.layers)), f"{r.layered_bytes / 2**20:.1f}", f"{r.single_bytes / 2**20:.1f}",
-                 f"{f(r.layered_sampling_ms, 0)} ({f(r.layered_sampling_q25_ms, 0)}--{f(r.layered_sampling_q75_ms, 0)})",
+                 # "--" where the fillings were not timed (--quick: every subject but the first)
+                 f"{f(r.layered_sampling_ms, 0)} ({f(r.layered_sampling_q25_ms, 0)}--{f(r.layered_sampling_q75_ms, 0)})"
+                 if np.isfinite(r.layered_sampling_ms) else "--",
                  f(r.single_sampling_ms, 0), str(int(r.max_crossings)),
                  f"{100 * r.nodes_truncated / r.nodes:.2f}", str(int(r.nodes_not_alternating)), str(int(r.hidden_vertices))])
 write_table(d, "table_layered", ["subject", "bone", "layers", "MiB", "single MiB", "ms (quartiles)", "single ms", "most crossings",
