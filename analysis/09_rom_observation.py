@@ -163,20 +163,22 @@ if meth is not None:
             rows.append([s, motion.replace("_", " ")] + [f(g.limit_deg.get(m, np.nan), 0) for m in order])
     write_table(d, "table_methods", ["subject", "motion"] + order, rows, align="llrrrr")
     cor = sens[sens.variant.str.startswith("cor") & sens.method.isin(order)]
+    # The subjects whose COR was moved (--quick: the first alone; the full run: every subject of methods.csv).
+    csubjects = [s for s in msubjects if s in set(cor.subject)]
     rows = []
-    for s in msubjects:
+    for s in csubjects:
         worst = [changes(cor[(cor.subject == s) & (cor.method == m)]).max() for m in order]
         rows.append([s] + [f(w) for w in worst])
     write_table(d, "table_method_sensitivity", ["subject"] + [m + " max $|\\Delta|$ deg" for m in order], rows,
                 align="lrrrr")
     eq = cor[cor.method == "equidistant"]
     fh = cor[cor.method == "femoral-head"]
-    per_subject = {s: changes(eq[eq.subject == s]).max() for s in msubjects}
+    per_subject = {s: changes(eq[eq.subject == s]).max() for s in csubjects}
     method_macros.update({
         "ROMeqSensMax": f(max(per_subject.values())),
         "ROMeqSensWorstSubject": max(per_subject, key=per_subject.get),
         "ROMeqSensWithinThree": str(sum(1 for v in per_subject.values() if v <= 3)),
-        "ROMmethodSubjects": str(len(msubjects)),
+        "ROMmethodSubjects": str(len(csubjects)),
         "ROMfhSensMax": f(changes(fh)[np.isfinite(changes(fh))].max()),
         "ROMfhSensVanish": str(int(np.isinf(changes(fh)).sum())),
         "ROMeqSensMedian": f(changes(eq).median(), 2),
@@ -342,7 +344,9 @@ write_table(d, "table_extra", ["subject", "motion", "limit", "where", "hidden", 
 rows = []
 for r in lay.itertuples():
     rows.append([r.subject, r.body, str(int(r.layers)), f"{r.layered_bytes / 2**20:.1f}", f"{r.single_bytes / 2**20:.1f}",
-                 f"{f(r.layered_sampling_ms, 0)} ({f(r.layered_sampling_q25_ms, 0)}--{f(r.layered_sampling_q75_ms, 0)})",
+                 # "--" where the fillings were not timed (--quick: every subject but the first)
+                 f"{f(r.layered_sampling_ms, 0)} ({f(r.layered_sampling_q25_ms, 0)}--{f(r.layered_sampling_q75_ms, 0)})"
+                 if np.isfinite(r.layered_sampling_ms) else "--",
                  f(r.single_sampling_ms, 0), str(int(r.max_crossings)),
                  f"{100 * r.nodes_truncated / r.nodes:.2f}", str(int(r.nodes_not_alternating)), str(int(r.hidden_vertices))])
 write_table(d, "table_layered", ["subject", "bone", "layers", "MiB", "single MiB", "ms (quartiles)", "single ms", "most crossings",
@@ -453,7 +457,8 @@ write_macros(d, "macros", {
     "ROMlayeredLimitsSingleMs": f"{slow.limits_ms_single.min():.1f}--{slow.limits_ms_single.max():.1f}",
     "ROMlayeredLimitsLayeredMs": f"{slow.limits_ms_layered.min():.1f}--{slow.limits_ms_layered.max():.1f}",
     "ROMlayeredLimitsIqrMax": f"{100 * ((slow.limits_layered_q75_ms - slow.limits_layered_q25_ms) / slow.limits_ms_layered).max():.0f}",
-    "ROMlayeredRuns": str(int(lay.timing_runs.min())),
+    # The timed subjects' rounds (--quick times the first subject alone: the others' timing_runs 0, times empty).
+    "ROMlayeredRuns": str(int(lay.timing_runs[lay.timing_runs > 0].min())),
     "ROMenvRuns": str(int(env.timing_runs.min())),
     "ROMlayeredNotAlternating": str(int(lay.nodes_not_alternating.sum())),
     "ROMlayeredTruncatedMax": f"{100 * (lay.nodes_truncated / lay.nodes).max():.1f}",

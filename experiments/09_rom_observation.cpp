@@ -35,7 +35,7 @@
 //                     at least 5 sessions) beside the single-layer map's; hidden vertices; the nine limits' search
 //                     time with and without layers (alternated, at least 5 rounds: medians and quartiles)
 //   envelope.csv      subject: the ROM envelope (every pose of flexion -30..130 x adduction -50..40 x internal
-//                     rotation -60..60, 1 deg; quick: 2 deg) by adaptive refinement beside the brute force that
+//                     rotation -60..60, 1 deg; quick: 5 deg) by adaptive refinement beside the brute force that
 //                     scans every pose (the refinement: at least 5 rounds, medians and quartiles; the brute force,
 //                     the reference, in one run: brute_force_runs), and the poses on which they differ
 //   cam.csv           thesis Fig. 60-61: the generated 12k hip without and with a 2 mm cam at the antero-superior
@@ -45,6 +45,11 @@
 //   clock_faces.csv   the acetabular clock face of each real subject in its pelvic frame
 //   thesis_table11.csv, published.csv   copies of the inputs the analysis compares with
 //   meta.json
+// --quick (CI's budget, issue 82 item 7): maps at 0.25 deg (sensitivity: 0.5), the envelope at 5 deg (the coarsest
+// step dividing every range); on every subject but the first, timing.csv's sampling and search are the subject's
+// first run's (sampling_runs, search_runs 1), layered.csv's sampling and limits are not timed (empty, timing_runs
+// 0), and the joint-centre methods' maps and COR moves are left out (their limits stay: methods.csv). The rounds
+// the paper gives as "at least 5" stay at 5 where they run.
 // Command: build/experiments/exp_09_rom_observation --out results --data ../shared/data/hips [--quick]
 #include <omp.h>
 
@@ -319,8 +324,10 @@ void record_limits(const SubjectRun& r, const Settings& st, Outputs& out) {
 
 // Extra-articular impingement (issue 14): layered maps of 4 crossings per node; the standard motions
 // and two with external rotation, counting every vertex (the limit) and the hidden ones only (the
-// first extra-articular contact), each checked exactly 0.5 deg either side.
-void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
+// first extra-articular contact), each checked exactly 0.5 deg either side. Without `timed` (--quick, every
+// subject but the first) the layered maps' sampling and the limits are not timed (layered.csv: empty times,
+// timing_runs 0).
+void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out, bool timed) {
   SessionOptions lo = r.options;
   lo.hip.joint.layers = 4;
   const Session lsession(lo);
@@ -330,11 +337,12 @@ void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
   const std::vector<StandardMotion> xm = extra_articular_motions();
   // The nine limits without and with the layers, timed alternately (medians and quartiles of --repetitions rounds).
   const HipJoint& hip = r.session.hip();
-  const int reps = std::max(5, st.reps);
+  const int reps = timed ? std::max(5, st.reps) : 0;
   const std::vector<std::vector<double>> lim_runs =
-      run_alternated({[&] { find_rom_limits(hip, r.run.motions, st.ro, r.run.baseline); },
-                      [&] { find_rom_limits(lhip, r.run.motions, st.ro, lbase); }},
-                     reps);
+      timed ? run_alternated({[&] { find_rom_limits(hip, r.run.motions, st.ro, r.run.baseline); },
+                              [&] { find_rom_limits(lhip, r.run.motions, st.ro, lbase); }},
+                             reps)
+            : std::vector<std::vector<double>>(2);
   const Timing lim_single = summarize(lim_runs[0]), lim_layered = summarize(lim_runs[1]);
   // The layered maps' sampling, again `reps` times (each a new session of the same options): its spread.
   std::vector<double> layered_ms[2];
@@ -385,7 +393,7 @@ void extra_articular(const SubjectRun& r, const Settings& st, Outputs& out) {
 void envelope(const SubjectRun& r, const Settings& st, Outputs& out) {
   const HipJoint& hip = r.session.hip();
   RomEnvelopeOptions eo;
-  eo.step_deg = st.quick ? 2 : 1;
+  eo.step_deg = st.quick ? 5 : 1;  // quick: 5 deg, the coarsest step that divides every range (1/125 the poses)
   eo.coarse_steps = 4;
   RomEnvelopeOptions bo = eo;
   bo.coarse_steps = 1;
@@ -409,8 +417,10 @@ void envelope(const SubjectRun& r, const Settings& st, Outputs& out) {
 }
 
 // The search's cost beside FCL collide on a subset of the map's poses (flexion 45, adduction 10,
-// internal rotation 0..58 step 2), extrapolated to the search's evaluations.
-void timing(const SubjectRun& r, const Settings& st, Outputs& out) {
+// internal rotation 0..58 step 2), extrapolated to the search's evaluations. Without `repeat` (--quick, every
+// subject but the first) the sampling and the search are the subject's first run's alone (sampling_runs and
+// search_runs 1).
+void timing(const SubjectRun& r, const Settings& st, Outputs& out, bool repeat) {
   const HipJoint& hip = r.session.hip();
   const Joint& joint = hip.joint();
   Timing fcl;  // FCL collide per pose: median and quartiles over the poses
@@ -431,7 +441,8 @@ void timing(const SubjectRun& r, const Settings& st, Outputs& out) {
   // Both maps' sampling, in new sessions of the same options (at least 5): its spread (the first session's alone was
   // one run).
   std::vector<double> sampling;
-  for (int k = 0; k < std::max(5, st.reps); ++k) {
+  if (!repeat) sampling.push_back(joint.ball().sampling_ms + joint.socket().sampling_ms);
+  for (int k = 0; repeat && k < std::max(5, st.reps); ++k) {
     const Session again(r.options);
     sampling.push_back(again.hip().joint().ball().sampling_ms + again.hip().joint().socket().sampling_ms);
   }
@@ -441,7 +452,8 @@ void timing(const SubjectRun& r, const Settings& st, Outputs& out) {
   // The search (limits and map) again, `reps` times: the medians and quartiles of its times (the limits and the map
   // of each run as run_rom reports them).
   std::vector<double> limits, map, search;
-  for (int k = 0; k < std::max(1, st.reps); ++k) {
+  if (!repeat) limits = {r.run.limits_ms}, map = {r.run.map_ms}, search = {r.run.limits_ms + r.run.map_ms};
+  for (int k = 0; repeat && k < std::max(1, st.reps); ++k) {
     const RomRun again = run_rom(r.session, SubjectRun::request(st));
     limits.push_back(again.limits_ms), map.push_back(again.map_ms), search.push_back(again.limits_ms + again.map_ms);
   }
@@ -470,12 +482,13 @@ void add_prefixed(Table& into, const Table& t, const std::string& subject, const
 }
 
 // Puls et al. 2010's four joint-centre methods side by side (issue 29), as `impinge rom` runs them by
-// default (layered maps, contact depth): limits and maps, and each method's limits with the initial
-// COR moved 1 mm along each pelvic axis.
-void methods(const SubjectRun& r, Outputs& out) {
+// default (layered maps, contact depth): limits, and with `whole` (--quick: the first subject only) the maps
+// (methods_map.csv) and each method's limits with the initial COR moved 1 mm along each pelvic axis.
+void methods(const SubjectRun& r, Outputs& out, bool whole) {
   if (!r.session.hip().acetabulum()) return;  // scan neutral (the generated model): femoral-head only
   const std::vector<StandardMotion> motions = standard_motions();
-  const RomRequest q = RunOptions::clinical().rom;  // the CLI's defaults: the distance metric
+  RomRequest q = RunOptions::clinical().rom;  // the CLI's defaults: the distance metric
+  q.map = q.map && whole;
   const Eigen::Vector3d centre = r.session.head().centre;
   const Eigen::Matrix3d axes = r.session.hip().frames()->pelvis.axes;
   const char* axis_name[3] = {"x", "y", "z"};
@@ -499,7 +512,7 @@ void methods(const SubjectRun& r, Outputs& out) {
     }
     add_prefixed(out.meth, rom_limits_table(s, run), r.subject.name, method);
     add_prefixed(out.meth_map, rom_map_table(run), r.subject.name, method);
-    for (int a = 0; a < 3; ++a)
+    for (int a = 0; a < 3 && whole; ++a)
       for (const double sign : {1.0, -1.0}) {
         SessionOptions m = o;
         m.cor.given = centre + sign * axes.col(a);  // the working frame is the subject's (RAS)
@@ -595,26 +608,36 @@ void cam_check(const Settings& st) {
 void write_meta_of(const Args& args, const Settings& st, const std::vector<Subject>& subjects, bool generated) {
   nlohmann::json subj = nlohmann::json::array();
   for (const Subject& s : subjects) subj.push_back({{"name", s.name}, {"source", s.source}});
-  write_meta(st.dir, args,
-             {{"resolution_deg", st.resolution},
-              {"sensitivity_resolutions_deg", st.sens_resolutions},
-              {"threshold_mm", st.ro.threshold_mm},
-              {"contact_depth_mm", st.ro.contact_depth_mm},
-              {"methods", "femoral-head, acetabular, combined, equidistant (Puls et al. 2010) with the CLI's defaults: "
-                          "layered maps (4 crossings, 0.5 deg), contact depth 0.25 mm, impingement contacts"},
-              {"step_deg", st.ro.step_deg},
-              {"tolerance_deg", st.ro.tolerance_deg},
-              {"observation_levels_mm", st.observation_levels.thresholds_mm},
-              {"neutral", generated ? "scan (generated model)" : "anatomical (ISB frames from the bones)"},
-              {"rom_map", "flexion 0..120 step 5 x adduction -20..40 step 5"},
-              {"exact_check", "CGAL ray casts from the COR for every counted first-surface vertex, 0.5 deg "
-                              "before and after each limit; hidden vertices are not checked"},
-              {"layers", 4},
-              {"envelope", "flexion -30..130 x adduction -50..40 x internal rotation -60..60 deg, 1 deg (quick: 2), "
-                           "refined from every 4th step; time: median and quartiles of at least 5 rounds; the brute force: one run"},
-              {"extra_articular_check", "CGAL all-intersection rays from the COR for every counted hidden vertex "
-                                        "(signed radial distance), plus the first-hit check when all vertices count"},
-              {"subjects", subj}});
+  nlohmann::json params = {
+      {"resolution_deg", st.resolution},
+      {"sensitivity_resolutions_deg", st.sens_resolutions},
+      {"threshold_mm", st.ro.threshold_mm},
+      {"contact_depth_mm", st.ro.contact_depth_mm},
+      {"methods",
+       "femoral-head, acetabular, combined, equidistant (Puls et al. 2010) with the CLI's defaults: "
+       "layered maps (4 crossings, 0.5 deg), contact depth 0.25 mm, impingement contacts"},
+      {"step_deg", st.ro.step_deg},
+      {"tolerance_deg", st.ro.tolerance_deg},
+      {"observation_levels_mm", st.observation_levels.thresholds_mm},
+      {"neutral", generated ? "scan (generated model)" : "anatomical (ISB frames from the bones)"},
+      {"rom_map", "flexion 0..120 step 5 x adduction -20..40 step 5"},
+      {"exact_check",
+       "CGAL ray casts from the COR for every counted first-surface vertex, 0.5 deg "
+       "before and after each limit; hidden vertices are not checked"},
+      {"layers", 4},
+      {"envelope",
+       "flexion -30..130 x adduction -50..40 x internal rotation -60..60 deg, 1 deg (quick: 5), "
+       "refined from every 4th step; time: median and quartiles of at least 5 rounds; the brute force: one run"},
+      {"extra_articular_check",
+       "CGAL all-intersection rays from the COR for every counted hidden vertex "
+       "(signed radial distance), plus the first-hit check when all vertices count"},
+      {"subjects", subj}};
+  if (st.quick)
+    params["quick"] =
+        "maps at 0.25 deg, the envelope at 5 deg; the repeated sampling and search timings (timing.csv), the layered "
+        "maps' timings (layered.csv) and the joint-centre methods' maps (methods_map.csv) and COR moves "
+        "(sensitivity.csv) on the first subject only";
+  write_meta(st.dir, args, params);
 }
 
 }  // namespace
@@ -642,14 +665,15 @@ int main(int argc, char** argv) {
   int done = 0;
   for (const Subject& s : subjects) {
     progress("09_rom_observation", ++done, static_cast<int>(subjects.size()), s.name);
+    const bool first = done == 1;  // --quick: the repeated timings and the methods' COR moves and maps: this one only
     const SubjectRun r(s, st);
     if (!s.generated) observe_table11(r, st, out);
     record_limits(r, st, out);
-    extra_articular(r, st, out);
+    extra_articular(r, st, out, !st.quick || first);
     envelope(r, st, out);
-    timing(r, st, out);
+    timing(r, st, out, !st.quick || first);
     sensitivity(r, st, out);
-    methods(r, out);
+    methods(r, out, !st.quick || first);
   }
   cam_check(st);
   write_csv(st.dir + "/rom_limits.csv", out.lim);

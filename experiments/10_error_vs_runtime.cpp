@@ -34,6 +34,7 @@
 // every-configuration table's subject) and at 0.1 deg on every subject (the refined table's resolution); the generated
 // hip, when real subjects are given, at 0.1 deg only (the peers' and the headline rows; no table or figure reads its
 // sweep, which repeated the real hips' trend).
+// --quick: p = 2, 1, 0.5 deg on the first subject, 0.5 deg alone on the others (CI's budget, issue 82 item 7).
 // Command: build/experiments/exp_10_error_vs_runtime --out results --data ../shared/data/hips [--quick]
 // Resolutions: largest node spacings p = 2, 1, 0.5 (quick: only these), 0.35, 0.25, 0.16, 0.1, 0.05 deg; every registered
 // scheme at the coarsest resolution that reaches p (resolution_for_spacing, issue 12), so a new
@@ -407,7 +408,8 @@ int main(int argc, char** argv) {
     const SubjectData d(s);
     for (double p : precisions) {
       progress("10_error_vs_runtime", ++done, total, s.name + " p=" + std::to_string(p));
-      if (s.generated && real && p != head_p) continue;
+      // The generated hip beside real ones, and (quick) every subject but the first: the finest resolution alone.
+      if (((s.generated && real) || (args.quick && k > 0)) && p != head_p) continue;
       measure_schemes(d, p, args.repetitions, k == 0 || p == head_p, out);
     }
     measure_peers(d, args.repetitions, out);

@@ -20,8 +20,8 @@ Outputs (OUT/14_studies/):
                        wall_s, task_s (summed), overhead, mean task s
   task_times.csv       every task of every run: run, kind, subject, time_s, joint_build_s, worker
   meta.json
---quick: 1 perturbation in the cohort, 2 in the scaling study of the first two subjects, and 2 rounds (its figures
-then test the pipeline, not the 1,000-subject estimate).
+--quick: the first two subjects, 1 perturbation in the cohort and 1 in the scaling study (4 tasks, 2 a worker), and 2
+rounds (its figures then test the pipeline, not the 1,000-subject estimate; CI's budget, issue 82 item 7).
 
 usage: exp_14_studies --out DIR [--data DIR] [--quick]
 (build/experiments/exp_14_studies runs this file with the module on PYTHONPATH)"""
@@ -84,13 +84,15 @@ def main():
     data = os.path.abspath(data) if data else None
     real = sorted(glob.glob(os.path.join(data, "*", "subject.json"))) if data and os.path.isdir(data) else []
     subjects = real if real else GENERATED
+    if quick:  # CI's budget (issue 82 item 7): the cohort and the scaling study on the first two subjects
+        subjects = subjects[:2]
     # The generated hips have no anatomical landmarks: scan neutral, where the femoral-head centre (the
     # thesis') is the only joint-centre method.
     joint_centre = "equidistant" if real else "femoral-head"
     samples = 1 if quick else 20
     # 5 perturbations (24 tasks, 12 a worker): the wall times, their ratio and the per-task overhead are measured the
     # same way as with 10 (issue 82 item 7: the 44 tasks' five rounds took 4 of the full run's minutes).
-    scaling_samples = 2 if quick else 5
+    scaling_samples = 1 if quick else 5
     rounds = 2 if quick else 5
     work = tempfile.mkdtemp(prefix="impinge-exp14-")
     cores = os.cpu_count() or 1
@@ -127,8 +129,7 @@ def main():
             f.write('name = "rom-scaling"\nseed = 27\nsubjects = []\n[joint]\nresolution = 0.5\n'
                     f'joint_centre = "{joint_centre}"\n[[task]]\nkind = "rom"\nmetric = "distance"\n'
                     '[perturb]\ncor_sd_mm = 1.0\nsamples = 0\n')
-        # --quick: two subjects (the figures test the pipeline; CI's budget, issue 82 item 7).
-        over = {"subjects": subjects[:2] if quick else subjects, "perturb.samples": scaling_samples}
+        over = {"subjects": subjects, "perturb.samples": scaling_samples}
 
         def dask_run(k, workers):
             print(f"[14_studies] scaling, round {k + 1}/{rounds}: ROM tasks on {workers} worker(s)", flush=True)

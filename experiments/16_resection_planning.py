@@ -19,6 +19,10 @@ clearance 0.3 mm, burr radius 2.5 mm, safety depth 30 % of the neck's least diam
 Timing: the plan of the generated hip with the largest cam and lhdl-ct's femur-only ir90 plan, 5 times each
 (--quick: 3), alternated: plan_times.csv.
 
+--quick (CI's budget, issue 82 item 7): maps at 0.5 deg, 3 timing runs, and the shared hips' parts (added_cam, ir90)
+on QUICK_HIPS alone (lhdl-ct, the timed hip, and tlem2-mri: a CT and an MRI hip; the mc22 pair is left out; the first
+two hips when neither is there).
+
 Outputs (OUT/16_resection_planning/): generated.csv, added_cam.csv, ir90.csv, plan_times.csv, published.csv (the published
 resection volumes and ROM gains the analysis sets beside ours: experiments/16_published.csv), meta.json.
 
@@ -40,6 +44,7 @@ GENERATED_TARGETS = ("flexion", "abduction", "internal_rotation")
 CAM_MM = 3.0
 CAM_WIDTH_DEG = 12.0
 TIMED_HIP = "lhdl-ct"  # the shared hip whose plan time the paper quotes
+QUICK_HIPS = (TIMED_HIP, "tlem2-mri")  # --quick: the shared hips planned
 CAM_FROM_NECK_DEG = 62.0  # the bump's centre: this far from the neck axis (towards the neck), at the junction
 
 
@@ -96,6 +101,8 @@ def main():
     precision = 0.5 if quick else 0.25
     hips = sorted(h for h in os.listdir(data) if os.path.exists(os.path.join(data, h, "subject.json"))) \
         if data and os.path.isdir(data) else []
+    if quick:
+        hips = [h for h in hips if h in QUICK_HIPS] or hips[:2]
     shutil.copyfile(os.path.join(HERE, "16_published.csv"), os.path.join(d, "published.csv"))
     plan_columns = ["volume_mm3", "area_mm2", "deepest_cut_mm", "mean_depth_mm", "clock_from_h", "clock_to_h"]
 
