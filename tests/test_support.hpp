@@ -16,9 +16,6 @@ namespace impinge::test {
 Eigen::Matrix3d random_rotation(std::mt19937_64& rng);
 /// Apply x -> R x + t to every vertex.
 TriangleMesh transformed(const TriangleMesh& m, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
-/// Every triangle of `m` split in four at its edges' midpoints (shared between neighbours): the same surface, 4x the
-/// triangles (tessellation-invariance tests, issue 81).
-TriangleMesh split_in_four(const TriangleMesh& m);
 /// The same mesh with its vertices and faces in a random order (seeded) and each face's corners turned.
 TriangleMesh renumbered(const TriangleMesh& m, unsigned seed);
 /// A fresh temporary directory for a test.

@@ -141,13 +141,13 @@ TEST(SurfaceSphereFit, SplittingRenumberingOrTurningTheMeshInsideOutMovesNothing
   const SphereFitResult a = fit(head);
   TriangleMesh inside_out = head;
   inside_out.F.col(1).swap(inside_out.F.col(2));
-  for (const TriangleMesh& m : {test::split_in_four(head), test::renumbered(head, 7), inside_out}) {
+  for (const TriangleMesh& m : {split_in_four(head), test::renumbered(head, 7), inside_out}) {
     const SphereFitResult b = fit(m);
     EXPECT_LT((b.centre - a.centre).norm(), 1e-6) << m.source;
     EXPECT_NEAR(b.radius, a.radius, 1e-6) << m.source;
   }
   // The vertices' fit moves when the mesh is split (its midpoints lie inside the surface's curvature).
-  const SphereFitResult v = fit_sphere_geometric(head.V), vs = fit_sphere_geometric(test::split_in_four(head).V);
+  const SphereFitResult v = fit_sphere_geometric(head.V), vs = fit_sphere_geometric(split_in_four(head).V);
   EXPECT_GT(std::abs(vs.radius - v.radius), 1e-3);
 }
 

@@ -137,7 +137,7 @@ TEST(JointCentre, EquidistantNeverPressesTheHeadIntoTheSocket) {
 // same equidistant translation at every rotation. The old guard, the lunate vertices, changed under the split (the
 // midpoints lie on the chords, nearer the head): splitting mc22's pelvis moved its IR limit 0.25 deg.
 TEST(JointCentre, TheGuardIsTheSameForASplitSurface) {
-  const TriangleMesh cup = bump_cup(120, 50), split = test::split_in_four(cup);
+  const TriangleMesh cup = bump_cup(120, 50), split = split_in_four(cup);
   const ScanSet a = guard_points(cup.V, cup.F, inner_flags(cup)), b = guard_points(split.V, split.F, inner_flags(split));
   ASSERT_GT(a.size(), 1000);
   auto covered = [](const ScanSet& from, const ScanSet& in) {  // every point of `from` is a point of `in` (to 1e-9 mm)

@@ -27,7 +27,6 @@ using Eigen::Vector3d;
 namespace {
 using test::renumbered;
 using test::scan_options;
-using test::split_in_four;
 // A closed prism: the triangle (p0, p1, p2) swept by e; faces wound outward.
 TriangleMesh make_prism(const Vector3d& p0, const Vector3d& p1, const Vector3d& p2, const Vector3d& e) {
   TriangleMesh m;

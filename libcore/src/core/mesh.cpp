@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
+#include <utility>
 #include <tuple>
 #include <vector>
 #include <sstream>
@@ -230,6 +232,33 @@ std::int64_t orient_consistently(TriangleMesh& mesh, std::int64_t* conflicts) {
   }
   if (conflicts != nullptr) *conflicts = bad;
   return flipped;
+}
+
+TriangleMesh split_in_four(const TriangleMesh& m) {
+  std::vector<Eigen::Vector3d> v;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) v.push_back(m.V.row(i).transpose());
+  std::map<std::pair<int, int>, int> mid;
+  auto midpoint = [&](int a, int b) {
+    const auto key = std::minmax(a, b);
+    const auto it = mid.find(key);
+    if (it != mid.end()) return it->second;
+    v.push_back(0.5 * (v[static_cast<std::size_t>(a)] + v[static_cast<std::size_t>(b)]));
+    return mid[key] = static_cast<int>(v.size()) - 1;
+  };
+  TriangleMesh out;
+  out.F.resize(4 * m.F.rows(), 3);
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    const int a = m.F(f, 0), b = m.F(f, 1), c = m.F(f, 2);
+    const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+    out.F.row(4 * f) << a, ab, ca;
+    out.F.row(4 * f + 1) << ab, b, bc;
+    out.F.row(4 * f + 2) << ca, bc, c;
+    out.F.row(4 * f + 3) << ab, bc, ca;
+  }
+  out.V.resize(static_cast<Eigen::Index>(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) out.V.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
+  out.source = m.source;
+  return out;
 }
 
 }  // namespace impinge

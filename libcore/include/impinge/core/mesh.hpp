@@ -68,4 +68,11 @@ std::int64_t orient_consistently(TriangleMesh& mesh, std::int64_t* conflicts = n
 /// first (impinge::Error on a bad index or coordinate).
 Eigen::VectorXd vertex_areas(const TriangleMesh& mesh);
 
+/// Every triangle of `m` (n x 3 vertices, m x 3 faces, mm) split in four at its edges' midpoints, a midpoint shared
+/// between the triangles on either side of its edge: the same surface with 4 m triangles and n + (edges) vertices.
+/// Face f becomes faces 4f..4f+3 (the three corners' triangles, then the middle one), wound as f; `source` is kept.
+/// Does not validate (an out-of-range index is the caller's to check). Source: impinge (issue 81: the tessellation
+/// tests; the plan's finer labrum).
+TriangleMesh split_in_four(const TriangleMesh& m);
+
 }  // namespace impinge
