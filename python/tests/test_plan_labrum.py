@@ -79,6 +79,10 @@ def check_labral_plan(tmp_path, subject, motion, common, femur_mesh):
     for other in (tmp_path / "lab" / "labrum.ply", tmp_path / "after" / "labrum.ply"):
         L, Lf = vertices(other)
         assert np.array_equal(Lf, LF) and np.abs(L - L0).max() < 1e-4, other
+    # A plan without the labrum in the same folder leaves no labrum.ply of the earlier run behind.
+    r = run(["plan", "--subject", subject, "--out", tmp_path / "lab", "--target", t_arg] + common)
+    assert r.returncode == 0, r.stderr + r.stdout
+    assert not (tmp_path / "lab" / "labrum.ply").exists()
     return {"bony": bony, "labral": labral, "target": target, "removed": removed,
             "labral_after": num(after["labral_limit_deg"]), "bony_after": num(after["limit_deg"])}
 

@@ -175,7 +175,7 @@ std::vector<std::string> command_outputs(const std::string& command) {
     out = {"morphology.json", "femur_sphericity.ply"};
   else if (command == "plan")
     out = {"plan.json", "femur_resected.ply", "femur_resected.vtp", "pelvis_resected.ply", "pelvis_resected.vtp",
-           "plan.png"};
+           "plan.png", "labrum.ply"};
   else
     return out;
   out.push_back("summary.json");
