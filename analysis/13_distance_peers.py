@@ -66,7 +66,8 @@ def power_of_ten(x):
 
 
 with open(os.path.join(d, "meta.json")) as fm:
-    versions = json.load(fm)["versions"]
+    meta13 = json.load(fm)
+versions = meta13["versions"]
 write_macros(d, "macros", {
     "PEERsubjects": str(len(subjects)),
     "PEERposes": str(int(t.groupby("subject").size().max())),
@@ -95,6 +96,8 @@ wp = read_csv(d, "whole_process.csv") if os.path.exists(wp_path) else None
 wp_macros = {}
 if wp is not None and len(wp):
     rows = []
+    # An Open3D job expected to take longer than this was left out (benchmarks/whole_process.py's SKIP_S).
+    left_out_s = meta13["parameters"].get("whole_process", {}).get("open3d_left_out_over_s", 60)
     for (job, mesh, poses, threads), g in wp.groupby(["job", "mesh", "poses", "threads"], sort=False):
         a, b = g[g.tool == "impinge"].iloc[0], g[g.tool == "open3d"].iloc[0]
         scale, unit = (1e3, "ms") if job == "pose" else (1.0, "s")
@@ -103,7 +106,7 @@ if wp is not None and len(wp):
 
         def span(r):
             if r.runs == 0:
-                return "left out (over 60 s)"
+                return f"left out (over {left_out_s:g} s)"
             return timing_text(scale * r.median_s, scale * r.q1_s, scale * r.q3_s, r.runs, lambda x: f"{x:.3g}",
                                sep="--", unit=f" {unit}")
         rows.append([mesh.replace("_", " "), what, span(a), span(b),

@@ -365,6 +365,7 @@ def main():
                                           "open3d": "compute_signed_distance(nthreads=threads)"},
                            "whole_process": {
                                "subject": subject, "repetitions": 3 if quick else 5,
+                               "open3d_left_out_over_s": whole_process.SKIP_S,
                                "impinge": "impinge distance (1 pose) / impinge motion (N poses), CLI defaults, "
                                           "--neutral scan --joint-centre femoral-head; per pose: Joint.detect_pose at "
                                           "OMP_NUM_THREADS 1, 2",
