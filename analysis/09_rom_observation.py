@@ -412,7 +412,13 @@ write_macros(d, "macros", {
     "ROMfirstSamplingRuns": f"{int(t0.sampling_runs)}",
     "ROMfirstEvaluations": f"{int(t0.evaluations)}",
     "ROMfirstPosesPerSecond": f"{t0.poses_per_second:.0f}",
-    "ROMfirstSkipped": f"{100 * t0.share_skipped:.0f}",
+    # The per-vertex test's search beside the exact one (timing.csv; "--" in a run without it).
+    "ROMfirstSkipped": f"{100 * t0.share_skipped:.0f}" if np.isfinite(t0.get("share_skipped", np.nan)) else "--",
+    "ROMfirstPerVertexMs": f"{t0.per_vertex_search_ms:.0f}" if "per_vertex_search_ms" in t0 else "--",
+    "ROMfirstExactOverVertex": (f"{t0.exact_over_per_vertex:.1f} ({t0.exact_over_per_vertex_q25:.1f}--"
+                                f"{t0.exact_over_per_vertex_q75:.1f})" if "exact_over_per_vertex" in t0 else "--"),
+    "ROMexactOverVertexRange": (f"{tim.exact_over_per_vertex.min():.1f}--{tim.exact_over_per_vertex.max():.1f}"
+                                if "exact_over_per_vertex" in tim and tim.exact_over_per_vertex.notna().any() else "--"),
     "ROMfirstFclMs": f"{t0.fcl_collide_ms_per_pose:.2f}",
     "ROMfirstFclMsQlow": f"{t0.fcl_collide_q25_ms:.2f}",
     "ROMfirstFclMsQhigh": f"{t0.fcl_collide_q75_ms:.2f}",
