@@ -256,8 +256,18 @@ if meth is not None and {"mc22", "mc22-left"} <= set(meth.subject):
             "ROMlrLeftInclination": f(b.loc["mc22-left", "inclination_deg"], 0),
             "ROMlrRightScanGap": f(b.loc["mc22", "scan_pose_min_gap_mm"], 2),
             "ROMlrLeftScanGap": f(b.loc["mc22-left", "scan_pose_min_gap_mm"], 2),
-            "ROMlrRightNeutralGap": f(b.loc["mc22", "neutral_min_gap_mm"], 2),
-            "ROMlrLeftNeutralGap": f(b.loc["mc22-left", "neutral_min_gap_mm"], 2),
+            "ROMlrRightNeutralGap": f(b.loc["mc22", "neutral_min_gap_mm"], 3),
+            "ROMlrLeftNeutralGap": f(b.loc["mc22-left", "neutral_min_gap_mm"], 3),
+        })
+        # The comparisons the text draws, from the same numbers (within 1 deg: about the same).
+        dc = b.loc["mc22", "median_coverage_deg"] - b.loc["mc22-left", "median_coverage_deg"]
+        di = b.loc["mc22", "inclination_deg"] - b.loc["mc22-left", "inclination_deg"]
+        lr_macros.update({
+            "ROMlrCoverageCompare": ("covers about as much of the head" if abs(dc) <= 1 else
+                                     "covers more of the head" if dc > 0 else "covers less of the head"),
+            "ROMlrSteepCompare": "about as steep" if abs(di) <= 1 else "less steep" if di < 0 else "steeper",
+            "ROMlrPincerText": (": a less steep socket, reaching farther over the head laterally, meets the neck "
+                                "sooner, as in pincer morphology" if di < -1 else ""),
         })
 
 # ROM maps.
