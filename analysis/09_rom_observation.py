@@ -467,6 +467,8 @@ write_macros(d, "macros", {
     "ROMallLimitsChecked": str(len(lim_all)),
     "ROMallLimitsConfirmed": str(int((lim_all.validated == "yes").sum())),
     "ROMlayeredBytesRatio": f"{(lay.layered_bytes / lay.single_bytes).min():.1f}",
+    # The layered map's spacing from its node count, (180/p + 1)(360/p) = nodes (the single-layer map's: ROMresolution).
+    "ROMlayeredSpacing": f"{1 / ((-360 + (360 ** 2 + 4 * 64800 * float(lay.nodes.iloc[0])) ** 0.5) / (2 * 64800)):.2g}",
     "ROMlayeredSamplingMs": f"{lay.layered_sampling_ms.min():.0f}--{lay.layered_sampling_ms.max():.0f}",
     "ROMlayeredSlowdown": f"{(slow.limits_ms_layered / slow.limits_ms_single).min():.1f}--"
                           f"{(slow.limits_ms_layered / slow.limits_ms_single).max():.1f}",
