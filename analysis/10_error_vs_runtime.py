@@ -258,7 +258,7 @@ for k in ("EqErrBestAny", "EqErrBestAnyBytesRatio", "EqErrBestAnyNsRatio", "EqEr
           "EqErrHelixBytesRatioMin", "EqErrHelixBytesRatioMax", "EqErrHelixNsRatioMin", "EqErrHelixNsRatioMax",
           "EqErrTargetVerdict", "EqErrBestNewNsRatioFine", "EqErrBestPerSubjectBytesRatioMin",
           "EqErrBestPerSubjectBytesRatioMax", "EqErrBestPerSubjectNsRatioMin", "EqErrBestPerSubjectNsRatioMax",
-          "EqErrBestPerSubjectSchemes"):
+          "EqErrBestPerSubjectSchemes", "EqErrByteTargetHolds"):
     macros.setdefault(k, "--")
 eq_rows = []
 rest = maps_all[(maps_all.pose == "rest") & ~maps_all.generated.astype(bool) &
