@@ -172,6 +172,23 @@ if len(real):
         med, lo, hi = paired(s, "pushed_3mm", method, "rsid", None, 0.1)
         macros.update({f"Det{name}OverRsid": f"{med:.{digits}f}", f"Det{name}OverRsidQlow": f"{lo:.{digits}f}",
                        f"Det{name}OverRsidQhigh": f"{hi:.{digits}f}"})
+# FCL against RSID (0.1 deg) at the pushed pose on every model: where each of FCL's two queries is the faster.
+fcl_all_faster, fcl_first_faster = [], []
+for s_, g in t[t.pose == "pushed_3mm"].groupby("subject", sort=False):
+    r_ = get(g, "rsid", 0.1)
+    if np.isfinite(r_):
+        if get(g, "fcl_collide") < r_:
+            fcl_all_faster.append(s_)
+        if get(g, "fcl_first_contact") < r_:
+            fcl_first_faster.append(s_)
+
+
+def models(names):
+    return ", ".join(f"\\texttt{{{n}}}" for n in names) if names else "no model"
+
+
+macros["DetFclAllFasterOn"] = models(fcl_all_faster)
+macros["DetFclFirstFasterOn"] = models(fcl_first_faster)
 # Against the thesis (generated levels, pushed pose): RSID at the table's precision, USID over RSID.
 gen_p = t[t.generated.astype(bool) & (t.pose == "pushed_3mm")]
 rsid_vs_thesis, usid_over_rsid = [], []
@@ -198,8 +215,10 @@ for res, name in ((0.1, "Fine"), (0.5, "Coarse")):
         w = get(t[(t.subject == s_) & (t.pose == "pushed_3mm")], "rsid", res)
         if np.isfinite(w) and w > 0:
             cold.append(1000.0 / g.poses_per_s.iloc[0] / w)
-    macros[f"DetColdOverWarm{name}Min"] = f"{min(cold):.1f}" if cold else "n/a"
-    macros[f"DetColdOverWarm{name}Max"] = f"{max(cold):.1f}" if cold else "n/a"
+    macros[f"DetColdOverWarm{name}Verdict"] = ("n/a" if not cold else "cheaper" if max(cold) < 1 else
+                                                "dearer" if min(cold) > 1 else "cheaper on some subjects, dearer on others")
+    macros[f"DetColdOverWarm{name}Min"] = f"{min(cold):.2g}" if cold else "n/a"
+    macros[f"DetColdOverWarm{name}Max"] = f"{max(cold):.2g}" if cold else "n/a"
     nodes = (180 / res + 1) * (360 / res)
     macros[f"DetMapMB{name}"] = f"{nodes * 4 / 1e6:.0f}"
 ups = []

@@ -343,6 +343,13 @@ write_macros(d, "macros", {
     "RDwithoutGap": f"{int(rv.distance_without_gap.sum()):,}",
     "RDinside": f"{int(rv.inside_by_distance.sum()):,}",
     "RDmissed": f"{int(rv.inside_missed_by_gap.sum()):,}",
+    # Where the penetrating area differs between the two quantities (more than 1 mm^2 or 1 %).
+    "RDareaDiffers": (lambda dif: (f"on {len(dif)} of {len(rv)} rows ("
+                                   + ", ".join(f"{r.subject} {r.pose.replace('_', ' ')} {'femur' if r.scan == 'ball' else 'pelvis'}: "
+                                               f"{r.area_penetrating_gap_mm2:.0f} against {r.area_penetrating_distance_mm2:.0f}~mm$^2$"
+                                               for r in dif.itertuples()) + ")") if len(dif) else "on no row")(
+        rv[(rv.area_penetrating_gap_mm2 - rv.area_penetrating_distance_mm2).abs() >
+           np.maximum(1.0, 0.01 * rv[["area_penetrating_gap_mm2", "area_penetrating_distance_mm2"]].max(axis=1))]),
     "RDreach": f"{meta['parameters']['radial_vs_distance']['reach_mm']:g}",
     "RDprecision": f"{meta['parameters']['radial_vs_distance']['precision_deg']:g}",
     "DMfinest": f"{finest:g}",

@@ -36,6 +36,18 @@ t11 = read_csv(d, "thesis_table11.csv")
 subjects = list(dict.fromkeys(lim.subject))
 
 
+def exact_over_vertex_range(t):
+    """The exact search's time over the per-vertex one across the subjects that timed both (timing.csv's
+    exact_over_per_vertex), as the appendix's clause: a range, or the one subject when only one was timed."""
+    r = t[t.exact_over_per_vertex.notna()] if "exact_over_per_vertex" in t else t.iloc[0:0]
+    if len(r) == 0:
+        return "not timed on any subject"
+    lo, hi = f"{r.exact_over_per_vertex.min():.1f}", f"{r.exact_over_per_vertex.max():.1f}"
+    if len(r) == 1:
+        return f"timed on {r.subject.iloc[0]} alone"
+    return f"{lo} times on every subject" if lo == hi else f"{lo}--{hi} times across the {len(r)} subjects"
+
+
 def f(x, n=1):
     if np.isnan(x):
         return "--"
@@ -256,8 +268,18 @@ if meth is not None and {"mc22", "mc22-left"} <= set(meth.subject):
             "ROMlrLeftInclination": f(b.loc["mc22-left", "inclination_deg"], 0),
             "ROMlrRightScanGap": f(b.loc["mc22", "scan_pose_min_gap_mm"], 2),
             "ROMlrLeftScanGap": f(b.loc["mc22-left", "scan_pose_min_gap_mm"], 2),
-            "ROMlrRightNeutralGap": f(b.loc["mc22", "neutral_min_gap_mm"], 2),
-            "ROMlrLeftNeutralGap": f(b.loc["mc22-left", "neutral_min_gap_mm"], 2),
+            "ROMlrRightNeutralGap": f(b.loc["mc22", "neutral_min_gap_mm"], 3),
+            "ROMlrLeftNeutralGap": f(b.loc["mc22-left", "neutral_min_gap_mm"], 3),
+        })
+        # The comparisons the text draws, from the same numbers (within 1 deg: about the same).
+        dc = b.loc["mc22", "median_coverage_deg"] - b.loc["mc22-left", "median_coverage_deg"]
+        di = b.loc["mc22", "inclination_deg"] - b.loc["mc22-left", "inclination_deg"]
+        lr_macros.update({
+            "ROMlrCoverageCompare": ("covers about as much of the head" if abs(dc) <= 1 else
+                                     "covers more of the head" if dc > 0 else "covers less of the head"),
+            "ROMlrSteepCompare": "about as steep" if abs(di) <= 1 else "less steep" if di < 0 else "steeper",
+            "ROMlrPincerText": (": a less steep socket, reaching farther over the head laterally, meets the neck "
+                                "sooner, as in pincer morphology" if di < -1 else ""),
         })
 
 # ROM maps.
@@ -412,7 +434,12 @@ write_macros(d, "macros", {
     "ROMfirstSamplingRuns": f"{int(t0.sampling_runs)}",
     "ROMfirstEvaluations": f"{int(t0.evaluations)}",
     "ROMfirstPosesPerSecond": f"{t0.poses_per_second:.0f}",
-    "ROMfirstSkipped": f"{100 * t0.share_skipped:.0f}",
+    # The per-vertex test's search beside the exact one (timing.csv; "--" in a run without it).
+    "ROMfirstSkipped": f"{100 * t0.share_skipped:.0f}" if np.isfinite(t0.get("share_skipped", np.nan)) else "--",
+    "ROMfirstPerVertexMs": f"{t0.per_vertex_search_ms:.0f}" if "per_vertex_search_ms" in t0 else "--",
+    "ROMfirstExactOverVertex": (f"{t0.exact_over_per_vertex:.1f} ({t0.exact_over_per_vertex_q25:.1f}--"
+                                f"{t0.exact_over_per_vertex_q75:.1f})" if "exact_over_per_vertex" in t0 else "--"),
+    "ROMexactOverVertexRange": exact_over_vertex_range(tim),
     "ROMfirstFclMs": f"{t0.fcl_collide_ms_per_pose:.2f}",
     "ROMfirstFclMsQlow": f"{t0.fcl_collide_q25_ms:.2f}",
     "ROMfirstFclMsQhigh": f"{t0.fcl_collide_q75_ms:.2f}",
@@ -451,6 +478,8 @@ write_macros(d, "macros", {
     "ROMallLimitsChecked": str(len(lim_all)),
     "ROMallLimitsConfirmed": str(int((lim_all.validated == "yes").sum())),
     "ROMlayeredBytesRatio": f"{(lay.layered_bytes / lay.single_bytes).min():.1f}",
+    # The layered map's spacing from its node count, (180/p + 1)(360/p) = nodes (the single-layer map's: ROMresolution).
+    "ROMlayeredSpacing": f"{1 / ((-360 + (360 ** 2 + 4 * 64800 * float(lay.nodes.iloc[0])) ** 0.5) / (2 * 64800)):.2g}",
     "ROMlayeredSamplingMs": f"{lay.layered_sampling_ms.min():.0f}--{lay.layered_sampling_ms.max():.0f}",
     "ROMlayeredSlowdown": f"{(slow.limits_ms_layered / slow.limits_ms_single).min():.1f}--"
                           f"{(slow.limits_ms_layered / slow.limits_ms_single).max():.1f}",

@@ -258,7 +258,7 @@ for k in ("EqErrBestAny", "EqErrBestAnyBytesRatio", "EqErrBestAnyNsRatio", "EqEr
           "EqErrHelixBytesRatioMin", "EqErrHelixBytesRatioMax", "EqErrHelixNsRatioMin", "EqErrHelixNsRatioMax",
           "EqErrTargetVerdict", "EqErrBestNewNsRatioFine", "EqErrBestPerSubjectBytesRatioMin",
           "EqErrBestPerSubjectBytesRatioMax", "EqErrBestPerSubjectNsRatioMin", "EqErrBestPerSubjectNsRatioMax",
-          "EqErrBestPerSubjectSchemes"):
+          "EqErrBestPerSubjectSchemes", "EqErrByteTargetHolds"):
     macros.setdefault(k, "--")
 eq_rows = []
 rest = maps_all[(maps_all.pose == "rest") & ~maps_all.generated.astype(bool) &
@@ -345,6 +345,10 @@ if eq_rows:
         macros["EqErrBestPerSubjectNsRatioMin"] = f"{min(x[1] for x in per):.2f}"
         macros["EqErrBestPerSubjectNsRatioMax"] = f"{max(x[1] for x in per):.2f}"
         macros["EqErrBestPerSubjectSchemes"] = ", ".join(sorted({x[2] for x in per}))
+        # Where the byte target (<= 0.65 times the bytes) holds, whatever the query time.
+        held = [s_ for s_, v_ in best.items() if v_ and min(v_)[0] <= 0.65]
+        macros["EqErrByteTargetHolds"] = (f"on {len(held)} of {len(per)} subjects ({', '.join(held)})" if held
+                                          else f"on none of the {len(per)} subjects")
     allb = [x for v_ in best.values() for x in v_]
     if allb:
         macros["EqErrNewBytesRatioMin"] = f"{min(x[0] for x in allb):.2f}"

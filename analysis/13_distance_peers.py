@@ -121,6 +121,8 @@ if wp is not None and len(wp):
     def ratio(g):
         return f"{g[g.tool == 'open3d'].median_s.iloc[0] / g[g.tool == 'impinge'].median_s.iloc[0]:.1f}"
     sub = wp[(wp.job == "process") & (wp.poses == 1) & (wp.mesh == "subdivided_4x")]
+    sub1 = wp[(wp.job == "pose") & (wp.threads == 1) & (wp.mesh == "subdivided_4x")]
+    sub2 = wp[(wp.job == "pose") & (wp.threads == 2) & (wp.mesh == "subdivided_4x")]
 
     def value(g):
         a, b = g[g.tool == "impinge"], g[g.tool == "open3d"]
@@ -133,21 +135,26 @@ if wp is not None and len(wp):
         if not got:
             return ""
         met = [f"{v:.1f}" for _, v in got if v >= target]
-        said = " and ".join(f"{v:.1f} ({name})" for name, v in got)
+        items = [f"{v:.1f} ({name})" for name, v in got]
+        said = items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
         verdict = "reached" if len(met) == len(got) else "not reached" if not met else "reached only in part"
         return f"the aim of {target} times {what} is {verdict}: {said} times"
     aims = [aim("for one pose", 5, [("native", value(one)), ("subdivided 4 times", value(sub))]),
-            aim("per pose", 200, [("one thread", value(pose1)), ("two threads", value(pose2))])]
+            aim("per pose", 200, [("native, one thread", value(pose1)), ("native, two threads", value(pose2)),
+                                  ("subdivided, one thread", value(sub1)),
+                                  ("subdivided, two threads", value(sub2))])]
     aims = [a for a in aims if a]
     wp_macros = {"WPonePose": ratio(one), "WPtenPoses": ratio(ten), "WPperPoseOne": ratio(pose1),
                  "WPperPoseTwo": ratio(pose2),
                  "WPonePoseSeconds": f"{one[one.tool == 'impinge'].median_s.iloc[0]:.2f}",
                  "WPonePoseOpenSeconds": f"{one[one.tool == 'open3d'].median_s.iloc[0]:.2f}",
-                 "WPaims": ("; ".join(aims) if aims else "the aims were not measured in this run")}
+                 "WPaims": ("; ".join(aims) if aims else "the aims were not measured in this run"),
+                 "WPleftOutSeconds": f"{left_out_s:g}"}
 else:
     wp_macros = {k: "--" for k in ("WPonePose", "WPtenPoses", "WPperPoseOne", "WPperPoseTwo", "WPonePoseSeconds",
                                    "WPonePoseOpenSeconds")}
     wp_macros["WPaims"] = "the aims were not measured in this run"
+    wp_macros["WPleftOutSeconds"] = "--"
 with open(os.path.join(d, "macros.tex"), "a") as f:
     for k, v in wp_macros.items():
         f.write("\\newcommand{\\%s}{%s}\n" % (k, v))

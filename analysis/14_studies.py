@@ -61,6 +61,9 @@ for s in sorted(summary.subject.unique()):
         row.append(f"{r.nominal:.1f} ({r.p05:.1f} to {r.p95:.1f})")
     rows.append(row)
 write_table(d, "table_cohort", ["subject"] + [label for _, _, label in figures], rows)
+# The spread of the ROM limits over the perturbed centres (95th less 5th percentile): what the text says of it.
+rom_rows = summary[(summary.kind == "rom") & summary.figure.isin([fig for kind, fig, _ in figures if kind == "rom"])]
+spread = (rom_rows.p95 - rom_rows.p05).dropna()
 
 fig, (a, b) = plt.subplots(1, 2, figsize=(8, 3.2))
 kinds = ["rom", "motion", "distance"]
@@ -91,6 +94,11 @@ cluster_hours = tasks_large * mean_task / (cluster_cores * efficiency) / 3600
 
 write_macros(d, "macros", {
     "STUDYcohortTasks": str(int(eq.tasks_local)),
+    "STUDYspreadMedian": f"{spread.median():.1f}" if len(spread) else "--",
+    "STUDYspreadMax": f"{spread.max():.1f}" if len(spread) else "--",
+    "STUDYspreadMaxWhere": (f"{rom_rows.loc[spread.idxmax(), 'subject']}, "
+                            f"{dict((fig, label) for _, fig, label in figures)[rom_rows.loc[spread.idxmax(), 'figure']].replace(' (deg)', '')}"
+                            if len(spread) else "--"),
     "STUDYcohortSubjects": str(len(meta["parameters"]["subjects"])),
     "STUDYcohortPerturbations": str(meta["parameters"]["cohort_perturbations"]),
     "STUDYserialPerturbations": str(meta["parameters"].get("cohort_serial_perturbations",

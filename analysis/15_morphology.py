@@ -107,9 +107,23 @@ if cams:
     macros["MOgenAlphaHigh"] = f(float(generated[generated.subject == hi].alpha_max_deg.iloc[0]))
     macros["MOgenIrZeroLow"], macros["MOgenIrZeroHigh"] = f(gen_ir(lo, 0)), f(gen_ir(hi, 0))
     macros["MOgenIrTwentyLow"], macros["MOgenIrTwentyHigh"] = f(gen_ir(lo, 20)), f(gen_ir(hi, 20))
+    # A limit the ROM map leaves NaN (in contact already without rotation, or free to 150 deg: the map does not say
+    # which) is said so, not printed as a number.
+    for key, flex in (("MOgenIrZeroHighText", 0), ("MOgenIrTwentyHighText", 20)):
+        v = gen_ir(hi, flex)
+        macros[key] = (f"{f(v)}$^\\circ$" if np.isfinite(v) else
+                       "no value (the ROM map's NaN: in contact already without rotation, or free to 150$^\\circ$)")
+    # The cams that lower the rotation by less than 2 deg at both flexions, and by how much at most.
+    drops = {c: max(gen_ir(lo, fl) - gen_ir(c, fl) for fl in (0, 20)) for c in cams[1:]}
+    small = [c for c, dv in drops.items() if np.isfinite(dv) and dv < 2]
+    macros["MOgenSmallCamsText"] = (
+        f"Cams of {' and '.join(c.replace('generated-cam', '') for c in small)}~mm lower it by at most "
+        f"{f(max(drops[c] for c in small))}$^\\circ$, until the bump reaches the rim's path." if small else
+        "Every cam lowers it by 2$^\\circ$ or more.")
 else:
     for k in ("MOgenCamLow", "MOgenCamHigh", "MOgenAlphaLow", "MOgenAlphaHigh", "MOgenIrZeroLow", "MOgenIrZeroHigh",
-              "MOgenIrTwentyLow", "MOgenIrTwentyHigh"):
+              "MOgenIrTwentyLow", "MOgenIrTwentyHigh", "MOgenIrZeroHighText", "MOgenIrTwentyHighText",
+              "MOgenSmallCamsText"):
         macros[k] = "--"
 write_macros(d, "macros", macros)
 

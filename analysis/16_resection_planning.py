@@ -61,10 +61,23 @@ macros["RPcamHeight"] = f(float(cam.cam_mm.iloc[0]), 0) if len(cam) else "--"
 macros["RPcamNoEffect"] = str(int((cam.motion == "none").sum()))
 if len(cam_plans):
     p = per_plan(cam_plans, ["subject"])
-    r = p.volume_mm3 / p.cam_volume_mm3
+    # The plans that cut (a plan that removes nothing has no volume ratio or share on the cam to give).
+    cut = p[p.volume_mm3 > 0]
+    r = cut.volume_mm3 / cut.cam_volume_mm3
     macros["RPcamTargets"], macros["RPcamMet"] = str(len(cam_plans)), str(int(cam_plans.met.sum()))
-    macros["RPcamRatioLow"], macros["RPcamRatioHigh"] = f(r.min(), 2), f(r.max(), 2)
-    macros["RPcamShareLow"], macros["RPcamShareHigh"] = f(100 * p.on_cam_share.min(), 0), f(100 * p.on_cam_share.max(), 0)
+    macros["RPcamRatioLow"], macros["RPcamRatioHigh"] = (f(r.min(), 2), f(r.max(), 2)) if len(cut) else ("--", "--")
+    macros["RPcamShareLow"], macros["RPcamShareHigh"] = ((f(100 * cut.on_cam_share.min(), 0),
+                                                         f(100 * cut.on_cam_share.max(), 0)) if len(cut) else ("--", "--"))
+    uncut = sorted(p[p.volume_mm3 <= 0].subject)
+    macros["RPcamUncutText"] = (f" where it cut ({', '.join(uncut)}: nothing removed, the target not met)" if uncut
+                                else "")
+    less, more = int((r < 1).sum()), int((r >= 1).sum())
+    macros["RPcamLessText"] = (
+        "The plan removes less than the cam because only the part of the cam that meets the rim along the target "
+        "motions has to go; a surgeon who removes the whole bump removes more than a motion needs." if more == 0 else
+        f"The plan removes less than the cam on {less} of {len(cut)} hips, where only the part of the cam that meets "
+        f"the rim along the target motions has to go, and more on {more}, where bone beyond the cam meets the rim "
+        "too.")
     macros["RPcamCheckedSame"] = str(int((np.abs(cam_plans.limit_after_deg - cam_plans.limit_checked_deg) < 1e-9).sum()))
     restored = cam_plans[cam_plans.met == 1]
     macros["RPcamRestoredHips"] = str(restored.subject.nunique())
@@ -83,8 +96,10 @@ for resect in ("femur", "both"):
     vol = rows.femur_volume_mm3 + rows.pelvis_volume_mm3
     macros[f"RPir{key}VolumeLow"] = f(vol.min(), 0) if len(rows) else "--"
     macros[f"RPir{key}VolumeHigh"] = f(vol.max(), 0) if len(rows) else "--"
-macros["RPirHeadBlocked"] = str(int(ir.note.fillna("").str.contains("articular surface").sum()))
-macros["RPirDepthBlocked"] = str(int(ir.note.fillna("").str.contains("safety depth").sum()))
+# Why a plan fell short of its target (plans that met it may still carry a note about a contact they cleared).
+short = ir[ir.met == 0]
+macros["RPirHeadBlocked"] = str(int(short.note.fillna("").str.contains("articular surface").sum()))
+macros["RPirDepthBlocked"] = str(int(short.note.fillna("").str.contains("safety depth").sum()))
 macros["RPirMsHigh"] = f(ir.plan_ms.max(), 0) if len(ir) else "--"
 macros["RPlhdlMs"], macros["RPlhdlMsQlow"], macros["RPlhdlMsQhigh"], _, timed_plan = timed("shared", 1000, 2)
 # The timed shared hip's ir90 plan with both bones trimmed, in s (one run; the README quotes it).

@@ -22,10 +22,13 @@
 //                     equidistant) x motion: the CLI's rom_limits.csv row with its defaults (layered maps,
 //                     contact depth), the method first
 //   methods_map.csv   subject x method x flexion x adduction: the ROM map under each method
-//   timing.csv        subject: sampling, limits, map, evaluations, poses per second, share of vertices
-//                     skipped by the bounds, FCL collide per pose and its extrapolated search time; limits, map
-//                     and search (both) are medians of --repetitions searches, search_q25_ms and search_q75_ms
-//                     the search's quartiles, search_runs their number; sampling (both maps) the median and
+//   timing.csv        subject: sampling, limits, map, evaluations, poses per second, FCL collide per pose and
+//                     its extrapolated search time; limits, map and search (both) are medians of --repetitions
+//                     searches (limits by the exact contact test, the default), search_q25_ms and search_q75_ms
+//                     the search's quartiles, search_runs their number; alternated with them, the same search by the
+//                     per-vertex test (RomOptions::exact_contact false: per_vertex_search_ms and quartiles, the
+//                     share of its look-ups the bounds skip, share_skipped, NaN without repeated timings) and the
+//                     exact search's time over it, paired round by round (exact_over_per_vertex and quartiles); sampling (both maps) the median and
 //                     quartiles of at least 5 new sessions (sampling_runs); FCL per pose the median and quartiles
 //                     over fcl_poses_timed poses
 //   extra_articular.csv  subject x motion x counted vertices (all, hidden): with layered maps (4 crossings
@@ -215,7 +218,9 @@ struct Outputs {
         tim(dir + "/timing.csv",
             {"subject", "resolution_deg", "threads", "sampling_ms", "sampling_q25_ms", "sampling_q75_ms",
              "sampling_runs", "limits_ms", "map_ms", "search_ms", "search_q25_ms", "search_q75_ms", "search_runs",
-             "evaluations", "poses_per_second", "share_skipped", "fcl_collide_ms_per_pose", "fcl_collide_q25_ms",
+             "evaluations", "poses_per_second", "share_skipped", "per_vertex_search_ms", "per_vertex_search_q25_ms",
+             "per_vertex_search_q75_ms", "exact_over_per_vertex", "exact_over_per_vertex_q25", "exact_over_per_vertex_q75",
+             "fcl_collide_ms_per_pose", "fcl_collide_q25_ms",
              "fcl_collide_q75_ms", "fcl_poses_timed",
              "fcl_search_ms_extrapolated", "fcl_over_ours", "excluded_vertices", "neutral_min_gap_mm"}),
         bony(dir + "/bony.csv",
@@ -449,21 +454,42 @@ void timing(const SubjectRun& r, const Settings& st, Outputs& out, bool repeat) 
   const Timing tsam = summarize(sampling);
   const RomRun& run = r.run;
   const std::int64_t all_evals = run.limit_evaluations + run.map_evaluations;
-  // The search (limits and map) again, `reps` times: the medians and quartiles of its times (the limits and the map
-  // of each run as run_rom reports them).
-  std::vector<double> limits, map, search;
+  // The search (limits and map) again, `reps` rounds: the medians and quartiles of its times (the limits and the map
+  // of each run as run_rom reports them), alternated with the same search by the per-vertex test (the thesis'
+  // Algorithm 2 with the bounds; RomOptions::exact_contact false), whose share of look-ups the bounds skip is what
+  // share_skipped gives (the exact test scans no vertices); their ratio paired round by round.
+  std::vector<double> limits, map, search, per_vertex;
+  RomRun vertex_run;
   if (!repeat) limits = {r.run.limits_ms}, map = {r.run.map_ms}, search = {r.run.limits_ms + r.run.map_ms};
-  for (int k = 0; repeat && k < std::max(1, st.reps); ++k) {
-    const RomRun again = run_rom(r.session, SubjectRun::request(st));
-    limits.push_back(again.limits_ms), map.push_back(again.map_ms), search.push_back(again.limits_ms + again.map_ms);
+  if (repeat) {
+    RomRequest by_vertex = SubjectRun::request(st);
+    by_vertex.search.exact_contact = false;
+    run_alternated({[&] {
+                      const RomRun again = run_rom(r.session, SubjectRun::request(st));
+                      limits.push_back(again.limits_ms), map.push_back(again.map_ms);
+                      search.push_back(again.limits_ms + again.map_ms);
+                    },
+                    [&] {
+                      vertex_run = run_rom(r.session, by_vertex);
+                      per_vertex.push_back(vertex_run.limits_ms + vertex_run.map_ms);
+                    }},
+                   std::max(1, st.reps));
+    // The warm-up round's times are not the rounds'.
+    limits.erase(limits.begin()), map.erase(map.begin()), search.erase(search.begin());
+    per_vertex.erase(per_vertex.begin());
   }
-  const Timing tl = summarize(limits), tm = summarize(map), ts = summarize(search);
+  std::vector<double> exact_over_vertex;
+  for (std::size_t k = 0; k < per_vertex.size(); ++k) exact_over_vertex.push_back(search[k] / per_vertex[k]);
+  const Timing tl = summarize(limits), tm = summarize(map), ts = summarize(search), tv = summarize(per_vertex),
+               tr = summarize(exact_over_vertex);
   const double search_ms = ts.median_ms;
+  const std::int64_t vertex_all = vertex_run.vertices_looked_up + vertex_run.vertices_skipped;
   const double fcl_total = fcl_ms * double(all_evals);
   out.tim.row(r.subject.name, st.resolution, st.threads, tsam.median_ms, tsam.q25_ms, tsam.q75_ms, tsam.runs,
               tl.median_ms, tm.median_ms, search_ms, ts.q25_ms, ts.q75_ms, ts.runs, all_evals,
               double(all_evals) / (search_ms / 1000),
-              double(run.vertices_skipped) / double(run.vertices_looked_up + run.vertices_skipped), fcl_ms,
+              vertex_all > 0 ? double(vertex_run.vertices_skipped) / double(vertex_all) : std::nan(""), tv.median_ms,
+              tv.q25_ms, tv.q75_ms, tr.median_ms, tr.q25_ms, tr.q75_ms, fcl_ms,
               fcl_poses > 0 ? fcl.q25_ms : std::nan(""), fcl_poses > 0 ? fcl.q75_ms : std::nan(""), fcl_poses,
               fcl_total, fcl_total / search_ms, run.baseline.excluded_vertices, run.baseline.min_gap_mm);
 }
