@@ -36,6 +36,13 @@ t11 = read_csv(d, "thesis_table11.csv")
 subjects = list(dict.fromkeys(lim.subject))
 
 
+def span(values, fmt):
+    """'low--high' of a Series at the format fmt, or the one value when both read the same (one subject timed, or
+    equal to the printed digits)."""
+    lo, hi = format(values.min(), fmt), format(values.max(), fmt)
+    return lo if lo == hi else f"{lo}--{hi}"
+
+
 def exact_over_vertex_range(t):
     """The exact search's time over the per-vertex one across the subjects that timed both (timing.csv's
     exact_over_per_vertex), as the appendix's clause: a range, or the one subject when only one was timed."""
@@ -234,6 +241,7 @@ for patient, zones in THESIS_ROM_ZONES.items():
 lr_macros = {"ROMlr" + k: "--" for k in ["WithinTen", "Compared", "RightCoverage", "LeftCoverage", "RightInclination",
                                          "LeftInclination", "RightScanGap", "LeftScanGap", "RightNeutralGap",
                                          "LeftNeutralGap"]}
+lr_macros.update(ROMlrCoverageCompare="--", ROMlrSteepCompare="--", ROMlrPincerText="")
 if meth is not None and {"mc22", "mc22-left"} <= set(meth.subject):
     eqm = meth[meth.method == "equidistant"].set_index(["subject", "motion"])
     rows, diffs = [], []
@@ -480,11 +488,10 @@ write_macros(d, "macros", {
     "ROMlayeredBytesRatio": f"{(lay.layered_bytes / lay.single_bytes).min():.1f}",
     # The layered map's spacing from its node count, (180/p + 1)(360/p) = nodes (the single-layer map's: ROMresolution).
     "ROMlayeredSpacing": f"{1 / ((-360 + (360 ** 2 + 4 * 64800 * float(lay.nodes.iloc[0])) ** 0.5) / (2 * 64800)):.2g}",
-    "ROMlayeredSamplingMs": f"{lay.layered_sampling_ms.min():.0f}--{lay.layered_sampling_ms.max():.0f}",
-    "ROMlayeredSlowdown": f"{(slow.limits_ms_layered / slow.limits_ms_single).min():.1f}--"
-                          f"{(slow.limits_ms_layered / slow.limits_ms_single).max():.1f}",
-    "ROMlayeredLimitsSingleMs": f"{slow.limits_ms_single.min():.1f}--{slow.limits_ms_single.max():.1f}",
-    "ROMlayeredLimitsLayeredMs": f"{slow.limits_ms_layered.min():.1f}--{slow.limits_ms_layered.max():.1f}",
+    "ROMlayeredSamplingMs": span(lay.layered_sampling_ms, ".0f"),
+    "ROMlayeredSlowdown": span(slow.limits_ms_layered / slow.limits_ms_single, ".1f"),
+    "ROMlayeredLimitsSingleMs": span(slow.limits_ms_single, ".1f"),
+    "ROMlayeredLimitsLayeredMs": span(slow.limits_ms_layered, ".1f"),
     "ROMlayeredLimitsIqrMax": f"{100 * ((slow.limits_layered_q75_ms - slow.limits_layered_q25_ms) / slow.limits_ms_layered).max():.0f}",
     # The timed subjects' rounds (--quick times the first subject alone: the others' timing_runs 0, times empty).
     "ROMlayeredRuns": str(int(lay.timing_runs[lay.timing_runs > 0].min())),

@@ -63,6 +63,9 @@ for s in sorted(summary.subject.unique()):
 write_table(d, "table_cohort", ["subject"] + [label for _, _, label in figures], rows)
 # The spread of the ROM limits over the perturbed centres (95th less 5th percentile): what the text says of it.
 rom_rows = summary[(summary.kind == "rom") & summary.figure.isin([fig for kind, fig, _ in figures if kind == "rom"])]
+# A percentile spread needs enough centres (the quick run draws one perturbation: 2 values a limit): none under 5.
+SPREAD_MIN_CENTRES = 5
+rom_rows = rom_rows[rom_rows.n - rom_rows.n_nan >= SPREAD_MIN_CENTRES]
 spread = (rom_rows.p95 - rom_rows.p05).dropna()
 
 fig, (a, b) = plt.subplots(1, 2, figsize=(8, 3.2))
@@ -98,7 +101,7 @@ write_macros(d, "macros", {
     "STUDYspreadMax": f"{spread.max():.1f}" if len(spread) else "--",
     "STUDYspreadMaxWhere": (f"{rom_rows.loc[spread.idxmax(), 'subject']}, "
                             f"{dict((fig, label) for _, fig, label in figures)[rom_rows.loc[spread.idxmax(), 'figure']].replace(' (deg)', '')}"
-                            if len(spread) else "--"),
+                            if len(spread) else f"fewer than {SPREAD_MIN_CENTRES} centres a limit in this run"),
     "STUDYcohortSubjects": str(len(meta["parameters"]["subjects"])),
     "STUDYcohortPerturbations": str(meta["parameters"]["cohort_perturbations"]),
     "STUDYserialPerturbations": str(meta["parameters"].get("cohort_serial_perturbations",

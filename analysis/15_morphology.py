@@ -109,10 +109,14 @@ if cams:
     macros["MOgenIrTwentyLow"], macros["MOgenIrTwentyHigh"] = f(gen_ir(lo, 20)), f(gen_ir(hi, 20))
     # A limit the ROM map leaves NaN (in contact already without rotation, or free to 150 deg: the map does not say
     # which) is said so, not printed as a number.
-    for key, flex in (("MOgenIrZeroHighText", 0), ("MOgenIrTwentyHighText", 20)):
-        v = gen_ir(hi, flex)
-        macros[key] = (f"{f(v)}$^\\circ$" if np.isfinite(v) else
-                       "no value (the ROM map's NaN: in contact already without rotation, or free to 150$^\\circ$)")
+    for key, flex in (("MOgenIrZeroText", 0), ("MOgenIrTwentyText", 20)):
+        v0, v = gen_ir(lo, flex), gen_ir(hi, flex)
+        if np.isfinite(v) and np.isfinite(v0):
+            verb = "falls" if v < v0 else "rises" if v > v0 else "stays"
+            macros[key] = f"{verb} from {f(v0)}$^\\circ$ to {f(v)}$^\\circ$ at {flex}$^\\circ$ flexion"
+        else:
+            macros[key] = (f"at {flex}$^\\circ$ flexion, from {f(v0)}$^\\circ$, has no value on the ROM map (its NaN: "
+                           "in contact already without rotation, or free to 150$^\\circ$; the map does not say which)")
     # The cams that lower the rotation by less than 2 deg at both flexions, and by how much at most.
     drops = {c: max(gen_ir(lo, fl) - gen_ir(c, fl) for fl in (0, 20)) for c in cams[1:]}
     small = [c for c, dv in drops.items() if np.isfinite(dv) and dv < 2]
@@ -122,7 +126,7 @@ if cams:
         "Every cam lowers it by 2$^\\circ$ or more.")
 else:
     for k in ("MOgenCamLow", "MOgenCamHigh", "MOgenAlphaLow", "MOgenAlphaHigh", "MOgenIrZeroLow", "MOgenIrZeroHigh",
-              "MOgenIrTwentyLow", "MOgenIrTwentyHigh", "MOgenIrZeroHighText", "MOgenIrTwentyHighText",
+              "MOgenIrTwentyLow", "MOgenIrTwentyHigh", "MOgenIrZeroText", "MOgenIrTwentyText",
               "MOgenSmallCamsText"):
         macros[k] = "--"
 write_macros(d, "macros", macros)

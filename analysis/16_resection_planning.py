@@ -72,12 +72,21 @@ if len(cam_plans):
     macros["RPcamUncutText"] = (f" where it cut ({', '.join(uncut)}: nothing removed, the target not met)" if uncut
                                 else "")
     less, more = int((r < 1).sum()), int((r >= 1).sum())
-    macros["RPcamLessText"] = (
-        "The plan removes less than the cam because only the part of the cam that meets the rim along the target "
-        "motions has to go; a surgeon who removes the whole bump removes more than a motion needs." if more == 0 else
-        f"The plan removes less than the cam on {less} of {len(cut)} hips, where only the part of the cam that meets "
-        f"the rim along the target motions has to go, and more on {more}, where bone beyond the cam meets the rim "
-        "too.")
+    hips = "hip" if len(cut) == 1 else "hips"
+    if not len(cut):
+        macros["RPcamLessText"] = ""
+    elif more == 0:
+        macros["RPcamLessText"] = (
+            "The plan removes less than the cam because only the part of the cam that meets the rim along the "
+            "target motions has to go; a surgeon who removes the whole bump removes more than a motion needs.")
+    elif less == 0:
+        macros["RPcamLessText"] = (f"The plan removes more than the cam on the {len(cut)} {hips} it cuts: bone "
+                                   "beyond the cam meets the rim too.")
+    else:
+        macros["RPcamLessText"] = (
+            f"The plan removes less than the cam on {less} of {len(cut)} {hips}, where only the part of the cam that "
+            f"meets the rim along the target motions has to go, and more on {more}, where bone beyond the cam meets "
+            "the rim too.")
     macros["RPcamCheckedSame"] = str(int((np.abs(cam_plans.limit_after_deg - cam_plans.limit_checked_deg) < 1e-9).sum()))
     restored = cam_plans[cam_plans.met == 1]
     macros["RPcamRestoredHips"] = str(restored.subject.nunique())
@@ -86,6 +95,7 @@ else:
     for k in ("RPcamTargets", "RPcamMet", "RPcamRatioLow", "RPcamRatioHigh", "RPcamShareLow", "RPcamShareHigh",
               "RPcamCheckedSame", "RPcamRestoredHips", "RPcamVolumeLow", "RPcamVolumeHigh"):
         macros[k] = "--"
+    macros["RPcamUncutText"] = macros["RPcamLessText"] = ""
 
 # Internal rotation at 90 deg flexion + 10 deg.
 macros["RPirHips"] = str(ir.subject.nunique())
@@ -98,8 +108,13 @@ for resect in ("femur", "both"):
     macros[f"RPir{key}VolumeHigh"] = f(vol.max(), 0) if len(rows) else "--"
 # Why a plan fell short of its target (plans that met it may still carry a note about a contact they cleared).
 short = ir[ir.met == 0]
-macros["RPirHeadBlocked"] = str(int(short.note.fillna("").str.contains("articular surface").sum()))
-macros["RPirDepthBlocked"] = str(int(short.note.fillna("").str.contains("safety depth").sum()))
+head_blocked = int(short.note.fillna("").str.contains("articular surface").sum())
+depth_blocked = int(short.note.fillna("").str.contains("safety depth").sum())
+# The sentence on the plans that fall short, empty when every plan meets its target.
+macros["RPirShortText"] = (
+    f" Where it does not, the plan says why: of the {len(short)} {'plan that falls' if len(short) == 1 else 'plans that fall'} "
+    f"short, the contact reaches the head inside the labrum line in {head_blocked}, and the depth needed passes the "
+    f"safety depth or the bone's thickness in {depth_blocked}." if len(short) else "")
 macros["RPirMsHigh"] = f(ir.plan_ms.max(), 0) if len(ir) else "--"
 macros["RPlhdlMs"], macros["RPlhdlMsQlow"], macros["RPlhdlMsQhigh"], _, timed_plan = timed("shared", 1000, 2)
 # The timed shared hip's ir90 plan with both bones trimmed, in s (one run; the README quotes it).
